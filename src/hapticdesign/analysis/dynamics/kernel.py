@@ -1,0 +1,166 @@
+"""Compiled (numba) kernel: inertia-matrix and gravity regressors of any frame tree.
+
+For every body ``b`` with body-frame Jacobian ``J_b = [Jv; Jw]`` (6 x N), the kinetic energy
+``1/2 qd^T H qd`` is linear in the standard parameters ``(m, h, J)`` of the body
+(see :mod:`hapticdesign.model.inertia`)::
+
+    H_b = m Jv^T Jv + sum_a h_a (A_a + A_a^T) + sum_ab J_ab Jw_a^T Jw_b,   A_a = Jw^T S(e_a) Jv
+
+and the gravity torque of the potential of seed 000 eq. 2.46 is
+``G_k = -(R_b^T g) . (m Jv_k + Jw_k x h)``. This is the regressor form of eq. 2.44-2.49.
+The Jacobian column of a variable elementary transform ``e`` is its unit twist moved to the
+body frame; dependent coordinates contribute through their affine coefficients.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def _node_poses(q, parent, axis, coef, offset, rot, pos):
+    for n in range(parent.shape[0]):
+        v = offset[n]
+        for k in range(q.shape[0]):
+            v += coef[n, k] * q[k]
+        pn = parent[n]
+        for i in range(3):
+            for j in range(3):
+                rot[n, i, j] = 1.0 if (pn < 0 and i == j) else (rot[pn, i, j] if pn >= 0 else 0.0)
+            pos[n, i] = pos[pn, i] if pn >= 0 else 0.0
+        a = axis[n] % 3
+        if axis[n] < 3:
+            b = (a + 1) % 3
+            c = (a + 2) % 3
+            cv = np.cos(v)
+            sv = np.sin(v)
+            for i in range(3):
+                rb = rot[n, i, b]
+                rc = rot[n, i, c]
+                rot[n, i, b] = rb * cv + rc * sv
+                rot[n, i, c] = -rb * sv + rc * cv
+        else:
+            for i in range(3):
+                pos[n, i] += rot[n, i, a] * v
+
+
+@njit(cache=True)
+def _body_jacobian(b, body_node, body_path, axis, coef, rot, pos, jac):
+    n_dof = jac.shape[1]
+    nb = body_node[b]
+    rb = np.eye(3)
+    pb = np.zeros(3)
+    if nb >= 0:
+        rb = rot[nb].copy()
+        pb = pos[nb].copy()
+    for i in range(6):
+        for k in range(n_dof):
+            jac[i, k] = 0.0
+    u = np.empty(3)
+    r = np.empty(3)
+    for t in range(body_path.shape[1]):
+        e = body_path[b, t]
+        if e < 0:
+            break
+        a = axis[e] % 3
+        for i in range(3):
+            u[i] = rb[0, i] * rot[e, 0, a] + rb[1, i] * rot[e, 1, a] + rb[2, i] * rot[e, 2, a]
+        if axis[e] < 3:
+            d0 = pos[e, 0] - pb[0]
+            d1 = pos[e, 1] - pb[1]
+            d2 = pos[e, 2] - pb[2]
+            for i in range(3):
+                r[i] = rb[0, i] * d0 + rb[1, i] * d1 + rb[2, i] * d2
+            v0 = r[1] * u[2] - r[2] * u[1]
+            v1 = r[2] * u[0] - r[0] * u[2]
+            v2 = r[0] * u[1] - r[1] * u[0]
+            for k in range(n_dof):
+                c = coef[e, k]
+                if c != 0.0:
+                    jac[0, k] += c * v0
+                    jac[1, k] += c * v1
+                    jac[2, k] += c * v2
+                    jac[3, k] += c * u[0]
+                    jac[4, k] += c * u[1]
+                    jac[5, k] += c * u[2]
+        else:
+            for k in range(n_dof):
+                c = coef[e, k]
+                if c != 0.0:
+                    jac[0, k] += c * u[0]
+                    jac[1, k] += c * u[1]
+                    jac[2, k] += c * u[2]
+    return rb
+
+
+@njit(cache=True)
+def _cross_axis(a, w0, w1, w2):
+    """Components of ``w x e_a``."""
+    if a == 0:
+        return 0.0, w2, -w1
+    if a == 1:
+        return -w2, 0.0, w0
+    return w1, -w0, 0.0
+
+
+@njit(cache=True)
+def regressor_kernel(qs, parent, axis, coef, offset, body_node, body_path, gravity):
+    """H and G regressors at poses ``qs`` (P, N).
+
+    Returns ``YH`` (P, N, N, 10 B) and ``YG`` (P, N, 10 B), with the standard parameters of
+    body ``b`` in columns ``10 b .. 10 b + 9`` ordered ``m, hx, hy, hz, Jxx, Jyy, Jzz, Jxy, Jxz, Jyz``.
+    """
+    n_pose, n_dof = qs.shape
+    n_body = body_node.shape[0]
+    n_node = parent.shape[0]
+    yh = np.zeros((n_pose, n_dof, n_dof, 10 * n_body))
+    yg = np.zeros((n_pose, n_dof, 10 * n_body))
+    rot = np.zeros((max(n_node, 1), 3, 3))
+    pos = np.zeros((max(n_node, 1), 3))
+    jac = np.zeros((6, n_dof))
+    for p in range(n_pose):
+        _node_poses(qs[p], parent, axis, coef, offset, rot, pos)
+        for b in range(n_body):
+            rb = _body_jacobian(b, body_node, body_path, axis, coef, rot, pos, jac)
+            col = 10 * b
+            g0 = rb[0, 0] * gravity[0] + rb[1, 0] * gravity[1] + rb[2, 0] * gravity[2]
+            g1 = rb[0, 1] * gravity[0] + rb[1, 1] * gravity[1] + rb[2, 1] * gravity[2]
+            g2 = rb[0, 2] * gravity[0] + rb[1, 2] * gravity[1] + rb[2, 2] * gravity[2]
+            for i in range(n_dof):
+                yg[p, i, col] -= g0 * jac[0, i] + g1 * jac[1, i] + g2 * jac[2, i]
+                for a in range(3):
+                    c0, c1, c2 = _cross_axis(a, jac[3, i], jac[4, i], jac[5, i])
+                    yg[p, i, col + 1 + a] -= g0 * c0 + g1 * c1 + g2 * c2
+                for j in range(n_dof):
+                    yh[p, i, j, col] += jac[0, i] * jac[0, j] + jac[1, i] * jac[1, j] + jac[2, i] * jac[2, j]
+                    for a in range(3):
+                        # A_a[i, j] = Jw_i . (e_a x Jv_j) = (Jw_i x e_a) . Jv_j
+                        c0, c1, c2 = _cross_axis(a, jac[3, i], jac[4, i], jac[5, i])
+                        aij = c0 * jac[0, j] + c1 * jac[1, j] + c2 * jac[2, j]
+                        d0, d1, d2 = _cross_axis(a, jac[3, j], jac[4, j], jac[5, j])
+                        aji = d0 * jac[0, i] + d1 * jac[1, i] + d2 * jac[2, i]
+                        yh[p, i, j, col + 1 + a] += aij + aji
+                    w0i, w1i, w2i = jac[3, i], jac[4, i], jac[5, i]
+                    w0j, w1j, w2j = jac[3, j], jac[4, j], jac[5, j]
+                    yh[p, i, j, col + 4] += w0i * w0j
+                    yh[p, i, j, col + 5] += w1i * w1j
+                    yh[p, i, j, col + 6] += w2i * w2j
+                    yh[p, i, j, col + 7] += w0i * w1j + w1i * w0j
+                    yh[p, i, j, col + 8] += w0i * w2j + w2i * w0j
+                    yh[p, i, j, col + 9] += w1i * w2j + w2i * w1j
+    return yh, yg
+
+
+@njit(cache=True)
+def jacobian_kernel(q, parent, axis, coef, offset, body_node, body_path, b):
+    """World pose ``(R, p)`` and body-frame Jacobian (6 x N, rows v then w) of body slot ``b``."""
+    n_node = parent.shape[0]
+    rot = np.zeros((max(n_node, 1), 3, 3))
+    pos = np.zeros((max(n_node, 1), 3))
+    jac = np.zeros((6, q.shape[0]))
+    _node_poses(q, parent, axis, coef, offset, rot, pos)
+    rb = _body_jacobian(b, body_node, body_path, axis, coef, rot, pos, jac)
+    nb = body_node[b]
+    pb = pos[nb].copy() if nb >= 0 else np.zeros(3)
+    return rb, pb, jac

@@ -1,0 +1,86 @@
+"""Shared command-line plumbing: one-line errors with exit status 2, JSON output, vectors.
+
+Every command body runs inside :func:`user_errors`: a :class:`~hapticdesign.errors.UserError`
+(or a malformed file) becomes one line on stderr and exit status 2, never a traceback.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+import numpy as np
+import typer
+
+from hapticdesign.errors import PhysicalConsistencyWarning, UserError
+
+
+@contextmanager
+def user_errors(strict: bool = False, quiet: bool = False) -> Iterator[None]:
+    """Turn user mistakes into ``error: ...`` on stderr and exit 2; consistency warnings into one line."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", PhysicalConsistencyWarning)
+        try:
+            yield
+        except UserError as exc:
+            typer.echo(f"error: {exc}", err=True)
+            raise typer.Exit(2) from None
+        finally:
+            if not quiet:
+                for w in caught:
+                    if issubclass(w.category, PhysicalConsistencyWarning):
+                        typer.echo(f"warning: {w.message}", err=True)
+
+
+def parse_vector(text: str | None, n: int, name: str) -> np.ndarray:
+    """Parse ``"0.1,0.2,0.3"`` into a vector of length ``n`` (zeros when ``text`` is None)."""
+    if text is None:
+        return np.zeros(n)
+    try:
+        values = [float(v) for v in text.replace(" ", "").split(",") if v != ""]
+    except ValueError:
+        raise UserError(f"--{name}: expected comma-separated numbers, got {text!r}") from None
+    if len(values) != n:
+        raise UserError(f"--{name}: expected {n} values, got {len(values)}")
+    if not all(math.isfinite(v) for v in values):
+        raise UserError(f"--{name}: values must be finite (got {text!r})")
+    return np.array(values)
+
+
+def to_jsonable(value):
+    """NumPy arrays and scalars to plain lists and floats."""
+    if isinstance(value, dict):
+        return {k: to_jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [to_jsonable(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def print_json(value) -> None:
+    typer.echo(json.dumps(to_jsonable(value)))
+
+
+def write_atomically(path: Path, text: str) -> None:
+    """Write a file so that an interruption never leaves it half-written."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(text)
+    tmp.replace(path)
+
+
+def fail(message: str) -> None:
+    """Raise a :class:`UserError` (for use in option callbacks)."""
+    raise UserError(message)
+
+
+__all__ = ["user_errors", "parse_vector", "print_json", "to_jsonable", "write_atomically", "fail"]

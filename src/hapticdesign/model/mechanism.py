@@ -1,0 +1,168 @@
+"""Mechanism: a tree of frames built from elementary transforms, with bodies attached to frames.
+
+A serial chain is a path in this tree; a hybrid (closed-loop) mechanism such as the Phantom's
+parallelogram is a tree whose dependent transforms are driven by affine combinations of the
+independent coordinates (seed 000 eq. 2.38-2.43). Jacobians, dynamics, stiffness and metrics
+all consume the compiled form :class:`CompiledMechanism`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from enum import Enum
+from functools import cached_property
+
+import numpy as np
+
+from hapticdesign.errors import UserError
+from hapticdesign.model.transforms import Axis, ElementaryTransform, elementary_matrix
+
+
+class JointType(str, Enum):
+    REVOLUTE = "revolute"
+    PRISMATIC = "prismatic"
+
+
+@dataclass(frozen=True)
+class Frame:
+    """A named frame: ``parent`` (``None`` for the base) followed by ``transforms``."""
+
+    name: str
+    parent: str | None
+    transforms: tuple[ElementaryTransform, ...]
+
+
+@dataclass(frozen=True)
+class BodyAttachment:
+    """A rigid body whose inertial parameters are expressed in the frame ``frame``."""
+
+    name: str
+    frame: str
+
+
+@dataclass
+class Mechanism:
+    """Independent coordinates, frames and bodies of a device.
+
+    ``gravity`` is the gravitational acceleration vector in the base frame
+    (seed 000 eq. 2.46: ``[0, 0, -g]``).
+    """
+
+    coordinates: tuple[str, ...]
+    joint_types: tuple[JointType, ...]
+    frames: tuple[Frame, ...]
+    bodies: tuple[BodyAttachment, ...]
+    gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
+    end_effector: str | None = None
+    metadata: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        names = [f.name for f in self.frames]
+        if len(set(names)) != len(names):
+            raise UserError("frame names must be unique")
+        known = {"base"}
+        for f in self.frames:
+            if f.parent not in known and f.parent is not None:
+                raise UserError(f"frame {f.name}: parent {f.parent!r} is not defined before it")
+            known.add(f.name)
+            for et in f.transforms:
+                for k, _ in et.value.coefficients:
+                    if not 0 <= k < self.n_dof:
+                        raise UserError(f"frame {f.name}: coordinate index {k} out of range")
+        for b in self.bodies:
+            if b.frame not in known:
+                raise UserError(f"body {b.name}: unknown frame {b.frame!r}")
+        if self.end_effector is not None and self.end_effector not in known:
+            raise UserError(f"unknown end-effector frame {self.end_effector!r}")
+
+    @property
+    def n_dof(self) -> int:
+        return len(self.coordinates)
+
+    @property
+    def body_names(self) -> tuple[str, ...]:
+        return tuple(b.name for b in self.bodies)
+
+    @cached_property
+    def compiled(self) -> "CompiledMechanism":
+        return CompiledMechanism.from_mechanism(self)
+
+    def frame_pose(self, q: np.ndarray, frame: str) -> np.ndarray:
+        """World pose (4x4) of a named frame at coordinates ``q``."""
+        return self.compiled.frame_pose(np.asarray(q, dtype=float), frame)
+
+
+@dataclass(frozen=True)
+class CompiledMechanism:
+    """Flat arrays of the frame tree: one node per elementary transform.
+
+    ``node_parent[n]`` is the previous node (``-1`` for the base), ``node_axis[n]`` the
+    :class:`Axis` code, ``node_coef[n]`` and ``node_offset[n]`` the affine joint value,
+    ``body_node[b]`` the node whose frame body ``b`` is attached to, and ``body_path[b]`` the
+    variable nodes from the base to that body (padded with ``-1``).
+    """
+
+    n_dof: int
+    node_parent: np.ndarray
+    node_axis: np.ndarray
+    node_coef: np.ndarray
+    node_offset: np.ndarray
+    frame_node: dict[str, int]
+    body_node: np.ndarray
+    body_path: np.ndarray
+    gravity: np.ndarray
+    prismatic: np.ndarray
+
+    @classmethod
+    def from_mechanism(cls, mech: Mechanism) -> "CompiledMechanism":
+        parent, axis, coef, offset = [], [], [], []
+        frame_node: dict[str, int] = {"base": -1}
+        for f in mech.frames:
+            last = frame_node["base" if f.parent is None else f.parent]
+            for et in f.transforms:
+                parent.append(last)
+                axis.append(int(et.axis))
+                coef.append(et.value.dense(mech.n_dof))
+                offset.append(float(et.value.offset))
+                last = len(parent) - 1
+            frame_node[f.name] = last
+        node_coef = np.array(coef, dtype=float).reshape(len(parent), mech.n_dof)
+        variable = np.any(node_coef != 0.0, axis=1)
+        paths = []
+        for b in mech.bodies:
+            path, n = [], frame_node[b.frame]
+            while n >= 0:
+                if variable[n]:
+                    path.append(n)
+                n = parent[n]
+            paths.append(path[::-1])
+        width = max([len(p) for p in paths] + [1])
+        body_path = -np.ones((len(paths), width), dtype=np.int64)
+        for i, p in enumerate(paths):
+            body_path[i, : len(p)] = p
+        prismatic = np.array([t == JointType.PRISMATIC for t in mech.joint_types], dtype=bool)
+        return cls(
+            n_dof=mech.n_dof,
+            node_parent=np.array(parent, dtype=np.int64),
+            node_axis=np.array(axis, dtype=np.int64),
+            node_coef=node_coef,
+            node_offset=np.array(offset, dtype=float),
+            frame_node=frame_node,
+            body_node=np.array([frame_node[b.frame] for b in mech.bodies], dtype=np.int64),
+            body_path=body_path,
+            gravity=np.array(mech.gravity, dtype=float),
+            prismatic=prismatic,
+        )
+
+    def frame_pose(self, q: np.ndarray, frame: str) -> np.ndarray:
+        if frame not in self.frame_node:
+            raise UserError(f"unknown frame {frame!r}")
+        chain = []
+        n = self.frame_node[frame]
+        while n >= 0:
+            chain.append(n)
+            n = self.node_parent[n]
+        t = np.eye(4)
+        for n in reversed(chain):
+            t = t @ elementary_matrix(Axis(self.node_axis[n]), self.node_offset[n] + self.node_coef[n] @ q)
+        return t
