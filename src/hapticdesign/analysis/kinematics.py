@@ -1,0 +1,77 @@
+"""Forward kinematics and geometric Jacobians of any frame of a mechanism.
+
+Positions follow seed 000 eq. 2.24-2.26, angular velocities eq. 2.20-2.23: the Jacobian
+column of a variable elementary transform is its unit twist (rotation axis through the frame
+origin, or translation axis) at the current pose, weighted by the coupling coefficients of
+dependent coordinates.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hapticdesign.errors import UserError
+from hapticdesign.model.mechanism import Mechanism
+from hapticdesign.model.transforms import Axis, elementary_matrix
+
+
+def _node_path(mech: Mechanism, frame: str) -> list[int]:
+    c = mech.compiled
+    if frame not in c.frame_node:
+        raise UserError(f"unknown frame {frame!r}; frames: {', '.join(sorted(c.frame_node))}")
+    path, n = [], c.frame_node[frame]
+    while n >= 0:
+        path.append(n)
+        n = int(c.node_parent[n])
+    return path[::-1]
+
+
+def _check_q(mech: Mechanism, q: np.ndarray) -> np.ndarray:
+    q = np.asarray(q, dtype=float)
+    if q.shape != (mech.n_dof,):
+        raise UserError(f"expected {mech.n_dof} joint coordinates, got shape {q.shape}")
+    if not np.all(np.isfinite(q)):
+        raise UserError("joint coordinates must be finite numbers")
+    return q
+
+
+def forward_kinematics(mech: Mechanism, q: np.ndarray, frame: str | None = None) -> np.ndarray:
+    """World pose (4x4) of ``frame`` (default: the end effector) at coordinates ``q``."""
+    frame = frame or mech.end_effector
+    if frame is None:
+        raise UserError("the mechanism names no end-effector frame")
+    q = _check_q(mech, q)
+    c = mech.compiled
+    t = np.eye(4)
+    for n in _node_path(mech, frame):
+        t = t @ elementary_matrix(Axis(c.node_axis[n]), c.node_offset[n] + c.node_coef[n] @ q)
+    return t
+
+
+def jacobian(mech: Mechanism, q: np.ndarray, frame: str | None = None) -> np.ndarray:
+    """Geometric Jacobian (6 x N) of ``frame``'s origin in the base frame: rows ``v`` then ``w``."""
+    frame = frame or mech.end_effector
+    if frame is None:
+        raise UserError("the mechanism names no end-effector frame")
+    q = _check_q(mech, q)
+    c = mech.compiled
+    path = _node_path(mech, frame)
+    poses = []
+    t = np.eye(4)
+    for n in path:
+        t = t @ elementary_matrix(Axis(c.node_axis[n]), c.node_offset[n] + c.node_coef[n] @ q)
+        poses.append(t)
+    p_end = t[:3, 3]
+    jac = np.zeros((6, mech.n_dof))
+    for n, pose in zip(path, poses):
+        coef = c.node_coef[n]
+        if not np.any(coef):
+            continue
+        axis = Axis(c.node_axis[n])
+        u = pose[:3, axis.unit]
+        if axis.is_rotation:
+            jac[:3] += np.outer(np.cross(u, p_end - pose[:3, 3]), coef)
+            jac[3:] += np.outer(u, coef)
+        else:
+            jac[:3] += np.outer(u, coef)
+    return jac

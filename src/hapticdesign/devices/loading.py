@@ -1,0 +1,37 @@
+"""Resolve the device a command works on: a preset or a device file, plus parameter overrides."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from hapticdesign.devices.registry import DEFAULT_PRESET, preset
+from hapticdesign.errors import UserError
+from hapticdesign.model.device import Device
+from hapticdesign.model.params_io import read_parameters
+
+
+def resolve_device(
+    preset_name: str | None = None,
+    device_file: Path | None = None,
+    params_file: Path | None = None,
+    strict: bool = False,
+    check: bool = True,
+) -> Device:
+    """The device named by ``--preset`` or ``--device``, with ``--params`` applied and checked.
+
+    Physical consistency errors raise :class:`UserError`; bodies that are positive definite but
+    break the triangle inequality warn (``strict`` makes them errors).
+    """
+    if preset_name and device_file:
+        raise UserError("give either --preset or --device, not both")
+    if device_file is not None:
+        from hapticdesign.devices.device_file import load_device_file
+
+        device = load_device_file(Path(device_file))
+    else:
+        device = preset(preset_name or DEFAULT_PRESET)
+    if params_file is not None:
+        device = device.with_params(read_parameters(Path(params_file)))
+    if check:
+        device.check(strict=strict)
+    return device
