@@ -1,0 +1,348 @@
+"""Exact symbolic equations of motion (seed 000 §2.4 and Appendix A), exportable.
+
+The same algorithm as the compiled kernel (:mod:`.kernel`) runs on exact polynomials: every
+joint angle ``q_k`` enters through ``c_k = cos q_k`` and ``s_k = sin q_k``, lengths and
+inertial parameters may stay symbolic, and products are reduced modulo ``s_k^2 + c_k^2 = 1``
+(a Groebner basis, so every result has one canonical form). Kinematic parameters enter the
+mechanism affinely (lengths in translations), which is recovered by probing the device's
+builder; constant angles must be multiples of pi/2 for exact rational arithmetic (other
+angles fall back to floating-point coefficients).
+
+The parameters are the seed's (Table 2.3: ``m_i``, ``r_i`` from the origin of frame ``i-1``,
+inertia about the mass centre with products of inertia entering with a minus sign).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+from math import pi
+
+import numpy as np
+import sympy as sp
+from sympy.polys.domains import QQ, RR
+from sympy.polys.rings import ring
+
+from hapticdesign.analysis.dynamics.model import pair_index
+from hapticdesign.errors import UserError
+from hapticdesign.model.device import Device
+from hapticdesign.model.inertia import SEED_FIELDS
+from hapticdesign.model.transforms import Axis
+
+
+@dataclass
+class SymbolicEquations:
+    """``tau = H qdd + C qd^2 + G`` as SymPy matrices in ``theta``, with the symbols used."""
+
+    device: str
+    H: sp.Matrix
+    C: sp.Matrix
+    G: sp.Matrix
+    theta: list[sp.Symbol]
+    thetad: list[sp.Symbol]
+    thetadd: list[sp.Symbol]
+    parameters: list[sp.Symbol]
+
+    @property
+    def tau(self) -> sp.Matrix:
+        n = len(self.theta)
+        qd2 = sp.Matrix([self.thetad[j] * self.thetad[k] for j, k in pair_index(n)])
+        return self.H * sp.Matrix(self.thetadd) + self.C * qd2 + self.G
+
+
+def _symbolic_names(device: Device, spec: str) -> list[str]:
+    names = device.parameter_names()
+    spec = spec.strip()
+    if spec == "all":
+        return names
+    if spec == "none":
+        return []
+    if spec == "inertial":
+        return device.inertial_names()
+    chosen = [s.strip() for s in spec.split(",") if s.strip()]
+    unknown = [s for s in chosen if s not in names]
+    if unknown:
+        raise UserError(f"--symbolic: unknown parameter name {unknown[0]!r} for device {device.name}")
+    return chosen
+
+
+def _exact(value: float):
+    """A float as an exact decimal rational (0.215 -> 43/200)."""
+    return Fraction(repr(float(value))) if np.isfinite(value) else None
+
+
+def _affine_offsets(device: Device, kin_symbolic: list[str]):
+    """Node offsets and gravity as affine functions of the symbolic kinematic parameters."""
+    base = dict(device.kinematic_values())
+    mech = device.builder(base)
+    c0 = mech.compiled
+    offsets0 = c0.node_offset.copy()
+    gravity0 = np.array(mech.gravity, dtype=float)
+    slopes, gslopes = [], []
+    rng = np.random.default_rng(12345)
+    for name in kin_symbolic:
+        step = float(rng.uniform(0.37, 0.71))
+        probe = dict(base)
+        probe[name] = base[name] + step
+        c1 = device.builder(probe).compiled
+        if c1.node_offset.shape != offsets0.shape or not np.array_equal(c1.node_axis, c0.node_axis):
+            raise UserError(f"parameter {name} changes the structure of the mechanism; keep it numeric")
+        slopes.append((c1.node_offset - offsets0) / step)
+        gslopes.append((np.array(device.builder(probe).gravity) - gravity0) / step)
+    check = dict(base)
+    for name in kin_symbolic:
+        check[name] = base[name] + float(rng.uniform(-0.3, 0.3))
+    cc = device.builder(check).compiled
+    predicted = offsets0 + sum(
+        (check[n] - base[n]) * s for n, s in zip(kin_symbolic, slopes)
+    ) if kin_symbolic else offsets0
+    if not np.allclose(cc.node_offset, predicted, rtol=1e-9, atol=1e-12):
+        raise UserError("the symbolic kinematic parameters do not enter the mechanism affinely; keep them numeric")
+    round_slope = lambda s: [Fraction(x).limit_denominator(1000) for x in s]  # noqa: E731
+    return c0, offsets0, [round_slope(s) for s in slopes], gravity0, [round_slope(s) for s in gslopes]
+
+
+def derive(device: Device, symbolic: str = "all") -> SymbolicEquations:
+    """Exact H, C, G of ``device`` with the parameters named in ``symbolic`` kept as symbols."""
+    keep = _symbolic_names(device, symbolic)
+    kin_sym = [k for k in device.kinematic if k in keep]
+    mech = device.mechanism
+    n = mech.n_dof
+    comp, offsets0, slopes, gravity0, gslopes = _affine_offsets(device, kin_sym)
+    base = dict(device.kinematic_values())
+    prismatic = list(comp.prismatic)
+    inertial = [f"{name}" for name in device.inertial_names() if name in keep]
+
+    gen_names = [f"s{k + 1}" for k in range(n)] + [f"c{k + 1}" for k in range(n)]
+    gen_names += [f"q{k + 1}" for k in range(n) if prismatic[k]] + kin_sym + inertial
+    angles_exact = all(
+        abs(o / (pi / 2) - round(o / (pi / 2))) < 1e-12
+        for o, a in zip(offsets0, comp.node_axis)
+        if a < 3
+    )
+    domain = QQ if angles_exact else RR
+    R, *gens = ring(",".join(gen_names), domain)
+    g = dict(zip(gen_names, gens))
+    s = [g[f"s{k + 1}"] for k in range(n)]
+    c = [g[f"c{k + 1}"] for k in range(n)]
+
+    def num(x: float):
+        return R(domain.convert(_exact(x) if domain is QQ else x))
+
+    def const_cos_sin(angle: float):
+        if angles_exact:
+            k = int(round(angle / (pi / 2))) % 4
+            return num([1, 0, -1, 0][k]), num([0, 1, 0, -1][k])
+        return num(np.cos(angle)), num(np.sin(angle))
+
+    def offset_poly(node: int):
+        value = num(offsets0[node] - sum(base[kn] * float(sl[node]) for kn, sl in zip(kin_sym, slopes)))
+        for kn, sl in zip(kin_sym, slopes):
+            if sl[node] != 0:
+                value += R(domain.convert(sl[node])) * g[kn]
+        return value
+
+    def angle_cos_sin(node: int):
+        coef = comp.node_coef[node]
+        cs = const_cos_sin(comp.node_offset[node])
+        for k in range(n):
+            if coef[k] == 0:
+                continue
+            if prismatic[k] or coef[k] != round(coef[k]):
+                raise UserError("symbolic derivation needs integer couplings between revolute joints")
+            m = int(round(coef[k]))
+            ck, sk = R(1), R(0)
+            for _ in range(abs(m)):
+                ck, sk = ck * c[k] - sk * s[k], sk * c[k] + ck * s[k]
+            if m < 0:
+                sk = -sk
+            cs = (cs[0] * ck - cs[1] * sk, cs[1] * ck + cs[0] * sk)
+        return cs
+
+    reducers = [s[k] ** 2 + c[k] ** 2 - 1 for k in range(n)]
+
+    def reduce(p):
+        return p.rem(reducers)
+
+    # node poses
+    n_nodes = comp.node_parent.shape[0]
+    rot: list = [None] * n_nodes
+    pos: list = [None] * n_nodes
+    eye = [[R(1) if i == j else R(0) for j in range(3)] for i in range(3)]
+    for node in range(n_nodes):
+        parent = comp.node_parent[node]
+        rp = eye if parent < 0 else rot[parent]
+        pp = [R(0)] * 3 if parent < 0 else pos[parent]
+        axis = Axis(int(comp.node_axis[node]))
+        a = axis.unit
+        if axis.is_rotation:
+            cv, sv = angle_cos_sin(node)
+            b, d = (a + 1) % 3, (a + 2) % 3
+            new = [row[:] for row in rp]
+            for i in range(3):
+                new[i][b] = reduce(rp[i][b] * cv + rp[i][d] * sv)
+                new[i][d] = reduce(-rp[i][b] * sv + rp[i][d] * cv)
+            rot[node], pos[node] = new, pp
+        else:
+            value = offset_poly(node)
+            for k in range(n):
+                if comp.node_coef[node, k] != 0:
+                    value += num(comp.node_coef[node, k]) * g[f"q{k + 1}"]
+            rot[node] = rp
+            pos[node] = [reduce(pp[i] + rp[i][a] * value) for i in range(3)]
+
+    gravity = []
+    for i in range(3):
+        gv = num(gravity0[i] - sum(base[kn] * float(gs[i]) for kn, gs in zip(kin_sym, gslopes)))
+        for kn, gs in zip(kin_sym, gslopes):
+            if gs[i] != 0:
+                gv += R(domain.convert(gs[i])) * g[kn]
+        gravity.append(gv)
+
+    def param(name: str):
+        return g[name] if name in g else num(device.params.get(name, 0.0))
+
+    H = [[R(0)] * n for _ in range(n)]
+    G = [R(0)] * n
+    for b, body in enumerate(device.body_names):
+        nb = comp.body_node[b]
+        rb = eye if nb < 0 else rot[nb]
+        pb = [R(0)] * 3 if nb < 0 else pos[nb]
+        jac = [[R(0)] * n for _ in range(6)]
+        for e in comp.body_path[b]:
+            if e < 0:
+                break
+            axis = Axis(int(comp.node_axis[e]))
+            a = axis.unit
+            u = [reduce(sum((rb[r][i] * rot[e][r][a] for r in range(3)), R(0))) for i in range(3)]
+            if axis.is_rotation:
+                d = [pos[e][r] - pb[r] for r in range(3)]
+                rr = [reduce(sum((rb[r][i] * d[r] for r in range(3)), R(0))) for i in range(3)]
+                v = [rr[1] * u[2] - rr[2] * u[1], rr[2] * u[0] - rr[0] * u[2], rr[0] * u[1] - rr[1] * u[0]]
+                w = u
+            else:
+                v, w = u, [R(0)] * 3
+            for k in range(n):
+                ck = comp.node_coef[e, k]
+                if ck != 0:
+                    ckp = num(ck)
+                    for i in range(3):
+                        jac[i][k] += ckp * v[i]
+                        jac[3 + i][k] += ckp * w[i]
+        jac = [[reduce(x) for x in row] for row in jac]
+        m, rx, ry, rz, ixx, iyy, izz, ixy, ixz, iyz = (
+            param(f"m{body}") if f == "m" else param(f"r{body}{f[1]}") if f.startswith("r") else param(f"{f}{body}")
+            for f in SEED_FIELDS
+        )
+        h = [m * rx, m * ry, m * rz]
+        jo = [
+            [ixx + m * (ry**2 + rz**2), -ixy - m * rx * ry, -ixz - m * rx * rz],
+            [-ixy - m * rx * ry, iyy + m * (rx**2 + rz**2), -iyz - m * ry * rz],
+            [-ixz - m * rx * rz, -iyz - m * ry * rz, izz + m * (rx**2 + ry**2)],
+        ]
+        jv, jw = jac[:3], jac[3:]
+        gb = [reduce(sum((rb[r][i] * gravity[r] for r in range(3)), R(0))) for i in range(3)]
+        for i in range(n):
+            wi = [jw[0][i], jw[1][i], jw[2][i]]
+            vi = [jv[0][i], jv[1][i], jv[2][i]]
+            wxh = [wi[1] * h[2] - wi[2] * h[1], wi[2] * h[0] - wi[0] * h[2], wi[0] * h[1] - wi[1] * h[0]]
+            G[i] -= sum((gb[r] * (m * vi[r] + wxh[r]) for r in range(3)), R(0))
+            for j in range(i, n):
+                wj = [jw[0][j], jw[1][j], jw[2][j]]
+                vj = [jv[0][j], jv[1][j], jv[2][j]]
+                term = m * sum((vi[r] * vj[r] for r in range(3)), R(0))
+                # h . (Jv_j x Jw_i) + h . (Jv_i x Jw_j): the first-moment coupling A + A^T
+                x1 = [vj[1] * wi[2] - vj[2] * wi[1], vj[2] * wi[0] - vj[0] * wi[2], vj[0] * wi[1] - vj[1] * wi[0]]
+                x2 = [vi[1] * wj[2] - vi[2] * wj[1], vi[2] * wj[0] - vi[0] * wj[2], vi[0] * wj[1] - vi[1] * wj[0]]
+                term += sum((h[r] * (x1[r] + x2[r]) for r in range(3)), R(0))
+                term += sum((wi[r] * jo[r][t] * wj[t] for r in range(3) for t in range(3)), R(0))
+                H[i][j] += term
+    H = [[reduce(H[min(i, j)][max(i, j)]) for j in range(n)] for i in range(n)]
+    G = [reduce(x) for x in G]
+
+    def d_dq(p, k: int):
+        if prismatic[k]:
+            return p.diff(g[f"q{k + 1}"])
+        return reduce(p.diff(s[k]) * c[k] - p.diff(c[k]) * s[k])
+
+    dH = [[[d_dq(H[i][j], k) for k in range(n)] for j in range(n)] for i in range(n)]
+    pairs = pair_index(n)
+    C = [[R(0)] * len(pairs) for _ in range(n)]
+    for i in range(n):
+        for col, (j, k) in enumerate(pairs):
+            gamma2 = dH[i][j][k] + dH[i][k][j] - dH[j][k][i]
+            C[i][col] = gamma2 * domain.convert(Fraction(1, 2)) if j == k else gamma2
+
+    theta = sp.symbols(f"theta1:{n + 1}", real=True)
+    thetad = sp.symbols(f"thetad1:{n + 1}", real=True)
+    thetadd = sp.symbols(f"thetadd1:{n + 1}", real=True)
+    sym = {name: sp.Symbol(name, real=True) for name in gen_names}
+    back = {sym[f"s{k + 1}"]: sp.sin(theta[k]) for k in range(n)}
+    back.update({sym[f"c{k + 1}"]: sp.cos(theta[k]) for k in range(n)})
+    back.update({sym[f"q{k + 1}"]: theta[k] for k in range(n) if prismatic[k]})
+    symbols_in_order = [sym[nm] for nm in gen_names]
+
+    def to_expr(p):
+        return p.as_expr(*symbols_in_order).xreplace(back)
+
+    return SymbolicEquations(
+        device=device.name,
+        H=sp.Matrix([[to_expr(x) for x in row] for row in H]),
+        C=sp.Matrix([[to_expr(x) for x in row] for row in C]),
+        G=sp.Matrix([to_expr(x) for x in G]),
+        theta=list(theta),
+        thetad=list(thetad),
+        thetadd=list(thetadd),
+        parameters=[sym[nm] for nm in kin_sym + inertial],
+    )
+
+
+def export(eqs: SymbolicEquations, fmt: str, part: str = "tau") -> str:
+    """The equations as LaTeX, Python source (a function with common subexpressions) or text."""
+    parts = {"tau": eqs.tau, "H": eqs.H, "C": eqs.C, "G": eqs.G}
+    if part not in (*parts, "all"):
+        raise UserError(f"--part: expected tau, H, C, G or all, got {part!r}")
+    chosen = parts if part == "all" else {part: parts[part]}
+    if fmt == "latex":
+        lines = []
+        for name, mat in chosen.items():
+            for idx in np.ndindex(mat.shape):
+                label = name if mat.shape[1] == 1 and name in ("tau", "G") else name
+                sub = f"{idx[0] + 1}" if mat.shape[1] == 1 else f"{idx[0] + 1},{idx[1] + 1}"
+                lines.append(f"{label}_{{{sub}}} = {sp.latex(mat[idx])}")
+        return "\n".join(lines)
+    if fmt == "text":
+        return "\n".join(f"{name}[{','.join(str(i + 1) for i in idx)}] = {mat[idx]}" for name, mat in chosen.items() for idx in np.ndindex(mat.shape))
+    if fmt == "python":
+        return _python_source(eqs, chosen)
+    raise UserError(f"--format: expected latex, python or text, got {fmt!r}")
+
+
+def _python_source(eqs: SymbolicEquations, chosen: dict[str, sp.Matrix]) -> str:
+    """A plain NumPy function; ``sin``/``cos`` of each angle are computed once up front."""
+    from sympy.printing.numpy import NumPyPrinter
+
+    args = [*eqs.theta, *eqs.thetad, *eqs.thetadd, *eqs.parameters]
+    trig = {}
+    for k, th in enumerate(eqs.theta):
+        trig[sp.sin(th)] = sp.Symbol(f"s{k + 1}")
+        trig[sp.cos(th)] = sp.Symbol(f"c{k + 1}")
+    printer = NumPyPrinter()
+    lines = [
+        f'"""Equations of motion of {eqs.device} (generated by hapticdesign; seed 000 eq. 2.50)."""',
+        "import numpy",
+        "",
+        "",
+        f"def equations({', '.join(str(a) for a in args)}):",
+        f'    """Return {", ".join(chosen)} as nested lists (SI units)."""',
+    ]
+    for trig_expr, name in trig.items():
+        lines.append(f"    {name} = {printer.doprint(trig_expr)}")
+    for name, mat in chosen.items():
+        rows = []
+        for i in range(mat.shape[0]):
+            row = [printer.doprint(mat[i, j].xreplace(trig)) for j in range(mat.shape[1])]
+            rows.append("[" + ", ".join(row) + "]")
+        lines.append(f"    {name} = [{', '.join(rows)}]")
+    lines.append(f"    return {', '.join(chosen)}")
+    return "\n".join(lines) + "\n"

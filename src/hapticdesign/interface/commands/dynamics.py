@@ -1,0 +1,93 @@
+"""Commands ``dynamics`` (numeric H, C, C_cvt, G, tau at a pose) and ``eom`` (symbolic equations)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+import numpy as np
+import typer
+
+from hapticdesign.devices.loading import resolve_device
+from hapticdesign.interface.common import parse_vector, print_json, user_errors
+
+PRESET_HELP = "Built-in device: phantom-3dof or phantom-6dof (default phantom-3dof)."
+DEVICE_HELP = "Device file (YAML or TOML) instead of a preset."
+PARAMS_HELP = "Parameter overrides by the seed's names (JSON, YAML or TOML)."
+STRICT_HELP = "Refuse inertias that break the triangle inequality (the seed's designs do)."
+
+
+def dynamics(
+    preset: Optional[str] = typer.Option(None, help=PRESET_HELP),
+    device: Optional[Path] = typer.Option(None, help=DEVICE_HELP),
+    params: Optional[Path] = typer.Option(None, help=PARAMS_HELP),
+    q: str = typer.Option(..., help="Joint coordinates, comma-separated (rad or m)."),
+    qd: Optional[str] = typer.Option(None, help="Joint rates, comma-separated."),
+    qdd: Optional[str] = typer.Option(None, help="Joint accelerations, comma-separated."),
+    strict: bool = typer.Option(False, help=STRICT_HELP),
+    json_out: bool = typer.Option(False, "--json", help="Print one JSON object."),
+    quiet: bool = typer.Option(False, help="No warnings on stderr."),
+) -> None:
+    """H, C (seed eq. 2.50 form), C_cvt (eq. 2.52), G and tau at one pose, in SI units."""
+    with user_errors(quiet=quiet):
+        dev = resolve_device(preset, device, params, strict=strict)
+        n = dev.n_dof
+        qv = parse_vector(q, n, "q")
+        qdv = parse_vector(qd, n, "qd")
+        qddv = parse_vector(qdd, n, "qdd")
+        result = {
+            "device": dev.name,
+            "q": qv,
+            "qd": qdv,
+            "qdd": qddv,
+            "H": dev.H(qv),
+            "C": dev.C(qv),
+            "C_cvt": dev.C_cvt(qv, qdv),
+            "G": dev.G(qv),
+            "tau": dev.inverse_dynamics(qv, qdv, qddv),
+        }
+        if json_out:
+            print_json(result)
+            return
+        typer.echo(f"{dev.name} at q = {_row(qv)}, qd = {_row(qdv)}, qdd = {_row(qddv)}")
+        pairs = ", ".join(f"({j + 1},{k + 1})" for j, k in dev.model.pairs)
+        for key, note in (
+            ("H", "mass matrix [kg m^2]"),
+            ("C", f"Coriolis/centrifugal, columns {pairs}"),
+            ("C_cvt", "N x N form of eq. 2.52"),
+            ("G", "gravity [N m]"),
+            ("tau", "joint torques [N m]"),
+        ):
+            typer.echo(f"\n{key}: {note}")
+            for row in np.atleast_2d(result[key]) if key not in ("G", "tau") else [result[key]]:
+                typer.echo("  " + _row(row))
+
+
+def _row(values: np.ndarray) -> str:
+    return " ".join(f"{v: .6e}" for v in np.ravel(values))
+
+
+def eom(
+    preset: Optional[str] = typer.Option(None, help=PRESET_HELP),
+    device: Optional[Path] = typer.Option(None, help=DEVICE_HELP),
+    params: Optional[Path] = typer.Option(None, help=PARAMS_HELP),
+    symbolic: str = typer.Option(
+        "all", help="Parameters kept as symbols: 'all', 'none', 'inertial', or names such as m2,r2x,l2."
+    ),
+    fmt: str = typer.Option("latex", "--format", help="latex, python or text."),
+    part: str = typer.Option("tau", help="What to print: tau, H, C, G or all."),
+    strict: bool = typer.Option(False, help=STRICT_HELP),
+    quiet: bool = typer.Option(False, help="No warnings on stderr."),
+) -> None:
+    """Print the equations of motion symbolically (seed 000 Appendix A), as LaTeX, Python or text."""
+    from hapticdesign.analysis.dynamics.symbolic import derive, export
+
+    with user_errors(quiet=quiet):
+        dev = resolve_device(preset, device, params, strict=strict)
+        eqs = derive(dev, symbolic)
+        typer.echo(export(eqs, fmt, part))
+
+
+def register(app: typer.Typer) -> None:
+    app.command("dynamics")(dynamics)
+    app.command("eom")(eom)
