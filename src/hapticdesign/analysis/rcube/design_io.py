@@ -1,0 +1,73 @@
+"""R-CUBE designs from command-line values or a YAML/JSON design file.
+
+File keys (SI units): ``l1, l2, l3`` (m), optional ``offset`` (m), ``sigma``, ``density``
+(kg/m^3) and ``links``: three entries ``{D, d, plies: [a, b, c, d]}`` (plies at 0, 90, -45 and
+45 degrees of M55J) or ``{D, d, E, G}`` (isotropic, Pa).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import yaml
+
+from hapticdesign.errors import UserError
+from hapticdesign.model.rcube import RCubeGeometry
+from hapticdesign.analysis.rcube.design import FINAL_DENSITY, RCubeDesign, final_design
+from hapticdesign.analysis.stiffness.link import LinkDesign
+from hapticdesign.analysis.stiffness.materials import isotropic, laminate
+from hapticdesign.analysis.stiffness.sections import Tube
+
+
+def _number(entry: Mapping, key: str, where: str) -> float:
+    if key not in entry:
+        raise UserError(f"{where}: missing {key!r}")
+    try:
+        return float(entry[key])
+    except (TypeError, ValueError):
+        raise UserError(f"{where}: {key} must be a number, got {entry[key]!r}") from None
+
+
+def link_from_mapping(entry: Mapping, density: float, where: str) -> LinkDesign:
+    """One link: a tube plus either ply counts (M55J laminate) or isotropic ``E`` and ``G``."""
+    tube = Tube(_number(entry, "D", where), _number(entry, "d", where))
+    if "plies" in entry:
+        moduli = laminate(tuple(entry["plies"]))
+    elif "E" in entry:
+        moduli = isotropic(_number(entry, "E", where), _number(entry, "G", where) if "G" in entry else None)
+    else:
+        raise UserError(f"{where}: give 'plies' (M55J laminate) or 'E' (isotropic material)")
+    return LinkDesign(tube, moduli, float(entry.get("density", density)))
+
+
+def design_from_mapping(data: Mapping) -> RCubeDesign:
+    """A design from a mapping; missing links take the final design's links (Table 7.8)."""
+    if not isinstance(data, Mapping):
+        raise UserError("a design file holds a mapping of l1, l2, l3, links, ...")
+    base = final_design()
+    geometry = RCubeGeometry(
+        float(data.get("l1", base.geometry.l1)),
+        float(data.get("l2", base.geometry.l2)),
+        float(data.get("l3", base.geometry.l3)),
+        None if data.get("offset") is None else float(data["offset"]),
+        int(data.get("sigma", -1)),
+    )
+    density = float(data.get("density", FINAL_DENSITY))
+    links = data.get("links")
+    if links is None:
+        return RCubeDesign(geometry, base.links)
+    if not isinstance(links, Sequence) or len(links) != 3:
+        raise UserError("'links' must list exactly three link entries")
+    return RCubeDesign(geometry, tuple(link_from_mapping(e, density, f"link {k + 1}") for k, e in enumerate(links)))
+
+
+def load_design(path: Path) -> RCubeDesign:
+    """Read a YAML or JSON design file."""
+    try:
+        data = yaml.safe_load(Path(path).read_text())
+    except OSError as exc:
+        raise UserError(f"cannot read design file {path}: {exc.strerror}") from None
+    except yaml.YAMLError as exc:
+        raise UserError(f"design file {path} is not valid YAML/JSON: {str(exc).splitlines()[0]}") from None
+    return design_from_mapping(data)

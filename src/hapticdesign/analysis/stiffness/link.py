@@ -1,0 +1,56 @@
+"""Stiffness matrix of one link lumped on its six-coordinate virtual joint (seed 001 eq. 4.58-4.59).
+
+The virtual joint sits at the link's end, its local x along the link (eq. 5.77-5.79); coordinates
+``(psi_1, psi_2, psi_3, phi_1, phi_2, phi_3)`` are the translations and rotations of eq. 5.76.
+The matrix is the end stiffness of a cantilever: axial ``E_x A / L``, bending
+``12 E I / L^3`` with the ``-+6 E I / L^2`` couplings and ``4 E I / L``, torsion ``G J / L``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from math import isfinite
+
+import numpy as np
+
+from hapticdesign.errors import UserError
+from hapticdesign.analysis.stiffness.materials import LinkModuli
+from hapticdesign.analysis.stiffness.sections import Tube
+
+
+def link_stiffness(moduli: LinkModuli, section: Tube, length: float) -> np.ndarray:
+    """6 x 6 virtual-joint stiffness of a straight link (eq. 4.59; eq. 4.58 when isotropic).
+
+    The bending terms use ``E_y = E_z`` exactly as eq. 4.59 prints them.
+    """
+    if not isfinite(length) or length <= 0.0:
+        raise UserError(f"link length must be positive, got {length!r}")
+    L, A, I, J = length, section.area, section.second_moment, section.polar_moment
+    Ex, Eb, G = moduli.E_x, moduli.E_y, moduli.G_xy
+    K = np.zeros((6, 6))
+    K[0, 0] = Ex * A / L
+    K[1, 1] = K[2, 2] = 12.0 * Eb * I / L**3
+    K[1, 5] = K[5, 1] = -6.0 * Eb * I / L**2
+    K[2, 4] = K[4, 2] = 6.0 * Eb * I / L**2
+    K[3, 3] = G * J / L
+    K[4, 4] = K[5, 5] = 4.0 * Eb * I / L
+    return K
+
+
+@dataclass(frozen=True)
+class LinkDesign:
+    """Cross-section and material of one link (its length comes from the geometry)."""
+
+    section: Tube
+    moduli: LinkModuli
+    density: float = 1790.0
+
+    def __post_init__(self) -> None:
+        if not isfinite(self.density) or self.density <= 0.0:
+            raise UserError(f"density must be positive, got {self.density!r}")
+
+    def stiffness(self, length: float) -> np.ndarray:
+        return link_stiffness(self.moduli, self.section, length)
+
+    def compliance(self, length: float) -> np.ndarray:
+        return np.linalg.inv(self.stiffness(length))

@@ -1,0 +1,66 @@
+"""Virtual joint method for one serial chain (seed 001 eq. 4.45-4.57, 5.98-5.123, 5.157-5.160).
+
+All functions broadcast over leading pose axes: Jacobians are ``(..., 6, n)``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.linalg import block_diag
+
+from hapticdesign.errors import UserError
+
+
+def joint_compliance(link_stiffnesses: list[np.ndarray]) -> np.ndarray:
+    """``K_theta^-1`` of a chain: block diagonal of the links' inverse 6 x 6 stiffnesses (eq. 5.105)."""
+    return block_diag(*[np.linalg.inv(k) for k in link_stiffnesses])
+
+
+def compliance(J_theta: np.ndarray, C_theta: np.ndarray) -> np.ndarray:
+    """Cartesian compliance of the chain with passive joints locked: ``J_theta K_theta^-1 J_theta^T``."""
+    return J_theta @ C_theta @ np.swapaxes(J_theta, -1, -2)
+
+
+def locked_stiffness(J_theta: np.ndarray, C_theta: np.ndarray) -> np.ndarray:
+    """``K_Ci* = (J_theta K_theta^-1 J_theta^T)^-1`` (eq. 4.55, 5.119, 6.60): passive joints ignored."""
+    try:
+        return np.linalg.inv(compliance(J_theta, C_theta))
+    except np.linalg.LinAlgError:
+        raise UserError("the chain's virtual-joint Jacobian is rank deficient (singular pose)") from None
+
+
+def chain_stiffness(J_theta: np.ndarray, C_theta: np.ndarray, J_p: np.ndarray) -> np.ndarray:
+    """``K_Ci``: the 6 x 6 block of the inverse bordered compliance matrix (eq. 5.121-5.122).
+
+    The passive joints (Jacobian ``J_p``, columns carry no load, eq. 5.118) make the result rank
+    deficient: it annihilates every passive twist, ``K_Ci J_p = 0``.
+    """
+    C = compliance(J_theta, C_theta)
+    n_p = J_p.shape[-1]
+    lead = np.broadcast_shapes(C.shape[:-2], J_p.shape[:-2])
+    B = np.zeros(lead + (6 + n_p, 6 + n_p))
+    B[..., :6, :6] = C
+    B[..., :6, 6:] = J_p
+    B[..., 6:, :6] = np.swapaxes(J_p, -1, -2)
+    try:
+        return np.linalg.inv(B)[..., :6, :6]
+    except np.linalg.LinAlgError:
+        raise UserError("the passive-joint Jacobian is rank deficient (singular pose)") from None
+
+
+def virtual_deflections(
+    J_theta: np.ndarray,
+    C_theta: np.ndarray,
+    wrench: np.ndarray,
+    J_weights: np.ndarray | None = None,
+    weights: np.ndarray | None = None,
+) -> np.ndarray:
+    """``theta = K_theta^-1 (J_theta^T F_ext + J_theta_g^T G)`` (eq. 5.117 unloaded, 5.157 loaded).
+
+    ``J_weights`` ``(..., 6 m, n)`` stacks the mass-centre Jacobians of eq. 5.153 and ``weights``
+    ``(6 m,)`` the link weights of eq. 5.154-5.156.
+    """
+    load = np.swapaxes(J_theta, -1, -2) @ np.asarray(wrench, dtype=float)
+    if J_weights is not None:
+        load = load + np.swapaxes(J_weights, -1, -2) @ np.asarray(weights, dtype=float)
+    return load @ C_theta.T

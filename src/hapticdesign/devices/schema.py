@@ -1,0 +1,288 @@
+"""Device file schema: pydantic models and the value grammar of a device file (docs/device-files.md).
+
+A device file is data, never code. Geometric values are *affine expressions*, parsed by the tiny
+grammar below (no ``eval``, no SymPy):
+
+    expression := [sign] term (sign term)*
+    term       := number | [number '*'] atom ['/' number]
+    atom       := name | 'pi'
+
+where ``name`` is a kinematic parameter (``l2``, a constant of the geometry) or a joint coordinate
+(``theta3``). Examples: ``0.3``, ``l2``, ``-l2a``, ``-pi/2``, ``2*pi/3``, ``-theta3``,
+``theta5 - pi/2`` (seed 000 Table 2.5), ``theta1 - theta2`` (a parallelogram coupling, eq. 2.38-2.43).
+An expression evaluates to ``offset + sum_k c_k q_k``: the :class:`~hapticdesign.model.transforms.JointValue`
+of an elementary transform.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
+
+from hapticdesign.model.inertia import SEED_FIELDS, BodyInertia, check_body
+from hapticdesign.model.transforms import Axis
+
+RESERVED = ("pi", "g", "base")
+IDENTIFIER = r"^[A-Za-z_][A-Za-z0-9_]*$"
+_NUMBER = r"(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
+_TOKEN = re.compile(rf"\s*(?:(?P<number>{_NUMBER})|(?P<name>[A-Za-z_]\w*)|(?P<op>[-+*/]))")
+
+
+@dataclass(frozen=True)
+class LinearExpr:
+    """``constant + sum(coefficient * value(name))``; names are parameters or coordinates."""
+
+    constant: float = 0.0
+    terms: tuple[tuple[str, float], ...] = ()
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(name for name, _ in self.terms)
+
+
+def _tokens(text: str) -> list[tuple[str, str]]:
+    out, pos, text = [], 0, text.rstrip()
+    while pos < len(text):
+        match = _TOKEN.match(text, pos)
+        if match is None:
+            raise ValueError(f"cannot read {text!r} at {text[pos:].strip()!r}")
+        kind = match.lastgroup
+        out.append((kind, match.group(kind)))
+        pos = match.end()
+    return out
+
+
+_TERM_SHAPES = ("n", "a", "n*a", "a/n", "n*a/n", "n/n")
+
+
+def parse_expression(text: str) -> LinearExpr:
+    """Parse an affine expression of the grammar in the module docstring."""
+    usage = f"{text!r} is not an affine expression such as 0.3, l2, -pi/2, 2*pi/3 or theta5 - pi/2"
+    terms: list[tuple[float, list[tuple[str, str]]]] = []
+    sign, pending, current = 1.0, False, []
+    for kind, token in _tokens(text):
+        if kind == "op" and token in "+-":
+            if current:
+                terms.append((sign, current))
+                current = []
+            elif pending or terms:
+                raise ValueError(usage)
+            sign, pending = (-1.0 if token == "-" else 1.0), True
+        else:
+            current.append((kind, token))
+    if not current:
+        raise ValueError(usage)
+    terms.append((sign, current))
+    constant, linear = 0.0, {}
+    for sign, term in terms:
+        shape = "".join({"number": "n", "name": "a"}.get(kind, token) for kind, token in term)
+        if shape not in _TERM_SHAPES:
+            raise ValueError(usage)
+        numbers = [float(token) for kind, token in term if kind == "number"]
+        atom = next((token for kind, token in term if kind == "name"), None)
+        coef = sign * (numbers[0] if shape[0] == "n" else 1.0)
+        if shape.endswith("/n"):
+            if numbers[-1] == 0.0:
+                raise ValueError(f"{text!r}: division by zero")
+            coef /= numbers[-1]
+        if atom is None:
+            constant += coef
+        elif atom == "pi":
+            constant += coef * math.pi
+        else:
+            linear[atom] = linear.get(atom, 0.0) + coef
+    return LinearExpr(constant, tuple((k, v) for k, v in linear.items() if v != 0.0))
+
+
+def _expression(value: object) -> LinearExpr:
+    if isinstance(value, LinearExpr):
+        return value
+    if isinstance(value, bool) or not isinstance(value, (int, float, str)):
+        raise ValueError(f"expected a number or an expression such as -pi/2 or l2, got {value!r}")
+    if isinstance(value, str):
+        return parse_expression(value)
+    if not math.isfinite(value):
+        raise ValueError(f"expected a finite number, got {value!r}")
+    return LinearExpr(float(value))
+
+
+def _constant(value: object) -> float:
+    """A number; strings are parsed too, because YAML 1.1 reads ``1e-3`` (no dot) as a string."""
+    expr = _expression(value)
+    if expr.terms:
+        raise ValueError(f"{value!r} must be a number (pi-multiples allowed), not depend on {', '.join(expr.names)}")
+    if not math.isfinite(expr.constant):
+        raise ValueError(f"expected a finite number, got {value!r}")
+    return expr.constant
+
+
+def _name(value: object) -> object:
+    return str(value) if isinstance(value, int) and not isinstance(value, bool) else value
+
+
+Expression = Annotated[LinearExpr, BeforeValidator(_expression)]
+Number = Annotated[float, BeforeValidator(_constant)]
+Identifier = Annotated[str, Field(pattern=IDENTIFIER)]
+Name = Annotated[str, BeforeValidator(_name), Field(min_length=1)]
+AXES = {"Rx": Axis.RX, "Ry": Axis.RY, "Rz": Axis.RZ, "tx": Axis.TX, "ty": Axis.TY, "tz": Axis.TZ}
+
+
+@dataclass(frozen=True)
+class TransformSpec:
+    """One elementary transform of a frame: ``axis`` and its affine value."""
+
+    axis: Axis
+    value: LinearExpr
+
+
+def _transform(value: object) -> TransformSpec:
+    if isinstance(value, TransformSpec):
+        return value
+    if not isinstance(value, dict) or len(value) != 1:
+        raise ValueError(f"a transform is one pair such as 'Rz: theta3' or 'tz: l3a', got {value!r}")
+    (key, raw), = value.items()
+    if key not in AXES:
+        raise ValueError(f"unknown transform {key!r}; use one of {', '.join(AXES)}")
+    return TransformSpec(AXES[key], _expression(raw))
+
+
+Transform = Annotated[TransformSpec, BeforeValidator(_transform)]
+
+
+class _FileModel(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class JointSpec(_FileModel):
+    """An independent coordinate: its name, type and viscous damping (N m s/rad or N s/m)."""
+
+    name: Identifier
+    type: Literal["revolute", "prismatic"] = "revolute"
+    damping: Annotated[Number, Field(ge=0.0)] = 0.0
+
+
+class DHRowSpec(_FileModel):
+    """One row of a seed-000 DH table (eq. 2.26): frames ``body<name>`` and ``link<name>``."""
+
+    name: Name | None = None
+    a: Expression = LinearExpr()
+    alpha: Expression = LinearExpr()
+    s: Expression = LinearExpr()
+    theta: Expression = LinearExpr()
+
+
+class FrameSpec(_FileModel):
+    """A frame placed on ``parent`` by a sequence of elementary transforms."""
+
+    name: Identifier
+    parent: Name = "base"
+    transforms: list[Transform] = Field(min_length=1)
+
+
+class BodySpec(_FileModel):
+    """A rigid body on ``frame`` with the seed's inertial parameters (Table 2.3)."""
+
+    name: Name
+    frame: Name
+    m: Number = 0.0
+    rx: Number = 0.0
+    ry: Number = 0.0
+    rz: Number = 0.0
+    Ixx: Number = 0.0
+    Iyy: Number = 0.0
+    Izz: Number = 0.0
+    Ixy: Number = 0.0
+    Ixz: Number = 0.0
+    Iyz: Number = 0.0
+
+    def inertia(self) -> BodyInertia:
+        return BodyInertia(**{f: getattr(self, f) for f in SEED_FIELDS})
+
+
+class DeviceFileSpec(_FileModel):
+    """A whole device file; cross references are checked after the fields (:func:`_check`)."""
+
+    name: Name
+    description: str = ""
+    parameters: dict[Identifier, Number] = {}
+    g: Annotated[Number, Field(ge=0.0)] = 9.81
+    joints: list[JointSpec] = Field(min_length=1)
+    dh: list[DHRowSpec] = []
+    frames: list[FrameSpec] = []
+    bodies: list[BodySpec] = Field(min_length=1)
+    end_effector: Name | None = None
+
+    def dh_names(self) -> list[str]:
+        return [row.name or str(i + 1) for i, row in enumerate(self.dh)]
+
+    @model_validator(mode="after")
+    def _cross_references(self) -> "DeviceFileSpec":
+        _check(self)
+        return self
+
+
+def _check(spec: DeviceFileSpec) -> None:
+    """Names, references, joint usage and body consistency; raises ValueError naming the field."""
+    coordinates = [j.name for j in spec.joints]
+    kinds = {j.name: j.type for j in spec.joints}
+    seen: set[str] = set()
+    for where, name in [("joints", c) for c in coordinates] + [("parameters", p) for p in spec.parameters]:
+        if name in RESERVED:
+            raise ValueError(f"{where}: {name!r} is reserved (pi, g = gravity, base = the base frame)")
+        if name in seen:
+            raise ValueError(f"{where}: name {name!r} is used twice")
+        seen.add(name)
+    used = {c: False for c in coordinates}
+
+    def check_expr(where: str, expr: LinearExpr, motion: str | None) -> None:
+        for name in expr.names:
+            if name not in seen:
+                raise ValueError(
+                    f"{where}: unknown name {name!r} (coordinates: {', '.join(coordinates)}; "
+                    f"parameters: {', '.join(spec.parameters) or 'none'})"
+                )
+            if name in kinds:
+                if motion is None:
+                    raise ValueError(f"{where}: must be constant, it cannot depend on coordinate {name}")
+                wanted = "revolute" if motion == "rotation" else "prismatic"
+                if kinds[name] != wanted:
+                    raise ValueError(f"{where}: {kinds[name]} coordinate {name} cannot drive a {motion}")
+                used[name] = True
+
+    frames = ["base"]
+    for i, (row, name) in enumerate(zip(spec.dh, spec.dh_names())):
+        check_expr(f"dh[{i}].a", row.a, None)
+        check_expr(f"dh[{i}].alpha", row.alpha, None)
+        check_expr(f"dh[{i}].s", row.s, "translation")
+        check_expr(f"dh[{i}].theta", row.theta, "rotation")
+        frames += [f"body{name}", f"link{name}"]
+    for i, frame in enumerate(spec.frames):
+        if frame.parent not in frames:
+            raise ValueError(
+                f"frames[{i}] ({frame.name}): unknown parent {frame.parent!r} "
+                f"(frames defined before it: {', '.join(frames)})"
+            )
+        for k, t in enumerate(frame.transforms):
+            check_expr(f"frames[{i}] ({frame.name}).transforms[{k}]", t.value,
+                       "rotation" if t.axis.is_rotation else "translation")
+        frames.append(frame.name)
+    duplicated = sorted({f for f in frames if frames.count(f) > 1})
+    if duplicated:
+        raise ValueError(f"frame {duplicated[0]!r} is defined twice (DH rows define body<name> and link<name>)")
+    idle = [c for c, flag in used.items() if not flag]
+    if idle:
+        raise ValueError(f"joints: coordinate {idle[0]} drives no transform")
+    for i, body in enumerate(spec.bodies):
+        if any(other.name == body.name for other in spec.bodies[:i]):
+            raise ValueError(f"bodies[{i}]: body name {body.name!r} is used twice")
+        if body.frame not in frames:
+            raise ValueError(f"bodies[{i}] ({body.name}): unknown frame {body.frame!r} (frames: {', '.join(frames)})")
+        report = check_body(body.name, body.inertia())
+        if report.error:
+            raise ValueError(f"bodies[{i}]: {report.error}")
+    if spec.end_effector is not None and spec.end_effector not in frames:
+        raise ValueError(f"end_effector: unknown frame {spec.end_effector!r}")

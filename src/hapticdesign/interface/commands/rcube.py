@@ -1,0 +1,232 @@
+"""Commands of the R-CUBE area (seed 001 ch. 4-5, §7.5): ``rcube ik | fk | stiffness | mass | metrics | maps``.
+
+Lengths in metres, angles in radians. Without options the seed's final design (Table 7.8) is used.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+import numpy as np
+import typer
+
+from hapticdesign.errors import UserError
+from hapticdesign.interface.common import parse_vector, print_json, user_errors
+
+rcube_app = typer.Typer(help="Modified R-CUBE: kinematics, VJM stiffness, dynamics, metrics (seed 001).", no_args_is_help=True)
+
+L1 = typer.Option(None, "--l1", help="Active link length l1 (m); default 0.1117 (Table 7.8).")
+L2 = typer.Option(None, "--l2", help="Passive link length l2 (m); default 0.0741.")
+L3 = typer.Option(None, "--l3", help="Passive link length l3 (m); default 0.1218.")
+OFFSET = typer.Option(None, "--offset", help="Chain offset S (m); default S = l1 (eq. 6.39).")
+SIGMA = typer.Option(-1, "--sigma", help="Passive configuration, -1 or +1 (eq. 5.42).")
+DESIGN = typer.Option(None, "--design", help="Design file (YAML/JSON: l1, l2, l3, links with D, d, plies).")
+OUTER = typer.Option(None, "--outer", help="Outer diameters D of links 1-3 (m), comma-separated.")
+INNER = typer.Option(None, "--inner", help="Inner diameters d of links 1-3 (m), comma-separated.")
+PLIES = typer.Option(None, "--plies", help="Ply counts at 0,90,-45,45 deg per link, e.g. '4,7,7,7;2,6,6,6;2,6,2,2'.")
+DENSITY = typer.Option(None, "--density", help="Link density (kg/m^3); default 1790.")
+POSITION = typer.Option(None, "--position", help="Platform position x,y,z (m); default home (S, S, S).")
+JSON = typer.Option(False, "--json", help="Print one JSON object.")
+
+
+def _design(design_file, l1, l2, l3, offset, sigma, outer=None, inner=None, plies=None, density=None):
+    from hapticdesign.analysis.rcube.design_io import design_from_mapping, load_design
+
+    base = load_design(design_file) if design_file else None
+    data: dict = {}
+    if base is not None:
+        g = base.geometry
+        data.update(l1=g.l1, l2=g.l2, l3=g.l3, offset=g.offset, sigma=g.sigma)
+    for key, value in (("l1", l1), ("l2", l2), ("l3", l3), ("offset", offset)):
+        if value is not None:
+            data[key] = value
+    data["sigma"] = sigma if sigma != -1 or "sigma" not in data else data["sigma"]
+    design = design_from_mapping(data)
+    if base is not None:
+        design = type(design)(design.geometry, base.links, base.centres, base.platform_mass, base.gravity)
+    if outer or inner or plies or density is not None:
+        design = _override_links(design, outer, inner, plies, density)
+    return design
+
+
+def _override_links(design, outer, inner, plies, density):
+    from hapticdesign.analysis.rcube.design_io import link_from_mapping
+
+    D = parse_vector(outer, 3, "outer") if outer else [link.section.D for link in design.links]
+    d = parse_vector(inner, 3, "inner") if inner else [link.section.d for link in design.links]
+    if plies:
+        groups = [g for g in plies.split(";") if g.strip()]
+        if len(groups) != 3:
+            raise UserError("--plies: expected three groups separated by ';'")
+        counts = [[_count(v) for v in g.split(",")] for g in groups]
+    else:
+        counts = [None] * 3
+    links = []
+    for k, link in enumerate(design.links):
+        entry = {"D": D[k], "d": d[k], "density": density if density is not None else link.density}
+        if counts[k] is not None:
+            entry["plies"] = counts[k]
+            links.append(link_from_mapping(entry, entry["density"], f"link {k + 1}"))
+        else:
+            from hapticdesign.analysis.stiffness.link import LinkDesign
+            from hapticdesign.analysis.stiffness.sections import Tube
+
+            links.append(LinkDesign(Tube(float(D[k]), float(d[k])), link.moduli, float(entry["density"])))
+    return type(design)(design.geometry, tuple(links), design.centres, design.platform_mass, design.gravity)
+
+
+def _count(text: str) -> int:
+    try:
+        value = float(text)
+    except ValueError:
+        raise UserError(f"--plies: {text!r} is not a number") from None
+    if value < 0 or value != int(value):
+        raise UserError(f"--plies: ply counts must be non-negative integers, got {text!r}")
+    return int(value)
+
+
+def _position(design, position):
+    return design.geometry.home if position is None else parse_vector(position, 3, "position")
+
+
+def _matrix_text(name: str, M: np.ndarray, unit: str) -> str:
+    rows = "\n".join("  " + " ".join(f"{v:12.5g}" for v in row) for row in np.atleast_2d(M))
+    return f"{name} [{unit}]\n{rows}"
+
+
+@rcube_app.command()
+def ik(l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[float] = L3,
+       offset: Optional[float] = OFFSET, sigma: int = SIGMA, design: Optional[Path] = DESIGN,
+       position: str = typer.Option(..., "--position", help="Platform position x,y,z (m)."),
+       json_out: bool = JSON) -> None:
+    """Inverse kinematics (eq. 5.30-5.45): all chain angles [[q11,q12,q13],[q21,..],[q31,..]] (rad)."""
+    from hapticdesign.analysis.rcube.kinematics import inverse_kinematics, require_regular
+
+    with user_errors():
+        dsg = _design(design, l1, l2, l3, offset, sigma)
+        q = inverse_kinematics(dsg.geometry, parse_vector(position, 3, "position"))
+        require_regular(dsg.geometry, q)
+        if json_out:
+            print_json({"q": q})
+            return
+        typer.echo(_matrix_text("q (rows: chains 1-3; columns q_i1, q_i2, q_i3)", q, "rad"))
+
+
+@rcube_app.command()
+def fk(q1: float = typer.Option(..., "--q1", help="Active angle q11 (rad)."),
+       q2: float = typer.Option(..., "--q2", help="Active angle q21 (rad)."),
+       q3: float = typer.Option(..., "--q3", help="Active angle q31 (rad)."),
+       l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[float] = L3,
+       offset: Optional[float] = OFFSET, sigma: int = SIGMA, design: Optional[Path] = DESIGN,
+       json_out: bool = JSON) -> None:
+    """Forward kinematics (eq. 5.28): platform position from the active angles."""
+    from hapticdesign.analysis.rcube.kinematics import forward_kinematics
+
+    with user_errors():
+        dsg = _design(design, l1, l2, l3, offset, sigma)
+        r = forward_kinematics(dsg.geometry, np.array([q1, q2, q3]))
+        if json_out:
+            print_json({"position": r})
+            return
+        typer.echo("position [m]: " + ", ".join(f"{v:.9g}" for v in r))
+
+
+@rcube_app.command()
+def stiffness(l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[float] = L3,
+              offset: Optional[float] = OFFSET, sigma: int = SIGMA, design: Optional[Path] = DESIGN,
+              outer: Optional[str] = OUTER, inner: Optional[str] = INNER, plies: Optional[str] = PLIES,
+              density: Optional[float] = DENSITY, position: Optional[str] = POSITION,
+              locked: bool = typer.Option(False, "--locked", help="K_C* with passive joints locked (eq. 6.60-6.61)."),
+              wrench: Optional[str] = typer.Option(None, "--wrench", help="Fx,Fy,Fz[,Mx,My,Mz]: also print the deflection."),
+              json_out: bool = JSON) -> None:
+    """Cartesian stiffness K_C (eq. 5.121-5.123), unloaded mode, direct solution."""
+    from hapticdesign.analysis.rcube.stiffness import cartesian_stiffness, platform_deflection
+
+    with user_errors():
+        dsg = _design(design, l1, l2, l3, offset, sigma, outer, inner, plies, density)
+        r = _position(dsg, position)
+        K = cartesian_stiffness(dsg, r, passive=not locked)
+        result = {"position": r, "K_C": K}
+        if wrench:
+            w = parse_vector(wrench, 6 if wrench.count(",") == 5 else 3, "wrench")
+            w = np.concatenate([w, np.zeros(6 - len(w))])
+            result["deflection"] = np.linalg.solve(K, w) if locked else platform_deflection(dsg, r, w)
+        if json_out:
+            print_json(result)
+            return
+        typer.echo(_matrix_text("K_C", K, "N/m, N/rad, N m/rad"))
+        if "deflection" in result:
+            typer.echo("deflection [m, rad]: " + ", ".join(f"{v:.6g}" for v in result["deflection"]))
+
+
+@rcube_app.command()
+def mass(l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[float] = L3,
+         offset: Optional[float] = OFFSET, sigma: int = SIGMA, design: Optional[Path] = DESIGN,
+         outer: Optional[str] = OUTER, inner: Optional[str] = INNER, density: Optional[float] = DENSITY,
+         position: Optional[str] = POSITION, json_out: bool = JSON) -> None:
+    """Cartesian inertia M_C (eq. 5.223, 5.227) and the total link mass (eq. 5.230)."""
+    from hapticdesign.analysis.rcube.dynamics import cartesian_mass_matrix
+
+    with user_errors():
+        dsg = _design(design, l1, l2, l3, offset, sigma, outer, inner, None, density)
+        r = _position(dsg, position)
+        M = cartesian_mass_matrix(dsg, r)
+        if json_out:
+            print_json({"position": r, "M_C": M, "link_mass": dsg.total_link_mass()})
+            return
+        typer.echo(_matrix_text("M_C", M, "kg"))
+        typer.echo(f"total link mass: {dsg.total_link_mass() * 1e3:.1f} g")
+
+
+@rcube_app.command()
+def metrics(l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[float] = L3,
+            offset: Optional[float] = OFFSET, sigma: int = SIGMA, design: Optional[Path] = DESIGN,
+            outer: Optional[str] = OUTER, inner: Optional[str] = INNER, plies: Optional[str] = PLIES,
+            density: Optional[float] = DENSITY, position: Optional[str] = POSITION, json_out: bool = JSON) -> None:
+    """Kinematic, stiffness and dynamic metrics at one position, with modes of M_C and K_CA."""
+    from hapticdesign.analysis.metrics.dynamic import modes
+    from hapticdesign.analysis.rcube.dynamics import cartesian_mass_matrix
+    from hapticdesign.analysis.rcube.kinematics import inverse_kinematics, require_regular
+    from hapticdesign.analysis.rcube.metrics import metrics_at
+    from hapticdesign.analysis.rcube.stiffness import cartesian_stiffness
+
+    with user_errors():
+        dsg = _design(design, l1, l2, l3, offset, sigma, outer, inner, plies, density)
+        r = _position(dsg, position)
+        require_regular(dsg.geometry, inverse_kinematics(dsg.geometry, r))
+        values = {k: float(v[0]) for k, v in metrics_at(dsg, r[None]).items()}
+        m = modes(cartesian_mass_matrix(dsg, r), cartesian_stiffness(dsg, r)[:3, :3])
+        result = {"position": r, "metrics": values, "natural_frequencies": m.frequencies, "modal_vectors": m.vectors}
+        if json_out:
+            print_json(result)
+            return
+        for k, v in values.items():
+            typer.echo(f"{k:>24s}: {v:.6g}")
+        typer.echo("natural frequencies [rad/s]: " + ", ".join(f"{v:.5g}" for v in m.frequencies))
+
+
+@rcube_app.command()
+def maps(out: Path = typer.Option(..., "--out", help="Directory for the PNG images."),
+         n: int = typer.Option(21, "--n", help="Points per side of each plane."),
+         side: float = typer.Option(0.12, "--side", help="Workspace cube edge (m)."),
+         l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[float] = L3,
+         offset: Optional[float] = OFFSET, sigma: int = SIGMA, design: Optional[Path] = DESIGN,
+         outer: Optional[str] = OUTER, inner: Optional[str] = INNER, plies: Optional[str] = PLIES,
+         density: Optional[float] = DENSITY) -> None:
+    """Metric maps on the planes z = home - side/2, home, home + side/2 (Figures 7.5-7.19)."""
+    from hapticdesign.analysis.rcube.metrics import save_workspace_maps
+
+    with user_errors():
+        if n < 2:
+            raise UserError("--n must be at least 2")
+        if not side > 0.0:
+            raise UserError("--side must be positive")
+        dsg = _design(design, l1, l2, l3, offset, sigma, outer, inner, plies, density)
+        h = side / 2
+        paths = save_workspace_maps(dsg, out, n, h, (-h, 0.0, h))
+        typer.echo(f"wrote {len(paths)} images to {out}")
+
+
+def register(app: typer.Typer) -> None:
+    app.add_typer(rcube_app, name="rcube")

@@ -1,0 +1,65 @@
+"""``hapticdesign rcube`` command contracts."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+from typer.testing import CliRunner
+
+from hapticdesign.analysis.rcube.kinematics import chain_position
+from hapticdesign.interface.cli import app
+from hapticdesign.model.rcube import RCubeGeometry
+
+runner = CliRunner()
+
+
+def run(*args):
+    return runner.invoke(app, ["rcube", *args])
+
+
+def test_ik_json_contract_and_fk_round_trip():
+    res = run("ik", "--l1", "0.12", "--l2", "0.08", "--l3", "0.13", "--position", "0.13,0.1,0.14", "--json")
+    assert res.exit_code == 0, res.output
+    q = np.array(json.loads(res.stdout)["q"])
+    assert q.shape == (3, 3)
+    g = RCubeGeometry(0.12, 0.08, 0.13)
+    for i in range(3):
+        assert np.allclose(chain_position(g, i, q[i]), [0.13, 0.1, 0.14], atol=1e-12)
+    res = run("fk", "--q1", str(q[0, 0]), "--q2", str(q[1, 0]), "--q3", str(q[2, 0]),
+              "--l1", "0.12", "--l2", "0.08", "--l3", "0.13", "--json")
+    assert res.exit_code == 0, res.output
+    assert np.allclose(json.loads(res.stdout)["position"], [0.13, 0.1, 0.14], atol=1e-12)
+
+
+def test_stiffness_mass_metrics_json():
+    K = np.array(json.loads(run("stiffness", "--json").stdout)["K_C"])
+    assert K.shape == (6, 6) and np.allclose(K, K.T, atol=1e-6 * np.abs(K).max())
+    M = np.array(json.loads(run("mass", "--json").stdout)["M_C"])
+    assert M.shape == (3, 3) and np.all(np.linalg.eigvalsh(M) > 0)
+    res = run("metrics", "--json", "--position", "0.12,0.1,0.13")
+    assert res.exit_code == 0, res.output
+    assert json.loads(res.stdout)["metrics"]["condition_number"] >= 1.0
+
+
+def test_maps_write_pngs(tmp_path):
+    res = run("maps", "--out", str(tmp_path), "--n", "3")
+    assert res.exit_code == 0, res.output
+    assert len(list(tmp_path.glob("*.png"))) == 48
+
+
+def test_bad_input_exits_2_with_one_line():
+    cases = [
+        ("ik", "--position", "1,1,1"),
+        ("ik", "--position", "0.1117,0.1117,0.1117", "--l2", "0.02", "--l3", "0.02"),
+        ("fk", "--q1", "0", "--q2", "0", "--q3", "0", "--l1", "-0.1"),
+        ("stiffness", "--outer", "0.01,0.01,0.01", "--inner", "0.02,0.005,0.005"),
+        ("stiffness", "--outer", "0,0.01,0.01"),
+        ("stiffness", "--plies", "1,1,1,1;1,-2,1,1;1,1,1,1"),
+        ("ik", "--position", "0.1117,0.1117,0.1117", "--sigma", "2"),
+        ("mass", "--position", "0.2234,0.1117,0.1117"),
+    ]
+    for args in cases:
+        res = run(*args)
+        assert res.exit_code == 2, (args, res.output)
+        assert res.stderr.count("\n") == 1 and res.stderr.startswith("error:"), (args, res.stderr)

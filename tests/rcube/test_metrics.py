@@ -1,0 +1,89 @@
+"""General metrics (seed 001 ch. 4) on the Phantom and the R-CUBE, against closed forms and SciPy."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.linalg import eigh
+
+from hapticdesign.analysis.kinematics import jacobian
+from hapticdesign.analysis.metrics import dynamic, kinematic, stiffness
+from hapticdesign.analysis.metrics.globalization import global_index
+from hapticdesign.analysis.rcube.design import final_design
+from hapticdesign.analysis.rcube.metrics import METRIC_NAMES, metrics_at, save_workspace_maps
+from hapticdesign.errors import UserError
+
+
+def two_r_jacobian(l1, l2, t1, t2):
+    return np.array([[-l1 * np.sin(t1) - l2 * np.sin(t1 + t2), -l2 * np.sin(t1 + t2)],
+                     [l1 * np.cos(t1) + l2 * np.cos(t1 + t2), l2 * np.cos(t1 + t2)]])
+
+
+def test_two_r_manipulability_eq_4_39_and_ellipsoids():
+    J = two_r_jacobian(0.3, 0.2, 0.4, 1.1)
+    assert kinematic.manipulability(J) == pytest.approx(0.3 * 0.2 * abs(np.sin(1.1)))
+    assert kinematic.absolute_manipulability(J) == pytest.approx(0.3 * 0.2 * abs(np.sin(1.1)))
+    radii, _ = kinematic.velocity_ellipsoid(J)
+    fr, _ = kinematic.force_ellipsoid(J)
+    assert np.prod(radii) == pytest.approx(kinematic.manipulability(J))
+    assert np.allclose(np.sort(radii * fr), 1.0)
+    assert kinematic.condition_number(J) == pytest.approx(np.linalg.cond(J))
+    assert kinematic.order_independent_manipulability(J) == pytest.approx(kinematic.manipulability(J))
+    # normalized Jacobian (eq. 4.42-4.44): J_n = J / (l1 + l2) has link ratios r1, r2
+    Jn = kinematic.normalized_jacobian(J, actual_reach=0.5)
+    assert np.allclose(Jn, two_r_jacobian(0.6, 0.4, 0.4, 1.1))
+    assert kinematic.condition_number(Jn) == pytest.approx(kinematic.condition_number(J))
+
+
+def test_phantom_metrics_from_the_core_jacobian_and_device_inertia(phantom3):
+    mech = phantom3.mechanism
+    q = np.array([0.2, 0.5, -0.4])
+    J = jacobian(mech, q)[:3]
+    H = phantom3.H(q)
+    M_C = dynamic.cartesian_inertia(H, J)
+    assert np.allclose(J.T @ M_C @ J, H)
+    assert dynamic.inertia_volume(M_C) == pytest.approx(np.linalg.det(H) / np.linalg.det(J.T @ J))  # eq. 4.93
+    assert dynamic.dynamic_manipulability(H, J) == pytest.approx(np.linalg.det(J) / np.linalg.det(H))  # eq. 4.97
+    assert dynamic.inertia_frobenius(M_C) == pytest.approx(np.sqrt(np.trace(M_C @ M_C.T)))
+    assert dynamic.inertia_uniformity(M_C) == pytest.approx(np.linalg.cond(M_C))
+    # a joint-space stiffness K gives the Cartesian one by the congruence of eq. 4.106
+    K = np.diag([3.0, 2.0, 1.0])
+    K_C = np.linalg.inv(J).T @ K @ np.linalg.inv(J)
+    m = dynamic.modes(M_C, K_C)
+    w2 = eigh(K, H, eigvals_only=True)
+    assert np.allclose(m.frequencies, np.sqrt(w2))  # invariant under the change of coordinates
+    assert stiffness.determinant(K_C) == pytest.approx(np.linalg.det(K) / np.linalg.det(J) ** 2)
+    assert dynamic.acceleration_radius(H, J) == pytest.approx(np.linalg.svd(J @ np.linalg.inv(H), compute_uv=False).min())
+
+
+def test_stiffness_metrics_blocks_and_pseudo_inverse():
+    rng = np.random.default_rng(2)
+    A = rng.normal(size=(6, 6))
+    K = A @ A.T + 6 * np.eye(6)
+    m = stiffness.all_stiffness_metrics(K)
+    assert m["S_e"] == pytest.approx(np.linalg.cond(K))
+    assert m["S_f"] == pytest.approx(np.sqrt(np.trace(K @ K.T)))
+    assert m["S_da"] == pytest.approx(np.linalg.det(K[:3, :3]))
+    assert m["S_dd"] == pytest.approx(np.linalg.det(K[3:, 3:]))
+    assert m["S_et"] == pytest.approx(np.linalg.cond(K[:3, :3]))
+    singular = np.diag([4.0, 2.0, 0.0])
+    assert stiffness.euclidean_condition(singular, pseudo=True) == pytest.approx(2.0)  # eq. 6.58
+
+
+def test_global_index_eq_4_108():
+    assert global_index([1.0, 2.0, np.nan, 3.0]) == pytest.approx(2.0)
+    assert global_index([1.0, 3.0], weights=[3.0, 1.0]) == pytest.approx(1.5)
+    with pytest.raises(UserError):
+        global_index([np.nan])
+
+
+def test_rcube_metrics_at_home_and_maps(tmp_path):
+    design = final_design()
+    home = design.geometry.home
+    m = metrics_at(design, np.stack([home, home + 5.0]))
+    assert set(m) == set(METRIC_NAMES)
+    assert m["condition_number"][0] == pytest.approx(1.0)  # J_m = l1 I at home
+    assert m["manipulability"][0] == pytest.approx(design.geometry.l1**3)  # eq. 6.2
+    assert all(np.isnan(m[k][1]) for k in METRIC_NAMES)  # unreachable point
+    paths = save_workspace_maps(design, tmp_path, n=3, names=("manipulability",))
+    assert len(paths) == 3 and all(p.stat().st_size > 0 and p.read_bytes()[:4] == b"\x89PNG" for p in paths)
