@@ -40,6 +40,15 @@ class Device:
     params: Mapping[str, float] = field(default_factory=dict)
     damping: tuple[float, ...] = ()
 
+    @classmethod
+    def from_file(cls, path) -> "Device":
+        """A device from a device file (YAML, TOML, JSON) or a URDF file (see docs/device-files.md)."""
+        from pathlib import Path
+
+        from hapticdesign.devices.device_file import load_device_file
+
+        return load_device_file(Path(path))
+
     # -- parameters ---------------------------------------------------------------------------
     @property
     def mechanism(self) -> Mechanism:

@@ -37,7 +37,7 @@ def read_mapping(path: Path) -> dict:
         first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise UserError(f"{path}: malformed {suffix[1:].upper()} ({first})") from None
     if not isinstance(data, dict):
-        raise UserError(f"{path}: expected a mapping of parameter names to numbers")
+        raise UserError(f"{path}: expected a mapping (name: value) at the top level")
     return data
 
 

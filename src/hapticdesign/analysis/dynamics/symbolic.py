@@ -273,9 +273,9 @@ def derive(device: Device, symbolic: str = "all") -> SymbolicEquations:
             gamma2 = dH[i][j][k] + dH[i][k][j] - dH[j][k][i]
             C[i][col] = gamma2 * domain.convert(Fraction(1, 2)) if j == k else gamma2
 
-    theta = sp.symbols(f"theta1:{n + 1}", real=True)
-    thetad = sp.symbols(f"thetad1:{n + 1}", real=True)
-    thetadd = sp.symbols(f"thetadd1:{n + 1}", real=True)
+    theta = [sp.Symbol(name, real=True) for name in mech.coordinates]
+    thetad = [sp.Symbol(f"{name}d", real=True) for name in mech.coordinates]
+    thetadd = [sp.Symbol(f"{name}dd", real=True) for name in mech.coordinates]
     sym = {name: sp.Symbol(name, real=True) for name in gen_names}
     back = {sym[f"s{k + 1}"]: sp.sin(theta[k]) for k in range(n)}
     back.update({sym[f"c{k + 1}"]: sp.cos(theta[k]) for k in range(n)})

@@ -12,7 +12,7 @@ from hapticdesign.devices.loading import resolve_device
 from hapticdesign.interface.common import parse_vector, print_json, user_errors
 
 PRESET_HELP = "Built-in device: phantom-3dof or phantom-6dof (default phantom-3dof)."
-DEVICE_HELP = "Device file (YAML or TOML) instead of a preset."
+DEVICE_HELP = "Device file (YAML, TOML, JSON or URDF) instead of a preset."
 PARAMS_HELP = "Parameter overrides by the seed's names (JSON, YAML or TOML)."
 STRICT_HELP = "Refuse inertias that break the triangle inequality (the seed's designs do)."
 

@@ -1,0 +1,229 @@
+"""Commands ``impedance-range``, ``transparency``, ``stability-boundary`` and ``campaign`` (seed 000 ch. 4)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+import numpy as np
+import typer
+
+from hapticdesign.devices.loading import resolve_device
+from hapticdesign.errors import UserError
+from hapticdesign.interface.common import print_json, user_errors, write_atomically
+
+PRESET_HELP = "Built-in device: phantom-3dof or phantom-6dof (default phantom-3dof)."
+DEVICE_HELP = "Device file (YAML or TOML) instead of a preset."
+PARAMS_HELP = "Parameter overrides by the seed's names (JSON, YAML or TOML)."
+STRICT_HELP = "Refuse inertias that break the triangle inequality (the seed's designs do)."
+
+
+def _loop_config(period, step, duration, counts, delay, error_percent, inertial, coriolis, gravity,
+                 wall_damping, hand_mass, hand_damping, hand_stiffness):
+    from hapticdesign.simulation.loop import Compensator, Hand, LoopConfig, Sensors, Wall
+
+    hand = None
+    if hand_mass or hand_damping or hand_stiffness:
+        hand = Hand(hand_mass, hand_damping, hand_stiffness)
+    config = LoopConfig(
+        duration=duration,
+        step=step,
+        sensors=Sensors(period=period, counts_per_revolution=counts, delay_samples=delay),
+        compensator=Compensator(inertial, coriolis, gravity, error_percent),
+        wall=Wall(damping=wall_damping),
+        hand=hand,
+    )
+    config.steps_per_sample()
+    return config
+
+
+def _sim_type(value: int) -> int:
+    if value not in (1, 2):
+        raise UserError(f"--type must be 1 or 2, got {value}")
+    return value
+
+
+# Options shared by the device-level commands.
+PERIOD = typer.Option(1e-3, help="Sample period T of the digital side [s].")
+STEP = typer.Option(1e-4, help="Plant integration step [s]; must divide the period.")
+COUNTS = typer.Option(None, help="Encoder counts per revolution (position quantization); none by default.")
+DELAY = typer.Option(0, help="Sensor delay in samples.")
+ERROR = typer.Option(0.0, help="Compensator modelling error in percent (scales its inertial parameters).")
+INERTIAL = typer.Option(True, "--inertial/--no-inertial", help="Compensate the inertial term H qdd.")
+CORIOLIS = typer.Option(True, "--coriolis/--no-coriolis", help="Compensate the Coriolis term C qd^2.")
+GRAVITY = typer.Option(True, "--gravity/--no-gravity", help="Compensate gravity G.")
+WALL_DAMPING = typer.Option(0.0, help="Virtual wall damper [N m s/rad].")
+HAND_MASS = typer.Option(0.0, help="Hand mass at the handle [kg] (off by default).")
+HAND_DAMPING = typer.Option(0.0, help="Hand damping at the handle [N s/m].")
+HAND_STIFFNESS = typer.Option(0.0, help="Hand stiffness at the handle [N/m].")
+
+
+def impedance_range_command(
+    preset: Optional[str] = typer.Option(None, help=PRESET_HELP),
+    device: Optional[Path] = typer.Option(None, help=DEVICE_HELP),
+    params: Optional[Path] = typer.Option(None, help=PARAMS_HELP),
+    sim_type: int = typer.Option(1, "--type", help="1: other joints held at 0; 2: driven at 0.52 sin(3 pi t)."),
+    joint: str = typer.Option("1", help="Joint carrying the virtual wall (1-based or coordinate name)."),
+    equilibrium: float = typer.Option(0.01, help="Wall equilibrium [rad]; the joints start at 0."),
+    method: str = typer.Option("fast", help="fast (doubling + bisection) or linear (K = 1, 2, 3, ...)."),
+    k_limit: int = typer.Option(200, help="Largest stiffness tried [N m/rad]."),
+    overshoot: float = typer.Option(0.012, help="Overshoot limit, peak excursion from the start [rad]."),
+    settle_tolerance: float = typer.Option(0.002, help="Settled: within this of the equilibrium at the end [rad]."),
+    settle_window: float = typer.Option(0.5, help="Final window checked for settling [s]."),
+    safety: float = typer.Option(0.06, help="Safety switch excursion [rad] (Figure 4.7)."),
+    true_boundary: bool = typer.Option(False, "--true-boundary", help="Also bisect the oscillation-growth boundary."),
+    duration: float = typer.Option(5.0, help="Simulated time per stiffness [s]."),
+    period: float = PERIOD, step: float = STEP, counts: Optional[int] = COUNTS, delay: int = DELAY,
+    error_percent: float = ERROR, inertial: bool = INERTIAL, coriolis: bool = CORIOLIS, gravity: bool = GRAVITY,
+    wall_damping: float = WALL_DAMPING, hand_mass: float = HAND_MASS, hand_damping: float = HAND_DAMPING,
+    hand_stiffness: float = HAND_STIFFNESS,
+    strict: bool = typer.Option(False, help=STRICT_HELP),
+    json_out: bool = typer.Option(False, "--json", help="Print one JSON object."),
+    quiet: bool = typer.Option(False, help="No warnings on stderr."),
+) -> None:
+    """Maximum stable impedance of one joint under a virtual spring (seed 000 §4.1.2-4.1.3)."""
+    from hapticdesign.simulation.impedance import Criteria, ImpedanceProblem, fast_search, linear_scan
+    from hapticdesign.simulation.impedance import true_boundary as growth_boundary
+    from hapticdesign.simulation.loop import joint_index
+
+    with user_errors(quiet=quiet):
+        dev = resolve_device(preset, device, params, strict=strict)
+        config = _loop_config(period, step, duration, counts, delay, error_percent, inertial, coriolis, gravity,
+                              wall_damping, hand_mass, hand_damping, hand_stiffness)
+        if method not in ("fast", "linear"):
+            raise UserError(f"--method must be 'fast' or 'linear', got {method!r}")
+        if k_limit < 1:
+            raise UserError("--k-limit must be at least 1")
+        criteria = Criteria(overshoot, settle_tolerance, settle_window, safety)
+        problem = ImpedanceProblem(dev, _sim_type(sim_type), joint_index(dev, joint), equilibrium, criteria, config)
+        result = (fast_search if method == "fast" else linear_scan)(problem, k_limit)
+        out = {"device": dev.name, "type": sim_type, "joint": problem.wall_joint + 1, **result.as_dict()}
+        if true_boundary:
+            out["k_true_boundary"] = growth_boundary(problem)
+        if json_out:
+            print_json(out)
+            return
+        typer.echo(f"{dev.name}, type {sim_type}, joint {out['joint']}: maximum stable impedance "
+                   f"{out['k_max']:g} N m/rad (first failure: {out['criterion']}; {out['simulations']} simulations)")
+        if true_boundary:
+            typer.echo(f"oscillation-growth boundary: {out['k_true_boundary']:.4g} N m/rad")
+
+
+def transparency_command(
+    preset: Optional[str] = typer.Option(None, help=PRESET_HELP),
+    device: Optional[Path] = typer.Option(None, help=DEVICE_HELP),
+    params: Optional[Path] = typer.Option(None, help=PARAMS_HELP),
+    sim_type: int = typer.Option(1, "--type", help="1: chirp on the wall joint only; 2: chirp on every joint."),
+    joint: str = typer.Option("1", help="Joint carrying the virtual wall (1-based or coordinate name)."),
+    stiffness: float = typer.Option(4.0, help="Virtual wall stiffness K [N m/rad]."),
+    amplitude: float = typer.Option(0.3, help="Chirp amplitude [rad]."),
+    f0: float = typer.Option(0.1, help="Chirp start frequency [Hz]."),
+    f1: float = typer.Option(15.0, help="Chirp end frequency [Hz]."),
+    sweep: float = typer.Option(10.0, help="Chirp sweep time [s] (linear sweep)."),
+    band: float = typer.Option(3.0, help="Transparency band [dB]."),
+    response: Optional[Path] = typer.Option(None, help="Write the frequency response (CSV) here."),
+    period: float = PERIOD, step: float = STEP, counts: Optional[int] = COUNTS, delay: int = DELAY,
+    error_percent: float = ERROR, inertial: bool = INERTIAL, coriolis: bool = CORIOLIS, gravity: bool = GRAVITY,
+    wall_damping: float = WALL_DAMPING,
+    strict: bool = typer.Option(False, help=STRICT_HELP),
+    json_out: bool = typer.Option(False, "--json", help="Print one JSON object."),
+    quiet: bool = typer.Option(False, help="No warnings on stderr."),
+) -> None:
+    """Transparency bandwidth of one joint: G_T = Z_M / Z_D leaves +-3 dB (seed 000 §4.2.2, eq. 4.1-4.2)."""
+    from hapticdesign.simulation.loop import joint_index
+    from hapticdesign.simulation.paths import Chirp
+    from hapticdesign.simulation.transparency import transparency
+
+    with user_errors(quiet=quiet):
+        dev = resolve_device(preset, device, params, strict=strict)
+        config = _loop_config(period, step, sweep, counts, delay, error_percent, inertial, coriolis, gravity,
+                              wall_damping, 0.0, 0.0, 0.0)
+        if not (band > 0):
+            raise UserError(f"--band must be positive, got {band}")
+        result = transparency(dev, _sim_type(sim_type), stiffness, Chirp(amplitude, f0, f1, sweep), config,
+                              joint_index(dev, joint), band_db=band)
+        if response is not None:
+            write_atomically(response, result.response_table())
+        out = {"device": dev.name, "type": sim_type, "joint": joint_index(dev, joint) + 1,
+               "stiffness": stiffness, **result.as_dict()}
+        if json_out:
+            print_json(out)
+            return
+        bw = out["bandwidth_hz"]
+        text = f"{bw:.3f} Hz" if bw is not None else f"beyond {f1:g} Hz"
+        typer.echo(f"{dev.name}, type {sim_type}, joint {out['joint']}, K = {stiffness:g} N m/rad: "
+                   f"transparency bandwidth {text}")
+
+
+def stability_boundary_command(
+    inertia: float = typer.Option(..., help="Inertia J [kg m^2]."),
+    damping: float = typer.Option(..., help="Viscous damping b [N m s/rad]."),
+    period: float = typer.Option(..., help="Sample period T [s]."),
+    delay: int = typer.Option(0, help="Sensor delay in samples."),
+    wall_damping: float = typer.Option(0.0, help="Virtual damper B [N m s/rad]."),
+    compensate_inertia: bool = typer.Option(False, help="Feed the sampled acceleration forward (J qdd)."),
+    substeps: int = typer.Option(10, help="Plant steps per sample in the simulation."),
+    samples: int = typer.Option(4000, help="Samples per simulation of the growth test."),
+    json_out: bool = typer.Option(False, "--json", help="Print one JSON object."),
+) -> None:
+    """1-DOF mass-damper under a sampled spring: exact (spectral radius) vs simulated stiffness limit."""
+    from hapticdesign.simulation.boundary import MassDamper, exact_boundary, simulated_boundary
+
+    with user_errors():
+        if substeps < 1 or samples < 40:
+            raise UserError("--substeps must be at least 1 and --samples at least 40")
+        system = MassDamper(inertia, damping, period, delay, wall_damping, compensate_inertia)
+        exact = exact_boundary(system)
+        simulated = simulated_boundary(system, samples=samples, substeps=substeps)
+        out = {"k_max_exact": exact, "k_max_simulated": simulated,
+               "relative_difference": (simulated - exact) / exact if exact not in (0.0, np.inf) else None,
+               "two_b_over_t": 2 * damping / period}
+        if json_out:
+            print_json(out)
+            return
+        typer.echo(f"exact {exact:.6g} N m/rad, simulated {simulated:.6g} N m/rad (2b/T = {2 * damping / period:.6g})")
+
+
+def campaign_command(
+    designs: Path = typer.Option(..., help="Design CSV: level, ln, ln_H, ln_C, ln_G and every inertial parameter."),
+    out: Path = typer.Option(..., help="Output folder (cases/, results.csv, summary.csv, summary.md, figures/)."),
+    scheduler: Optional[str] = typer.Option(None, help="Dask scheduler address; local processes by default."),
+    workers: Optional[int] = typer.Option(None, help="Local worker processes (default: all cores)."),
+    preset: str = typer.Option("phantom-3dof", help=PRESET_HELP),
+    k_limit: int = typer.Option(200, help="Largest stiffness tried [N m/rad]."),
+    duration: float = typer.Option(5.0, help="Simulated time per stiffness [s] (seed: 5)."),
+    stiffness: float = typer.Option(4.0, help="Wall stiffness of the transparency runs [N m/rad] (seed: 4)."),
+    sweep: float = typer.Option(10.0, help="Chirp sweep time [s] (seed: 10)."),
+    f1: float = typer.Option(15.0, help="Chirp end frequency [Hz] (seed: 15)."),
+) -> None:
+    """Both criteria and both types over a design set; resumable (seed 000 §4.1.4, §4.2.4)."""
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeRemainingColumn
+
+    from hapticdesign.simulation.campaign import CampaignOptions, run_campaign
+    from hapticdesign.simulation.paths import Chirp
+
+    with user_errors():
+        if workers is not None and workers < 1:
+            raise UserError("--workers must be at least 1")
+        if k_limit < 1:
+            raise UserError("--k-limit must be at least 1")
+        if not (duration > 0 and stiffness > 0):
+            raise UserError("--duration and --stiffness must be positive")
+        options = CampaignOptions(preset, k_limit, stiffness, Chirp(0.3, 0.1, f1, sweep), duration)
+        with Progress("[progress.description]{task.description}", BarColumn(), MofNCompleteColumn(),
+                      TimeRemainingColumn(), transient=False) as bar:
+            task = bar.add_task("cases", total=None)
+
+            def advance(done: int, total: int) -> None:
+                bar.update(task, completed=done, total=total)
+
+            counts = run_campaign(designs, out, options, scheduler, workers, advance)
+        typer.echo(f"{counts['cases']} cases: {counts['run']} run, {counts['skipped']} already done; "
+                   f"tables and figures in {out}")
+
+
+def register(app: typer.Typer) -> None:
+    app.command("impedance-range")(impedance_range_command)
+    app.command("transparency")(transparency_command)
+    app.command("stability-boundary")(stability_boundary_command)
+    app.command("campaign")(campaign_command)

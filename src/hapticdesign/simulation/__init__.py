@@ -1,0 +1,11 @@
+"""Sampled-data haptic rendering simulation (seed 000 chapter 4).
+
+- :mod:`.tables`: the equations of motion as coefficient tables, evaluated inside numba.
+- :mod:`.loop`: the fixed-step plant with the digital side (sampling, quantization, delay,
+  zero-order hold, model-based compensator, virtual wall, safety switch, optional hand).
+- :mod:`.reference`: the same loop written plainly with ``scipy.integrate.solve_ivp``.
+- :mod:`.impedance`: the stable impedance range (seed §4.1.2-4.1.3).
+- :mod:`.boundary`: exact and simulated stability boundary of a 1-DOF mass-damper.
+- :mod:`.transparency`: the transparency bandwidth (seed §4.2.2-4.2.3).
+- :mod:`.campaign` and :mod:`.figures`: design-set campaigns (seed §4.1.4, §4.2.4).
+"""

@@ -1,0 +1,262 @@
+"""Campaigns over a design set: both criteria, both types (seed 000 §4.1.4, §4.2.4, Tables 4.4, 4.6).
+
+Design files are CSV with the columns ``level, ln, ln_H, ln_C, ln_G`` and every inertial
+parameter of the device in the seed's names (``m1 ... Iyz3a``); an optional ``design`` column
+names the rows. The LN columns are carried along (``nan`` allowed where unknown); ``level`` groups. Every case (design x criterion x type) runs on Dask workers (local processes by
+default, or a cluster at ``--scheduler``) and is written to ``cases/<key>.json`` the moment it
+finishes; a rerun skips the cases already written. The aggregation writes the per-design table
+(``results.csv``), per-level range, mean and standard deviation with the share of designs whose
+type 1 and type 2 results agree (``summary.csv``, ``summary.md``) and the figures.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+import warnings
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from hapticdesign.devices.registry import preset
+from hapticdesign.errors import PhysicalConsistencyWarning, UserError
+from hapticdesign.interface.common import write_atomically
+from hapticdesign.simulation.impedance import ImpedanceProblem, fast_search
+from hapticdesign.simulation.paths import Chirp
+from hapticdesign.simulation.transparency import transparency
+
+META_COLUMNS = ("level", "ln", "ln_H", "ln_C", "ln_G")
+CRITERIA = ("impedance", "transparency")
+TYPES = (1, 2)
+
+
+@dataclass(frozen=True)
+class Design:
+    """One row of a design file."""
+
+    name: str
+    level: float
+    meta: dict[str, float]
+    params: dict[str, float]
+
+
+@dataclass(frozen=True)
+class CampaignOptions:
+    """Settings shared by every case (the seed's by default)."""
+
+    preset: str = "phantom-3dof"
+    k_limit: int = 200
+    stiffness: float = 4.0
+    chirp: Chirp = field(default_factory=Chirp)
+    duration: float = 5.0
+    bandwidth_agreement_hz: float = 0.1
+
+
+def _number(text: str, where: str, allow_nan: bool = False) -> float:
+    try:
+        value = float(text)
+    except (TypeError, ValueError):
+        raise UserError(f"{where}: {text!r} is not a number") from None
+    if not (math.isfinite(value) or (allow_nan and math.isnan(value))):
+        raise UserError(f"{where}: value must be finite, got {text!r}")
+    return value
+
+
+def read_designs(path: Path, preset_name: str = "phantom-3dof") -> list[Design]:
+    """Read and check a design file: required columns, numbers, physically meaningful bodies."""
+    path = Path(path)
+    device = preset(preset_name)
+    try:
+        with path.open(newline="") as handle:
+            rows = list(csv.DictReader(handle))
+            header = rows[0].keys() if rows else []
+    except OSError as exc:
+        raise UserError(f"cannot read {path}: {exc.strerror or exc}") from None
+    if not rows:
+        raise UserError(f"{path}: no designs")
+    names = device.inertial_names()
+    missing = [c for c in (*META_COLUMNS, *names) if c not in header]
+    if missing:
+        shown = ", ".join(missing[:8]) + (" ..." if len(missing) > 8 else "")
+        raise UserError(f"{path}: missing columns {shown}")
+    designs = []
+    for i, row in enumerate(rows, start=1):
+        where = f"{path} row {i}"
+        name = (row.get("design") or f"d{i:04d}").strip()
+        meta = {c: _number(row[c], f"{where} column {c}", allow_nan=c != "level") for c in META_COLUMNS}
+        params = {c: _number(row[c], f"{where} column {c}") for c in names}
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", PhysicalConsistencyWarning)
+            try:
+                device.with_params(params).check(strict=False)
+            except UserError as exc:
+                raise UserError(f"{where} ({name}): {exc}") from None
+        designs.append(Design(name, meta["level"], meta, params))
+    if len({d.name for d in designs}) != len(designs):
+        raise UserError(f"{path}: design names must be unique")
+    return designs
+
+
+def case_key(design: str, criterion: str, sim_type: int) -> str:
+    return f"{design}__{criterion}__type{sim_type}"
+
+
+def run_case(preset_name: str, params: dict[str, float], criterion: str, sim_type: int,
+             options: CampaignOptions) -> dict:
+    """One simulation case on a worker: maximum stable impedance or transparency bandwidth."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PhysicalConsistencyWarning)
+        device = preset(preset_name).with_params(params)
+    if criterion == "impedance":
+        from hapticdesign.simulation.loop import LoopConfig
+
+        result = fast_search(ImpedanceProblem(device, sim_type, config=LoopConfig(duration=options.duration)),
+                             options.k_limit)
+        return {"value": float(result.k_max), **result.as_dict()}
+    result = transparency(device, sim_type, options.stiffness, options.chirp)
+    keep = result.frequency <= options.chirp.f1
+    return {
+        "value": result.bandwidth_hz,
+        "bandwidth_hz": result.bandwidth_hz,
+        "frequency": result.frequency[keep].tolist(),
+        "g_t_db": (20 * np.log10(np.abs(result.g_t[keep]))).tolist(),
+    }
+
+
+def _client(scheduler: str | None, workers: int | None):
+    from dask.distributed import Client, LocalCluster
+
+    if scheduler:
+        try:
+            return Client(scheduler, timeout="20s")
+        except (OSError, TimeoutError) as exc:
+            raise UserError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
+    n = workers or os.cpu_count() or 1
+    return Client(LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None))
+
+
+def run_campaign(designs_path: Path, out: Path, options: CampaignOptions | None = None,
+                 scheduler: str | None = None, workers: int | None = None,
+                 progress: Callable[[int, int], None] | None = None) -> dict:
+    """Run every missing case, then aggregate; returns counts of cases run and skipped."""
+    options = options or CampaignOptions()
+    designs = read_designs(designs_path, options.preset)
+    out = Path(out)
+    cases_dir = out / "cases"
+    cases_dir.mkdir(parents=True, exist_ok=True)
+    settings = json.dumps({**asdict(options), "designs": [asdict(d) for d in designs]}, sort_keys=True)
+    stamp = out / "campaign.json"
+    if stamp.exists() and stamp.read_text() != settings:
+        raise UserError(f"{out} holds a campaign with other designs or settings; choose another --out")
+    write_atomically(stamp, settings)
+    todo = [(d, c, t) for d in designs for c in CRITERIA for t in TYPES
+            if not (cases_dir / f"{case_key(d.name, c, t)}.json").exists()]
+    total = len(designs) * len(CRITERIA) * len(TYPES)
+    if todo:
+        from dask.distributed import as_completed
+
+        client = _client(scheduler, workers)
+        try:
+            futures = {}
+            for d, c, t in todo:
+                fut = client.submit(run_case, options.preset, d.params, c, t, options, key=f"case-{case_key(d.name, c, t)}",
+                                    pure=False)
+                futures[fut] = (d, c, t)
+            done = total - len(todo)
+            for fut in as_completed(futures):
+                d, c, t = futures[fut]
+                record = {"design": d.name, "level": d.level, "criterion": c, "type": t, **fut.result()}
+                write_atomically(cases_dir / f"{case_key(d.name, c, t)}.json", json.dumps(record))
+                done += 1
+                if progress is not None:
+                    progress(done, total)
+        finally:
+            cluster = getattr(client, "cluster", None)
+            client.close()
+            if cluster is not None and not scheduler:
+                cluster.close()
+    aggregate(designs, out, options)
+    return {"cases": total, "run": len(todo), "skipped": total - len(todo)}
+
+
+def load_cases(designs: list[Design], out: Path) -> dict[tuple[str, str, int], dict]:
+    cases = {}
+    for d in designs:
+        for c in CRITERIA:
+            for t in TYPES:
+                path = Path(out) / "cases" / f"{case_key(d.name, c, t)}.json"
+                cases[(d.name, c, t)] = json.loads(path.read_text())
+    return cases
+
+
+def agree(criterion: str, a: float | None, b: float | None, options: CampaignOptions) -> bool:
+    """Same result in types 1 and 2: equal stiffness; bandwidths equal at the seed's 0.1 Hz resolution."""
+    if a is None or b is None:
+        return a is None and b is None
+    if criterion == "impedance":
+        return a == b
+    return abs(a - b) < 0.5 * options.bandwidth_agreement_hz
+
+
+def summarize(designs: list[Design], cases: dict, options: CampaignOptions) -> list[dict]:
+    """Per level, criterion and type: count, min, max, mean, standard deviation; agreement share."""
+    rows = []
+    for level in sorted({d.level for d in designs}):
+        members = [d for d in designs if d.level == level]
+        for c in CRITERIA:
+            same = sum(agree(c, cases[(d.name, c, 1)]["value"], cases[(d.name, c, 2)]["value"], options) for d in members)
+            for t in TYPES:
+                values = np.array([np.nan if cases[(d.name, c, t)]["value"] is None else cases[(d.name, c, t)]["value"]
+                                   for d in members], dtype=float)
+                finite = values[np.isfinite(values)]
+                rows.append({
+                    "level": level, "criterion": c, "type": t, "n": len(members),
+                    "min": float(finite.min()) if finite.size else None,
+                    "max": float(finite.max()) if finite.size else None,
+                    "mean": float(finite.mean()) if finite.size else None,
+                    "std": float(finite.std(ddof=1)) if finite.size > 1 else None,
+                    "agreement_share": same / len(members),
+                })
+    return rows
+
+
+def _fmt(value, digits: int = 3) -> str:
+    return "" if value is None else f"{value:.{digits}g}"
+
+
+def aggregate(designs: list[Design], out: Path, options: CampaignOptions) -> None:
+    """Write results.csv, summary.csv, summary.md and the figures from the case files."""
+    from hapticdesign.simulation import figures
+
+    out = Path(out)
+    cases = load_cases(designs, out)
+    header = ["design", *META_COLUMNS, "k_max_type1", "k_max_type2", "criterion_type1", "criterion_type2",
+              "bandwidth_hz_type1", "bandwidth_hz_type2"]
+    lines = [",".join(header)]
+    for d in designs:
+        imp1, imp2 = cases[(d.name, "impedance", 1)], cases[(d.name, "impedance", 2)]
+        bw1, bw2 = cases[(d.name, "transparency", 1)]["value"], cases[(d.name, "transparency", 2)]["value"]
+        row = [d.name, *(repr(d.meta[c]) for c in META_COLUMNS), _fmt(imp1["value"], 6), _fmt(imp2["value"], 6),
+               imp1["criterion"], imp2["criterion"], _fmt(bw1, 6), _fmt(bw2, 6)]
+        lines.append(",".join(row))
+    write_atomically(out / "results.csv", "\n".join(lines) + "\n")
+    summary = summarize(designs, cases, options)
+    keys = list(summary[0])
+    write_atomically(out / "summary.csv", "\n".join([",".join(keys)] + [
+        ",".join("" if r[k] is None else str(r[k]) for k in keys) for r in summary]) + "\n")
+    md = ["# Campaign summary", ""]
+    for c, unit, title in (("impedance", "N m/rad", "Maximum stable impedance (Table 4.4 layout)"),
+                           ("transparency", "Hz", "Transparency bandwidth (Table 4.6 layout)")):
+        md += [f"## {title}", "", f"| level | type | range [{unit}] | mean | std (1 sigma) | type 1 = type 2 |",
+               "|---|---|---|---|---|---|"]
+        for r in (r for r in summary if r["criterion"] == c):
+            md.append(f"| {r['level']:g} | {r['type']} | {_fmt(r['min'])} - {_fmt(r['max'])} | {_fmt(r['mean'])} | "
+                      f"{_fmt(r['std'])} | {100 * r['agreement_share']:.0f} % |")
+        md.append("")
+    write_atomically(out / "summary.md", "\n".join(md))
+    figures.write_all(designs, cases, summary, out / "figures")
+

@@ -1,0 +1,130 @@
+"""Campaign figures (seed 000 Figures 4.9-4.11, 4.18-4.21), PNG and SVG, matplotlib Agg backend."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+LABELS = {"impedance": ("Maximum stable impedance [N m/rad]", "k_max"),
+          "transparency": ("Transparency bandwidth [Hz]", "bandwidth")}
+
+
+def _save(fig, path: Path) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    for suffix in (".png", ".svg"):
+        fig.savefig(path.with_suffix(suffix), dpi=120, bbox_inches="tight")
+    plt.close(fig)
+
+
+def swarm_offsets(values: np.ndarray, width: float = 0.35, resolution: float | None = None) -> np.ndarray:
+    """Horizontal offsets that spread (near-)equal values symmetrically, beeswarm style."""
+    values = np.asarray(values, dtype=float)
+    if resolution is None:
+        span = np.nanmax(values) - np.nanmin(values) if values.size else 0.0
+        resolution = span / 40 if span > 0 else 1.0
+    bins = np.round(values / resolution)
+    offsets = np.zeros_like(values)
+    for b in np.unique(bins[np.isfinite(bins)]):
+        idx = np.nonzero(bins == b)[0]
+        k = len(idx)
+        step = min(0.04, 2 * width / max(k, 1))
+        offsets[idx] = (np.arange(k) - (k - 1) / 2) * step
+    return offsets
+
+
+def _levels(designs) -> list[float]:
+    return sorted({d.level for d in designs})
+
+
+def _values(designs, cases, criterion, sim_type):
+    return np.array([np.nan if cases[(d.name, criterion, sim_type)]["value"] is None
+                     else cases[(d.name, criterion, sim_type)]["value"] for d in designs], dtype=float)
+
+
+def beeswarm(designs, cases, criterion: str, path: Path) -> None:
+    """Type 1 values per level with mean and 1 sigma (Figures 4.9, 4.19)."""
+    ylabel, _ = LABELS[criterion]
+    levels = _levels(designs)
+    fig, ax = plt.subplots(figsize=(7, 4))
+    for x, level in enumerate(levels):
+        members = [d for d in designs if d.level == level]
+        v = _values(members, cases, criterion, 1)
+        ax.scatter(x + swarm_offsets(v), v, s=14, facecolors="none", edgecolors="tab:blue")
+        finite = v[np.isfinite(v)]
+        if finite.size:
+            sd = finite.std(ddof=1) if finite.size > 1 else 0.0
+            ax.errorbar(x + 0.42, finite.mean(), yerr=sd, fmt="s", color="tab:red", capsize=4)
+    ax.set_xticks(range(len(levels)), [f"{lv:g}" for lv in levels])
+    ax.set_xlabel("Linearity Number")
+    ax.set_ylabel(ylabel)
+    ax.set_title(f"{ylabel.split(' [')[0]} vs LN, type 1 (mean and 1 sigma in red)")
+    _save(fig, path)
+
+
+def type_comparison(designs, cases, criterion: str, path: Path) -> None:
+    """Type 1 and type 2 per design, one panel per level (Figures 4.10, 4.20)."""
+    ylabel, _ = LABELS[criterion]
+    levels = _levels(designs)
+    cols = min(3, len(levels))
+    rows = int(np.ceil(len(levels) / cols))
+    fig, axes = plt.subplots(rows, cols, figsize=(4 * cols, 3 * rows), squeeze=False)
+    for ax, level in zip(axes.ravel(), levels):
+        members = [d for d in designs if d.level == level]
+        x = np.arange(1, len(members) + 1)
+        ax.plot(x, _values(members, cases, criterion, 1), "o", mfc="none", label="type 1")
+        ax.plot(x, _values(members, cases, criterion, 2), "x", label="type 2")
+        ax.set_title(f"LN = {level:g}")
+        ax.set_xlabel("design")
+        ax.set_ylabel(ylabel)
+    for ax in axes.ravel()[len(levels):]:
+        ax.axis("off")
+    axes[0, 0].legend()
+    fig.tight_layout()
+    _save(fig, path)
+
+
+def agreement_bars(summary, criterion: str, path: Path) -> None:
+    """Designs with the same and with different type 1 / type 2 results per level (Figures 4.11, 4.21)."""
+    rows = [r for r in summary if r["criterion"] == criterion and r["type"] == 1]
+    levels = [r["level"] for r in rows]
+    same = np.array([r["agreement_share"] * r["n"] for r in rows])
+    total = np.array([r["n"] for r in rows])
+    x = np.arange(len(levels))
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.bar(x - 0.2, same, 0.4, label="same")
+    ax.bar(x + 0.2, total - same, 0.4, label="different")
+    ax.set_xticks(x, [f"{lv:g}" for lv in levels])
+    ax.set_xlabel("Linearity Number")
+    ax.set_ylabel("number of designs")
+    ax.set_title(f"{LABELS[criterion][0].split(' [')[0]}: type 1 vs type 2")
+    ax.legend()
+    _save(fig, path)
+
+
+def frequency_responses(designs, cases, path: Path) -> None:
+    """|G_T| against frequency for the first design of each level, type 1 (Figure 4.18)."""
+    fig, ax = plt.subplots(figsize=(7, 4))
+    for level in _levels(designs):
+        d = next(d for d in designs if d.level == level)
+        case = cases[(d.name, "transparency", 1)]
+        ax.plot(case["frequency"], case["g_t_db"], label=f"{d.name} (LN = {level:g})")
+    for edge in (3.0, -3.0):
+        ax.axhline(edge, color="grey", linestyle="--", linewidth=0.8)
+    ax.set_xscale("log")
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel("|G_T| [dB]")
+    ax.legend(fontsize=7)
+    _save(fig, path)
+
+
+def write_all(designs, cases, summary, folder: Path) -> None:
+    for criterion in ("impedance", "transparency"):
+        beeswarm(designs, cases, criterion, folder / f"{criterion}_beeswarm_type1")
+        type_comparison(designs, cases, criterion, folder / f"{criterion}_type1_vs_type2")
+        agreement_bars(summary, criterion, folder / f"{criterion}_agreement")
+    frequency_responses(designs, cases, folder / "transparency_frequency_response")

@@ -1,0 +1,232 @@
+"""Stable impedance range of one joint (seed 000 §4.1.2-4.1.3, Tables 4.1-4.3).
+
+A virtual spring ``K`` on the wall joint (equilibrium 0.01 rad, start 0) is stable when
+- the peak excursion from the start stays below ``overshoot_limit`` (0.012 rad: the seed's
+  "overshoot" and the safety switch's 0.06 rad = 5 x 0.012 are both measured from the joint's
+  reference point, so 0.012 rad is a 20 % overshoot of the 0.01 rad step; our reading),
+- the response has settled at the end: in the last ``settle_window`` seconds the joint stays
+  within ``settle_tolerance`` of the equilibrium,
+- the safety switch (0.06 rad) has not tripped and the simulation has not diverged.
+
+The seed scans K = 1, 2, 3, ... and reports the last stable K. :func:`fast_search` returns the
+same answer with an exponential bracket and a bisection over integers whenever the stable set
+is ``{1, ..., K_max}`` (monotone criterion; the tests compare both on several designs).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from hapticdesign.errors import UserError
+from hapticdesign.model.device import Device
+from hapticdesign.simulation.boundary import envelope_grows
+from hapticdesign.simulation.loop import LoopConfig, Wall, model_device, simulate
+from hapticdesign.simulation.paths import Held, Path, Sine
+from hapticdesign.simulation.tables import DynamicsTables
+
+
+@dataclass(frozen=True)
+class Criteria:
+    """Stability criteria of the seed's method (all configurable)."""
+
+    overshoot_limit: float = 0.012
+    settle_tolerance: float = 0.002
+    settle_window: float = 0.5
+    safety_limit: float = 0.06
+
+    def __post_init__(self) -> None:
+        for name in ("overshoot_limit", "settle_tolerance", "settle_window", "safety_limit"):
+            value = getattr(self, name)
+            if not (value > 0 and math.isfinite(value)):
+                raise UserError(f"{name.replace('_', ' ')} must be positive, got {value}")
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """Outcome of one gain: stable, or the criterion that failed first."""
+
+    stiffness: float
+    stable: bool
+    criterion: str
+    peak: float
+    final_error: float
+
+
+def type_paths(sim_type: int, n_dof: int, wall_joint: int = 0) -> dict[int, Path]:
+    """Motions of the other joints: type 1 held at 0, type 2 driven at 0.52 sin(3 pi t) (Table 4.3)."""
+    if sim_type not in (1, 2):
+        raise UserError(f"simulation type must be 1 or 2, got {sim_type}")
+    path: Path = Held(0.0) if sim_type == 1 else Sine(0.52, 3 * np.pi)
+    return {j: path for j in range(n_dof) if j != wall_joint}
+
+
+@dataclass
+class ImpedanceProblem:
+    """One device, one simulation type: runs single gains and caches the dynamics tables."""
+
+    device: Device
+    sim_type: int = 1
+    wall_joint: int = 0
+    equilibrium: float = 0.01
+    criteria: Criteria = field(default_factory=Criteria)
+    config: LoopConfig = field(default_factory=LoopConfig)
+
+    def __post_init__(self) -> None:
+        self.paths = type_paths(self.sim_type, self.device.n_dof, self.wall_joint)
+        self.plant = DynamicsTables.from_device(self.device)
+        self.model = DynamicsTables.from_device(model_device(self.device, self.config.compensator.error_percent))
+        self.config = replace(self.config, safety_limit=self.criteria.safety_limit,
+                              stop_excursion=self.criteria.overshoot_limit)
+
+    def estimate(self) -> int:
+        """Starting guess: the 1-DOF limit ``b^2 / H_ww`` of full inertial compensation at the start
+        pose (see :mod:`.boundary`), or ``2 b / T`` without it; only a guess, never the answer."""
+        w = self.wall_joint
+        b = (self.config.damping or self.device.damping)[w]
+        h = self.device.H(np.zeros(self.device.n_dof))[w, w]
+        guess = b * b / h if self.config.compensator.inertial else 2 * b / self.config.sensors.period
+        return int(guess) if math.isfinite(guess) and guess >= 1 else 1
+
+    def verdict(self, stiffness: float) -> Verdict:
+        """Simulate the wall at ``stiffness`` and apply the criteria."""
+        cfg = replace(self.config, wall=replace(self.config.wall, joint=self.wall_joint, stiffness=float(stiffness),
+                                                equilibrium=self.equilibrium))
+        trace = simulate(self.device, cfg, self.paths, plant=self.plant, model=self.model)
+        q = trace.q[:, self.wall_joint]
+        peak = float(np.max(np.abs(q - q[0]))) if q.size else math.nan
+        tail = q[trace.t >= trace.t[-1] - self.criteria.settle_window] if q.size else q
+        final = float(np.max(np.abs(tail - self.equilibrium))) if tail.size else math.nan
+        if trace.diverged or not np.isfinite(peak):
+            return Verdict(stiffness, False, "diverged", peak, final)
+        if peak >= self.criteria.overshoot_limit:
+            return Verdict(stiffness, False, "overshoot", peak, final)
+        if trace.tripped:
+            return Verdict(stiffness, False, "safety switch", peak, final)
+        if final > self.criteria.settle_tolerance:
+            return Verdict(stiffness, False, "not settled", peak, final)
+        return Verdict(stiffness, True, "stable", peak, final)
+
+
+@dataclass(frozen=True)
+class RangeResult:
+    """The maximum stable impedance (0 when K = 1 already fails) and the first failing verdict."""
+
+    k_max: float
+    criterion: str
+    simulations: int
+    first_unstable: Verdict | None
+    method: str
+
+    def as_dict(self) -> dict:
+        first = self.first_unstable
+        return {
+            "k_max": float(self.k_max),
+            "criterion": first.criterion if first else "none (limit reached)",
+            "first_unstable_k": None if first is None else float(first.stiffness),
+            "peak_at_first_unstable": None if first is None else first.peak,
+            "simulations": self.simulations,
+            "method": self.method,
+        }
+
+
+def linear_scan(problem: ImpedanceProblem, k_limit: int = 200) -> RangeResult:
+    """The seed's method: K = 1, 2, 3, ... until a criterion fails; the previous K is the maximum."""
+    for k in range(1, k_limit + 1):
+        v = problem.verdict(k)
+        if not v.stable:
+            return RangeResult(k - 1, v.criterion, k, v, "linear")
+    return RangeResult(k_limit, "none", k_limit, None, "linear")
+
+
+def fast_search(problem: ImpedanceProblem, k_limit: int = 200, start: int | None = None) -> RangeResult:
+    """Same answer as :func:`linear_scan` for a monotone criterion, in a few runs.
+
+    Gallops with doubling steps from ``start`` (default: :meth:`ImpedanceProblem.estimate`) to a
+    stable/unstable pair, then bisects over the integers between them.
+    """
+    runs = 0
+
+    def check(k: int) -> Verdict:
+        nonlocal runs
+        runs += 1
+        return problem.verdict(k)
+
+    k = min(max(1, start if start is not None else problem.estimate()), k_limit)
+    v = check(k)
+    step = 1
+    if v.stable:
+        good, bad, bad_verdict = k, None, None
+        while good < k_limit:
+            k = min(good + step, k_limit)
+            v = check(k)
+            if not v.stable:
+                bad, bad_verdict = k, v
+                break
+            good, step = k, 2 * step
+        if bad is None:
+            return RangeResult(good, "none", runs, None, "fast")
+    else:
+        good, bad, bad_verdict = 0, k, v
+        while bad > 1:
+            k = max(bad - step, 1)
+            v = check(k)
+            if v.stable:
+                good = k
+                break
+            bad, bad_verdict, step = k, v, 2 * step
+    while bad - good > 1:
+        mid = (good + bad) // 2
+        v = check(mid)
+        if v.stable:
+            good = mid
+        else:
+            bad, bad_verdict = mid, v
+    return RangeResult(good, bad_verdict.criterion, runs, bad_verdict, "fast")
+
+
+def true_boundary(problem: ImpedanceProblem, rel_tol: float = 2e-3, margin: float = 0.05,
+                  k_limit: float = 1e5) -> float:
+    """Stiffness at which the oscillation of the wall joint starts to grow (no overshoot criterion).
+
+    Each run lasts the configured duration without safety switch; the envelope of the last quarter
+    is compared with the second quarter (``margin`` absorbs the forced motion of type 2), and runs
+    that leave the joint by more than 1 rad count as growing.
+    """
+    cfg = replace(problem.config, safety_limit=None, stop_excursion=1.0)
+
+    def grows(k: float) -> bool:
+        wall = replace(cfg.wall, joint=problem.wall_joint, stiffness=k, equilibrium=problem.equilibrium)
+        trace = simulate(problem.device, replace(cfg, wall=wall), problem.paths, plant=problem.plant,
+                         model=problem.model)
+        if trace.status != 0:
+            return True
+        return envelope_grows(trace.q[:, problem.wall_joint] - problem.equilibrium, margin)
+
+    lo, hi = 0.0, 1.0
+    while not grows(hi):
+        lo, hi = hi, 2.0 * hi
+        if hi > k_limit:
+            return math.inf
+    while hi - lo > rel_tol * hi:
+        mid = 0.5 * (lo + hi)
+        if grows(mid):
+            hi = mid
+        else:
+            lo = mid
+    return 0.5 * (lo + hi)
+
+
+def impedance_range(device: Device, sim_type: int = 1, method: str = "fast", k_limit: int = 200,
+                    criteria: Criteria | None = None, config: LoopConfig | None = None,
+                    wall_joint: int = 0, equilibrium: float = 0.01) -> RangeResult:
+    """Maximum stable impedance of ``wall_joint`` for simulation type 1 or 2 (seed §4.1.2)."""
+    if method not in ("fast", "linear"):
+        raise UserError(f"search method must be 'fast' or 'linear', got {method!r}")
+    if k_limit < 1:
+        raise UserError("the stiffness limit must be at least 1 N m/rad")
+    problem = ImpedanceProblem(device, sim_type, wall_joint, equilibrium, criteria or Criteria(),
+                               config or LoopConfig(wall=Wall()))
+    return (fast_search if method == "fast" else linear_scan)(problem, k_limit)

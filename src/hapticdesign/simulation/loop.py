@@ -1,0 +1,239 @@
+"""Configure and run one sampled-data haptic simulation (seed 000 §4.1.1, §4.2.1).
+
+:func:`simulate` wraps the numba kernel of :mod:`.kernel`; see that module for the model.
+Defaults follow the seed: plant step 1e-4 s, sample period 1 ms, joint damping from the device
+(0.50, 0.50, 0.35 N m s/rad for the Phantom, Table 4.1), perfect sensors (condition ix), no
+modelling error (condition vi), no hand (condition vii), safety switch at 0.06 rad (Fig. 4.7).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from hapticdesign.analysis.kinematics import jacobian
+from hapticdesign.errors import UserError
+from hapticdesign.model.device import Device
+from hapticdesign.simulation import kernel
+from hapticdesign.simulation.paths import Path
+from hapticdesign.simulation.tables import DynamicsTables, workspace_size
+
+
+@dataclass(frozen=True)
+class Wall:
+    """Virtual wall on one joint: spring ``stiffness`` (N m/rad), optional ``damping``, ``equilibrium``."""
+
+    joint: int = 0
+    stiffness: float = 1.0
+    damping: float = 0.0
+    equilibrium: float = 0.01
+
+
+@dataclass(frozen=True)
+class Compensator:
+    """Inverse dynamics of a model device; ``error_percent`` scales its inertial parameters (§4.1.1.2)."""
+
+    inertial: bool = True
+    coriolis: bool = True
+    gravity: bool = True
+    error_percent: float = 0.0
+
+
+@dataclass(frozen=True)
+class Sensors:
+    """Sampling period ``T``, optional encoder counts per revolution and delay in samples."""
+
+    period: float = 1e-3
+    counts_per_revolution: int | None = None
+    delay_samples: int = 0
+
+
+@dataclass(frozen=True)
+class Hand:
+    """Linear hand at the handle: mass (kg), damping (N s/m), stiffness (N/m), off by default.
+
+    Mapped to the joints through the translational Jacobian at the start pose (a linearized grasp).
+    """
+
+    mass: float = 0.0
+    damping: float = 0.0
+    stiffness: float = 0.0
+
+
+@dataclass(frozen=True)
+class LoopConfig:
+    """Everything but the device and the joint motions."""
+
+    duration: float = 5.0
+    step: float = 1e-4
+    sensors: Sensors = field(default_factory=Sensors)
+    compensator: Compensator = field(default_factory=Compensator)
+    wall: Wall = field(default_factory=Wall)
+    damping: tuple[float, ...] | None = None
+    safety_limit: float | None = 0.06
+    hand: Hand | None = None
+    record_stride: int | None = None
+    stop_excursion: float | None = None
+
+    def steps_per_sample(self) -> int:
+        if not (self.step > 0 and math.isfinite(self.step)):
+            raise UserError(f"the plant step must be positive, got {self.step}")
+        period = self.sensors.period
+        if not (period > 0 and math.isfinite(period)):
+            raise UserError(f"the sample period must be positive, got {period}")
+        ratio = period / self.step
+        if abs(ratio - round(ratio)) > 1e-9 * ratio or round(ratio) < 1:
+            raise UserError(f"the plant step {self.step} s does not divide the sample period {period} s")
+        return int(round(ratio))
+
+
+@dataclass
+class Trace:
+    """Recorded signals (rows every ``stride`` plant steps) and how the run ended."""
+
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    u: np.ndarray
+    tau_f: np.ndarray
+    tau_imp: np.ndarray
+    tau_c: np.ndarray
+    status: int
+    trip_time: float | None
+
+    @property
+    def diverged(self) -> bool:
+        return self.status == kernel.STATUS_DIVERGED
+
+    @property
+    def tripped(self) -> bool:
+        return self.trip_time is not None
+
+
+def model_device(device: Device, error_percent: float) -> Device:
+    """The compensator's device: every inertial parameter times ``1 - error_percent / 100``."""
+    if not math.isfinite(error_percent) or error_percent > 100:
+        raise UserError(f"error percentage must be a finite number <= 100, got {error_percent}")
+    if error_percent == 0:
+        return device
+    factor = 1.0 - error_percent / 100.0
+    return device.with_params({k: device.params.get(k, 0.0) * factor for k in device.inertial_names()})
+
+
+def joint_index(device: Device, joint: int | str) -> int:
+    """0-based index of a joint given 1-based (``1``) or by coordinate name (``theta1``)."""
+    names = device.mechanism.coordinates
+    if isinstance(joint, str) and not joint.strip().lstrip("-").isdigit():
+        if joint not in names:
+            raise UserError(f"unknown joint {joint!r}; joints: {', '.join(names)}")
+        return names.index(joint)
+    j = int(joint)
+    if not 1 <= j <= len(names):
+        raise UserError(f"unknown joint {joint}; the device has joints 1..{len(names)}")
+    return j - 1
+
+
+def _hand_matrices(device: Device, hand: Hand | None, q0: np.ndarray):
+    n = len(q0)
+    if hand is None:
+        return np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n))
+    if min(hand.mass, hand.damping, hand.stiffness) < 0:
+        raise UserError("hand mass, damping and stiffness must be non-negative")
+    jv = jacobian(device.mechanism, q0)[:3]
+    jtj = jv.T @ jv
+    return hand.mass * jtj, hand.damping * jtj, hand.stiffness * jtj
+
+
+def simulate(
+    device: Device,
+    config: LoopConfig,
+    paths: dict[int, Path] | None = None,
+    q0: np.ndarray | None = None,
+    plant: DynamicsTables | None = None,
+    model: DynamicsTables | None = None,
+) -> Trace:
+    """Simulate the loop; ``paths`` maps 0-based joint indices to prescribed paths (others are free).
+
+    ``plant``/``model`` tables may be passed to skip rebuilding them (campaign searches).
+    """
+    n = device.n_dof
+    q_start = np.zeros(n) if q0 is None else np.asarray(q0, dtype=float).copy()
+    for j, path in (paths or {}).items():
+        if 0 <= j < n:
+            q_start[j] = float(path.sample(np.zeros(1))[0][0])
+    hand = _hand_matrices(device, config.hand, q_start)
+    plant = plant or DynamicsTables.from_device(device)
+    model = model or DynamicsTables.from_device(model_device(device, config.compensator.error_percent))
+    damping = config.damping if config.damping is not None else device.damping
+    return simulate_tables(plant, model, config, damping, paths, q_start, hand)
+
+
+def simulate_tables(
+    plant: DynamicsTables,
+    model: DynamicsTables,
+    config: LoopConfig,
+    damping,
+    paths: dict[int, Path] | None = None,
+    q0: np.ndarray | None = None,
+    hand: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+) -> Trace:
+    """Simulate the loop for plant and compensator tables directly (any number of joints)."""
+    n = plant.n_dof
+    sub = config.steps_per_sample()
+    if not (config.duration > 0 and math.isfinite(config.duration)):
+        raise UserError(f"the duration must be positive, got {config.duration}")
+    wall = config.wall
+    if not 0 <= wall.joint < n:
+        raise UserError(f"unknown joint {wall.joint + 1}; the device has joints 1..{n}")
+    if not all(math.isfinite(v) for v in (wall.stiffness, wall.damping, wall.equilibrium)):
+        raise UserError("the wall stiffness, damping and equilibrium must be finite")
+    paths = dict(paths or {})
+    for j in paths:
+        if not 0 <= j < n:
+            raise UserError(f"unknown joint {j + 1}; the device has joints 1..{n}")
+    sensors = config.sensors
+    if sensors.delay_samples < 0:
+        raise UserError("the sensor delay must be a non-negative number of samples")
+    quant = 0.0
+    if sensors.counts_per_revolution is not None:
+        if sensors.counts_per_revolution <= 0:
+            raise UserError("encoder counts per revolution must be positive")
+        quant = 2 * np.pi / sensors.counts_per_revolution
+    damping = np.asarray(damping, dtype=float)
+    if damping.shape != (n,) or not np.all(np.isfinite(damping)):
+        raise UserError(f"expected {n} finite joint dampings, got {damping.tolist()}")
+    n_steps = int(round(config.duration / config.step))
+    stride = config.record_stride or sub
+    if stride < 1:
+        raise UserError("the record stride must be at least one plant step")
+    q_start = np.zeros(n) if q0 is None else np.asarray(q0, dtype=float).copy()
+    t_half = 0.5 * config.step * np.arange(2 * n_steps + 1)
+    path_q, path_qd, path_qdd = (np.zeros((t_half.size, n)) for _ in range(3))
+    prescribed = np.zeros(n, dtype=np.bool_)
+    for j, path in paths.items():
+        prescribed[j] = True
+        path_q[:, j], path_qd[:, j], path_qdd[:, j] = path.sample(t_half)
+        q_start[j] = path_q[0, j]
+    hand_mass, hand_damping, hand_stiffness = hand if hand is not None else (np.zeros((n, n)),) * 3
+    comp = config.compensator
+    n_values = workspace_size(plant)
+    n_rec = n_steps // stride + 1
+    rec = [np.zeros((n_rec, n)) for _ in range(6)]
+    switches = np.array([comp.inertial, comp.coriolis, comp.gravity], dtype=float)
+    written, status, trip = kernel.run_loop(
+        (plant.coef, plant.index, plant.kinds, plant.degrees),
+        (model.coef, model.index, model.kinds, model.degrees),
+        kernel.make_workspace(n, n_values, plant.coef.shape[1]),
+        kernel.make_workspace(n, n_values, plant.coef.shape[1]),
+        np.diag(damping) + hand_damping, hand_mass, hand_stiffness, q_start.copy(), prescribed,
+        path_q, path_qd, path_qdd, q_start, np.zeros(n), config.step, sub, n_steps,
+        wall.joint, float(wall.stiffness), float(wall.damping), float(wall.equilibrium), switches, quant,
+        int(sensors.delay_samples),
+        math.inf if config.safety_limit is None else float(config.safety_limit), float(q_start[wall.joint]),
+        math.inf if config.stop_excursion is None else float(config.stop_excursion), stride, *rec,
+    )
+    t = np.arange(written) * stride * config.step
+    q, qd, u, tau_f, tau_imp, tau_c = (r[:written] for r in rec)
+    return Trace(t, q, qd, u, tau_f, tau_imp, tau_c, int(status), None if trip < 0 else float(trip))

@@ -1,0 +1,110 @@
+"""Equations of motion as coefficient tables, evaluated inside numba (seed 000 eq. 2.50).
+
+The :class:`~hapticdesign.analysis.dynamics.model.DynamicsModel` writes every entry of H, C and
+G as ``sum_b phi_b(q) coef[b, e]`` with ``phi_b`` a product of 1-D basis functions (revolute:
+``1, cos q, sin q, cos 2q, sin 2q, ...``; cyclic: ``1``; prescribed: ``1, q, q^2, ...``) chosen
+by the multi-index ``index[b]``. Entries are ``[unique H upper triangle (row-major) | C rows
+flattened (N x N(N+1)/2) | G]``. This module carries those tables into numba.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numba as nb
+import numpy as np
+
+from hapticdesign.analysis.dynamics.basis import CoordinateKind
+from hapticdesign.model.device import Device
+
+KIND_CODES = {CoordinateKind.CYCLIC: 0, CoordinateKind.REVOLUTE: 1, CoordinateKind.PRISMATIC: 2}
+
+
+@dataclass(frozen=True)
+class DynamicsTables:
+    """Basis coefficients of H, C, G for one parameter set, ready for :func:`evaluate_entries`."""
+
+    coef: np.ndarray  # (n_basis, E)
+    index: np.ndarray  # (n_basis, N), int64
+    kinds: np.ndarray  # (N,), int64 codes of KIND_CODES
+    degrees: np.ndarray  # (N,), int64
+
+    @property
+    def n_dof(self) -> int:
+        return self.index.shape[1]
+
+    @classmethod
+    def from_device(cls, device: Device) -> "DynamicsTables":
+        model = device.model
+        return cls(
+            coef=np.ascontiguousarray(model.coefficients_for(device.standard_parameters())),
+            index=np.ascontiguousarray(model.index, dtype=np.int64),
+            kinds=np.array([KIND_CODES[b.kind] for b in model.bases], dtype=np.int64),
+            degrees=np.array([b.degree for b in model.bases], dtype=np.int64),
+        )
+
+    @classmethod
+    def constant_inertia(cls, inertia: float) -> "DynamicsTables":
+        """A 1-DOF body of constant inertia ``J`` (no Coriolis, no gravity): ``tau = J qdd``."""
+        return cls(
+            coef=np.array([[float(inertia), 0.0, 0.0]]),
+            index=np.zeros((1, 1), dtype=np.int64),
+            kinds=np.zeros(1, dtype=np.int64),
+            degrees=np.zeros(1, dtype=np.int64),
+        )
+
+
+@nb.njit(cache=True)
+def evaluate_entries(q, coef, index, kinds, degrees, values, out):
+    """All entries at ``q`` into ``out`` (E,); ``values`` (N, max basis size) is workspace."""
+    n = q.shape[0]
+    for k in range(n):
+        values[k, 0] = 1.0
+        if kinds[k] == 1:
+            for j in range(1, degrees[k] + 1):
+                values[k, 2 * j - 1] = np.cos(j * q[k])
+                values[k, 2 * j] = np.sin(j * q[k])
+        elif kinds[k] == 2:
+            for j in range(1, degrees[k] + 1):
+                values[k, j] = values[k, j - 1] * q[k]
+    out[:] = 0.0
+    for b in range(index.shape[0]):
+        phi = 1.0
+        for k in range(n):
+            phi *= values[k, index[b, k]]
+        for e in range(coef.shape[1]):
+            out[e] += phi * coef[b, e]
+
+
+@nb.njit(cache=True)
+def unpack_entries(entries, n, h, c, g):
+    """Entries -> ``H`` (N, N), ``C`` (N, N(N+1)/2) and ``G`` (N,)."""
+    m = n * (n + 1) // 2
+    u = 0
+    for i in range(n):
+        for j in range(i, n):
+            h[i, j] = entries[u]
+            h[j, i] = entries[u]
+            u += 1
+    for i in range(n):
+        for col in range(m):
+            c[i, col] = entries[m + i * m + col]
+    for i in range(n):
+        g[i] = entries[m + n * m + i]
+
+
+@nb.njit(cache=True)
+def velocity_products(qd, out):
+    """``thetadot^2`` of eq. 2.50: (1,1), (1,2), ..., (N,N)."""
+    n = qd.shape[0]
+    u = 0
+    for j in range(n):
+        for k in range(j, n):
+            out[u] = qd[j] * qd[k]
+            u += 1
+
+
+def workspace_size(tables: DynamicsTables) -> int:
+    """Columns of the per-coordinate basis workspace."""
+    sizes = [2 * d + 1 if k == 1 else (d + 1 if k == 2 else 1) for k, d in zip(tables.kinds, tables.degrees)]
+    return max(sizes)

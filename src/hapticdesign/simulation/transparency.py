@@ -1,0 +1,123 @@
+"""Transparency bandwidth of one joint (seed 000 §4.2.2-4.2.3, eq. 4.1-4.2).
+
+The wall joint follows a linear chirp (0.3 rad, 0.1-15 Hz over 10 s); type 1 holds the other
+joints at 0, type 2 drives every joint with the same chirp (Table 4.5). Recorded at the plant
+step: ``tau_h`` (the torque that moves the device along the path: its inverse dynamics and joint
+damping), ``tau_f`` (held compensator torque), ``tau_imp`` (held torque of the implemented wall),
+``tau_D = K (q - q_eq) + B qd`` (the ideal wall, continuous), and the transmitted torque
+``tau_M = tau_h + tau_imp - tau_f`` (eq. 4.1), which is the torque the user's motion source
+supplies. Impedances ``Z = S_q,tau / S_q,q`` (cross-spectrum over auto-spectrum, Welch);
+``G_T = Z_M / Z_D`` (eq. 4.2); the bandwidth is where ``|G_T|`` first leaves +-3 dB.
+
+With perfect compensation ``G_T = 1 + j b w / K``, so the joint damping alone sets the
+bandwidth to ``K / (2 pi b)`` (1.27 Hz for K = 4 N m/rad, b = 0.5 N m s/rad).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+from scipy.signal import csd, welch
+
+from hapticdesign.errors import UserError
+from hapticdesign.model.device import Device
+from hapticdesign.simulation.loop import LoopConfig, Wall, simulate
+from hapticdesign.simulation.paths import Chirp, Held, Path
+
+
+@dataclass(frozen=True)
+class TransparencyResult:
+    """Frequency response of eq. 4.2 and the bandwidth (``None`` inside the band up to the top)."""
+
+    frequency: np.ndarray
+    z_desired: np.ndarray
+    z_transmitted: np.ndarray
+    bandwidth_hz: float | None
+    band_db: float
+    signals: dict[str, np.ndarray] = field(repr=False)
+
+    @property
+    def g_t(self) -> np.ndarray:
+        return self.z_transmitted / self.z_desired
+
+    def as_dict(self) -> dict:
+        return {"bandwidth_hz": self.bandwidth_hz, "band_db": self.band_db,
+                "z_desired_mean_magnitude": float(np.mean(np.abs(self.z_desired)))}
+
+    def response_table(self) -> str:
+        """CSV of the frequency response: frequency, |Z_D|, |Z_M|, |G_T| in dB, phase of G_T."""
+        lines = ["frequency_hz,abs_z_desired,abs_z_transmitted,g_t_db,g_t_phase_deg"]
+        for f, zd, zm, g in zip(self.frequency, self.z_desired, self.z_transmitted, self.g_t):
+            lines.append(f"{f:.6g},{abs(zd):.6g},{abs(zm):.6g},{20 * np.log10(abs(g)):.6g},{np.degrees(np.angle(g)):.6g}")
+        return "\n".join(lines) + "\n"
+
+
+def impedance(q: np.ndarray, tau: np.ndarray, fs: float, nperseg: int, window: str = "boxcar") -> tuple[np.ndarray, np.ndarray]:
+    """``Z(f) = S_q,tau(f) / S_q,q(f)`` by Welch's method (seed §4.2.2)."""
+    f, s_qt = csd(q, tau, fs=fs, nperseg=nperseg, window=window)
+    _, s_qq = welch(q, fs=fs, nperseg=nperseg, window=window)
+    return f, s_qt / s_qq
+
+
+def first_exit(frequency: np.ndarray, gain_db: np.ndarray, band_db: float) -> float | None:
+    """First frequency where ``|gain_db|`` reaches ``band_db``, linearly interpolated between bins."""
+    outside = np.nonzero(np.abs(gain_db) >= band_db)[0]
+    if outside.size == 0:
+        return None
+    i = int(outside[0])
+    if i == 0:
+        return float(frequency[0])
+    g0, g1 = gain_db[i - 1], gain_db[i]
+    target = math.copysign(band_db, g1)
+    return float(frequency[i - 1] + (target - g0) / (g1 - g0) * (frequency[i] - frequency[i - 1]))
+
+
+def transparency(
+    device: Device,
+    sim_type: int = 1,
+    stiffness: float = 4.0,
+    chirp: Chirp | None = None,
+    config: LoopConfig | None = None,
+    wall_joint: int = 0,
+    equilibrium: float = 0.0,
+    segment_seconds: float | None = None,
+    window: str = "boxcar",
+    band_db: float = 3.0,
+) -> TransparencyResult:
+    """Transparency bandwidth of ``wall_joint`` for simulation type 1 or 2 (seed §4.2.2).
+
+    By default the spectra use one rectangular segment spanning the whole sweep (0.1 Hz
+    resolution): a chirp is not stationary, and tapered, overlapping Welch segments under-weight
+    the low frequencies swept near the ends of the record.
+    """
+    if sim_type not in (1, 2):
+        raise UserError(f"simulation type must be 1 or 2, got {sim_type}")
+    if not (stiffness > 0 and math.isfinite(stiffness)):
+        raise UserError(f"the wall stiffness must be positive, got {stiffness}")
+    chirp = chirp or Chirp()
+    base = config or LoopConfig()
+    cfg = replace(base, duration=chirp.sweep_time, safety_limit=None, stop_excursion=None, record_stride=1,
+                  wall=Wall(wall_joint, stiffness, base.wall.damping, equilibrium))
+    n = device.n_dof
+    paths: dict[int, Path] = {j: (chirp if (j == wall_joint or sim_type == 2) else Held(0.0)) for j in range(n)}
+    trace = simulate(device, cfg, paths)
+    q = trace.q[:, wall_joint]
+    tau_m = trace.tau_c[:, wall_joint]
+    tau_d = stiffness * (q - equilibrium) + cfg.wall.damping * trace.qd[:, wall_joint]
+    fs = 1.0 / cfg.step
+    seconds = chirp.sweep_time if segment_seconds is None else segment_seconds
+    if not (seconds > 0 and math.isfinite(seconds)):
+        raise UserError(f"the spectral segment must be positive, got {seconds}")
+    nperseg = min(len(q), int(round(seconds * fs)))
+    f, z_d = impedance(q, tau_d, fs, nperseg, window)
+    _, z_m = impedance(q, tau_m, fs, nperseg, window)
+    keep = (f >= max(chirp.f0, 1.0 / seconds)) & (f <= chirp.f1)
+    f, z_d, z_m = f[keep], z_d[keep], z_m[keep]
+    gain_db = 20 * np.log10(np.abs(z_m / z_d))
+    signals = {
+        "t": trace.t, "q": q, "tau_h": tau_m + trace.u[:, wall_joint], "tau_f": trace.tau_f[:, wall_joint],
+        "tau_imp": trace.tau_imp[:, wall_joint], "tau_D": tau_d, "tau_M": tau_m,
+    }
+    return TransparencyResult(f, z_d, z_m, first_exit(f, gain_db, band_db), band_db, signals)

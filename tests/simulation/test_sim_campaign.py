@@ -1,0 +1,67 @@
+"""Campaigns: design-file checks, a Dask LocalCluster run, resumption, tables and figures."""
+
+import csv
+import json
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from hapticdesign.errors import UserError
+from hapticdesign.interface.cli import app
+from hapticdesign.simulation.campaign import CampaignOptions, read_designs, run_campaign
+from hapticdesign.simulation.paths import Chirp
+
+from sim_designs import write_designs
+
+QUICK = CampaignOptions(k_limit=60, chirp=Chirp(0.3, 0.1, 6.0, 10.0), duration=3.0)
+
+
+def test_design_file_errors(tmp_path):
+    with pytest.raises(UserError, match="missing columns ln_H"):
+        read_designs(write_designs(tmp_path / "a.csv", drop="ln_H"))
+    with pytest.raises(UserError, match="missing columns Ixy3a"):
+        read_designs(write_designs(tmp_path / "b.csv", drop="Ixy3a"))
+    with pytest.raises(UserError, match="row 1"):
+        read_designs(write_designs(tmp_path / "c.csv", edit={"m2": -0.1}))
+    result = CliRunner().invoke(app, ["campaign", "--designs", str(tmp_path / "a.csv"), "--out", str(tmp_path / "o")])
+    assert result.exit_code == 2 and "missing columns" in result.output
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    from dask.distributed import LocalCluster
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as c:
+        yield c
+
+
+def test_campaign_on_local_cluster_resumes_and_summarizes(tmp_path, cluster):
+    designs = write_designs(tmp_path / "designs.csv")
+    out = tmp_path / "out"
+    first = run_campaign(designs, out, QUICK, scheduler=cluster.scheduler_address)
+    assert first == {"cases": 16, "run": 16, "skipped": 0}
+    before = (out / "results.csv").read_text()
+    (out / "cases" / "x2__impedance__type2.json").unlink()
+    second = run_campaign(designs, out, QUICK, scheduler=cluster.scheduler_address)
+    assert second == {"cases": 16, "run": 1, "skipped": 15}
+    assert (out / "results.csv").read_text() == before  # deterministic: same numbers after resuming
+    rows = list(csv.DictReader((out / "results.csv").open()))
+    k1 = {r["design"]: float(r["k_max_type1"]) for r in rows}
+    # the LN = 0 design gives the same result in both types (seed §4.1.4.2), and K_max < b^2 / H11
+    assert rows[0]["k_max_type1"] == rows[0]["k_max_type2"]
+    assert rows[0]["bandwidth_hz_type1"] == rows[0]["bandwidth_hz_type2"]
+    assert k1["x0"] < 0.25 / 0.039031 < k1["x0"] + 1
+    summary = list(csv.DictReader((out / "summary.csv").open()))
+    level0 = [r for r in summary if r["level"] == "0.0" and r["criterion"] == "impedance"]
+    assert float(level0[0]["agreement_share"]) == 1.0
+    values = [k1["x0"], k1["x1"]]
+    assert float(level0[0]["mean"]) == pytest.approx(np.mean(values))
+    for name in ("impedance_beeswarm_type1", "impedance_type1_vs_type2", "transparency_agreement",
+                 "transparency_frequency_response"):
+        assert (out / "figures" / f"{name}.png").stat().st_size > 1000
+        assert (out / "figures" / f"{name}.svg").exists()
+    case = json.loads((out / "cases" / "x0__transparency__type1.json").read_text())
+    assert case["bandwidth_hz"] == pytest.approx(4 / (2 * np.pi * 0.5), rel=0.05)
+    with pytest.raises(UserError, match="other designs or settings"):
+        run_campaign(designs, out, CampaignOptions(k_limit=10), scheduler=cluster.scheduler_address)
