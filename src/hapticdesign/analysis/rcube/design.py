@@ -63,6 +63,28 @@ def final_design() -> RCubeDesign:
     return RCubeDesign(RCubeGeometry(0.1117, 0.0741, 0.1218), links)
 
 
+def seed_final_design() -> RCubeDesign:
+    """Table 7.8's design as the seed's own computation of eq. 7.7 evidently built its links.
+
+    Two departures from :func:`final_design`, both needed together to reproduce the printed
+    ``K_C`` of eq. 7.7 (209110 N/m, 727 N m/rad, coupling 6495 N; within 0.7 %, see
+    docs/rcube.md): the +-45 degree plies take the shear modulus as eq. 5.175 prints it, and the
+    section properties of eq. 5.162-5.165 are evaluated with Table 7.8's diameters in place of the
+    radii, i.e. tubes of twice the printed diameters. The density is scaled by 1/4 so that the
+    links keep Table 7.9's 77.7 g. For reproduction only; :func:`final_design` is the physical one.
+    """
+    rows = [  # printed D, d (m) and plies at 0, 90, -45, 45 degrees (Table 7.8)
+        (15e-3, 11.25e-3, (4, 7, 7, 7)),
+        (12e-3, 9e-3, (2, 6, 6, 6)),
+        (7.2e-3, 5.4e-3, (2, 6, 2, 2)),
+    ]
+    links = tuple(
+        LinkDesign(Tube(2.0 * D, 2.0 * d), laminate(plies, shear="eq. 5.175"), FINAL_DENSITY / 4.0)
+        for D, d, plies in rows
+    )
+    return RCubeDesign(RCubeGeometry(0.1117, 0.0741, 0.1218), links)
+
+
 def uniform_design(
     geometry: RCubeGeometry, D: float, d: float, moduli: LinkModuli | None = None, density: float = 2000.0
 ) -> RCubeDesign:

@@ -107,11 +107,35 @@ def check_plies(plies: tuple[int, int, int, int]) -> tuple[int, int, int, int]:
     return tuple(counts)
 
 
-def laminate(plies: tuple[int, int, int, int], lamina: Lamina = M55J) -> LinkModuli:
-    """Ply-count weighted average of the oriented moduli (eq. 5.179-5.181)."""
+def printed_45_shear(lamina: Lamina) -> float:
+    """``G_xy`` of a +-45 degree ply exactly as eq. 5.175/5.178 print it (Pa).
+
+    ``1/G = 2 (2/(4 E1) + 2/(4 E2) + 4 nu12/(4 E1) - 1/(4 G12)) + 1/(4 G12)``: eq. 4.69 with
+    ``sin^2 cos^2 = 1/4`` put inside the bracket and ``sin^4 + cos^4 = 1/2`` written as ``1/4``
+    (25.9 GPa for M55J instead of eq. 4.69's 11.3 GPa). The seed's final-design ``K_C`` (eq. 7.7)
+    reproduces only with this value (see docs/rcube.md).
+    """
+    E1, E2, G12, nu = lamina.E1, lamina.E2, lamina.G12, lamina.nu12
+    return 1.0 / (2.0 * (2.0 / (4 * E1) + 2.0 / (4 * E2) + 4.0 * nu / (4 * E1) - 1.0 / (4 * G12)) + 1.0 / (4 * G12))
+
+
+SHEAR_RULES = ("eq. 4.69", "eq. 5.175")
+"""How a +-45 degree ply's ``G_xy`` is computed: eq. 4.69 (default) or as eq. 5.175 prints it."""
+
+
+def laminate(plies: tuple[int, int, int, int], lamina: Lamina = M55J, shear: str = "eq. 4.69") -> LinkModuli:
+    """Ply-count weighted average of the oriented moduli (eq. 5.179-5.181).
+
+    ``shear="eq. 5.175"`` takes the +-45 degree plies' ``G_xy`` as printed (:func:`printed_45_shear`).
+    """
+    if shear not in SHEAR_RULES:
+        raise UserError(f"unknown shear rule {shear!r}; choose one of {', '.join(SHEAR_RULES)}")
     counts = check_plies(plies)
     total = float(sum(counts))
     parts = [off_axis(lamina, angle) for angle in PLY_ANGLES]
+    if shear == "eq. 5.175":
+        G45 = printed_45_shear(lamina)
+        parts = [LinkModuli(p.E_x, p.E_y, G45) if abs(a) == 45.0 else p for p, a in zip(parts, PLY_ANGLES)]
     return LinkModuli(
         E_x=sum(n * p.E_x for n, p in zip(counts, parts)) / total,
         E_y=sum(n * p.E_y for n, p in zip(counts, parts)) / total,
