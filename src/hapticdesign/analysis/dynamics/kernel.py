@@ -164,3 +164,40 @@ def jacobian_kernel(q, parent, axis, coef, offset, body_node, body_path, b):
     nb = body_node[b]
     pb = pos[nb].copy() if nb >= 0 else np.zeros(3)
     return rb, pb, jac
+
+
+@njit(cache=True)
+def basis_kernel(qs, kinds, degrees, index):
+    """Tensor-product basis functions (see :mod:`.basis`) at poses ``qs`` (P, N) -> (P, B).
+
+    ``kinds``: 0 cyclic, 1 revolute (1, cos q, sin q, cos 2q, sin 2q, ...), 2 prismatic
+    (1, q, q^2, ...); multiples of the angle come from the angle-addition recurrence.
+    """
+    n_pose, n_dof = qs.shape
+    n_basis = index.shape[0]
+    width = 1
+    for k in range(n_dof):
+        width = max(width, 2 * degrees[k] + 1)
+    values = np.empty((n_dof, width))
+    out = np.empty((n_pose, n_basis))
+    for p in range(n_pose):
+        for k in range(n_dof):
+            values[k, 0] = 1.0
+            if kinds[k] == 1:
+                c = np.cos(qs[p, k])
+                s = np.sin(qs[p, k])
+                cj, sj = 1.0, 0.0
+                for j in range(1, degrees[k] + 1):
+                    cj, sj = cj * c - sj * s, sj * c + cj * s
+                    values[k, 2 * j - 1] = cj
+                    values[k, 2 * j] = sj
+            elif kinds[k] == 2:
+                for j in range(1, degrees[k] + 1):
+                    values[k, j] = values[k, j - 1] * qs[p, k]
+        for b in range(n_basis):
+            v = 1.0
+            for k in range(n_dof):
+                if kinds[k] != 0:
+                    v *= values[k, index[b, k]]
+            out[p, b] = v
+    return out

@@ -26,7 +26,7 @@ from hapticdesign.analysis.dynamics.basis import (
     grid,
     tensor_values,
 )
-from hapticdesign.analysis.dynamics.kernel import regressor_kernel
+from hapticdesign.analysis.dynamics.kernel import basis_kernel, regressor_kernel
 from hapticdesign.errors import UserError
 from hapticdesign.model.mechanism import CompiledMechanism, Mechanism
 
@@ -163,8 +163,15 @@ class DynamicsModel:
         return self.index.shape[0]
 
     def basis(self, q: np.ndarray) -> np.ndarray:
-        """Basis functions at poses (P, N) -> (P, n_basis)."""
-        return tensor_values(self.bases, self._poses(q), self.index)
+        """Basis functions at poses (P, N) -> (P, n_basis), compiled (:func:`.kernel.basis_kernel`)."""
+        return basis_kernel(np.ascontiguousarray(self._poses(q)), *self._basis_tables)
+
+    @cached_property
+    def _basis_tables(self) -> tuple[np.ndarray, ...]:
+        codes = {CoordinateKind.CYCLIC: 0, CoordinateKind.REVOLUTE: 1, CoordinateKind.PRISMATIC: 2}
+        kinds = np.array([codes[b.kind] for b in self.bases], dtype=np.int64)
+        degrees = np.array([b.degree for b in self.bases], dtype=np.int64)
+        return kinds, degrees, np.ascontiguousarray(self.index, dtype=np.int64)
 
     def _poses(self, q: np.ndarray) -> np.ndarray:
         q = np.asarray(q, dtype=float)

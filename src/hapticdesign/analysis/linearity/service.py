@@ -1,0 +1,182 @@
+"""Front door for the command line: resolve a device, build its form, evaluate."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from hapticdesign.analysis.linearity.bounds import practical_bounds
+from hapticdesign.analysis.linearity.conditions import linear_conditions, seed_conditions
+from hapticdesign.analysis.linearity.design_sets import DesignSet, Method, design_set
+from hapticdesign.analysis.linearity.form import PARTS, LinearityForm, linearity_form
+from hapticdesign.analysis.linearity.linear_designs import find_linear_designs
+from hapticdesign.analysis.linearity.verdict import decide_linearizable, minimum_ln
+from hapticdesign.analysis.linearity.region import Region, parse_region
+from hapticdesign.analysis.linearity.weights import Weights, read_weights
+from hapticdesign.devices.loading import resolve_device
+from hapticdesign.errors import UserError
+from hapticdesign.interface.common import write_atomically
+from hapticdesign.model.device import Device
+from hapticdesign.model.inertia import Realizability
+
+
+@dataclass(frozen=True)
+class LNResult:
+    device: str
+    region: str
+    ln: float
+    parts: dict[str, float]
+
+
+def device_form(device: Device, region: Region | None = None, weights: Weights | None = None) -> LinearityForm:
+    """The LN form of a device (cached per geometry when region and weights are the defaults)."""
+    if region is None and weights is None:
+        return _default_form(device.model)
+    return linearity_form(device.model, region, weights)
+
+
+@lru_cache(maxsize=8)
+def _default_form(model) -> LinearityForm:
+    return linearity_form(model)
+
+
+def evaluate_ln(
+    preset: str | None,
+    device_file: Path | None,
+    params_file: Path | None,
+    strict: bool,
+    region_text: str | None,
+    weights_file: Path | None,
+) -> LNResult:
+    device = resolve_device(preset, device_file, params_file, strict)
+    region = parse_region(region_text, device.n_dof)
+    weights = read_weights(weights_file, device.n_dof) if weights_file is not None else None
+    form = device_form(device, None if region.is_torus else region, weights)
+    parts = form.parts(device.standard_parameters())
+    return LNResult(
+        device.name,
+        region.describe(device.mechanism.coordinates),
+        float(parts.sum()),
+        {k: float(v) for k, v in zip(PARTS, parts)},
+    )
+
+
+def parse_realizability(text: str) -> Realizability:
+    choices = {"rigid-body": Realizability.RIGID_BODY, "seed": Realizability.POSITIVE_DEFINITE}
+    if text not in choices:
+        raise UserError(f"--realizability: choose rigid-body or seed, got {text!r}")
+    return choices[text]
+
+
+def parse_levels(text: str) -> tuple[float, ...]:
+    try:
+        levels = tuple(float(v) for v in text.split(",") if v.strip())
+    except ValueError:
+        raise UserError(f"--levels: expected comma-separated numbers, got {text!r}") from None
+    if not levels:
+        raise UserError("--levels: give at least one level")
+    for level in levels:
+        if not math.isfinite(level) or level < 0:
+            raise UserError(f"--levels: LN levels must be finite and >= 0, got {level:g}")
+    return levels
+
+
+def _designs_csv(names: list[str], designs: np.ndarray, form: LinearityForm, level: float = 0.0) -> str:
+    parts = form.parts_seed(designs)
+    return DesignSet(np.full(len(designs), level), parts, designs).to_csv(names)
+
+
+def linearize_report(
+    preset: str | None,
+    device_file: Path | None,
+    params_file: Path | None,
+    strict: bool,
+    find: int,
+    seed: int,
+    out: Path | None,
+    realizability: str,
+) -> list[str]:
+    """Text of ``hapticdesign linearize``."""
+    kind = parse_realizability(realizability)
+    if find < 0:
+        raise UserError("--find: the number of designs must be >= 0")
+    device = resolve_device(preset, device_file, params_file, strict)
+    form = device_form(device)
+    conditions = linear_conditions(device, form)
+    lines = [f"device {device.name}: LN = 0 exactly when these {len(conditions.pivots)} linear equations hold",
+             "in the standard parameters (m, h = m r, J about the body frame origin):"]
+    lines += ["  " + eq for eq in conditions.equations()]
+    verdict = decide_linearizable(device, form, kind)
+    if not verdict.linear_possible:
+        cert = verdict.certificate
+        mins = minimum_ln(device, form, practical_bounds(device), kind)
+        lines += [
+            "",
+            f"verdict: NO realizable ({kind.value}) design with LN = 0 exists (any bounds, incl. eq. 3.40-3.42).",
+            f"certificate: PSD blocks Z_i on bodies {', '.join(cert.support())} (sum of traces 1, smallest eigenvalue "
+            f"{cert.min_eigenvalue():.2e}) with |sum_i tr(Z_i F_i(pi))| <= {cert.residual:.2e} |z|_1 on every fully",
+            "  linear design pi = N z; hence min_i lambda_min(F_i(pi)) <= that bound, i.e. no strictly realizable one.",
+            "exact certificate (Z = e_k e_k^T): these diagonal entries of the realizability matrix vanish on every",
+            "  fully linear design: " + ", ".join(f"body {b} entry ({k + 1},{k + 1})" for b, k in verdict.exact),
+            f"minimum LN under practical bounds: {mins.ln:.6g} (convex lower bound {mins.lower_bound:.3g}); "
+            f"design within bounds: {mins.within_bounds}",
+            "  design (seed variables):",
+        ]
+        lines += [f"    {n} = {v:.8g}" for n, v in zip(device.inertial_names(), mins.design.ravel())]
+        lines.append("minimum LN under eq. 3.40-3.42: 0 is the infimum (LN scales with the square of the inertial")
+        lines.append(f"  parameters), e.g. {scaled_minimum(device, mins):.3g} with the design above scaled to the 1e-15 bounds; never attained.")
+        return lines
+    solved = seed_conditions(device, conditions)
+    lines += ["", "in the seed's design variables (cf. eq. 3.12-3.26):"]
+    lines += [f"  {k} = {v}" for k, v in solved.solution.items()]
+    lines += ["", f"free parameters ({len(solved.free)}, cf. Table 3.2): " + ", ".join(s.name for s in solved.free)]
+    lines += ["", "constant inertia matrix on the solution set (eq. 3.27), for the current parameters:"]
+    h = conditions.constant_h @ device.standard_parameters()
+    lines += ["  [" + ", ".join(f"{v:.6g}" for v in row) + "]" for row in h]
+    lines.append(f"current LN = {form.ln(device.standard_parameters()):.3g}")
+    if find:
+        designs = find_linear_designs(device, form, conditions, practical_bounds(device), find, seed, kind)
+        text = _designs_csv(device.inertial_names(), designs, form)
+        if out is None:
+            lines += ["", text.rstrip()]
+        else:
+            write_atomically(out, text)
+            lines.append(f"wrote {find} realizable fully linear designs (max LN {form.ln_seed(designs).max():.2g}) to {out}")
+    return lines
+
+
+def scaled_minimum(device: Device, mins) -> float:
+    """LN of the practical optimum scaled down until its smallest mass or moment is 1e-15 (eq. 3.40-3.42)."""
+    bodies = [k for k, b in enumerate(device.body_names)]
+    smallest = min(min(mins.design[k, 0], mins.design[k, 4:7].min()) for k in bodies if mins.design[k, 0] > 0)
+    return mins.ln * (1e-15 / smallest) ** 2
+
+
+def write_design_set(
+    preset: str | None,
+    device_file: Path | None,
+    params_file: Path | None,
+    strict: bool,
+    levels_text: str,
+    count: int,
+    seed: int,
+    out: Path,
+    method: str,
+    realizability: str,
+) -> str:
+    kind = parse_realizability(realizability)
+    levels = parse_levels(levels_text)
+    try:
+        chosen = Method(method)
+    except ValueError:
+        raise UserError(f"--method: choose fast or de, got {method!r}") from None
+    device = resolve_device(preset, device_file, params_file, strict)
+    form = device_form(device)
+    conditions = linear_conditions(device, form)
+    result = design_set(device, form, conditions, practical_bounds(device), levels, count, seed, chosen, kind)
+    write_atomically(out, result.to_csv(device.inertial_names()))
+    return f"wrote {len(result.levels)} designs ({count} per level at {', '.join(f'{v:g}' for v in levels)}) to {out}"

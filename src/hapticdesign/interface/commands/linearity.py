@@ -1,0 +1,84 @@
+"""Commands of the Linearity Number area (seed 000 chapter 3): ``ln``, ``linearize``, ``designs``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+from hapticdesign.interface.common import print_json, user_errors
+
+PRESET = typer.Option(None, "--preset", help="Built-in device (phantom-3dof, phantom-6dof).")
+DEVICE = typer.Option(None, "--device", help="Device file instead of a preset.")
+PARAMS = typer.Option(None, "--params", help="Parameter overrides (JSON/YAML/TOML, seed's names).")
+STRICT = typer.Option(False, "--strict", help="Refuse bodies that break the triangle inequality.")
+
+
+def ln_command(
+    preset: Optional[str] = PRESET,
+    device: Optional[Path] = DEVICE,
+    params: Optional[Path] = PARAMS,
+    strict: bool = STRICT,
+    region: Optional[str] = typer.Option(
+        None, "--region", help='Joint ranges in radians, e.g. "q2=-0.5:0.5,q3=0:1"; default the torus (eq. 3.4).'
+    ),
+    weights: Optional[Path] = typer.Option(None, "--weights", help="Weights file with keys H, C, G (eq. 3.1)."),
+    as_json: bool = typer.Option(False, "--json", help="Print JSON."),
+) -> None:
+    """Linearity Number of a device (seed 000 eq. 3.1-3.4) and its H, C, G parts."""
+    with user_errors(strict):
+        from hapticdesign.analysis.linearity.service import evaluate_ln
+
+        result = evaluate_ln(preset, device, params, strict, region, weights)
+        if as_json:
+            print_json({"ln": result.ln, "parts": result.parts})
+            return
+        typer.echo(f"device   {result.device}")
+        typer.echo(f"region   {result.region}")
+        typer.echo(f"LN       {result.ln:.10g}")
+        for key, value in result.parts.items():
+            typer.echo(f"  {key}      {value:.10g}")
+
+
+def linearize_command(
+    preset: Optional[str] = PRESET,
+    device: Optional[Path] = DEVICE,
+    params: Optional[Path] = PARAMS,
+    strict: bool = STRICT,
+    find: int = typer.Option(0, "--find", help="Write this many realizable fully linear designs."),
+    seed: int = typer.Option(1, "--seed", help="Random seed for --find."),
+    out: Optional[Path] = typer.Option(None, "--out", help="CSV file for --find (default: print)."),
+    realizability: str = typer.Option("rigid-body", "--realizability", help="rigid-body or seed (eq. 3.28)."),
+) -> None:
+    """Conditions for LN = 0 (seed 000 eq. 3.12-3.27), free parameters, constant H; verdict when impossible."""
+    with user_errors(strict):
+        from hapticdesign.analysis.linearity.service import linearize_report
+
+        for line in linearize_report(preset, device, params, strict, find, seed, out, realizability):
+            typer.echo(line)
+
+
+def designs_command(
+    preset: Optional[str] = PRESET,
+    device: Optional[Path] = DEVICE,
+    params: Optional[Path] = PARAMS,
+    strict: bool = STRICT,
+    levels: str = typer.Option("0,0.001,0.01,0.1,1,2", "--levels", help="LN levels (Table 3.3)."),
+    count: int = typer.Option(100, "--count", help="Designs per level."),
+    seed: int = typer.Option(1, "--seed", help="Random seed."),
+    out: Path = typer.Option(Path("designs.csv"), "--out", help="CSV output."),
+    method: str = typer.Option("fast", "--method", help="fast (quadratic structure) or de (seed's differential evolution)."),
+    realizability: str = typer.Option("rigid-body", "--realizability", help="rigid-body or seed (eq. 3.28 only)."),
+) -> None:
+    """Designs at prescribed LN levels under eq. 3.35-3.38 (seed 000 §3.2.2), written to CSV."""
+    with user_errors(strict):
+        from hapticdesign.analysis.linearity.service import write_design_set
+
+        typer.echo(write_design_set(preset, device, params, strict, levels, count, seed, out, method, realizability))
+
+
+def register(app: typer.Typer) -> None:
+    app.command("ln")(ln_command)
+    app.command("linearize")(linearize_command)
+    app.command("designs")(designs_command)
