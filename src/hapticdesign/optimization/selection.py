@@ -1,0 +1,86 @@
+"""Post-evaluation, normalization and RMS selection of Pareto designs (seed 001 §7.1-7.2,
+Table 7.3-7.5, eq. 7.1-7.4, Figures 7.1-7.3).
+
+Post-evaluation (Table 7.3): every design gets the same tubes (D = 20 mm, d = 10 mm,
+rho = 2000 kg/m^3) and is evaluated at home for one serial chain: ``I_f = ||M_C1||_F``
+(eq. 4.98, 5.223), ``S_f = ||K_C1||_F`` (eq. 4.73, 5.122), ``omega_n = ||M_C1^-1 K_C1A||_F``
+(eq. 4.107), with the critical ``mu_v = l1 cos q_max`` (eq. 6.8) and ``c_v = 1 / cos^2 q_max``
+(eq. 6.18).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hapticdesign.errors import UserError
+from hapticdesign.analysis.metrics.dynamic import inertia_frobenius, natural_frequency_index
+from hapticdesign.analysis.metrics.stiffness import frobenius, translational_block
+from hapticdesign.analysis.rcube.dynamics import chain_cartesian_mass
+from hapticdesign.analysis.rcube.kinematics import critical_condition_number, critical_manipulability, inverse_kinematics
+from hapticdesign.analysis.rcube.stiffness import chain_stiffness_matrices
+from hapticdesign.optimization.constraints import Workspace
+from hapticdesign.optimization.objectives import EvaluationLinks, geometry_of
+
+METRIC_NAMES = ("I_f", "S_f", "omega_n", "mu_v", "c_v")
+LARGER_IS_BETTER = ("S_f", "omega_n", "mu_v")
+"""Indices flipped by eq. 7.2-7.4 so that 0 is the best value of every normalized index."""
+
+
+def post_evaluate(X, workspace: Workspace = Workspace(), links: EvaluationLinks = EvaluationLinks()) -> dict[str, np.ndarray]:
+    """Table 7.3's five indices for each design vector ``(q_max, l2, l3)`` of ``X (n, 3)``."""
+    X = np.atleast_2d(np.asarray(X, dtype=float))
+    out = {name: np.empty(len(X)) for name in METRIC_NAMES}
+    for k, x in enumerate(X):
+        geometry = geometry_of(x, workspace)
+        design = links.design(geometry)
+        home = geometry.home
+        q = inverse_kinematics(geometry, home)
+        M = chain_cartesian_mass(design, 0, q[0])
+        K = chain_stiffness_matrices(design, home, passive=links.passive_eliminated)[0]
+        out["I_f"][k] = inertia_frobenius(M)
+        out["S_f"][k] = frobenius(K)
+        out["omega_n"][k] = natural_frequency_index(M, translational_block(K))
+        out["mu_v"][k] = critical_manipulability(geometry, x[0])
+        out["c_v"][k] = critical_condition_number(x[0])
+    return out
+
+
+def normalize(values) -> np.ndarray:
+    """``p_n = (p - p_min) / (p_max - p_min)`` over the solutions (eq. 7.1); constant columns give 0."""
+    p = np.asarray(values, dtype=float)
+    if p.size == 0:
+        raise UserError("nothing to normalize: the front is empty")
+    span = p.max() - p.min()
+    return np.zeros_like(p) if span == 0.0 else (p - p.min()) / span
+
+
+def normalized_indices(metrics: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """Table 7.4 (eq. 7.1) followed by eq. 7.2-7.4 (``1 - p_n`` for the larger-is-better indices):
+    0 is the best value of every returned index."""
+    out = {}
+    for name, values in metrics.items():
+        n = normalize(values)
+        out[name] = 1.0 - n if name in LARGER_IS_BETTER else n
+    return out
+
+
+def weighted_rms(primary, secondary, weight: float = 1.0) -> np.ndarray:
+    """``sqrt((a^2 + w b^2) / 2)`` (Figures 7.2-7.3): ``w = 1`` is the plain RMS of ``a`` and ``b``.
+
+    With ``a = omega_nn*`` and ``b = mu_vn*`` this reproduces the seed's choices from Table 7.3:
+    Sol. 29 at ``w = 1`` and Sol. 1, 2, 6, 16 at ``w = 0, 0.25, 0.5, 0.75`` (Table 7.5).
+    """
+    if not 0.0 <= weight:
+        raise UserError(f"a weight must be non-negative, got {weight!r}")
+    a, b = np.asarray(primary, dtype=float), np.asarray(secondary, dtype=float)
+    return np.sqrt((a**2 + weight * b**2) / 2.0)
+
+
+def select(metrics: dict[str, np.ndarray], weights=(0.0, 0.25, 0.5, 0.75)) -> dict[str, int | dict[float, int]]:
+    """Index of the minimum RMS of ``(omega_nn*, mu_vn*)`` (Fig. 7.2) and of the minimum weighted RMS
+    for each weight on ``mu_vn*`` (Fig. 7.3, Table 7.5)."""
+    n = normalized_indices(metrics)
+    return {
+        "rms": int(np.argmin(weighted_rms(n["omega_n"], n["mu_v"]))),
+        "weighted": {float(w): int(np.argmin(weighted_rms(n["omega_n"], n["mu_v"], w))) for w in weights},
+    }
