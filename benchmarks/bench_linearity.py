@@ -1,4 +1,4 @@
-"""Linearity Number: batched LN per design (3 and 6 DOF), 6-DOF set-up, the 600-design set."""
+"""Linearity Number: batched LN per design (3 and 6 DOF), set-up, closed form, the 600-design set."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ import numpy as np
 
 from hapticdesign.analysis.dynamics.model import DynamicsModel
 from hapticdesign.analysis.linearity.bounds import practical_bounds
+from hapticdesign.analysis.linearity.closed_form import closed_form
 from hapticdesign.analysis.linearity.conditions import linear_conditions
 from hapticdesign.analysis.linearity.design_sets import design_set
 from hapticdesign.analysis.linearity.form import linearity_form
@@ -32,6 +33,13 @@ def main() -> None:
         setup = time.perf_counter() - start
         print(f"{name}: set-up (model + LN form) {setup:.2f} s; LN per design (batch of 20000) "
               f"{1e6 * _per_design(form, device):.2f} us")
+        start = time.perf_counter()
+        closed = closed_form(device, form)
+        build = time.perf_counter() - start
+        start = time.perf_counter()
+        closed.export("latex"), closed.export("python")
+        print(f"{name}: closed-form LN from Q {build:.2f} s ({len(closed.terms())} terms); "
+              f"LaTeX + Python export {time.perf_counter() - start:.2f} s")
     device = preset("phantom-3dof")
     form = linearity_form(device.model)
     start = time.perf_counter()

@@ -87,3 +87,59 @@ def test_linearize_find_writes_linear_designs(tmp_path):
     rows = list(csv.DictReader(out.open()))
     assert len(rows) == 2 and all(float(r["ln"]) < 1e-12 for r in rows)
     assert np.isfinite([float(v) for v in rows[0].values()]).all()
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["--format", "latex"],
+        ["--part", "G"],
+        ["--symbolic-gravity"],
+        ["--symbolic", "--json"],
+        ["--symbolic", "--format", "pdf"],
+        ["--symbolic", "--part", "Q"],
+        ["--symbolic", "--region", "q3=2:1"],
+    ],
+)
+def test_ln_symbolic_bad_input_exit_2(args):
+    result = runner.invoke(app, ["ln", "--preset", "phantom-3dof", *args])
+    assert result.exit_code == 2
+    assert result.stderr.startswith("error:") and result.stderr.count("\n") == 1
+
+
+@pytest.mark.parametrize("weights", [{"X": 1}, {"G": -1}, {"C": "a"}, {"H": [[1, 2], [3]]}])
+def test_ln_bad_weights_exit_2(tmp_path, weights):
+    path = tmp_path / "w.json"
+    path.write_text(json.dumps(weights))
+    result = runner.invoke(app, ["ln", "--preset", "phantom-3dof", "--weights", str(path)])
+    assert result.exit_code == 2
+    assert "error:" in result.stderr
+
+
+def test_ln_symbolic_python_export_matches_numeric_ln(tmp_path, appendix_c):
+    result = runner.invoke(app, ["ln", "--preset", "phantom-3dof", "--symbolic", "--format", "python"])
+    assert result.exit_code == 0, result.output
+    namespace: dict = {}
+    exec(result.stdout, namespace)
+    design = next(d for d in appendix_c if d["level"] == 2.0)
+    path = tmp_path / "p.json"
+    path.write_text(json.dumps(design["params"]))
+    numeric = json.loads(runner.invoke(app, ["ln", "--preset", "phantom-3dof", "--params", str(path), "--json"]).stdout)
+    from hapticdesign.devices.registry import preset
+
+    values = {**preset("phantom-3dof").params, **design["params"]}
+    assert namespace["linearity_number"](**values) == pytest.approx(numeric["ln"], rel=1e-11)
+
+
+def test_ln_symbolic_latex_gravity_part():
+    result = runner.invoke(app, ["ln", "--preset", "phantom-3dof", "--symbolic", "--format", "latex", "--part", "G",
+                                 "--symbolic-gravity"])
+    assert result.exit_code == 0, result.output
+    assert result.stdout.startswith(r"\mathrm{LN}_G = 0.5 m_{2}^{2} r_{2x}^{2} g^{2}")
+
+
+@pytest.mark.parametrize("args", [["--find", "-1"], ["--realizability", "x"], ["--preset", "nope"]])
+def test_linearize_bad_input_exit_2(args):
+    result = runner.invoke(app, ["linearize", *args])
+    assert result.exit_code == 2
+    assert "error:" in result.stderr

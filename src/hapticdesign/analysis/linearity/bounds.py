@@ -90,3 +90,17 @@ def within_bounds(seed: np.ndarray, bodies: tuple[str, ...], bounds: dict[str, B
         if np.any(np.abs(products) > b.products * (1 + rel_tol)):
             return False
     return True
+
+
+def clip_to_bounds(seed: np.ndarray, bodies: tuple[str, ...], bounds: dict[str, BodyBounds]) -> np.ndarray:
+    """Seed-variable parameters (bodies, 10) with every bounded value clipped into its box."""
+    out = np.array(seed, dtype=float)
+    for k, body in enumerate(bodies):
+        if body not in bounds:
+            continue
+        b = bounds[body]
+        out[k, 0] = np.clip(out[k, 0], *b.mass)
+        out[k, 1:4] = np.clip(out[k, 1:4], *b.centre)
+        out[k, 4:7] = np.clip(out[k, 4:7], *b.moments)
+        out[k, 7:10] = np.clip(out[k, 7:10], -b.products, b.products)
+    return out

@@ -121,7 +121,8 @@ def linear_conditions(device: Device, form: LinearityForm, rel_tol: float = 1e-1
         a[1:, model.slice_g][:, w_g > 0],
     ]
     stacked = np.concatenate([b.reshape(-1, model.n_params) for b in blocks])
-    _, sing, vt = np.linalg.svd(stacked, full_matrices=False)
+    # same right singular vectors as the tall stack, at a third of the cost: QR first, then SVD of R
+    _, sing, vt = np.linalg.svd(np.linalg.qr(stacked, mode="r"))
     row_space = vt[sing > rel_tol * max(sing.max(), 1e-300)]
     names = standard_names(device.body_names)
     rows, pivots = _rref(row_space, _pivot_order(names, SEED_PIVOTS.get(device.name, ())), 1e-9)

@@ -28,6 +28,25 @@ from hapticdesign.model.inertia import Realizability
 SCALE = np.array([0.1, 0.01, 0.01, 0.01, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3])
 
 
+def bounds_scale(bounds: dict[str, BodyBounds], bodies: tuple[str, ...]) -> np.ndarray:
+    """Per-parameter scale of the standard parameters from each body's bounds.
+
+    Mass by its upper bound, first moments by ``m_hi r_max``, the inertia entries by the lower
+    bound on the mass-centre moments, so that the active lower bounds (1e-7 kg m^2 for the
+    gimbal links next to 0.3 kg masses) are of order one for the interior-point solver; bodies
+    without bounds use :data:`SCALE`.
+    """
+    out = []
+    for body in bodies:
+        b = bounds.get(body)
+        if b is None:
+            out.append(SCALE)
+            continue
+        first = b.mass[1] * max(abs(b.centre[0]), abs(b.centre[1]), 1e-3)
+        out.append(np.array([b.mass[1], first, first, first] + [max(b.moments[0], 1e-9 * b.moments[1], 1e-30)] * 6))
+    return np.concatenate(out)
+
+
 def _inertia(p) -> cp.Expression:
     return cp.bmat([[p[4], p[7], p[8]], [p[7], p[5], p[9]], [p[8], p[9], p[6]]])
 

@@ -47,6 +47,18 @@ class Method(str, Enum):
 
 
 @dataclass(frozen=True)
+class DESettings:
+    """Differential evolution settings; the defaults are the seed's (population 50, §3.2.2)."""
+
+    population: int = 50
+    generations: int = 300
+
+    def __post_init__(self) -> None:
+        if self.population < 5 or self.generations < 1:
+            raise UserError("differential evolution needs a population of at least 5 and at least 1 generation")
+
+
+@dataclass(frozen=True)
 class DesignSet:
     levels: np.ndarray  # (S,)
     parts: np.ndarray  # (S, 3)
@@ -134,8 +146,10 @@ def _on_level(ln: float, level: float) -> bool:
     return level <= ln <= level * (1 + LEVEL_TOLERANCE)
 
 
-def _de_design(sampler: _Sampler, level: float, rng: np.random.Generator, kind: Realizability) -> np.ndarray:
-    """The seed's differential evolution (rand/1/bin, F = 1, CR = 0.5, population 50)."""
+def _de_design(
+    sampler: _Sampler, level: float, rng: np.random.Generator, kind: Realizability, settings: DESettings
+) -> np.ndarray:
+    """The seed's differential evolution (rand/1/bin, F = 1, CR = 0.5, population 50 by default)."""
     names = sampler.device.body_names
     box = []
     for k in sampler.bodies:
@@ -156,10 +170,10 @@ def _de_design(sampler: _Sampler, level: float, rng: np.random.Generator, kind: 
         return ln + 1e3 * max(level - ln, 0.0) + 1e3 * broken
 
     lo, hi = np.array(box).T
-    init = lo + (hi - lo) * rng.random((50, len(box)))
+    init = lo + (hi - lo) * rng.random((settings.population, len(box)))
     result = differential_evolution(
         objective, box, strategy="rand1bin", mutation=1.0, recombination=0.5, init=init,
-        maxiter=300, tol=1e-10, polish=False, rng=rng,
+        maxiter=settings.generations, tol=1e-10, polish=False, rng=rng,
     )
     return design(result.x)
 
@@ -174,6 +188,7 @@ def design_set(
     seed: int = 1,
     method: Method = Method.FAST,
     kind: Realizability = Realizability.RIGID_BODY,
+    de: DESettings = DESettings(),
 ) -> DesignSet:
     """``count`` designs at each LN level, every one realizable, within bounds and on its level."""
     if count < 1:
@@ -187,7 +202,7 @@ def design_set(
     rows_level, rows_design = [], []
     for level in levels:
         for i in range(count):
-            x = _design(sampler, conditions, zero[i], level, rng, method, kind)
+            x = _design(sampler, conditions, zero[i], level, rng, method, kind, de)
             rows_level.append(level)
             rows_design.append(x)
     designs = np.array(rows_design)
@@ -199,11 +214,11 @@ def design_set(
     return DesignSet(np.array(rows_level), parts, designs)
 
 
-def _design(sampler, conditions, linear, level, rng, method, kind) -> np.ndarray:
+def _design(sampler, conditions, linear, level, rng, method, kind, de) -> np.ndarray:
     bodies = sampler.device.body_names
     for _ in range(50):
         if method is Method.DE:
-            candidate = _de_design(sampler, level, rng, kind)
+            candidate = _de_design(sampler, level, rng, kind, de)
             if level == 0:
                 standard = conditions.project(standard_from_seed(candidate.reshape(-1, 10)).ravel())
                 candidate = seed_from_standard(standard.reshape(-1, 10)).ravel()

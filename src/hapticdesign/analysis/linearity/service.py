@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from hapticdesign.analysis.linearity.bounds import practical_bounds
+from hapticdesign.analysis.linearity.closed_form import closed_form
 from hapticdesign.analysis.linearity.conditions import linear_conditions, seed_conditions
 from hapticdesign.analysis.linearity.design_sets import DesignSet, Method, design_set
 from hapticdesign.analysis.linearity.form import PARTS, LinearityForm, linearity_form
@@ -63,6 +64,25 @@ def evaluate_ln(
         float(parts.sum()),
         {k: float(v) for k, v in zip(PARTS, parts)},
     )
+
+
+def symbolic_ln(
+    preset: str | None,
+    device_file: Path | None,
+    params_file: Path | None,
+    strict: bool,
+    region_text: str | None,
+    weights_file: Path | None,
+    fmt: str,
+    part: str,
+    symbolic_gravity: bool,
+) -> str:
+    """The closed-form LN (Appendix B.1 / B.2 equivalent) as text, LaTeX or Python source."""
+    device = resolve_device(preset, device_file, params_file, strict)
+    region = parse_region(region_text, device.n_dof)
+    weights = read_weights(weights_file, device.n_dof) if weights_file is not None else None
+    form = device_form(device, None if region.is_torus else region, weights)
+    return closed_form(device, form, symbolic_gravity).export(fmt, part)
 
 
 def parse_realizability(text: str) -> Realizability:
@@ -122,8 +142,8 @@ def linearize_report(
             "  linear design pi = N z; hence min_i lambda_min(F_i(pi)) <= that bound, i.e. no strictly realizable one.",
             "exact certificate (Z = e_k e_k^T): these diagonal entries of the realizability matrix vanish on every",
             "  fully linear design: " + ", ".join(f"body {b} entry ({k + 1},{k + 1})" for b, k in verdict.exact),
-            f"minimum LN under practical bounds: {mins.ln:.6g} (convex lower bound {mins.lower_bound:.3g}); "
-            f"design within bounds: {mins.within_bounds}",
+            f"minimum LN under practical bounds: {mins.ln:.6g} (convex lower bound {mins.lower_bound:.6g}); "
+            f"design within bounds: {mins.within_bounds}, realizable ({kind.value}): {mins.realizable}",
             "  design (seed variables):",
         ]
         lines += [f"    {n} = {v:.8g}" for n, v in zip(device.inertial_names(), mins.design.ravel())]

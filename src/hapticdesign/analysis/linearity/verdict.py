@@ -19,12 +19,14 @@ from dataclasses import dataclass
 import cvxpy as cp
 import numpy as np
 
-from hapticdesign.analysis.linearity.bounds import BodyBounds, within_bounds
+from hapticdesign.analysis.linearity.bounds import BodyBounds, clip_to_bounds, within_bounds
 from hapticdesign.analysis.linearity.convert import seed_from_standard
-from hapticdesign.analysis.linearity.convex import SCALE, body_constraints, realizability_lmi, solve
+from hapticdesign.analysis.linearity.convex import SCALE, body_constraints, bounds_scale, realizability_lmi, solve
 from hapticdesign.analysis.linearity.form import LinearityForm
+from hapticdesign.analysis.linearity.linear_designs import realizable
+from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
-from hapticdesign.model.inertia import Realizability
+from hapticdesign.model.inertia import Realizability, standard_from_seed
 
 
 @dataclass(frozen=True)
@@ -81,13 +83,43 @@ def _lmi_values(kind: Realizability, direction: np.ndarray, n_bodies: int) -> li
 
 
 def decide_linearizable(device: Device, form: LinearityForm, kind: Realizability = Realizability.RIGID_BODY) -> Verdict:
-    """Strict feasibility of realizable fully linear designs, with design or certificate."""
+    """Strict feasibility of realizable fully linear designs, with design or certificate.
+
+    Vanishing diagonal entries (:func:`vanishing_diagonals`) settle the question exactly; only
+    without them is the margin ``max t: F(z) >= t 1`` solved for (a degenerate, and therefore
+    inaccurate, interior-point problem when the answer is no).
+    """
     bodies = device.body_names
     null = form.null_space()
     scale = np.tile(SCALE, len(bodies))
     null_scaled = null / scale[:, None]  # directions in scaled coordinates keep the solver well conditioned
     null_scaled /= np.linalg.norm(null_scaled, axis=0)
     basis = null_scaled * scale[:, None]
+    exact = vanishing_diagonals(device, null, kind)
+    if not exact:
+        design = _strictly_realizable(basis, kind, len(bodies))
+        if design is not None:
+            return Verdict(True, kind, None, design)
+    return Verdict(False, kind, _dual_certificate(basis, kind, bodies), None, exact)
+
+
+def _strictly_realizable(basis: np.ndarray, kind: Realizability, n_bodies: int) -> np.ndarray | None:
+    """A fully linear design with every realizability matrix >= 1e-6 * 1 (|z|_inf <= 1), if any."""
+    t = cp.Variable()
+    z = cp.Variable(basis.shape[1])
+    pi = basis @ z
+    constraints = [cp.norm(z, "inf") <= 1]
+    for k in range(n_bodies):
+        lmi = realizability_lmi(pi[10 * k : 10 * k + 10], kind, 0.0)
+        constraints.append(0.5 * (lmi + lmi.T) >> t * np.eye(lmi.shape[0]))
+    solve(cp.Problem(cp.Maximize(t), constraints))
+    if t.value is None or float(t.value) <= 1e-6:
+        return None
+    return seed_from_standard((basis @ z.value).reshape(n_bodies, 10))
+
+
+def _dual_certificate(basis: np.ndarray, kind: Realizability, bodies: tuple[str, ...]) -> Certificate:
+    """PSD blocks ``Z_i`` (sum of traces 1) minimizing ``max_k |sum_i tr(Z_i F_i(N e_k))|``."""
     directions = [_lmi_values(kind, basis[:, j], len(bodies)) for j in range(basis.shape[1])]
     size = directions[0][0].shape[0]
     blocks = [cp.Variable((size, size), PSD=True) for _ in bodies]
@@ -97,29 +129,21 @@ def decide_linearizable(device: Device, form: LinearityForm, kind: Realizability
     solve(dual)
     z_values = {b: 0.5 * (z.value + z.value.T) for b, z in zip(bodies, blocks)}
     residual = max(abs(sum(np.trace(z_values[b] @ directions[j][i]) for i, b in enumerate(bodies))) for j in range(len(directions)))
-    certificate = Certificate(z_values, float(residual), basis)
-    t = cp.Variable()
-    z = cp.Variable(basis.shape[1])
-    pi = basis @ z
-    constraints = [cp.norm(z, "inf") <= 1]
-    for k in range(len(bodies)):
-        lmi = realizability_lmi(pi[10 * k : 10 * k + 10], kind, 0.0)
-        constraints.append(0.5 * (lmi + lmi.T) >> t * np.eye(size))
-    primal = cp.Problem(cp.Maximize(t), constraints)
-    solve(primal)
-    margin = float(t.value) if t.value is not None else 0.0
-    if margin > 1e-6:
-        design = seed_from_standard((basis @ z.value).reshape(len(bodies), 10))
-        return Verdict(True, kind, None, design)
-    return Verdict(False, kind, certificate, None, vanishing_diagonals(device, form.null_space(), kind))
+    return Certificate(z_values, float(residual), basis)
 
 
 @dataclass(frozen=True)
 class MinimumLN:
-    ln: float
+    ln: float  # re-evaluated exactly from ``design`` (an attained value, so an upper bound on the minimum)
     lower_bound: float
     design: np.ndarray  # seed variables (bodies, 10)
     within_bounds: bool
+    realizable: bool
+
+
+# Relative margin on the mass-centre moment lower bounds of the solve: the interior-point solution
+# meets its constraints only to its tolerance, the margin keeps it inside the true bounds.
+MOMENT_MARGIN = 1e-4
 
 
 def minimum_ln(
@@ -130,13 +154,18 @@ def minimum_ln(
 ) -> MinimumLN:
     """Smallest LN over realizable designs within the bounds (a convex program in ``pi``).
 
-    The conservative upper bounds on mass-centre moments (:mod:`.convex`) give a feasible
-    design and so an upper bound; replacing them by their valid relaxation
-    ``J_xx <= hi + 2 r_max^2 m`` gives a lower bound on the true minimum.
+    ``min |L pi|`` (``LN = |L pi|^2``, a second-order cone objective that stays well scaled where
+    LN itself spans twelve orders of magnitude) in variables scaled per body from its bounds
+    (:func:`.convex.bounds_scale`). The conservative upper bounds on mass-centre moments
+    (:mod:`.convex`) and a small margin on their lower bounds give a design inside the bounds;
+    it is clipped to the bounds in the seed's variables (a no-op up to the solver's tolerance),
+    checked for realizability and its LN re-evaluated exactly: an attained upper bound on the
+    minimum. Replacing the conservative bounds by their valid relaxation
+    ``J_xx <= hi + 2 r_max^2 m`` (and no margin) gives a lower bound on the true minimum.
     """
     bodies = device.body_names
     factor = form.factor()
-    scale = np.tile(SCALE, len(bodies))
+    scale = bounds_scale(bounds, bodies)
     fixed = device.standard_parameters()
     results = []
     for relaxed in (False, True):
@@ -146,20 +175,27 @@ def minimum_ln(
         for k, body in enumerate(bodies):
             p = pi[10 * k : 10 * k + 10]
             if body not in bounds:
-                constraints.append(x[10 * k : 10 * k + 10] == fixed[10 * k : 10 * k + 10] / SCALE)
+                constraints.append(x[10 * k : 10 * k + 10] == fixed[10 * k : 10 * k + 10] / scale[10 * k : 10 * k + 10])
                 continue
             b = bounds[body]
             if relaxed:
                 r2 = max(abs(b.centre[0]), abs(b.centre[1])) ** 2
                 b = BodyBounds(b.mass, b.centre, (b.moments[0], b.moments[1] + 2 * r2 * b.mass[1]), b.products + r2 * b.mass[1])
+            else:
+                b = BodyBounds(b.mass, b.centre, (b.moments[0] * (1 + MOMENT_MARGIN), b.moments[1]), b.products)
             constraints += body_constraints(p, b, kind, 0.0)
-        weight = cp.Parameter(nonneg=True, value=1.0)
-        problem = cp.Problem(cp.Minimize(weight * cp.sum_squares(factor @ pi)), constraints)
+        problem = cp.Problem(cp.Minimize(cp.norm(factor @ pi)), constraints)
         solve(problem)
-        weight.value = 1.0 / max(problem.value, 1e-30)  # re-solve with the optimum near 1 for accuracy
-        solve(problem)
-        results.append((problem.value / weight.value, x.value * scale))
+        if problem.status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):
+            raise UserError(f"no realizable design within the bounds (solver: {problem.status})")
+        results.append((problem.value**2, x.value * scale))
     (_, best), (lower, _) = results
-    standard = best.reshape(len(bodies), 10)
-    design = seed_from_standard(standard)
-    return MinimumLN(float(form.ln(best)), max(float(lower), 0.0), design, within_bounds(design, bodies, bounds))
+    design = clip_to_bounds(seed_from_standard(best.reshape(len(bodies), 10)), bodies, bounds)
+    standard = standard_from_seed(design)
+    return MinimumLN(
+        float(form.ln(standard.ravel())),
+        float(lower),
+        design,
+        within_bounds(design, bodies, bounds),
+        realizable(design, standard, kind),
+    )

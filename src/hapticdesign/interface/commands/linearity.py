@@ -25,11 +25,27 @@ def ln_command(
     ),
     weights: Optional[Path] = typer.Option(None, "--weights", help="Weights file with keys H, C, G (eq. 3.1)."),
     as_json: bool = typer.Option(False, "--json", help="Print JSON."),
+    symbolic: bool = typer.Option(
+        False, "--symbolic", help="Print LN as a polynomial in the seed's design variables (Appendix B.1/B.2)."
+    ),
+    fmt: Optional[str] = typer.Option(None, "--format", help="With --symbolic: text (default), latex or python."),
+    part: Optional[str] = typer.Option(None, "--part", help="With --symbolic: all (default), H, C or G."),
+    symbolic_gravity: bool = typer.Option(False, "--symbolic-gravity", help="With --symbolic: keep g as a symbol."),
 ) -> None:
-    """Linearity Number of a device (seed 000 eq. 3.1-3.4) and its H, C, G parts."""
+    """Linearity Number of a device (seed 000 eq. 3.1-3.4) and its H, C, G parts, or its closed form."""
     with user_errors(strict):
-        from hapticdesign.analysis.linearity.service import evaluate_ln
+        from hapticdesign.analysis.linearity.service import evaluate_ln, symbolic_ln
+        from hapticdesign.errors import UserError
 
+        if symbolic:
+            if as_json:
+                raise UserError("--json does not apply to --symbolic; choose --format text, latex or python")
+            typer.echo(
+                symbolic_ln(preset, device, params, strict, region, weights, fmt or "text", part or "all", symbolic_gravity)
+            )
+            return
+        if fmt is not None or part is not None or symbolic_gravity:
+            raise UserError("--format, --part and --symbolic-gravity need --symbolic")
         result = evaluate_ln(preset, device, params, strict, region, weights)
         if as_json:
             print_json({"ln": result.ln, "parts": result.parts})
