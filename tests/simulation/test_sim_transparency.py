@@ -51,3 +51,35 @@ def test_first_exit_interpolates_between_bins():
     assert first_exit(f, np.array([0.0, 2.0, 4.0]), 3.0) == pytest.approx(2.5)
     assert first_exit(f, np.array([0.0, -1.0, -5.0]), 3.0) == pytest.approx(2.5)
     assert first_exit(f, np.array([0.0, 1.0, 2.0]), 3.0) is None
+
+
+def _same_h11_other_links(device):
+    """A second design with the same H11 at the start pose: link 3 changed, link 1's inertia about
+    joint 1's axis adjusted by the difference (H11 is linear in it with unit coefficient)."""
+    changed = device.with_params({"m3": 0.05, "r3y": 0.01, "Ixy3": 2e-4})
+    delta = changed.H(np.zeros(3))[0, 0] - device.H(np.zeros(3))[0, 0]
+    for name in ("Ixx1", "Iyy1", "Izz1"):
+        trial = changed.with_params({name: changed.params[name] - delta})
+        if abs(trial.H(np.zeros(3))[0, 0] - device.H(np.zeros(3))[0, 0]) < 1e-12:
+            return trial
+    raise AssertionError("no link-1 inertia enters H11 with unit coefficient")
+
+
+def test_type_1_response_depends_on_the_design_only_through_h11():
+    """Type 1 holds joints 2, 3 at 0 and joint 1's axis is vertical: G_1 = 0, dH11/dq1 = 0, so
+    tau_h = H11 qdd + b qd and two designs with equal H11(0) give the same G_T (seed Table 4.6 can
+    only depend on the design through H11)."""
+    device = preset("phantom-3dof")
+    other = _same_h11_other_links(device)
+    assert not np.allclose(device.H(np.zeros(3)), other.H(np.zeros(3)))
+    chirp = Chirp(0.3, 0.1, 5.0, 2.0)
+    a, b = transparency(device, 1, chirp=chirp), transparency(other, 1, chirp=chirp)
+    assert np.allclose(a.g_t, b.g_t, rtol=1e-9, atol=0)
+
+
+def test_power_scale_reading_gives_sqrt3_times_the_damping_bandwidth():
+    """Reading the 3 dB band on a power scale (|G_T| = 2, 6.02 dB of 20 log10) moves the crossing of
+    |1 + j b w / K| to sqrt(3) K / (2 pi b) = 2.205 Hz: the seed's Table 4.6 level at LN = 0."""
+    device = preset("phantom-3dof")
+    result = transparency(device, 1, stiffness=4.0, band_db=20 * np.log10(2.0))
+    assert result.bandwidth_hz == pytest.approx(np.sqrt(3) * 4.0 / (2 * np.pi * device.damping[0]), rel=0.01)
