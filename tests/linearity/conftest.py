@@ -1,4 +1,4 @@
-"""Shared fixtures: the two Phantom presets and their LN forms (built once per session)."""
+"""Shared fixtures: LN forms of the two Phantom presets (built once per session; presets in tests/conftest.py)."""
 
 from __future__ import annotations
 
@@ -8,19 +8,8 @@ from pathlib import Path
 import pytest
 
 from hapticdesign.analysis.linearity.service import device_form
-from hapticdesign.devices.registry import preset
 
 APPENDIX_C = Path(__file__).resolve().parents[3] / "shared" / "reference" / "seed000_appendix_c_designs.json"
-
-
-@pytest.fixture(scope="session")
-def phantom3():
-    return preset("phantom-3dof")
-
-
-@pytest.fixture(scope="session")
-def phantom6():
-    return preset("phantom-6dof")
 
 
 @pytest.fixture(scope="session")

@@ -12,7 +12,7 @@ from hapticdesign.errors import UserError
 from hapticdesign.optimization.constraints import constraint_values, link1_length
 from hapticdesign.optimization.objectives import geometry_of, objectives
 from hapticdesign.optimization.swarm import weighted_sum_swarm
-from hapticdesign.optimization.synthesis import BOUND_SETS, Bounds, hypervolume, merge_fronts, pareto_filter, synthesize
+from hapticdesign.optimization.synthesis import Bounds, hypervolume, merge_fronts, pareto_filter, synthesize
 
 
 @pytest.fixture(scope="module")

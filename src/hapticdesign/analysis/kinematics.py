@@ -15,17 +15,6 @@ from hapticdesign.model.mechanism import Mechanism
 from hapticdesign.model.transforms import Axis, elementary_matrix
 
 
-def _node_path(mech: Mechanism, frame: str) -> list[int]:
-    c = mech.compiled
-    if frame not in c.frame_node:
-        raise UserError(f"unknown frame {frame!r}; frames: {', '.join(sorted(c.frame_node))}")
-    path, n = [], c.frame_node[frame]
-    while n >= 0:
-        path.append(n)
-        n = int(c.node_parent[n])
-    return path[::-1]
-
-
 def _check_q(mech: Mechanism, q: np.ndarray) -> np.ndarray:
     q = np.asarray(q, dtype=float)
     if q.shape != (mech.n_dof,):
@@ -43,7 +32,7 @@ def forward_kinematics(mech: Mechanism, q: np.ndarray, frame: str | None = None)
     q = _check_q(mech, q)
     c = mech.compiled
     t = np.eye(4)
-    for n in _node_path(mech, frame):
+    for n in mech.compiled.path_to(frame):
         t = t @ elementary_matrix(Axis(c.node_axis[n]), c.node_offset[n] + c.node_coef[n] @ q)
     return t
 
@@ -55,7 +44,7 @@ def jacobian(mech: Mechanism, q: np.ndarray, frame: str | None = None) -> np.nda
         raise UserError("the mechanism names no end-effector frame")
     q = _check_q(mech, q)
     c = mech.compiled
-    path = _node_path(mech, frame)
+    path = mech.compiled.path_to(frame)
     poses = []
     t = np.eye(4)
     for n in path:

@@ -154,15 +154,18 @@ class CompiledMechanism:
             prismatic=prismatic,
         )
 
-    def frame_pose(self, q: np.ndarray, frame: str) -> np.ndarray:
+    def path_to(self, frame: str) -> list[int]:
+        """Nodes from the base to ``frame``, in order."""
         if frame not in self.frame_node:
-            raise UserError(f"unknown frame {frame!r}")
-        chain = []
-        n = self.frame_node[frame]
+            raise UserError(f"unknown frame {frame!r}; frames: {', '.join(sorted(self.frame_node))}")
+        path, n = [], self.frame_node[frame]
         while n >= 0:
-            chain.append(n)
-            n = self.node_parent[n]
+            path.append(n)
+            n = int(self.node_parent[n])
+        return path[::-1]
+
+    def frame_pose(self, q: np.ndarray, frame: str) -> np.ndarray:
         t = np.eye(4)
-        for n in reversed(chain):
+        for n in self.path_to(frame):
             t = t @ elementary_matrix(Axis(self.node_axis[n]), self.node_offset[n] + self.node_coef[n] @ q)
         return t

@@ -81,13 +81,7 @@ def _path_arrays(mech: Mechanism, frame: str) -> tuple[np.ndarray, np.ndarray, n
     hit = _PATHS.get(key)
     if hit is not None and hit[0] is c:
         return hit[1]
-    if frame not in c.frame_node:
-        raise UserError(f"unknown frame {frame!r}; frames: {', '.join(sorted(c.frame_node))}")
-    path, n = [], c.frame_node[frame]
-    while n >= 0:
-        path.append(n)
-        n = int(c.node_parent[n])
-    path = path[::-1]
+    path = c.path_to(frame)
     arrays = (
         np.ascontiguousarray(c.node_axis[path], dtype=np.int64),
         np.ascontiguousarray(c.node_coef[path], dtype=float),

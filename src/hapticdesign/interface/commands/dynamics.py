@@ -8,25 +8,22 @@ from typing import Optional
 import numpy as np
 import typer
 
+from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
 from hapticdesign.devices.loading import resolve_device
 from hapticdesign.interface.common import parse_vector, print_json, user_errors
 
-PRESET_HELP = "Built-in device: phantom-3dof or phantom-6dof (default phantom-3dof)."
-DEVICE_HELP = "Device file (YAML, TOML, JSON or URDF) instead of a preset."
-PARAMS_HELP = "Parameter overrides by the seed's names (JSON, YAML or TOML)."
-STRICT_HELP = "Refuse inertias that break the triangle inequality (the seed's designs do)."
 
 
 def dynamics(
-    preset: Optional[str] = typer.Option(None, help=PRESET_HELP),
-    device: Optional[Path] = typer.Option(None, help=DEVICE_HELP),
-    params: Optional[Path] = typer.Option(None, help=PARAMS_HELP),
+    preset: Optional[str] = PRESET,
+    device: Optional[Path] = DEVICE,
+    params: Optional[Path] = PARAMS,
     q: str = typer.Option(..., help="Joint coordinates, comma-separated (rad or m)."),
     qd: Optional[str] = typer.Option(None, help="Joint rates, comma-separated."),
     qdd: Optional[str] = typer.Option(None, help="Joint accelerations, comma-separated."),
-    strict: bool = typer.Option(False, help=STRICT_HELP),
-    json_out: bool = typer.Option(False, "--json", help="Print one JSON object."),
-    quiet: bool = typer.Option(False, help="No warnings on stderr."),
+    strict: bool = STRICT,
+    json_out: bool = JSON_OUT,
+    quiet: bool = QUIET,
 ) -> None:
     """H, C (seed eq. 2.50 form), C_cvt (eq. 2.52), G and tau at one pose, in SI units."""
     with user_errors(quiet=quiet):
@@ -68,16 +65,16 @@ def _row(values: np.ndarray) -> str:
 
 
 def eom(
-    preset: Optional[str] = typer.Option(None, help=PRESET_HELP),
-    device: Optional[Path] = typer.Option(None, help=DEVICE_HELP),
-    params: Optional[Path] = typer.Option(None, help=PARAMS_HELP),
+    preset: Optional[str] = PRESET,
+    device: Optional[Path] = DEVICE,
+    params: Optional[Path] = PARAMS,
     symbolic: str = typer.Option(
         "all", help="Parameters kept as symbols: 'all', 'none', 'inertial', or names such as m2,r2x,l2."
     ),
     fmt: str = typer.Option("latex", "--format", help="latex, python or text."),
     part: str = typer.Option("tau", help="What to print: tau, H, C, G or all."),
-    strict: bool = typer.Option(False, help=STRICT_HELP),
-    quiet: bool = typer.Option(False, help="No warnings on stderr."),
+    strict: bool = STRICT,
+    quiet: bool = QUIET,
 ) -> None:
     """Print the equations of motion symbolically (seed 000 Appendix A), as LaTeX, Python or text."""
     from hapticdesign.analysis.dynamics.symbolic import derive, export

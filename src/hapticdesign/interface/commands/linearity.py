@@ -7,12 +7,9 @@ from typing import Optional
 
 import typer
 
+from hapticdesign.interface.options import DEVICE, PARAMS, PRESET, STRICT
 from hapticdesign.interface.common import print_json, user_errors
 
-PRESET = typer.Option(None, "--preset", help="Built-in device (phantom-3dof, phantom-6dof).")
-DEVICE = typer.Option(None, "--device", help="Device file instead of a preset.")
-PARAMS = typer.Option(None, "--params", help="Parameter overrides (JSON/YAML/TOML, seed's names).")
-STRICT = typer.Option(False, "--strict", help="Refuse bodies that break the triangle inequality.")
 
 
 def ln_command(

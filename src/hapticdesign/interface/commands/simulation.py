@@ -8,14 +8,11 @@ from typing import Optional
 import numpy as np
 import typer
 
+from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
 from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import print_json, user_errors, write_atomically
 
-PRESET_HELP = "Built-in device: phantom-3dof or phantom-6dof (default phantom-3dof)."
-DEVICE_HELP = "Device file (YAML or TOML) instead of a preset."
-PARAMS_HELP = "Parameter overrides by the seed's names (JSON, YAML or TOML)."
-STRICT_HELP = "Refuse inertias that break the triangle inequality (the seed's designs do)."
 
 
 def _loop_config(period, step, duration, counts, delay, error_percent, inertial, coriolis, gravity,
@@ -59,9 +56,9 @@ HAND_STIFFNESS = typer.Option(0.0, help="Hand stiffness at the handle [N/m].")
 
 
 def impedance_range_command(
-    preset: Optional[str] = typer.Option(None, help=PRESET_HELP),
-    device: Optional[Path] = typer.Option(None, help=DEVICE_HELP),
-    params: Optional[Path] = typer.Option(None, help=PARAMS_HELP),
+    preset: Optional[str] = PRESET,
+    device: Optional[Path] = DEVICE,
+    params: Optional[Path] = PARAMS,
     sim_type: int = typer.Option(1, "--type", help="1: other joints held at 0; 2: driven at 0.52 sin(3 pi t)."),
     joint: str = typer.Option("1", help="Joint carrying the virtual wall (1-based or coordinate name)."),
     equilibrium: float = typer.Option(0.01, help="Wall equilibrium [rad]; the joints start at 0."),
@@ -77,9 +74,9 @@ def impedance_range_command(
     error_percent: float = ERROR, inertial: bool = INERTIAL, coriolis: bool = CORIOLIS, gravity: bool = GRAVITY,
     wall_damping: float = WALL_DAMPING, hand_mass: float = HAND_MASS, hand_damping: float = HAND_DAMPING,
     hand_stiffness: float = HAND_STIFFNESS,
-    strict: bool = typer.Option(False, help=STRICT_HELP),
-    json_out: bool = typer.Option(False, "--json", help="Print one JSON object."),
-    quiet: bool = typer.Option(False, help="No warnings on stderr."),
+    strict: bool = STRICT,
+    json_out: bool = JSON_OUT,
+    quiet: bool = QUIET,
 ) -> None:
     """Maximum stable impedance of one joint under a virtual spring (seed 000 §4.1.2-4.1.3)."""
     from hapticdesign.simulation.impedance import Criteria, ImpedanceProblem, fast_search, linear_scan
@@ -110,9 +107,9 @@ def impedance_range_command(
 
 
 def transparency_command(
-    preset: Optional[str] = typer.Option(None, help=PRESET_HELP),
-    device: Optional[Path] = typer.Option(None, help=DEVICE_HELP),
-    params: Optional[Path] = typer.Option(None, help=PARAMS_HELP),
+    preset: Optional[str] = PRESET,
+    device: Optional[Path] = DEVICE,
+    params: Optional[Path] = PARAMS,
     sim_type: int = typer.Option(1, "--type", help="1: chirp on the wall joint only; 2: chirp on every joint."),
     joint: str = typer.Option("1", help="Joint carrying the virtual wall (1-based or coordinate name)."),
     stiffness: float = typer.Option(4.0, help="Virtual wall stiffness K [N m/rad]."),
@@ -125,9 +122,9 @@ def transparency_command(
     period: float = PERIOD, step: float = STEP, counts: Optional[int] = COUNTS, delay: int = DELAY,
     error_percent: float = ERROR, inertial: bool = INERTIAL, coriolis: bool = CORIOLIS, gravity: bool = GRAVITY,
     wall_damping: float = WALL_DAMPING,
-    strict: bool = typer.Option(False, help=STRICT_HELP),
-    json_out: bool = typer.Option(False, "--json", help="Print one JSON object."),
-    quiet: bool = typer.Option(False, help="No warnings on stderr."),
+    strict: bool = STRICT,
+    json_out: bool = JSON_OUT,
+    quiet: bool = QUIET,
 ) -> None:
     """Transparency bandwidth of one joint: G_T = Z_M / Z_D leaves +-3 dB (seed 000 §4.2.2, eq. 4.1-4.2)."""
     from hapticdesign.simulation.loop import joint_index
@@ -164,7 +161,7 @@ def stability_boundary_command(
     compensate_inertia: bool = typer.Option(False, help="Feed the sampled acceleration forward (J qdd)."),
     substeps: int = typer.Option(10, help="Plant steps per sample in the simulation."),
     samples: int = typer.Option(4000, help="Samples per simulation of the growth test."),
-    json_out: bool = typer.Option(False, "--json", help="Print one JSON object."),
+    json_out: bool = JSON_OUT,
 ) -> None:
     """1-DOF mass-damper under a sampled spring: exact (spectral radius) vs simulated stiffness limit."""
     from hapticdesign.simulation.boundary import MassDamper, exact_boundary, simulated_boundary
@@ -189,7 +186,7 @@ def campaign_command(
     out: Path = typer.Option(..., help="Output folder (cases/, results.csv, summary.csv, summary.md, figures/)."),
     scheduler: Optional[str] = typer.Option(None, help="Dask scheduler address; local processes by default."),
     workers: Optional[int] = typer.Option(None, help="Local worker processes (default: all cores)."),
-    preset: str = typer.Option("phantom-3dof", help=PRESET_HELP),
+    preset: str = typer.Option("phantom-3dof", help="Preset whose geometry the design file fills in."),
     k_limit: int = typer.Option(200, help="Largest stiffness tried [N m/rad]."),
     duration: float = typer.Option(5.0, help="Simulated time per stiffness [s] (seed: 5)."),
     stiffness: float = typer.Option(4.0, help="Wall stiffness of the transparency runs [N m/rad] (seed: 4)."),

@@ -1,0 +1,12 @@
+"""Command-line options shared by every command, so names and help read the same everywhere."""
+
+from __future__ import annotations
+
+import typer
+
+PRESET = typer.Option(None, "--preset", help="Built-in device: phantom-3dof or phantom-6dof (default phantom-3dof).")
+DEVICE = typer.Option(None, "--device", help="Device file (YAML, TOML, JSON or URDF) instead of a preset.")
+PARAMS = typer.Option(None, "--params", help="Parameter overrides by the seed's names (JSON, YAML or TOML).")
+STRICT = typer.Option(False, "--strict", help="Refuse inertias that break the triangle inequality (the seed's designs do).")
+JSON_OUT = typer.Option(False, "--json", help="Print one JSON object.")
+QUIET = typer.Option(False, "--quiet", help="No warnings or progress on stderr.")
