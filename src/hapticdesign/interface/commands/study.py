@@ -1,0 +1,176 @@
+"""Commands ``study phantom``, ``study rcube`` (the seeds end to end, one report each) and ``demo``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+import typer
+from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
+
+from hapticdesign.errors import UserError
+from hapticdesign.interface.common import print_json, user_errors
+from hapticdesign.interface.options import DEVICE, PRESET
+from hapticdesign.studies.steps import STATUS_DONE, StepResult
+
+study_app = typer.Typer(help="The seeds' pipelines end to end, each ending in one HTML report.", no_args_is_help=True)
+
+QUICK = typer.Option(False, "--quick", help="A small version that finishes in a few minutes.")
+OUT = typer.Option(..., "--out", help="Folder for report.html, tables/*.csv, figures/*.png|svg and summary.json.")
+SEED = typer.Option(1, "--seed", help="Seed of every random process (same seed, same numbers).")
+QUIET = typer.Option(False, "--quiet", help="No progress bars or messages; only errors.")
+JSON = typer.Option(False, "--json", help="Print a JSON summary (report path, statuses, key numbers).")
+SCALE = typer.Option(None, "--scale", hidden=True, help="full, quick or smoke (the test suite's smallest run).")
+
+
+class RichProgress:
+    """Study progress on stderr: one line per step, a bar where the step reports its progress."""
+
+    def __init__(self, console: Console) -> None:
+        self.bars = Progress(SpinnerColumn(), TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+                             TimeElapsedColumn(), console=console)
+        self.task = None
+
+    def begin(self, title: str) -> None:
+        self.task = self.bars.add_task(_short(title), total=None)
+
+    def update(self, done: int, total: int) -> None:
+        self.bars.update(self.task, completed=done, total=total)
+
+    def end(self, result: StepResult) -> None:
+        mark = "" if result.status == STATUS_DONE else f" [{result.status}]"
+        self.bars.update(self.task, description=_short(result.title) + mark, total=1, completed=1)
+
+
+def _short(title: str, width: int = 44) -> str:
+    """A step title cut at its first parenthesis or at ``width`` characters, for the progress column."""
+    head = title.split(" (")[0]
+    return head if len(head) <= width else head[: width - 1] + "…"
+
+
+def _scale(quick: bool, scale: Optional[str]) -> str:
+    return scale or ("quick" if quick else "full")
+
+
+def _check_out(out: Path) -> Path:
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise UserError(f"--out {out} is a file; give a folder")
+    return out
+
+
+def _run(module, settings, out: Path, quiet: bool, as_json: bool) -> dict:
+    """Run one study with progress (unless quiet or JSON) and write its report; returns the summary."""
+    from hapticdesign.interface.report import write_report
+    from hapticdesign.interface.report.writer import summary
+
+    console = Console(stderr=True)
+    show = not (quiet or as_json)
+    if show:
+        minutes = settings.estimate_seconds() / 60
+        size = f"{settings.scale} run, " if hasattr(settings, "scale") else ""
+        console.print(f"{module.TITLE}\n{size}estimated {minutes:.1f} min on a 2-core machine")
+    if show:
+        progress = RichProgress(console)
+        with progress.bars:
+            result = module.run(settings, out / "work", progress)
+    else:
+        result = module.run(settings, out / "work")
+    report = write_report(result, out)
+    if show:
+        console.print(f"{result.title}: {result.seconds:.1f} s")
+    return summary(result, report)
+
+
+def _finish(found: dict, quiet: bool, as_json: bool) -> None:
+    if as_json:
+        print_json(found)
+    elif not quiet:
+        typer.echo(f"report: {found['report']}")
+
+
+def phantom(quick: bool = QUICK, out: Path = OUT, seed: int = SEED,
+            workers: int = typer.Option(2, "--workers", help="Local processes for the simulation campaign."),
+            quiet: bool = QUIET, as_json: bool = JSON, scale: Optional[str] = SCALE) -> None:
+    """Seed 000 end to end: equations of motion, LN, linearization, 6-DOF verdict, design sets, chapter 4."""
+    from hapticdesign.studies import phantom as study
+
+    with user_errors(quiet=True):
+        settings = study.PhantomSettings.for_scale(_scale(quick, scale), seed, workers)
+        _finish(_run(study, settings, _check_out(out), quiet, as_json), quiet, as_json)
+
+
+def rcube(quick: bool = QUICK, out: Path = OUT, seed: int = SEED, quiet: bool = QUIET, as_json: bool = JSON,
+          scale: Optional[str] = SCALE) -> None:
+    """Seed 001 end to end: kinematics, final design against the seed, workspace maps, optimization chain."""
+    from hapticdesign.studies import rcube as study
+
+    with user_errors(quiet=True):
+        settings = study.RCubeSettings.for_scale(_scale(quick, scale), seed)
+        _finish(_run(study, settings, _check_out(out), quiet, as_json), quiet, as_json)
+
+
+def device(device_file: Optional[Path] = DEVICE, preset: Optional[str] = PRESET,
+           out: Path = OUT, seed: int = SEED, quiet: bool = QUIET, as_json: bool = JSON) -> None:
+    """Seed 000's analyses on your own device (--device FILE): dynamics, LN, linearization, rendering."""
+    from hapticdesign.studies import device as study
+
+    with user_errors(quiet=True):
+        settings = study.DeviceSettings.for_device(device_file, preset, seed)
+        _finish(_run(study, settings, _check_out(out), quiet, as_json), quiet, as_json)
+
+
+def _print_equations(echo) -> None:
+    """The default 3-DOF Phantom's exact H and G, the size of the fully symbolic form, and evaluations."""
+    import numpy as np
+    import sympy as sp
+
+    from hapticdesign.analysis.dynamics.symbolic import derive, export
+    from hapticdesign.devices.registry import preset
+
+    device = preset("phantom-3dof")
+    echo(f"Equations of motion of the built-in {device.name} (seed 000 eq. 2.50: tau = H thetadd + C thetad^2 + G)")
+    numeric = derive(device, "none")
+    echo(export(numeric, "text", "H"))
+    echo(export(numeric, "text", "G"))
+    full = derive(device, "all")
+    terms = sum(len(sp.Add.make_args(sp.expand(e))) for e in (*full.H, *full.C, *full.G))
+    echo(f"Fully symbolic (every length and inertial parameter a symbol): {terms} terms in H, C and G.")
+    echo("The default design is fully linear (LN = 0): H is constant and G vanishes (up to 1e-11 from the rounded "
+         "parameters), so tau below does not depend on q.")
+    for q in (np.zeros(3), np.array([0.3, -0.4, 0.7])):
+        qd, qdd = np.full(3, 0.5), np.ones(3)
+        tau = device.inverse_dynamics(q, qd, qdd)
+        echo(f"q = {q.tolist()}, qd = {qd.tolist()}, qdd = {qdd.tolist()}: tau = "
+             + " ".join(f"{v:.6e}" for v in tau) + " N m")
+
+
+def demo(out: Path = typer.Option(Path("out/demo"), "--out", help="Folder for the two reports."),
+         quiet: bool = QUIET, as_json: bool = JSON, scale: Optional[str] = SCALE) -> None:
+    """The toolkit in one command: the Phantom's equations of motion, then both studies in quick form."""
+    from hapticdesign.studies import phantom as phantom_study
+    from hapticdesign.studies import rcube as rcube_study
+
+    with user_errors(quiet=True):
+        out = _check_out(out)
+        level = scale or "quick"
+        if not (quiet or as_json):
+            _print_equations(typer.echo)
+        found = {
+            "phantom": _run(phantom_study, phantom_study.PhantomSettings.for_scale(level), out / "phantom", quiet, as_json),
+            "rcube": _run(rcube_study, rcube_study.RCubeSettings.for_scale(level), out / "rcube", quiet, as_json),
+        }
+        if as_json:
+            print_json(found)
+        elif not quiet:
+            for name, item in found.items():
+                typer.echo(f"{name} report: {item['report']}")
+
+
+def register(app: typer.Typer) -> None:
+    study_app.command("phantom")(phantom)
+    study_app.command("rcube")(rcube)
+    study_app.command("device")(device)
+    app.add_typer(study_app, name="study")
+    app.command("demo")(demo)

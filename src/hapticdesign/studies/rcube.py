@@ -1,0 +1,235 @@
+"""Study ``rcube``: seed 001 end to end on the modified R-CUBE (Gorgulu 2018).
+
+Steps: kinematics and workspace of the final design (§5.1, Table 7.2), Table 7.3's kinematic
+columns, the final design's stiffness, inertia and modes side by side with eq. 7.6-7.13 and Table
+7.9, workspace maps of the metrics (§7.5, Figures 7.5-7.19), and the optimization chain (ch. 6-7)
+when its engine is installed.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from hapticdesign.errors import UserError
+from hapticdesign.studies.plots import plt
+from hapticdesign.studies.seed_reference import RCUBE_FINAL, TABLE_7_3
+from hapticdesign.studies.steps import Context, Outcome, Step, Table, engine, figure_from_files, figure_from_matplotlib
+
+SCALES = ("full", "quick", "smoke")
+MAP_METRICS = ("manipulability", "condition_number", "I_f", "S_f", "S_d", "omega_n")
+
+
+@dataclass(frozen=True)
+class RCubeSettings:
+    """What a run covers: map resolution and the optimization's effort (``full`` = the seed's)."""
+
+    scale: str = "full"
+    seed: int = 1
+    map_points: int = 21
+    ik_points: int = 9
+    optimization_effort: str = "full"
+
+    @classmethod
+    def for_scale(cls, scale: str, seed: int = 1) -> "RCubeSettings":
+        if scale not in SCALES:
+            raise UserError(f"unknown scale {scale!r}; choose one of {', '.join(SCALES)}")
+        points, ik = {"full": (21, 9), "quick": (21, 7), "smoke": (7, 3)}[scale]
+        return cls(scale=scale, seed=seed, map_points=points, ik_points=ik, optimization_effort=scale)
+
+    def estimate_seconds(self) -> float:
+        """Rough run time on a 2-core machine, dominated by the optimization chain."""
+        return {"full": 75.0, "quick": 30.0, "smoke": 15.0}[self.scale]
+
+
+def _final():
+    final_design = engine("hapticdesign.analysis.rcube.design", "final_design")
+    return final_design()
+
+
+def kinematics_step(ctx: Context) -> Outcome:
+    """Inverse then forward kinematics over the dexterous cube (eq. 5.28-5.45), q_max (eq. 6.24), Table 7.3."""
+    K = engine("hapticdesign.analysis.rcube", "kinematics")
+    design = _final()
+    g = design.geometry
+    n = ctx.settings.ik_points
+    grid = K.cube_grid(g, 0.12, n)
+    q = K.inverse_kinematics(g, grid)
+    back = K.forward_kinematics(g, q[..., 0])
+    error = float(np.abs(back - grid).max())
+    q_max = float(K.q_max_for_cube(g, 0.12))
+    dexterous = bool(K.dexterous_cube(g, 0.12))
+    rows = []
+    for sol, l1, l2, l3, mu, cv in TABLE_7_3:
+        geom = type(g)(l1 / 1e3, l2 / 1e3, l3 / 1e3)
+        qm = K.q_max_for_cube(geom)
+        rows.append([sol, l1, l2, l3, mu, float(K.critical_manipulability(geom, qm)), cv,
+                     float(K.critical_condition_number(qm))])
+    return Outcome(
+        summary=f"Final design l1, l2, l3 = {g.l1 * 1e3:.1f}, {g.l2 * 1e3:.1f}, {g.l3 * 1e3:.1f} mm: the 120 mm cube is "
+                f"{'dexterous' if dexterous else 'NOT dexterous'}, q_max = {np.degrees(q_max):.2f} deg "
+                f"(seed {RCUBE_FINAL['q_max_deg']} deg), IK then FK returns {n ** 3} cube points within {error:.1e} m.",
+        tables=[Table("table_7_3", "Table 7.3, kinematic columns: seed against ours (eq. 6.8, 6.18)",
+                      ["solution", "l1 [mm]", "l2 [mm]", "l3 [mm]", "mu_v seed", "mu_v ours", "c_v seed", "c_v ours"], rows)],
+        numbers={"q_max_deg": float(np.degrees(q_max)), "ik_fk_max_error_m": error, "dexterous_cube": dexterous},
+    )
+
+
+def final_design_step(ctx: Context) -> Outcome:
+    """The final design (Table 7.8) at home: mass, M_C, K_C, modes (eq. 7.6-7.13), deflection (Table 7.9)."""
+    K = engine("hapticdesign.analysis.rcube", "kinematics")
+    S = engine("hapticdesign.analysis.rcube", "stiffness")
+    D = engine("hapticdesign.analysis.rcube", "dynamics")
+    modes = engine("hapticdesign.analysis.metrics.dynamic", "modes")
+    design = _final()
+    g = design.geometry
+    mass_g = 1e3 * design.total_link_mass()
+    M_C = D.cartesian_mass_matrix(design, g.home)
+    K_C = S.cartesian_stiffness(design, g.home)
+    K_Cs = S.cartesian_stiffness(design, g.home, passive=False)
+    m = modes(M_C, K_Cs[:3, :3])
+    extended = K.critical_poses(g, K.q_max_for_cube(g, 0.12))["extended"]
+    load = np.array([5.0, 5.0, 5.0, 0.0, 0.0, 0.0])
+    deflection = {p: 1e3 * float(np.linalg.norm(np.linalg.solve(S.cartesian_stiffness(design, extended, passive=p), load)[:3]))
+                  for p in (True, False)}
+    seed = RCUBE_FINAL
+    rows = [
+        ["total link mass [g] (Table 7.9)", seed["link_mass_g"], mass_g, "density 1790 kg/m^3 inferred"],
+        ["M_C diagonal [kg] (eq. 7.6)", seed["M_C_diagonal_kg"], M_C[0, 0], "structure reproduces, values do not"],
+        ["M_C off-diagonal [kg] (eq. 7.6)", seed["M_C_off_diagonal_kg"], M_C[0, 1], ""],
+        ["K_C translational diagonal [N/m] (eq. 7.7)", seed["K_C_translational_N_per_m"], K_Cs[0, 0],
+         f"ours: passive-locked K_C*; passive-eliminated K_C gives {K_C[0, 0]:.4g}"],
+        ["K_C rotational diagonal [N m/rad] (eq. 7.7)", seed["K_C_rotational_Nm_per_rad"], K_Cs[3, 3],
+         f"passive-eliminated K_C gives {K_C[3, 3]:.4g}"],
+        *[[f"natural frequency {i + 1} [rad/s] (eq. 7.11-7.13)", seed["natural_frequencies_rad_s"][i], m.frequencies[i],
+           "ours from our M_C and K_C*"] for i in range(3)],
+        ["max deflection, 5 N per axis, extended pose [mm] (Table 7.9)", seed["max_deflection_mm"], deflection[False],
+         f"seed: below; with K_C* (passive-eliminated K_C gives {deflection[True]:.3g} mm)"],
+    ]
+    return Outcome(
+        summary=f"Final design: {mass_g:.1f} g of links (seed {seed['link_mass_g']} g), K_C* diagonal {K_Cs[0, 0]:.4g} N/m "
+                f"(seed {seed['K_C_translational_N_per_m']:.6g}), deflection {deflection[False]:.3f} mm under 5 N per axis.",
+        paragraphs=["Where ours and the seed's differ, docs/rcube.md explains why (corrected printed equations, the "
+                    "seed's K_C matching the passive-locked sum K_C* on the diagonal)."],
+        tables=[Table("final_design", "Final design (Table 7.8) at home: seed against ours",
+                      ["quantity", "seed", "ours", "note"], rows),
+                Table("stiffness", "Cartesian stiffness K_C (passive joints eliminated, eq. 5.121-5.123) at home",
+                      ["row", *[f"c{j + 1}" for j in range(6)]], [[f"r{i + 1}", *K_C[i]] for i in range(6)])],
+        numbers={"link_mass_g": mass_g, "M_C": M_C, "K_C_locked_diagonal": float(K_Cs[0, 0]),
+                 "natural_frequencies_rad_s": m.frequencies, "max_deflection_mm_locked": deflection[False],
+                 "max_deflection_mm_eliminated": deflection[True]},
+    )
+
+
+def maps_step(ctx: Context) -> Outcome:
+    """Metric maps over three planes of the workspace (§7.5, Figures 7.5-7.19) and their global values (eq. 4.108)."""
+    metrics = engine("hapticdesign.analysis.rcube", "metrics")
+    global_indices = engine("hapticdesign.analysis.metrics.globalization", "global_indices")
+    design = _final()
+    n = ctx.settings.map_points
+    offsets = (-0.06, 0.0, 0.06)
+    planes = metrics.workspace_maps(design, n=n, offsets=offsets)
+    extent = (-60, 60, -60, 60)
+    figures = []
+    for name in MAP_METRICS:
+        fig, axes = plt.subplots(1, 3, figsize=(11, 3.4), constrained_layout=True)
+        for ax, o, maps in zip(axes, offsets, planes):
+            image = ax.imshow(np.ma.masked_invalid(maps[name]).T, origin="lower", extent=extent, cmap="viridis")
+            ax.set_title(f"plane z {o * 1e3:+.0f} mm")
+            ax.set_xlabel("x [mm]")
+            ax.set_ylabel("y [mm]")
+            fig.colorbar(image, ax=ax, shrink=0.8)
+        figures.append(figure_from_matplotlib(fig, f"map_{name}", f"{name} over the workspace",
+                                              f"{n} x {n} points per plane"))
+    merged = {k: np.concatenate([p[k].ravel() for p in planes]) for k in planes[0]}
+    glob = global_indices(merged)
+    rows = [[k, float(v)] for k, v in glob.items()]
+    return Outcome(
+        summary=f"{len(planes[0])} metrics on 3 planes of {n} x {n} points; {len(MAP_METRICS)} shown.",
+        tables=[Table("global", "Global indices over the three planes (eq. 4.108)", ["metric", "global value"], rows)],
+        figures=figures,
+        numbers={"global": {k: float(v) for k, v in glob.items()}},
+    )
+
+
+def _chain_settings(effort: str):
+    Settings = engine("hapticdesign.optimization.chain", "Settings")
+    return {"full": Settings(), "quick": Settings.quick().with_population(60, 40), "smoke": Settings.quick()}[effort]
+
+
+def _csv_table(path, name: str, title: str) -> Table:
+    import csv
+
+    with open(path, newline="") as handle:
+        rows = list(csv.reader(handle))
+    return Table(name, title, rows[0], [[_number(v) for v in row] for row in rows[1:]])
+
+
+def _number(text: str):
+    try:
+        return float(text)
+    except ValueError:
+        return text
+
+
+def optimization_step(ctx: Context) -> Outcome:
+    """Chapters 6-7: NSGA-II synthesis, selection, weighted-sum swarm, cross-section ratio, plies, final design."""
+    run_chain = engine("hapticdesign.optimization.chain", "run_chain")
+    write_chain = engine("hapticdesign.optimization.chain", "write_chain")
+    chain_summary = engine("hapticdesign.optimization.chain", "chain_summary")
+    settings = _chain_settings(ctx.settings.optimization_effort)
+    result = run_chain(ctx.settings.seed, settings, progress=lambda step, done, total: ctx.update(done, total))
+    out = ctx.work_dir / f"optimization_{ctx.settings.scale}"
+    write_chain(out, result)
+    found = chain_summary(result)
+    sel, specs = found["selected"], found["specifications"]
+    seed = RCUBE_FINAL
+    rows = [
+        ["l1 [mm] (Table 7.8)", 111.7, 1e3 * sel["l1"]], ["l2 [mm]", 74.1, 1e3 * sel["l2"]],
+        ["l3 [mm]", 121.8, 1e3 * sel["l3"]], ["q_max [deg] (Table 7.2)", seed["q_max_deg"], sel["q_max_deg"]],
+        ["diameter ratio d/D (§7.3)", 0.768, found["ratio"]],
+        ["total link mass [g] (Table 7.9)", seed["link_mass_g"], specs.get("total_link_mass_g")],
+        ["max deflection [mm] (Table 7.9, below)", seed["max_deflection_mm"], specs.get("max_deflection_locked_mm")],
+    ]
+    tables = [Table("side_by_side", "Selected design against the seed's final design", ["quantity", "seed", "ours"], rows)]
+    for stem, title in (("table_7_2_front", "Pareto front of the kinematic synthesis (Table 7.2 layout)"),
+                        ("table_7_3_post_evaluation", "Post-evaluation of the front (Table 7.3 layout)"),
+                        ("table_7_5_weighted_rms", "Weighted RMS selection (Table 7.5 layout)"),
+                        ("table_7_6_7_plies", "Ply front (Tables 7.6-7.7 layout)"),
+                        ("table_7_8_final_design", "Final design (Table 7.8 layout)"),
+                        ("table_7_9_specifications", "Specifications (Table 7.9 layout)")):
+        tables.append(_csv_table(out / f"{stem}.csv", stem, title))
+    figures = [figure_from_files(png.with_suffix(""), png.stem, png.stem.replace("_", " "))
+               for png in sorted(out.glob("*.png")) if png.with_suffix(".svg").exists()]
+    return Outcome(
+        summary=f"Front of {found['front_size']} solutions (hypervolume {found['hypervolume']:.4g}); selected l1, l2, l3 = "
+                f"{1e3 * sel['l1']:.1f}, {1e3 * sel['l2']:.1f}, {1e3 * sel['l3']:.1f} mm, d/D = {found['ratio']:.3f}.",
+        paragraphs=[f"Effort: {ctx.settings.optimization_effort} (synthesis population {settings.population}, "
+                    f"{settings.generations} generations; the seed-size run is the full form). Results are reproducible "
+                    "from the seed; a small run gives a coarser front than the seed's."],
+        tables=tables, figures=figures,
+        numbers={"front_size": found["front_size"], "hypervolume": found["hypervolume"], "selected": sel,
+                 "ratio": found["ratio"], "specifications": specs},
+    )
+
+
+def steps() -> list[Step]:
+    return [
+        Step("kinematics", "Kinematics and workspace (§5.1, Tables 7.2-7.3)", kinematics_step),
+        Step("final_design", "Final design: stiffness, inertia, modes (Tables 7.8-7.9, eq. 7.6-7.13)", final_design_step),
+        Step("maps", "Workspace maps of the metrics (§7.5, Figures 7.5-7.19)", maps_step),
+        Step("optimization", "Optimization chain (ch. 6-7, Tables 7.1-7.9)", optimization_step),
+    ]
+
+
+TITLE = "Modified R-CUBE: impedance-oriented optimal design (seed 001)"
+INTRO = ("Gorgulu (2018), end to end: kinematics and workspace, virtual-joint-method stiffness with composite links, "
+         "Cartesian inertia and modes, workspace maps of the performance metrics, and the optimization chain, with the "
+         "seed's printed numbers side by side with ours.")
+
+
+def run(settings: RCubeSettings, work_dir, progress=None):
+    from hapticdesign.studies.study import run_study
+
+    return run_study("rcube", TITLE, INTRO, steps(), settings, work_dir, progress)

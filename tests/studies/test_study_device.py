@@ -1,0 +1,41 @@
+"""``study device`` on a device file of one's own: every step runs and reports the engines' numbers."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from hapticdesign.analysis.linearity.service import device_form
+from hapticdesign.model.device import Device
+from hapticdesign.studies import device as study
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "devices"
+
+
+def test_device_file_study(tmp_path, cli):
+    path = EXAMPLES / "arm-3r.toml"
+    done = cli("study", "device", "--device", str(path), "--out", str(tmp_path), "--json")
+    assert done.returncode == 0, done.stderr
+    summary = json.loads(done.stdout)
+    assert {k: v["status"] for k, v in summary["steps"].items()} == {s.key: "done" for s in study.steps()}
+    device = Device.from_file(path)
+    numbers = summary["numbers"]
+    assert numbers["ln"]["ln"] == pytest.approx(float(device_form(device).ln(device.standard_parameters())), rel=1e-12)
+    assert np.allclose(numbers["eom"]["H_at_zero"], device.H(np.zeros(device.n_dof)), rtol=1e-12, atol=0)
+    assert numbers["eom"]["max_symbolic_vs_compiled"] < 1e-9
+    # a 3R arm with gravity is not linear: its LN is positive and the linear designs found have LN ~ 0
+    assert numbers["ln"]["ln"] > 1e-6
+    with open(tmp_path / "tables" / "linearization_found.csv") as handle:
+        rows = [line.split(",") for line in handle.read().splitlines()[1:]]
+    assert rows and all(float(r[1]) < 1e-12 and r[2] == "True" for r in rows)
+    assert (tmp_path / "report.html").read_text().count("<img ") == len(list((tmp_path / "figures").glob("*.png")))
+
+
+def test_device_study_needs_a_device(tmp_path, cli):
+    done = cli("study", "device", "--preset", "phantom-9dof", "--out", str(tmp_path / "x"))
+    assert done.returncode == 2 and done.stderr.startswith("error: unknown preset")
+    done = cli("study", "device", "--device", str(tmp_path / "missing.yaml"), "--out", str(tmp_path / "x"))
+    assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1
