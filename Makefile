@@ -6,7 +6,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 
-.PHONY: demo test bench browser clean
+.PHONY: demo test bench docs browser clean
 
 $(STAMP): pyproject.toml
 	test -d $(VENV) || $(PYTHON) -m venv $(VENV)
@@ -27,6 +27,12 @@ test: $(STAMP) browser
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/run_all.py
+
+# docs/equations.md (seed equation -> code) and the API reference (docs/reference/) from docstrings.
+docs: $(STAMP)
+	$(BIN)/pip install -q -e '.[test,docs]'
+	$(BIN)/python -m hapticdesign.interface.equation_index docs/equations.md
+	$(BIN)/pdoc hapticdesign -o docs/reference --docformat restructuredtext
 
 clean:
 	rm -rf $(VENV) build src/*.egg-info out

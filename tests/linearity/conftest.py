@@ -2,14 +2,10 @@
 
 from __future__ import annotations
 
-import json
-from pathlib import Path
-
 import pytest
 
 from hapticdesign.analysis.linearity.service import device_form
-
-APPENDIX_C = Path(__file__).resolve().parents[3] / "shared" / "reference" / "seed000_appendix_c_designs.json"
+from hapticdesign.studies.seed_reference import appendix_c_designs
 
 
 @pytest.fixture(scope="session")
@@ -24,4 +20,5 @@ def form6(phantom6):
 
 @pytest.fixture(scope="session")
 def appendix_c():
-    return json.loads(APPENDIX_C.read_text())
+    """The 30 designs printed in seed 000 Appendix C (a copy of shared/reference, shipped with the package)."""
+    return appendix_c_designs()
