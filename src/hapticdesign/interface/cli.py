@@ -2,33 +2,86 @@
 
 Each module of :mod:`hapticdesign.interface.commands` contributes its commands through a
 ``register(app)`` function, so every area (dynamics, Linearity Number, simulation, R-CUBE,
-studies) keeps its command-line code next to its own name.
+studies) keeps its command-line code next to its own name. Here they are ordered and grouped
+into the sections of ``hapticdesign --help``, following the seeds' chapters.
 """
 
 from __future__ import annotations
 
 import importlib
 import pkgutil
+import sys
 
 import typer
+from typer.core import TyperGroup
 
 from hapticdesign.interface import commands
 
+CONTENTS = {
+    "dynamics": "Equations of motion (seed 000 ch. 2)",
+    "linearity": "Linearity Number and linear designs (seed 000 ch. 3)",
+    "simulation": "Haptic rendering simulation (seed 000 ch. 4)",
+    "rcube": "R-CUBE mechanism and its optimization (seed 001)",
+    "rcube_optimize": "R-CUBE mechanism and its optimization (seed 001)",
+    "study": "Studies and reports (both seeds end to end)",
+}
+OTHER = "More commands"
+
+
+class OneLineErrors(TyperGroup):
+    """A usage mistake (unknown option, missing or malformed value) as one ``error:`` line and exit status 2."""
+
+    def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
+        from typer._click.exceptions import ClickException, NoArgsIsHelpError
+
+        if not standalone_mode:
+            return super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
+        try:
+            code = super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
+        except NoArgsIsHelpError as exc:  # the help is already printed
+            sys.exit(exc.exit_code)
+        except ClickException as exc:
+            command = exc.ctx.command_path if getattr(exc, "ctx", None) is not None else "hapticdesign"
+            typer.echo(f"error: {exc.format_message()} (see {command} --help)", err=True)
+            sys.exit(exc.exit_code)
+        sys.exit(code if isinstance(code, int) else 0)
+
+    def list_commands(self, ctx) -> list[str]:
+        """Commands section by section, in the order of :data:`CONTENTS`."""
+        sections = [*dict.fromkeys(CONTENTS.values()), OTHER]
+        names = super().list_commands(ctx)
+        return sorted(names, key=lambda n: sections.index(getattr(self.commands[n], "rich_help_panel", None) or OTHER))
+
+
 app = typer.Typer(
     name="hapticdesign",
-    help="Design kinesthetic haptic devices for high impedance performance.",
+    cls=OneLineErrors,
+    help="Design kinesthetic haptic devices for high impedance performance: equations of motion and the "
+    "Linearity Number of the Phantom (seed 000), rendering simulations, and the R-CUBE mechanism's analysis and "
+    "optimization (seed 001). Every command takes --json (one JSON object on stdout) and --quiet (nothing on "
+    "stderr but errors); mistakes print one 'error:' line and exit with status 2.",
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
 )
 
 
+def _contents_order(name: str) -> tuple[int, str]:
+    order = list(CONTENTS)
+    return (order.index(name) if name in CONTENTS else len(order), name)
+
+
 def _register_all() -> None:
-    for info in sorted(pkgutil.iter_modules(commands.__path__), key=lambda m: m.name):
-        module = importlib.import_module(f"{commands.__name__}.{info.name}")
+    modules = sorted((m.name for m in pkgutil.iter_modules(commands.__path__)), key=_contents_order)
+    for name in modules:
+        module = importlib.import_module(f"{commands.__name__}.{name}")
         register = getattr(module, "register", None)
-        if register is not None:
-            register(app)
+        if register is None:
+            continue
+        known = len(app.registered_commands), len(app.registered_groups)
+        register(app)
+        for info in app.registered_commands[known[0]:] + app.registered_groups[known[1]:]:
+            info.rich_help_panel = info.rich_help_panel or CONTENTS.get(name, OTHER)
 
 
 _register_all()

@@ -8,9 +8,8 @@ from __future__ import annotations
 
 import json
 import math
-
 import warnings
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -78,9 +77,55 @@ def write_atomically(path: Path, text: str) -> None:
     tmp.replace(path)
 
 
+Report = Callable[[str, int, int | None], None]
+
+
+@contextmanager
+def progress_bar(enabled: bool) -> Iterator[Report | None]:
+    """Rich progress bars on a terminal's stderr, fed by ``report(step, done, total)`` (``total`` None: unknown).
+
+    Yields None (no bars) when ``enabled`` is false (``--quiet`` or ``--json``) or stderr is not a terminal,
+    so progress never mixes with a command's output on stdout.
+    """
+    from rich.console import Console
+
+    console = Console(stderr=True)
+    if not (enabled and console.is_terminal):
+        yield None
+        return
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+                  console=console, transient=True) as bars:
+        tasks: dict[str, int] = {}
+
+        def report(step: str, done: int, total: int | None) -> None:
+            if step not in tasks:
+                tasks[step] = bars.add_task(step, total=total)
+            bars.update(tasks[step], completed=done, total=total)
+
+        yield report
+
+
+@contextmanager
+def activity(enabled: bool, description: str) -> Iterator[None]:
+    """An indeterminate progress bar for a step that cannot report how far it is (see :func:`progress_bar`)."""
+    with progress_bar(enabled) as report:
+        if report is not None:
+            report(description, 0, None)
+        yield
+
+
+def note(message: str, quiet: bool) -> None:
+    """An informational line on stderr (files written, ...), silenced by ``--quiet``."""
+    if not quiet:
+        typer.echo(message, err=True)
+
+
 def fail(message: str) -> None:
     """Raise a :class:`UserError` (for use in option callbacks)."""
     raise UserError(message)
 
 
-__all__ = ["user_errors", "parse_vector", "print_json", "to_jsonable", "write_atomically", "fail"]
+__all__ = ["activity", "fail", "note", "parse_vector", "print_json", "progress_bar", "to_jsonable", "user_errors",
+           "write_atomically"]

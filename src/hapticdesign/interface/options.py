@@ -8,5 +8,6 @@ PRESET = typer.Option(None, "--preset", help="Built-in device: phantom-3dof or p
 DEVICE = typer.Option(None, "--device", help="Device file (YAML, TOML, JSON or URDF) instead of a preset.")
 PARAMS = typer.Option(None, "--params", help="Parameter overrides by the seed's names (JSON, YAML or TOML).")
 STRICT = typer.Option(False, "--strict", help="Refuse inertias that break the triangle inequality (the seed's designs do).")
-JSON_OUT = typer.Option(False, "--json", help="Print one JSON object.")
-QUIET = typer.Option(False, "--quiet", help="No warnings or progress on stderr.")
+JSON_OUT = typer.Option(False, "--json", help="Print the result as one JSON object on stdout.")
+QUIET = typer.Option(False, "--quiet", help="No warnings, notes or progress bars on stderr; errors still print.")
+SEED = typer.Option(1, "--seed", help="Random seed: the same seed gives the same numbers.")

@@ -25,7 +25,7 @@ def dynamics(
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
 ) -> None:
-    """H, C (seed eq. 2.50 form), C_cvt (eq. 2.52), G and tau at one pose, in SI units."""
+    """H, C, C_cvt, G and tau at one pose, in SI units (seed 000 eq. 2.50-2.52)."""
     with user_errors(quiet=quiet):
         dev = resolve_device(preset, device, params, strict=strict)
         n = dev.n_dof
@@ -74,15 +74,32 @@ def eom(
     fmt: str = typer.Option("latex", "--format", help="latex, python or text."),
     part: str = typer.Option("tau", help="What to print: tau, H, C, G or all."),
     strict: bool = STRICT,
+    json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
 ) -> None:
-    """Print the equations of motion symbolically (seed 000 Appendix A), as LaTeX, Python or text."""
+    """Equations of motion as LaTeX, Python or text, symbols as chosen (seed 000 eq. 2.50, Appendix A)."""
     from hapticdesign.analysis.dynamics.symbolic import derive, export
 
     with user_errors(quiet=quiet):
         dev = resolve_device(preset, device, params, strict=strict)
-        eqs = derive(dev, symbolic)
-        typer.echo(export(eqs, fmt, part))
+        text = export(derive(dev, symbolic), fmt, part)
+        if not json_out:
+            typer.echo(text)
+            return
+        result = {"device": dev.name, "format": fmt, "part": part}
+        if fmt == "python":
+            result["source"] = text
+        else:
+            result["equations"] = dict(_equation_entry(line) for line in text.splitlines())
+        print_json(result)
+
+
+def _equation_entry(line: str) -> tuple[str, str]:
+    """``"H_{1,2} = ..."`` (LaTeX) or ``"H[1,2] = ..."`` (text) as ``("H_1_2", "...")``; vectors tau, G: ``tau_1``."""
+    label, expression = line.split(" = ", 1)
+    name, _, index = "".join(c for c in label if c not in "{}]").replace("[", "_").partition("_")
+    indices = index.split(",")
+    return "_".join([name, *(indices[:1] if name in ("tau", "G") else indices)]), expression
 
 
 def register(app: typer.Typer) -> None:

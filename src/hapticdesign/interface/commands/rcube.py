@@ -12,9 +12,10 @@ import numpy as np
 import typer
 
 from hapticdesign.errors import UserError
-from hapticdesign.interface.common import parse_vector, print_json, user_errors
+from hapticdesign.interface.common import parse_vector, print_json, progress_bar, user_errors
+from hapticdesign.interface.options import JSON_OUT, QUIET
 
-rcube_app = typer.Typer(help="Modified R-CUBE: kinematics, VJM stiffness, dynamics, metrics (seed 001).", no_args_is_help=True)
+rcube_app = typer.Typer(help="Modified R-CUBE: kinematics, VJM stiffness, dynamics, metrics, optimization (seed 001 ch. 4-7).", no_args_is_help=True)
 
 L1 = typer.Option(None, "--l1", help="Active link length l1 (m); default 0.1117 (Table 7.8).")
 L2 = typer.Option(None, "--l2", help="Passive link length l2 (m); default 0.0741.")
@@ -27,7 +28,6 @@ INNER = typer.Option(None, "--inner", help="Inner diameters d of links 1-3 (m), 
 PLIES = typer.Option(None, "--plies", help="Ply counts at 0,90,-45,45 deg per link, e.g. '4,7,7,7;2,6,6,6;2,6,2,2'.")
 DENSITY = typer.Option(None, "--density", help="Link density (kg/m^3); default 1790.")
 POSITION = typer.Option(None, "--position", help="Platform position x,y,z (m); default home (S, S, S).")
-JSON = typer.Option(False, "--json", help="Print one JSON object.")
 
 
 def _design(design_file, l1, l2, l3, offset, sigma, outer=None, inner=None, plies=None, density=None):
@@ -99,11 +99,11 @@ def _matrix_text(name: str, M: np.ndarray, unit: str) -> str:
 def ik(l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[float] = L3,
        offset: Optional[float] = OFFSET, sigma: int = SIGMA, design: Optional[Path] = DESIGN,
        position: str = typer.Option(..., "--position", help="Platform position x,y,z (m)."),
-       json_out: bool = JSON) -> None:
-    """Inverse kinematics (eq. 5.30-5.45): all chain angles [[q11,q12,q13],[q21,..],[q31,..]] (rad)."""
+       json_out: bool = JSON_OUT, quiet: bool = QUIET) -> None:
+    """Inverse kinematics (eq. 5.30-5.45): angles q_i1, q_i2, q_i3 of chains i = 1, 2, 3 (rad), one row per chain."""
     from hapticdesign.analysis.rcube.kinematics import inverse_kinematics, require_regular
 
-    with user_errors():
+    with user_errors(quiet=quiet):
         dsg = _design(design, l1, l2, l3, offset, sigma)
         q = inverse_kinematics(dsg.geometry, parse_vector(position, 3, "position"))
         require_regular(dsg.geometry, q)
@@ -119,11 +119,11 @@ def fk(q1: float = typer.Option(..., "--q1", help="Active angle q11 (rad)."),
        q3: float = typer.Option(..., "--q3", help="Active angle q31 (rad)."),
        l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[float] = L3,
        offset: Optional[float] = OFFSET, sigma: int = SIGMA, design: Optional[Path] = DESIGN,
-       json_out: bool = JSON) -> None:
+       json_out: bool = JSON_OUT, quiet: bool = QUIET) -> None:
     """Forward kinematics (eq. 5.28): platform position from the active angles."""
     from hapticdesign.analysis.rcube.kinematics import forward_kinematics
 
-    with user_errors():
+    with user_errors(quiet=quiet):
         dsg = _design(design, l1, l2, l3, offset, sigma)
         r = forward_kinematics(dsg.geometry, np.array([q1, q2, q3]))
         if json_out:
@@ -139,11 +139,11 @@ def stiffness(l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[f
               density: Optional[float] = DENSITY, position: Optional[str] = POSITION,
               locked: bool = typer.Option(False, "--locked", help="K_C* with passive joints locked (eq. 6.60-6.61)."),
               wrench: Optional[str] = typer.Option(None, "--wrench", help="Fx,Fy,Fz[,Mx,My,Mz]: also print the deflection."),
-              json_out: bool = JSON) -> None:
+              json_out: bool = JSON_OUT, quiet: bool = QUIET) -> None:
     """Cartesian stiffness K_C (eq. 5.121-5.123), unloaded mode, direct solution."""
     from hapticdesign.analysis.rcube.stiffness import cartesian_stiffness, platform_deflection
 
-    with user_errors():
+    with user_errors(quiet=quiet):
         dsg = _design(design, l1, l2, l3, offset, sigma, outer, inner, plies, density)
         r = _position(dsg, position)
         K = cartesian_stiffness(dsg, r, passive=not locked)
@@ -164,11 +164,11 @@ def stiffness(l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[f
 def mass(l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[float] = L3,
          offset: Optional[float] = OFFSET, sigma: int = SIGMA, design: Optional[Path] = DESIGN,
          outer: Optional[str] = OUTER, inner: Optional[str] = INNER, density: Optional[float] = DENSITY,
-         position: Optional[str] = POSITION, json_out: bool = JSON) -> None:
+         position: Optional[str] = POSITION, json_out: bool = JSON_OUT, quiet: bool = QUIET) -> None:
     """Cartesian inertia M_C (eq. 5.223, 5.227) and the total link mass (eq. 5.230)."""
     from hapticdesign.analysis.rcube.dynamics import cartesian_mass_matrix
 
-    with user_errors():
+    with user_errors(quiet=quiet):
         dsg = _design(design, l1, l2, l3, offset, sigma, outer, inner, None, density)
         r = _position(dsg, position)
         M = cartesian_mass_matrix(dsg, r)
@@ -183,15 +183,16 @@ def mass(l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[float]
 def metrics(l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[float] = L3,
             offset: Optional[float] = OFFSET, sigma: int = SIGMA, design: Optional[Path] = DESIGN,
             outer: Optional[str] = OUTER, inner: Optional[str] = INNER, plies: Optional[str] = PLIES,
-            density: Optional[float] = DENSITY, position: Optional[str] = POSITION, json_out: bool = JSON) -> None:
-    """Kinematic, stiffness and dynamic metrics at one position, with modes of M_C and K_CA."""
+            density: Optional[float] = DENSITY, position: Optional[str] = POSITION, json_out: bool = JSON_OUT,
+            quiet: bool = QUIET) -> None:
+    """Kinematic, stiffness and dynamic metrics at one position, modes of M_C and K_CA (seed 001 ch. 4, §6.1-6.3)."""
     from hapticdesign.analysis.metrics.dynamic import modes
     from hapticdesign.analysis.rcube.dynamics import cartesian_mass_matrix
     from hapticdesign.analysis.rcube.kinematics import inverse_kinematics, require_regular
     from hapticdesign.analysis.rcube.metrics import metrics_at
     from hapticdesign.analysis.rcube.stiffness import cartesian_stiffness
 
-    with user_errors():
+    with user_errors(quiet=quiet):
         dsg = _design(design, l1, l2, l3, offset, sigma, outer, inner, plies, density)
         r = _position(dsg, position)
         require_regular(dsg.geometry, inverse_kinematics(dsg.geometry, r))
@@ -213,18 +214,27 @@ def maps(out: Path = typer.Option(..., "--out", help="Directory for the PNG imag
          l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[float] = L3,
          offset: Optional[float] = OFFSET, sigma: int = SIGMA, design: Optional[Path] = DESIGN,
          outer: Optional[str] = OUTER, inner: Optional[str] = INNER, plies: Optional[str] = PLIES,
-         density: Optional[float] = DENSITY) -> None:
+         density: Optional[float] = DENSITY, json_out: bool = JSON_OUT, quiet: bool = QUIET) -> None:
     """Metric maps on the planes z = home - side/2, home, home + side/2 (Figures 7.5-7.19)."""
     from hapticdesign.analysis.rcube.metrics import save_workspace_maps
 
-    with user_errors():
+    with user_errors(quiet=quiet):
         if n < 2:
             raise UserError("--n must be at least 2")
         if not side > 0.0:
             raise UserError("--side must be positive")
         dsg = _design(design, l1, l2, l3, offset, sigma, outer, inner, plies, density)
         h = side / 2
-        paths = save_workspace_maps(dsg, out, n, h, (-h, 0.0, h))
+        planes = (-h, 0.0, h)
+        paths = []
+        with progress_bar(not (quiet or json_out)) as report:
+            for k, plane in enumerate(planes):
+                if report:
+                    report("planes", k, len(planes))
+                paths += save_workspace_maps(dsg, out, n, h, (plane,))
+        if json_out:
+            print_json({"out": str(out), "files": [str(p) for p in paths]})
+            return
         typer.echo(f"wrote {len(paths)} images to {out}")
 
 

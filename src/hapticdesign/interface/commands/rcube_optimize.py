@@ -3,21 +3,19 @@
 
 from __future__ import annotations
 
-from contextlib import contextmanager
 from pathlib import Path
 from typing import Optional
 
 import typer
 
 from hapticdesign.errors import UserError
-from hapticdesign.interface.common import print_json, to_jsonable, user_errors
+from hapticdesign.interface.common import note, print_json, progress_bar, to_jsonable, user_errors
+from hapticdesign.interface.options import JSON_OUT, QUIET, SEED
 
-SEED = typer.Option(1, "--seed", help="Random seed: the same seed gives the same numbers.")
 OUT = typer.Option(None, "--out", help="Directory for the CSV tables and PNG/SVG figures.")
 QUICK = typer.Option(False, "--quick", help="Small populations and few generations (tests, demos).")
 POPULATION = typer.Option(None, "--population", help="Population size (default 100; --quick 24).")
 GENERATIONS = typer.Option(None, "--generations", help="Generations (default 150 synthesis, 100 cross-section, 200 plies).")
-JSON = typer.Option(False, "--json", help="Print one JSON summary.")
 WEIGHT = typer.Option(0.0, "--weight", help="Weight on mu_vn* of the selection (Table 7.5; the seed picks 0).")
 BOUNDS = typer.Option(None, "--bounds", help="One bound set 'qlo,qhi;l2lo,l2hi;l3lo,l3hi' (rad; m) instead of Table 7.1's three.")
 SIDE = typer.Option(0.120, "--side", help="Workspace cube edge (m), 120 mm in the seed.")
@@ -50,32 +48,8 @@ def _bound_sets(text: Optional[str]):
     return (Bounds(tuple(p[0] for p in pairs), tuple(p[1] for p in pairs)),)
 
 
-@contextmanager
-def _progress(enabled: bool):
-    """A rich progress bar for ``(step, done, total)`` reports on a terminal's stderr (none for --json)."""
-    from rich.console import Console
-
-    console = Console(stderr=True)
-    if not (enabled and console.is_terminal):
-        yield None
-        return
-    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
-
-    with Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total}"),
-                  TimeElapsedColumn(), console=console, transient=True) as bar:
-        tasks: dict[str, int] = {}
-
-        def report(step: str, done: int, total: int) -> None:
-            if step not in tasks:
-                tasks[step] = bar.add_task(step, total=total)
-            bar.update(tasks[step], completed=done)
-
-        yield report
-
-
-def _echo_paths(out: Optional[Path], paths) -> None:
-    if out is not None:
-        typer.echo(f"wrote {len(paths)} files to {out}", err=True)
+def _note_paths(out: Path, quiet: bool, paths) -> None:
+    note(f"wrote {len(paths)} files to {out}", quiet)
 
 
 def register(app: typer.Typer) -> None:
@@ -86,19 +60,19 @@ def register(app: typer.Typer) -> None:
                  generations: Optional[int] = GENERATIONS, weight: float = WEIGHT, bounds: Optional[str] = BOUNDS,
                  side: float = SIDE, virtual_side: float = VIRTUAL,
                  max_deflection: Optional[float] = typer.Option(None, "--max-deflection", help="Ply choice: fewest plies with CF1 below this (m) under 20 N."),
-                 json_out: bool = JSON) -> None:
+                 json_out: bool = JSON_OUT, quiet: bool = QUIET) -> None:
         """The whole chain: synthesis, selection, swarm, cross-section and plies (seed 001 ch. 7)."""
         from hapticdesign.optimization.chain import chain_summary, run_chain, write_chain
         from hapticdesign.optimization.constraints import Workspace
 
-        with user_errors():
+        with user_errors(quiet=quiet):
             settings = _settings(quick, population, generations)
-            with _progress(not json_out) as report:
+            with progress_bar(not (quiet or json_out)) as report:
                 result = run_chain(seed, settings, weight, _bound_sets(bounds), Workspace(side, virtual_side),
                                    max_deflection=max_deflection, progress=report)
             summary = chain_summary(result)
             if out is not None:
-                _echo_paths(out, write_chain(out, result))
+                _note_paths(out, quiet, write_chain(out, result))
             if json_out:
                 print_json(summary)
                 return
@@ -114,22 +88,22 @@ def register(app: typer.Typer) -> None:
     @rcube_app.command()
     def synthesize(seed: int = SEED, out: Optional[Path] = OUT, quick: bool = QUICK, population: Optional[int] = POPULATION,
                    generations: Optional[int] = GENERATIONS, weight: float = WEIGHT, bounds: Optional[str] = BOUNDS,
-                   side: float = SIDE, virtual_side: float = VIRTUAL, json_out: bool = JSON) -> None:
+                   side: float = SIDE, virtual_side: float = VIRTUAL, json_out: bool = JSON_OUT, quiet: bool = QUIET) -> None:
         """Kinematic synthesis by NSGA-II over Table 7.1's bounds, post-evaluation and selection (§7.1-7.2)."""
         from hapticdesign.optimization import chain
         from hapticdesign.optimization.constraints import Workspace
         from hapticdesign.optimization.synthesis import synthesize as run
 
-        with user_errors():
+        with user_errors(quiet=quiet):
             s = _settings(quick, population, generations)
             workspace = Workspace(side, virtual_side)
             sets = _bound_sets(bounds)
-            with _progress(not json_out) as report:
+            with progress_bar(not (quiet or json_out)) as report:
                 callback = (lambda k, gen: report("synthesis", k * s.generations + gen, len(sets) * s.generations)) if report else None
                 result = run(sets, s.population, s.generations, seed, workspace, progress=callback)
             selection = chain.select_solution(result, weight, workspace)
             if out is not None:
-                _echo_paths(out, chain.write_synthesis(out, result) + chain.write_selection(out, selection))
+                _note_paths(out, quiet, chain.write_synthesis(out, result) + chain.write_selection(out, selection))
             summary = {"selected": chain.selected_summary(result, selection.selected), "front_size": len(result.front),
                        "hypervolume": result.hypervolume, "rms_choice": selection.rms_choice + 1,
                        "weighted_choice": {str(w): c + 1 for w, c in selection.weighted_choice.items()}}
@@ -146,16 +120,16 @@ def register(app: typer.Typer) -> None:
                       population: Optional[int] = POPULATION, generations: Optional[int] = GENERATIONS,
                       lower: float = typer.Option(0.0, "--lower", help="Lower bound of d/D."),
                       upper: float = typer.Option(0.9, "--upper", help="Upper bound of d/D (thin-wall limit)."),
-                      json_out: bool = JSON) -> None:
+                      json_out: bool = JSON_OUT, quiet: bool = QUIET) -> None:
         """Inner/outer diameter ratio from CS1 = 1/S_l and CS2 = I_l (eq. 6.85-6.90, Figure 7.4)."""
         from hapticdesign.optimization import chain
         from hapticdesign.optimization.cross_section import exact_ratio, optimize_ratio
 
-        with user_errors():
+        with user_errors(quiet=quiet):
             s = _settings(quick, population, generations)
             result = optimize_ratio((lower, upper), s.cs_population, s.cs_generations, seed)
             if out is not None:
-                _echo_paths(out, chain.write_cross_section(out, result))
+                _note_paths(out, quiet, chain.write_cross_section(out, result))
             summary = {"ratio": result.ratio, "exact_ratio": exact_ratio((lower, upper)), "front_size": len(result.ratios)}
             if json_out:
                 print_json(summary)
@@ -170,23 +144,23 @@ def register(app: typer.Typer) -> None:
               l3: float = typer.Option(0.1218, "--l3", help="Link length l3 (m)."),
               ratio: float = typer.Option(0.768, "--ratio", help="Diameter ratio d/D (eq. 7.5)."),
               max_deflection: Optional[float] = typer.Option(None, "--max-deflection", help="Fewest plies with CF1 below this (m)."),
-              json_out: bool = JSON) -> None:
+              json_out: bool = JSON_OUT, quiet: bool = QUIET) -> None:
         """Integer ply counts at 0, 90, +-45 deg per link under 20 N at full extension (eq. 6.91-6.96)."""
         from hapticdesign.model.rcube import RCubeGeometry
         from hapticdesign.optimization import chain
         from hapticdesign.optimization.plies import optimize_plies, ply_design
 
-        with user_errors():
+        with user_errors(quiet=quiet):
             s = _settings(quick, population, generations)
             geometry = RCubeGeometry(l1, l2, l3)
-            with _progress(not json_out) as report:
+            with progress_bar(not (quiet or json_out)) as report:
                 callback = (lambda gen: report("plies", gen, s.ply_generations)) if report else None
                 result = optimize_plies(geometry, ratio, s.ply_population, s.ply_generations, seed, progress=callback)
             k = chain.choose_plies(result, max_deflection)
             design = ply_design(geometry, result.counts[k], ratio)
             specs = chain.specifications(design)
             if out is not None:
-                _echo_paths(out, chain.write_plies(out, result, k) + chain.write_final(out, design, result.counts[k], specs))
+                _note_paths(out, quiet, chain.write_plies(out, result, k) + chain.write_final(out, design, result.counts[k], specs))
             summary = to_jsonable({"front_size": len(result.F), "chosen": k + 1, "counts": result.counts[k],
                                    "CF1_mm": float(result.F[k, 0] * 1e3), "plies": int(result.F[k, 2]),
                                    "D_mm": [link.section.D * 1e3 for link in design.links],

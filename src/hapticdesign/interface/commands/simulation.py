@@ -11,7 +11,7 @@ import typer
 from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
 from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
-from hapticdesign.interface.common import print_json, user_errors, write_atomically
+from hapticdesign.interface.common import print_json, progress_bar, user_errors, write_atomically
 
 
 
@@ -162,11 +162,12 @@ def stability_boundary_command(
     substeps: int = typer.Option(10, help="Plant steps per sample in the simulation."),
     samples: int = typer.Option(4000, help="Samples per simulation of the growth test."),
     json_out: bool = JSON_OUT,
+    quiet: bool = QUIET,
 ) -> None:
-    """1-DOF mass-damper under a sampled spring: exact (spectral radius) vs simulated stiffness limit."""
+    """Exact vs simulated stiffness limit of a 1-DOF mass-damper under a sampled spring (check of seed 000 ch. 4)."""
     from hapticdesign.simulation.boundary import MassDamper, exact_boundary, simulated_boundary
 
-    with user_errors():
+    with user_errors(quiet=quiet):
         if substeps < 1 or samples < 40:
             raise UserError("--substeps must be at least 1 and --samples at least 40")
         system = MassDamper(inertia, damping, period, delay, wall_damping, compensate_inertia)
@@ -186,35 +187,37 @@ def campaign_command(
     out: Path = typer.Option(..., help="Output folder (cases/, results.csv, summary.csv, summary.md, figures/)."),
     scheduler: Optional[str] = typer.Option(None, help="Dask scheduler address; local processes by default."),
     workers: Optional[int] = typer.Option(None, help="Local worker processes (default: all cores)."),
-    preset: str = typer.Option("phantom-3dof", help="Preset whose geometry the design file fills in."),
+    preset: Optional[str] = PRESET,
     k_limit: int = typer.Option(200, help="Largest stiffness tried [N m/rad]."),
     duration: float = typer.Option(5.0, help="Simulated time per stiffness [s] (seed: 5)."),
     stiffness: float = typer.Option(4.0, help="Wall stiffness of the transparency runs [N m/rad] (seed: 4)."),
     sweep: float = typer.Option(10.0, help="Chirp sweep time [s] (seed: 10)."),
     f1: float = typer.Option(15.0, help="Chirp end frequency [Hz] (seed: 15)."),
+    json_out: bool = JSON_OUT,
+    quiet: bool = QUIET,
 ) -> None:
     """Both criteria and both types over a design set; resumable (seed 000 §4.1.4, §4.2.4)."""
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeRemainingColumn
-
-    from hapticdesign.simulation.campaign import CampaignOptions, run_campaign
+    from hapticdesign.simulation.campaign import CampaignOptions, load_cases, read_designs, run_campaign, summarize
     from hapticdesign.simulation.paths import Chirp
 
-    with user_errors():
+    with user_errors(quiet=quiet):
         if workers is not None and workers < 1:
             raise UserError("--workers must be at least 1")
         if k_limit < 1:
             raise UserError("--k-limit must be at least 1")
         if not (duration > 0 and stiffness > 0):
             raise UserError("--duration and --stiffness must be positive")
-        options = CampaignOptions(preset, k_limit, stiffness, Chirp(0.3, 0.1, f1, sweep), duration)
-        with Progress("[progress.description]{task.description}", BarColumn(), MofNCompleteColumn(),
-                      TimeRemainingColumn(), transient=False) as bar:
-            task = bar.add_task("cases", total=None)
-
-            def advance(done: int, total: int) -> None:
-                bar.update(task, completed=done, total=total)
-
+        options = CampaignOptions(preset or "phantom-3dof", k_limit, stiffness, Chirp(0.3, 0.1, f1, sweep), duration)
+        with progress_bar(not (quiet or json_out)) as report:
+            advance = (lambda done, total: report("cases", done, total)) if report else None
             counts = run_campaign(designs, out, options, scheduler, workers, advance)
+        if json_out:
+            chosen = read_designs(designs, options.preset)
+            print_json({**counts, "out": str(out),
+                        "tables": [str(out / name) for name in ("results.csv", "summary.csv", "summary.md")],
+                        "figures": sorted(str(f) for f in (out / "figures").iterdir()),
+                        "summary": summarize(chosen, load_cases(chosen, out), options)})
+            return
         typer.echo(f"{counts['cases']} cases: {counts['run']} run, {counts['skipped']} already done; "
                    f"tables and figures in {out}")
 

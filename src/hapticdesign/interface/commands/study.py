@@ -11,16 +11,16 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, SpinnerColumn
 
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import print_json, user_errors
-from hapticdesign.interface.options import DEVICE, PRESET
+from hapticdesign.interface.options import DEVICE, JSON_OUT, PRESET, QUIET, SEED
 from hapticdesign.studies.steps import STATUS_DONE, StepResult
 
-study_app = typer.Typer(help="The seeds' pipelines end to end, each ending in one HTML report.", no_args_is_help=True)
+study_app = typer.Typer(
+    help="The seeds' pipelines end to end (seed 000 ch. 2-4, seed 001 ch. 4-7), each ending in one HTML report.",
+    no_args_is_help=True,
+)
 
 QUICK = typer.Option(False, "--quick", help="A small version that finishes in a few minutes.")
 OUT = typer.Option(..., "--out", help="Folder for report.html, tables/*.csv, figures/*.png|svg and summary.json.")
-SEED = typer.Option(1, "--seed", help="Seed of every random process (same seed, same numbers).")
-QUIET = typer.Option(False, "--quiet", help="No progress bars or messages; only errors.")
-JSON = typer.Option(False, "--json", help="Print a JSON summary (report path, statuses, key numbers).")
 SCALE = typer.Option(None, "--scale", hidden=True, help="full, quick or smoke (the test suite's smallest run).")
 
 
@@ -92,7 +92,7 @@ def _finish(found: dict, quiet: bool, as_json: bool) -> None:
 
 def phantom(quick: bool = QUICK, out: Path = OUT, seed: int = SEED,
             workers: int = typer.Option(2, "--workers", help="Local processes for the simulation campaign."),
-            quiet: bool = QUIET, as_json: bool = JSON, scale: Optional[str] = SCALE) -> None:
+            quiet: bool = QUIET, as_json: bool = JSON_OUT, scale: Optional[str] = SCALE) -> None:
     """Seed 000 end to end: equations of motion, LN, linearization, 6-DOF verdict, design sets, chapter 4."""
     from hapticdesign.studies import phantom as study
 
@@ -101,7 +101,7 @@ def phantom(quick: bool = QUICK, out: Path = OUT, seed: int = SEED,
         _finish(_run(study, settings, _check_out(out), quiet, as_json), quiet, as_json)
 
 
-def rcube(quick: bool = QUICK, out: Path = OUT, seed: int = SEED, quiet: bool = QUIET, as_json: bool = JSON,
+def rcube(quick: bool = QUICK, out: Path = OUT, seed: int = SEED, quiet: bool = QUIET, as_json: bool = JSON_OUT,
           scale: Optional[str] = SCALE) -> None:
     """Seed 001 end to end: kinematics, final design against the seed, workspace maps, optimization chain."""
     from hapticdesign.studies import rcube as study
@@ -112,7 +112,7 @@ def rcube(quick: bool = QUICK, out: Path = OUT, seed: int = SEED, quiet: bool = 
 
 
 def device(device_file: Optional[Path] = DEVICE, preset: Optional[str] = PRESET,
-           out: Path = OUT, seed: int = SEED, quiet: bool = QUIET, as_json: bool = JSON) -> None:
+           out: Path = OUT, seed: int = SEED, quiet: bool = QUIET, as_json: bool = JSON_OUT) -> None:
     """Seed 000's analyses on your own device (--device FILE): dynamics, LN, linearization, rendering."""
     from hapticdesign.studies import device as study
 
@@ -147,8 +147,8 @@ def _print_equations(echo) -> None:
 
 
 def demo(out: Path = typer.Option(Path("out/demo"), "--out", help="Folder for the two reports."),
-         quiet: bool = QUIET, as_json: bool = JSON, scale: Optional[str] = SCALE) -> None:
-    """The toolkit in one command: the Phantom's equations of motion, then both studies in quick form."""
+         quiet: bool = QUIET, as_json: bool = JSON_OUT, scale: Optional[str] = SCALE) -> None:
+    """The toolkit in one command: the Phantom's equations of motion (seed 000 eq. 2.50), then both studies in quick form."""
     from hapticdesign.studies import phantom as phantom_study
     from hapticdesign.studies import rcube as rcube_study
 
