@@ -32,7 +32,7 @@ bench: $(STAMP)
 docs: $(STAMP)
 	$(BIN)/pip install -q -e '.[test,docs]'
 	$(BIN)/python -m hapticdesign.interface.equation_index docs/equations.md
-	$(BIN)/pdoc hapticdesign -o docs/reference --docformat restructuredtext
+	$(BIN)/pdoc hapticdesign hapticdesign.model hapticdesign.devices hapticdesign.analysis hapticdesign.simulation hapticdesign.optimization hapticdesign.studies hapticdesign.interface -o docs/reference --docformat restructuredtext
 
 clean:
 	rm -rf $(VENV) build src/*.egg-info out

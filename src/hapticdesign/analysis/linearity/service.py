@@ -110,7 +110,7 @@ def _designs_csv(names: list[str], designs: np.ndarray, form: LinearityForm, lev
     return DesignSet(np.full(len(designs), level), parts, designs).to_csv(names)
 
 
-def linearize_report(
+def linearize(
     preset: str | None,
     device_file: Path | None,
     params_file: Path | None,
@@ -119,53 +119,90 @@ def linearize_report(
     seed: int,
     out: Path | None,
     realizability: str,
-) -> list[str]:
-    """Text of ``hapticdesign linearize``."""
+) -> dict:
+    """``hapticdesign linearize`` as data: the conditions for LN = 0, then the seed-variable solution,
+    free parameters and constant H (eq. 3.12-3.27), or the verdict with its certificate and the
+    minimum LN (eq. 3.40-3.42) when no realizable design is fully linear."""
     kind = parse_realizability(realizability)
     if find < 0:
         raise UserError("--find: the number of designs must be >= 0")
     device = resolve_device(preset, device_file, params_file, strict)
     form = device_form(device)
     conditions = linear_conditions(device, form)
-    lines = [f"device {device.name}: LN = 0 exactly when these {len(conditions.pivots)} linear equations hold",
-             "in the standard parameters (m, h = m r, J about the body frame origin):"]
-    lines += ["  " + eq for eq in conditions.equations()]
+    result: dict = {"device": device.name, "conditions": conditions.equations()}
     verdict = decide_linearizable(device, form, kind)
+    result["linear_possible"] = verdict.linear_possible
+    names = device.inertial_names()
     if not verdict.linear_possible:
         cert = verdict.certificate
         mins = minimum_ln(device, form, practical_bounds(device), kind)
-        lines += [
-            "",
-            f"verdict: NO realizable ({kind.value}) design with LN = 0 exists (any bounds, incl. eq. 3.40-3.42).",
-            f"certificate: PSD blocks Z_i on bodies {', '.join(cert.support())} (sum of traces 1, smallest eigenvalue "
-            f"{cert.min_eigenvalue():.2e}) with |sum_i tr(Z_i F_i(pi))| <= {cert.residual:.2e} |z|_1 on every fully",
-            "  linear design pi = N z; hence min_i lambda_min(F_i(pi)) <= that bound, i.e. no strictly realizable one.",
-            "exact certificate (Z = e_k e_k^T): these diagonal entries of the realizability matrix vanish on every",
-            "  fully linear design: " + ", ".join(f"body {b} entry ({k + 1},{k + 1})" for b, k in verdict.exact),
-            f"minimum LN under practical bounds: {mins.ln:.6g} (convex lower bound {mins.lower_bound:.6g}); "
-            f"design within bounds: {mins.within_bounds}, realizable ({kind.value}): {mins.realizable}",
-            "  design (seed variables):",
-        ]
-        lines += [f"    {n} = {v:.8g}" for n, v in zip(device.inertial_names(), mins.design.ravel())]
-        lines.append("minimum LN under eq. 3.40-3.42: 0 is the infimum (LN scales with the square of the inertial")
-        lines.append(f"  parameters), e.g. {scaled_minimum(device, mins):.3g} with the design above scaled to the 1e-15 bounds; never attained.")
-        return lines
+        result["verdict"] = {
+            "realizability": kind.value,
+            "certificate": {"bodies": cert.support(), "min_eigenvalue": cert.min_eigenvalue(), "residual": cert.residual},
+            "exact": [{"body": body, "entry": k + 1} for body, k in verdict.exact],
+            "minimum_ln": {"ln": mins.ln, "lower_bound": mins.lower_bound, "within_bounds": mins.within_bounds,
+                           "realizable": mins.realizable, "design": dict(zip(names, mins.design.ravel()))},
+            "scaled_minimum_ln": scaled_minimum(device, mins),
+        }
+        return result
     solved = seed_conditions(device, conditions)
-    lines += ["", "in the seed's design variables (cf. eq. 3.12-3.26):"]
-    lines += [f"  {k} = {v}" for k, v in solved.solution.items()]
-    lines += ["", f"free parameters ({len(solved.free)}, cf. Table 3.2): " + ", ".join(s.name for s in solved.free)]
-    lines += ["", "constant inertia matrix on the solution set (eq. 3.27), for the current parameters:"]
-    h = conditions.constant_h @ device.standard_parameters()
-    lines += ["  [" + ", ".join(f"{v:.6g}" for v in row) + "]" for row in h]
-    lines.append(f"current LN = {form.ln(device.standard_parameters()):.3g}")
+    pi = device.standard_parameters()
+    result.update(
+        seed_conditions={str(k): str(v) for k, v in solved.solution.items()},
+        free_parameters=[s.name for s in solved.free],
+        constant_H=conditions.constant_h @ pi,
+        ln=form.ln(pi),
+    )
     if find:
         designs = find_linear_designs(device, form, conditions, practical_bounds(device), find, seed, kind)
-        text = _designs_csv(device.inertial_names(), designs, form)
+        text = _designs_csv(names, designs, form)
+        result["designs"] = {"count": find, "max_ln": form.ln_seed(designs).max()}
         if out is None:
-            lines += ["", text.rstrip()]
+            result["designs"]["values"] = [dict(zip(names, row)) for row in designs]
+            result["designs"]["csv"] = text
         else:
             write_atomically(out, text)
-            lines.append(f"wrote {find} realizable fully linear designs (max LN {form.ln_seed(designs).max():.2g}) to {out}")
+            result["designs"]["path"] = str(out)
+    return result
+
+
+def linearize_report(result: dict) -> list[str]:
+    """Text of ``hapticdesign linearize`` from :func:`linearize`'s result."""
+    lines = [f"device {result['device']}: LN = 0 exactly when these {len(result['conditions'])} linear equations hold",
+             "in the standard parameters (m, h = m r, J about the body frame origin):"]
+    lines += ["  " + eq for eq in result["conditions"]]
+    if not result["linear_possible"]:
+        v = result["verdict"]
+        cert, mins = v["certificate"], v["minimum_ln"]
+        lines += [
+            "",
+            f"verdict: NO realizable ({v['realizability']}) design with LN = 0 exists (any bounds, incl. eq. 3.40-3.42).",
+            f"certificate: PSD blocks Z_i on bodies {', '.join(cert['bodies'])} (sum of traces 1, smallest eigenvalue "
+            f"{cert['min_eigenvalue']:.2e}) with |sum_i tr(Z_i F_i(pi))| <= {cert['residual']:.2e} |z|_1 on every fully",
+            "  linear design pi = N z; hence min_i lambda_min(F_i(pi)) <= that bound, i.e. no strictly realizable one.",
+            "exact certificate (Z = e_k e_k^T): these diagonal entries of the realizability matrix vanish on every",
+            "  fully linear design: " + ", ".join(f"body {e['body']} entry ({e['entry']},{e['entry']})" for e in v["exact"]),
+            f"minimum LN under practical bounds: {mins['ln']:.6g} (convex lower bound {mins['lower_bound']:.6g}); "
+            f"design within bounds: {mins['within_bounds']}, realizable ({v['realizability']}): {mins['realizable']}",
+            "  design (seed variables):",
+        ]
+        lines += [f"    {n} = {x:.8g}" for n, x in mins["design"].items()]
+        lines.append("minimum LN under eq. 3.40-3.42: 0 is the infimum (LN scales with the square of the inertial")
+        lines.append(f"  parameters), e.g. {v['scaled_minimum_ln']:.3g} with the design above scaled to the 1e-15 bounds; never attained.")
+        return lines
+    lines += ["", "in the seed's design variables (cf. eq. 3.12-3.26):"]
+    lines += [f"  {k} = {x}" for k, x in result["seed_conditions"].items()]
+    free = result["free_parameters"]
+    lines += ["", f"free parameters ({len(free)}, cf. Table 3.2): " + ", ".join(free)]
+    lines += ["", "constant inertia matrix on the solution set (eq. 3.27), for the current parameters:"]
+    lines += ["  [" + ", ".join(f"{x:.6g}" for x in row) + "]" for row in result["constant_H"]]
+    lines.append(f"current LN = {result['ln']:.3g}")
+    designs = result.get("designs")
+    if designs:
+        if "path" in designs:
+            lines.append(f"wrote {designs['count']} realizable fully linear designs (max LN {designs['max_ln']:.2g}) to {designs['path']}")
+        else:
+            lines += ["", designs["csv"].rstrip()]
     return lines
 
 

@@ -68,70 +68,14 @@ def linearize_command(
 ) -> None:
     """Conditions for LN = 0 (seed 000 eq. 3.12-3.27), free parameters, constant H; verdict when impossible."""
     with user_errors(strict, quiet), activity(not (quiet or json_out), "linearizing"):
+        from hapticdesign.analysis.linearity.service import linearize, linearize_report
+
+        result = linearize(preset, device, params, strict, find, seed, out, realizability)
         if json_out:
-            print_json(linearize_json(preset, device, params, strict, find, seed, out, realizability))
+            print_json(result)
             return
-        from hapticdesign.analysis.linearity.service import linearize_report
-
-        lines = linearize_report(preset, device, params, strict, find, seed, out, realizability)
-    for line in lines:
+    for line in linearize_report(result):
         typer.echo(line)
-
-
-def linearize_json(preset, device_file, params_file, strict, find, seed, out, realizability) -> dict:
-    """``linearize --json``: the conditions, then the seed-variable solution, free parameters and constant H
-    (eq. 3.12-3.27), or the 6-DOF verdict with its certificate summary and minimum LN (eq. 3.40-3.42)."""
-    from hapticdesign.analysis.linearity.bounds import practical_bounds
-    from hapticdesign.analysis.linearity.conditions import linear_conditions, seed_conditions
-    from hapticdesign.analysis.linearity.linear_designs import find_linear_designs
-    from hapticdesign.analysis.linearity.service import (
-        _designs_csv, device_form, parse_realizability, scaled_minimum,
-    )
-    from hapticdesign.analysis.linearity.verdict import decide_linearizable, minimum_ln
-    from hapticdesign.devices.loading import resolve_device
-    from hapticdesign.errors import UserError
-    from hapticdesign.interface.common import write_atomically
-
-    kind = parse_realizability(realizability)
-    if find < 0:
-        raise UserError("--find: the number of designs must be >= 0")
-    dev = resolve_device(preset, device_file, params_file, strict)
-    form = device_form(dev)
-    conditions = linear_conditions(dev, form)
-    result: dict = {"device": dev.name, "conditions": conditions.equations()}
-    verdict = decide_linearizable(dev, form, kind)
-    result["linear_possible"] = verdict.linear_possible
-    names = dev.inertial_names()
-    if not verdict.linear_possible:
-        cert = verdict.certificate
-        mins = minimum_ln(dev, form, practical_bounds(dev), kind)
-        result["verdict"] = {
-            "realizability": kind.value,
-            "certificate": {"bodies": cert.support(), "min_eigenvalue": cert.min_eigenvalue(),
-                            "residual": cert.residual},
-            "exact": [{"body": body, "entry": k + 1} for body, k in verdict.exact],
-            "minimum_ln": {"ln": mins.ln, "lower_bound": mins.lower_bound, "within_bounds": mins.within_bounds,
-                           "realizable": mins.realizable, "design": dict(zip(names, mins.design.ravel()))},
-            "scaled_minimum_ln": scaled_minimum(dev, mins),
-        }
-        return result
-    solved = seed_conditions(dev, conditions)
-    pi = dev.standard_parameters()
-    result.update(
-        seed_conditions={str(k): str(v) for k, v in solved.solution.items()},
-        free_parameters=[s.name for s in solved.free],
-        constant_H=conditions.constant_h @ pi,
-        ln=form.ln(pi),
-    )
-    if find:
-        designs = find_linear_designs(dev, form, conditions, practical_bounds(dev), find, seed, kind)
-        result["designs"] = {"count": find, "max_ln": form.ln_seed(designs).max()}
-        if out is None:
-            result["designs"]["values"] = [dict(zip(names, row)) for row in designs]
-        else:
-            write_atomically(out, _designs_csv(names, designs, form))
-            result["designs"]["path"] = str(out)
-    return result
 
 
 def designs_command(
