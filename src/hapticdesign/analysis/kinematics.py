@@ -24,33 +24,32 @@ def _check_q(mech: Mechanism, q: np.ndarray) -> np.ndarray:
     return q
 
 
-def forward_kinematics(mech: Mechanism, q: np.ndarray, frame: str | None = None) -> np.ndarray:
-    """World pose (4x4) of ``frame`` (default: the end effector) at coordinates ``q``."""
+def _node_poses(mech: Mechanism, q: np.ndarray, frame: str | None) -> tuple[list[int], list[np.ndarray]]:
+    """Nodes from the base to ``frame`` (default: the end effector) and their world poses."""
     frame = frame or mech.end_effector
     if frame is None:
         raise UserError("the mechanism names no end-effector frame")
     q = _check_q(mech, q)
     c = mech.compiled
-    t = np.eye(4)
-    for n in mech.compiled.path_to(frame):
+    path = c.path_to(frame)
+    poses, t = [], np.eye(4)
+    for n in path:
         t = t @ elementary_matrix(Axis(c.node_axis[n]), c.node_offset[n] + c.node_coef[n] @ q)
-    return t
+        poses.append(t)
+    return path, poses
+
+
+def forward_kinematics(mech: Mechanism, q: np.ndarray, frame: str | None = None) -> np.ndarray:
+    """World pose (4x4) of ``frame`` (default: the end effector) at coordinates ``q``."""
+    _, poses = _node_poses(mech, q, frame)
+    return poses[-1] if poses else np.eye(4)
 
 
 def jacobian(mech: Mechanism, q: np.ndarray, frame: str | None = None) -> np.ndarray:
     """Geometric Jacobian (6 x N) of ``frame``'s origin in the base frame: rows ``v`` then ``w``."""
-    frame = frame or mech.end_effector
-    if frame is None:
-        raise UserError("the mechanism names no end-effector frame")
-    q = _check_q(mech, q)
+    path, poses = _node_poses(mech, q, frame)
     c = mech.compiled
-    path = mech.compiled.path_to(frame)
-    poses = []
-    t = np.eye(4)
-    for n in path:
-        t = t @ elementary_matrix(Axis(c.node_axis[n]), c.node_offset[n] + c.node_coef[n] @ q)
-        poses.append(t)
-    p_end = t[:3, 3]
+    p_end = poses[-1][:3, 3] if poses else np.zeros(3)
     jac = np.zeros((6, mech.n_dof))
     for n, pose in zip(path, poses):
         coef = c.node_coef[n]
