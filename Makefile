@@ -15,9 +15,10 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 # Headless Chromium for the report test (Debian packages chromium and chromium-driver).
+APT_INSTALL = $(SUDO) apt-get update -qq && $(SUDO) env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium chromium-driver
 browser:
 	@command -v chromium >/dev/null && command -v chromedriver >/dev/null || \
-	  ($(SUDO) apt-get update -qq && $(SUDO) env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium chromium-driver)
+	  ($(APT_INSTALL)) || (sleep 10 && $(APT_INSTALL))
 
 demo: $(STAMP)
 	$(BIN)/hapticdesign demo
