@@ -21,6 +21,7 @@ CONTENTS = {
     "dynamics": "Equations of motion (seed 000 ch. 2)",
     "linearity": "Linearity Number and linear designs (seed 000 ch. 3)",
     "simulation": "Haptic rendering simulation (seed 000 ch. 4)",
+    "metrics": "Performance metrics of any device (seed 001 ch. 4)",
     "rcube": "R-CUBE mechanism and its optimization (seed 001)",
     "rcube_optimize": "R-CUBE mechanism and its optimization (seed 001)",
     "study": "Studies and reports (both seeds end to end)",

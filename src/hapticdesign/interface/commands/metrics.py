@@ -1,0 +1,99 @@
+"""Command ``metrics``: kinematic and dynamic performance metrics of any device at one pose.
+
+The metrics of seed 001 chapter 4 are general: here they take the end-effector Jacobian of the
+kinematic core (translational rows for devices of up to 3 joints, all six rows for 6 joints)
+and the joint-space mass matrix H of the equations of motion.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+import numpy as np
+import typer
+
+from hapticdesign.analysis.kinematics import jacobian
+from hapticdesign.analysis.metrics import dynamic, kinematic
+from hapticdesign.devices.loading import resolve_device
+from hapticdesign.errors import UserError
+from hapticdesign.interface.common import parse_vector, print_json, user_errors
+from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
+from hapticdesign.model.device import Device
+
+SINGULAR_CONDITION = 1e10
+
+
+def task_jacobian(device: Device, q: np.ndarray) -> np.ndarray:
+    """End-effector Jacobian with as many task rows as joints.
+
+    3 joints: the translational rows in base coordinates; 6 joints: all six rows; 1-2 joints
+    (planar devices): the translational rows projected on the plane (or line) of motion, i.e. on
+    the leading left singular vectors, which leaves every metric unchanged by the choice of axes.
+    """
+    full = jacobian(device.mechanism, q)
+    n = device.n_dof
+    if n == 3:
+        return full[:3]
+    if n == 6:
+        return full
+    if n < 3:
+        u, _, _ = np.linalg.svd(full[:3])
+        return u[:, :n].T @ full[:3]
+    raise UserError(f"metrics need 1-3 or 6 joints (a square task Jacobian); {device.name} has {n}")
+
+
+def device_metrics(device: Device, q: np.ndarray) -> dict:
+    """Kinematic (eq. 4.24-4.38) and dynamic (eq. 4.90-4.99) metrics at pose ``q``."""
+    J = task_jacobian(device, q)
+    cond = float(kinematic.condition_number(J))
+    if not np.isfinite(cond) or cond > SINGULAR_CONDITION:
+        raise UserError(f"singular configuration at q = {np.round(q, 6).tolist()}: the Jacobian loses rank")
+    H = device.H(q)
+    M_C = dynamic.cartesian_inertia(H, J)
+    radii, _ = kinematic.velocity_ellipsoid(J)
+    return {
+        "device": device.name,
+        "q": q,
+        "jacobian": J,
+        "manipulability": kinematic.manipulability(J),
+        "condition_number": cond,
+        "velocity_ellipsoid_radii": radii,
+        "cartesian_inertia": M_C,
+        "inertia_volume": dynamic.inertia_volume(M_C),
+        "dynamic_manipulability": dynamic.dynamic_manipulability(H, J),
+        "inertia_frobenius": dynamic.inertia_frobenius(M_C),
+        "inertia_uniformity": dynamic.inertia_uniformity(M_C),
+        "acceleration_radius": dynamic.acceleration_radius(H, J),
+    }
+
+
+def metrics(
+    preset: Optional[str] = PRESET,
+    device: Optional[Path] = DEVICE,
+    params: Optional[Path] = PARAMS,
+    q: str = typer.Option(..., help="Joint coordinates, comma-separated (rad or m)."),
+    strict: bool = STRICT,
+    json_out: bool = JSON_OUT,
+    quiet: bool = QUIET,
+) -> None:
+    """Kinematic and dynamic metrics of any device at one pose (seed 001 eq. 4.24-4.38, 4.90-4.99)."""
+    with user_errors(quiet=quiet):
+        dev = resolve_device(preset, device, params, strict=strict)
+        result = device_metrics(dev, parse_vector(q, dev.n_dof, "q"))
+        if json_out:
+            print_json(result)
+            return
+        for key, value in result.items():
+            if key in ("jacobian", "cartesian_inertia"):
+                typer.echo(f"{key}:")
+                for row in value:
+                    typer.echo("  " + " ".join(f"{v: .6e}" for v in row))
+            elif isinstance(value, np.ndarray) and value.ndim:
+                typer.echo(f"{key}: " + " ".join(f"{v:.6g}" for v in value))
+            else:
+                typer.echo(f"{key}: {value if isinstance(value, str) else f'{float(value):.6g}'}")
+
+
+def register(app: typer.Typer) -> None:
+    app.command("metrics")(metrics)

@@ -1,0 +1,75 @@
+"""``hapticdesign metrics``: seed 001's general metrics on devices of the kinematic core."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from hapticdesign.analysis.kinematics import forward_kinematics
+from hapticdesign.devices.loading import resolve_device
+from hapticdesign.interface.cli import app
+
+runner = CliRunner()
+PANTOGRAPH = str(Path(__file__).resolve().parents[2] / "examples" / "devices" / "pantograph-2dof.yaml")
+
+
+def _fd_jacobian(device, q: np.ndarray, eps: float = 1e-7) -> np.ndarray:
+    """Translational Jacobian by central differences of forward kinematics (independent of ``jacobian``)."""
+    mech = device.mechanism
+    cols = [
+        (forward_kinematics(mech, q + eps * e)[:3, 3] - forward_kinematics(mech, q - eps * e)[:3, 3]) / (2 * eps)
+        for e in np.eye(device.n_dof)
+    ]
+    return np.stack(cols, axis=1)
+
+
+def _run(args):
+    result = runner.invoke(app, ["metrics", *args, "--json"])
+    assert result.exit_code == 0, result.output
+    return json.loads(result.stdout)
+
+
+def test_phantom_metrics_against_finite_differences_and_kinetic_energy(phantom3):
+    rng = np.random.default_rng(3)
+    q = np.array([0.1, 0.5, 0.3])
+    out = _run(["--q", "0.1,0.5,0.3"])
+    J = _fd_jacobian(phantom3, q)
+    assert out["manipulability"] == pytest.approx(np.sqrt(np.linalg.det(J @ J.T)), rel=1e-6)
+    s = np.linalg.svd(J, compute_uv=False)
+    assert out["condition_number"] == pytest.approx(s[0] / s[-1], rel=1e-6)
+    M_C = np.array(out["cartesian_inertia"])
+    H = phantom3.H(q)
+    for _ in range(3):
+        v = rng.normal(size=3)
+        qd = np.linalg.solve(J, v)
+        assert 0.5 * v @ M_C @ v == pytest.approx(0.5 * qd @ H @ qd, rel=1e-6)
+    assert out["inertia_volume"] == pytest.approx(np.linalg.det(M_C), rel=1e-9)
+
+
+def test_planar_device_metrics_do_not_depend_on_axes():
+    """A 2-DOF pantograph: the area scaling sqrt(det(J^T J)) of the 3 x 2 Jacobian is the manipulability."""
+    device = resolve_device(device_file=PANTOGRAPH)
+    q = np.array([0.3, 1.2])
+    out = _run(["--device", PANTOGRAPH, "--q", "0.3,1.2"])
+    J = _fd_jacobian(device, q)
+    assert out["manipulability"] == pytest.approx(np.sqrt(np.linalg.det(J.T @ J)), rel=1e-6)
+    qd = np.array([0.4, -0.7])
+    v2 = np.array(out["jacobian"]) @ qd
+    M_C = np.array(out["cartesian_inertia"])
+    assert 0.5 * v2 @ M_C @ v2 == pytest.approx(0.5 * qd @ device.H(q) @ qd, rel=1e-9)
+
+
+def test_six_dof_uses_the_full_jacobian():
+    out = _run(["--preset", "phantom-6dof", "--q", "0.1,0.5,0.3,0.2,0.4,0.1"])
+    assert np.array(out["jacobian"]).shape == (6, 6)
+    assert np.array(out["cartesian_inertia"]).shape == (6, 6)
+
+
+def test_singular_pose_is_one_line_exit_2():
+    result = runner.invoke(app, ["metrics", "--q", "0,0,1.5707963267948966"])
+    assert result.exit_code == 2
+    assert result.stderr.startswith("error: singular configuration") and result.stderr.count("\n") == 1
