@@ -116,7 +116,7 @@ def chain_deflections(design: RCubeDesign, chain: int, q_chain, wrench, loaded: 
 
 
 def loaded_chain_stiffness_matrices(
-    design: RCubeDesign, position, wrench=np.zeros(6), iterative: bool = False
+    design: RCubeDesign, position, wrench=None, iterative: bool = False
 ) -> np.ndarray:
     """Loaded mode ``K_Cgf,i`` (eq. 5.157-5.158): the Jacobians re-evaluated at the deflected pose.
 
@@ -126,7 +126,7 @@ def loaded_chain_stiffness_matrices(
     """
     q = _joint_angles(design, np.asarray(position, dtype=float))
     C_theta = joint_compliance(design)
-    wrench = _check_wrench(wrench)
+    wrench = _check_wrench(np.zeros(6) if wrench is None else wrench)
     out = []
     for i in range(3):
         theta = _chain_equilibrium(design, i, q[i], wrench, True, iterative)
