@@ -33,6 +33,10 @@ def test_final_design_against_the_seed(rcube_study):
     m_c = np.array(n["final_design"]["M_C"])
     assert np.allclose(m_c, m_c.T) and np.all(np.linalg.eigvalsh(m_c) > 0)
     assert m_c[0, 0] == pytest.approx(m_c[1, 1]) == pytest.approx(m_c[2, 2])  # eq. 7.6 structure
+    k_c = np.array(n["final_design"]["K_C_seed_evaluation"])  # eq. 7.7: 209110, 727, 6495
+    assert k_c[0, 0] == pytest.approx(209110, rel=0.01)
+    assert k_c[3, 3] == pytest.approx(727, rel=0.01)
+    assert k_c[0, 5] == pytest.approx(6495, rel=0.01)
 
 
 def test_table_7_3_columns_reproduce(rcube_study):

@@ -50,6 +50,7 @@ RCUBE_FINAL = {
     "M_C_off_diagonal_kg": -0.0039,  # eq. 7.6
     "K_C_translational_N_per_m": 209110.0,   # eq. 7.7 diagonal
     "K_C_rotational_Nm_per_rad": 727.0,      # eq. 7.7 diagonal
+    "K_C_coupling_N": 6495.0,                # eq. 7.7 entry (1, 6)
     "natural_frequencies_rad_s": (2113.3, 2113.3, 2442.7),  # eq. 7.11-7.13
     "max_deflection_mm": 0.07,       # Table 7.9 ("below")
     "q_max_deg": 32.5,               # Table 7.2
