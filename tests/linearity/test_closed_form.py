@@ -10,6 +10,7 @@ from hapticdesign.analysis.linearity.closed_form import closed_form
 from hapticdesign.analysis.linearity.form import PARTS, linearity_form
 from hapticdesign.analysis.linearity.region import parse_region
 from hapticdesign.errors import UserError
+from tests.linearity.appendix_b import appendix_b1_gravity
 
 
 @pytest.fixture(scope="module")
@@ -46,26 +47,10 @@ def test_appendix_b2_coefficients_of_the_poly(closed6):
     assert float(poly.coeff_monomial(s["Iyy5"] ** 2)) == pytest.approx(13.9062, abs=5e-5)
 
 
-def _appendix_b1_gravity(p, l2, l3a, g):
-    """The gravity polynomial printed at the end of seed 000 Appendix B.1, term by term."""
-    return 0.5 * g**2 * (
-        l2**2 * p["m2a"] ** 2 + 2 * l3a**2 * p["m2a"] ** 2 + 2 * l2**2 * p["m2a"] * p["m3"] + l2**2 * p["m3"] ** 2
-        + 4 * l3a**2 * p["m2a"] * p["m3a"] + 2 * l3a**2 * p["m3a"] ** 2 + 2 * l2 * p["m2a"] ** 2 * p["r2ax"]
-        + 2 * l2 * p["m2a"] * p["m3"] * p["r2ax"] + p["m2a"] ** 2 * p["r2ax"] ** 2 + p["m2a"] ** 2 * p["r2ay"] ** 2
-        + 2 * l2 * p["m2"] * p["m2a"] * p["r2x"] + 2 * l2 * p["m2"] * p["m3"] * p["r2x"]
-        + 2 * p["m2"] * p["m2a"] * p["r2ax"] * p["r2x"] + p["m2"] ** 2 * p["r2x"] ** 2
-        + 2 * p["m2"] * p["m2a"] * p["r2ay"] * p["r2y"] + p["m2"] ** 2 * p["r2y"] ** 2 + 2 * p["m3a"] ** 2 * p["r3ax"] ** 2
-        + 4 * l3a * p["m2a"] * p["m3a"] * p["r3az"] + 4 * l3a * p["m3a"] ** 2 * p["r3az"] + 2 * p["m3a"] ** 2 * p["r3az"] ** 2
-        + 4 * p["m3"] * p["m3a"] * p["r3ax"] * p["r3x"] + 2 * p["m3"] ** 2 * p["r3x"] ** 2
-        + 4 * l3a * p["m2a"] * p["m3"] * p["r3z"] + 4 * l3a * p["m3"] * p["m3a"] * p["r3z"]
-        + 4 * p["m3"] * p["m3a"] * p["r3az"] * p["r3z"] + 2 * p["m3"] ** 2 * p["r3z"] ** 2
-    )
-
-
 def test_appendix_b1_gravity_polynomial_term_by_term(closed3, phantom3):
     """Same monomials (g symbolic, lengths numeric) and the same coefficient for each."""
     p = {s.name: s for s in closed3.gens}
-    seed = sp.Poly(sp.expand(_appendix_b1_gravity(p, sp.Rational("0.215"), sp.Rational("0.0325"), p["g"])), *closed3.gens)
+    seed = sp.Poly(sp.expand(appendix_b1_gravity(p, sp.Rational("0.215"), sp.Rational("0.0325"), p["g"])), *closed3.gens)
     expected = {m: float(c) for m, c in seed.as_dict().items()}
     ours = closed3.terms("G")
     assert set(ours) == set(expected)

@@ -9,6 +9,7 @@ from hapticdesign.analysis.linearity.form import linearity_form
 from hapticdesign.analysis.linearity.region import parse_region
 from hapticdesign.analysis.linearity.weights import Weights
 from hapticdesign.errors import UserError
+from tests.linearity.appendix_b import appendix_b1_gravity
 
 
 def _seed_vector(device, values):
@@ -60,29 +61,13 @@ def test_appendix_b2_cross_coefficient(form6, phantom6):
     assert both - single == pytest.approx(5.46875, rel=1e-12)
 
 
-def _appendix_b1_gravity(p, l2, l3a, g):
-    """The gravity polynomial printed at the end of seed 000 Appendix B.1."""
-    return 0.5 * g**2 * (
-        l2**2 * p["m2a"] ** 2 + 2 * l3a**2 * p["m2a"] ** 2 + 2 * l2**2 * p["m2a"] * p["m3"] + l2**2 * p["m3"] ** 2
-        + 4 * l3a**2 * p["m2a"] * p["m3a"] + 2 * l3a**2 * p["m3a"] ** 2 + 2 * l2 * p["m2a"] ** 2 * p["r2ax"]
-        + 2 * l2 * p["m2a"] * p["m3"] * p["r2ax"] + p["m2a"] ** 2 * p["r2ax"] ** 2 + p["m2a"] ** 2 * p["r2ay"] ** 2
-        + 2 * l2 * p["m2"] * p["m2a"] * p["r2x"] + 2 * l2 * p["m2"] * p["m3"] * p["r2x"]
-        + 2 * p["m2"] * p["m2a"] * p["r2ax"] * p["r2x"] + p["m2"] ** 2 * p["r2x"] ** 2
-        + 2 * p["m2"] * p["m2a"] * p["r2ay"] * p["r2y"] + p["m2"] ** 2 * p["r2y"] ** 2 + 2 * p["m3a"] ** 2 * p["r3ax"] ** 2
-        + 4 * l3a * p["m2a"] * p["m3a"] * p["r3az"] + 4 * l3a * p["m3a"] ** 2 * p["r3az"] + 2 * p["m3a"] ** 2 * p["r3az"] ** 2
-        + 4 * p["m3"] * p["m3a"] * p["r3ax"] * p["r3x"] + 2 * p["m3"] ** 2 * p["r3x"] ** 2
-        + 4 * l3a * p["m2a"] * p["m3"] * p["r3z"] + 4 * l3a * p["m3"] * p["m3a"] * p["r3z"]
-        + 4 * p["m3"] * p["m3a"] * p["r3az"] * p["r3z"] + 2 * p["m3"] ** 2 * p["r3z"] ** 2
-    )
-
-
 def test_appendix_b1_gravity_polynomial(form3, phantom3):
     rng = np.random.default_rng(3)
     names = phantom3.inertial_names()
     for _ in range(5):
         x = rng.uniform(-0.3, 0.3, len(names))
         p = dict(zip(names, x))
-        expected = _appendix_b1_gravity(p, phantom3.params["l2"], phantom3.params["l3a"], phantom3.params["g"])
+        expected = appendix_b1_gravity(p, phantom3.params["l2"], phantom3.params["l3a"], phantom3.params["g"])
         assert form3.parts_seed(x)[2] == pytest.approx(expected, rel=1e-11)
 
 

@@ -113,6 +113,18 @@ def accelerations(q, qd, qdd_path, u, prescribed, coef, index, kinds, degrees, d
 
 
 @nb.njit(cache=True)
+def _stage_state(q, qd, kq, a, h, prescribed, path_q_row, path_qd_row, qs, qds):
+    """RK4 stage state ``(q + h kq, qd + h a)``; prescribed joints take the path's value instead."""
+    for i in range(q.shape[0]):
+        if prescribed[i]:
+            qs[i] = path_q_row[i]
+            qds[i] = path_qd_row[i]
+        else:
+            qs[i] = q[i] + h * kq[i]
+            qds[i] = qd[i] + h * a[i]
+
+
+@nb.njit(cache=True)
 def compensator_torque(q, qd, qdd, coef, index, kinds, degrees, switches, ws_values, ws_entries, h, c, g, qd2, out):
     """Model-based feedforward ``tau_f = s_H H qdd + s_C C qd^2 + s_G G`` (seed §4.1.1.2)."""
     n = q.shape[0]
@@ -240,31 +252,16 @@ def run_loop(plant, model, ws_plant, ws_model, damping, hand_mass, hand_stiffnes
                 qd[i] = path_qd[2 * it + 2, i]
         else:
             # RK4 stages 2-4; prescribed joints follow the path at each stage time
-            for i in range(n):
-                k1q[i] = qd[i]
-                qs[i] = q[i] + 0.5 * step * k1q[i]
-                qds[i] = qd[i] + 0.5 * step * a1[i]
-                if prescribed[i]:
-                    qs[i] = path_q[2 * it + 1, i]
-                    qds[i] = path_qd[2 * it + 1, i]
+            k1q[:] = qd
+            _stage_state(q, qd, k1q, a1, 0.5 * step, prescribed, path_q[2 * it + 1], path_qd[2 * it + 1], qs, qds)
             k2q[:] = qds
             accelerations(qs, qds, path_qdd[2 * it + 1], u, prescribed, coef, index, kinds, degrees, damping,
                           hand_mass, hand_stiffness, hand_rest, ws_plant, a2, tau_c)
-            for i in range(n):
-                qs[i] = q[i] + 0.5 * step * k2q[i]
-                qds[i] = qd[i] + 0.5 * step * a2[i]
-                if prescribed[i]:
-                    qs[i] = path_q[2 * it + 1, i]
-                    qds[i] = path_qd[2 * it + 1, i]
+            _stage_state(q, qd, k2q, a2, 0.5 * step, prescribed, path_q[2 * it + 1], path_qd[2 * it + 1], qs, qds)
             k3q[:] = qds
             accelerations(qs, qds, path_qdd[2 * it + 1], u, prescribed, coef, index, kinds, degrees, damping,
                           hand_mass, hand_stiffness, hand_rest, ws_plant, a3, tau_c)
-            for i in range(n):
-                qs[i] = q[i] + step * k3q[i]
-                qds[i] = qd[i] + step * a3[i]
-                if prescribed[i]:
-                    qs[i] = path_q[2 * it + 2, i]
-                    qds[i] = path_qd[2 * it + 2, i]
+            _stage_state(q, qd, k3q, a3, step, prescribed, path_q[2 * it + 2], path_qd[2 * it + 2], qs, qds)
             k4q[:] = qds
             accelerations(qs, qds, path_qdd[2 * it + 2], u, prescribed, coef, index, kinds, degrees, damping,
                           hand_mass, hand_stiffness, hand_rest, ws_plant, a4, tau_c)
