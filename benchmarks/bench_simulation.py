@@ -27,7 +27,8 @@ import numpy as np
 from hapticdesign.devices.registry import preset
 from hapticdesign.simulation.campaign import META_COLUMNS, run_campaign
 from hapticdesign.simulation.impedance import type_paths
-from hapticdesign.simulation.loop import LoopConfig, Wall, simulate
+from hapticdesign.simulation.config import LoopConfig, Wall
+from hapticdesign.simulation.loop import simulate
 from hapticdesign.simulation.reference import simulate_adaptive
 
 

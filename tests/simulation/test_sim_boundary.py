@@ -1,11 +1,18 @@
 """1-DOF mass-damper: exact boundary (spectral radius of the exact discretization) vs the simulated loop."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from scipy.signal import cont2discrete
 
+from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
-from hapticdesign.simulation.boundary import MassDamper, closed_loop_matrix, exact_boundary, simulated_boundary
+from hapticdesign.simulation.boundary import (
+    MassDamper, closed_loop_matrix, compensated_boundary, exact_boundary, simulated_boundary,
+)
+from hapticdesign.simulation.config import Compensator, Hand, LoopConfig
+from hapticdesign.simulation.impedance import ImpedanceProblem, true_boundary
 
 CASES = [
     (0.01, 0.5, 1e-3, 0, False),
@@ -53,3 +60,48 @@ def test_discretization_matches_scipy_cont2discrete():
 def test_bad_mass_damper_raises(kwargs):
     with pytest.raises(UserError):
         MassDamper(**kwargs)
+
+
+@pytest.mark.parametrize("inertia, damping, period", [(0.04, 0.5, 1e-3), (0.01, 0.2, 5e-4), (0.2, 0.05, 1e-3)])
+@pytest.mark.parametrize("fraction", [1.0, 0.99, 0.9, 0.5, 0.0])
+def test_closed_form_with_compensator_error_is_the_spectral_radius_boundary(inertia, damping, period, fraction):
+    """K* = b^2 (1-a)(1-ac) / [J (1-a)(1-ac) - T a b (1-c)], a = exp(-bT/J), against eigenvalues."""
+    system = MassDamper(inertia, damping, period, compensate_inertia=True, model_inertia=fraction * inertia)
+    assert compensated_boundary(inertia, damping, period, fraction) == pytest.approx(exact_boundary(system), rel=1e-8)
+
+
+def test_closed_form_limits():
+    j, b, t = 0.04, 0.5, 1e-3
+    assert compensated_boundary(j, b, t, 1.0) == pytest.approx(b * b / j, rel=1e-12)
+    near = compensated_boundary(j, b, t, 0.999) - b * b / j
+    assert near == pytest.approx(0.001 * b / t, rel=0.02)
+    assert compensated_boundary(j, b, t, 0.0) == pytest.approx(2 * b / t, rel=0.01)
+
+
+@pytest.mark.parametrize("error_percent", [1.0, 20.0])
+def test_simulated_loop_with_compensator_error_meets_the_closed_form(error_percent):
+    j, b, t = 0.039, 0.5, 1e-3
+    c = 1 - error_percent / 100
+    system = MassDamper(j, b, t, compensate_inertia=True, model_inertia=c * j)
+    simulated = simulated_boundary(system, rel_tol=1e-4, samples=4000)
+    assert simulated == pytest.approx(compensated_boundary(j, b, t, c), rel=2e-3)
+
+
+def test_hand_on_a_one_dof_device_meets_the_exact_discrete_analysis():
+    """A hand (mass m_h, damping b_h, stiffness k_h at radius r) adds m_h r^2 to the plant's inertia
+    (not to the compensator's model), b_h r^2 to its damping and a physical spring k_h r^2: the
+    simulated growth boundary of the device equals the spectral-radius boundary of that 1-DOF loop."""
+    device = resolve_device(None, Path(__file__).with_name("one_link.yaml"), None)
+    j = device.H(np.zeros(1))[0, 0]
+    assert j == pytest.approx(0.007, rel=1e-12)
+    r2 = 0.15 ** 2
+    hand = Hand(mass=0.4, damping=2.0, stiffness=40.0)
+    config = LoopConfig(hand=hand, compensator=Compensator(coriolis=False, gravity=False))
+    simulated = true_boundary(ImpedanceProblem(device, 1, config=config))
+    system = MassDamper(j + hand.mass * r2, 0.3 + hand.damping * r2, 1e-3, compensate_inertia=True,
+                        model_inertia=j, plant_stiffness=hand.stiffness * r2)
+    exact = exact_boundary(system)
+    assert simulated == pytest.approx(exact, rel=2e-3)
+    without_mass = exact_boundary(MassDamper(j, 0.3 + hand.damping * r2, 1e-3, compensate_inertia=True,
+                                             plant_stiffness=hand.stiffness * r2))
+    assert abs(without_mass - exact) > 0.2 * exact

@@ -5,7 +5,8 @@ import pytest
 
 from hapticdesign.devices.registry import preset
 from hapticdesign.errors import UserError
-from hapticdesign.simulation.loop import Compensator, LoopConfig, Sensors, Wall, simulate, joint_index
+from hapticdesign.simulation.config import Compensator, LoopConfig, Sensors, Wall
+from hapticdesign.simulation.loop import joint_index, simulate
 from hapticdesign.simulation.paths import Chirp, Held, Sine
 from hapticdesign.simulation.reference import simulate_adaptive
 
@@ -81,3 +82,18 @@ def test_diverging_run_is_a_result_not_a_crash():
     config = LoopConfig(duration=2.0, wall=Wall(0, 5000.0, 0.0, 0.01), safety_limit=None)
     trace = simulate(preset("phantom-3dof"), config, {1: Held(0.0), 2: Held(0.0)})
     assert trace.diverged or np.abs(trace.q[:, 0]).max() > 1.0
+
+
+def test_safety_switch_and_excursion_stop_at_the_same_plant_step_as_the_scipy_loop():
+    """Both loops check the excursion at every plant step: equal trip time, stop time and peak."""
+    device = preset("phantom-3dof").with_params(NONLINEAR)
+    paths = {1: Held(0.0), 2: Held(0.0)}
+    tripping = LoopConfig(duration=1.5, wall=Wall(0, 30.0, 0.0, 0.01), safety_limit=0.0217)
+    fast, slow = simulate(device, tripping, paths), simulate_adaptive(device, tripping, paths)
+    assert fast.trip_time is not None and fast.trip_time == pytest.approx(slow.trip_time, abs=1e-12)
+    assert abs(fast.trip_time * 1e3 - round(fast.trip_time * 1e3)) > 1e-6  # between two samples
+    stopping = LoopConfig(duration=1.5, wall=Wall(0, 30.0, 0.0, 0.01), stop_excursion=0.012)
+    fast, slow = simulate(device, stopping, paths), simulate_adaptive(device, stopping, paths)
+    assert fast.stopped_at_excursion and slow.stopped_at_excursion
+    assert fast.end_time == pytest.approx(slow.end_time, abs=1e-12)
+    assert fast.peak == pytest.approx(slow.peak, rel=1e-7) and fast.peak >= 0.012

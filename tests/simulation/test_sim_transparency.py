@@ -5,7 +5,7 @@ import pytest
 from scipy.optimize import brentq
 
 from hapticdesign.devices.registry import preset
-from hapticdesign.simulation.loop import LoopConfig
+from hapticdesign.simulation.config import LoopConfig
 from hapticdesign.simulation.paths import Chirp
 from hapticdesign.simulation.transparency import first_exit, transparency
 

@@ -1,14 +1,34 @@
-"""Stability boundary of a 1-DOF mass-damper under a sampled virtual spring (CONVENTIONS.md).
+"""Stability boundary of a 1-DOF mass-damper under a sampled virtual spring (seed 000 ch. 4, §5).
 
-Plant ``J qdd + b qd = u``; every ``T`` the digital side reads ``q, qd`` (and the acceleration
-under the previous held torque), optionally ``delay`` samples late, and holds
-``u = c J_m a - K q - B qd`` (``c = 1`` with the inertial compensator, model inertia ``J_m``).
+Plant ``J qdd + b qd + k_p q = u`` (``k_p``: a physical spring such as a hand's, 0 by default);
+every ``T`` the digital side reads ``q, qd`` (and the acceleration under the previous held
+torque), optionally ``delay`` samples late, and holds ``u = J_m a - K q - B qd`` with the
+inertial compensator (model inertia ``J_m``, ``J_m = c J`` for a modelling error of
+``E = 100 (1 - c)`` percent), ``u = - K q - B qd`` without it.
 
 - :func:`exact_boundary`: the plant discretized exactly (``scipy.linalg.expm`` of the augmented
   matrix), the closed loop written as one linear map of the sampled state, and the smallest
   ``K`` at which its spectral radius reaches 1 (about ``2 b / T`` without compensation).
+- :func:`compensated_boundary`: the closed form of that limit with the inertial compensator,
+  no delay and no virtual damper (derived below), the oracle of the simulation tests.
 - :func:`simulated_boundary`: the numba loop itself, ``K`` bisected on the growth of the
   oscillation (the envelope of the last quarter of the run against the second quarter).
+
+The closed form. Over one period the held torque moves the plant (``k_p = 0``) by
+``v+ = a v + (1 - a) u / b`` and ``q+ = q + J (1 - a) v / b + (T/b - J (1 - a)/b^2) u`` with
+``a = exp(-b T / J)``. The acceleration sampled just before instant k is
+``(u_(k-1) - b v_k) / J``, so the law is ``u_k = c (u_(k-1) - b v_k) - K q_k``: a three-state
+linear map of ``(q, v, u_prev)``. Its cubic characteristic polynomial keeps a real root inside
+the unit circle and loses stability when its complex pair reaches ``|z| = 1``; the Schur-Cohn
+(Jury) condition for that crossing is linear in K and gives
+
+    K* = b^2 (1 - a)(1 - a c) / [J (1 - a)(1 - a c) - T a b (1 - c)],
+
+which is ``b^2 / J`` at ``c = 1`` (the compensated loop's torque is a running sum
+``u_k = u_(k-1) - b v_k - K q_k``), about ``b^2 / J + (1 - c) b / T`` for ``c`` near 1 (a 1 %
+modelling error adds ``b / (100 T)``: 5 N m/rad at b = 0.5, T = 1 ms) and about ``2 b / T`` at
+``c = 0``. The tests check it against the spectral radius of :func:`closed_loop_matrix` and the
+simulated loop.
 """
 
 from __future__ import annotations
@@ -22,7 +42,8 @@ from scipy.linalg import expm
 from scipy.optimize import brentq
 
 from hapticdesign.errors import UserError
-from hapticdesign.simulation.loop import Compensator, LoopConfig, Sensors, Wall, simulate_tables
+from hapticdesign.simulation.config import Compensator, LoopConfig, Sensors, Wall
+from hapticdesign.simulation.loop import simulate_tables
 from hapticdesign.simulation.tables import DynamicsTables
 
 
@@ -37,6 +58,7 @@ class MassDamper:
     virtual_damping: float = 0.0
     compensate_inertia: bool = False
     model_inertia: float | None = None
+    plant_stiffness: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ("inertia", "period"):
@@ -47,6 +69,10 @@ class MassDamper:
             raise UserError(f"the damping must be non-negative, got {self.damping}")
         if self.delay_samples < 0:
             raise UserError("the delay must be a non-negative number of samples")
+        if not (self.plant_stiffness >= 0 and math.isfinite(self.plant_stiffness)):
+            raise UserError(f"the plant stiffness must be non-negative, got {self.plant_stiffness}")
+        if self.model_inertia is not None and not (self.model_inertia >= 0 and math.isfinite(self.model_inertia)):
+            raise UserError(f"the model inertia must be non-negative, got {self.model_inertia}")
 
     @property
     def j_model(self) -> float:
@@ -54,21 +80,34 @@ class MassDamper:
 
 
 @lru_cache(maxsize=64)
-def _discretize(j: float, b: float, t: float) -> tuple[np.ndarray, np.ndarray]:
-    """Exact zero-order-hold discretization of ``J qdd + b qd = u`` over one period."""
-    a = np.array([[0.0, 1.0, 0.0], [0.0, -b / j, 1.0 / j], [0.0, 0.0, 0.0]])
+def _discretize(j: float, b: float, t: float, k_p: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Exact zero-order-hold discretization of ``J qdd + b qd + k_p q = u`` over one period."""
+    a = np.array([[0.0, 1.0, 0.0], [-k_p / j, -b / j, 1.0 / j], [0.0, 0.0, 0.0]])
     e = expm(a * t)
     return e[:2, :2], e[:2, 2]
+
+
+def compensated_boundary(inertia: float, damping: float, period: float, fraction: float = 1.0) -> float:
+    """Closed-form ``K*`` of a 1-DOF inertia with a compensator feeding ``fraction * J * a`` forward.
+
+    ``fraction = c = 1 - E/100`` for a modelling error of E percent; see the module docstring.
+    ``inf`` when the denominator is not positive (no spring destabilizes the loop).
+    """
+    a = math.exp(-damping * period / inertia)
+    num = damping ** 2 * (1 - a) * (1 - a * fraction)
+    den = inertia * (1 - a) * (1 - a * fraction) - period * a * damping * (1 - fraction)
+    return num / den if den > 0 else math.inf
 
 
 def closed_loop_matrix(system: MassDamper, stiffness: float) -> np.ndarray:
     """One-sample map of ``[q, qd, u_prev, s_(k-1), ..., s_(k-d)]`` with ``s = (q, qd, a)``."""
     j, b, d = system.inertia, system.damping, system.delay_samples
-    phi, gamma = _discretize(j, b, system.period)
+    phi, gamma = _discretize(j, b, system.period, system.plant_stiffness)
     size = 3 + 3 * d
     sense = np.zeros((3, size))  # s_k from z_k
     sense[0, 0] = 1.0
     sense[1, 1] = 1.0
+    sense[2, 0] = -system.plant_stiffness / j
     sense[2, 1] = -b / j
     sense[2, 2] = 1.0 / j
     gains = np.array([-stiffness, -system.virtual_damping, float(system.compensate_inertia) * system.j_model])
@@ -118,10 +157,12 @@ def grows(system: MassDamper, stiffness: float, samples: int = 4000, substeps: i
     plant = DynamicsTables.constant_inertia(system.inertia)
     model = DynamicsTables.constant_inertia(system.j_model)
     cfg = _config(system, stiffness, samples * system.period, system.period / substeps)
-    trace = simulate_tables(plant, model, cfg, (system.damping,))
+    spring = np.array([[system.plant_stiffness]])
+    trace = simulate_tables(plant, model, cfg, (system.damping,), hand=(np.zeros((1, 1)), np.zeros((1, 1)), spring))
     if trace.diverged or len(trace.t) < samples + 1:
         return True
-    return envelope_grows(trace.q[:, 0] - 0.01)
+    rest = stiffness * cfg.wall.equilibrium / (stiffness + system.plant_stiffness)
+    return envelope_grows(trace.q[:, 0] - rest)
 
 
 def envelope_grows(error: np.ndarray, margin: float = 0.0) -> bool:

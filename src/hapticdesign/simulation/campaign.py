@@ -112,7 +112,7 @@ def run_case(preset_name: str, params: dict[str, float], criterion: str, sim_typ
         warnings.simplefilter("ignore", PhysicalConsistencyWarning)
         device = preset(preset_name).with_params(params)
     if criterion == "impedance":
-        from hapticdesign.simulation.loop import LoopConfig
+        from hapticdesign.simulation.config import LoopConfig
 
         result = fast_search(ImpedanceProblem(device, sim_type, config=LoopConfig(duration=options.duration)),
                              options.k_limit)

@@ -23,7 +23,8 @@ import numpy as np
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation.boundary import envelope_grows
-from hapticdesign.simulation.loop import LoopConfig, Wall, model_device, simulate
+from hapticdesign.simulation.config import LoopConfig, Wall, model_device
+from hapticdesign.simulation.loop import simulate
 from hapticdesign.simulation.paths import Held, Path, Sine
 from hapticdesign.simulation.tables import DynamicsTables
 
@@ -46,13 +47,22 @@ class Criteria:
 
 @dataclass(frozen=True)
 class Verdict:
-    """Outcome of one gain: stable, or the criterion that failed first."""
+    """Outcome of one gain: stable, or the criterion that failed first.
+
+    ``peak`` is the largest excursion from the start over every plant step; ``stopped_at`` is the
+    time a run ended early (excursion limit reached or diverged), ``None`` for a full run.
+    """
 
     stiffness: float
     stable: bool
     criterion: str
     peak: float
     final_error: float
+    stopped_at: float | None = None
+
+    def as_dict(self) -> dict:
+        return {"k": float(self.stiffness), "stable": self.stable, "criterion": self.criterion,
+                "peak": self.peak, "final_error": self.final_error, "stopped_at": self.stopped_at}
 
 
 def type_paths(sim_type: int, n_dof: int, wall_joint: int = 0) -> dict[int, Path]:
@@ -81,28 +91,29 @@ class ImpedanceProblem:
         self.config = replace(self.config, safety_limit=self.criteria.safety_limit,
                               stop_excursion=self.criteria.overshoot_limit)
 
-    def estimate(self) -> int:
+    def estimate(self) -> float:
         """Starting guess: the 1-DOF limit ``b^2 / H_ww`` of full inertial compensation at the start
         pose (see :mod:`.boundary`), or ``2 b / T`` without it; only a guess, never the answer."""
         w = self.wall_joint
         b = (self.config.damping or self.device.damping)[w]
         h = self.device.H(np.zeros(self.device.n_dof))[w, w]
         guess = b * b / h if self.config.compensator.inertial else 2 * b / self.config.sensors.period
-        return int(guess) if math.isfinite(guess) and guess >= 1 else 1
+        return guess if math.isfinite(guess) and guess > 0 else 1.0
 
     def verdict(self, stiffness: float) -> Verdict:
         """Simulate the wall at ``stiffness`` and apply the criteria."""
         cfg = replace(self.config, wall=replace(self.config.wall, joint=self.wall_joint, stiffness=float(stiffness),
                                                 equilibrium=self.equilibrium))
         trace = simulate(self.device, cfg, self.paths, plant=self.plant, model=self.model)
+        peak = trace.peak
+        if trace.diverged or not math.isfinite(peak):
+            return Verdict(stiffness, False, "diverged", peak, math.nan, trace.end_time)
+        if trace.stopped_at_excursion or peak >= self.criteria.overshoot_limit:
+            stopped = trace.end_time if trace.stopped_at_excursion else None
+            return Verdict(stiffness, False, "overshoot", peak, math.nan, stopped)
         q = trace.q[:, self.wall_joint]
-        peak = float(np.max(np.abs(q - q[0]))) if q.size else math.nan
-        tail = q[trace.t >= trace.t[-1] - self.criteria.settle_window] if q.size else q
-        final = float(np.max(np.abs(tail - self.equilibrium))) if tail.size else math.nan
-        if trace.diverged or not np.isfinite(peak):
-            return Verdict(stiffness, False, "diverged", peak, final)
-        if peak >= self.criteria.overshoot_limit:
-            return Verdict(stiffness, False, "overshoot", peak, final)
+        tail = q[trace.t >= trace.t[-1] - self.criteria.settle_window]
+        final = float(np.max(np.abs(tail - self.equilibrium)))
         if trace.tripped:
             return Verdict(stiffness, False, "safety switch", peak, final)
         if final > self.criteria.settle_tolerance:
@@ -112,21 +123,30 @@ class ImpedanceProblem:
 
 @dataclass(frozen=True)
 class RangeResult:
-    """The maximum stable impedance (0 when K = 1 already fails) and the first failing verdict."""
+    """The maximum stable impedance (0 when no grid value passes) and the first failing verdict.
+
+    ``k_min`` is the lowest passing grid value (``None`` when none passes); ``resolution`` the grid
+    spacing (1 for the seed's integer scan).
+    """
 
     k_max: float
     criterion: str
     simulations: int
     first_unstable: Verdict | None
     method: str
+    k_min: float | None = None
+    resolution: float = 1.0
 
     def as_dict(self) -> dict:
         first = self.first_unstable
         return {
             "k_max": float(self.k_max),
+            "k_min": self.k_min,
+            "resolution": self.resolution,
             "criterion": first.criterion if first else "none (limit reached)",
             "first_unstable_k": None if first is None else float(first.stiffness),
             "peak_at_first_unstable": None if first is None else first.peak,
+            "stopped_at_first_unstable": None if first is None else first.stopped_at,
             "simulations": self.simulations,
             "method": self.method,
         }
@@ -137,8 +157,8 @@ def linear_scan(problem: ImpedanceProblem, k_limit: int = 200) -> RangeResult:
     for k in range(1, k_limit + 1):
         v = problem.verdict(k)
         if not v.stable:
-            return RangeResult(k - 1, v.criterion, k, v, "linear")
-    return RangeResult(k_limit, "none", k_limit, None, "linear")
+            return RangeResult(k - 1, v.criterion, k, v, "linear", 1.0 if k > 1 else None)
+    return RangeResult(k_limit, "none", k_limit, None, "linear", 1.0)
 
 
 def fast_search(problem: ImpedanceProblem, k_limit: int = 200, start: int | None = None) -> RangeResult:
@@ -154,7 +174,7 @@ def fast_search(problem: ImpedanceProblem, k_limit: int = 200, start: int | None
         runs += 1
         return problem.verdict(k)
 
-    k = min(max(1, start if start is not None else problem.estimate()), k_limit)
+    k = min(max(1, start if start is not None else int(problem.estimate())), k_limit)
     v = check(k)
     step = 1
     if v.stable:
@@ -167,7 +187,7 @@ def fast_search(problem: ImpedanceProblem, k_limit: int = 200, start: int | None
                 break
             good, step = k, 2 * step
         if bad is None:
-            return RangeResult(good, "none", runs, None, "fast")
+            return RangeResult(good, "none", runs, None, "fast", 1.0)
     else:
         good, bad, bad_verdict = 0, k, v
         while bad > 1:
@@ -184,17 +204,81 @@ def fast_search(problem: ImpedanceProblem, k_limit: int = 200, start: int | None
             good = mid
         else:
             bad, bad_verdict = mid, v
-    return RangeResult(good, bad_verdict.criterion, runs, bad_verdict, "fast")
+    return RangeResult(good, bad_verdict.criterion, runs, bad_verdict, "fast", 1.0 if good >= 1 else None)
 
 
-def true_boundary(problem: ImpedanceProblem, rel_tol: float = 2e-3, margin: float = 0.05,
+def grid_search(problem: ImpedanceProblem, resolution: float, k_limit: float = 200.0) -> RangeResult:
+    """Stable range on the grid ``R, 2R, 3R, ...`` (N m/rad, or N/m for a prismatic joint).
+
+    ``k_min`` is the lowest passing grid value and ``k_max`` the largest one such that every grid
+    value from ``k_min`` up to it passes; below ``k_min`` the spring is too soft to settle within
+    the run. Assuming the passing set is one interval of the grid (the tests compare with a scan
+    of every grid value), a passing value is found first (halving down from half the
+    :meth:`~ImpedanceProblem.estimate`, then doubling up), and each end is found by galloping
+    away from it and bisecting.
+    """
+    if not (resolution > 0 and math.isfinite(resolution)):
+        raise UserError(f"the stiffness resolution must be positive, got {resolution}")
+    n_limit = int(math.floor(k_limit / resolution + 1e-9))
+    if n_limit < 1:
+        raise UserError(f"the stiffness limit {k_limit} is below the resolution {resolution}")
+    seen: dict[int, Verdict] = {}
+
+    def check(n: int) -> Verdict:
+        if n not in seen:
+            seen[n] = problem.verdict(n * resolution)
+        return seen[n]
+
+    start = min(max(1, int(0.5 * problem.estimate() / resolution)), n_limit)
+    candidates = [start]
+    while candidates[-1] > 1:
+        candidates.append(candidates[-1] // 2)
+    up = start
+    while up < n_limit:
+        up = min(2 * up, n_limit)
+        candidates.append(up)
+    passing = next((n for n in candidates if check(n).stable), None)
+    if passing is None:
+        worst = check(candidates[0])
+        return RangeResult(0.0, worst.criterion, len(seen), worst, "grid", None, resolution)
+
+    def edge(direction: int) -> int:
+        good, step = passing, 1
+        while True:
+            n = min(max(good + direction * step, 1), n_limit)
+            if n == good:
+                return good
+            if not check(n).stable:
+                bad = n
+                break
+            good, step = n, 2 * step
+        while abs(bad - good) > 1:
+            mid = (good + bad) // 2
+            if check(mid).stable:
+                good = mid
+            else:
+                bad = mid
+        return good
+
+    top, bottom = edge(+1), edge(-1)
+    first = seen.get(top + 1)
+    return RangeResult(top * resolution, first.criterion if first else "none", len(seen), first, "grid",
+                       bottom * resolution, resolution)
+
+
+def true_boundary(problem: ImpedanceProblem, rel_tol: float = 1e-4, margin: float | None = None,
                   k_limit: float = 1e5) -> float:
     """Stiffness at which the oscillation of the wall joint starts to grow (no overshoot criterion).
 
     Each run lasts the configured duration without safety switch; the envelope of the last quarter
-    is compared with the second quarter (``margin`` absorbs the forced motion of type 2), and runs
-    that leave the joint by more than 1 rad count as growing.
+    is compared with the second quarter, and runs that leave the joint by more than 1 rad count as
+    growing. ``margin`` (default 0 for type 1, 5 % for type 2, whose forced motion of the other
+    joints keeps a periodic component in the envelope) is the relative growth that counts. For
+    type 1 with full inertial compensation the answer converges to the exact ``b^2 / H_ww`` of
+    :mod:`.boundary` (bisection to ``rel_tol``).
     """
+    if margin is None:
+        margin = 0.0 if problem.sim_type == 1 else 0.05
     cfg = replace(problem.config, safety_limit=None, stop_excursion=1.0)
 
     def grows(k: float) -> bool:
@@ -221,12 +305,19 @@ def true_boundary(problem: ImpedanceProblem, rel_tol: float = 2e-3, margin: floa
 
 def impedance_range(device: Device, sim_type: int = 1, method: str = "fast", k_limit: int = 200,
                     criteria: Criteria | None = None, config: LoopConfig | None = None,
-                    wall_joint: int = 0, equilibrium: float = 0.01) -> RangeResult:
-    """Maximum stable impedance of ``wall_joint`` for simulation type 1 or 2 (seed §4.1.2)."""
+                    wall_joint: int = 0, equilibrium: float = 0.01,
+                    resolution: float | None = None) -> RangeResult:
+    """Maximum stable impedance of ``wall_joint`` for simulation type 1 or 2 (seed §4.1.2).
+
+    Without ``resolution`` the seed's integer scan K = 1, 2, 3 ... (``method`` "linear", or "fast"
+    for the same answer in fewer runs); with it, :func:`grid_search` on ``R, 2R, 3R ...``.
+    """
     if method not in ("fast", "linear"):
         raise UserError(f"search method must be 'fast' or 'linear', got {method!r}")
     if k_limit < 1:
         raise UserError("the stiffness limit must be at least 1 N m/rad")
     problem = ImpedanceProblem(device, sim_type, wall_joint, equilibrium, criteria or Criteria(),
                                config or LoopConfig(wall=Wall()))
+    if resolution is not None:
+        return grid_search(problem, resolution, k_limit)
     return (fast_search if method == "fast" else linear_scan)(problem, k_limit)

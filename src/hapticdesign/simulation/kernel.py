@@ -20,11 +20,8 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
+from hapticdesign.simulation.config import STATUS_COMPLETED, STATUS_DIVERGED, STATUS_EXCURSION
 from hapticdesign.simulation.tables import evaluate_entries, unpack_entries, velocity_products
-
-STATUS_COMPLETED = 0
-STATUS_EXCURSION = 1
-STATUS_DIVERGED = 2
 
 
 @nb.njit(cache=True)
@@ -156,7 +153,11 @@ def run_loop(plant, model, ws_plant, ws_model, damping, hand_mass, hand_stiffnes
              path_q, path_qd, path_qdd, q0, qd0, step, sub, n_steps, wall_joint, wall_k, wall_b, wall_eq,
              switches, quant, delay, safety_limit, reference, stop_excursion, stride,
              rec_q, rec_qd, rec_u, rec_f, rec_imp, rec_c):
-    """Run the loop; returns (records written, status, time the safety switch tripped or -1)."""
+    """Run the loop; returns (records written, status, time the safety switch tripped or -1, peak
+    excursion of the wall joint from ``reference`` over every plant step, time the run ended).
+
+    The excursion is checked at every plant step, so a run stopped at ``stop_excursion`` reports a
+    peak at or above it even when no recorded row (every ``stride`` steps) shows it."""
     coef, index, kinds, degrees = plant
     coef_m = model[0]
     n = q0.shape[0]
@@ -186,6 +187,8 @@ def run_loop(plant, model, ws_plant, ws_model, damping, hand_mass, hand_stiffnes
     trip_time = -1.0
     written = 0
     status = STATUS_COMPLETED
+    peak = 0.0
+    end_time = 0.0
     for it in range(n_steps + 1):
         t = it * step
         if it % sub == 0:
@@ -237,10 +240,13 @@ def run_loop(plant, model, ws_plant, ws_model, damping, hand_mass, hand_stiffnes
         for i in range(n):
             if not (np.isfinite(q[i]) and np.isfinite(qd[i])) or abs(qd[i]) > 1e8:
                 finite = False
+        end_time = t
         if not finite:
             status = STATUS_DIVERGED
             break
         excursion = abs(q[wall_joint] - reference)
+        if excursion > peak:
+            peak = excursion
         if excursion >= stop_excursion:
             status = STATUS_EXCURSION
             break
@@ -279,4 +285,4 @@ def run_loop(plant, model, ws_plant, ws_model, damping, hand_mass, hand_stiffnes
                 tau_f[i] = 0.0
                 tau_imp[i] = 0.0
                 u[i] = 0.0
-    return written, status, trip_time
+    return written, status, trip_time, peak, end_time

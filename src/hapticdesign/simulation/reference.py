@@ -4,7 +4,10 @@ Between samples the held torques are constant, so each sample period is one ``so
 on the free joints, with the prescribed joints following their paths and the dynamics from
 :class:`~hapticdesign.analysis.dynamics.model.DynamicsModel` in NumPy. This is the optional
 adaptive integrator, the cross-check of the numba kernel, and the speed baseline of the
-benchmark. Records are taken at the sample instants; the safety switch is checked there too.
+benchmark. It shares only the configuration types with the fast loop (:mod:`.config`), none of
+its code. Records are taken at the sample instants; the excursion stop and the safety switch are
+checked at every plant-step instant (``config.step``) from the dense output of each period, as the
+fast loop checks them, and a tripped switch removes the torques from that instant on.
 """
 
 from __future__ import annotations
@@ -16,8 +19,9 @@ from scipy.integrate import solve_ivp
 
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
-from hapticdesign.simulation.kernel import STATUS_COMPLETED, STATUS_DIVERGED, STATUS_EXCURSION
-from hapticdesign.simulation.loop import LoopConfig, Trace, _hand_matrices, model_device
+from hapticdesign.simulation.config import (
+    STATUS_COMPLETED, STATUS_DIVERGED, STATUS_EXCURSION, LoopConfig, Trace, hand_matrices, model_device,
+)
 from hapticdesign.simulation.paths import Path
 
 
@@ -36,7 +40,7 @@ def simulate_adaptive(
 ) -> Trace:
     """Run the loop of :func:`~hapticdesign.simulation.loop.simulate` with SciPy's RK45."""
     n = device.n_dof
-    config.steps_per_sample()
+    sub = config.steps_per_sample()
     period = config.sensors.period
     paths = dict(paths or {})
     wall = config.wall
@@ -62,7 +66,7 @@ def simulate_adaptive(
 
     q_start = np.zeros(n) if q0 is None else np.asarray(q0, dtype=float).copy()
     q_start[fixed] = path_at(0.0)[0][fixed]
-    hand_mass, hand_damping, hand_stiffness = _hand_matrices(device, config.hand, q_start)
+    hand_mass, hand_damping, hand_stiffness = hand_matrices(device, config.hand, q_start)
     damping = damping + hand_damping
 
     def accel(t: float, q: np.ndarray, qd: np.ndarray, u: np.ndarray):
@@ -94,13 +98,32 @@ def simulate_adaptive(
     rec = {k: [] for k in ("q", "qd", "u", "f", "imp", "c")}
     tripped_at = None
     status = STATUS_COMPLETED
-    tau_f, tau_imp = np.zeros(n), np.zeros(n)
+    reference = q_start[wall.joint]
+    peak, end_time = 0.0, 0.0
+    j_, k_ = np.triu_indices(n)
+
+    def state_at(t: float, y: np.ndarray):
+        qp, qdp, _ = path_at(t)
+        q_t, qd_t = qp.copy(), qdp.copy()
+        q_t[free], qd_t[free] = y[: len(free)], y[len(free):]
+        return q_t, qd_t
+
+    def plant_step_check(t: float, q_t: np.ndarray, qd_t: np.ndarray) -> int | None:
+        """The checks the loop makes at one plant-step instant: finite state, peak, excursion stop."""
+        nonlocal peak, end_time
+        end_time = t
+        if not (np.all(np.isfinite(q_t)) and np.all(np.isfinite(qd_t))) or np.max(np.abs(qd_t)) > 1e8:
+            return STATUS_DIVERGED
+        excursion = abs(q_t[wall.joint] - reference)
+        peak = max(peak, excursion)
+        return STATUS_EXCURSION if excursion >= stop else None
+
     for k in range(n_samples + 1):
         t = k * period
         qp, qdp, _ = path_at(t)
         q[fixed], qd[fixed] = qp[fixed], qdp[fixed]
-        if not (np.all(np.isfinite(q)) and np.all(np.isfinite(qd))):
-            status = STATUS_DIVERGED
+        if k == 0 and (ended := plant_step_check(t, q, qd)) is not None:
+            status = ended
             break
         qdd_minus, _ = accel(t, q, qd, u)
         if k == 0:
@@ -110,7 +133,6 @@ def simulate_adaptive(
         if quant > 0:
             qs = np.round(qs / quant) * quant
         h_m, c_m, g_m = _terms(device, pi_model, qs)
-        j_, k_ = np.triu_indices(n)
         tau_f = comp.inertial * (h_m @ qdds) + comp.coriolis * (c_m @ (qds[j_] * qds[k_])) + comp.gravity * g_m
         tau_imp = np.zeros(n)
         tau_imp[wall.joint] = wall.stiffness * (qs[wall.joint] - wall.equilibrium) + wall.damping * qds[wall.joint]
@@ -120,19 +142,35 @@ def simulate_adaptive(
         _, tau_c = accel(t, q, qd, u)
         for key, val in zip(rec, (q, qd, u, tau_f, tau_imp, tau_c)):
             rec[key].append(val.copy())
-        if abs(q[wall.joint] - q_start[wall.joint]) >= stop:
-            status = STATUS_EXCURSION
-            break
         if k == n_samples:
             break
-        if free:
-            sol = solve_ivp(rhs, (t, t + period), np.concatenate([q[free], qd[free]]), method="RK45",
-                            rtol=rtol, atol=atol, args=(u,))
-            y = sol.y[:, -1]
-            q[free], qd[free] = y[: len(free)], y[len(free):]
-        if tripped_at is None and abs(q[wall.joint] - q_start[wall.joint]) >= safety:
-            tripped_at = t + period
+        ended, start, y = None, t, np.concatenate([q[free], qd[free]])
+        instants = t + config.step * np.arange(1, sub + 1)
+        while start < instants[-1] - 0.5 * config.step and ended is None:
+            todo = instants[instants > start + 0.5 * config.step]
+            if free:
+                sol = solve_ivp(rhs, (start, todo[-1]), y, method="RK45", rtol=rtol, atol=atol, args=(u,),
+                                dense_output=True)
+                states = sol.sol(todo).T
+            else:
+                states = np.zeros((len(todo), 0))
+            for t_j, y_j in zip(todo, states):
+                q_j, qd_j = state_at(t_j, y_j)
+                ended = plant_step_check(t_j, q_j, qd_j)
+                if ended is not None:
+                    break
+                if tripped_at is None and abs(q_j[wall.joint] - reference) >= safety:
+                    tripped_at = t_j
+                    u = np.zeros(n)
+                    start, y = t_j, y_j
+                    break
+            else:
+                start, y = todo[-1], states[-1] if free else y
+        q, qd = state_at(instants[-1], y)
+        if ended is not None:
+            status = ended
+            break
     arrays = {k: np.array(v).reshape(-1, n) for k, v in rec.items()}
     times = np.arange(len(arrays["q"])) * period
     return Trace(times, arrays["q"], arrays["qd"], arrays["u"], arrays["f"], arrays["imp"], arrays["c"],
-                 status, tripped_at)
+                 status, tripped_at, peak, end_time)

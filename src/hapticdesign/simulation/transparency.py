@@ -23,7 +23,8 @@ from scipy.signal import csd, welch
 
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
-from hapticdesign.simulation.loop import LoopConfig, Wall, simulate
+from hapticdesign.simulation.config import LoopConfig, Wall
+from hapticdesign.simulation.loop import simulate
 from hapticdesign.simulation.paths import Chirp, Held, Path
 
 

@@ -17,7 +17,7 @@ from hapticdesign.interface.common import print_json, progress_bar, user_errors,
 
 def _loop_config(period, step, duration, counts, delay, error_percent, inertial, coriolis, gravity,
                  wall_damping, hand_mass, hand_damping, hand_stiffness):
-    from hapticdesign.simulation.loop import Compensator, Hand, LoopConfig, Sensors, Wall
+    from hapticdesign.simulation.config import Compensator, Hand, LoopConfig, Sensors, Wall
 
     hand = None
     if hand_mass or hand_damping or hand_stiffness:
@@ -63,6 +63,9 @@ def impedance_range_command(
     joint: str = typer.Option("1", help="Joint carrying the virtual wall (1-based or coordinate name)."),
     equilibrium: float = typer.Option(0.01, help="Wall equilibrium [rad]; the joints start at 0."),
     method: str = typer.Option("fast", help="fast (doubling + bisection) or linear (K = 1, 2, 3, ...)."),
+    resolution: Optional[float] = typer.Option(
+        None, help="Stiffness grid R, 2R, 3R ... [N m/rad, or N/m for a prismatic joint]; reports k_min and k_max "
+                   "on it. Default: the seed's integer scan."),
     k_limit: int = typer.Option(200, help="Largest stiffness tried [N m/rad]."),
     overshoot: float = typer.Option(0.012, help="Overshoot limit, peak excursion from the start [rad]."),
     settle_tolerance: float = typer.Option(0.002, help="Settled: within this of the equilibrium at the end [rad]."),
@@ -79,7 +82,7 @@ def impedance_range_command(
     quiet: bool = QUIET,
 ) -> None:
     """Maximum stable impedance of one joint under a virtual spring (seed 000 §4.1.2-4.1.3)."""
-    from hapticdesign.simulation.impedance import Criteria, ImpedanceProblem, fast_search, linear_scan
+    from hapticdesign.simulation.impedance import Criteria, ImpedanceProblem, fast_search, grid_search, linear_scan
     from hapticdesign.simulation.impedance import true_boundary as growth_boundary
     from hapticdesign.simulation.loop import joint_index
 
@@ -91,17 +94,26 @@ def impedance_range_command(
             raise UserError(f"--method must be 'fast' or 'linear', got {method!r}")
         if k_limit < 1:
             raise UserError("--k-limit must be at least 1")
+        if resolution is not None and not (resolution > 0 and np.isfinite(resolution)):
+            raise UserError(f"--resolution must be a positive number, got {resolution}")
+        if resolution is not None and resolution > k_limit:
+            raise UserError(f"--resolution {resolution} is above --k-limit {k_limit}")
         criteria = Criteria(overshoot, settle_tolerance, settle_window, safety)
         problem = ImpedanceProblem(dev, _sim_type(sim_type), joint_index(dev, joint), equilibrium, criteria, config)
-        result = (fast_search if method == "fast" else linear_scan)(problem, k_limit)
+        if resolution is not None:
+            result = grid_search(problem, resolution, k_limit)
+        else:
+            result = (fast_search if method == "fast" else linear_scan)(problem, k_limit)
         out = {"device": dev.name, "type": sim_type, "joint": problem.wall_joint + 1, **result.as_dict()}
         if true_boundary:
             out["k_true_boundary"] = growth_boundary(problem)
         if json_out:
             print_json(out)
             return
+        lowest = "" if out["k_min"] is None else f", lowest passing {out['k_min']:g}"
         typer.echo(f"{dev.name}, type {sim_type}, joint {out['joint']}: maximum stable impedance "
-                   f"{out['k_max']:g} N m/rad (first failure: {out['criterion']}; {out['simulations']} simulations)")
+                   f"{out['k_max']:g} N m/rad{lowest} (first failure: {out['criterion']}; "
+                   f"{out['simulations']} simulations)")
         if true_boundary:
             typer.echo(f"oscillation-growth boundary: {out['k_true_boundary']:.4g} N m/rad")
 
@@ -159,27 +171,39 @@ def stability_boundary_command(
     delay: int = typer.Option(0, help="Sensor delay in samples."),
     wall_damping: float = typer.Option(0.0, help="Virtual damper B [N m s/rad]."),
     compensate_inertia: bool = typer.Option(False, help="Feed the sampled acceleration forward (J qdd)."),
+    error_percent: float = typer.Option(
+        0.0, help="Compensator modelling error E [%]: it feeds (1 - E/100) J qdd forward (needs --compensate-inertia)."),
     substeps: int = typer.Option(10, help="Plant steps per sample in the simulation."),
     samples: int = typer.Option(4000, help="Samples per simulation of the growth test."),
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
 ) -> None:
     """Exact vs simulated stiffness limit of a 1-DOF mass-damper under a sampled spring (check of seed 000 ch. 4)."""
-    from hapticdesign.simulation.boundary import MassDamper, exact_boundary, simulated_boundary
+    from hapticdesign.simulation.boundary import MassDamper, compensated_boundary, exact_boundary, simulated_boundary
 
     with user_errors(quiet=quiet):
         if substeps < 1 or samples < 40:
             raise UserError("--substeps must be at least 1 and --samples at least 40")
-        system = MassDamper(inertia, damping, period, delay, wall_damping, compensate_inertia)
+        if not (np.isfinite(error_percent) and error_percent <= 100):
+            raise UserError(f"--error-percent must be a finite number <= 100, got {error_percent}")
+        if error_percent and not compensate_inertia:
+            raise UserError("--error-percent needs --compensate-inertia (it scales the compensator's inertia)")
+        fraction = 1.0 - error_percent / 100.0
+        system = MassDamper(inertia, damping, period, delay, wall_damping, compensate_inertia,
+                            model_inertia=fraction * inertia)
         exact = exact_boundary(system)
+        closed = (compensated_boundary(inertia, damping, period, fraction)
+                  if compensate_inertia and delay == 0 and wall_damping == 0 else None)
         simulated = simulated_boundary(system, samples=samples, substeps=substeps)
-        out = {"k_max_exact": exact, "k_max_simulated": simulated,
+        out = {"k_max_exact": exact, "k_max_closed_form": closed, "k_max_simulated": simulated,
                "relative_difference": (simulated - exact) / exact if exact not in (0.0, np.inf) else None,
-               "two_b_over_t": 2 * damping / period}
+               "two_b_over_t": 2 * damping / period, "error_percent": error_percent}
         if json_out:
             print_json(out)
             return
-        typer.echo(f"exact {exact:.6g} N m/rad, simulated {simulated:.6g} N m/rad (2b/T = {2 * damping / period:.6g})")
+        form = "" if closed is None else f", closed form {closed:.6g}"
+        typer.echo(f"exact {exact:.6g} N m/rad{form}, simulated {simulated:.6g} N m/rad "
+                   f"(2b/T = {2 * damping / period:.6g})")
 
 
 def campaign_command(
