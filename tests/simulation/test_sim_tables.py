@@ -10,8 +10,8 @@ from hapticdesign.simulation.tables import DynamicsTables, evaluate_entries, unp
 def _numba_terms(tables, q):
     n = tables.n_dof
     values = np.zeros((n, workspace_size(tables)))
-    entries = np.zeros(tables.coef.shape[1])
-    evaluate_entries(q, tables.coef, tables.index, tables.kinds, tables.degrees, values, entries)
+    entries, phi = np.zeros(tables.n_entries), np.zeros(tables.index.shape[0])
+    evaluate_entries(q, *tables.sparse, tables.index, tables.kinds, tables.degrees, values, phi, entries)
     h, c, g = np.zeros((n, n)), np.zeros((n, n * (n + 1) // 2)), np.zeros(n)
     unpack_entries(entries, n, h, c, g)
     return h, c, g

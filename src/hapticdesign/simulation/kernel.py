@@ -24,7 +24,7 @@ from hapticdesign.simulation.config import STATUS_COMPLETED, STATUS_DIVERGED, ST
 from hapticdesign.simulation.tables import evaluate_entries, unpack_entries, velocity_products
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def _solve_in_place(a, b, n):
     """Gaussian elimination with partial pivoting on the leading n x n block; b becomes x."""
     for col in range(n):
@@ -48,9 +48,10 @@ def _solve_in_place(a, b, n):
         b[col] = s / a[col, col]
 
 
-@nb.njit(cache=True)
-def _plant_terms(q, coef, index, kinds, degrees, ws_values, ws_entries, cache_q, cache_valid, h, c, g):
-    """H, C, G of the plant at q, reusing the last evaluation when the non-cyclic q is unchanged."""
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _plant_terms(q, table, hand_mass, ws_values, ws_phi, ws_entries, cache_q, cache_valid, h, c, g):
+    """H + M_hand, C, G of the plant at q, reusing the last evaluation when the non-cyclic q is unchanged."""
+    rows, cols, vals, index, kinds, degrees = table
     n = q.shape[0]
     same = cache_valid[0] == 1
     if same:
@@ -59,20 +60,24 @@ def _plant_terms(q, coef, index, kinds, degrees, ws_values, ws_entries, cache_q,
                 same = False
                 break
     if not same:
-        evaluate_entries(q, coef, index, kinds, degrees, ws_values, ws_entries)
+        evaluate_entries(q, rows, cols, vals, index, kinds, degrees, ws_values, ws_phi, ws_entries)
         unpack_entries(ws_entries, n, h, c, g)
+        for i in range(n):
+            for j in range(n):
+                h[i, j] += hand_mass[i, j]
         for k in range(n):
             cache_q[k] = q[k]
         cache_valid[0] = 1
 
 
-@nb.njit(cache=True)
-def accelerations(q, qd, qdd_path, u, prescribed, coef, index, kinds, degrees, damping, hand_mass,
-                  hand_stiffness, hand_rest, ws, qdd, tau_c):
-    """Joint accelerations (free joints solved, prescribed taken from the path) and constraint torques."""
-    ws_values, ws_entries, cache_q, cache_valid, h, c, g, qd2, a, rhs, free = ws
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def accelerations(q, qd, qdd_path, u, prescribed, table, damping, hand_mass, hand_stiffness, hand_rest, ws, qdd,
+                  tau_c, want_tau_c=True):
+    """Joint accelerations (free joints solved, prescribed taken from the path) and, when
+    ``want_tau_c``, the constraint torques (``tau_c`` is scratch otherwise)."""
+    ws_values, ws_phi, ws_entries, cache_q, cache_valid, h, c, g, qd2, a, rhs, free = ws
     n = q.shape[0]
-    _plant_terms(q, coef, index, kinds, degrees, ws_values, ws_entries, cache_q, cache_valid, h, c, g)
+    _plant_terms(q, table, hand_mass, ws_values, ws_phi, ws_entries, cache_q, cache_valid, h, c, g)
     velocity_products(qd, qd2)
     bias = tau_c
     for i in range(n):
@@ -80,7 +85,9 @@ def accelerations(q, qd, qdd_path, u, prescribed, coef, index, kinds, degrees, d
         for col in range(qd2.shape[0]):
             s += c[i, col] * qd2[col]
         for j in range(n):
-            s += damping[i, j] * qd[j] + hand_stiffness[i, j] * (q[j] - hand_rest[j])
+            s += damping[i, j] * qd[j]
+            if hand_stiffness[i, j] != 0.0:
+                s += hand_stiffness[i, j] * (q[j] - hand_rest[j])
         bias[i] = s
     nf = 0
     for i in range(n):
@@ -94,22 +101,24 @@ def accelerations(q, qd, qdd_path, u, prescribed, coef, index, kinds, degrees, d
         s = -bias[i]
         for j in range(n):
             if prescribed[j]:
-                s -= (h[i, j] + hand_mass[i, j]) * qdd[j]
+                s -= h[i, j] * qdd[j]
         rhs[r] = s
         for cc in range(nf):
-            a[r, cc] = h[i, free[cc]] + hand_mass[i, free[cc]]
+            a[r, cc] = h[i, free[cc]]
     if nf > 0:
         _solve_in_place(a, rhs, nf)
     for r in range(nf):
         qdd[free[r]] = rhs[r]
+    if not want_tau_c:
+        return
     for i in range(n):
         s = bias[i]
         for j in range(n):
-            s += (h[i, j] + hand_mass[i, j]) * qdd[j]
+            s += h[i, j] * qdd[j]
         tau_c[i] = 0.0 if not prescribed[i] else s
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def _stage_state(q, qd, kq, a, h, prescribed, path_q_row, path_qd_row, qs, qds):
     """RK4 stage state ``(q + h kq, qd + h a)``; prescribed joints take the path's value instead."""
     for i in range(q.shape[0]):
@@ -121,11 +130,12 @@ def _stage_state(q, qd, kq, a, h, prescribed, path_q_row, path_qd_row, qs, qds):
             qds[i] = qd[i] + h * a[i]
 
 
-@nb.njit(cache=True)
-def compensator_torque(q, qd, qdd, coef, index, kinds, degrees, switches, ws_values, ws_entries, h, c, g, qd2, out):
+@nb.njit(cache=True, error_model="numpy")
+def compensator_torque(q, qd, qdd, table, switches, ws_values, ws_phi, ws_entries, h, c, g, qd2, out):
     """Model-based feedforward ``tau_f = s_H H qdd + s_C C qd^2 + s_G G`` (seed §4.1.1.2)."""
+    rows, cols, vals, index, kinds, degrees = table
     n = q.shape[0]
-    evaluate_entries(q, coef, index, kinds, degrees, ws_values, ws_entries)
+    evaluate_entries(q, rows, cols, vals, index, kinds, degrees, ws_values, ws_phi, ws_entries)
     unpack_entries(ws_entries, n, h, c, g)
     velocity_products(qd, qd2)
     for i in range(n):
@@ -138,17 +148,17 @@ def compensator_torque(q, qd, qdd, coef, index, kinds, degrees, switches, ws_val
         out[i] = switches[0] * s_h + switches[1] * s_c + switches[2] * g[i]
 
 
-def make_workspace(n: int, n_values: int, n_entries: int):
+def make_workspace(n: int, n_values: int, n_basis: int, n_entries: int):
     """Scratch arrays for :func:`accelerations` (one set per plant)."""
     m = n * (n + 1) // 2
     return (
-        np.zeros((n, n_values)), np.zeros(n_entries), np.zeros(n), np.zeros(1, dtype=np.int64),
+        np.zeros((n, n_values)), np.zeros(n_basis), np.zeros(n_entries), np.zeros(n), np.zeros(1, dtype=np.int64),
         np.zeros((n, n)), np.zeros((n, m)), np.zeros(n), np.zeros(m), np.zeros((n, n)), np.zeros(n),
         np.zeros(n, dtype=np.int64),
     )
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, error_model="numpy")
 def run_loop(plant, model, ws_plant, ws_model, damping, hand_mass, hand_stiffness, hand_rest, prescribed,
              path_q, path_qd, path_qdd, q0, qd0, step, sub, n_steps, wall_joint, wall_k, wall_b, wall_eq,
              switches, quant, delay, safety_limit, reference, stop_excursion, stride,
@@ -158,8 +168,6 @@ def run_loop(plant, model, ws_plant, ws_model, damping, hand_mass, hand_stiffnes
 
     The excursion is checked at every plant step, so a run stopped at ``stop_excursion`` reports a
     peak at or above it even when no recorded row (every ``stride`` steps) shows it."""
-    coef, index, kinds, degrees = plant
-    coef_m = model[0]
     n = q0.shape[0]
     q = q0.copy()
     qd = qd0.copy()
@@ -178,7 +186,7 @@ def run_loop(plant, model, ws_plant, ws_model, damping, hand_mass, hand_stiffnes
     qs = np.zeros(n); qds = np.zeros(n)
     buf = np.zeros((delay + 1, 3, n))
     sensed = np.zeros((3, n))
-    m_values, m_entries, _, _, m_h, m_c, m_g, m_qd2, _, _, _ = ws_model
+    m_values, m_phi, m_entries, _, _, m_h, m_c, m_g, m_qd2, _, _, _ = ws_model
     n_free = 0
     for i in range(n):
         if not prescribed[i]:
@@ -192,7 +200,7 @@ def run_loop(plant, model, ws_plant, ws_model, damping, hand_mass, hand_stiffnes
     for it in range(n_steps + 1):
         t = it * step
         if it % sub == 0:
-            accelerations(q, qd, path_qdd[2 * it], u, prescribed, coef, index, kinds, degrees, damping,
+            accelerations(q, qd, path_qdd[2 * it], u, prescribed, plant, damping,
                           hand_mass, hand_stiffness, hand_rest, ws_plant, qdd, c1)
             if it == 0:
                 for i in range(n):
@@ -212,8 +220,8 @@ def run_loop(plant, model, ws_plant, ws_model, damping, hand_mass, hand_stiffnes
                 sensed[0, i] = pos
                 sensed[1, i] = buf[old, 1, i]
                 sensed[2, i] = buf[old, 2, i]
-            compensator_torque(sensed[0], sensed[1], sensed[2], coef_m, index, kinds, degrees, switches,
-                               m_values, m_entries, m_h, m_c, m_g, m_qd2, tau_f)
+            compensator_torque(sensed[0], sensed[1], sensed[2], model, switches,
+                               m_values, m_phi, m_entries, m_h, m_c, m_g, m_qd2, tau_f)
             for i in range(n):
                 tau_imp[i] = 0.0
             tau_imp[wall_joint] = wall_k * (sensed[0, wall_joint] - wall_eq) + wall_b * sensed[1, wall_joint]
@@ -224,7 +232,7 @@ def run_loop(plant, model, ws_plant, ws_model, damping, hand_mass, hand_stiffnes
             for i in range(n):
                 u[i] = tau_f[i] - tau_imp[i]
         # stage 1 (also gives the recorded constraint torque)
-        accelerations(q, qd, path_qdd[2 * it], u, prescribed, coef, index, kinds, degrees, damping,
+        accelerations(q, qd, path_qdd[2 * it], u, prescribed, plant, damping,
                       hand_mass, hand_stiffness, hand_rest, ws_plant, a1, c1)
         if it % stride == 0:
             r = it // stride
@@ -261,16 +269,16 @@ def run_loop(plant, model, ws_plant, ws_model, damping, hand_mass, hand_stiffnes
             k1q[:] = qd
             _stage_state(q, qd, k1q, a1, 0.5 * step, prescribed, path_q[2 * it + 1], path_qd[2 * it + 1], qs, qds)
             k2q[:] = qds
-            accelerations(qs, qds, path_qdd[2 * it + 1], u, prescribed, coef, index, kinds, degrees, damping,
-                          hand_mass, hand_stiffness, hand_rest, ws_plant, a2, tau_c)
+            accelerations(qs, qds, path_qdd[2 * it + 1], u, prescribed, plant, damping,
+                          hand_mass, hand_stiffness, hand_rest, ws_plant, a2, tau_c, False)
             _stage_state(q, qd, k2q, a2, 0.5 * step, prescribed, path_q[2 * it + 1], path_qd[2 * it + 1], qs, qds)
             k3q[:] = qds
-            accelerations(qs, qds, path_qdd[2 * it + 1], u, prescribed, coef, index, kinds, degrees, damping,
-                          hand_mass, hand_stiffness, hand_rest, ws_plant, a3, tau_c)
+            accelerations(qs, qds, path_qdd[2 * it + 1], u, prescribed, plant, damping,
+                          hand_mass, hand_stiffness, hand_rest, ws_plant, a3, tau_c, False)
             _stage_state(q, qd, k3q, a3, step, prescribed, path_q[2 * it + 2], path_qd[2 * it + 2], qs, qds)
             k4q[:] = qds
-            accelerations(qs, qds, path_qdd[2 * it + 2], u, prescribed, coef, index, kinds, degrees, damping,
-                          hand_mass, hand_stiffness, hand_rest, ws_plant, a4, tau_c)
+            accelerations(qs, qds, path_qdd[2 * it + 2], u, prescribed, plant, damping,
+                          hand_mass, hand_stiffness, hand_rest, ws_plant, a4, tau_c, False)
             for i in range(n):
                 if prescribed[i]:
                     q[i] = path_q[2 * it + 2, i]

@@ -110,10 +110,10 @@ def simulate_tables(
     rec = [np.zeros((n_rec, n)) for _ in range(6)]
     switches = np.array([comp.inertial, comp.coriolis, comp.gravity], dtype=float)
     written, status, trip, peak, end_time = kernel.run_loop(
-        (plant.coef, plant.index, plant.kinds, plant.degrees),
-        (model.coef, model.index, model.kinds, model.degrees),
-        kernel.make_workspace(n, n_values, plant.coef.shape[1]),
-        kernel.make_workspace(n, n_values, plant.coef.shape[1]),
+        (*plant.sparse, plant.index, plant.kinds, plant.degrees),
+        (*model.sparse, model.index, model.kinds, model.degrees),
+        kernel.make_workspace(n, n_values, plant.index.shape[0], plant.n_entries),
+        kernel.make_workspace(n, n_values, model.index.shape[0], model.n_entries),
         np.diag(damping) + hand_damping, hand_mass, hand_stiffness, q_start.copy(), prescribed,
         path_q, path_qd, path_qdd, q_start, np.zeros(n), config.step, sub, n_steps,
         wall.joint, float(wall.stiffness), float(wall.damping), float(wall.equilibrium), switches, quant,
