@@ -10,7 +10,7 @@ from hapticdesign.model.inertia import BodyInertia, check_body, pseudo_inertia
 
 
 def test_default_design_is_consistent_and_exactly_linear(phantom3):
-    """CONVENTIONS: the built-in default is eq. 3.33 made exact and realizable: H, G constant, C = 0."""
+    """The built-in default is eq. 3.33 made exact and realizable: H, G constant, C = 0."""
     assert phantom3.check(strict=True) == []
     rng = np.random.default_rng(0)
     qs = rng.uniform(-np.pi, np.pi, (50, 3))

@@ -17,7 +17,7 @@ Mapping (seed 000 eq. 2.53-2.55, Appendix A.3), with the literature lengths
   inertias about the joint axes: we move them to the mass centre with the parallel-axis
   theorem before handing them to our model (the seed's Appendix A.3 leaves this implicit).
 
-Test vectors: the literature closed form at g = 9.81 (CONVENTIONS.md).
+Test vectors: the literature closed form at g = 9.81 (public transcriptions of Cavusoglu & Feygin 2001).
 """
 
 from __future__ import annotations
@@ -110,7 +110,7 @@ def test_literature_closed_form_mass_matrix_at_random_poses(phantom3):
 
 
 def test_literature_inertias_are_not_rigid_bodies():
-    """CONVENTIONS: the be and df inertias, as published, break the triangle inequality."""
+    """The be and df inertias, as published, break the triangle inequality."""
     assert check_body("2", _body(MASS["be"], (L5, 0, 0), INERTIA["be"], SET1)).warning is not None
     assert check_body("3a", _body(MASS["df"], (0, 0, -L6), INERTIA["df"], SET2)).warning is not None
     assert check_body("3", _body(MASS["a"], (0, 0, L2 / 2), INERTIA["a"], SET2)).warning is None

@@ -30,7 +30,7 @@ def test_mass_matrix_positive_definite_and_passivity(name, request):
 
 @pytest.mark.parametrize("name", ["phantom3", "phantom6"])
 def test_christoffel_from_finite_differences(name, request):
-    """C's columns hold Gamma_ijj and 2 Gamma_ijk built from dH/dq (CONVENTIONS, eq. 2.50)."""
+    """C's columns hold Gamma_ijj and 2 Gamma_ijk built from dH/dq (eq. 2.50; Appendix A.2's code computes them so)."""
     device = request.getfixturevalue(name)
     model = device.model
     rng = np.random.default_rng(3)

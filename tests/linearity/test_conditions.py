@@ -16,7 +16,7 @@ DEPENDENT = ("r2x", "r2y", "r2z", "r2ay", "r3x", "r3y", "r3z", "r3ax", "r3az", "
 
 
 def seed_equations(p: dict, l2: float, l3a: float) -> dict:
-    """Eq. 3.12-3.26 as printed (eq. 3.22 with l3a^2 m2a, CONVENTIONS.md)."""
+    """Eq. 3.12-3.26 as printed (eq. 3.22 read as l3a^2 m2a: with the printed l4^2 m2a the conditions do not give LN = 0)."""
     p = dict(p)
     p["r2x"] = -(l2 * p["m2a"] + l2 * p["m3"] + p["m2a"] * p["r2ax"]) / p["m2"]
     p["r2y"] = p["r2ay"] = p["r3x"] = p["r3ax"] = 0.0

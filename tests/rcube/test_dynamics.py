@@ -63,7 +63,7 @@ def test_nonlinear_terms_equal_the_cartesian_lagrangian():
 
 
 def test_total_link_mass_table_7_9():
-    # Table 7.8's tubes at the laminate density CONVENTIONS.md derives (1.79 g/cm^3): 77.7 g
+    # Table 7.8's tubes at a laminate density of 1.79 g/cm^3: 77.7 g
     assert DESIGN.total_link_mass() == pytest.approx(0.0777, abs=5e-5)
 
 

@@ -32,7 +32,7 @@ def test_simulated_boundary_agrees_with_exact_within_one_percent(inertia, dampin
 
 
 def test_exact_boundary_is_slightly_above_two_b_over_t():
-    """Without compensation the limit is about 2b/T, slightly above (CONVENTIONS.md)."""
+    """Without compensation the limit is about 2b/T, slightly above."""
     for inertia, damping, period in [(0.01, 0.5, 1e-3), (0.1, 0.2, 1e-3), (0.005, 0.1, 2e-4)]:
         k = exact_boundary(MassDamper(inertia, damping, period))
         assert 2 * damping / period < k < 1.02 * 2 * damping / period

@@ -3,13 +3,14 @@
 Frames: ``body<i>`` carries link i's inertial parameters in the seed's convention (origin
 ``P_{i-1}``, orientation ``C(0,i)``), ``link<i>`` is DH frame i. The parallelogram links:
 link 2a has link 2's orientation and origin ``P_2a = P_2 + l3a C(0,3) u3``; link 3a has link 3's
-orientation and origin ``P_3a = P_2a - l2a C(0,2) u1`` (eq. 2.38-2.39 and CONVENTIONS.md);
+orientation and origin ``P_3a = P_2a - l2a C(0,2) u1`` (eq. 2.38-2.39);
 their mass centres are ``P_2a + C(0,2) r_2a`` and ``P_3a + C(0,3) r_3a`` (eq. 2.31-2.32).
 As elementary transforms: ``2a = link2 . Rz(q3) Rx(-pi/2) tz(l3a) Rx(pi/2) Rz(-q3)`` and
 ``3a = 2a . tx(-l2a) Rz(q3) Rx(-pi/2)`` (the dependent angle ``-q3`` undoes the rotation).
 
 Default inertial parameters of links 1-3: the exactly linear, physically consistent variant of
-the seed's example design (eq. 3.33) given in CONVENTIONS.md: eq. 3.33's free values with
+the seed's example design (eq. 3.33; as printed it has LN = 1.18e-6 and link 2 breaks the triangle
+inequality): eq. 3.33's free values with
 ``r2x, r3z, r3az, Iyy2a, Izz3a`` solved exactly from eq. 3.12-3.26 and ``Ixx2`` lowered from
 0.00982641 to 0.00975562 so that link 2 meets the triangle inequality.
 

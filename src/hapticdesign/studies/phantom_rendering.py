@@ -22,26 +22,34 @@ def default_design(ctx: Context) -> Outcome:
     """Maximum stable impedance (§4.1.2-4.1.3) and transparency bandwidth (§4.2.2-4.2.3), types 1 and 2."""
     impedance_range = engine("hapticdesign.simulation.impedance", "impedance_range")
     type_paths = engine("hapticdesign.simulation.impedance", "type_paths")
+    Criteria = engine("hapticdesign.simulation.impedance", "Criteria")
     transparency = engine("hapticdesign.simulation.transparency", "transparency")
     loop = engine("hapticdesign.simulation.loop", "simulate")
-    LoopConfig = engine("hapticdesign.simulation.loop", "LoopConfig")
-    Wall = engine("hapticdesign.simulation.loop", "Wall")
+    LoopConfig = engine("hapticdesign.simulation.config", "LoopConfig")
+    Wall = engine("hapticdesign.simulation.config", "Wall")
     device = ctx.settings.device()
     ranges = {t: impedance_range(device, t, k_limit=ctx.settings.k_limit) for t in (1, 2)}
+    resolution = 1.0
+    if ranges[1].k_max < 1:  # below the seed's integer grid: find the range on a finer one
+        resolution = 0.01
+        ranges = {t: impedance_range(device, t, k_limit=ctx.settings.k_limit, resolution=resolution) for t in (1, 2)}
     ctx.update(1, 3)
-    bands = {t: transparency(device, t) for t in (1, 2)}
-    ctx.update(2, 3)
     k = ranges[1].k_max
+    seed_stiffness = 4.0
+    stiffness = seed_stiffness if k >= seed_stiffness or k == 0 else k
+    bands = {t: transparency(device, t, stiffness) for t in (1, 2)}
+    ctx.update(2, 3)
+    overshoot = Criteria().overshoot_limit
     fig, ax = plt.subplots(figsize=(7, 3.8))
-    for stiffness, style in ((k, "-"), (k + 1, "--")):
-        trace = loop(device, LoopConfig(duration=5.0, wall=Wall(0, float(stiffness), 0.0, 0.01)), type_paths(1, device.n_dof))
-        ax.plot(trace.t, trace.q[:, 0], style, label=f"K = {stiffness:g} N m/rad")
-    ax.axhline(0.01 + 0.012, color="grey", lw=0.8, ls=":", label="overshoot limit")
+    for gain, style in ((k, "-"), (k + resolution, "--")):
+        trace = loop(device, LoopConfig(duration=5.0, wall=Wall(0, float(gain), 0.0, 0.01)), type_paths(1, device.n_dof))
+        ax.plot(trace.t, trace.q[:, 0], style, label=f"K = {gain:g} N m/rad")
+    ax.axhline(overshoot, color="grey", lw=0.8, ls=":", label=f"overshoot limit ({overshoot:g} rad from the start)")
     ax.set_xlabel("t [s]")
     ax.set_ylabel("theta1 [rad]")
     ax.legend()
     wall_fig = figure_from_matplotlib(fig, "wall_response", "Virtual wall on joint 1, type 1",
-                                      "at the maximum stable stiffness and one step above it")
+                                      f"at the maximum stable stiffness and one grid step ({resolution:g} N m/rad) above it")
     fig, ax = plt.subplots(figsize=(7, 3.8))
     for t, result in bands.items():
         ax.semilogx(result.frequency, 20 * np.log10(np.abs(result.g_t)), label=f"type {t}")
@@ -53,6 +61,15 @@ def default_design(ctx: Context) -> Outcome:
     gt_fig = figure_from_matplotlib(fig, "transparency", "Transparency of the default design (eq. 4.2, Figure 4.18 layout)")
     ctx.update(3, 3)
     rows = [[f"type {t}", ranges[t].k_max, ranges[t].criterion, bands[t].bandwidth_hz] for t in (1, 2)]
+    damping = ", ".join(f"{b:.2f}" for b in device.damping)
+    if stiffness == seed_stiffness and k < seed_stiffness:
+        wall_note = (f"Warning: K = {seed_stiffness:g} N m/rad, the seed's transparency stiffness, is not stable for this "
+                     f"design (K_max = {k:g} N m/rad); the bandwidths below are those of an unstable wall.")
+    elif stiffness != seed_stiffness:
+        wall_note = (f"Transparency is computed at K = {stiffness:g} N m/rad, this design's largest stable stiffness, "
+                     f"because the seed's K = {seed_stiffness:g} N m/rad is not stable for it.")
+    else:
+        wall_note = f"Transparency is computed at the seed's K = {seed_stiffness:g} N m/rad, stable for this design."
     settings = _settings_table(device, LoopConfig(), type_paths(2, device.n_dof)[1])
     same = ranges[1].k_max == ranges[2].k_max
     ln = float(engine("hapticdesign.analysis.linearity.service", "device_form")(device).ln(device.standard_parameters()))
@@ -65,15 +82,20 @@ def default_design(ctx: Context) -> Outcome:
         summary=f"{device.name}: maximum stable impedance {ranges[1].k_max:g} / {ranges[2].k_max:g} N m/rad and "
                 f"transparency bandwidth {_hz(bands[1].bandwidth_hz)} / {_hz(bands[2].bandwidth_hz)} (type 1 / type 2).",
         paragraphs=[
-            "Seed settings: damping 0.50, 0.50, 0.35 N m s/rad (Table 4.1), plant step 1e-4 s, 1 kHz sampling with "
-            "zero-order hold, wall equilibrium 0.01 rad (Table 4.2), overshoot limit 0.012 rad, settling within 5 s, "
-            "safety switch at 0.06 rad; transparency with a 0.3 rad chirp from 0.1 to 15 Hz over 10 s and K = 4 N m/rad.",
+            f"Settings used: this device's joint damping {damping} N m s/rad (the seed's Table 4.1 has 0.50, 0.50, "
+            "0.35 for the Phantom), plant step 1e-4 s, 1 kHz sampling with zero-order hold, wall equilibrium 0.01 rad "
+            "(Table 4.2), overshoot limit 0.012 rad of excursion from the start (checked at every plant step), "
+            "settling within 5 s, safety switch at 0.06 rad; transparency with a 0.3 rad chirp from 0.1 to 15 Hz over "
+            f"10 s. Stiffness grid: {resolution:g} N m/rad" + (" (the seed's integer scan)." if resolution == 1 else
+                                                                 " (no integer stiffness is stable)."),
+            wall_note,
             finding,
         ],
         tables=[settings, Table("default_design", "Joint 1 of the design", ["simulation", "K_max [N m/rad]",
                                                                                 "limiting criterion", "bandwidth [Hz]"], rows)],
         figures=[wall_fig, gt_fig],
-        numbers={"k_max_type1": ranges[1].k_max, "k_max_type2": ranges[2].k_max,
+        numbers={"k_max_type1": ranges[1].k_max, "k_max_type2": ranges[2].k_max, "resolution": resolution,
+                 "transparency_stiffness": stiffness,
                  "bandwidth_hz_type1": bands[1].bandwidth_hz, "bandwidth_hz_type2": bands[2].bandwidth_hz},
     )
 
@@ -105,7 +127,8 @@ def _hz(value) -> str:
 
 
 def boundary(ctx: Context) -> Outcome:
-    """The sampled-data check of CONVENTIONS.md: exact (spectral radius) against simulated boundary."""
+    """The check any sampled-data simulator must pass: exact (spectral radius) against simulated boundary
+    of a 1-DOF mass-damper under a zero-order-hold spring."""
     MassDamper = engine("hapticdesign.simulation.boundary", "MassDamper")
     exact_boundary = engine("hapticdesign.simulation.boundary", "exact_boundary")
     simulated_boundary = engine("hapticdesign.simulation.boundary", "simulated_boundary")

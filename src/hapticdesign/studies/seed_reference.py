@@ -1,6 +1,6 @@
 """The seeds' printed numbers that the studies put side by side with ours.
 
-Seed 000 = Kizilbey (2019), seed 001 = Gorgulu (2018); see ``CONVENTIONS.md``. Values are as printed
+Seed 000 = Kizilbey (2019), seed 001 = Gorgulu (2018). Values are as printed
 (OCR transcription checked against the seed text); where a printed value is known to be rounded or
 mistyped the study says so next to it.
 """

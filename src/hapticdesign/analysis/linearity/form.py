@@ -2,7 +2,7 @@
 
 Seed 000 eq. 3.1-3.3: ``LN = sum_ij w_ij E[H_ij] + sum w E'[C] + sum_i w_i E[G_i]`` where ``E`` is
 the variance over the region R (eq. 3.2-3.3 divided by the region's volume V) and, as in the
-seed's Appendix B and CONVENTIONS.md, the C part is the mean square (C should vanish, not only
+seed's Appendix B (whose printed coefficients, e.g. ``Ixy3^2: 5``, reproduce so), the C part is the mean square (C should vanish, not only
 be constant). Every entry is ``sum_b phi_b(q) (A[b, e, :] @ pi)`` (the dynamics model's exact
 basis expansion), so with the basis covariance ``K_ab = Cov[phi_a, phi_b]`` and mean ``mu``:
 

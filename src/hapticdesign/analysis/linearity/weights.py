@@ -2,7 +2,7 @@
 
 One weight per entry of H (N x N), C (N x N(N+1)/2, eq. 2.50's form) and G (N). The seed
 uses unit weights throughout. Every (i, j) entry of H is counted, so an off-diagonal entry of
-the symmetric H contributes with ``W_H[i, j] + W_H[j, i]`` (CONVENTIONS.md).
+the symmetric H contributes with ``W_H[i, j] + W_H[j, i]`` (the reading under which Appendix B's printed coefficients reproduce).
 """
 
 from __future__ import annotations

@@ -16,7 +16,7 @@ from hapticdesign.analysis.stiffness.sections import Tube
 
 FINAL_DENSITY = 1790.0
 """Laminate density (kg/m^3) implied by Table 7.9's 77.7 g of links for Table 7.8's tubes (the seed
-states no density; see CONVENTIONS.md)."""
+states no density)."""
 
 
 @dataclass(frozen=True)
