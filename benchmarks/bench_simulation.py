@@ -2,7 +2,8 @@
 
 1. One 5-s virtual-wall simulation of the 3-DOF Phantom at the seed's settings (type 1, K = 4
    N m/rad, T = 1 ms, step 1e-4 s) with the numba RK4 loop and with the plain SciPy loop
-   (``solve_ivp`` RK45 per sample period), in the same run. Goal: 100 x faster.
+   (``solve_ivp`` RK45 per sample period, checking the excursion at every plant step as the
+   kernel does), in the same run. Goal (issue 15): 200 x faster.
 2. A mini campaign (16 designs x 2 criteria x 2 types) on local Dask processes, extrapolated to
    the seed's 600 designs (2400 cases). Goal: under 15 minutes on 2 cores.
 3. With ``--full``: the seed's whole campaign for real, 600 designs (Table 3.3 levels, 100 each,

@@ -81,6 +81,8 @@ def accelerations(q, qd, qdd_path, u, prescribed, table, damping, hand_mass, han
     velocity_products(qd, qd2)
     bias = tau_c
     for i in range(n):
+        if prescribed[i] and not want_tau_c:
+            continue
         s = g[i] - u[i]
         for col in range(qd2.shape[0]):
             s += c[i, col] * qd2[col]

@@ -105,15 +105,14 @@ def simulate_tables(
         q_start[j] = path_q[0, j]
     hand_mass, hand_damping, hand_stiffness = hand if hand is not None else (np.zeros((n, n)),) * 3
     comp = config.compensator
-    n_values = workspace_size(plant)
     n_rec = n_steps // stride + 1
     rec = [np.zeros((n_rec, n)) for _ in range(6)]
     switches = np.array([comp.inertial, comp.coriolis, comp.gravity], dtype=float)
     written, status, trip, peak, end_time = kernel.run_loop(
         (*plant.sparse, plant.index, plant.kinds, plant.degrees),
         (*model.sparse, model.index, model.kinds, model.degrees),
-        kernel.make_workspace(n, n_values, plant.index.shape[0], plant.n_entries),
-        kernel.make_workspace(n, n_values, model.index.shape[0], model.n_entries),
+        kernel.make_workspace(n, workspace_size(plant), plant.index.shape[0], plant.n_entries),
+        kernel.make_workspace(n, workspace_size(model), model.index.shape[0], model.n_entries),
         np.diag(damping) + hand_damping, hand_mass, hand_stiffness, q_start.copy(), prescribed,
         path_q, path_qd, path_qdd, q_start, np.zeros(n), config.step, sub, n_steps,
         wall.joint, float(wall.stiffness), float(wall.damping), float(wall.equilibrium), switches, quant,

@@ -20,6 +20,27 @@ from hapticdesign.studies.steps import Context, Outcome, Step, Table, engine, fi
 SCALES = ("full", "quick", "smoke")
 MAP_METRICS = ("manipulability", "condition_number", "I_f", "S_f", "S_d", "omega_n")
 
+METRIC_INFO = {
+    "manipulability": ("absolute manipulability |det J_m| (eq. 4.38)", "m^3/rad^3"),
+    "condition_number": ("condition number of J_m (eq. 4.33)", "dimensionless"),
+    "positioning_resolution": ("positioning resolution ||J_m|| (eq. 4.30)", "m/rad"),
+    "I_m": ("inertia volume det M_C (eq. 4.92-4.93)", "kg^3"),
+    "I_f": ("inertia norm ||M_C||_F (eq. 4.98)", "kg"),
+    "I_e": ("inertia uniformity ||M_C|| ||M_C^-1|| (eq. 4.99)", "dimensionless"),
+    "I_d": ("dynamic manipulability det(J_m M^-1) (eq. 4.97)", "1/(kg^3 m^3)"),
+    "acceleration_radius": ("acceleration radius (eq. 4.96)", "1/(kg m)"),
+    "S_e": ("stiffness uniformity ||K_C|| ||K_C^-1|| (eq. 4.72)", "dimensionless (of the mixed-unit K_C in SI)"),
+    "S_f": ("stiffness norm ||K_C||_F (eq. 4.73)", "mixed: N/m, N and N m/rad entries, in SI"),
+    "S_d": ("stiffness volume det K_C (eq. 4.74)", "N^6/rad^3"),
+    "S_et": ("translational stiffness uniformity (eq. 6.55)", "dimensionless"),
+    "S_er": ("rotational stiffness uniformity (eq. 6.56)", "dimensionless"),
+    "S_da": ("translational stiffness volume det K_CA (eq. 6.74)", "N^3/m^3"),
+    "S_dd": ("rotational stiffness volume det K_CD (eq. 6.75)", "N^3 m^3/rad^3"),
+    "omega_n": ("natural frequency index ||M_C^-1 K_CA||_F (eq. 4.107)", "1/s^2"),
+}
+"""Each metric's description and unit: ``J_m`` maps joint rates (rad/s) to platform velocity (m/s),
+``M_C`` is in kg, ``K_C`` has N/m, N and N m/rad blocks (seed 001 §4, eq. 6.54)."""
+
 
 @dataclass(frozen=True)
 class RCubeSettings:
@@ -77,6 +98,9 @@ def kinematics_step(ctx: Context) -> Outcome:
 
 
 SEED_EVALUATION = "passive joints eliminated, tubes evaluated as the seed did (seed_final_design)"
+DEFLECTION_LOCKED = "max deflection, 5 N per axis, extended pose, passive joints locked (K_C*, eq. 6.60-6.61) [mm]"
+DEFLECTION_FREE = ("max deflection, 5 N per axis, extended pose, passive joints free (K_C, eq. 5.121-5.123; "
+                   "physical) [mm]")
 
 
 def final_design_step(ctx: Context) -> Outcome:
@@ -111,8 +135,8 @@ def final_design_step(ctx: Context) -> Outcome:
          f"{SEED_EVALUATION}; the physical design gives {K_C[0, 5]:.4g}"],
         *[[f"natural frequency {i + 1} [rad/s] (eq. 7.11-7.13)", seed["natural_frequencies_rad_s"][i], m.frequencies[i],
            "ours from our M_C and K_C*"] for i in range(3)],
-        ["max deflection, 5 N per axis, extended pose [mm] (Table 7.9)", seed["max_deflection_mm"], deflection[False],
-         f"seed: below; with K_C* (passive-eliminated K_C gives {deflection[True]:.3g} mm)"],
+        [DEFLECTION_LOCKED, seed["max_deflection_mm"], deflection[False], "seed: 'below'; the seed's evaluation (eq. 6.91)"],
+        [DEFLECTION_FREE, None, deflection[True], "not given by the seed; the physical deflection"],
     ]
     return Outcome(
         summary=f"Final design: {mass_g:.1f} g of links (seed {seed['link_mass_g']} g); eq. 7.7's K_C reproduces as "
@@ -151,15 +175,19 @@ def maps_step(ctx: Context) -> Outcome:
             ax.set_title(f"plane z {o * 1e3:+.0f} mm")
             ax.set_xlabel("x [mm]")
             ax.set_ylabel("y [mm]")
-            fig.colorbar(image, ax=ax, shrink=0.8)
-        figures.append(figure_from_matplotlib(fig, f"map_{name}", f"{name} over the workspace",
-                                              f"{n} x {n} points per plane"))
+            fig.colorbar(image, ax=ax, shrink=0.8, label=f"{name} [{METRIC_INFO[name][1]}]")
+        label, unit = METRIC_INFO[name]
+        figures.append(figure_from_matplotlib(
+            fig, f"map_{name}", f"{label[0].upper()}{label[1:]} over the workspace of the final design",
+            f"Table 7.8's design on the planes z = -60, 0, +60 mm through the 120 mm cube (§7.5), {n} x {n} points "
+            f"per plane; colour: {name} in {unit}; blank cells are unreachable or singular poses."))
     merged = {k: np.concatenate([p[k].ravel() for p in planes]) for k in planes[0]}
     glob = global_indices(merged)
-    rows = [[k, float(v)] for k, v in glob.items()]
+    rows = [[k, float(v), METRIC_INFO.get(k, ("", ""))[1], METRIC_INFO.get(k, ("", ""))[0]] for k, v in glob.items()]
     return Outcome(
         summary=f"{len(planes[0])} metrics on 3 planes of {n} x {n} points; {len(MAP_METRICS)} shown.",
-        tables=[Table("global", "Global indices over the three planes (eq. 4.108)", ["metric", "global value"], rows)],
+        tables=[Table("global", "Global indices over the three planes (eq. 4.108)",
+                      ["metric", "global value", "unit", "definition"], rows)],
         figures=figures,
         numbers={"global": {k: float(v) for k, v in glob.items()}},
     )
