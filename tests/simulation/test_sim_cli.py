@@ -1,0 +1,53 @@
+"""The rendering commands' new options from the command line: --resolution and --error-percent."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+from typer.testing import CliRunner
+
+from hapticdesign.interface.cli import app
+
+runner = CliRunner()
+
+
+def _closed_form(j: float, b: float, t: float, c: float) -> float:
+    """K* written out independently of the engine (derivation in docs/simulation.md)."""
+    a = math.exp(-b * t / j)
+    return b * b * (1 - a) * (1 - a * c) / (j * (1 - a) * (1 - a * c) - t * a * b * (1 - c))
+
+
+def test_resolution_gives_a_real_value_below_one():
+    result = runner.invoke(app, ["impedance-range", "--device", "examples/devices/pantograph-2dof.yaml",
+                                 "--resolution", "0.02", "--json"])
+    assert result.exit_code == 0, result.output
+    out = json.loads(result.stdout)
+    assert 0 < out["k_max"] < 1 and out["resolution"] == 0.02 and 0 < out["k_min"] <= out["k_max"]
+    assert out["first_unstable_k"] == pytest.approx(out["k_max"] + 0.02)
+    assert out["criterion"] != "stable"
+
+
+def test_error_percent_reports_the_closed_form():
+    result = runner.invoke(app, ["stability-boundary", "--inertia", "0.04", "--damping", "0.5", "--period", "0.001",
+                                 "--compensate-inertia", "--error-percent", "1", "--samples", "2000", "--json"])
+    assert result.exit_code == 0, result.output
+    out = json.loads(result.stdout)
+    expected = _closed_form(0.04, 0.5, 1e-3, 0.99)
+    assert out["k_max_closed_form"] == pytest.approx(expected, rel=1e-9)
+    assert out["k_max_exact"] == pytest.approx(expected, rel=1e-8)
+    assert out["k_max_simulated"] == pytest.approx(expected, rel=5e-3)
+    assert out["k_max_exact"] - 0.5 ** 2 / 0.04 == pytest.approx(0.01 * 0.5 / 1e-3, rel=0.02)
+
+
+@pytest.mark.parametrize("args, message", [
+    (["stability-boundary", "--inertia", "0.04", "--damping", "0.5", "--period", "0.001", "--error-percent", "1"],
+     "needs --compensate-inertia"),
+    (["impedance-range", "--resolution", "-1"], "--resolution must be a positive number"),
+    (["impedance-range", "--resolution", "500"], "above --k-limit"),
+])
+def test_bad_settings_are_one_line_errors(args, message):
+    result = runner.invoke(app, args)
+    assert result.exit_code == 2
+    assert message in result.output and len(result.output.strip().splitlines()) == 1
