@@ -12,6 +12,8 @@ R-CUBE):
 - :mod:`hapticdesign.analysis.rcube` and :mod:`hapticdesign.optimization`: the R-CUBE.
 """
 
+from importlib.metadata import PackageNotFoundError, version
+
 from hapticdesign.analysis.linearity.conditions import linear_conditions
 from hapticdesign.analysis.linearity.service import device_form as linearity_form
 from hapticdesign.devices.registry import preset
@@ -20,7 +22,13 @@ from hapticdesign.model.device import Device
 from hapticdesign.simulation.impedance import impedance_range
 from hapticdesign.simulation.transparency import transparency
 
+try:
+    __version__ = version("hapticdesign")
+except PackageNotFoundError:  # running from a source tree that was never installed
+    __version__ = "0+unknown"
+
 __all__ = [
+    "__version__",
     "Device",
     "UserError",
     "impedance_range",

@@ -97,6 +97,8 @@ def _json_cases(tmp: Path) -> dict[tuple[str, ...], list]:
         ("rcube", "plies"): ["--quick"],
         ("rcube", "synthesize"): ["--quick"],
         ("rcube", "optimize"): ["--quick"],
+        ("rcube", "fem"): ["--position", "0.1117,0.1117,0.1117"],
+        ("rcube", "tolerance"): ["--samples", "5", "--seed", "1"],
     }
 
 
@@ -246,6 +248,8 @@ def _bad_inputs(tmp: Path) -> dict[tuple[str, ...], list]:
         ("rcube", "synthesize"): ["--quick", "--bounds", "1,2;3"],
         ("rcube", "cross-section"): ["--quick", "--population", "0"],
         ("rcube", "plies"): ["--quick", "--l1", "-0.1"],
+        ("rcube", "fem"): ["--position", "1,2"],
+        ("rcube", "tolerance"): ["--samples", "-1"],
         ("study", "phantom"): ["--out", a_file],
         ("study", "rcube"): ["--out", a_file],
         ("study", "device"): ["--device", tmp / "missing.yaml", "--out", tmp / "s"],
@@ -270,6 +274,12 @@ def test_usage_mistakes_are_one_line_too(path):
     result = _invoke([*path, "--no-such-option"])
     _one_line_error(result)
     assert "--no-such-option" in result.stderr and f"hapticdesign {' '.join(path)} --help" in result.stderr
+
+
+def test_units_survive_in_help():
+    """Square brackets are text in help (a markup mode that eats ``[s]`` would drop every unit)."""
+    result = _invoke(["impedance-range", "--help"], env={"COLUMNS": "250"})
+    assert "[s]" in result.stdout and "[rad]" in result.stdout and "[N m/rad" in result.stdout
 
 
 def test_help_reads_as_a_table_of_contents():

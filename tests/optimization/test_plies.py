@@ -37,7 +37,9 @@ def test_ply_design_laminates_and_deflection_against_the_stiffness_module():
     design = ply_design(GEOMETRY, counts, TABLE_RATIO)
     for link, c in zip(design.links, counts):
         assert link.moduli == laminate((c[0], c[1], c[2], c[2]))
-    assert design.total_link_mass() * 1e3 == pytest.approx(77.7, abs=0.05)  # Table 7.9 at 1790 kg/m^3
+    volumes = [np.pi / 4 * (D**2 - d**2) * L for D, d, L in ((15e-3, 11.25e-3, 0.1117), (12e-3, 9e-3, 0.0741),
+                                                              (7.2e-3, 5.4e-3, 0.1218))]  # Table 7.8
+    assert design.total_link_mass() == pytest.approx(3 * sum(volumes) * 1790.0, rel=1e-12)  # stated density
     ev = PlyEvaluator(GEOMETRY, TABLE_RATIO)
     K_star = chain_stiffness_matrices(design, GEOMETRY.home + 0.06, passive=False)[0]  # eq. 6.60
     assert np.allclose(ev.deflection(counts), np.linalg.solve(K_star, [20.0, 0, 0, 0, 0, 0]), rtol=1e-8, atol=1e-15)
@@ -46,7 +48,8 @@ def test_ply_design_laminates_and_deflection_against_the_stiffness_module():
 
 
 def test_table_7_6_ordering_reproduces():
-    ev = PlyEvaluator(GEOMETRY, TABLE_RATIO)
+    # the seed's evaluation bent the tubes with eq. 4.59's E_y; the physical E_x ranks them differently
+    ev = PlyEvaluator(GEOMETRY, TABLE_RATIO, bending="eq. 4.59")
     t6 = table("table_7_6")
     ours = np.array([ev.objectives(c)[0] for c in seed_counts()])
     # the deflections differ in scale (docs/optimization.md) but rank the seed's 35 designs alike

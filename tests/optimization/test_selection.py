@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from hapticdesign.errors import UserError
+from hapticdesign.optimization.objectives import SEED_EVALUATION_MATERIAL, EvaluationLinks
 from hapticdesign.optimization.selection import (
     METRIC_NAMES,
     normalize,
@@ -69,3 +71,19 @@ def test_post_evaluation_kinematic_columns_reproduce_table_7_3():
     assert m["S_f"][0] > m["S_f"][1] > m["S_f"][2]
     assert m["omega_n"][0] > m["omega_n"][1] > m["omega_n"][2]
     assert m["I_f"][0] < m["I_f"][1] < m["I_f"][2]
+
+
+def test_post_evaluation_material_is_explicit_and_steel_reproduces_table_7_3_stiffness():
+    """S_f = ||K_C1||_F of all 40 rows of Table 7.3 with structural steel tubes (the seed states only
+    D = 20 mm, d = 10 mm, rho = 2000 kg/m^3), within what Table 7.2's rounding of the lengths to 0.1 mm
+    allows: +-0.05 mm on each of three lengths, each entering a cantilever stiffness at most as l^-3."""
+    links = EvaluationLinks(material=SEED_EVALUATION_MATERIAL)
+    assert links.settings() == {"material": "structural steel", "D": 0.02, "d": 0.01, "density": 2000.0,
+                                "passive_eliminated": True}
+    assert EvaluationLinks().settings()["material"] == "M55J quasi-isotropic"
+    m = post_evaluate(table_7_2_designs(), links=links)
+    lengths = table("table_7_2")[:, 1:4]
+    rounding = 3 * 3 * 0.05 / lengths.min(axis=1)
+    assert np.all(np.abs(m["S_f"] / table("table_7_3")[:, 2] - 1.0) <= rounding)
+    with pytest.raises(UserError):
+        EvaluationLinks(material="unobtainium")

@@ -63,3 +63,28 @@ def test_bad_input_exits_2_with_one_line():
         res = run(*args)
         assert res.exit_code == 2, (args, res.output)
         assert res.stderr.count("\n") == 1 and res.stderr.startswith("error:"), (args, res.stderr)
+
+
+def test_stiffness_with_joint_stiffness_adds_the_bearing_compliance(tmp_path):
+    """Translational bearings of stiffness k at the five joints of a chain, in series with the links:
+    each adds I/k to the chain's translational compliance (locked passive joints, eq. 5.119), so
+    K_C* = sum_i ((K_Ci*)^-1 + diag(5/k, 5/k, 5/k, 0, 0, 0))^-1."""
+    from hapticdesign.analysis.rcube.design import final_design
+    from hapticdesign.analysis.rcube.stiffness import chain_stiffness_matrices
+
+    k = 3e5
+    res = run("stiffness", "--locked", "--joint-translational", str(k), "--json")
+    assert res.exit_code == 0, res.output
+    out = json.loads(res.stdout)
+    d = final_design()
+    extra = np.diag([5 / k] * 3 + [0.0] * 3)
+    expected = sum(np.linalg.inv(np.linalg.inv(K) + extra) for K in chain_stiffness_matrices(d, d.geometry.home, passive=False))
+    assert np.allclose(out["K_C"], expected, rtol=1e-9, atol=1e-9 * np.abs(expected).max())
+    share = np.array(out["joint_compliance_share"])
+    assert np.all((share > 0) & (share < 1))
+    design_file = tmp_path / "d.yaml"
+    design_file.write_text(f"joints: {{translational: {k}}}\n")
+    res = run("stiffness", "--locked", "--design", str(design_file), "--json")
+    assert np.allclose(json.loads(res.stdout)["K_C"], out["K_C"], rtol=1e-12)
+    res = run("stiffness", "--joint-stiffness", "-5")
+    assert res.exit_code == 2 and res.stderr.startswith("error:") and res.stderr.count("\n") == 1

@@ -70,8 +70,7 @@ def test_printed_45_degree_shear_modulus_eq_5_175():
 
 def test_final_design_cartesian_stiffness_eq_7_7():
     """Passive joints eliminated (eq. 5.121-5.123), home, no load: the printed diagonal and coupling."""
-    design = seed_final_design()
-    assert design.total_link_mass() == pytest.approx(0.0777, abs=5e-5)  # Table 7.9
+    design = seed_final_design()  # its mass: tests/rcube/test_anchors.py
     K = S.cartesian_stiffness(design, design.geometry.home)
     assert np.diag(K)[:3] == pytest.approx([209110.0] * 3, rel=0.01)
     assert np.diag(K)[3:] == pytest.approx([727.0] * 3, rel=0.005)

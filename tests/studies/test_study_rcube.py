@@ -55,7 +55,7 @@ def test_maps_and_optimization_files(rcube_study):
         assert (out / "figures" / f"maps_map_{name}.svg").stat().st_size > 0
     front = _rows(out / "tables" / "optimization_table_7_2_front.csv")
     assert len(front) == summary["numbers"]["optimization"]["front_size"] > 0
-    assert all(float(r["total_mm"]) < 400 for r in front)  # seed §7.1: kept solutions below 400 mm
+    assert all(float(r["total [mm]"]) < 400 for r in front)  # seed §7.1: kept solutions below 400 mm
     selected = summary["numbers"]["optimization"]["selected"]
     assert selected["l1"] + selected["l2"] + selected["l3"] < 0.4
     assert 0 < summary["numbers"]["optimization"]["ratio"] < 1

@@ -44,6 +44,9 @@ def _check(driver, report: Path, summary: dict) -> None:
         "return Array.from(document.images).map(i => [i.complete, i.naturalWidth, i.naturalHeight])")
     assert len(images) == len(list((report.parent / "figures").glob("*.png"))) > 0
     assert all(done and w > 0 and h > 0 for done, w, h in images)
+    # wide tables scroll inside their box instead of widening the page
+    assert driver.execute_script(
+        "return document.documentElement.scrollWidth <= document.documentElement.clientWidth")
     problems = [e for e in driver.get_log("browser") if e["level"] in ("SEVERE", "WARNING")]
     assert problems == []
 

@@ -27,7 +27,13 @@ from hapticdesign.model.inertia import SEED_FIELDS, BodyInertia, check_body
 from hapticdesign.model.transforms import Axis
 
 RESERVED = ("pi", "g", "base")
-IDENTIFIER = r"^[A-Za-z_][A-Za-z0-9_]*$"
+IDENTIFIER_PATTERN = r"^[A-Za-z_][A-Za-z0-9_]*$"
+IDENTIFIER = re.compile(IDENTIFIER_PATTERN)
+BODY_NAME_PATTERN = r"^[A-Za-z0-9_]+$"
+BODY_NAME = re.compile(BODY_NAME_PATTERN)
+"""Coordinate and parameter names are identifiers; body names are letters, digits and ``_`` (they
+become the suffix of parameter names such as ``m2a``): no user string that reaches generated code
+(``eom --format python``, ``ln --symbolic``) can carry code or markup."""
 _NUMBER = r"(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
 _TOKEN = re.compile(rf"\s*(?:(?P<number>{_NUMBER})|(?P<name>[A-Za-z_]\w*)|(?P<op>[-+*/]))")
 
@@ -126,8 +132,9 @@ def _name(value: object) -> object:
 
 Expression = Annotated[LinearExpr, BeforeValidator(_expression)]
 Number = Annotated[float, BeforeValidator(_constant)]
-Identifier = Annotated[str, Field(pattern=IDENTIFIER)]
-Name = Annotated[str, BeforeValidator(_name), Field(min_length=1)]
+Identifier = Annotated[str, Field(pattern=IDENTIFIER_PATTERN)]
+Name = Annotated[str, BeforeValidator(_name), Field(min_length=1, max_length=200)]
+BodyName = Annotated[str, BeforeValidator(_name), Field(pattern=BODY_NAME_PATTERN, max_length=64)]
 AXES = {"Rx": Axis.RX, "Ry": Axis.RY, "Rz": Axis.RZ, "tx": Axis.TX, "ty": Axis.TY, "tz": Axis.TZ}
 
 
@@ -168,7 +175,7 @@ class JointSpec(_FileModel):
 class DHRowSpec(_FileModel):
     """One row of a seed-000 DH table (eq. 2.26): frames ``body<name>`` and ``link<name>``."""
 
-    name: Name | None = None
+    name: BodyName | None = None
     a: Expression = LinearExpr()
     alpha: Expression = LinearExpr()
     s: Expression = LinearExpr()
@@ -186,7 +193,7 @@ class FrameSpec(_FileModel):
 class BodySpec(_FileModel):
     """A rigid body on ``frame`` with the seed's inertial parameters (Table 2.3)."""
 
-    name: Name
+    name: BodyName
     frame: Name
     m: Number = 0.0
     rx: Number = 0.0

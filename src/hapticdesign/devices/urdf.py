@@ -24,6 +24,7 @@ body. Links without ``<inertial>`` are massless. Gravity is ``g = 9.81`` along `
 
 from __future__ import annotations
 
+import keyword
 import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -31,8 +32,9 @@ from pathlib import Path
 import numpy as np
 
 from hapticdesign.devices.device_file import ChainBuilder, FrameTemplate, assemble_device
-from hapticdesign.devices.schema import LinearExpr, TransformSpec
+from hapticdesign.devices.schema import BODY_NAME, IDENTIFIER, LinearExpr, TransformSpec
 from hapticdesign.errors import UserError
+from hapticdesign.files import quote, read_text
 from hapticdesign.model.device import Device
 from hapticdesign.model.inertia import BodyInertia, check_body
 from hapticdesign.model.mechanism import JointType
@@ -118,6 +120,8 @@ def _inertia(link: ET.Element, where: str) -> BodyInertia | None:
 
 
 def _parse(text: str, source: str) -> ET.Element:
+    if "<!DOCTYPE" in text or "<!ENTITY" in text:  # URDF needs neither; entities can expand without bound
+        raise UserError(f"{source}: document type declarations and entities are not allowed in URDF files")
     try:
         robot = ET.fromstring(text)
     except ET.ParseError as exc:
@@ -133,7 +137,10 @@ def _joint_tree(robot: ET.Element, source: str) -> tuple[dict[str, ET.Element], 
     for link in robot.findall("link"):
         name = link.get("name")
         if not name or name in links:
-            raise UserError(f"{source}: every <link> needs a unique name (got {name!r})")
+            raise UserError(f"{source}: every <link> needs a unique name (got {quote(name)})")
+        if not BODY_NAME.match(name):
+            raise UserError(f"{source}: link name {quote(name)} must consist of letters, digits and '_' "
+                            "(it names the body's parameters, e.g. m<link>)")
         links[name] = link
     children: dict[str, list[ET.Element]] = {name: [] for name in links}
     parent_of: dict[str, str] = {}
@@ -141,7 +148,10 @@ def _joint_tree(robot: ET.Element, source: str) -> tuple[dict[str, ET.Element], 
     for joint in robot.findall("joint"):
         name = joint.get("name")
         if not name or name in names:
-            raise UserError(f"{source}: every <joint> needs a unique name (got {name!r})")
+            raise UserError(f"{source}: every <joint> needs a unique name (got {quote(name)})")
+        if not IDENTIFIER.match(name) or keyword.iskeyword(name):
+            raise UserError(f"{source}: joint name {quote(name)} must be an identifier (letters, digits, '_', "
+                            "not starting with a digit): it names a coordinate")
         names.add(name)
         ends = [(role, joint.find(role)) for role in ("parent", "child")]
         parent, child = (e.get("link") if e is not None else None for _, e in ends)
@@ -248,8 +258,4 @@ def _joint_value(joint: ET.Element, coordinates: list[str], types: list[JointTyp
 def load_urdf(path: Path, g: float = 9.81) -> Device:
     """Import a URDF file (see :func:`device_from_urdf`)."""
     path = Path(path)
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise UserError(f"cannot read {path}: {exc.strerror or exc}") from None
-    return device_from_urdf(text, str(path), g)
+    return device_from_urdf(read_text(path, "URDF file"), str(path), g)

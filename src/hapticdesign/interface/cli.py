@@ -9,6 +9,7 @@ into the sections of ``hapticdesign --help``, following the seeds' chapters.
 from __future__ import annotations
 
 import importlib
+import os
 import pkgutil
 import sys
 
@@ -64,7 +65,22 @@ app = typer.Typer(
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
+    rich_markup_mode="markdown",  # units such as [rad] or [kg] stay text (rich markup would eat them)
 )
+
+
+def _version(value: bool) -> None:
+    if value:
+        from hapticdesign import __version__
+
+        typer.echo(f"hapticdesign {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(version: bool = typer.Option(False, "--version", callback=_version, is_eager=True,
+                                       help="Print the version and exit.")) -> None:
+    """Design kinesthetic haptic devices for high impedance performance."""
 
 
 def _contents_order(name: str) -> tuple[int, str]:
@@ -89,4 +105,16 @@ _register_all()
 
 
 def main() -> None:
-    app()
+    """Run the command; an output stream that cannot be written (``> /dev/full``) is one line, exit 2."""
+    try:
+        app()
+        sys.stdout.flush()
+    except OSError as exc:
+        if isinstance(exc, BrokenPipeError):
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+            sys.exit(1)
+        try:
+            sys.stdout = open(os.devnull, "w")
+        finally:
+            sys.stderr.write(f"error: cannot write the output: {exc.strerror or exc}\n")
+        sys.exit(2)

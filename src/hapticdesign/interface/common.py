@@ -6,17 +6,15 @@ Every command body runs inside :func:`user_errors`: a :class:`~hapticdesign.erro
 
 from __future__ import annotations
 
-import json
 import math
 import warnings
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from pathlib import Path
-
 import numpy as np
 import typer
 
 from hapticdesign.errors import PhysicalConsistencyWarning, UserError
+from hapticdesign.files import dumps_json, to_jsonable, write_atomically
 
 
 @contextmanager
@@ -51,30 +49,9 @@ def parse_vector(text: str | None, n: int, name: str) -> np.ndarray:
     return np.array(values)
 
 
-def to_jsonable(value):
-    """NumPy arrays and scalars to plain lists and floats."""
-    if isinstance(value, dict):
-        return {k: to_jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [to_jsonable(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, np.generic):
-        return value.item()
-    return value
-
-
 def print_json(value) -> None:
-    typer.echo(json.dumps(to_jsonable(value)))
-
-
-def write_atomically(path: Path, text: str) -> None:
-    """Write a file so that an interruption never leaves it half-written."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text)
-    tmp.replace(path)
+    """One strict JSON object on stdout (a NaN or infinity is a one-line error, not output)."""
+    typer.echo(dumps_json(value))
 
 
 Report = Callable[[str, int, int | None], None]

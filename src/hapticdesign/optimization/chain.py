@@ -8,7 +8,7 @@ import csv
 import io
 import json
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -18,7 +18,7 @@ from hapticdesign.analysis.rcube.design import RCubeDesign
 from hapticdesign.analysis.rcube.dynamics import cartesian_mass_matrix
 from hapticdesign.analysis.rcube.kinematics import dexterous_cube
 from hapticdesign.analysis.rcube.stiffness import cartesian_stiffness
-from hapticdesign.interface.common import to_jsonable, write_atomically
+from hapticdesign.files import to_jsonable, write_atomically
 from hapticdesign.optimization import figures
 from hapticdesign.optimization.constraints import Workspace
 from hapticdesign.optimization.cross_section import RATIO_BOUNDS, CrossSectionResult, optimize_ratio
@@ -77,6 +77,10 @@ class Selection:
     rms_choice: int
     weighted_choice: dict[float, int]
     selected: int
+    weight: float = 0.0
+    """The weight on ``mu_vn*`` of the rule that selected ``selected`` (Table 7.5)."""
+    evaluation: dict = field(default_factory=dict)
+    """The post-evaluation tube (material, D, d, density) the metrics of Table 7.3 were computed with."""
 
 
 def select_solution(synthesis: SynthesisResult, weight: float = 0.0, workspace: Workspace = Workspace(),
@@ -88,7 +92,8 @@ def select_solution(synthesis: SynthesisResult, weight: float = 0.0, workspace: 
     rms = weighted_rms(n["omega_n"], n["mu_v"])
     weighted = {float(w): weighted_rms(n["omega_n"], n["mu_v"], w) for w in sorted(set(WEIGHTS) | {weight})}
     choices = {w: int(np.argmin(v)) for w, v in weighted.items()}
-    return Selection(metrics, n, rms, weighted, int(np.argmin(rms)), choices, choices[float(weight)])
+    return Selection(metrics, n, rms, weighted, int(np.argmin(rms)), choices, choices[float(weight)], float(weight),
+                     links.settings())
 
 
 SEED_RELATIVE_DEFLECTION = 0.291 / 0.048
@@ -101,8 +106,12 @@ def choose_plies(result: PlyResult, max_deflection: float | None = None,
     without it, below ``relative`` times the smallest ``CF1`` of the front (the seed's choice of
     Table 7.6 Sol. 29, scale free so that it carries over to a model with different absolute
     deflections)."""
-    limit = max_deflection if max_deflection is not None else relative * float(result.F[:, 0].min())
-    return choose(result.F, limit)
+    return choose(result.F, ply_limit(result, max_deflection, relative))
+
+
+def ply_limit(result: PlyResult, max_deflection: float | None = None, relative: float = SEED_RELATIVE_DEFLECTION) -> float:
+    """The ``CF1`` limit (m) of :func:`choose_plies`."""
+    return max_deflection if max_deflection is not None else relative * float(result.F[:, 0].min())
 
 
 def specifications(design: RCubeDesign, workspace: Workspace = Workspace()) -> dict[str, float | bool]:
@@ -136,6 +145,8 @@ class ChainResult:
     ply_choice: int
     design: RCubeDesign
     specs: dict
+    ply_limit: float = float("nan")
+    """The ``CF1`` limit (m) that chose the plies."""
 
 
 def run_chain(seed: int = 1, settings: Settings = Settings(), weight: float = 0.0, bound_sets=BOUND_SETS,
@@ -164,7 +175,8 @@ def run_chain(seed: int = 1, settings: Settings = Settings(), weight: float = 0.
                            progress=report("plies", s.ply_generations))
     k = choose_plies(plies, max_deflection)
     design = ply_design(geometry, plies.counts[k], cross.ratio)
-    return ChainResult(synthesis, selection, swarm, cross, plies, k, design, specifications(design, workspace))
+    return ChainResult(synthesis, selection, swarm, cross, plies, k, design, specifications(design, workspace),
+                       ply_limit(plies, max_deflection))
 
 
 def _write_csv(path: Path, header: list[str], rows) -> Path:
@@ -205,10 +217,12 @@ def write_selection(out: Path, selection: Selection) -> list[Path]:
         _write_csv(out / "table_7_5_weighted_rms.csv", ["weight_mu_vn", "solution"],
                    ([w, c + 1] for w, c in selection.weighted_choice.items())),
     ]
-    paths += figures.frequency_vs_manipulability(n["omega_n"], n["mu_v"], selection.rms_choice, out)
-    paths += figures.rms_curves({"RMS": selection.rms}, out, "figure_7_2_rms", "Figure 7.2")
+    paths += figures.frequency_vs_manipulability(n["omega_n"], n["mu_v"], selection.rms_choice, selection.selected,
+                                                 selection.weight, out)
+    paths += figures.rms_curves({"RMS, eq. 7.2-7.4": selection.rms}, out, "figure_7_2_rms",
+                                "Figure 7.2: RMS of omega_nn* and mu_vn*", selection.selected, selection.weight)
     paths += figures.rms_curves({f"weight {w:g}": v for w, v in selection.weighted.items()}, out,
-                                "figure_7_3_weighted_rms", "Figure 7.3")
+                                "figure_7_3_weighted_rms", "Figure 7.3: weighted RMS", selection.selected, selection.weight)
     return paths
 
 
@@ -232,10 +246,11 @@ def ply_rows(plies: PlyResult):
         yield [k + 1, F[0] * 1e3, float(np.degrees(F[1])), int(F[2]), *counts.ravel().tolist(), *tubes]
 
 
-def write_plies(out: Path, plies: PlyResult, chosen: int) -> list[Path]:
-    """Tables 7.6-7.7 (one table) and the ply front figure."""
+def write_plies(out: Path, plies: PlyResult, chosen: int, limit: float | None = None) -> list[Path]:
+    """Tables 7.6-7.7 (one table) and the ply front figure; ``limit`` (m) is the ``CF1`` bound that chose."""
     paths = [_write_csv(out / "table_7_6_7_plies.csv", PLY_HEADER, ply_rows(plies))]
-    return paths + figures.ply_front(plies.F, chosen, out)
+    rule = "" if limit is None or not np.isfinite(limit) else f"fewest plies with CF1 <= {limit * 1e3:.3g} mm"
+    return paths + figures.ply_front(plies.F, chosen, out, rule)
 
 
 def write_final(out: Path, design: RCubeDesign, counts: np.ndarray, specs: dict) -> list[Path]:
@@ -255,6 +270,21 @@ def selected_summary(synthesis: SynthesisResult, index: int) -> dict:
             "q_max_deg": float(np.degrees(f.X[index, 0]))}
 
 
+def shortest_summary(synthesis: SynthesisResult) -> dict:
+    """The front's shortest design, the certified constrained minimum of the total length (both
+    ``l1, l2, l3, q_max, total_length`` in m and rad; None when not computed) and its certificate."""
+    minimum = synthesis.constrained_minimum
+    certificate = None if minimum is None else {
+        "active_constraints": list(minimum.certificate.active),
+        "multipliers": [float(v) for v in minimum.certificate.multipliers],
+        "stationarity": minimum.certificate.stationarity,
+        "strict_local_minimum": minimum.certificate.strict_local_minimum,
+        "starts": minimum.starts, "starts_reaching_it": minimum.converged}
+    return {"shortest": synthesis.front.shortest(),
+            "constrained_minimum": None if minimum is None else minimum.summary(),
+            "constrained_minimum_certificate": certificate}
+
+
 def chain_summary(result: ChainResult) -> dict:
     """The JSON summary of the whole chain."""
     sel, sw = result.selection, result.swarm
@@ -263,7 +293,9 @@ def chain_summary(result: ChainResult) -> dict:
         "front_size": len(result.synthesis.front),
         "hypervolume": result.synthesis.hypervolume,
         "evaluations": result.synthesis.evaluations,
+        **shortest_summary(result.synthesis),
         "selected": selected_summary(result.synthesis, sel.selected),
+        "post_evaluation": sel.evaluation,
         "rms_choice": sel.rms_choice + 1,
         "weighted_choice": {str(w): c + 1 for w, c in sel.weighted_choice.items()},
         "swarm": {"l2": float(sw.x[1]), "l3": float(sw.x[2]), "q_max_deg": float(np.degrees(sw.x[0])),
@@ -283,7 +315,7 @@ def write_chain(out: Path, result: ChainResult) -> list[Path]:
     """Every table (CSV), figure (PNG and SVG) and ``summary.json`` of the chain."""
     out = Path(out)
     paths = write_synthesis(out, result.synthesis) + write_selection(out, result.selection)
-    paths += write_cross_section(out, result.cross_section) + write_plies(out, result.plies, result.ply_choice)
+    paths += write_cross_section(out, result.cross_section) + write_plies(out, result.plies, result.ply_choice, result.ply_limit)
     paths += write_final(out, result.design, result.plies.counts[result.ply_choice], result.specs)
     summary = out / "summary.json"
     write_atomically(summary, json.dumps(chain_summary(result), indent=2))

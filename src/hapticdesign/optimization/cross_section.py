@@ -7,10 +7,11 @@ increases, CS2 decreases), so every ratio in the bounds is Pareto optimal; the c
 minimum RMS of the two objectives normalized over the front (eq. 7.1), the front point closest to
 the origin of Figure 7.4.
 
-The seed gives no bounds for ``r``. The upper bound is the thin-wall limit ``r <= 0.9`` here: CS1
-grows without bound as ``r -> 1`` and the normalization of eq. 7.1 then pushes the choice to the
-wall. On the exact front over ``0 <= r <= 0.9`` the minimum RMS lies at ``r = 0.7636``; the seed's
-0.768 is the front point of its genetic algorithm nearest to it.
+The seed gives no bounds for ``r``, and the choice depends on the upper one: the normalization of
+eq. 7.1 divides by the objectives' spans over the front, and CS1 grows without bound as ``r -> 1``.
+:func:`ratio_for_upper_limit` gives the minimum-RMS ratio of the exact front as a function of that
+limit (0.7636 at the thin-wall limit 0.9 used here by default; the seed's 0.768 corresponds to a
+limit near 0.9035).
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from math import isfinite, pi
 
 import numpy as np
 from pymoo.algorithms.moo.nsga2 import NSGA2
+from scipy.optimize import minimize_scalar
 from pymoo.core.problem import Problem
 from pymoo.optimize import minimize
 
@@ -96,6 +98,32 @@ def optimize_ratio(bounds=RATIO_BOUNDS, population: int = 100, generations: int 
     ratios = X[keep, 0][order]
     best, rms = min_rms_ratio(ratios)
     return CrossSectionResult(ratios, cs1(ratios), cs2(ratios), rms, float(ratios[best]))
+
+
+def exact_rms(ratio, bounds=RATIO_BOUNDS) -> np.ndarray:
+    """RMS of the normalized ``CS1, CS2`` on the exact front over ``bounds`` (eq. 7.1, Figure 7.4).
+
+    Every ratio in the bounds is Pareto optimal and both objectives are monotone (CS1 rises, CS2
+    falls), so the spans of eq. 7.1 are the objectives at the two bounds.
+    """
+    lo, hi = _check(bounds)
+    n1 = (cs1(ratio) - cs1(lo)) / (cs1(hi) - cs1(lo))
+    n2 = (cs2(ratio) - cs2(hi)) / (cs2(lo) - cs2(hi))
+    return weighted_rms(n1, n2)
+
+
+def ratio_for_upper_limit(upper: float, lower: float = RATIO_BOUNDS[0]) -> float:
+    """The minimum-RMS ratio of the exact front over ``[lower, upper]`` (eq. 6.90, 7.5), to 1e-10.
+
+    The seed does not state the search's upper limit on ``d / D``; the chosen ratio is a function
+    of it (0.7636 at 0.90).
+    """
+    lo, hi = _check((lower, upper))
+    if hi == lo:
+        raise UserError(f"the ratio bounds must span an interval, got {lo:g}..{hi:g}")
+    result = minimize_scalar(lambda r: float(exact_rms(r, (lo, hi))), bounds=(lo, hi), method="bounded",
+                             options={"xatol": 1e-10})
+    return float(result.x)
 
 
 def exact_ratio(bounds=RATIO_BOUNDS, n: int = 200001) -> float:

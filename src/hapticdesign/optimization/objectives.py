@@ -5,7 +5,9 @@ at home (eq. 6.83), ``O3 = 1 / det K_CA`` at the fully extended pose (eq. 6.84).
 ``K_C`` are those of :mod:`hapticdesign.analysis.rcube` for links of the post-evaluation tube
 (D = 20 mm, d = 10 mm, rho = 2000 kg/m^3, §7.1), so that only the link lengths and the active
 range change between designs (§6.2: "material properties and cross-section dimensions are assumed
-to be constant").
+to be constant"). The seed does not state the tube's material; it is the explicit setting
+:attr:`EvaluationLinks.material`: M55J quasi-isotropic by default, structural steel
+(E = 200 GPa, nu = 0.3) being the one with which Table 7.3's ``S_f`` column reproduces.
 """
 
 from __future__ import annotations
@@ -18,23 +20,50 @@ from hapticdesign.model.rcube import RCubeGeometry
 from hapticdesign.analysis.rcube.design import RCubeDesign, uniform_design
 from hapticdesign.analysis.rcube.dynamics import cartesian_mass_matrix
 from hapticdesign.analysis.rcube.stiffness import cartesian_stiffness
+from hapticdesign.analysis.stiffness.materials import STRUCTURAL_STEEL, LinkModuli, laminate
+from hapticdesign.errors import UserError
 from hapticdesign.optimization.constraints import Workspace, link1_length
 
 OBJECTIVE_NAMES = ("O1", "O2", "O3")
 
+EVALUATION_MATERIALS: dict[str, LinkModuli] = {
+    "M55J quasi-isotropic": laminate((1, 1, 1, 1)),
+    "structural steel": STRUCTURAL_STEEL,
+}
+"""Materials of the post-evaluation tube by name: M55J plies at 0, 90, -45, 45 degrees (eq. 5.179-5.181),
+or structural steel (E = 200 GPa, nu = 0.3)."""
+
+SEED_EVALUATION_MATERIAL = "structural steel"
+"""The material with which Table 7.3's ``S_f`` reproduces (all 40 rows, see docs/optimization.md)."""
+
 
 @dataclass(frozen=True)
 class EvaluationLinks:
-    """The tube every link gets while the lengths are optimized (§7.1): ``D``, ``d`` (m), ``density``."""
+    """The tube every link gets while the lengths are optimized (§7.1): ``D``, ``d`` (m), ``density``
+    (kg/m^3) and ``material`` (a key of :data:`EVALUATION_MATERIALS`)."""
 
     D: float = 0.020
     d: float = 0.010
     density: float = 2000.0
     passive_eliminated: bool = True
     """``K_C`` with passive joints eliminated (eq. 5.121-5.123); False: ``K_C*`` (eq. 6.60-6.61)."""
+    material: str = "M55J quasi-isotropic"
+
+    def __post_init__(self) -> None:
+        if self.material not in EVALUATION_MATERIALS:
+            raise UserError(f"unknown evaluation material {self.material!r}; choose one of {', '.join(EVALUATION_MATERIALS)}")
+
+    @property
+    def moduli(self) -> LinkModuli:
+        return EVALUATION_MATERIALS[self.material]
+
+    def settings(self) -> dict[str, float | bool | str]:
+        """The evaluation tube as reported beside Table 7.3 (SI units)."""
+        return {"material": self.material, "D": self.D, "d": self.d, "density": self.density,
+                "passive_eliminated": self.passive_eliminated}
 
     def design(self, geometry: RCubeGeometry) -> RCubeDesign:
-        return uniform_design(geometry, self.D, self.d, density=self.density)
+        return uniform_design(geometry, self.D, self.d, self.moduli, density=self.density)
 
 
 def geometry_of(x, workspace: Workspace = Workspace()) -> RCubeGeometry:

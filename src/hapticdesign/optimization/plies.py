@@ -6,7 +6,9 @@ diameter follows from the cross-section ratio ``d / D``; with the tables' ``D = 
 :func:`hapticdesign.analysis.stiffness.sections.tube_from_plies`) that is
 ``d = ratio t / (1 - ratio)``. Objectives: ``CF1 = ||Delta kappa_1-3||`` and
 ``CF2 = ||Delta kappa_4-6||`` of ``Delta kappa = (K_C1*)^-1 F`` (eq. 6.91-6.93) for 20 N along
-chain 1's motion axis at the fully extended pose, and the number of plies.
+chain 1's motion axis at the fully extended pose, and the number of plies. The tubes bend with the
+laminate's axial modulus ``E_x``; ``bending="eq. 4.59"`` takes the hoop modulus as eq. 4.59 prints
+it, for comparisons with the seed's Table 7.6 only.
 """
 
 from __future__ import annotations
@@ -58,10 +60,10 @@ def ply_tube(counts, ratio: float, ply_thickness: float = PLY_THICKNESS) -> Tube
 
 
 def ply_design(geometry: RCubeGeometry, counts, ratio: float, lamina: Lamina = M55J,
-               density: float = FINAL_DENSITY) -> RCubeDesign:
+               density: float = FINAL_DENSITY, bending: str = "E_x") -> RCubeDesign:
     """An R-CUBE design from ply counts ``(3, 3)`` (rows: links 1-3; ``n_0, n_90, n_45``)."""
     rows = np.asarray(counts).reshape(3, 3)
-    links = tuple(LinkDesign(ply_tube(row, ratio), laminate(link_plies(row), lamina), density) for row in rows)
+    links = tuple(LinkDesign(ply_tube(row, ratio), laminate(link_plies(row), lamina), density, bending) for row in rows)
     return RCubeDesign(geometry, links)
 
 
@@ -73,17 +75,17 @@ class PlyEvaluator:
     """
 
     def __init__(self, geometry: RCubeGeometry, ratio: float, half: float = 0.060, force: float = DESIGN_FORCE,
-                 lamina: Lamina = M55J):
-        self.geometry, self.ratio, self.lamina = geometry, ratio, lamina
+                 lamina: Lamina = M55J, bending: str = "E_x"):
+        self.geometry, self.ratio, self.lamina, self.bending = geometry, ratio, lamina, bending
         position = geometry.home + half
         q = inverse_kinematics(geometry, position)
-        reference = ply_design(geometry, np.ones((3, 3), dtype=int), ratio, lamina)
+        reference = ply_design(geometry, np.ones((3, 3), dtype=int), ratio, lamina, bending=bending)
         self.J_theta = chain_jacobians(reference, 0, q[0]).theta
         self.wrench = np.array([force, 0.0, 0.0, 0.0, 0.0, 0.0])
 
     def deflection(self, counts) -> np.ndarray:
         """``Delta kappa_1* = (K_C1*)^-1 F = J_theta K_theta^-1 J_theta^T F`` (eq. 6.91), 6-vector (m, rad)."""
-        design = ply_design(self.geometry, counts, self.ratio, self.lamina)
+        design = ply_design(self.geometry, counts, self.ratio, self.lamina, bending=self.bending)
         C = vjm.joint_compliance([link.stiffness(L) for link, L in zip(design.links, design.lengths)])
         return vjm.compliance(self.J_theta, C) @ self.wrench
 

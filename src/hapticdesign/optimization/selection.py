@@ -2,7 +2,9 @@
 Table 7.3-7.5, eq. 7.1-7.4, Figures 7.1-7.3).
 
 Post-evaluation (Table 7.3): every design gets the same tubes (D = 20 mm, d = 10 mm,
-rho = 2000 kg/m^3) and is evaluated at home for one serial chain: ``I_f = ||M_C1||_F``
+rho = 2000 kg/m^3, material :attr:`EvaluationLinks.material`, reported by
+:meth:`EvaluationLinks.settings`; the seed's ``S_f`` reproduces with structural steel) and is
+evaluated at home for one serial chain: ``I_f = ||M_C1||_F``
 (eq. 4.98, 5.223), ``S_f = ||K_C1||_F`` (eq. 4.73, 5.122), ``omega_n = ||M_C1^-1 K_C1A||_F``
 (eq. 4.107), with the critical ``mu_v = l1 cos q_max`` (eq. 6.8) and ``c_v = 1 / cos^2 q_max``
 (eq. 6.18).

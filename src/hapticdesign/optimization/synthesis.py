@@ -4,6 +4,11 @@ Design vector ``(q_max, l2, l3)`` (rad, m, m) within one of the bound sets of Ta
 constraints 3-8 of :mod:`hapticdesign.optimization.constraints`; objectives ``O1, O2, O3`` of
 :mod:`hapticdesign.optimization.objectives`. The fronts of the three bound sets are merged, reduced
 to the non-dominated designs and to those with ``l1 + l2 + l3 < 400 mm`` (§7.1).
+
+Before the runs, the shortest feasible design is found by direct constrained minimization
+(:mod:`hapticdesign.optimization.shortest`) and placed in the initial population of every bound set
+that holds it; the rest of each initial population is uniform random, drawn with the run's seed. The
+shortest design minimizes ``O3`` on the front, so NSGA-II's elitism keeps it.
 """
 
 from __future__ import annotations
@@ -23,6 +28,7 @@ from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 from hapticdesign.errors import UserError
 from hapticdesign.optimization.constraints import Q_MAX_RANGE, Workspace, constraint_values, link1_length
 from hapticdesign.optimization.objectives import EvaluationLinks, objectives
+from hapticdesign.optimization.shortest import ConstrainedMinimum, constrained_minimum, design_summary, inside
 
 INFEASIBLE_OBJECTIVE = 1e30
 """Objective value given to designs that break a constraint (pymoo ranks them by violation only)."""
@@ -106,18 +112,36 @@ class Front:
     def __len__(self) -> int:
         return len(self.X)
 
+    def shortest(self) -> dict[str, float]:
+        """The front's shortest design (the first row): ``l1, l2, l3, q_max, total_length`` (m, rad)."""
+        k = int(np.argmin(self.total_length))
+        return design_summary(self.X[k], self.workspace)
+
+
+def initial_population(bounds: Bounds, population: int, seed: int, designs: np.ndarray | None = None) -> np.ndarray:
+    """``designs`` (rows within ``bounds``) followed by uniform random rows drawn with ``seed``:
+    ``population`` rows in all."""
+    given = np.zeros((0, 3)) if designs is None else np.atleast_2d(np.asarray(designs, dtype=float))[:population]
+    rng = np.random.default_rng(seed)
+    rest = rng.uniform(bounds.lower, bounds.upper, (population - len(given), 3))
+    return np.vstack([given, rest])
+
 
 def run_nsga2(bounds: Bounds, population: int, generations: int, seed: int, workspace: Workspace = Workspace(),
-              links: EvaluationLinks = EvaluationLinks(), progress: Callable[[int], None] | None = None) -> tuple[Front, int]:
+              links: EvaluationLinks = EvaluationLinks(), progress: Callable[[int], None] | None = None,
+              initial: np.ndarray | None = None) -> tuple[Front, int]:
     """One NSGA-II run (pymoo) over one bound set; returns its feasible front and the number of
-    objective evaluations."""
+    objective evaluations. ``initial``: designs placed in the first population (see
+    :func:`initial_population`); without them pymoo's own seeded random sampling is used."""
     if population < 2:
         raise UserError(f"population must be at least 2, got {population}")
     if generations < 1:
         raise UserError(f"generations must be at least 1, got {generations}")
     problem = SynthesisProblem(bounds, workspace, links)
     options = {"callback": _Progress(progress)} if progress else {}
-    result = minimize(problem, NSGA2(pop_size=population), ("n_gen", generations), seed=seed, verbose=False, **options)
+    sampling = {} if initial is None else {"sampling": initial_population(bounds, population, seed, initial)}
+    result = minimize(problem, NSGA2(pop_size=population, **sampling), ("n_gen", generations), seed=seed,
+                      verbose=False, **options)
     pop = result.pop
     X, F, G = pop.get("X"), pop.get("F"), pop.get("G")
     ok = np.all(G <= 0.0, axis=1)
@@ -164,20 +188,31 @@ class SynthesisResult:
     per_set: tuple[Front, ...]
     evaluations: int
     hypervolume: float
+    constrained_minimum: ConstrainedMinimum | None = None
+    """The certified shortest feasible design (None when not computed or no start was feasible)."""
+
+
+MINIMIZATION_STARTS = 32
+"""Seeded starts of the direct constrained minimization of the total length."""
 
 
 def synthesize(bound_sets=BOUND_SETS, population: int = 100, generations: int = 150, seed: int = 1,
                workspace: Workspace = Workspace(), links: EvaluationLinks = EvaluationLinks(),
-               length_limit: float = TOTAL_LENGTH_LIMIT, progress: Callable[[int, int], None] | None = None) -> SynthesisResult:
+               length_limit: float = TOTAL_LENGTH_LIMIT, progress: Callable[[int, int], None] | None = None,
+               starts: int = MINIMIZATION_STARTS) -> SynthesisResult:
     """NSGA-II over each bound set (seed ``seed + k`` for set ``k``), merged as in §7.1.
 
-    ``progress(set_index, generation)`` is called after each generation. Raises :class:`UserError`
-    when no design meets the constraints (an infeasible workspace for the bounds).
+    The shortest feasible design (:func:`hapticdesign.optimization.shortest.constrained_minimum`,
+    ``starts`` starts drawn with ``seed``; 0 skips it) joins the initial population of every bound
+    set that holds it. ``progress(set_index, generation)`` is called after each generation. Raises
+    :class:`UserError` when no design meets the constraints (an infeasible workspace for the bounds).
     """
+    minimum = constrained_minimum(bound_sets, workspace, starts, seed) if starts != 0 else None
     fronts, evaluations = [], 0
     for k, bounds in enumerate(bound_sets):
         report = (lambda gen, k=k: progress(k, gen)) if progress else None
-        front, n = run_nsga2(bounds, population, generations, seed + k, workspace, links, report)
+        initial = minimum.x[None] if minimum is not None and inside(minimum.x, bounds) else None
+        front, n = run_nsga2(bounds, population, generations, seed + k, workspace, links, report, initial)
         fronts.append(front)
         evaluations += n
     merged = merge_fronts(fronts, length_limit)
@@ -186,4 +221,4 @@ def synthesize(bound_sets=BOUND_SETS, population: int = 100, generations: int = 
             f"no design meets Constraints 3-8 with a total link length below {length_limit * 1e3:g} mm: the "
             f"{workspace.side * 1e3:g} mm workspace is infeasible for these bounds (raise the l2, l3 upper bounds)"
         )
-    return SynthesisResult(merged, tuple(fronts), evaluations, hypervolume(merged.F))
+    return SynthesisResult(merged, tuple(fronts), evaluations, hypervolume(merged.F), minimum)

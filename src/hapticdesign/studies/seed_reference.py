@@ -56,6 +56,9 @@ RCUBE_FINAL = {
     "q_max_deg": 32.5,               # Table 7.2
 }
 
+# Seed 001 Table 7.2, the two shortest solutions: link lengths l1, l2, l3 [mm].
+TABLE_7_2_SHORTEST = [(1, 111.7, 74.1, 121.8), (2, 113.3, 74.4, 123.4)]
+
 # Seed 001 Table 7.3 (solutions 1, 20, 40): link lengths [mm], manipulability mu_v, condition number c_v.
 TABLE_7_3 = [(1, 111.7, 74.1, 121.8, 0.094, 1.406), (20, 121.5, 86.3, 129.3, 0.106, 1.322),
              (40, 149.8, 97.4, 134.8, 0.137, 1.191)]

@@ -30,6 +30,7 @@ from sympy.polys.rings import ring
 from hapticdesign.analysis.linearity.form import PARTS, LinearityForm
 from hapticdesign.analysis.linearity.symbols import seed_symbols, standard_expressions
 from hapticdesign.errors import UserError
+from hapticdesign.escape import docstring_text, python_identifier
 from hapticdesign.model.device import Device
 from hapticdesign.model.inertia import SEED_FIELDS
 
@@ -115,9 +116,9 @@ class ClosedForm:
             factors = "".join(f" * {g.name}" + (f"**{k}" if k > 1 else "") for g, k in zip(self.gens, monom) if k)
             terms.append(f"{coeff!r}{factors}")
         body = "\n        + ".join(terms) if terms else "0.0"
-        signature = ", ".join(["*", *(s.name for s in self.variables(part)), "**_unused"])
+        signature = ", ".join(["*", *(python_identifier(s.name) for s in self.variables(part)), "**_unused"])
         return (
-            f'"""{_title(part)} of {self.device} in the seed\'s design variables '
+            f'"""{_title(part)} of {docstring_text(self.device)} in the seed\'s design variables '
             '(seed 000 eq. 3.1-3.4, Appendix B)."""\n\n\n'
             f"def linearity_number({signature}) -> float:\n"
             f"    return (\n        {body}\n    )\n"

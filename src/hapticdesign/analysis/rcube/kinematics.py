@@ -64,27 +64,31 @@ def inverse_kinematics(geometry: RCubeGeometry, position) -> np.ndarray:
     """
     r = _as_positions(position)
     g = geometry
-    q1 = active_angles(g, r)
+    active_angles(g, r)  # raises when out of the active links' reach
     c3_all = passive_reach(g, r)
     if np.any(np.abs(c3_all) > 1.0):
         raise UserError(
             f"position {np.round(r, 6).tolist()} is unreachable by the passive links l2 = {g.l2:g}, "
             f"l3 = {g.l3:g} m (|cos q_i3| > 1, eq. 5.39)"
         )
-    q = np.empty(r.shape[:-1] + (3, 3))
-    for chain in range(3):
-        a, b, c = axis_permutation(chain)
-        x = r[..., c] - g.l1 * np.cos(q1[..., a])
-        rb = r[..., b]
-        c3 = c3_all[..., chain]
-        s3 = g.sigma * np.sqrt(np.clip(1.0 - c3**2, 0.0, None))
-        den = g.l2**2 + g.l3**2 + 2 * g.l2 * g.l3 * c3
-        c2 = (g.l2 * x + g.l3 * x * c3 - g.l3 * rb * s3) / den
-        s2 = (-g.l2 * rb - g.l3 * rb * c3 - g.l3 * x * s3) / den
-        q[..., chain, 0] = q1[..., a]
-        q[..., chain, 1] = np.arctan2(s2, c2)
-        q[..., chain, 2] = np.arctan2(s3, c3)
-    return q
+    return np.stack([chain_angles(g, chain, r) for chain in range(3)], axis=-2)
+
+
+def chain_angles(geometry: RCubeGeometry, chain: int, position) -> np.ndarray:
+    """Angles ``(q_i1, q_i2, q_i3)`` of one chain ``(..., 3)`` (eq. 5.30-5.45), unchecked: positions out
+    of that chain's reach give clipped (meaningless) angles; see :func:`passive_reach`."""
+    r = _as_positions(position)
+    g = geometry
+    a, b, c = axis_permutation(chain)
+    q1 = np.arcsin(np.clip((r[..., a] - g.S) / g.l1, -1.0, 1.0))
+    x = r[..., c] - g.l1 * np.cos(q1)
+    rb = r[..., b]
+    c3 = np.clip((x**2 + rb**2 - g.l2**2 - g.l3**2) / (2 * g.l2 * g.l3), -1.0, 1.0)
+    s3 = g.sigma * np.sqrt(1.0 - c3**2)
+    den = g.l2**2 + g.l3**2 + 2 * g.l2 * g.l3 * c3
+    c2 = (g.l2 * x + g.l3 * x * c3 - g.l3 * rb * s3) / den
+    s2 = (-g.l2 * rb - g.l3 * rb * c3 - g.l3 * x * s3) / den
+    return np.stack([q1, np.arctan2(s2, c2), np.arctan2(s3, c3)], axis=-1)
 
 
 def forward_kinematics(geometry: RCubeGeometry, q_active) -> np.ndarray:

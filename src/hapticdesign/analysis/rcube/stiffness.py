@@ -5,6 +5,10 @@ Per chain: Jacobians ``J_theta (6x18)``, ``J_p (6x4)``, ``J_a (6x1)`` of the pla
 ``K_Ci`` from the bordered compliance matrix (eq. 5.121-5.122), ``K_C = sum K_Ci`` (eq. 5.123);
 loaded mode with the link weights (eq. 5.139-5.160); direct and iterative solutions (Fig. 5.6-5.8).
 Wrenches are ``(F_x, F_y, F_z, M_x, M_y, M_z)`` in the base frame, at the platform point.
+
+Joint and bearing compliance (beyond the seed, which takes the joints as ideal): each of a chain's
+five joints may carry a spring (:class:`hapticdesign.analysis.stiffness.joints.JointStiffness`) whose
+Cartesian compliance adds to the links' before the passive joints are eliminated (eq. 5.121-5.122).
 """
 
 from __future__ import annotations
@@ -27,6 +31,10 @@ from hapticdesign.analysis.rcube.batch_kinematics import poses_and_jacobians
 from hapticdesign.analysis.rcube.design import RCubeDesign
 from hapticdesign.analysis.rcube.kinematics import inverse_kinematics, require_regular
 from hapticdesign.analysis.stiffness import vjm
+from hapticdesign.analysis.stiffness.joints import spring_compliance
+
+JOINT_FRAMES = ("link1", "k1", "link2", "link3", "k3")
+"""Frames of the stiffness chain whose z axis is the axis of joints ``phi_i1 .. phi_i5`` (eq. 5.5-5.14)."""
 
 ITERATION_TOLERANCE = 1e-12
 MAX_ITERATIONS = 100
@@ -62,6 +70,23 @@ def chain_jacobians(design: RCubeDesign, chain: int, q_chain, theta=None, frame:
     return ChainJacobians(J[..., :N_VIRTUAL], J[..., PASSIVE_SLICE], J[..., ACTIVE_INDEX])
 
 
+def joint_spring_compliance(design: RCubeDesign, chain: int, q_chain, theta=None) -> np.ndarray | None:
+    """Cartesian compliance at the platform point of the chain's joint springs, ``(..., 6, 6)``;
+    ``None`` when every joint is rigid (the seed's model)."""
+    if design.rigid_joints:
+        return None
+    mech = stiffness_chain_mechanism(design.geometry, chain, design.centres)
+    Q = stiffness_coordinates(q_chain, theta)
+    frames = [poses_and_jacobians(mech, Q, name)[0] for name in JOINT_FRAMES]
+    platform = poses_and_jacobians(mech, Q, "platform")[0][..., :3, 3]
+    return spring_compliance(frames, platform, list(design.joints))
+
+
+def _require_rigid_joints(design: RCubeDesign, what: str) -> None:
+    if not design.rigid_joints:
+        raise UserError(f"joint compliance is modelled in the unloaded direct solution only, not in {what}")
+
+
 def _joint_angles(design: RCubeDesign, position) -> np.ndarray:
     q = inverse_kinematics(design.geometry, position)
     require_regular(design.geometry, q)
@@ -79,7 +104,9 @@ def chain_stiffness_matrices(design: RCubeDesign, position, passive: bool = True
     out = []
     for i in range(3):
         J = chain_jacobians(design, i, q[..., i, :])
-        out.append(vjm.chain_stiffness(J.theta, C_theta, J.passive) if passive else vjm.locked_stiffness(J.theta, C_theta))
+        C_joints = joint_spring_compliance(design, i, q[..., i, :])
+        out.append(vjm.chain_stiffness(J.theta, C_theta, J.passive, C_joints) if passive
+                   else vjm.locked_stiffness(J.theta, C_theta, C_joints))
     return np.stack(out, axis=-3)
 
 
@@ -105,12 +132,33 @@ def weight_jacobians(design: RCubeDesign, chain: int, q_chain, theta=None) -> np
     return np.concatenate(blocks, axis=-2)
 
 
+def own_weight_loads(design: RCubeDesign, chain: int, q_chain, theta=None) -> np.ndarray:
+    """Each link's own distributed weight on its virtual joint (18,), in the joint's coordinates.
+
+    Eq. 5.149-5.153 load a virtual joint only with the weights beyond it; a link's own weight,
+    spread along the link, bends the link too (:func:`hapticdesign.analysis.stiffness.vjm.own_weight_load`).
+    """
+    mech = stiffness_chain_mechanism(design.geometry, chain, design.centres)
+    Q = stiffness_coordinates(q_chain, theta)
+    g = np.asarray(design.gravity, dtype=float)
+    parts = []
+    for j, (m, L) in enumerate(zip(design.link_masses(), design.lengths)):
+        R = poses_and_jacobians(mech, Q, f"link{j + 1}")[0][:3, :3]  # link frame: x along the link
+        parts.append(vjm.own_weight_load(R.T @ (m * g), L))
+    return np.concatenate(parts)
+
+
 def chain_deflections(design: RCubeDesign, chain: int, q_chain, wrench, loaded: bool = False, theta=None) -> np.ndarray:
-    """Virtual-joint deflections ``theta_i`` of one chain (eq. 5.117 unloaded, eq. 5.157 loaded)."""
+    """Virtual-joint deflections ``theta_i`` of one chain (eq. 5.117 unloaded, eq. 5.157 loaded).
+
+    Loaded mode: the weights beyond each virtual joint through the mass-centre Jacobians
+    (eq. 5.149-5.157) plus each link's own distributed weight (:func:`own_weight_loads`).
+    """
     J = chain_jacobians(design, chain, q_chain, theta)
     if loaded:
         return vjm.virtual_deflections(
-            J.theta, joint_compliance(design), wrench, weight_jacobians(design, chain, q_chain, theta), link_weights(design)
+            J.theta, joint_compliance(design), wrench, weight_jacobians(design, chain, q_chain, theta), link_weights(design),
+            own_weight_loads(design, chain, q_chain, theta),
         )
     return vjm.virtual_deflections(J.theta, joint_compliance(design), wrench)
 
@@ -124,6 +172,7 @@ def loaded_chain_stiffness_matrices(
     iterative one repeats it with the Jacobians of the last deflection until the deflections
     change by less than ``ITERATION_TOLERANCE`` (force equilibrium, Fig. 5.7).
     """
+    _require_rigid_joints(design, "the loaded mode")
     q = _joint_angles(design, np.asarray(position, dtype=float))
     C_theta = joint_compliance(design)
     wrench = _check_wrench(np.zeros(6) if wrench is None else wrench)
@@ -170,6 +219,7 @@ def platform_deflection(design: RCubeDesign, position, wrench, method: str = "di
         return np.linalg.solve(cartesian_stiffness(design, position), w)
     if method != "pose":
         raise UserError(f"unknown solution method {method!r}; choose direct or pose")
+    _require_rigid_joints(design, "the pose equilibrium")
     q = _joint_angles(design, np.asarray(position, dtype=float))
     C_theta = joint_compliance(design)
     thetas = [np.zeros(N_VIRTUAL) for _ in range(3)]

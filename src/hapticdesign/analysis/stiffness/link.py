@@ -4,6 +4,11 @@ The virtual joint sits at the link's end, its local x along the link (eq. 5.77-5
 ``(psi_1, psi_2, psi_3, phi_1, phi_2, phi_3)`` are the translations and rotations of eq. 5.76.
 The matrix is the end stiffness of a cantilever: axial ``E_x A / L``, bending
 ``12 E I / L^3`` with the ``-+6 E I / L^2`` couplings and ``4 E I / L``, torsion ``G J / L``.
+
+A tube bends with its laminate's axial modulus ``E = E_x`` (the fibres along the link carry the
+bending stresses) and twists with ``G_xy``. Eq. 4.59 prints the hoop modulus ``E_y = E_z`` in the
+bending terms, a slip that the seed's own final-design ``K_C`` (eq. 7.7) carries: ``bending="eq. 4.59"``
+keeps that reading for reproducing the seed only.
 """
 
 from __future__ import annotations
@@ -18,15 +23,26 @@ from hapticdesign.analysis.stiffness.materials import LinkModuli
 from hapticdesign.analysis.stiffness.sections import Tube
 
 
-def link_stiffness(moduli: LinkModuli, section: Tube, length: float) -> np.ndarray:
+BENDING_RULES = ("E_x", "eq. 4.59")
+"""Bending modulus of a link: the axial ``E_x`` (physical, default) or ``E_y`` as eq. 4.59 prints it."""
+
+
+def bending_modulus(moduli: LinkModuli, bending: str = "E_x") -> float:
+    """The modulus of the bending terms: ``E_x`` (beam theory) or ``E_y`` (eq. 4.59 as printed)."""
+    if bending not in BENDING_RULES:
+        raise UserError(f"unknown bending rule {bending!r}; choose one of {', '.join(BENDING_RULES)}")
+    return moduli.E_x if bending == "E_x" else moduli.E_y
+
+
+def link_stiffness(moduli: LinkModuli, section: Tube, length: float, bending: str = "E_x") -> np.ndarray:
     """6 x 6 virtual-joint stiffness of a straight link (eq. 4.59; eq. 4.58 when isotropic).
 
-    The bending terms use ``E_y = E_z`` exactly as eq. 4.59 prints them.
+    The bending terms use :func:`bending_modulus` (``E_x`` unless ``bending="eq. 4.59"``).
     """
     if not isfinite(length) or length <= 0.0:
         raise UserError(f"link length must be positive, got {length!r}")
     L, A, I, J = length, section.area, section.second_moment, section.polar_moment
-    Ex, Eb, G = moduli.E_x, moduli.E_y, moduli.G_xy
+    Ex, Eb, G = moduli.E_x, bending_modulus(moduli, bending), moduli.G_xy
     K = np.zeros((6, 6))
     K[0, 0] = Ex * A / L
     K[1, 1] = K[2, 2] = 12.0 * Eb * I / L**3
@@ -39,18 +55,21 @@ def link_stiffness(moduli: LinkModuli, section: Tube, length: float) -> np.ndarr
 
 @dataclass(frozen=True)
 class LinkDesign:
-    """Cross-section and material of one link (its length comes from the geometry)."""
+    """Cross-section, material, density (kg/m^3) and bending rule of one link (its length comes
+    from the geometry); ``bending="eq. 4.59"`` only for reproducing the seed."""
 
     section: Tube
     moduli: LinkModuli
     density: float = 1790.0
+    bending: str = "E_x"
 
     def __post_init__(self) -> None:
         if not isfinite(self.density) or self.density <= 0.0:
             raise UserError(f"density must be positive, got {self.density!r}")
+        bending_modulus(self.moduli, self.bending)
 
     def stiffness(self, length: float) -> np.ndarray:
-        return link_stiffness(self.moduli, self.section, length)
+        return link_stiffness(self.moduli, self.section, length, self.bending)
 
     def compliance(self, length: float) -> np.ndarray:
         return np.linalg.inv(self.stiffness(length))

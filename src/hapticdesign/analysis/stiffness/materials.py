@@ -1,7 +1,8 @@
 """Link materials: isotropic, unidirectional lamina and laminate averages (seed 001 §4.2.4, §5.2.4).
 
-A material gives the three moduli the link stiffness matrix uses (eq. 4.59): ``E_x`` (axial),
-``E_y = E_z`` (the seed's bending modulus) and ``G_xy`` (torsion).
+A material gives the moduli the link stiffness matrix uses (eq. 4.59): ``E_x`` (axial, and the
+bending modulus of a tube), ``E_y = E_z`` (hoop; eq. 4.59 prints it in the bending terms, see
+:func:`hapticdesign.analysis.stiffness.link.bending_modulus`) and ``G_xy`` (torsion).
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ def _positive(name: str, value: float) -> float:
 
 @dataclass(frozen=True)
 class LinkModuli:
-    """Moduli (Pa) entering eq. 4.59: axial ``E_x``, bending ``E_y`` (= ``E_z``), shear ``G_xy``."""
+    """Moduli (Pa) entering eq. 4.59: axial ``E_x``, hoop ``E_y`` (= ``E_z``), shear ``G_xy``."""
 
     E_x: float
     E_y: float

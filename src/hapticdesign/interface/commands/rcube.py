@@ -5,6 +5,8 @@ Lengths in metres, angles in radians. Without options the seed's final design (T
 
 from __future__ import annotations
 
+from dataclasses import replace
+from math import inf
 from pathlib import Path
 from typing import Optional
 
@@ -44,7 +46,7 @@ def _design(design_file, l1, l2, l3, offset, sigma, outer=None, inner=None, plie
     data["sigma"] = sigma if sigma != -1 or "sigma" not in data else data["sigma"]
     design = design_from_mapping(data)
     if base is not None:
-        design = type(design)(design.geometry, base.links, base.centres, base.platform_mass, base.gravity)
+        design = replace(base, geometry=design.geometry)
     if outer or inner or plies or density is not None:
         design = _override_links(design, outer, inner, plies, density)
     return design
@@ -73,7 +75,7 @@ def _override_links(design, outer, inner, plies, density):
             from hapticdesign.analysis.stiffness.sections import Tube
 
             links.append(LinkDesign(Tube(float(D[k]), float(d[k])), link.moduli, float(entry["density"])))
-    return type(design)(design.geometry, tuple(links), design.centres, design.platform_mass, design.gravity)
+    return replace(design, links=tuple(links))
 
 
 def _count(text: str) -> int:
@@ -84,6 +86,27 @@ def _count(text: str) -> int:
     if value < 0 or value != int(value):
         raise UserError(f"--plies: ply counts must be non-negative integers, got {text!r}")
     return int(value)
+
+
+def _with_joints(design, rotational: Optional[float], translational: Optional[float]):
+    """Every joint of every chain with the given bearing stiffnesses (N m/rad, N/m); ``None`` keeps the
+    design's joints (rigid unless the design file gives ``joints``)."""
+    if rotational is None and translational is None:
+        return design
+    from hapticdesign.analysis.stiffness.joints import JointStiffness
+
+    return design.with_joints(JointStiffness(inf if rotational is None else rotational,
+                                             inf if translational is None else translational))
+
+
+def _joint_share(design, position, K: np.ndarray, passive: bool) -> np.ndarray:
+    """Fraction of the translational compliance (diagonal of ``K_C^-1``) that the joints add."""
+    from hapticdesign.analysis.rcube.design import RIGID_JOINTS
+    from hapticdesign.analysis.rcube.stiffness import cartesian_stiffness
+
+    rigid = cartesian_stiffness(replace(design, joints=RIGID_JOINTS), position, passive)
+    C, C0 = np.diag(np.linalg.inv(K))[:3], np.diag(np.linalg.inv(rigid))[:3]
+    return 1.0 - C0 / C
 
 
 def _position(design, position):
@@ -139,15 +162,24 @@ def stiffness(l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[f
               density: Optional[float] = DENSITY, position: Optional[str] = POSITION,
               locked: bool = typer.Option(False, "--locked", help="K_C* with passive joints locked (eq. 6.60-6.61)."),
               wrench: Optional[str] = typer.Option(None, "--wrench", help="Fx,Fy,Fz[,Mx,My,Mz]: also print the deflection."),
+              joint_stiffness: Optional[float] = typer.Option(
+                  None, "--joint-stiffness",
+                  help="Rotational stiffness of every joint's bearing (tilt) and of the active joint's drive (N m/rad); default rigid."),
+              joint_translational: Optional[float] = typer.Option(
+                  None, "--joint-translational", help="Translational stiffness of every joint's bearing (N/m); default rigid."),
               json_out: bool = JSON_OUT, quiet: bool = QUIET) -> None:
-    """Cartesian stiffness K_C (eq. 5.121-5.123), unloaded mode, direct solution."""
+    """Cartesian stiffness K_C (eq. 5.121-5.123), unloaded mode, direct solution; with joint stiffness,
+    also the share of the translational compliance that sits in the joints."""
     from hapticdesign.analysis.rcube.stiffness import cartesian_stiffness, platform_deflection
 
     with user_errors(quiet=quiet):
         dsg = _design(design, l1, l2, l3, offset, sigma, outer, inner, plies, density)
+        dsg = _with_joints(dsg, joint_stiffness, joint_translational)
         r = _position(dsg, position)
         K = cartesian_stiffness(dsg, r, passive=not locked)
         result = {"position": r, "K_C": K}
+        if not dsg.rigid_joints:
+            result["joint_compliance_share"] = _joint_share(dsg, r, K, not locked)
         if wrench:
             w = parse_vector(wrench, 6 if wrench.count(",") == 5 else 3, "wrench")
             w = np.concatenate([w, np.zeros(6 - len(w))])
@@ -156,6 +188,9 @@ def stiffness(l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[f
             print_json(result)
             return
         typer.echo(_matrix_text("K_C", K, "N/m, N/rad, N m/rad"))
+        if "joint_compliance_share" in result:
+            typer.echo("share of the x, y, z compliance in the joints: "
+                       + ", ".join(f"{100 * v:.1f} %" for v in result["joint_compliance_share"]))
         if "deflection" in result:
             typer.echo("deflection [m, rad]: " + ", ".join(f"{v:.6g}" for v in result["deflection"]))
 
@@ -239,4 +274,7 @@ def maps(out: Path = typer.Option(..., "--out", help="Directory for the PNG imag
 
 
 def register(app: typer.Typer) -> None:
+    from hapticdesign.interface.commands.rcube_checks import add_commands
+
+    add_commands(rcube_app)
     app.add_typer(rcube_app, name="rcube")

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Optional
 
@@ -48,6 +49,19 @@ def _bound_sets(text: Optional[str]):
     return (Bounds(tuple(p[0] for p in pairs), tuple(p[1] for p in pairs)),)
 
 
+def _mm(design: dict) -> str:
+    return (f"{design['l1'] * 1e3:.1f} / {design['l2'] * 1e3:.1f} / {design['l3'] * 1e3:.1f} mm "
+            f"({design['total_length'] * 1e3:.1f} mm) at q_max {math.degrees(design['q_max']):.2f} deg")
+
+
+def _shortest_line(summary: dict) -> str:
+    """The front's shortest design beside the certified constrained minimum of the total length."""
+    text = f"shortest on the front: {_mm(summary['shortest'])}"
+    if summary["constrained_minimum"] is not None:
+        text += f"; constrained minimum: {_mm(summary['constrained_minimum'])}"
+    return text
+
+
 def _note_paths(out: Path, quiet: bool, paths) -> None:
     note(f"wrote {len(paths)} files to {out}", quiet)
 
@@ -78,6 +92,7 @@ def register(app: typer.Typer) -> None:
                 return
             sel = summary["selected"]
             typer.echo(f"front: {summary['front_size']} designs, hypervolume {summary['hypervolume']:.4f}")
+            typer.echo(_shortest_line(summary))
             typer.echo(f"selected solution {sel['solution']}: l1 = {sel['l1'] * 1e3:.1f} mm, l2 = {sel['l2'] * 1e3:.1f} mm, "
                        f"l3 = {sel['l3'] * 1e3:.1f} mm, q_max = {sel['q_max_deg']:.1f} deg")
             typer.echo(f"cross-section ratio d/D = {summary['ratio']:.4f}")
@@ -105,7 +120,8 @@ def register(app: typer.Typer) -> None:
             if out is not None:
                 _note_paths(out, quiet, chain.write_synthesis(out, result) + chain.write_selection(out, selection))
             summary = {"selected": chain.selected_summary(result, selection.selected), "front_size": len(result.front),
-                       "hypervolume": result.hypervolume, "rms_choice": selection.rms_choice + 1,
+                       "hypervolume": result.hypervolume, **to_jsonable(chain.shortest_summary(result)),
+                       "rms_choice": selection.rms_choice + 1,
                        "weighted_choice": {str(w): c + 1 for w, c in selection.weighted_choice.items()}}
             if json_out:
                 print_json(summary)
@@ -114,6 +130,7 @@ def register(app: typer.Typer) -> None:
             for row in chain.front_rows(result):
                 typer.echo(" ".join(f"{v:10.1f}" if isinstance(v, float) else f"{v:10d}" for v in row[:6]))
             typer.echo(f"selected solution {selection.selected + 1}; hypervolume {result.hypervolume:.4f}")
+            typer.echo(_shortest_line(summary))
 
     @rcube_app.command("cross-section")
     def cross_section(seed: int = SEED, out: Optional[Path] = OUT, quick: bool = QUICK,
@@ -134,7 +151,7 @@ def register(app: typer.Typer) -> None:
             if json_out:
                 print_json(summary)
                 return
-            typer.echo(f"d/D = {result.ratio:.4f} (front of {len(result.ratios)}); exact front: {summary['exact_ratio']:.4f}; seed: 0.768")
+            typer.echo(f"d/D = {result.ratio:.4f} (front of {len(result.ratios)}); exact front: {summary['exact_ratio']:.4f}; seed: 0.768 (an upper d/D limit of 0.9034)")
 
     @rcube_app.command()
     def plies(seed: int = SEED, out: Optional[Path] = OUT, quick: bool = QUICK,
@@ -160,7 +177,8 @@ def register(app: typer.Typer) -> None:
             design = ply_design(geometry, result.counts[k], ratio)
             specs = chain.specifications(design)
             if out is not None:
-                _note_paths(out, quiet, chain.write_plies(out, result, k) + chain.write_final(out, design, result.counts[k], specs))
+                written = chain.write_plies(out, result, k, chain.ply_limit(result, max_deflection))
+                _note_paths(out, quiet, written + chain.write_final(out, design, result.counts[k], specs))
             summary = to_jsonable({"front_size": len(result.F), "chosen": k + 1, "counts": result.counts[k],
                                    "CF1_mm": float(result.F[k, 0] * 1e3), "plies": int(result.F[k, 2]),
                                    "D_mm": [link.section.D * 1e3 for link in design.links],

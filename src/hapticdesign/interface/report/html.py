@@ -18,6 +18,9 @@ table { border-collapse: collapse; margin: .6em 0 1.2em; font-size: .9em; }
 th, td { border: 1px solid #bbc; padding: .25em .6em; text-align: right; }
 th { background: #eef; }
 td:first-child, th:first-child, td.text { text-align: left; }
+.table-wrap { max-width: 100%; overflow-x: auto; }
+table.wide { font-size: .75em; }
+table.wide th { white-space: normal; }
 caption { caption-side: top; text-align: left; font-weight: bold; padding: .3em 0; }
 pre { background: #f6f6f8; border: 1px solid #dde; padding: .6em; overflow-x: auto; font-size: .85em; }
 figure { margin: 1em 0; }
@@ -41,12 +44,18 @@ def _cell(value) -> str:
     return f"<td{css}>{escape(cell_text(value))}</td>"
 
 
+WIDE_TABLE = 8
+"""Tables with more columns than this get a smaller font."""
+
+
 def _table(table: Table, csv_href: str) -> str:
+    """A table in a horizontally scrolling box, so that a wide table never overflows the page."""
     head = "".join(f"<th>{escape(c)}</th>" for c in table.columns)
     body = "".join("<tr>" + "".join(_cell(v) for v in row) + "</tr>" for row in table.rows)
     note = f'<p class="note">{escape(table.note)}</p>' if table.note else ""
-    return (f"<table><caption>{escape(table.title)}</caption><thead><tr>{head}</tr></thead><tbody>{body}</tbody>"
-            f'</table>{note}<p class="files"><a href="{escape(csv_href)}">{escape(csv_href)}</a></p>')
+    css = ' class="wide"' if len(table.columns) > WIDE_TABLE else ""
+    return (f'<div class="table-wrap"><table{css}><caption>{escape(table.title)}</caption><thead><tr>{head}</tr></thead>'
+            f'<tbody>{body}</tbody></table></div>{note}<p class="files"><a href="{escape(csv_href)}">{escape(csv_href)}</a></p>')
 
 
 def _figure(figure: Figure, stem: str) -> str:
@@ -59,7 +68,7 @@ def _figure(figure: Figure, stem: str) -> str:
 
 def _key_value_table(title: str, mapping: dict) -> str:
     rows = "".join(f"<tr><td>{escape(str(k))}</td><td>{escape(cell_text(v))}</td></tr>" for k, v in mapping.items())
-    return f"<table><caption>{escape(title)}</caption><tbody>{rows}</tbody></table>"
+    return f'<div class="table-wrap"><table><caption>{escape(title)}</caption><tbody>{rows}</tbody></table></div>'
 
 
 def _step(step: StepResult, table_href, figure_stem) -> str:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from hapticdesign.interface.common import to_jsonable, write_atomically
+from hapticdesign.files import to_jsonable, write_atomically
 from hapticdesign.interface.report.html import render
 from hapticdesign.interface.report.tables import csv_text
 from hapticdesign.interface.report.versions import versions

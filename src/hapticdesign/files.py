@@ -1,0 +1,180 @@
+"""Reading and writing the user's files safely: one helper for every reader and writer.
+
+Every data file (parameters, devices, URDF, weights, R-CUBE designs, design sets, campaign cases)
+is read through :func:`read_text` and, when structured, :func:`load_structured`; every output
+goes through :func:`write_atomically`. The limits are stated here once:
+
+- a data file may hold at most ``MAX_FILE_BYTES`` (20 MB) of UTF-8 text; larger, binary (a NUL
+  byte) or non-UTF-8 files are refused with one line;
+- YAML aliases and anchors are refused (data files are data: an alias "bomb" of a few lines
+  expands to gigabytes), as are Python-specific tags (``yaml.SafeLoader`` already refuses them);
+- structures nested deeper than ``MAX_DEPTH`` (64) levels are refused;
+- a message quotes at most ``QUOTE_LIMIT`` (60) characters of a user's value (:func:`quote`).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import re
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from hapticdesign.errors import UserError
+
+MAX_FILE_BYTES = 20 * 1024 * 1024
+MAX_DEPTH = 64
+QUOTE_LIMIT = 60
+
+
+def quote(value: object, limit: int = QUOTE_LIMIT) -> str:
+    """``repr(value)`` cut to ``limit`` characters (a message never echoes a whole hostile value)."""
+    if isinstance(value, (dict, list, tuple)) and len(value) > 8:
+        return f"<{type(value).__name__} of {len(value)} items>"
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def read_text(path: Path | str, what: str = "file") -> str:
+    """The UTF-8 text of a user's file, or a one-line :class:`UserError` (missing, too large, binary)."""
+    path = Path(path)
+    try:
+        size = path.stat().st_size
+        if path.is_dir():
+            raise UserError(f"cannot read {what} {path}: it is a directory")
+        if size > MAX_FILE_BYTES:
+            raise UserError(f"{what} {path} is {size / 2**20:.0f} MB; data files are limited to "
+                            f"{MAX_FILE_BYTES // 2**20} MB")
+        data = path.read_bytes()
+    except OSError as exc:
+        raise UserError(f"cannot read {what} {path}: {exc.strerror or exc}") from None
+    if b"\x00" in data:
+        raise UserError(f"{what} {path} is a binary file, not text")
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise UserError(f"{what} {path} is not UTF-8 text (byte {exc.start})") from None
+
+
+class _DataLoader(yaml.SafeLoader):
+    """YAML's safe loader without aliases, reading ``1e-1`` as a number (YAML 1.2, as JSON and TOML do)."""
+
+    def compose_node(self, parent, index):  # noqa: D102 - PyYAML hook
+        if self.check_event(yaml.events.AliasEvent):
+            event = self.peek_event()
+            raise yaml.YAMLError(f"aliases (*{event.anchor}) are not allowed in data files, line "
+                                 f"{event.start_mark.line + 1}")
+        return super().compose_node(parent, index)
+
+
+_FLOAT = re.compile(r"^[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?[eE][-+]?[0-9]+$")
+_DataLoader.add_implicit_resolver("tag:yaml.org,2002:float", _FLOAT, list("-+0123456789"))
+
+
+def _depth(value: object, limit: int) -> int:
+    """Nesting depth of lists and mappings, without recursion (stops counting past ``limit``)."""
+    deepest, stack = 0, [(value, 1)]
+    while stack:
+        item, level = stack.pop()
+        if isinstance(item, (dict, list)):
+            deepest = max(deepest, level)
+            if deepest > limit:
+                return deepest
+            children = item.values() if isinstance(item, dict) else item
+            stack.extend((child, level + 1) for child in children)
+    return deepest
+
+
+def parse_structured(text: str, kind: str, where: str) -> object:
+    """Parse JSON, YAML or TOML text (``kind``: json, yaml, toml) with the limits above."""
+    try:
+        if kind == "json":
+            data = json.loads(text)
+        elif kind == "yaml":
+            data = yaml.load(text, Loader=_DataLoader)  # noqa: S506 - a SafeLoader subclass
+        elif kind == "toml":
+            data = tomllib.loads(text)
+        else:
+            raise UserError(f"{where}: unknown file type {kind!r} (use .json, .yaml, .yml or .toml)")
+    except RecursionError:
+        raise UserError(f"{where}: nested too deeply (at most {MAX_DEPTH} levels)") from None
+    except (json.JSONDecodeError, yaml.YAMLError, tomllib.TOMLDecodeError) as exc:
+        first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise UserError(f"{where}: malformed {kind.upper()} ({first[:200]})") from None
+    if _depth(data, MAX_DEPTH) > MAX_DEPTH:
+        raise UserError(f"{where}: nested too deeply (at most {MAX_DEPTH} levels)")
+    return data
+
+
+def load_structured(path: Path | str, what: str = "file") -> object:
+    """Read and parse a JSON, YAML or TOML file chosen by its suffix."""
+    path = Path(path)
+    kinds = {".json": "json", ".yaml": "yaml", ".yml": "yaml", ".toml": "toml"}
+    kind = kinds.get(path.suffix.lower())
+    if kind is None:
+        raise UserError(f"{path}: unknown file type {quote(path.suffix)} (use .json, .yaml, .yml or .toml)")
+    return parse_structured(read_text(path, what), kind, str(path))
+
+
+def to_jsonable(value):
+    """NumPy arrays and scalars to plain lists and floats."""
+    if isinstance(value, dict):
+        return {k: to_jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [to_jsonable(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def _first_non_finite(value, path: str = "") -> str | None:
+    if isinstance(value, float) and not math.isfinite(value):
+        return path or "the result"
+    if isinstance(value, dict):
+        for k, v in value.items():
+            found = _first_non_finite(v, f"{path}.{k}" if path else str(k))
+            if found:
+                return found
+    if isinstance(value, list):
+        for i, v in enumerate(value):
+            found = _first_non_finite(v, f"{path}[{i}]")
+            if found:
+                return found
+    return None
+
+
+def dumps_json(value, **kwargs) -> str:
+    """Strict JSON: a NaN or infinity is refused with the key that holds it (it is not JSON)."""
+    plain = to_jsonable(value)
+    bad = _first_non_finite(plain)
+    if bad is not None:
+        raise UserError(f"the result is not finite ({bad}); check that the inputs are within physical ranges")
+    return json.dumps(plain, **kwargs)
+
+
+def write_atomically(path: Path | str, content: str | bytes) -> None:
+    """Write a file so that an interruption or a failure never leaves it (or a ``.tmp``) half-written.
+
+    Any problem with the output place (a directory in the way, a read-only folder, a full disk) is
+    a one-line :class:`UserError`.
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise UserError(f"cannot write {path}: it is a directory")
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        if isinstance(content, bytes):
+            tmp.write_bytes(content)
+        else:
+            tmp.write_text(content, encoding="utf-8")
+        tmp.replace(path)
+    except OSError as exc:
+        tmp.unlink(missing_ok=True)
+        raise UserError(f"cannot write {path}: {exc.strerror or exc}") from None

@@ -1,0 +1,170 @@
+"""The shortest feasible R-CUBE design, found by direct constrained minimization and certified
+(seed 001 §6.1.3, §7.1).
+
+The kinematic synthesis keeps Table 7.2's designs sorted by total link length ``l1 + l2 + l3``
+with ``l1 = h / sin q_max`` (Constraint 1, eq. 6.24). Its short end is where Constraints 3-8
+(eq. 6.45-6.49, 6.52) bind. This module minimizes the total length under exactly the constraints of
+:func:`hapticdesign.optimization.constraints.constraint_values` and the bounds of the synthesis
+(Table 7.1, Constraint 2, eq. 6.28) with SciPy's SLSQP from many seeded starts, then certifies the
+result by the Karush-Kuhn-Tucker conditions: the active constraint gradients span the design
+space and their multipliers are positive, so the point is a strict local minimum (a vertex of the
+feasible set), and it is the best of all starts.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import minimize
+
+from hapticdesign.errors import UserError
+from hapticdesign.optimization.constraints import CONSTRAINT_NAMES, Workspace, constraint_values, is_feasible, link1_length
+
+FEASIBILITY_MARGIN = 1e-10
+"""The local solver keeps ``g <= -margin`` so that its answer meets ``g <= 0`` exactly (constraint units)."""
+
+ACTIVE_TOLERANCE = 1e-7
+"""A constraint with ``g > -tolerance`` at the answer counts as active."""
+
+SAME_POINT = 1e-6
+"""Starts whose answers differ from the best by less than this (m of total length) found the same minimum."""
+
+GRADIENT_STEP = 1e-7
+"""Central-difference step (rad, m) of the KKT check."""
+
+
+def total_length(x, workspace: Workspace = Workspace()) -> np.ndarray:
+    """``l1 + l2 + l3`` of design vectors ``(q_max, l2, l3)`` with ``l1 = h / sin q_max`` (eq. 6.24)."""
+    X = np.atleast_2d(np.asarray(x, dtype=float))
+    return link1_length(X[:, 0], workspace) + X[:, 1] + X[:, 2]
+
+
+def _gradient(fun, x: np.ndarray, step: float = GRADIENT_STEP) -> np.ndarray:
+    """Central-difference Jacobian of a vector function of ``x`` (rows: outputs)."""
+    columns = []
+    for k in range(len(x)):
+        e = np.zeros_like(x)
+        e[k] = step
+        columns.append((np.atleast_1d(fun(x + e)) - np.atleast_1d(fun(x - e))) / (2.0 * step))
+    return np.stack(columns, axis=-1)
+
+
+@dataclass(frozen=True)
+class Certificate:
+    """The KKT conditions at a candidate minimum: which Constraints 3-8 are active, their
+    multipliers ``mu`` in ``grad f + sum mu_i grad g_i = 0``, the relative stationarity residual and
+    the rank of the active gradients."""
+
+    active: tuple[str, ...]
+    multipliers: np.ndarray
+    stationarity: float
+    rank: int
+
+    @property
+    def strict_local_minimum(self) -> bool:
+        """Active gradients spanning the three design variables with positive multipliers: a vertex
+        of the feasible set at which the length grows along every feasible direction."""
+        return self.rank == 3 and bool(np.all(self.multipliers > 0.0)) and self.stationarity < 1e-5
+
+
+def certify(x, workspace: Workspace = Workspace(), tolerance: float = ACTIVE_TOLERANCE) -> Certificate:
+    """KKT check of a feasible design ``x`` for the minimum total length (eq. 6.24, 6.45-6.52)."""
+    x = np.asarray(x, dtype=float)
+    g = constraint_values(x[None], workspace)[0]
+    active = np.flatnonzero(g > -tolerance)
+    grad_f = _gradient(lambda y: total_length(y, workspace), x)[0]
+    if len(active) == 0:
+        return Certificate((), np.zeros(0), 1.0, 0)
+    grad_g = _gradient(lambda y: constraint_values(y[None], workspace)[0][active], x).reshape(len(active), 3)
+    mu, *_ = np.linalg.lstsq(-grad_g.T, grad_f, rcond=None)
+    residual = np.linalg.norm(grad_f + grad_g.T @ mu) / np.linalg.norm(grad_f)
+    return Certificate(tuple(CONSTRAINT_NAMES[k] for k in active), mu, float(residual), int(np.linalg.matrix_rank(grad_g)))
+
+
+@dataclass(frozen=True)
+class ConstrainedMinimum:
+    """The shortest feasible design ``x = (q_max, l2, l3)``, how many of the seeded starts reached
+    it, and its KKT certificate."""
+
+    x: np.ndarray
+    certificate: Certificate
+    converged: int
+    starts: int
+    workspace: Workspace = Workspace()
+
+    @property
+    def l1(self) -> float:
+        return float(link1_length(self.x[0], self.workspace))
+
+    @property
+    def total_length(self) -> float:
+        return float(total_length(self.x, self.workspace)[0])
+
+    def summary(self) -> dict[str, float]:
+        """``l1, l2, l3, q_max, total_length`` in metres and radians."""
+        return design_summary(self.x, self.workspace)
+
+
+def design_summary(x, workspace: Workspace = Workspace()) -> dict[str, float]:
+    """``{"l1", "l2", "l3", "q_max", "total_length"}`` of a design vector (m, rad; eq. 6.24)."""
+    q, l2, l3 = (float(v) for v in x)
+    l1 = float(link1_length(q, workspace))
+    return {"l1": l1, "l2": l2, "l3": l3, "q_max": q, "total_length": l1 + l2 + l3}
+
+
+def _hull(bound_sets: Sequence) -> tuple[np.ndarray, np.ndarray]:
+    """The smallest box holding every bound set (Table 7.1)."""
+    return (np.min([b.lower for b in bound_sets], axis=0), np.max([b.upper for b in bound_sets], axis=0))
+
+
+def inside(x, bounds) -> bool:
+    """Whether ``x`` lies within one bound set."""
+    return bool(np.all(np.asarray(bounds.lower) <= x) and np.all(x <= np.asarray(bounds.upper)))
+
+
+def _local_minimum(x0: np.ndarray, lower: np.ndarray, upper: np.ndarray, workspace: Workspace) -> np.ndarray | None:
+    """SLSQP from ``x0``; the answer if it meets Constraints 2-8 (eq. 6.28, 6.45-6.52), else None."""
+    constraint = {"type": "ineq", "fun": lambda x: -constraint_values(x[None], workspace)[0] - FEASIBILITY_MARGIN}
+    result = minimize(lambda x: float(total_length(x, workspace)[0]), x0, method="SLSQP", constraints=[constraint],
+                      bounds=list(zip(lower, upper)), options={"ftol": 1e-14, "maxiter": 500})
+    x = np.clip(result.x, lower, upper)
+    return x if is_feasible(x[None], workspace)[0] else None
+
+
+def _minimize_in_box(lower: np.ndarray, upper: np.ndarray, starts: int, seed: int,
+                     workspace: Workspace) -> tuple[np.ndarray, int] | None:
+    """Best feasible local minimum over ``starts`` uniform starts drawn with ``seed``, and how many
+    starts reached it."""
+    rng = np.random.default_rng(seed)
+    found = [x for x in (_local_minimum(x0, lower, upper, workspace) for x0 in rng.uniform(lower, upper, (starts, 3)))
+             if x is not None]
+    if not found:
+        return None
+    lengths = total_length(np.array(found), workspace)
+    best = int(np.argmin(lengths))
+    return found[best], int(np.sum(lengths - lengths[best] < SAME_POINT))
+
+
+def constrained_minimum(bound_sets: Sequence, workspace: Workspace = Workspace(), starts: int = 32,
+                        seed: int = 1) -> ConstrainedMinimum | None:
+    """The minimum of ``l1 + l2 + l3`` (eq. 6.24) under Constraints 2-8 (eq. 6.28, 6.45-6.52) over
+    the union of ``bound_sets``; None when no start reaches a feasible design.
+
+    The box holding every set is searched first; if its minimum lies outside every set (only
+    possible for sets that are not nested, unlike Table 7.1's), each set is searched on its own.
+    """
+    if starts < 1:
+        raise UserError(f"the constrained minimization needs at least one start, got {starts}")
+    found = _minimize_in_box(*_hull(bound_sets), starts, seed, workspace)
+    if found is None and len(bound_sets) == 1:
+        return None
+    if found is None or not any(inside(found[0], b) for b in bound_sets):
+        per_set = [_minimize_in_box(np.array(b.lower), np.array(b.upper), starts, seed, workspace) for b in bound_sets]
+        per_set = [p for p in per_set if p is not None]
+        if not per_set:
+            return None
+        found = min(per_set, key=lambda p: float(total_length(p[0], workspace)[0]))
+    x, converged = found
+    return ConstrainedMinimum(x, certify(x, workspace), converged, starts, workspace)
