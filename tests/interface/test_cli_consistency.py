@@ -98,6 +98,7 @@ def _json_cases(tmp: Path) -> dict[tuple[str, ...], list]:
         ("rcube", "synthesize"): ["--quick"],
         ("rcube", "optimize"): ["--quick"],
         ("rcube", "fem"): ["--position", "0.1117,0.1117,0.1117"],
+        ("zwidth",): ["--inertia", "0.01", "--damping", "0.5", "--b-values", "0,0.1"],
         ("rcube", "tolerance"): ["--samples", "5", "--seed", "1"],
     }
 
@@ -249,6 +250,7 @@ def _bad_inputs(tmp: Path) -> dict[tuple[str, ...], list]:
         ("rcube", "cross-section"): ["--quick", "--population", "0"],
         ("rcube", "plies"): ["--quick", "--l1", "-0.1"],
         ("rcube", "fem"): ["--position", "1,2"],
+        ("zwidth",): ["--inertia", "0.01", "--damping", "0.5", "--velocity", "filtered"],
         ("rcube", "tolerance"): ["--samples", "-1"],
         ("study", "phantom"): ["--out", a_file],
         ("study", "rcube"): ["--out", a_file],

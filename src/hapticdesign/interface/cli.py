@@ -22,6 +22,7 @@ CONTENTS = {
     "dynamics": "Equations of motion (seed 000 ch. 2)",
     "linearity": "Linearity Number and linear designs (seed 000 ch. 3)",
     "simulation": "Haptic rendering simulation (seed 000 ch. 4)",
+    "stability": "Haptic rendering simulation (seed 000 ch. 4)",
     "metrics": "Performance metrics of any device (seed 001 ch. 4)",
     "rcube": "R-CUBE mechanism and its optimization (seed 001)",
     "rcube_optimize": "R-CUBE mechanism and its optimization (seed 001)",

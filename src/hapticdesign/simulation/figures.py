@@ -128,3 +128,32 @@ def write_all(designs, cases, summary, folder: Path) -> None:
         type_comparison(designs, cases, criterion, folder / f"{criterion}_type1_vs_type2")
         agreement_bars(summary, criterion, folder / f"{criterion}_agreement")
     frequency_responses(designs, cases, folder / "transparency_frequency_response")
+
+
+def zwidth_chart(zw, title: str, path: Path) -> list[Path]:
+    """The Z-width (Colgate & Brown 1994): stable (B, K) below the exact boundary, with the passivity
+    bound and the short-delay linear approximation beside it; written atomically as PNG and SVG."""
+    import io
+
+    from hapticdesign.files import write_atomically
+
+    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    ax.fill_between(zw.B, 0, zw.K, color="tab:blue", alpha=0.15, label="stable (exact, discrete time)")
+    ax.plot(zw.B, zw.K, "-", color="tab:blue", lw=1.8, label="K_max(B), exact")
+    ax.plot(zw.B, zw.passivity, "--", color="tab:red", label="passivity: b > K T / 2 + |B|")
+    ax.plot(zw.B, zw.linear, ":", color="k", label="linear approximation 2 (b + B) / (T (1 + 2 N))")
+    top = max(max(zw.K), 1e-12)
+    ax.set_ylim(0, 1.15 * top)
+    ax.set_xlabel("virtual damping B [N m s/rad]")
+    ax.set_ylabel("virtual stiffness K [N m/rad]")
+    ax.set_title(title, fontsize=10)
+    ax.legend(fontsize=8)
+    written = []
+    for suffix in (".png", ".svg"):
+        buffer = io.BytesIO()
+        fig.savefig(buffer, format=suffix[1:], dpi=120, bbox_inches="tight")
+        target = path.with_suffix(suffix)
+        write_atomically(target, buffer.getvalue())
+        written.append(target)
+    plt.close(fig)
+    return written
