@@ -39,8 +39,10 @@ def zwidth_command(
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
 ) -> None:
-    """Z-width of a 1-DOF haptic display: K_max for each virtual damper B, exact for the sampled loop,
-    with the passivity bound beside it (seed 000 ch. 5; Colgate & Brown 1994)."""
+    """Exact Z-width of a 1-DOF haptic display, K_max for each virtual damper B (seed 000 ch. 5 future work).
+
+    Exact for the sampled-data loop (zero-order hold, delay, compensator), with the passivity bound of
+    Colgate & Schenkel beside it (Colgate & Brown 1994)."""
     from hapticdesign.simulation.figures import zwidth_chart
     from hapticdesign.simulation.zwidth import DisplayLoop, zwidth
 
