@@ -176,5 +176,8 @@ def write_atomically(path: Path | str, content: str | bytes) -> None:
             tmp.write_text(content, encoding="utf-8")
         tmp.replace(path)
     except OSError as exc:
-        tmp.unlink(missing_ok=True)
+        try:
+            tmp.unlink(missing_ok=True)
+        except OSError:  # the place itself is broken (a file where a folder should be): nothing was written
+            pass
         raise UserError(f"cannot write {path}: {exc.strerror or exc}") from None

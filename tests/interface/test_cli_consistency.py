@@ -77,6 +77,18 @@ def test_one_name_per_concept():
 SLOW = {("study", "phantom"), ("study", "rcube"), ("study", "device"), ("demo",)}
 
 
+def _one_design(tmp: Path) -> Path:
+    """A design file with the built-in design, as `designs` writes it."""
+    from hapticdesign.devices.registry import preset
+
+    device = preset("phantom-3dof")
+    names = device.inertial_names()
+    path = tmp / "one_design.csv"
+    path.write_text("design,level,ln,ln_H,ln_C,ln_G," + ",".join(names) + "\n"
+                    + "d1,0,0,0,0,0," + ",".join(repr(float(device.params.get(k, 0.0))) for k in names) + "\n")
+    return path
+
+
 def _json_cases(tmp: Path) -> dict[tuple[str, ...], list]:
     return {
         ("dynamics",): ["--q", "0.1,0.2,0.3"],
@@ -99,6 +111,8 @@ def _json_cases(tmp: Path) -> dict[tuple[str, ...], list]:
         ("rcube", "optimize"): ["--quick"],
         ("rcube", "fem"): ["--position", "0.1117,0.1117,0.1117"],
         ("zwidth",): ["--inertia", "0.01", "--damping", "0.5", "--b-values", "0,0.1"],
+        ("robustness",): ["--designs", _one_design(tmp), "--errors", "0,5"],
+        ("show",): ["--out", tmp / "view"],
         ("rcube", "tolerance"): ["--samples", "5", "--seed", "1"],
     }
 
@@ -251,6 +265,8 @@ def _bad_inputs(tmp: Path) -> dict[tuple[str, ...], list]:
         ("rcube", "plies"): ["--quick", "--l1", "-0.1"],
         ("rcube", "fem"): ["--position", "1,2"],
         ("zwidth",): ["--inertia", "0.01", "--damping", "0.5", "--velocity", "filtered"],
+        ("robustness",): ["--designs", tmp / "missing.csv"],
+        ("show",): ["--q", "1,2"],
         ("rcube", "tolerance"): ["--samples", "-1"],
         ("study", "phantom"): ["--out", a_file],
         ("study", "rcube"): ["--out", a_file],

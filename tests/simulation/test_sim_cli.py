@@ -51,3 +51,30 @@ def test_bad_settings_are_one_line_errors(args, message):
     result = runner.invoke(app, args)
     assert result.exit_code == 2
     assert message in result.output and len(result.output.strip().splitlines()) == 1
+
+
+def test_zwidth_of_a_device_joint_at_a_pose():
+    """Joint 1 of the Phantom at a pose with the other joints held: J = H11(q); compensated, K = b^2 / J."""
+    import numpy as np
+
+    from hapticdesign.devices.registry import preset
+
+    device = preset("phantom-3dof")
+    result = runner.invoke(app, ["zwidth", "--preset", "phantom-3dof", "--q", "0,0.5,0.3", "--compensate-inertia",
+                                 "--b-values", "0", "--json"])
+    assert result.exit_code == 0, result.output
+    out = json.loads(result.stdout)
+    h11 = device.H(np.array([0.0, 0.5, 0.3]))[0, 0]
+    assert out["loop"]["inertia"] == pytest.approx(h11, rel=1e-12)
+    assert out["K"][0] == pytest.approx(0.5 ** 2 / h11, rel=1e-8)
+    assert out["passivity_K"] is None
+
+
+def test_zwidth_chart_and_analytic_method(tmp_path):
+    result = runner.invoke(app, ["zwidth", "--inertia", "0.039", "--damping", "0.5", "--velocity", "difference",
+                                 "--delay", "1", "--points", "5", "--out", str(tmp_path), "--json"])
+    assert result.exit_code == 0, result.output
+    assert (tmp_path / "zwidth.png").stat().st_size > 1000 and (tmp_path / "zwidth.svg").exists()
+    result = runner.invoke(app, ["impedance-range", "--method", "analytic", "--json"])
+    out = json.loads(result.stdout)
+    assert out["method"] == "analytic" and out["analytic_exact"] is True and out["k_max"] == 6.0

@@ -97,3 +97,32 @@ def test_safety_switch_and_excursion_stop_at_the_same_plant_step_as_the_scipy_lo
     assert fast.stopped_at_excursion and slow.stopped_at_excursion
     assert fast.end_time == pytest.approx(slow.end_time, abs=1e-12)
     assert fast.peak == pytest.approx(slow.peak, rel=1e-7) and fast.peak >= 0.012
+
+
+def test_coulomb_friction_and_group_errors_match_the_scipy_loop():
+    """Friction in the plant and a seeded per-group modelling error: both loops agree."""
+    device = preset("phantom-3dof").with_params(NONLINEAR)
+    compensator = Compensator(group_errors=(("mass", 5.0), ("inertia", 10.0)), error_seed=3)
+    config = LoopConfig(duration=0.3, wall=Wall(0, 5.0, 0.01, 0.01), compensator=compensator,
+                        coulomb=(0.004, 0.002, 0.001))
+    paths = {1: Sine(0.52, 3 * np.pi), 2: Sine(0.52, 3 * np.pi)}
+    fast, slow = simulate(device, config, paths), simulate_adaptive(device, config, paths, rtol=1e-10, atol=1e-12)
+    assert np.abs(fast.q - slow.q).max() < 1e-8
+    frictionless = simulate(device, LoopConfig(duration=0.3, wall=Wall(0, 5.0, 0.01, 0.01), compensator=compensator),
+                            paths)
+    assert np.abs(frictionless.q - fast.q).max() > 1e-5  # the friction is felt
+
+
+def test_coulomb_friction_holds_a_joint_below_its_breakaway_torque():
+    """A free joint under a constant torque smaller than its Coulomb friction barely creeps
+    (velocity below the smoothing scale v_f), and slides when the torque exceeds it."""
+    from hapticdesign.simulation.config import FRICTION_VELOCITY
+
+    device = preset("phantom-3dof")
+    paths = {1: Held(0.0), 2: Held(0.0)}
+    base = dict(duration=1.0, compensator=Compensator(False, False, False), safety_limit=None)
+    # the wall at equilibrium 0.01 with K = 1 pushes with 0.01 N m at the start
+    held = simulate(device, LoopConfig(**base, wall=Wall(0, 1.0, 0.0, 0.01), coulomb=(0.05, 0, 0)), paths)
+    slid = simulate(device, LoopConfig(**base, wall=Wall(0, 1.0, 0.0, 0.01), coulomb=(0.002, 0, 0)), paths)
+    assert np.abs(held.qd[:, 0]).max() < FRICTION_VELOCITY
+    assert np.abs(slid.qd[:, 0]).max() > 3 * FRICTION_VELOCITY

@@ -68,11 +68,12 @@ def test_boundary_separates_decaying_from_growing_recursions(velocity, delay, da
 
 
 @pytest.mark.parametrize("velocity", ["sampled", "difference"])
-def test_passivity_bound_is_never_above_the_exact_boundary(velocity):
-    loop = DisplayLoop(0.01, 0.5, 1e-3, 0, velocity)
+@pytest.mark.parametrize("delay", [0, 1, 3])
+def test_passivity_bound_is_never_above_the_exact_boundary(velocity, delay):
+    loop = DisplayLoop(0.01, 0.5, 1e-3, delay, velocity)
     zw = zwidth(loop, [0.0, 0.05, 0.1, 0.2, 0.3, 0.45, 0.5, 1.0])
     assert all(p <= k for p, k in zip(zw.passivity, zw.K))
-    assert zw.passivity[0] == pytest.approx(2 * 0.5 / 1e-3) and zw.passivity[-1] == 0.0
+    assert zw.passivity[0] == pytest.approx(2 * 0.5 / (1e-3 * (1 + 2 * delay))) and zw.passivity[-1] == 0.0
     assert passivity_stiffness(loop, -0.2) == passivity_stiffness(loop, 0.2)
 
 
@@ -83,8 +84,22 @@ def test_default_grid_ends_where_a_damper_alone_destabilizes():
 
 
 @pytest.mark.parametrize("kwargs", [dict(inertia=0.0), dict(damping=-1.0), dict(delay=-1), dict(velocity="x"),
-                                    dict(fraction=1.5), dict(period=math.inf)])
+                                    dict(fraction=2.5), dict(period=math.inf), dict(plant_stiffness=-1.0)])
 def test_bad_loops_are_user_errors(kwargs):
     base = dict(inertia=0.01, damping=0.5, period=1e-3)
     with pytest.raises(UserError):
         DisplayLoop(**{**base, **kwargs})
+
+
+def test_stiffness_map_is_b_squared_over_h11_with_full_compensation():
+    from hapticdesign.devices.registry import preset
+    from hapticdesign.simulation.zwidth import stiffness_map
+
+    device = preset("phantom-3dof").with_params({"m3": 0.1, "r3x": 0.05, "m2": 0.25})
+    result = stiffness_map(device, 0, (1, 2), 3, fraction=1.0)
+    for i, a in enumerate(result.first):
+        for j, b in enumerate(result.second):
+            h11 = device.H(np.array([0.0, a, b]))[0, 0]
+            assert result.K[i][j] == pytest.approx(0.5 ** 2 / h11, rel=1e-8)
+    with pytest.raises(UserError):
+        stiffness_map(device, 0, (0, 2), 3)

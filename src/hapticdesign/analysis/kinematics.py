@@ -3,7 +3,9 @@
 Positions follow seed 000 eq. 2.24-2.26, angular velocities eq. 2.20-2.23: the Jacobian
 column of a variable elementary transform is its unit twist (rotation axis through the frame
 origin, or translation axis) at the current pose, weighted by the coupling coefficients of
-dependent coordinates.
+dependent coordinates. Closed loops (passive joints) are solved by
+:mod:`hapticdesign.analysis.loops.solver`; :func:`actuated_pose` and :func:`actuated_jacobian` take
+the actuated coordinates of any device and, for loops, map velocities by ``qd = T qd_a``.
 """
 
 from __future__ import annotations
@@ -63,3 +65,25 @@ def jacobian(mech: Mechanism, q: np.ndarray, frame: str | None = None) -> np.nda
         else:
             jac[:3] += np.outer(u, coef)
     return jac
+
+
+def actuated_pose(mech: Mechanism, q_a: np.ndarray, frame: str | None = None, solver=None) -> np.ndarray:
+    """World pose (4x4) of ``frame`` at actuated coordinates (passive joints solved on the assembly branch)."""
+    return forward_kinematics(mech, _closed(mech, q_a, solver)[0], frame)
+
+
+def actuated_jacobian(mech: Mechanism, q_a: np.ndarray, frame: str | None = None, solver=None) -> np.ndarray:
+    """Geometric Jacobian (6 x N_a) of ``frame`` over the actuated coordinates: ``J(q) T`` with loops."""
+    q, solver = _closed(mech, q_a, solver)
+    full = jacobian(mech, q, frame)
+    return full if solver is None else full @ solver.velocity_transform(q)
+
+
+def _closed(mech: Mechanism, q_a: np.ndarray, solver):
+    """Full coordinates of actuated ones (the identity for a tree) and the loop solver (None for a tree)."""
+    if mech.loops is None:
+        return np.asarray(q_a, dtype=float), None
+    from hapticdesign.analysis.loops.solver import LoopSolver
+
+    solver = solver or LoopSolver(mech)
+    return solver.solve(np.asarray(q_a, dtype=float)), solver

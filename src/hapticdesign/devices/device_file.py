@@ -17,10 +17,12 @@ from pathlib import Path
 from pydantic import ValidationError
 
 from hapticdesign.devices.schema import DeviceFileSpec, LinearExpr, TransformSpec
+from hapticdesign.model.actuators import Actuator, Limits, per_joint
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.model.dh import DHRow, dh_frames
 from hapticdesign.model.inertia import SEED_FIELDS, BodyInertia, seed_parameter_name
+from hapticdesign.model.loops import ClosedLoops, LoopClosure
 from hapticdesign.model.mechanism import BodyAttachment, Frame, JointType, Mechanism
 from hapticdesign.model.params_io import read_mapping
 from hapticdesign.model.transforms import ElementaryTransform, JointValue, combination
@@ -60,6 +62,7 @@ class ChainBuilder:
     frames: tuple[FrameTemplate, ...]
     bodies: tuple[tuple[str, str], ...]
     end_effector: str | None = None
+    loops: ClosedLoops | None = None
 
     def value(self, expr: LinearExpr, params: Mapping[str, float]) -> JointValue:
         """The joint value ``offset + sum_k c_k q_k`` of an expression at parameter values ``params``."""
@@ -93,6 +96,7 @@ class ChainBuilder:
             bodies=tuple(BodyAttachment(name, frame) for name, frame in self.bodies),
             gravity=(0.0, 0.0, -float(params["g"])),
             end_effector=self.end_effector,
+            loops=self.loops,
         )
 
 
@@ -103,8 +107,13 @@ def assemble_device(
     builder: ChainBuilder,
     inertias: Mapping[str, BodyInertia],
     damping: tuple[float, ...],
+    actuators: tuple[Actuator, ...] = (),
+    limits: tuple[Limits, ...] = (),
 ) -> Device:
-    """A Device whose ``params`` hold every kinematic and inertial name (``m2``, ``r2x``, ``Ixy2``...)."""
+    """A Device whose ``params`` hold every kinematic and inertial name (``m2``, ``r2x``, ``Ixy2``...).
+
+    ``damping`` is the joints' own; the actuators' viscous damping is added to it per coordinate.
+    """
     params = dict(kinematic)
     for body, inertia in inertias.items():
         for f in SEED_FIELDS:
@@ -112,7 +121,10 @@ def assemble_device(
             if key in params:
                 raise UserError(f"parameter name {key!r} is ambiguous (rename a body or a parameter)")
             params[key] = float(getattr(inertia, f))
-    device = Device(name, description, tuple(kinematic), builder, params, damping)
+    if actuators:
+        damping = tuple(a + b for a, b in zip(damping, per_joint(actuators, len(damping), "damping")))
+    device = Device(name, description, tuple(kinematic), builder, params, damping, tuple(actuators),
+                    tuple(limits) if any(span is not None for span in limits) else ())
     device.mechanism  # build once: geometry errors surface at load time, not at first use
     return device
 
@@ -130,6 +142,7 @@ def device_from_spec(spec: DeviceFileSpec) -> Device:
         ),
         bodies=tuple((b.name, b.frame) for b in spec.bodies),
         end_effector=spec.end_effector,
+        loops=_closed_loops(spec),
     )
     return assemble_device(
         spec.name,
@@ -137,7 +150,31 @@ def device_from_spec(spec: DeviceFileSpec) -> Device:
         {**spec.parameters, "g": spec.g},
         builder,
         {b.name: b.inertia() for b in spec.bodies},
-        tuple(j.damping for j in spec.joints),
+        tuple(j.damping for j in spec.joints if j.actuated),
+        _actuators(spec),
+        tuple(None if j.limits is None else (float(j.limits[0]), float(j.limits[1])) for j in spec.joints
+              if j.actuated),
+    )
+
+
+def _closed_loops(spec: DeviceFileSpec) -> ClosedLoops | None:
+    """Passive joints, closures, assembly guess and home of a file with ``loops`` (None for a tree)."""
+    if not spec.loops:
+        return None
+    names = [j.name for j in spec.joints]
+    return ClosedLoops(
+        passive=tuple(k for k, j in enumerate(spec.joints) if not j.actuated),
+        closures=tuple(LoopClosure(tuple(loop.frames), tuple(loop.close)) for loop in spec.loops),
+        assembly=tuple(float(spec.assembly[j.name]) for j in spec.joints if not j.actuated),
+        home=tuple(float(spec.home.get(name, 0.0)) for name, j in zip(names, spec.joints) if j.actuated),
+    )
+
+
+def _actuators(spec: DeviceFileSpec) -> tuple[Actuator, ...]:
+    """The file's actuators with 0-based indices among the actuated joints (in the order of ``joints``)."""
+    index = {j.name: k for k, j in enumerate(j for j in spec.joints if j.actuated)}
+    return tuple(
+        Actuator(index[a.joint], a.rotor_inertia, a.gear_ratio, a.coulomb, a.damping) for a in spec.actuators
     )
 
 

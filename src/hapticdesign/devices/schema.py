@@ -24,6 +24,7 @@ from typing import Annotated, Literal
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
 
 from hapticdesign.model.inertia import SEED_FIELDS, BodyInertia, check_body
+from hapticdesign.model.loops import component_indices
 from hapticdesign.model.transforms import Axis
 
 RESERVED = ("pi", "g", "base")
@@ -165,11 +166,40 @@ class _FileModel(BaseModel):
 
 
 class JointSpec(_FileModel):
-    """An independent coordinate: its name, type and viscous damping (N m s/rad or N s/m)."""
+    """An independent coordinate: its name, type, viscous damping (N m s/rad or N s/m) and optional
+    range ``limits: [low, high]`` (rad or m; the default region of LN and of metric maps)."""
 
     name: Identifier
     type: Literal["revolute", "prismatic"] = "revolute"
     damping: Annotated[Number, Field(ge=0.0)] = 0.0
+    limits: tuple[Number, Number] | None = None
+    actuated: bool = True
+
+
+class ActuatorSpec(_FileModel):
+    """A motor on ``joint`` (:mod:`hapticdesign.model.actuators`): rotor inertia [kg m^2], transmission
+    ratio (rotor rad per joint rad or m), joint-side Coulomb friction (N m or N) and viscous damping."""
+
+    joint: Identifier
+    rotor_inertia: Annotated[Number, Field(ge=0.0)] = 0.0
+    gear_ratio: Annotated[Number, Field(gt=0.0)] = 1.0
+    coulomb: Annotated[Number, Field(ge=0.0)] = 0.0
+    damping: Annotated[Number, Field(ge=0.0)] = 0.0
+
+
+def _components(value: object) -> tuple[int, ...]:
+    if isinstance(value, tuple) and all(isinstance(v, int) for v in value):
+        return value
+    if not isinstance(value, (str, list, tuple)):
+        raise ValueError(f"close: expected position, pose or a list such as [x, z], got {value!r}")
+    return component_indices(value if isinstance(value, str) else [str(v) for v in value])
+
+
+class LoopSpec(_FileModel):
+    """A loop closure (:mod:`hapticdesign.model.loops`): ``frames`` coincide in the ``close`` components."""
+
+    frames: tuple[Name, Name]
+    close: Annotated[tuple[int, ...], BeforeValidator(_components)]
 
 
 class DHRowSpec(_FileModel):
@@ -222,6 +252,10 @@ class DeviceFileSpec(_FileModel):
     frames: list[FrameSpec] = []
     bodies: list[BodySpec] = Field(min_length=1)
     end_effector: Name | None = None
+    actuators: list[ActuatorSpec] = []
+    loops: list[LoopSpec] = []
+    assembly: dict[Identifier, Number] = {}
+    home: dict[Identifier, Number] = {}
 
     def dh_names(self) -> list[str]:
         return [row.name or str(i + 1) for i, row in enumerate(self.dh)]
@@ -293,3 +327,49 @@ def _check(spec: DeviceFileSpec) -> None:
             raise ValueError(f"bodies[{i}]: {report.error}")
     if spec.end_effector is not None and spec.end_effector not in frames:
         raise ValueError(f"end_effector: unknown frame {spec.end_effector!r}")
+    _check_limits_and_actuators(spec, coordinates)
+    _check_loops(spec, frames)
+
+
+def _check_loops(spec: DeviceFileSpec, frames: list[str]) -> None:
+    """Passive joints, loops, assembly and home refer to each other consistently (squareness: model.loops)."""
+    passive = [j.name for j in spec.joints if not j.actuated]
+    actuated = [j.name for j in spec.joints if j.actuated]
+    for i, joint in enumerate(spec.joints):
+        if not joint.actuated and (joint.damping or joint.limits is not None):
+            raise ValueError(f"joints[{i}] ({joint.name}): a passive joint takes no damping or limits (not supported)")
+    for i, actuator in enumerate(spec.actuators):
+        if actuator.joint in passive:
+            raise ValueError(f"actuators[{i}].joint: {actuator.joint} is passive (actuated: false)")
+    if passive and not spec.loops:
+        raise ValueError(f"joints: passive joint {passive[0]} needs loops: [{{frames: [a, b], close: ...}}] to close")
+    if spec.loops and not passive:
+        raise ValueError("loops: no passive joint to solve (mark the loop's unactuated joints actuated: false)")
+    for i, loop in enumerate(spec.loops):
+        for frame in loop.frames:
+            if frame not in frames:
+                raise ValueError(f"loops[{i}].frames: unknown frame {frame!r} (frames: {', '.join(frames)})")
+    for name in spec.assembly:
+        if name not in passive:
+            raise ValueError(f"assembly: {name!r} is not a passive joint (passive: {', '.join(passive) or 'none'})")
+    missing = [name for name in passive if name not in spec.assembly]
+    if missing:
+        raise ValueError(f"assembly: give a value near the intended branch at home for passive joint {missing[0]}")
+    for name in spec.home:
+        if name not in actuated:
+            raise ValueError(f"home: {name!r} is not an actuated joint (actuated: {', '.join(actuated)})")
+
+
+def _check_limits_and_actuators(spec: DeviceFileSpec, coordinates: list[str]) -> None:
+    """Joint ranges with low < high; one actuator at most per joint, on a joint of the file."""
+    for i, joint in enumerate(spec.joints):
+        if joint.limits is not None and not joint.limits[0] < joint.limits[1]:
+            raise ValueError(f"joints[{i}] ({joint.name}).limits: need low < high, got [{joint.limits[0]:g}, "
+                             f"{joint.limits[1]:g}]")
+    driven: set[str] = set()
+    for i, actuator in enumerate(spec.actuators):
+        if actuator.joint not in coordinates:
+            raise ValueError(f"actuators[{i}].joint: unknown joint {actuator.joint!r} (joints: {', '.join(coordinates)})")
+        if actuator.joint in driven:
+            raise ValueError(f"actuators[{i}].joint: joint {actuator.joint} has two actuators (give one per joint)")
+        driven.add(actuator.joint)

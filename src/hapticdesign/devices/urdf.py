@@ -11,6 +11,8 @@ rotation ``Rz(yaw) Ry(pitch) Rx(roll)``) followed by the joint motion along/abou
   ``Rz(c) Ry(b) . Rz(q) . Ry(-b) Rz(-c)`` (conjugation of the z motion by the rotation that
   takes z onto ``a``), likewise with ``tz(q)`` for prismatic joints;
 - ``continuous`` joints are revolute, ``fixed`` joints add constant transforms only;
+- ``<limit lower= upper=>`` of a revolute or prismatic joint becomes the coordinate's range (both
+  attributes needed; URDF's defaults of 0 would make an empty range, so a missing one means none);
 - ``<mimic joint= multiplier= offset=>``: the joint value is ``offset + multiplier * q_joint``,
   a coupling as in the device files.
 
@@ -197,6 +199,7 @@ def device_from_urdf(text: str, source: str = "URDF", g: float = 9.81) -> Device
     coordinates: list[str] = []
     types: list[JointType] = []
     damping: list[float] = []
+    limits: list[tuple[float, float] | None] = []
     for joint in order:
         kind, where = joint.get("type"), f"{source}: joint {joint.get('name')!r}"
         if kind != "fixed" and kind not in SUPPORTED:
@@ -205,6 +208,7 @@ def device_from_urdf(text: str, source: str = "URDF", g: float = 9.81) -> Device
             coordinates.append(joint.get("name"))
             types.append(SUPPORTED[kind])
             damping.append(_floats(joint.find("dynamics"), "damping", 1, 0.0, where)[0])
+            limits.append(_limits(joint, where) if kind != "continuous" else None)
     if not coordinates:
         raise UserError(f"{source}: no movable joint (revolute, continuous or prismatic) to import")
 
@@ -237,7 +241,20 @@ def device_from_urdf(text: str, source: str = "URDF", g: float = 9.81) -> Device
         end_effector=_child(order[-1]),
     )
     name = robot.get("name") or Path(source).stem
-    return assemble_device(name, f"imported from {source}", {"g": g}, builder, inertias, tuple(damping))
+    return assemble_device(name, f"imported from {source}", {"g": g}, builder, inertias, tuple(damping),
+                           limits=tuple(limits))
+
+
+def _limits(joint: ET.Element, where: str) -> tuple[float, float] | None:
+    """``<limit lower upper>`` as ``(low, high)``; None unless both are given."""
+    element = joint.find("limit")
+    if element is None or element.get("lower") is None or element.get("upper") is None:
+        return None
+    (low,) = _floats(element, "lower", 1, 0.0, f"{where} <limit>")
+    (high,) = _floats(element, "upper", 1, 0.0, f"{where} <limit>")
+    if not low < high:
+        raise UserError(f"{where}: <limit> needs lower < upper, got lower={low:g} upper={high:g}")
+    return (low, high)
 
 
 def _joint_value(joint: ET.Element, coordinates: list[str], types: list[JointType], where: str) -> LinearExpr:

@@ -10,4 +10,6 @@ PARAMS = typer.Option(None, "--params", help="Parameter overrides by the seed's 
 STRICT = typer.Option(False, "--strict", help="Refuse inertias that break the triangle inequality (the seed's designs do).")
 JSON_OUT = typer.Option(False, "--json", help="Print the result as one JSON object on stdout.")
 QUIET = typer.Option(False, "--quiet", help="No warnings, notes or progress bars on stderr; errors still print.")
-SEED = typer.Option(1, "--seed", help="Random seed: the same seed gives the same numbers.")
+SEED = typer.Option(1, "--seed", min=0, help="Random seed (>= 0): the same seed gives the same numbers.")
+FORCE = typer.Option(False, "--force", help="Run work estimated above the stated limits (docs/limits.md).")
+FORCE_HINT = "add --force to run it anyway"

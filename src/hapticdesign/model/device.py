@@ -3,6 +3,11 @@
 A device couples kinematic parameters (lengths, ``g``) that shape the mechanism with the
 inertial parameters of its bodies (seed 000 Table 2.3 names: ``m2``, ``r2ax``, ``Ixy3a``, ...).
 Overrides by name return a new device; unknown names and non-finite values are refused.
+
+Actuators and joint limits (:mod:`hapticdesign.model.actuators`) ride along: ``damping`` is the
+total viscous damping per coordinate (joints plus actuators), ``coulomb`` the Coulomb friction per
+coordinate, ``reflected_inertia`` the constant ``n^2 J_r`` added to the diagonal of H
+(seed 000 eq. 2.50), ``limits`` each coordinate's range or ``None``.
 """
 
 from __future__ import annotations
@@ -10,12 +15,13 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 
 import numpy as np
 
 from hapticdesign.errors import PhysicalConsistencyWarning, UserError
+from hapticdesign.model.actuators import Actuator, Limits, full_turn, limit_warnings, per_joint
 from hapticdesign.model.inertia import (
     SEED_FIELDS,
     BodyInertia,
@@ -39,6 +45,8 @@ class Device:
     builder: MechanismBuilder = field(compare=False, repr=False)
     params: Mapping[str, float] = field(default_factory=dict)
     damping: tuple[float, ...] = ()
+    actuators: tuple[Actuator, ...] = ()
+    limits: tuple[Limits, ...] = ()
 
     @classmethod
     def from_file(cls, path) -> "Device":
@@ -56,7 +64,8 @@ class Device:
 
     @property
     def n_dof(self) -> int:
-        return self.mechanism.n_dof
+        """Independent coordinates: the actuated joints (passive joints of closed loops are solved)."""
+        return self.mechanism.n_actuated
 
     @property
     def body_names(self) -> tuple[str, ...]:
@@ -72,8 +81,12 @@ class Device:
         return list(self.kinematic) + self.inertial_names()
 
     def with_params(self, overrides: Mapping[str, float]) -> "Device":
-        """A copy with some parameters replaced; unknown names and non-finite values raise."""
+        """A copy with some parameters replaced; unknown names, non-finite values, negative masses and a
+        negative ``g`` raise."""
+        if not isinstance(overrides, Mapping):
+            raise UserError(f"parameter overrides must be a mapping of names to numbers, got {type(overrides).__name__}")
         known = set(self.parameter_names())
+        masses = {seed_parameter_name("m", b) for b in self.body_names}
         merged = dict(self.params)
         for key, value in overrides.items():
             if key not in known:
@@ -86,8 +99,12 @@ class Device:
                 raise UserError(f"parameter {key}: {value!r} is not a number") from None
             if not math.isfinite(val):
                 raise UserError(f"parameter {key}: value must be finite, got {value!r}")
+            if key in masses and val < 0:
+                raise UserError(f"parameter {key}: negative mass {val:g} (a mass must be >= 0)")
+            if key == "g" and val < 0:
+                raise UserError(f"parameter g: gravity must be >= 0 m/s^2 (it points down the base z axis), got {val:g}")
             merged[key] = val
-        return Device(self.name, self.description, self.kinematic, self.builder, merged, self.damping)
+        return replace(self, params=merged)
 
     def body(self, name: str) -> BodyInertia:
         return BodyInertia(**{f: float(self.params.get(seed_parameter_name(f, name), 0.0)) for f in SEED_FIELDS})
@@ -97,8 +114,18 @@ class Device:
         return np.array([[float(self.params.get(seed_parameter_name(f, b), 0.0)) for f in SEED_FIELDS] for b in self.body_names])
 
     def standard_parameters(self) -> np.ndarray:
-        """Standard inertial parameters, flat (10 x bodies,), in the regressor's column order."""
-        return standard_from_seed(self.seed_parameters()).ravel()
+        """Standard inertial parameters, flat (10 x bodies,), in the regressor's column order.
+
+        Refuses parameters whose standard form overflows or holds a negative mass."""
+        seed = self.seed_parameters()
+        with np.errstate(over="ignore", invalid="ignore"):
+            standard = standard_from_seed(seed).ravel()
+        if not np.all(np.isfinite(standard)):
+            raise UserError(f"the inertial parameters of {self.name} overflow (m r or m r^2 is not a finite number)")
+        if np.any(seed[:, 0] < 0):
+            body = self.body_names[int(np.argmax(seed[:, 0] < 0))]
+            raise UserError(f"body {body} of {self.name} has a negative mass")
+        return standard
 
     def check(self, strict: bool = False) -> list[str]:
         """Physical consistency of every body; errors raise, triangle-inequality breaks warn."""
@@ -108,13 +135,44 @@ class Device:
             warnings.warn(message, PhysicalConsistencyWarning, stacklevel=2)
         return found
 
+    # -- actuators and limits -----------------------------------------------------------------
+    @property
+    def reflected_inertia(self) -> tuple[float, ...]:
+        """``n^2 J_r`` per coordinate (kg m^2 or kg), added to the diagonal of H; zeros without actuators."""
+        return per_joint(self.actuators, self.n_dof, "reflected_inertia")
+
+    @property
+    def coulomb(self) -> tuple[float, ...]:
+        """Coulomb friction per coordinate on the joint side (N m or N); zeros without actuators."""
+        return per_joint(self.actuators, self.n_dof, "coulomb")
+
+    def joint_limits(self) -> tuple[Limits, ...]:
+        """Each coordinate's range ``(low, high)`` in rad or m, or ``None`` where none is given."""
+        return self.limits or (None,) * self.n_dof
+
+    def joint_ranges(self) -> tuple[tuple[float, float], ...]:
+        """Ranges for sampling poses (LN regions, metric maps): limits, else the full turn ``[-pi, pi]``."""
+        return tuple(full_turn(span) for span in self.joint_limits())
+
+    def limit_warnings(self, q: np.ndarray) -> list[str]:
+        """One message per coordinate of ``q`` outside its limits (values outside are allowed)."""
+        return limit_warnings(np.ravel(q), self.joint_limits(), self.mechanism.actuated_coordinates)
+
     # -- dynamics -----------------------------------------------------------------------------
     @property
     def model(self):
-        """The compiled regressor model of the equations of motion (cached per geometry)."""
+        """The compiled regressor model of the equations of motion (cached per geometry).
+
+        With actuators, H carries the constant reflected rotor inertia (seed 000 eq. 2.50 plus
+        ``diag(n^2 J_r)``); the regressor in the inertial parameters is the same object's.
+        """
+        from hapticdesign.analysis.dynamics.closed_loop import ClosedLoopModel
         from hapticdesign.analysis.dynamics.model import DynamicsModel
 
-        return _model(DynamicsModel, self.builder, self.kinematic_values())
+        kind = ClosedLoopModel if self.mechanism.loops is not None else DynamicsModel
+        base = _model(kind, self.builder, self.kinematic_values())
+        extra = self.reflected_inertia if self.actuators else ()
+        return _with_rotors(base, extra) if any(extra) else base
 
     def H(self, q: np.ndarray) -> np.ndarray:
         return self.model.H(q, self.standard_parameters())
@@ -143,3 +201,8 @@ def _build(builder: MechanismBuilder, kinematic: tuple[tuple[str, float], ...]) 
 @lru_cache(maxsize=16)
 def _model(cls, builder: MechanismBuilder, kinematic: tuple[tuple[str, float], ...]):
     return cls(_build(builder, kinematic))
+
+
+@lru_cache(maxsize=16)
+def _with_rotors(base, reflected: tuple[float, ...]):
+    return base.with_constant_inertia(np.diag(reflected))

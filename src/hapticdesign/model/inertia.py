@@ -128,6 +128,10 @@ def check_body(name: str, body: BodyInertia, rel_tol: float = 1e-12) -> Consiste
     Errors: NaN, negative mass, a massless body with inertia, an inertia tensor that is not
     positive definite. Warning: positive definite but breaking the triangle inequality
     (accepted by the seed's eq. 3.28, not realizable by a rigid body).
+
+    A *point mass* (positive mass, every moment and product exactly zero) is consistent: its
+    pseudo-inertia ``m [r; 1][r; 1]^T`` is positive semi-definite (rank one), the limit of a
+    shrinking rigid body, and its inertia about the frame origin is ``m (r.r 1 - r r^T)``.
     """
     values = np.array([getattr(body, f) for f in SEED_FIELDS])
     if not np.all(np.isfinite(values)):
@@ -139,6 +143,8 @@ def check_body(name: str, body: BodyInertia, rel_tol: float = 1e-12) -> Consiste
     if body.m == 0:
         if np.abs(inertia).max() > 0:
             return ConsistencyReport(name, error=f"body {name}: massless body with non-zero inertia")
+        return ConsistencyReport(name)
+    if not np.any(inertia):  # a point mass
         return ConsistencyReport(name)
     eig = np.linalg.eigvalsh(inertia)
     if eig[0] <= rel_tol * scale:

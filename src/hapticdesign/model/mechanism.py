@@ -2,8 +2,10 @@
 
 A serial chain is a path in this tree; a hybrid (closed-loop) mechanism such as the Phantom's
 parallelogram is a tree whose dependent transforms are driven by affine combinations of the
-independent coordinates (seed 000 eq. 2.38-2.43). Jacobians, dynamics, stiffness and metrics
-all consume the compiled form :class:`CompiledMechanism`.
+independent coordinates (seed 000 eq. 2.38-2.43). Loops whose closure is not affine (a five-bar
+with separate base pivots, a delta) keep their passive joints as tree coordinates and add closure
+constraints (:class:`~hapticdesign.model.loops.ClosedLoops`, ``loops``). Jacobians, dynamics,
+stiffness and metrics all consume the compiled form :class:`CompiledMechanism`.
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ from functools import cached_property
 import numpy as np
 
 from hapticdesign.errors import UserError
+from hapticdesign.model.loops import ClosedLoops
 from hapticdesign.model.transforms import Axis, ElementaryTransform, elementary_matrix
 
 
@@ -55,6 +58,7 @@ class Mechanism:
     gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
     end_effector: str | None = None
     metadata: dict = field(default_factory=dict)
+    loops: ClosedLoops | None = None
 
     def __post_init__(self) -> None:
         names = [f.name for f in self.frames]
@@ -74,10 +78,23 @@ class Mechanism:
                 raise UserError(f"body {b.name}: unknown frame {b.frame!r}")
         if self.end_effector is not None and self.end_effector not in known:
             raise UserError(f"unknown end-effector frame {self.end_effector!r}")
+        if self.loops is not None:
+            self.loops.validate(self.coordinates, known)
 
     @property
     def n_dof(self) -> int:
         return len(self.coordinates)
+
+    @property
+    def n_actuated(self) -> int:
+        """Independent (actuated) coordinates: all of them for a tree, fewer with passive joints."""
+        return self.n_dof - (len(self.loops.passive) if self.loops else 0)
+
+    @property
+    def actuated_coordinates(self) -> tuple[str, ...]:
+        if self.loops is None:
+            return self.coordinates
+        return tuple(self.coordinates[k] for k in self.loops.actuated(self.n_dof))
 
     @property
     def body_names(self) -> tuple[str, ...]:

@@ -45,6 +45,9 @@ from hapticdesign.errors import UserError
 from hapticdesign.simulation.config import Compensator, LoopConfig, Sensors, Wall
 from hapticdesign.simulation.loop import simulate_tables
 from hapticdesign.simulation.tables import DynamicsTables
+from hapticdesign.workload import EIGEN_ORDER_LIMIT, require_memory, require_plant_steps, require_within
+
+BOUNDARY_RUNS = 42  # doublings from b / T to the 1e12 cap of :func:`simulated_boundary`
 
 
 @dataclass(frozen=True)
@@ -128,6 +131,10 @@ def spectral_radius(system: MassDamper, stiffness: float) -> float:
 
 def exact_boundary(system: MassDamper, k_max: float = 1e9) -> float:
     """Smallest spring stiffness at which the exactly discretized loop loses stability."""
+    order = 3 + 3 * system.delay_samples
+    what = f"the closed-loop matrix of a {system.delay_samples:,}-sample delay"
+    require_memory(what, 8.0 * order * order)
+    require_within(what, order, EIGEN_ORDER_LIMIT, "rows")
     lo = 1e-9
     if spectral_radius(system, lo) >= 1.0:
         return 0.0
@@ -174,6 +181,10 @@ def envelope_grows(error: np.ndarray, margin: float = 0.0) -> bool:
 
 def simulated_boundary(system: MassDamper, rel_tol: float = 1e-3, samples: int = 4000, substeps: int = 10) -> float:
     """Bisect the simulated loop for the stiffness at which oscillations start to grow."""
+    if samples < 40 or substeps < 1:
+        raise UserError("the growth test needs at least 40 samples and 1 plant step per sample")
+    runs = BOUNDARY_RUNS + math.ceil(math.log2(1.0 / rel_tol))
+    require_plant_steps(f"{runs} simulations of {samples:,} samples x {substeps:,} plant steps", runs * samples * substeps)
     lo, hi = 0.0, system.damping / system.period + 1e-9
     while not grows(system, hi, samples, substeps):
         lo, hi = hi, 2.0 * hi

@@ -12,11 +12,15 @@ type 1 and type 2 results agree (``summary.csv``, ``summary.md``) and the figure
 from __future__ import annotations
 
 import csv
+import fcntl
 import json
+import logging
 import math
 import os
+import re
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -24,14 +28,22 @@ import numpy as np
 
 from hapticdesign.devices.registry import preset
 from hapticdesign.errors import PhysicalConsistencyWarning, UserError
-from hapticdesign.interface.common import write_atomically
-from hapticdesign.simulation.impedance import ImpedanceProblem, fast_search
+from hapticdesign.files import write_atomically
+from hapticdesign.simulation.impedance import (ImpedanceProblem, fast_search, planned_simulations,
+                                               require_search_workload)
 from hapticdesign.simulation.paths import Chirp
 from hapticdesign.simulation.transparency import transparency
+from hapticdesign.workload import require_plant_steps, worker_count
 
 META_COLUMNS = ("level", "ln", "ln_H", "ln_C", "ln_G")
 CRITERIA = ("impedance", "transparency")
 TYPES = (1, 2)
+# Design names become file names under cases/: letters, digits, '.', '_', '-', not starting with '.'.
+DESIGN_NAME = re.compile(r"^[A-Za-z0-9_-][A-Za-z0-9._-]{0,99}$")
+LOCK_FILE = "campaign.lock"
+DASK_LOG_ENV = "DASK_LOGGING__DISTRIBUTED"
+# Entries of H, C, G beyond this overflow once multiplied by rates and gains in the simulation.
+DYNAMICS_BOUND = 1e150
 
 
 @dataclass(frozen=True)
@@ -87,18 +99,42 @@ def read_designs(path: Path, preset_name: str = "phantom-3dof") -> list[Design]:
     for i, row in enumerate(rows, start=1):
         where = f"{path} row {i}"
         name = (row.get("design") or f"d{i:04d}").strip()
+        if not DESIGN_NAME.match(name):
+            raise UserError(f"{where}: design name {name[:40]!r} cannot name a file (use at most 100 letters, digits, "
+                            "'.', '_' or '-', not starting with '.')")
         meta = {c: _number(row[c], f"{where} column {c}", allow_nan=c != "level") for c in META_COLUMNS}
         params = {c: _number(row[c], f"{where} column {c}") for c in names}
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", PhysicalConsistencyWarning)
             try:
-                device.with_params(params).check(strict=False)
+                _check_design(device.with_params(params))
             except UserError as exc:
                 raise UserError(f"{where} ({name}): {exc}") from None
         designs.append(Design(name, meta["level"], meta, params))
     if len({d.name for d in designs}) != len(designs):
         raise UserError(f"{path}: design names must be unique")
     return designs
+
+
+def _check_design(device) -> None:
+    """Physically consistent bodies and finite dynamics (checked before any case runs)."""
+    device.check(strict=False)
+    rng = np.random.default_rng(0)
+    poses = np.vstack([np.zeros(device.n_dof), rng.uniform(-np.pi, np.pi, (4, device.n_dof))])
+    with np.errstate(all="ignore"):
+        largest = max(float(np.max(np.abs(f(q)))) for q in poses for f in (device.H, device.C, device.G))
+    if not largest <= DYNAMICS_BOUND:
+        raise UserError(f"its parameters make the equations of motion overflow (entries of H, C or G reach "
+                        f"{largest:.3g}, beyond {DYNAMICS_BOUND:g})")
+
+
+def _require_case_workload(options: CampaignOptions) -> None:
+    """Refuse cases whose own plant steps exceed the workload limit (a campaign has many; each is one job)."""
+    from hapticdesign.simulation.config import LoopConfig
+
+    require_search_workload(LoopConfig(duration=options.duration), planned_simulations("fast", options.k_limit))
+    require_plant_steps(f"a transparency case of {options.chirp.sweep_time:g} s",
+                        options.chirp.sweep_time / LoopConfig().step)
 
 
 def case_key(design: str, criterion: str, sim_type: int) -> str:
@@ -127,25 +163,109 @@ def run_case(preset_name: str, params: dict[str, float], criterion: str, sim_typ
     }
 
 
-def _client(scheduler: str | None, workers: int | None):
+SCHEDULER_ADDRESS = re.compile(r"^(?:(?:tcp|tls|inproc|ucx|ws|wss)://)?[A-Za-z0-9.\-\[\]:]+:\d{1,5}$")
+
+
+@contextmanager
+def dask_logging(quiet: bool) -> Iterator[None]:
+    """Dask's loggers here and in the worker processes it starts: warnings and errors only (no
+    connection chatter), nothing at all when ``quiet``."""
+    logger = logging.getLogger("distributed")
+    before, env_before = logger.level, os.environ.get(DASK_LOG_ENV)
+    logger.setLevel(logging.CRITICAL + 1 if quiet else logging.WARNING)
+    os.environ[DASK_LOG_ENV] = "critical" if quiet else "warning"  # read by the spawned worker processes
+    try:
+        yield
+    finally:
+        logger.setLevel(before)
+        if env_before is None:
+            os.environ.pop(DASK_LOG_ENV, None)
+        else:
+            os.environ[DASK_LOG_ENV] = env_before
+
+
+def check_scheduler(address: str) -> None:
+    """Refuse text that is not a Dask scheduler address (``tcp://host:port`` or ``host:port``)."""
+    if not SCHEDULER_ADDRESS.match(address.strip()):
+        raise UserError(f"{address[:80]!r} is not a Dask scheduler address (expected e.g. tcp://host:8786)")
+
+
+def _client(scheduler: str | None, workers: int | None, quiet: bool = False):
     from dask.distributed import Client, LocalCluster
 
     if scheduler:
+        check_scheduler(scheduler)
         try:
-            return Client(scheduler, timeout="20s")
-        except (OSError, TimeoutError) as exc:
-            raise UserError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
-    n = workers or os.cpu_count() or 1
-    return Client(LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None))
+            return Client(scheduler.strip(), timeout="20s")
+        except (OSError, TimeoutError, ValueError, TypeError) as exc:
+            first = str(exc).splitlines()[0][:200] if str(exc) else type(exc).__name__
+            raise UserError(f"cannot reach the Dask scheduler at {scheduler}: {first}") from None
+    return Client(LocalCluster(n_workers=worker_count(workers), threads_per_worker=1, processes=True,
+                               dashboard_address=None, silence_logs=logging.CRITICAL + 1 if quiet else logging.ERROR))
+
+
+def _close(client, own_cluster: bool) -> None:
+    """Stop the client, then the local cluster it started (workers first, so none heartbeats a closed
+    scheduler)."""
+    cluster = getattr(client, "cluster", None) if own_cluster else None
+    if cluster is not None:
+        try:
+            client.retire_workers(close_workers=True)
+        except Exception:  # a worker that is already gone needs no retiring  # noqa: BLE001
+            pass
+    client.close()
+    if cluster is not None:
+        cluster.close()
+
+
+@contextmanager
+def campaign_lock(out: Path) -> Iterator[None]:
+    """An exclusive lock on ``out`` for the run: a second campaign in the same folder is refused."""
+    out.mkdir(parents=True, exist_ok=True)
+    handle = (out / LOCK_FILE).open("a")
+    try:
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            raise UserError(f"another campaign is running in {out}; wait for it or choose another output folder") from None
+        yield
+    finally:
+        handle.close()
+
+
+def case_done(path: Path, design: str, criterion: str, sim_type: int) -> bool:
+    """True when ``path`` holds this case's complete record; empty, corrupt or stray files are not done."""
+    try:
+        record = json.loads(path.read_text())
+    except (OSError, UnicodeDecodeError, ValueError):
+        return False
+    result_key = "k_max" if criterion == "impedance" else "bandwidth_hz"
+    return (isinstance(record, dict) and record.get("design") == design and record.get("type") == sim_type
+            and "value" in record and result_key in record)
 
 
 def run_campaign(designs_path: Path, out: Path, options: CampaignOptions | None = None,
                  scheduler: str | None = None, workers: int | None = None,
-                 progress: Callable[[int, int], None] | None = None) -> dict:
-    """Run every missing case, then aggregate; returns counts of cases run and skipped."""
+                 progress: Callable[[int, int], None] | None = None, quiet: bool = False) -> dict:
+    """Run every missing case, then aggregate; returns counts of cases run and skipped.
+
+    Cases whose file is missing, empty, corrupt or not this case's record are (re)computed; a lock
+    on ``out`` refuses a second campaign in the same folder; ``quiet`` silences Dask's logs.
+    """
     options = options or CampaignOptions()
+    if scheduler:
+        check_scheduler(scheduler)
+    else:
+        worker_count(workers)
+    _require_case_workload(options)
     designs = read_designs(designs_path, options.preset)
     out = Path(out)
+    with campaign_lock(out), dask_logging(quiet):
+        return _run_locked(designs, out, options, scheduler, workers, progress, quiet)
+
+
+def _run_locked(designs: list[Design], out: Path, options: CampaignOptions, scheduler: str | None,
+                workers: int | None, progress: Callable[[int, int], None] | None, quiet: bool) -> dict:
     cases_dir = out / "cases"
     cases_dir.mkdir(parents=True, exist_ok=True)
     settings = json.dumps({**asdict(options), "designs": [asdict(d) for d in designs]}, sort_keys=True)
@@ -154,12 +274,12 @@ def run_campaign(designs_path: Path, out: Path, options: CampaignOptions | None 
         raise UserError(f"{out} holds a campaign with other designs or settings; choose another --out")
     write_atomically(stamp, settings)
     todo = [(d, c, t) for d in designs for c in CRITERIA for t in TYPES
-            if not (cases_dir / f"{case_key(d.name, c, t)}.json").exists()]
+            if not case_done(cases_dir / f"{case_key(d.name, c, t)}.json", d.name, c, t)]
     total = len(designs) * len(CRITERIA) * len(TYPES)
     if todo:
         from dask.distributed import as_completed
 
-        client = _client(scheduler, workers)
+        client = _client(scheduler, workers, quiet)
         try:
             futures = {}
             for d, c, t in todo:
@@ -175,10 +295,7 @@ def run_campaign(designs_path: Path, out: Path, options: CampaignOptions | None 
                 if progress is not None:
                     progress(done, total)
         finally:
-            cluster = getattr(client, "cluster", None)
-            client.close()
-            if cluster is not None and not scheduler:
-                cluster.close()
+            _close(client, own_cluster=not scheduler)
     aggregate(designs, out, options)
     return {"cases": total, "run": len(todo), "skipped": total - len(todo)}
 
@@ -189,6 +306,8 @@ def load_cases(designs: list[Design], out: Path) -> dict[tuple[str, str, int], d
         for c in CRITERIA:
             for t in TYPES:
                 path = Path(out) / "cases" / f"{case_key(d.name, c, t)}.json"
+                if not case_done(path, d.name, c, t):
+                    raise UserError(f"{path} is missing or corrupt; run the campaign again to recompute it")
                 cases[(d.name, c, t)] = json.loads(path.read_text())
     return cases
 

@@ -16,10 +16,15 @@ import numpy as np
 from hapticdesign.analysis.kinematics import jacobian
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
+from hapticdesign.model.inertia import SEED_FIELDS
 
 STATUS_COMPLETED = 0
 STATUS_EXCURSION = 1
 STATUS_DIVERGED = 2
+
+FRICTION_VELOCITY = 1e-3
+"""Coulomb friction acts as ``F_c tanh(qd / v_f)`` with ``v_f`` = 1e-3 rad/s (or m/s): the sign function
+made smooth enough for a fixed-step integrator; above 3 v_f it is within 0.5 % of ``F_c sign(qd)``."""
 
 
 @dataclass(frozen=True)
@@ -34,12 +39,22 @@ class Wall:
 
 @dataclass(frozen=True)
 class Compensator:
-    """Inverse dynamics of a model device; ``error_percent`` scales its inertial parameters (§4.1.1.2)."""
+    """Inverse dynamics of a model device (§4.1.1.2) and its modelling error.
+
+    ``error_percent`` scales every inertial parameter by ``1 - E/100`` (the seed's "error %" of
+    masses, inertias and mass centres alike). ``group_errors`` gives each group its own error in
+    percent: ``{"mass": E_m, "centre": E_r, "inertia": E_I}`` (masses ``m``; mass-centre offsets
+    ``rx ry rz``; inertia entries ``Ixx ... Iyz``); with ``error_seed`` each parameter of a group gets
+    a random sign (``numpy.random.default_rng(error_seed)``, in the order of the device's parameter
+    names), so the model over- and underestimates as a real identification would.
+    """
 
     inertial: bool = True
     coriolis: bool = True
     gravity: bool = True
     error_percent: float = 0.0
+    group_errors: tuple[tuple[str, float], ...] = ()
+    error_seed: int | None = None
 
 
 @dataclass(frozen=True)
@@ -73,6 +88,8 @@ class LoopConfig:
     compensator: Compensator = field(default_factory=Compensator)
     wall: Wall = field(default_factory=Wall)
     damping: tuple[float, ...] | None = None
+    coulomb: tuple[float, ...] | None = None
+    """Coulomb friction torque (N m) or force (N) per joint in the plant; None: the device's (or none)."""
     safety_limit: float | None = 0.06
     hand: Hand | None = None
     record_stride: int | None = None
@@ -85,6 +102,8 @@ class LoopConfig:
         if not (period > 0 and math.isfinite(period)):
             raise UserError(f"the sample period must be positive, got {period}")
         ratio = period / self.step
+        if not math.isfinite(ratio):
+            raise UserError(f"the sample period {period} s over the plant step {self.step} s overflows")
         if abs(ratio - round(ratio)) > 1e-9 * ratio or round(ratio) < 1:
             raise UserError(f"the plant step {self.step} s does not divide the sample period {period} s")
         return int(round(ratio))
@@ -123,14 +142,68 @@ class Trace:
         return self.trip_time is not None
 
 
-def model_device(device: Device, error_percent: float) -> Device:
-    """The compensator's device: every inertial parameter times ``1 - error_percent / 100``."""
-    if not math.isfinite(error_percent) or error_percent > 100:
-        raise UserError(f"error percentage must be a finite number <= 100, got {error_percent}")
-    if error_percent == 0:
+def require_device(device: object) -> Device:
+    """``device`` itself when it is a :class:`Device`; anything else is a :class:`UserError`."""
+    if not isinstance(device, Device):
+        raise UserError(f"expected a Device (e.g. hapticdesign.preset('phantom-3dof')), got {type(device).__name__} "
+                        f"{str(device)[:40]!r}")
+    return device
+
+
+def require_options(sim_type: object, config: object, config_type: type) -> None:
+    """The simulation type is 1 or 2 and ``config`` (when given) a ``config_type``."""
+    if isinstance(sim_type, bool) or sim_type not in (1, 2):
+        raise UserError(f"simulation type must be 1 or 2, got {sim_type!r}")
+    if config is not None and not isinstance(config, config_type):
+        raise UserError(f"config must be a {config_type.__name__}, got {type(config).__name__}")
+
+
+ERROR_GROUPS = {"mass": ("m",), "centre": ("rx", "ry", "rz"), "inertia": ("Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz")}
+
+
+def _check_percent(value: float, what: str) -> None:
+    if not (math.isfinite(value) and -100 < value < 100):
+        raise UserError(f"{what} must be a finite number between -100 and 100 (exclusive), got {value}")
+
+
+def model_device(device: Device, error_percent: float, group_errors: tuple[tuple[str, float], ...] = (),
+                 error_seed: int | None = None) -> Device:
+    """The compensator's device: every inertial parameter times ``1 - error_percent / 100``, then each
+    group of :data:`ERROR_GROUPS` times ``1 + s E_group / 100`` (``s = -1``, or a seeded random sign)."""
+    _check_percent(error_percent, "error percentage")
+    groups = dict(group_errors)
+    for name, value in groups.items():
+        if name not in ERROR_GROUPS:
+            raise UserError(f"unknown error group {name!r}; groups: {', '.join(ERROR_GROUPS)}")
+        _check_percent(value, f"the {name} error")
+    if error_percent == 0 and not any(groups.values()):
         return device
     factor = 1.0 - error_percent / 100.0
-    return device.with_params({k: device.params.get(k, 0.0) * factor for k in device.inertial_names()})
+    names = device.inertial_names()
+    fields = [f for _ in device.body_names for f in SEED_FIELDS]
+    rng = np.random.default_rng(error_seed) if error_seed is not None else None
+    signs = rng.choice([-1.0, 1.0], size=len(names)) if rng is not None else -np.ones(len(names))
+    values = {}
+    for name, kind, sign in zip(names, fields, signs):
+        group = next((g for g, members in ERROR_GROUPS.items() if kind in members), None)
+        scale = factor * (1.0 + sign * groups.get(group, 0.0) / 100.0)
+        values[name] = device.params.get(name, 0.0) * scale
+    return device.with_params(values)
+
+
+def compensator_device(device: Device, compensator: Compensator) -> Device:
+    """The device the compensator models, with its errors (:func:`model_device`)."""
+    return model_device(device, compensator.error_percent, compensator.group_errors, compensator.error_seed)
+
+
+def plant_friction(device: Device, config: LoopConfig) -> np.ndarray:
+    """Coulomb friction per joint: the configuration's, else the device's actuators' (``device.coulomb``), else 0."""
+    values = config.coulomb if config.coulomb is not None else getattr(device, "coulomb", None)
+    friction = np.zeros(device.n_dof) if values is None else np.asarray(values, dtype=float)
+    if friction.shape != (device.n_dof,) or not np.all(np.isfinite(friction)) or np.any(friction < 0):
+        raise UserError(f"expected {device.n_dof} finite, non-negative Coulomb friction values, got "
+                        f"{np.atleast_1d(friction).tolist()[:8]}")
+    return friction
 
 
 def hand_matrices(device: Device, hand: Hand | None, q0: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import io
 from pathlib import Path
 
 import matplotlib
@@ -9,6 +10,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+
+from hapticdesign.files import write_atomically  # noqa: E402
 
 LABELS = {"impedance": ("Maximum stable impedance [N m/rad]", "k_max"),
           "transparency": ("Transparency bandwidth [Hz]", "bandwidth")}
@@ -19,6 +22,19 @@ def _save(fig, path: Path) -> None:
     for suffix in (".png", ".svg"):
         fig.savefig(path.with_suffix(suffix), dpi=120, bbox_inches="tight")
     plt.close(fig)
+
+
+def _save_atomically(fig, path: Path) -> list[Path]:
+    """PNG and SVG of ``fig`` through :func:`hapticdesign.files.write_atomically` (one-line errors)."""
+    written = []
+    for suffix in (".png", ".svg"):
+        buffer = io.BytesIO()
+        fig.savefig(buffer, format=suffix[1:], dpi=120, bbox_inches="tight")
+        target = path.with_suffix(suffix)
+        write_atomically(target, buffer.getvalue())
+        written.append(target)
+    plt.close(fig)
+    return written
 
 
 def swarm_offsets(values: np.ndarray, width: float = 0.35, resolution: float | None = None) -> np.ndarray:
@@ -133,27 +149,43 @@ def write_all(designs, cases, summary, folder: Path) -> None:
 def zwidth_chart(zw, title: str, path: Path) -> list[Path]:
     """The Z-width (Colgate & Brown 1994): stable (B, K) below the exact boundary, with the passivity
     bound and the short-delay linear approximation beside it; written atomically as PNG and SVG."""
-    import io
-
-    from hapticdesign.files import write_atomically
-
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
     ax.fill_between(zw.B, 0, zw.K, color="tab:blue", alpha=0.15, label="stable (exact, discrete time)")
     ax.plot(zw.B, zw.K, "-", color="tab:blue", lw=1.8, label="K_max(B), exact")
-    ax.plot(zw.B, zw.passivity, "--", color="tab:red", label="passivity: b > K T / 2 + |B|")
-    ax.plot(zw.B, zw.linear, ":", color="k", label="linear approximation 2 (b + B) / (T (1 + 2 N))")
+    if zw.passivity is not None:
+        ax.plot(zw.B, zw.passivity, "--", color="tab:red", label="passivity: b > K (T/2 + N T) + |B|")
+        ax.plot(zw.B, zw.linear, ":", color="k", label="linear approximation 2 (b + B) / (T (1 + 2 N))")
     top = max(max(zw.K), 1e-12)
     ax.set_ylim(0, 1.15 * top)
     ax.set_xlabel("virtual damping B [N m s/rad]")
     ax.set_ylabel("virtual stiffness K [N m/rad]")
     ax.set_title(title, fontsize=10)
     ax.legend(fontsize=8)
-    written = []
-    for suffix in (".png", ".svg"):
-        buffer = io.BytesIO()
-        fig.savefig(buffer, format=suffix[1:], dpi=120, bbox_inches="tight")
-        target = path.with_suffix(suffix)
-        write_atomically(target, buffer.getvalue())
-        written.append(target)
-    plt.close(fig)
-    return written
+    return _save_atomically(fig, path)
+
+
+def robustness_chart(rows: list[dict], path: Path) -> list[Path]:
+    """Mean relative change of the stable range against the modelling error, one line per LN level."""
+    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    for level in sorted({r["level"] for r in rows}):
+        chosen = sorted((r for r in rows if r["level"] == level), key=lambda r: r["error_percent"])
+        ax.plot([r["error_percent"] for r in chosen], [100 * (r["mean_relative_change"] or 0.0) for r in chosen],
+                "o-", label=f"LN = {level:g}")
+    ax.set_xlabel("modelling error of masses and inertias [%] (seeded random signs)")
+    ax.set_ylabel("mean |K_max - K_max(0)| / K_max(0) [%]")
+    ax.set_title("Stable impedance range under modelling error, type 1", fontsize=10)
+    ax.legend(fontsize=8)
+    return _save_atomically(fig, path)
+
+
+def stiffness_map_chart(result, joint_names: list[str], wall_name: str, path: Path) -> list[Path]:
+    """Heat map of the largest stable stiffness over two joints' angles."""
+    fig, ax = plt.subplots(figsize=(5.8, 4.6))
+    image = ax.pcolormesh(result.second, result.first, np.array(result.K), shading="nearest", cmap="viridis")
+    bar = fig.colorbar(image, ax=ax, label=f"K_max of {wall_name} [N m/rad]")
+    bar.formatter.set_useOffset(False)
+    bar.update_ticks()
+    ax.set_xlabel(f"{joint_names[1]} [rad]")
+    ax.set_ylabel(f"{joint_names[0]} [rad]")
+    ax.set_title(f"Largest stable stiffness of {wall_name}, other joints held", fontsize=10, pad=12)
+    return _save_atomically(fig, path)

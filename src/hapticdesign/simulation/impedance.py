@@ -22,55 +22,13 @@ import numpy as np
 
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
+from hapticdesign.simulation.analytic import AnalyticProblem
 from hapticdesign.simulation.boundary import envelope_grows
-from hapticdesign.simulation.config import LoopConfig, Wall, model_device
+from hapticdesign.simulation.config import LoopConfig, Wall, compensator_device, require_device, require_options
 from hapticdesign.simulation.loop import simulate
-from hapticdesign.simulation.paths import Held, Path, Sine
+from hapticdesign.simulation.criteria import Criteria, Verdict, check_settle_window, type_paths
 from hapticdesign.simulation.tables import DynamicsTables
-
-
-@dataclass(frozen=True)
-class Criteria:
-    """Stability criteria of the seed's method (all configurable)."""
-
-    overshoot_limit: float = 0.012
-    settle_tolerance: float = 0.002
-    settle_window: float = 0.5
-    safety_limit: float = 0.06
-
-    def __post_init__(self) -> None:
-        for name in ("overshoot_limit", "settle_tolerance", "settle_window", "safety_limit"):
-            value = getattr(self, name)
-            if not (value > 0 and math.isfinite(value)):
-                raise UserError(f"{name.replace('_', ' ')} must be positive, got {value}")
-
-
-@dataclass(frozen=True)
-class Verdict:
-    """Outcome of one gain: stable, or the criterion that failed first.
-
-    ``peak`` is the largest excursion from the start over every plant step; ``stopped_at`` is the
-    time a run ended early (excursion limit reached or diverged), ``None`` for a full run.
-    """
-
-    stiffness: float
-    stable: bool
-    criterion: str
-    peak: float
-    final_error: float
-    stopped_at: float | None = None
-
-    def as_dict(self) -> dict:
-        return {"k": float(self.stiffness), "stable": self.stable, "criterion": self.criterion,
-                "peak": self.peak, "final_error": self.final_error, "stopped_at": self.stopped_at}
-
-
-def type_paths(sim_type: int, n_dof: int, wall_joint: int = 0) -> dict[int, Path]:
-    """Motions of the other joints: type 1 held at 0, type 2 driven at 0.52 sin(3 pi t) (Table 4.3)."""
-    if sim_type not in (1, 2):
-        raise UserError(f"simulation type must be 1 or 2, got {sim_type}")
-    path: Path = Held(0.0) if sim_type == 1 else Sine(0.52, 3 * np.pi)
-    return {j: path for j in range(n_dof) if j != wall_joint}
+from hapticdesign.workload import require_plant_steps
 
 
 @dataclass
@@ -85,9 +43,10 @@ class ImpedanceProblem:
     config: LoopConfig = field(default_factory=LoopConfig)
 
     def __post_init__(self) -> None:
+        check_settle_window(self.criteria, self.config.duration)
         self.paths = type_paths(self.sim_type, self.device.n_dof, self.wall_joint)
         self.plant = DynamicsTables.from_device(self.device)
-        self.model = DynamicsTables.from_device(model_device(self.device, self.config.compensator.error_percent))
+        self.model = DynamicsTables.from_device(compensator_device(self.device, self.config.compensator))
         self.config = replace(self.config, safety_limit=self.criteria.safety_limit,
                               stop_excursion=self.criteria.overshoot_limit)
 
@@ -136,10 +95,14 @@ class RangeResult:
     method: str
     k_min: float | None = None
     resolution: float = 1.0
+    exact: bool | None = None
+    """For the analytic method: whether the linearized loop is exact for this device and type."""
 
     def as_dict(self) -> dict:
         first = self.first_unstable
+        extra = {} if self.exact is None else {"analytic_exact": self.exact}
         return {
+            **extra,
             "k_max": float(self.k_max),
             "k_min": self.k_min,
             "resolution": self.resolution,
@@ -150,6 +113,25 @@ class RangeResult:
             "simulations": self.simulations,
             "method": self.method,
         }
+
+
+def planned_simulations(method: str, k_limit: float, resolution: float | None = None,
+                        true_boundary: bool = False) -> int:
+    """The most simulations a search can run: gallop and bisect (fast, grid), one per K (linear)."""
+    if resolution is not None:
+        runs = 6 * math.ceil(math.log2(max(k_limit / resolution, 1.0) + 1)) + 2
+    elif method == "linear":
+        runs = max(int(k_limit), 1)
+    else:
+        runs = 4 * math.ceil(math.log2(max(k_limit, 1) + 1)) + 2
+    return runs + (40 if true_boundary else 0)
+
+
+def require_search_workload(config: LoopConfig, runs: int) -> None:
+    """Refuse a search whose plant steps (runs x duration / step) exceed the workload limit."""
+    steps = config.duration / config.step
+    require_plant_steps(f"{runs:,} simulations of {config.duration:g} s at a plant step of {config.step:g} s",
+                        runs * steps)
 
 
 def linear_scan(problem: ImpedanceProblem, k_limit: int = 200) -> RangeResult:
@@ -311,13 +293,26 @@ def impedance_range(device: Device, sim_type: int = 1, method: str = "fast", k_l
 
     Without ``resolution`` the seed's integer scan K = 1, 2, 3 ... (``method`` "linear", or "fast"
     for the same answer in fewer runs); with it, :func:`grid_search` on ``R, 2R, 3R ...``.
+    ``method="analytic"`` answers the same searches from the exact linear response of the sampled
+    loop at the start pose (:mod:`.analytic`; no ODE integration; exact for type 1 and for LN = 0).
     """
-    if method not in ("fast", "linear"):
-        raise UserError(f"search method must be 'fast' or 'linear', got {method!r}")
+    require_device(device)
+    require_options(sim_type, config, LoopConfig)
+    if criteria is not None and not isinstance(criteria, Criteria):
+        raise UserError(f"criteria must be a Criteria, got {type(criteria).__name__}")
+    if method not in ("fast", "linear", "analytic"):
+        raise UserError(f"search method must be 'fast', 'linear' or 'analytic', got {method!r}")
+    if isinstance(k_limit, bool) or not isinstance(k_limit, (int, float)) or not math.isfinite(k_limit):
+        raise UserError(f"the stiffness limit must be a number, got {k_limit!r}")
     if k_limit < 1:
         raise UserError("the stiffness limit must be at least 1 N m/rad")
-    problem = ImpedanceProblem(device, sim_type, wall_joint, equilibrium, criteria or Criteria(),
-                               config or LoopConfig(wall=Wall()))
+    config = config or LoopConfig(wall=Wall())
+    require_search_workload(config, planned_simulations(method, k_limit, resolution))
+    if method == "analytic":
+        analytic = AnalyticProblem(device, sim_type, wall_joint, equilibrium, criteria or Criteria(), config)
+        found = grid_search(analytic, resolution, k_limit) if resolution is not None else fast_search(analytic, k_limit)
+        return replace(found, method="analytic", exact=analytic.exact)
+    problem = ImpedanceProblem(device, sim_type, wall_joint, equilibrium, criteria or Criteria(), config)
     if resolution is not None:
         return grid_search(problem, resolution, k_limit)
     return (fast_search if method == "fast" else linear_scan)(problem, k_limit)

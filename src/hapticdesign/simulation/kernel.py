@@ -1,7 +1,7 @@
 """The fixed-step sampled-data loop in numba (seed 000 §4.1.1, Figures 4.1-4.8, 4.12-4.16).
 
 Continuous side: the device's nonlinear dynamics ``(H + M_hand) qdd + C qd^2 + G + D qd +
-K_hand (q - q_hand) = u + tau_c`` integrated by classical RK4 at step ``h``. Joints are either
+F_c tanh(qd / v_f) + K_hand (q - q_hand) = u + tau_c`` (Coulomb friction ``F_c`` per joint) integrated by classical RK4 at step ``h``. Joints are either
 free (``tau_c = 0``) or prescribed: their position, velocity and acceleration follow a path and
 ``tau_c`` is the torque that imposes it (only the free joints are integrated; our choice, exact
 for an ideal motion actuator such as Simscape's motion-actuated joint).
@@ -20,7 +20,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from hapticdesign.simulation.config import STATUS_COMPLETED, STATUS_DIVERGED, STATUS_EXCURSION
+from hapticdesign.simulation.config import FRICTION_VELOCITY, STATUS_COMPLETED, STATUS_DIVERGED, STATUS_EXCURSION
 from hapticdesign.simulation.tables import evaluate_entries, unpack_entries, velocity_products
 
 
@@ -71,8 +71,8 @@ def _plant_terms(q, table, hand_mass, ws_values, ws_phi, ws_entries, cache_q, ca
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
-def accelerations(q, qd, qdd_path, u, prescribed, table, damping, hand_mass, hand_stiffness, hand_rest, ws, qdd,
-                  tau_c, want_tau_c=True):
+def accelerations(q, qd, qdd_path, u, prescribed, table, damping, coulomb, hand_mass, hand_stiffness, hand_rest, ws,
+                  qdd, tau_c, want_tau_c=True):
     """Joint accelerations (free joints solved, prescribed taken from the path) and, when
     ``want_tau_c``, the constraint torques (``tau_c`` is scratch otherwise)."""
     ws_values, ws_phi, ws_entries, cache_q, cache_valid, h, c, g, qd2, a, rhs, free = ws
@@ -86,6 +86,8 @@ def accelerations(q, qd, qdd_path, u, prescribed, table, damping, hand_mass, han
         s = g[i] - u[i]
         for col in range(qd2.shape[0]):
             s += c[i, col] * qd2[col]
+        if coulomb[i] != 0.0:
+            s += coulomb[i] * np.tanh(qd[i] / FRICTION_VELOCITY)
         for j in range(n):
             s += damping[i, j] * qd[j]
             if hand_stiffness[i, j] != 0.0:
@@ -161,7 +163,7 @@ def make_workspace(n: int, n_values: int, n_basis: int, n_entries: int):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def run_loop(plant, model, ws_plant, ws_model, damping, hand_mass, hand_stiffness, hand_rest, prescribed,
+def run_loop(plant, model, ws_plant, ws_model, damping, coulomb, hand_mass, hand_stiffness, hand_rest, prescribed,
              path_q, path_qd, path_qdd, q0, qd0, step, sub, n_steps, wall_joint, wall_k, wall_b, wall_eq,
              switches, quant, delay, safety_limit, reference, stop_excursion, stride,
              rec_q, rec_qd, rec_u, rec_f, rec_imp, rec_c):
@@ -202,7 +204,7 @@ def run_loop(plant, model, ws_plant, ws_model, damping, hand_mass, hand_stiffnes
     for it in range(n_steps + 1):
         t = it * step
         if it % sub == 0:
-            accelerations(q, qd, path_qdd[2 * it], u, prescribed, plant, damping,
+            accelerations(q, qd, path_qdd[2 * it], u, prescribed, plant, damping, coulomb,
                           hand_mass, hand_stiffness, hand_rest, ws_plant, qdd, c1)
             if it == 0:
                 for i in range(n):
@@ -234,7 +236,7 @@ def run_loop(plant, model, ws_plant, ws_model, damping, hand_mass, hand_stiffnes
             for i in range(n):
                 u[i] = tau_f[i] - tau_imp[i]
         # stage 1 (also gives the recorded constraint torque)
-        accelerations(q, qd, path_qdd[2 * it], u, prescribed, plant, damping,
+        accelerations(q, qd, path_qdd[2 * it], u, prescribed, plant, damping, coulomb,
                       hand_mass, hand_stiffness, hand_rest, ws_plant, a1, c1)
         if it % stride == 0:
             r = it // stride
@@ -271,15 +273,15 @@ def run_loop(plant, model, ws_plant, ws_model, damping, hand_mass, hand_stiffnes
             k1q[:] = qd
             _stage_state(q, qd, k1q, a1, 0.5 * step, prescribed, path_q[2 * it + 1], path_qd[2 * it + 1], qs, qds)
             k2q[:] = qds
-            accelerations(qs, qds, path_qdd[2 * it + 1], u, prescribed, plant, damping,
+            accelerations(qs, qds, path_qdd[2 * it + 1], u, prescribed, plant, damping, coulomb,
                           hand_mass, hand_stiffness, hand_rest, ws_plant, a2, tau_c, False)
             _stage_state(q, qd, k2q, a2, 0.5 * step, prescribed, path_q[2 * it + 1], path_qd[2 * it + 1], qs, qds)
             k3q[:] = qds
-            accelerations(qs, qds, path_qdd[2 * it + 1], u, prescribed, plant, damping,
+            accelerations(qs, qds, path_qdd[2 * it + 1], u, prescribed, plant, damping, coulomb,
                           hand_mass, hand_stiffness, hand_rest, ws_plant, a3, tau_c, False)
             _stage_state(q, qd, k3q, a3, step, prescribed, path_q[2 * it + 2], path_qd[2 * it + 2], qs, qds)
             k4q[:] = qds
-            accelerations(qs, qds, path_qdd[2 * it + 2], u, prescribed, plant, damping,
+            accelerations(qs, qds, path_qdd[2 * it + 2], u, prescribed, plant, damping, coulomb,
                           hand_mass, hand_stiffness, hand_rest, ws_plant, a4, tau_c, False)
             for i in range(n):
                 if prescribed[i]:

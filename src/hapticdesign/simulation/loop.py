@@ -15,9 +15,10 @@ import numpy as np
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation import kernel
-from hapticdesign.simulation.config import LoopConfig, Trace, hand_matrices, model_device
+from hapticdesign.simulation.config import LoopConfig, Trace, compensator_device, hand_matrices, plant_friction
 from hapticdesign.simulation.paths import Path
 from hapticdesign.simulation.tables import DynamicsTables, workspace_size
+from hapticdesign.workload import loop_bytes, require_memory
 
 
 def joint_index(device: Device, joint: int | str) -> int:
@@ -52,9 +53,9 @@ def simulate(
             q_start[j] = float(path.sample(np.zeros(1))[0][0])
     hand = hand_matrices(device, config.hand, q_start)
     plant = plant or DynamicsTables.from_device(device)
-    model = model or DynamicsTables.from_device(model_device(device, config.compensator.error_percent))
+    model = model or DynamicsTables.from_device(compensator_device(device, config.compensator))
     damping = config.damping if config.damping is not None else device.damping
-    return simulate_tables(plant, model, config, damping, paths, q_start, hand)
+    return simulate_tables(plant, model, config, damping, paths, q_start, hand, plant_friction(device, config))
 
 
 def simulate_tables(
@@ -65,6 +66,7 @@ def simulate_tables(
     paths: dict[int, Path] | None = None,
     q0: np.ndarray | None = None,
     hand: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+    coulomb: np.ndarray | None = None,
 ) -> Trace:
     """Simulate the loop for plant and compensator tables directly (any number of joints)."""
     n = plant.n_dof
@@ -76,6 +78,8 @@ def simulate_tables(
         raise UserError(f"unknown joint {wall.joint + 1}; the device has joints 1..{n}")
     if not all(math.isfinite(v) for v in (wall.stiffness, wall.damping, wall.equilibrium)):
         raise UserError("the wall stiffness, damping and equilibrium must be finite")
+    if wall.damping < 0:
+        raise UserError(f"the virtual wall damping must be non-negative, got {wall.damping}")
     paths = dict(paths or {})
     for j in paths:
         if not 0 <= j < n:
@@ -91,10 +95,17 @@ def simulate_tables(
     damping = np.asarray(damping, dtype=float)
     if damping.shape != (n,) or not np.all(np.isfinite(damping)):
         raise UserError(f"expected {n} finite joint dampings, got {damping.tolist()}")
-    n_steps = int(round(config.duration / config.step))
+    ratio = config.duration / config.step
+    if not math.isfinite(ratio):
+        raise UserError(f"the simulated time {config.duration:g} s over the plant step {config.step:g} s overflows")
+    n_steps = int(round(ratio))
     stride = config.record_stride or sub
     if stride < 1:
         raise UserError("the record stride must be at least one plant step")
+    if sensors.delay_samples * sensors.period >= config.duration:
+        raise UserError(f"the sensor delay ({sensors.delay_samples} samples = {sensors.delay_samples * sensors.period:g} s) "
+                        f"must be shorter than the simulated time ({config.duration:g} s)")
+    require_memory(f"a simulation of {n_steps:,} plant steps", loop_bytes(n_steps, n, stride, sensors.delay_samples))
     q_start = np.zeros(n) if q0 is None else np.asarray(q0, dtype=float).copy()
     t_half = 0.5 * config.step * np.arange(2 * n_steps + 1)
     path_q, path_qd, path_qdd = (np.zeros((t_half.size, n)) for _ in range(3))
@@ -113,7 +124,8 @@ def simulate_tables(
         (*model.sparse, model.index, model.kinds, model.degrees),
         kernel.make_workspace(n, workspace_size(plant), plant.index.shape[0], plant.n_entries),
         kernel.make_workspace(n, workspace_size(model), model.index.shape[0], model.n_entries),
-        np.diag(damping) + hand_damping, hand_mass, hand_stiffness, q_start.copy(), prescribed,
+        np.diag(damping) + hand_damping, np.zeros(n) if coulomb is None else np.asarray(coulomb, dtype=float),
+        hand_mass, hand_stiffness, q_start.copy(), prescribed,
         path_q, path_qd, path_qdd, q_start, np.zeros(n), config.step, sub, n_steps,
         wall.joint, float(wall.stiffness), float(wall.damping), float(wall.equilibrium), switches, quant,
         int(sensors.delay_samples),

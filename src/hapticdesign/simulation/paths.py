@@ -6,6 +6,7 @@ numerically, eq. 4.3; analytic derivatives are the exact limit of that formula).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -53,6 +54,12 @@ class Chirp:
     def __post_init__(self) -> None:
         if not (self.sweep_time > 0 and self.f0 >= 0 and self.f1 > 0):
             raise UserError("chirp: frequencies must be non-negative and the sweep time positive")
+        if not all(math.isfinite(v) for v in (self.amplitude, self.f0, self.f1, self.sweep_time)):
+            raise UserError("chirp: amplitude, frequencies and sweep time must be finite numbers")
+        if self.amplitude == 0:
+            raise UserError("chirp: the amplitude must not be zero (the joint would not move)")
+        if not self.f0 < self.f1:
+            raise UserError(f"chirp: the start frequency {self.f0:g} Hz must be below the end frequency {self.f1:g} Hz")
 
     def sample(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         rate = (self.f1 - self.f0) / self.sweep_time

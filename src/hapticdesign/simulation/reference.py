@@ -20,7 +20,8 @@ from scipy.integrate import solve_ivp
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation.config import (
-    STATUS_COMPLETED, STATUS_DIVERGED, STATUS_EXCURSION, LoopConfig, Trace, hand_matrices, model_device,
+    FRICTION_VELOCITY, STATUS_COMPLETED, STATUS_DIVERGED, STATUS_EXCURSION, LoopConfig, Trace, compensator_device,
+    hand_matrices, plant_friction,
 )
 from hapticdesign.simulation.paths import Path
 
@@ -48,7 +49,7 @@ def simulate_adaptive(
         raise UserError(f"unknown joint {wall.joint + 1}; the device has joints 1..{n}")
     comp = config.compensator
     pi_plant = device.standard_parameters()
-    pi_model = model_device(device, comp.error_percent).standard_parameters()
+    pi_model = compensator_device(device, comp).standard_parameters()
     damping = np.diag(np.asarray(config.damping if config.damping is not None else device.damping, dtype=float))
     quant = 0.0 if config.sensors.counts_per_revolution is None else 2 * np.pi / config.sensors.counts_per_revolution
     delay = config.sensors.delay_samples
@@ -68,6 +69,7 @@ def simulate_adaptive(
     q_start[fixed] = path_at(0.0)[0][fixed]
     hand_mass, hand_damping, hand_stiffness = hand_matrices(device, config.hand, q_start)
     damping = damping + hand_damping
+    friction = plant_friction(device, config)
 
     def accel(t: float, q: np.ndarray, qd: np.ndarray, u: np.ndarray):
         qp, qdp, qddp = path_at(t)
@@ -76,7 +78,8 @@ def simulate_adaptive(
         h, c, g = _terms(device, pi_plant, q)
         h = h + hand_mass
         j, k = np.triu_indices(n)
-        bias = c @ (qd[j] * qd[k]) + g + damping @ qd + hand_stiffness @ (q - q_start) - u
+        bias = (c @ (qd[j] * qd[k]) + g + damping @ qd + friction * np.tanh(qd / FRICTION_VELOCITY)
+                + hand_stiffness @ (q - q_start) - u)
         qdd = qddp.copy()
         if free:
             rhs = -bias[free] - h[np.ix_(free, fixed)] @ qddp[fixed]

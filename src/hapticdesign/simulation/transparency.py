@@ -23,9 +23,10 @@ from scipy.signal import csd, welch
 
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
-from hapticdesign.simulation.config import LoopConfig, Wall
+from hapticdesign.simulation.config import LoopConfig, Wall, require_device, require_options
 from hapticdesign.simulation.loop import simulate
 from hapticdesign.simulation.paths import Chirp, Held, Path
+from hapticdesign.workload import require_plant_steps
 
 
 @dataclass(frozen=True)
@@ -93,12 +94,23 @@ def transparency(
     resolution): a chirp is not stationary, and tapered, overlapping Welch segments under-weight
     the low frequencies swept near the ends of the record.
     """
-    if sim_type not in (1, 2):
-        raise UserError(f"simulation type must be 1 or 2, got {sim_type}")
+    require_device(device)
+    require_options(sim_type, config, LoopConfig)
+    if chirp is not None and not isinstance(chirp, Chirp):
+        raise UserError(f"chirp must be a Chirp, got {type(chirp).__name__}")
+    if isinstance(stiffness, bool) or not isinstance(stiffness, (int, float)):
+        raise UserError(f"the wall stiffness must be a number, got {stiffness!r}")
     if not (stiffness > 0 and math.isfinite(stiffness)):
         raise UserError(f"the wall stiffness must be positive, got {stiffness}")
     chirp = chirp or Chirp()
     base = config or LoopConfig()
+    base.steps_per_sample()
+    require_plant_steps(f"a chirp of {chirp.sweep_time:g} s at a plant step of {base.step:g} s",
+                        chirp.sweep_time / base.step)
+    nyquist = 0.5 / base.sensors.period
+    if not chirp.f1 <= nyquist:
+        raise UserError(f"the chirp's end frequency {chirp.f1:g} Hz is beyond the Nyquist frequency {nyquist:g} Hz "
+                        f"of the {base.sensors.period:g} s sample period")
     cfg = replace(base, duration=chirp.sweep_time, safety_limit=None, stop_excursion=None, record_stride=1,
                   wall=Wall(wall_joint, stiffness, base.wall.damping, equilibrium))
     n = device.n_dof

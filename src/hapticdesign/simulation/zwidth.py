@@ -14,12 +14,15 @@ unit circle. The law, as in the simulation engine (:mod:`.kernel`), with a compu
 ``v^`` is the sampled velocity (the seed's perfect sensor) or the backward difference
 ``(q_(k-N) - q_(k-N-1)) / T`` of sampled positions (Colgate & Brown 1994); the last term is the
 inertial compensator ``c J a`` with the acceleration read just before the sample under the held
-torque (``c = 1 - E/100`` for a modelling error of E percent, 0 without compensation).
+torque (``c = 1 - E/100`` for a modelling error of E percent, 0 without compensation; with a
+physical spring ``k_p`` in the plant the acceleration carries ``- k_p q`` too).
 
-Beside it: the passivity condition ``b > K T / 2 + |B|`` (Colgate & Schenkel 1997), i.e.
-``K_pass = 2 (b - |B|) / T``, and the linear approximation of the stability boundary for short
-delays, as we read Gil, Sánchez, Hulin, Preusche & Hirzinger (2009):
-``K_lin = 2 (b + B) / (T + 2 N T)``.
+Beside it: the passivity condition ``b > K T / 2 + |B|`` (Colgate & Schenkel 1997), with a delay
+``t_d = N T`` ``b > K (T/2 + t_d) + |B|`` (as we read Hulin, Albu-Schäffer & Hirzinger 2014), i.e.
+``K_pass = 2 (b - |B|) / (T (1 + 2 N))``, and the linear approximation of the stability boundary
+for short delays, as we read Gil, Sánchez, Hulin, Preusche & Hirzinger (2009):
+``K_lin = 2 (b + B) / (T (1 + 2 N))``. Passivity ignores that a virtual damper stabilizes the loop,
+so it is the more conservative the larger B is.
 """
 
 from __future__ import annotations
@@ -40,7 +43,8 @@ VELOCITIES = ("sampled", "difference")
 @dataclass(frozen=True)
 class DisplayLoop:
     """A 1-DOF haptic display: inertia ``J`` [kg m^2], damping ``b`` [N m s/rad], period ``T`` [s],
-    delay in samples, velocity estimate, compensator fraction ``c`` (0: none, 1: exact)."""
+    delay in samples, velocity estimate, compensator fraction ``c`` (0: none, 1: exact) and a
+    physical spring ``k_p`` [N m/rad] in the plant (a hand's stiffness; 0 by default)."""
 
     inertia: float
     damping: float
@@ -48,6 +52,7 @@ class DisplayLoop:
     delay: int = 0
     velocity: str = "sampled"
     fraction: float = 0.0
+    plant_stiffness: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ("inertia", "period"):
@@ -60,14 +65,16 @@ class DisplayLoop:
             raise UserError(f"the delay must be a whole number of samples between 0 and 200, got {self.delay}")
         if self.velocity not in VELOCITIES:
             raise UserError(f"the velocity must be one of {', '.join(VELOCITIES)}, got {self.velocity!r}")
-        if not (math.isfinite(self.fraction) and 0.0 <= self.fraction <= 1.0):
-            raise UserError(f"the compensator fraction must lie in [0, 1], got {self.fraction}")
+        if not (math.isfinite(self.fraction) and 0.0 <= self.fraction < 2.0):
+            raise UserError(f"the compensator fraction must lie in [0, 2), got {self.fraction}")
+        if not (self.plant_stiffness >= 0 and math.isfinite(self.plant_stiffness)):
+            raise UserError(f"the plant stiffness must be non-negative and finite, got {self.plant_stiffness}")
 
 
 @lru_cache(maxsize=256)
 def plant(loop: DisplayLoop) -> control.StateSpace:
-    """``J qdd + b qd = u`` with outputs ``(q, qd)``, discretized exactly with a zero-order hold."""
-    a = np.array([[0.0, 1.0], [0.0, -loop.damping / loop.inertia]])
+    """``J qdd + b qd + k_p q = u`` with outputs ``(q, qd)``, discretized exactly with a zero-order hold."""
+    a = np.array([[0.0, 1.0], [-loop.plant_stiffness / loop.inertia, -loop.damping / loop.inertia]])
     b = np.array([[0.0], [1.0 / loop.inertia]])
     return control.c2d(control.ss(a, b, np.eye(2), np.zeros((2, 1))), loop.period, method="zoh")
 
@@ -97,6 +104,7 @@ def controller(loop: DisplayLoop, stiffness: float, virtual_damping: float) -> c
         add("q", n, -virtual_damping / T)
         add("q", n + 1, virtual_damping / T)
     add("v", n, -loop.fraction * loop.damping)
+    add("q", n, -loop.fraction * loop.plant_stiffness)
     add("u", n + 1, loop.fraction)
     A, B = np.zeros((size, size)), np.zeros((size, 2))
     B[0, 0] = 1.0  # q_k enters the position line
@@ -134,8 +142,8 @@ def max_stiffness(loop: DisplayLoop, virtual_damping: float = 0.0, k_limit: floa
 
 
 def passivity_stiffness(loop: DisplayLoop, virtual_damping: float) -> float:
-    """Colgate & Schenkel's passivity bound ``K < 2 (b - |B|) / T`` (no delay, no compensator)."""
-    return max(0.0, 2.0 * (loop.damping - abs(virtual_damping)) / loop.period)
+    """The passivity bound ``K < 2 (b - |B|) / (T (1 + 2 N))`` (Colgate & Schenkel; delay as Hulin et al.)."""
+    return max(0.0, 2.0 * (loop.damping - abs(virtual_damping)) / (loop.period * (1 + 2 * loop.delay)))
 
 
 def linear_approximation(loop: DisplayLoop, virtual_damping: float) -> float:
@@ -145,12 +153,13 @@ def linear_approximation(loop: DisplayLoop, virtual_damping: float) -> float:
 
 @dataclass(frozen=True)
 class ZWidth:
-    """The boundary ``K_max(B)`` at the given virtual dampers, with the two approximations beside it."""
+    """The boundary ``K_max(B)`` at the given virtual dampers, with the two approximations beside it
+    (``None`` with an inertial compensator, which neither formula models)."""
 
     B: list[float]
     K: list[float]
-    passivity: list[float]
-    linear: list[float]
+    passivity: list[float] | None
+    linear: list[float] | None
 
     def as_dict(self) -> dict:
         return {"B": self.B, "K": self.K, "passivity_K": self.passivity, "linear_approximation_K": self.linear,
@@ -180,5 +189,40 @@ def zwidth(loop: DisplayLoop, dampers: list[float] | None = None, points: int = 
     values = damping_grid(loop, points) if dampers is None else [float(b) for b in dampers]
     if any(not math.isfinite(b) for b in values):
         raise UserError("the virtual dampers must be finite numbers")
+    bounds = loop.fraction == 0.0 and loop.plant_stiffness == 0.0
     return ZWidth(values, [max_stiffness(loop, b) for b in values],
-                  [passivity_stiffness(loop, b) for b in values], [linear_approximation(loop, b) for b in values])
+                  [passivity_stiffness(loop, b) for b in values] if bounds else None,
+                  [linear_approximation(loop, b) for b in values] if bounds else None)
+
+
+@dataclass(frozen=True)
+class StiffnessMap:
+    """``K_max`` of one joint (virtual damper B) over a grid of two other joints' angles."""
+
+    axes: tuple[int, int]
+    first: list[float]
+    second: list[float]
+    K: list[list[float]]
+
+
+def stiffness_map(device, joint: int, axes: tuple[int, int], n: int, period: float = 1e-3, delay: int = 0,
+                  velocity: str = "sampled", fraction: float = 0.0, virtual_damping: float = 0.0,
+                  span: tuple[float, float] = (-math.pi, math.pi)) -> StiffnessMap:
+    """The Z-width's K at one B over the workspace: ``J = H_jj(q)`` on an ``n x n`` grid of joints
+    ``axes`` (the others at 0), each cell exact for the sampled loop with the other joints held."""
+    if not 2 <= n <= 101:
+        raise UserError(f"the map needs 2 to 101 points per axis, got {n}")
+    if len(set(axes)) != 2 or joint in axes or not all(0 <= a < device.n_dof for a in axes):
+        raise UserError(f"the map needs two joints other than the wall joint, of 1..{device.n_dof}")
+    grid = np.linspace(span[0], span[1], n)
+    values = []
+    for x in grid:
+        row = []
+        for y in grid:
+            q = np.zeros(device.n_dof)
+            q[axes[0]], q[axes[1]] = x, y
+            loop = DisplayLoop(float(device.H(q)[joint, joint]), float(device.damping[joint]), period, delay,
+                               velocity, fraction)
+            row.append(max_stiffness(loop, virtual_damping))
+        values.append(row)
+    return StiffnessMap(axes, grid.tolist(), grid.tolist(), values)

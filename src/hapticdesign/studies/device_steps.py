@@ -9,8 +9,18 @@ from __future__ import annotations
 
 import numpy as np
 
+from hapticdesign.analysis.dynamics.symbolic import derive, export
+from hapticdesign.analysis.linearity.bounds import practical_bounds
+from hapticdesign.analysis.linearity.conditions import (
+    linear_conditions,
+    seed_conditions,
+)
+from hapticdesign.analysis.linearity.linear_designs import find_linear_designs as find
+from hapticdesign.analysis.linearity.service import device_form
+from hapticdesign.analysis.linearity.verdict import decide_linearizable as decide
+from hapticdesign.analysis.linearity.verdict import minimum_ln
 from hapticdesign.errors import UserError
-from hapticdesign.studies.steps import Context, Outcome, Table, engine
+from hapticdesign.studies.steps import Context, Outcome, Table
 
 
 def matrix_text(name: str, m: np.ndarray) -> str:
@@ -21,9 +31,6 @@ def matrix_text(name: str, m: np.ndarray) -> str:
 def equations_of_motion(ctx: Context) -> Outcome:
     """Seed 000 eq. 2.50-2.52: exact H and G of the design, evaluations, and the size of the symbolic form."""
     import sympy as sp
-
-    derive = engine("hapticdesign.analysis.dynamics.symbolic", "derive")
-    export = engine("hapticdesign.analysis.dynamics.symbolic", "export")
     device = ctx.settings.device()
     numeric = derive(device, "none")
     full = derive(device, "all")
@@ -65,7 +72,6 @@ def equations_of_motion(ctx: Context) -> Outcome:
 
 def linearity_number(ctx: Context) -> Outcome:
     """Seed 000 eq. 3.1-3.4 on the torus (box regions for prismatic joints as the engine defines them)."""
-    device_form = engine("hapticdesign.analysis.linearity.service", "device_form")
     device = ctx.settings.device()
     parts = device_form(device).parts(device.standard_parameters())
     return Outcome(
@@ -94,8 +100,6 @@ def link_table(device) -> list[list]:
 
 def found_designs(ctx: Context, device, form, conditions, count: int = 3) -> Table:
     """Realizable fully linear designs from the engine (practical bounds, rigid-body realizability)."""
-    find = engine("hapticdesign.analysis.linearity.linear_designs", "find_linear_designs")
-    practical_bounds = engine("hapticdesign.analysis.linearity.bounds", "practical_bounds")
     try:
         designs = find(device, form, conditions, practical_bounds(device), count, ctx.settings.seed)
     except UserError as exc:  # none exists within the bounds (the verdict step says whether any exists at all)
@@ -114,9 +118,6 @@ def found_designs(ctx: Context, device, form, conditions, count: int = 3) -> Tab
 def linearization(ctx: Context) -> Outcome:
     """Seed 000 §3.2.1: the conditions for LN = 0 (eq. 3.12-3.26) in the seed's variables, the free
     parameters (Table 3.2), the constant H (eq. 3.27), the design's realizability and linear designs."""
-    device_form = engine("hapticdesign.analysis.linearity.service", "device_form")
-    linear_conditions = engine("hapticdesign.analysis.linearity.conditions", "linear_conditions")
-    seed_conditions = engine("hapticdesign.analysis.linearity.conditions", "seed_conditions")
     device = ctx.settings.device()
     form = device_form(device)
     conditions = linear_conditions(device, form)
@@ -162,10 +163,6 @@ def linearization(ctx: Context) -> Outcome:
 def verdict(ctx: Context, device=None) -> Outcome:
     """Seed 000 §3.3, Appendix D: does a physically realizable design with LN = 0 exist? The verdict with its
     certificate, and the smallest LN under the practical bounds."""
-    device_form = engine("hapticdesign.analysis.linearity.service", "device_form")
-    decide = engine("hapticdesign.analysis.linearity.verdict", "decide_linearizable")
-    minimum_ln = engine("hapticdesign.analysis.linearity.verdict", "minimum_ln")
-    practical_bounds = engine("hapticdesign.analysis.linearity.bounds", "practical_bounds")
     device = device or ctx.settings.device()
     form = device_form(device)
     found = decide(device, form)

@@ -3,25 +3,39 @@
 Steps: equations of motion (§2.4), the Linearity Number (eq. 3.1-3.4) with Appendix C side by side,
 the analytic linearization and a realizable linear design (§3.2.1, eq. 3.12-3.33), the 6-DOF
 question (§3.3), design sets (§3.2.2), rendering of the default design (§4.1-4.2) and the
-campaigns behind Tables 4.4 and 4.6. Each step calls the engines' Python API; a step whose engine
-is missing is reported as not available.
+campaigns behind Tables 4.4 and 4.6. Each step calls the engines' Python API.
 """
 
 from __future__ import annotations
 
-from decimal import Decimal
-
 import warnings
 from dataclasses import dataclass
+from decimal import Decimal
 
 import numpy as np
 
+from hapticdesign.analysis.linearity.bounds import practical_bounds
+from hapticdesign.analysis.linearity.closed_form import closed_form
+from hapticdesign.analysis.linearity.conditions import linear_conditions
+from hapticdesign.analysis.linearity.design_sets import design_set
+from hapticdesign.analysis.linearity.service import device_form
 from hapticdesign.devices.registry import preset
 from hapticdesign.errors import PhysicalConsistencyWarning, UserError
 from hapticdesign.studies import device_steps, phantom_rendering
 from hapticdesign.studies.plots import plt
-from hapticdesign.studies.seed_reference import APPENDIX_B, EQ_3_33, LEVELS, appendix_c_designs
-from hapticdesign.studies.steps import Context, Outcome, Step, Table, engine, figure_from_matplotlib
+from hapticdesign.studies.seed_reference import (
+    APPENDIX_B,
+    EQ_3_33,
+    LEVELS,
+    appendix_c_designs,
+)
+from hapticdesign.studies.steps import (
+    Context,
+    Outcome,
+    Step,
+    Table,
+    figure_from_matplotlib,
+)
 
 SCALES = ("full", "quick", "smoke")
 
@@ -109,8 +123,6 @@ def _classify(level: float, printed: float, ours: float, bound: float) -> str:
 
 def _appendix_b(ctx: Context) -> Table:
     """Coefficients of the closed-form LN (Appendix B.1, B.2) beside the engine's closed form."""
-    device_form = engine("hapticdesign.analysis.linearity.service", "device_form")
-    closed_form = engine("hapticdesign.analysis.linearity.closed_form", "closed_form")
     forms = {}
     rows = []
     for name, powers, printed in APPENDIX_B:
@@ -131,7 +143,6 @@ def _appendix_b(ctx: Context) -> Table:
 
 def linearity_number(ctx: Context) -> Outcome:
     """Seed 000 eq. 3.1-3.4 for the default design, the 6-DOF default, and Appendix C's 30 designs."""
-    device_form = engine("hapticdesign.analysis.linearity.service", "device_form")
     device = ctx.settings.device()
     form = device_form(device)
     parts = form.parts(device.standard_parameters())
@@ -198,7 +209,6 @@ def linearity_number(ctx: Context) -> Outcome:
 def linearization(ctx: Context) -> Outcome:
     """Seed 000 §3.2.1 on the default design (:func:`device_steps.linearization`), with eq. 3.33 as printed
     beside the exact, realizable built-in default."""
-    device_form = engine("hapticdesign.analysis.linearity.service", "device_form")
     outcome = device_steps.linearization(ctx)
     device = ctx.settings.device()
     form = device_form(device)
@@ -228,10 +238,6 @@ def six_dof(ctx: Context) -> Outcome:
 
 def design_sets(ctx: Context) -> Outcome:
     """Seed 000 §3.2.2, Table 3.3: designs at each LN level, every one realizable and within eq. 3.35-3.38."""
-    device_form = engine("hapticdesign.analysis.linearity.service", "device_form")
-    linear_conditions = engine("hapticdesign.analysis.linearity.conditions", "linear_conditions")
-    design_set = engine("hapticdesign.analysis.linearity.design_sets", "design_set")
-    practical_bounds = engine("hapticdesign.analysis.linearity.bounds", "practical_bounds")
     s = ctx.settings
     device = s.device()
     form = device_form(device)

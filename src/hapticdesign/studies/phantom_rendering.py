@@ -11,22 +11,45 @@ from pathlib import Path
 
 import numpy as np
 
+from hapticdesign.analysis.linearity.service import device_form
 from hapticdesign.errors import PhysicalConsistencyWarning
 from hapticdesign.model.inertia import SEED_FIELDS, seed_parameter_name
+from hapticdesign.simulation.boundary import (
+    MassDamper,
+    exact_boundary,
+    simulated_boundary,
+)
+from hapticdesign.simulation.campaign import (
+    CampaignOptions,
+    load_cases,
+    read_designs,
+    run_campaign,
+    summarize,
+)
+from hapticdesign.simulation.config import LoopConfig, Wall
+from hapticdesign.simulation.impedance import Criteria, impedance_range, type_paths
+from hapticdesign.simulation.loop import simulate
+from hapticdesign.simulation.paths import Chirp
+from hapticdesign.simulation.transparency import transparency
 from hapticdesign.studies.plots import plt
-from hapticdesign.studies.seed_reference import AGREEMENT, TABLE_4_4, TABLE_4_6, appendix_c_designs
-from hapticdesign.studies.steps import Context, NotAvailable, Outcome, Table, engine, figure_from_files, figure_from_matplotlib
+from hapticdesign.studies.seed_reference import (
+    AGREEMENT,
+    TABLE_4_4,
+    TABLE_4_6,
+    appendix_c_designs,
+)
+from hapticdesign.studies.steps import (
+    Context,
+    NotAvailable,
+    Outcome,
+    Table,
+    figure_from_files,
+    figure_from_matplotlib,
+)
 
 
 def default_design(ctx: Context) -> Outcome:
     """Maximum stable impedance (§4.1.2-4.1.3) and transparency bandwidth (§4.2.2-4.2.3), types 1 and 2."""
-    impedance_range = engine("hapticdesign.simulation.impedance", "impedance_range")
-    type_paths = engine("hapticdesign.simulation.impedance", "type_paths")
-    Criteria = engine("hapticdesign.simulation.impedance", "Criteria")
-    transparency = engine("hapticdesign.simulation.transparency", "transparency")
-    loop = engine("hapticdesign.simulation.loop", "simulate")
-    LoopConfig = engine("hapticdesign.simulation.config", "LoopConfig")
-    Wall = engine("hapticdesign.simulation.config", "Wall")
     device = ctx.settings.device()
     ranges = {t: impedance_range(device, t, k_limit=ctx.settings.k_limit) for t in (1, 2)}
     resolution = 1.0
@@ -42,7 +65,7 @@ def default_design(ctx: Context) -> Outcome:
     overshoot = Criteria().overshoot_limit
     fig, ax = plt.subplots(figsize=(7, 3.8))
     for gain, style in ((k, "-"), (k + resolution, "--")):
-        trace = loop(device, LoopConfig(duration=5.0, wall=Wall(0, float(gain), 0.0, 0.01)), type_paths(1, device.n_dof))
+        trace = simulate(device, LoopConfig(duration=5.0, wall=Wall(0, float(gain), 0.0, 0.01)), type_paths(1, device.n_dof))
         ax.plot(trace.t, trace.q[:, 0], style, label=f"K = {gain:g} N m/rad")
     ax.axhline(overshoot, color="grey", lw=0.8, ls=":", label=f"overshoot limit ({overshoot:g} rad from the start)")
     ax.set_xlabel("t [s]")
@@ -72,7 +95,7 @@ def default_design(ctx: Context) -> Outcome:
         wall_note = f"Transparency is computed at the seed's K = {seed_stiffness:g} N m/rad, stable for this design."
     settings = _settings_table(device, LoopConfig(), type_paths(2, device.n_dof)[1])
     same = ranges[1].k_max == ranges[2].k_max
-    ln = float(engine("hapticdesign.analysis.linearity.service", "device_form")(device).ln(device.standard_parameters()))
+    ln = float(device_form(device).ln(device.standard_parameters()))
     if ln < 1e-12:
         finding = (f"The design is exactly linear (LN = {ln:.1e}), so the seed's finding that linear designs give the "
                    "same results in types 1 and 2 predicts equal columns: " + ("they are equal." if same else "they differ."))
@@ -102,9 +125,6 @@ def default_design(ctx: Context) -> Outcome:
 
 def _settings_table(device, config, driven) -> Table:
     """Seed 000 Tables 4.1-4.3 and 4.5 beside the values the simulation engine used."""
-    Criteria = engine("hapticdesign.simulation.impedance", "Criteria")
-    Chirp = engine("hapticdesign.simulation.paths", "Chirp")
-    impedance_range = engine("hapticdesign.simulation.impedance", "impedance_range")
     criteria, chirp = Criteria(), Chirp()
     equilibrium = inspect.signature(impedance_range).parameters["equilibrium"].default
     rows = [
@@ -129,9 +149,6 @@ def _hz(value) -> str:
 def boundary(ctx: Context) -> Outcome:
     """The check any sampled-data simulator must pass: exact (spectral radius) against simulated boundary
     of a 1-DOF mass-damper under a zero-order-hold spring."""
-    MassDamper = engine("hapticdesign.simulation.boundary", "MassDamper")
-    exact_boundary = engine("hapticdesign.simulation.boundary", "exact_boundary")
-    simulated_boundary = engine("hapticdesign.simulation.boundary", "simulated_boundary")
     cases = [(0.003, 0.5, 1e-3), (0.01, 0.35, 1e-3), (0.003, 0.5, 5e-4)]
     if ctx.settings.scale == "smoke":
         cases = cases[:1]
@@ -156,7 +173,7 @@ def boundary(ctx: Context) -> Outcome:
 def _appendix_c_csv(ctx: Context, path: Path, per_level: int) -> None:
     """Appendix C's designs as a campaign design file (link 1 from the built-in default, as eq. 3.33 prints it)."""
     device = ctx.settings.device()
-    form = engine("hapticdesign.analysis.linearity.service", "device_form")(device)
+    form = device_form(device)
     names = device.inertial_names()
     first = [seed_parameter_name(f, device.body_names[0]) for f in SEED_FIELDS]
     link1 = {k: float(device.params.get(k, 0.0)) for k in first}
@@ -195,11 +212,6 @@ def campaign_appendix_c(ctx: Context) -> Outcome:
 
 def _campaign(ctx: Context, designs_csv: Path, source: str) -> Outcome:
     """Run (or resume) a campaign and lay its results beside Tables 4.4, 4.6 and Figures 4.9-4.11, 4.18-4.21."""
-    run_campaign = engine("hapticdesign.simulation.campaign", "run_campaign")
-    CampaignOptions = engine("hapticdesign.simulation.campaign", "CampaignOptions")
-    read_designs = engine("hapticdesign.simulation.campaign", "read_designs")
-    load_cases = engine("hapticdesign.simulation.campaign", "load_cases")
-    summarize = engine("hapticdesign.simulation.campaign", "summarize")
     s = ctx.settings
     digest = hashlib.sha1(Path(designs_csv).read_bytes()).hexdigest()[:12]
     out = ctx.work_dir / f"campaign_{digest}"  # a rerun with the same designs resumes; other designs start afresh

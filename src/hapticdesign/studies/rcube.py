@@ -2,8 +2,7 @@
 
 Steps: kinematics and workspace of the final design (§5.1, Table 7.2), Table 7.3's kinematic
 columns, the final design's stiffness, inertia and modes side by side with eq. 7.6-7.13 and Table
-7.9, workspace maps of the metrics (§7.5, Figures 7.5-7.19), and the optimization chain (ch. 6-7)
-when its engine is installed.
+7.9, workspace maps of the metrics (§7.5, Figures 7.5-7.19), and the optimization chain (ch. 6-7).
 """
 
 from __future__ import annotations
@@ -12,10 +11,37 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hapticdesign.analysis.metrics.dynamic import modes
+from hapticdesign.analysis.metrics.globalization import global_indices
+from hapticdesign.analysis.rcube import dynamics as rcube_dynamics
+from hapticdesign.analysis.rcube import kinematics as rcube_kinematics
+from hapticdesign.analysis.rcube import metrics as rcube_metrics
+from hapticdesign.analysis.rcube import stiffness as rcube_stiffness
+from hapticdesign.analysis.rcube.design import final_design, seed_final_design
 from hapticdesign.errors import UserError
+from hapticdesign.model.rcube import RCubeGeometry
+from hapticdesign.optimization.chain import (
+    Settings,
+    chain_summary,
+    run_chain,
+    write_chain,
+)
+from hapticdesign.optimization.constraints import Workspace, constraint_values
+from hapticdesign.optimization.plies import ply_design
 from hapticdesign.studies.plots import plt
-from hapticdesign.studies.seed_reference import RCUBE_FINAL, TABLE_7_2_SHORTEST, TABLE_7_3
-from hapticdesign.studies.steps import Context, Outcome, Step, Table, engine, figure_from_files, figure_from_matplotlib
+from hapticdesign.studies.seed_reference import (
+    RCUBE_FINAL,
+    TABLE_7_2_SHORTEST,
+    TABLE_7_3,
+)
+from hapticdesign.studies.steps import (
+    Context,
+    Outcome,
+    Step,
+    Table,
+    figure_from_files,
+    figure_from_matplotlib,
+)
 
 SCALES = ("full", "quick", "smoke")
 MAP_METRICS = ("manipulability", "condition_number", "I_f", "S_f", "S_d", "omega_n")
@@ -65,28 +91,26 @@ class RCubeSettings:
 
 
 def _final():
-    final_design = engine("hapticdesign.analysis.rcube.design", "final_design")
     return final_design()
 
 
 def kinematics_step(ctx: Context) -> Outcome:
     """Inverse then forward kinematics over the dexterous cube (eq. 5.28-5.45), q_max (eq. 6.24), Table 7.3."""
-    K = engine("hapticdesign.analysis.rcube", "kinematics")
     design = _final()
     g = design.geometry
     n = ctx.settings.ik_points
-    grid = K.cube_grid(g, 0.12, n)
-    q = K.inverse_kinematics(g, grid)
-    back = K.forward_kinematics(g, q[..., 0])
+    grid = rcube_kinematics.cube_grid(g, 0.12, n)
+    q = rcube_kinematics.inverse_kinematics(g, grid)
+    back = rcube_kinematics.forward_kinematics(g, q[..., 0])
     error = float(np.abs(back - grid).max())
-    q_max = float(K.q_max_for_cube(g, 0.12))
-    dexterous = bool(K.dexterous_cube(g, 0.12))
+    q_max = float(rcube_kinematics.q_max_for_cube(g, 0.12))
+    dexterous = bool(rcube_kinematics.dexterous_cube(g, 0.12))
     rows = []
     for sol, l1, l2, l3, mu, cv in TABLE_7_3:
         geom = type(g)(l1 / 1e3, l2 / 1e3, l3 / 1e3)
-        qm = K.q_max_for_cube(geom)
-        rows.append([sol, l1, l2, l3, mu, float(K.critical_manipulability(geom, qm)), cv,
-                     float(K.critical_condition_number(qm))])
+        qm = rcube_kinematics.q_max_for_cube(geom)
+        rows.append([sol, l1, l2, l3, mu, float(rcube_kinematics.critical_manipulability(geom, qm)), cv,
+                     float(rcube_kinematics.critical_condition_number(qm))])
     return Outcome(
         summary=f"Final design l1, l2, l3 = {g.l1 * 1e3:.1f}, {g.l2 * 1e3:.1f}, {g.l3 * 1e3:.1f} mm: the 120 mm cube is "
                 f"{'dexterous' if dexterous else 'NOT dexterous'}, q_max = {np.degrees(q_max):.2f} deg "
@@ -110,22 +134,17 @@ DEFLECTION_FREE = ("max deflection, 5 N per axis, extended pose, passive joints 
 
 def final_design_step(ctx: Context) -> Outcome:
     """The final design (Table 7.8) at home: mass, M_C, K_C, modes (eq. 7.6-7.13), deflection (Table 7.9)."""
-    K = engine("hapticdesign.analysis.rcube", "kinematics")
-    S = engine("hapticdesign.analysis.rcube", "stiffness")
-    D = engine("hapticdesign.analysis.rcube", "dynamics")
-    modes = engine("hapticdesign.analysis.metrics.dynamic", "modes")
     design = _final()
     g = design.geometry
     mass_g = 1e3 * design.total_link_mass()
-    M_C = D.cartesian_mass_matrix(design, g.home)
-    K_C = S.cartesian_stiffness(design, g.home)
-    K_Cs = S.cartesian_stiffness(design, g.home, passive=False)
-    seed_final_design = engine("hapticdesign.analysis.rcube.design", "seed_final_design")
-    K_seed = S.cartesian_stiffness(seed_final_design(), g.home)
+    M_C = rcube_dynamics.cartesian_mass_matrix(design, g.home)
+    K_C = rcube_stiffness.cartesian_stiffness(design, g.home)
+    K_Cs = rcube_stiffness.cartesian_stiffness(design, g.home, passive=False)
+    K_seed = rcube_stiffness.cartesian_stiffness(seed_final_design(), g.home)
     m = modes(M_C, K_Cs[:3, :3])
-    extended = K.critical_poses(g, K.q_max_for_cube(g, 0.12))["extended"]
+    extended = rcube_kinematics.critical_poses(g, rcube_kinematics.q_max_for_cube(g, 0.12))["extended"]
     load = np.array([5.0, 5.0, 5.0, 0.0, 0.0, 0.0])
-    deflection = {p: 1e3 * float(np.linalg.norm(np.linalg.solve(S.cartesian_stiffness(design, extended, passive=p), load)[:3]))
+    deflection = {p: 1e3 * float(np.linalg.norm(np.linalg.solve(rcube_stiffness.cartesian_stiffness(design, extended, passive=p), load)[:3]))
                   for p in (True, False)}
     seed = RCUBE_FINAL
     rows = [
@@ -165,12 +184,10 @@ def final_design_step(ctx: Context) -> Outcome:
 
 def maps_step(ctx: Context) -> Outcome:
     """Metric maps over three planes of the workspace (§7.5, Figures 7.5-7.19) and their global values (eq. 4.108)."""
-    metrics = engine("hapticdesign.analysis.rcube", "metrics")
-    global_indices = engine("hapticdesign.analysis.metrics.globalization", "global_indices")
     design = _final()
     n = ctx.settings.map_points
     offsets = (-0.06, 0.0, 0.06)
-    planes = metrics.workspace_maps(design, n=n, offsets=offsets)
+    planes = rcube_metrics.workspace_maps(design, n=n, offsets=offsets)
     extent = (-60, 60, -60, 60)
     figures = []
     for name in MAP_METRICS:
@@ -199,7 +216,6 @@ def maps_step(ctx: Context) -> Outcome:
 
 
 def _chain_settings(effort: str):
-    Settings = engine("hapticdesign.optimization.chain", "Settings")
     return {"full": Settings(), "quick": Settings.quick().with_population(60, 40), "smoke": Settings.quick()}[effort]
 
 
@@ -292,7 +308,6 @@ def _optimization_figures(out, result, found: dict) -> list:
 
 def _design_row(label: str, l1: float, l2: float, l3: float, q_max: float, workspace) -> list:
     """A design in mm and degrees with its Constraint 5 (eq. 6.47) and 8 (eq. 6.52, C1) values."""
-    constraint_values = engine("hapticdesign.optimization.constraints", "constraint_values")
     g = constraint_values([[q_max, l2, l3]], workspace)[0]
     return [label, 1e3 * l1, 1e3 * l2, 1e3 * l3, 1e3 * (l1 + l2 + l3), float(np.degrees(q_max)), float(g[2]), float(g[5])]
 
@@ -309,7 +324,6 @@ def _seed_shortest(workspace) -> list[list]:
 def _shortest_table(found: dict) -> tuple[Table, str]:
     """The seed's shortest designs, the front's shortest and the certified minimum, with the
     constraints they sit on; and a paragraph on the seed's Constraint 5 at 65 and 64 mm."""
-    Workspace = engine("hapticdesign.optimization.constraints", "Workspace")
     printed, shifted = Workspace(), Workspace(0.120, 0.128)
     rows = _seed_shortest(printed)
     ours = [("front's shortest (NSGA-II)", found["shortest"])]
@@ -344,8 +358,6 @@ def _o3_text(result) -> str:
 
 def _mass_note(result, found: dict) -> str:
     """Why the selected design's link mass differs from Table 7.9's 77.7 g, from the run's own numbers."""
-    ply_design = engine("hapticdesign.optimization.plies", "ply_design")
-    RCubeGeometry = engine("hapticdesign.model.rcube", "RCubeGeometry")
     density = result.design.links[0].density
     seed_design = ply_design(RCubeGeometry(*(v / 1e3 for v in TABLE_7_3[0][1:4])), SEED_PLIES, SEED_RATIO, density=density)
     ours = result.plies.counts[result.ply_choice]
@@ -377,9 +389,6 @@ def _side_by_side(result, found: dict) -> Table:
 
 def optimization_step(ctx: Context) -> Outcome:
     """Chapters 6-7: NSGA-II synthesis, selection, weighted-sum swarm, cross-section ratio, plies, final design."""
-    run_chain = engine("hapticdesign.optimization.chain", "run_chain")
-    write_chain = engine("hapticdesign.optimization.chain", "write_chain")
-    chain_summary = engine("hapticdesign.optimization.chain", "chain_summary")
     settings = _chain_settings(ctx.settings.optimization_effort)
     result = run_chain(ctx.settings.seed, settings, progress=lambda step, done, total: ctx.update(done, total))
     out = ctx.work_dir / f"optimization_{ctx.settings.scale}"

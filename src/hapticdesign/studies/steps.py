@@ -1,14 +1,14 @@
 """Study steps: what one step produces (text, tables, figures, key numbers) and a timed runner.
 
 A step is a function ``step(context) -> Outcome``. The runner times it and records one of three
-states: ``done``; ``not available`` when the engine function it needs does not exist yet (the
-step raised :class:`NotAvailable`; the report says so and shows no numbers); ``failed`` with the
-one-line reason when the engine raised. A study therefore always ends in a report.
+states: ``done``; ``not available`` when an earlier step it builds on did not finish (the step
+raised :class:`NotAvailable`; the report says so and shows no numbers); ``failed`` with the
+one-line reason when the engine raised. Steps import the engines plainly, so a renamed engine
+function fails the tests instead of showing "not available" in a report. A study therefore always ends in a report.
 """
 
 from __future__ import annotations
 
-import importlib
 import io
 import time
 import traceback
@@ -23,21 +23,7 @@ STATUS_FAILED = "failed"
 
 
 class NotAvailable(Exception):
-    """The engine function a step needs is not part of this installation."""
-
-
-def engine(module: str, name: str) -> Any:
-    """``module.name`` (an attribute or a submodule) from the engines, or :class:`NotAvailable` naming what is missing."""
-    try:
-        mod = importlib.import_module(module)
-    except ImportError:
-        raise NotAvailable(f"{module} is not available in this installation") from None
-    if hasattr(mod, name):
-        return getattr(mod, name)
-    try:
-        return importlib.import_module(f"{module}.{name}")
-    except ImportError:
-        raise NotAvailable(f"{module}.{name} is not available in this installation") from None
+    """A step cannot run because an earlier step it builds on did not finish."""
 
 
 @dataclass

@@ -47,50 +47,56 @@ def _node_poses(q, parent, axis, coef, offset, rot, pos):
 
 @njit(cache=True)
 def _body_jacobian(b, body_node, body_path, axis, coef, rot, pos, jac):
+    """Body-frame Jacobian of body slot ``b`` into ``jac`` (6 x N); returns the body's world rotation.
+
+    The rotation returned is a view of ``rot`` (valid until the next pose); no allocation unless the
+    body sits on the base.
+    """
     n_dof = jac.shape[1]
     nb = body_node[b]
-    rb = np.eye(3)
-    pb = np.zeros(3)
     if nb >= 0:
-        rb = rot[nb].copy()
-        pb = pos[nb].copy()
+        rb = rot[nb]
+        pb0, pb1, pb2 = pos[nb, 0], pos[nb, 1], pos[nb, 2]
+    else:
+        rb = np.eye(3)
+        pb0 = pb1 = pb2 = 0.0
     for i in range(6):
         for k in range(n_dof):
             jac[i, k] = 0.0
-    u = np.empty(3)
-    r = np.empty(3)
     for t in range(body_path.shape[1]):
         e = body_path[b, t]
         if e < 0:
             break
         a = axis[e] % 3
-        for i in range(3):
-            u[i] = rb[0, i] * rot[e, 0, a] + rb[1, i] * rot[e, 1, a] + rb[2, i] * rot[e, 2, a]
+        u0 = rb[0, 0] * rot[e, 0, a] + rb[1, 0] * rot[e, 1, a] + rb[2, 0] * rot[e, 2, a]
+        u1 = rb[0, 1] * rot[e, 0, a] + rb[1, 1] * rot[e, 1, a] + rb[2, 1] * rot[e, 2, a]
+        u2 = rb[0, 2] * rot[e, 0, a] + rb[1, 2] * rot[e, 1, a] + rb[2, 2] * rot[e, 2, a]
         if axis[e] < 3:
-            d0 = pos[e, 0] - pb[0]
-            d1 = pos[e, 1] - pb[1]
-            d2 = pos[e, 2] - pb[2]
-            for i in range(3):
-                r[i] = rb[0, i] * d0 + rb[1, i] * d1 + rb[2, i] * d2
-            v0 = r[1] * u[2] - r[2] * u[1]
-            v1 = r[2] * u[0] - r[0] * u[2]
-            v2 = r[0] * u[1] - r[1] * u[0]
+            d0 = pos[e, 0] - pb0
+            d1 = pos[e, 1] - pb1
+            d2 = pos[e, 2] - pb2
+            r0 = rb[0, 0] * d0 + rb[1, 0] * d1 + rb[2, 0] * d2
+            r1 = rb[0, 1] * d0 + rb[1, 1] * d1 + rb[2, 1] * d2
+            r2 = rb[0, 2] * d0 + rb[1, 2] * d1 + rb[2, 2] * d2
+            v0 = r1 * u2 - r2 * u1
+            v1 = r2 * u0 - r0 * u2
+            v2 = r0 * u1 - r1 * u0
             for k in range(n_dof):
                 c = coef[e, k]
                 if c != 0.0:
                     jac[0, k] += c * v0
                     jac[1, k] += c * v1
                     jac[2, k] += c * v2
-                    jac[3, k] += c * u[0]
-                    jac[4, k] += c * u[1]
-                    jac[5, k] += c * u[2]
+                    jac[3, k] += c * u0
+                    jac[4, k] += c * u1
+                    jac[5, k] += c * u2
         else:
             for k in range(n_dof):
                 c = coef[e, k]
                 if c != 0.0:
-                    jac[0, k] += c * u[0]
-                    jac[1, k] += c * u[1]
-                    jac[2, k] += c * u[2]
+                    jac[0, k] += c * u0
+                    jac[1, k] += c * u1
+                    jac[2, k] += c * u2
     return rb
 
 
@@ -102,6 +108,41 @@ def _cross_axis(a, w0, w1, w2):
     if a == 1:
         return -w2, 0.0, w0
     return w1, -w0, 0.0
+
+
+@njit(cache=True)
+def body_regressor(jac, rb, gravity, yh, yg, col):
+    """Add one body's H and G regressor columns ``col .. col + 9`` for a body Jacobian ``jac`` (6 x n).
+
+    ``yh`` is (n, n, columns), ``yg`` (n, columns); ``jac`` may be over any coordinates, e.g. the
+    actuated ones of a closed loop (``J T``, :mod:`.actuated_kernel`).
+    """
+    n_dof = jac.shape[1]
+    g0 = rb[0, 0] * gravity[0] + rb[1, 0] * gravity[1] + rb[2, 0] * gravity[2]
+    g1 = rb[0, 1] * gravity[0] + rb[1, 1] * gravity[1] + rb[2, 1] * gravity[2]
+    g2 = rb[0, 2] * gravity[0] + rb[1, 2] * gravity[1] + rb[2, 2] * gravity[2]
+    for i in range(n_dof):
+        yg[i, col] -= g0 * jac[0, i] + g1 * jac[1, i] + g2 * jac[2, i]
+        for a in range(3):
+            c0, c1, c2 = _cross_axis(a, jac[3, i], jac[4, i], jac[5, i])
+            yg[i, col + 1 + a] -= g0 * c0 + g1 * c1 + g2 * c2
+        for j in range(n_dof):
+            yh[i, j, col] += jac[0, i] * jac[0, j] + jac[1, i] * jac[1, j] + jac[2, i] * jac[2, j]
+            for a in range(3):
+                # A_a[i, j] = Jw_i . (e_a x Jv_j) = (Jw_i x e_a) . Jv_j
+                c0, c1, c2 = _cross_axis(a, jac[3, i], jac[4, i], jac[5, i])
+                aij = c0 * jac[0, j] + c1 * jac[1, j] + c2 * jac[2, j]
+                d0, d1, d2 = _cross_axis(a, jac[3, j], jac[4, j], jac[5, j])
+                aji = d0 * jac[0, i] + d1 * jac[1, i] + d2 * jac[2, i]
+                yh[i, j, col + 1 + a] += aij + aji
+            w0i, w1i, w2i = jac[3, i], jac[4, i], jac[5, i]
+            w0j, w1j, w2j = jac[3, j], jac[4, j], jac[5, j]
+            yh[i, j, col + 4] += w0i * w0j
+            yh[i, j, col + 5] += w1i * w1j
+            yh[i, j, col + 6] += w2i * w2j
+            yh[i, j, col + 7] += w0i * w1j + w1i * w0j
+            yh[i, j, col + 8] += w0i * w2j + w2i * w0j
+            yh[i, j, col + 9] += w1i * w2j + w2i * w1j
 
 
 @njit(cache=True)
@@ -123,32 +164,7 @@ def regressor_kernel(qs, parent, axis, coef, offset, body_node, body_path, gravi
         _node_poses(qs[p], parent, axis, coef, offset, rot, pos)
         for b in range(n_body):
             rb = _body_jacobian(b, body_node, body_path, axis, coef, rot, pos, jac)
-            col = 10 * b
-            g0 = rb[0, 0] * gravity[0] + rb[1, 0] * gravity[1] + rb[2, 0] * gravity[2]
-            g1 = rb[0, 1] * gravity[0] + rb[1, 1] * gravity[1] + rb[2, 1] * gravity[2]
-            g2 = rb[0, 2] * gravity[0] + rb[1, 2] * gravity[1] + rb[2, 2] * gravity[2]
-            for i in range(n_dof):
-                yg[p, i, col] -= g0 * jac[0, i] + g1 * jac[1, i] + g2 * jac[2, i]
-                for a in range(3):
-                    c0, c1, c2 = _cross_axis(a, jac[3, i], jac[4, i], jac[5, i])
-                    yg[p, i, col + 1 + a] -= g0 * c0 + g1 * c1 + g2 * c2
-                for j in range(n_dof):
-                    yh[p, i, j, col] += jac[0, i] * jac[0, j] + jac[1, i] * jac[1, j] + jac[2, i] * jac[2, j]
-                    for a in range(3):
-                        # A_a[i, j] = Jw_i . (e_a x Jv_j) = (Jw_i x e_a) . Jv_j
-                        c0, c1, c2 = _cross_axis(a, jac[3, i], jac[4, i], jac[5, i])
-                        aij = c0 * jac[0, j] + c1 * jac[1, j] + c2 * jac[2, j]
-                        d0, d1, d2 = _cross_axis(a, jac[3, j], jac[4, j], jac[5, j])
-                        aji = d0 * jac[0, i] + d1 * jac[1, i] + d2 * jac[2, i]
-                        yh[p, i, j, col + 1 + a] += aij + aji
-                    w0i, w1i, w2i = jac[3, i], jac[4, i], jac[5, i]
-                    w0j, w1j, w2j = jac[3, j], jac[4, j], jac[5, j]
-                    yh[p, i, j, col + 4] += w0i * w0j
-                    yh[p, i, j, col + 5] += w1i * w1j
-                    yh[p, i, j, col + 6] += w2i * w2j
-                    yh[p, i, j, col + 7] += w0i * w1j + w1i * w0j
-                    yh[p, i, j, col + 8] += w0i * w2j + w2i * w0j
-                    yh[p, i, j, col + 9] += w1i * w2j + w2i * w1j
+            body_regressor(jac, rb, gravity, yh[p], yg[p], 10 * b)
     return yh, yg
 
 
@@ -160,7 +176,7 @@ def jacobian_kernel(q, parent, axis, coef, offset, body_node, body_path, b):
     pos = np.zeros((max(n_node, 1), 3))
     jac = np.zeros((6, q.shape[0]))
     _node_poses(q, parent, axis, coef, offset, rot, pos)
-    rb = _body_jacobian(b, body_node, body_path, axis, coef, rot, pos, jac)
+    rb = _body_jacobian(b, body_node, body_path, axis, coef, rot, pos, jac).copy()
     nb = body_node[b]
     pb = pos[nb].copy() if nb >= 0 else np.zeros(3)
     return rb, pb, jac

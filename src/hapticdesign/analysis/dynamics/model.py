@@ -15,6 +15,7 @@ as in Appendix A.2). ``C_cvt`` is eq. 2.52: ``C_cvt_ij = sum_k Gamma_ijk qd_k``.
 
 from __future__ import annotations
 
+import copy
 from functools import cached_property
 
 import numpy as np
@@ -43,12 +44,43 @@ def velocity_products(qd: np.ndarray) -> np.ndarray:
     return qd[..., j] * qd[..., k]
 
 
+def _float_array(value, what: str, n: int) -> np.ndarray:
+    """``value`` as a float array of shape (n,) or (P, n); anything else is a :class:`UserError`."""
+    if value is None:
+        raise UserError(f"{what} must be numbers: a vector of {n} or an array (P, {n}), got None")
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise UserError(f"{what} must be numbers: a vector of {n} or an array (P, {n}), got {type(value).__name__}") from None
+    if array.ndim not in (1, 2):
+        raise UserError(f"{what} must be a vector of {n} or an array (P, {n}), got an array of shape {array.shape}")
+    return array
+
+
+def _require_basis_memory(bases: list[CoordinateBasis], n_dof: int, n_params: int) -> None:
+    """Refuse, before building it, an exact basis this machine should not or cannot hold."""
+    from hapticdesign.workload import basis_bytes, require_memory
+
+    points = int(np.prod([b.size for b in bases], dtype=float))
+    kinds = ", ".join(f"{sum(b.kind is k for b in bases)} {k.value}" for k in CoordinateKind
+                      if any(b.kind is k for b in bases))
+    degree = max((b.degree for b in bases), default=0)
+    require_memory(f"the exact equations of motion of a {n_dof}-joint device ({kinds}; degree {degree}, "
+                   f"{points:,} grid poses)", basis_bytes(points, n_dof, n_params))
+
+
 class DynamicsModel:
     """Regressor model of one mechanism geometry; parameters ``pi`` are inputs of every call.
 
     Arrays of poses ``q`` have shape (P, N) or (N,); parameters have shape (n_params,) or
     (S, n_params) for S parameter sets at once (results then lead with S).
+
+    ``constant`` (None, or one value per entry) is added to every evaluation: the reflected rotor
+    inertia of actuators (:meth:`with_constant_inertia`); ``coefficients`` and :meth:`regressor`
+    stay purely linear in the inertial parameters.
     """
+
+    constant: np.ndarray | None = None
 
     def __init__(self, mechanism: Mechanism, max_degree: int = 4, tol: float = 1e-10, seed: int = 0):
         self.mechanism = mechanism
@@ -102,6 +134,7 @@ class DynamicsModel:
     def _fit(self, bases: list[CoordinateBasis]) -> np.ndarray:
         """Basis coefficients of the unique H entries and G: (prod sizes, N(N+1)/2 + N, n_params)."""
         n = self.n_dof
+        _require_basis_memory(bases, n, self.n_params)
         yh, yg = self._regressors(grid(bases))
         iu, ju = np.triu_indices(n)
         values = np.concatenate([yh[:, iu, ju, :], yg], axis=1)
@@ -174,7 +207,7 @@ class DynamicsModel:
         return kinds, degrees, np.ascontiguousarray(self.index, dtype=np.int64)
 
     def _poses(self, q: np.ndarray) -> np.ndarray:
-        q = np.asarray(q, dtype=float)
+        q = _float_array(q, "joint coordinates", self.n_dof)
         if q.shape[-1] != self.n_dof:
             raise UserError(f"expected {self.n_dof} joint coordinates, got {q.shape[-1]}")
         if not np.all(np.isfinite(q)):
@@ -182,19 +215,41 @@ class DynamicsModel:
         return np.atleast_2d(q)
 
     def _params(self, pi: np.ndarray) -> np.ndarray:
-        pi = np.asarray(pi, dtype=float)
+        pi = _float_array(pi, "standard inertial parameters", self.n_params)
         if pi.shape[-1] != self.n_params:
             raise UserError(f"expected {self.n_params} standard inertial parameters, got {pi.shape[-1]}")
         return pi
 
+    def with_constant_inertia(self, h: np.ndarray) -> "DynamicsModel":
+        """This model with the constant matrix ``h`` (N, N) added to H: ``H(q) = H_pi(q) + h``.
+
+        For reflected rotor inertia ``h = diag(n^2 J_r)`` (:mod:`hapticdesign.model.actuators`). A
+        constant changes neither C (its derivatives vanish, eq. 2.51-2.52) nor G; it enters the
+        constant basis function (index 0), so the tables are shared with this model.
+        """
+        h = np.asarray(h, dtype=float)
+        if h.shape != (self.n_dof, self.n_dof) or not np.allclose(h, h.T) or not np.all(np.isfinite(h)):
+            raise UserError(f"a constant inertia must be a finite symmetric {self.n_dof} x {self.n_dof} matrix")
+        out = copy.copy(self)
+        constant = np.zeros(self.coefficients.shape[1])
+        iu, ju = np.triu_indices(self.n_dof)
+        constant[self.slice_h] = h[iu, ju]
+        out.constant = constant + (0.0 if self.constant is None else self.constant)
+        return out
+
     def coefficients_for(self, pi: np.ndarray) -> np.ndarray:
         """Basis coefficients of every entry for parameters (n_params,) -> (n_basis, n_entries)."""
-        return self.coefficients @ self._params(pi)
+        coef = self.coefficients @ self._params(pi)
+        if self.constant is not None:
+            coef[0] += self.constant
+        return coef
 
     def entries(self, q: np.ndarray, pi: np.ndarray) -> np.ndarray:
         """All entries (unique H, C, G) at poses: (P, E) or (S, P, E) for parameter sets (S, n)."""
         phi = self.basis(q)
         coef = np.tensordot(self.coefficients, self._params(pi), axes=([2], [-1]))
+        if self.constant is not None:
+            coef[0] += self.constant if coef.ndim == 2 else self.constant[:, None]
         if coef.ndim == 2:
             return phi @ coef
         return np.einsum("pb,bes->spe", phi, coef)
@@ -243,7 +298,7 @@ class DynamicsModel:
         return np.einsum("...ijk,...k->...ij", self.christoffel(q, pi), qd)
 
     def _velocities(self, v: np.ndarray, q: np.ndarray) -> np.ndarray:
-        v = np.asarray(v, dtype=float)
+        v = _float_array(v, "joint rates", self.n_dof)
         if v.shape[-1] != self.n_dof:
             raise UserError(f"expected {self.n_dof} joint rates, got {v.shape[-1]}")
         if not np.all(np.isfinite(v)):
@@ -279,10 +334,16 @@ class DynamicsModel:
             raise UserError("the mass matrix is singular at this pose (check the inertial parameters)") from None
         return self._squeeze(q, qdd)
 
+    def entry_regressor(self, q: np.ndarray) -> np.ndarray:
+        """Every entry (unique H, C, G) as a row of the standard parameters: (P, E, n_params)."""
+        return np.tensordot(self.basis(q), self.coefficients, axes=(1, 0))
+
     def regressor(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
-        """Joint-torque regressor ``Y`` with ``tau = Y pi``: (P, N, n_params) or (N, n_params)."""
-        phi = self.basis(q)
-        e = np.tensordot(phi, self.coefficients, axes=(1, 0))  # (P, E, n_params)
+        """Joint-torque regressor ``Y`` with ``tau = Y pi``: (P, N, n_params) or (N, n_params).
+
+        ``Y pi`` leaves out a :attr:`constant` (reflected rotor inertia ``h``: add ``h qdd``).
+        """
+        e = self.entry_regressor(q)  # (P, E, n_params)
         n, m = self.n_dof, len(self.pairs)
         h = self._h_from(np.moveaxis(e, -1, 1)).transpose(0, 2, 3, 1)  # (P, N, N, n_params)
         c = e[:, self.slice_c].reshape(e.shape[0], n, m, self.n_params)

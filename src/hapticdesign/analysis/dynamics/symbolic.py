@@ -260,6 +260,9 @@ def derive(device: Device, symbolic: str = "all") -> SymbolicEquations:
                 H[i][j] += term
     H = [[reduce(H[min(i, j)][max(i, j)]) for j in range(n)] for i in range(n)]
     G = [reduce(x) for x in G]
+    for k, reflected in enumerate(device.reflected_inertia):  # actuators: constant n^2 J_r on the diagonal
+        if reflected:
+            H[k][k] = H[k][k] + num(reflected)
 
     def d_dq(p, k: int):
         if prismatic[k]:

@@ -192,7 +192,7 @@ def design_set(
 ) -> DesignSet:
     """``count`` designs at each LN level, every one realizable, within bounds and on its level."""
     if count < 1:
-        raise UserError("--count must be at least 1")
+        raise UserError("the number of designs per level must be at least 1")
     if any(level < 0 or not np.isfinite(level) for level in levels):
         raise UserError("LN levels must be finite and non-negative")
     rng = np.random.default_rng(seed)

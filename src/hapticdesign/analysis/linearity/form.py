@@ -34,6 +34,9 @@ class LinearityForm:
     Q: np.ndarray
     region: Region
     weights: Weights
+    accuracy: float = 0.0
+    """Estimated relative error of Q: 0 for the exact basis of a tree, the last change of converged
+    quadrature for a closed-loop device (:mod:`.quadrature`)."""
 
     @property
     def n_params(self) -> int:
@@ -115,7 +118,15 @@ def _weighted_form(coef: np.ndarray, weights: np.ndarray, gram: np.ndarray) -> n
 
 
 def linearity_form(model: DynamicsModel, region: Region | None = None, weights: Weights | None = None) -> LinearityForm:
-    """Precompute ``Q_H, Q_C, Q_G`` for one device geometry (seed 000 eq. 3.1-3.4)."""
+    """Precompute ``Q_H, Q_C, Q_G`` for one device geometry (seed 000 eq. 3.1-3.4).
+
+    Trees use the exact basis moments below; closed-loop devices (no exact basis) use converged
+    quadrature over the region (:func:`.quadrature.quadrature_form`).
+    """
+    if not getattr(model, "exact_basis", True):
+        from hapticdesign.analysis.linearity.quadrature import quadrature_form
+
+        return quadrature_form(model, region, weights)
     region = region or Region()
     weights = weights or Weights.unit(model.n_dof)
     expected = Weights.unit(model.n_dof)

@@ -93,7 +93,7 @@ def find_linear_designs(
 ) -> np.ndarray:
     """``count`` fully linear realizable designs in the seed's variables, (count, bodies * 10)."""
     if count < 1:
-        raise UserError("--find: the number of designs must be at least 1")
+        raise UserError("the number of fully linear designs must be at least 1")
     rng = np.random.default_rng(seed)
     prob = linear_design_problem(device, conditions, bounds, kind)
     bodies = device.body_names

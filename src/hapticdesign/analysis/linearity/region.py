@@ -8,6 +8,9 @@ one-dimensional moments: the mean ``w_k = E[phi_i(q_k)]`` and the covariance
 ``C_k = Cov[phi_i(q_k), phi_j(q_k)]`` of each coordinate's basis. On the torus they are exact
 closed forms (orthogonal Fourier basis); on a box they come from Gauss-Legendre quadrature,
 converged to machine precision.
+
+A device's joint limits (device files' ``joints[].limits``, URDF ``<limit>``) define its default
+region: the box of its limits, with full turns only where no limit is given (:func:`limits_region`).
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ import numpy as np
 
 from hapticdesign.analysis.dynamics.basis import CoordinateBasis, CoordinateKind
 from hapticdesign.errors import UserError
+from hapticdesign.workload import QUADRATURE_POINTS_LIMIT, require_within
 
 PANEL_POINTS = 24
 PANEL_LENGTH = math.pi
@@ -56,6 +60,11 @@ class Region:
         return w, cov
 
 
+def quadrature_points(lo: float, hi: float) -> int:
+    """Quadrature points of the uniform average over [lo, hi] (see :func:`_box_moments`)."""
+    return max(1, math.ceil((hi - lo) / PANEL_LENGTH)) * PANEL_POINTS
+
+
 def _box_moments(basis: CoordinateBasis, lo: float, hi: float) -> tuple[np.ndarray, np.ndarray]:
     """Uniform average over [lo, hi] by composite Gauss-Legendre quadrature.
 
@@ -63,8 +72,12 @@ def _box_moments(basis: CoordinateBasis, lo: float, hi: float) -> tuple[np.ndarr
     order 4 to machine precision; values are centred before their products are formed, so
     small variances keep their relative accuracy.
     """
+    if not (math.isfinite(lo) and math.isfinite(hi) and math.isfinite(hi - lo) and lo < hi):
+        raise UserError(f"a joint range must be finite with low < high, got [{lo}, {hi}]")
+    require_within(f"averaging over [{lo:g}, {hi:g}]", quadrature_points(lo, hi), QUADRATURE_POINTS_LIMIT,
+                   "quadrature points")
     x, wx = np.polynomial.legendre.leggauss(PANEL_POINTS)
-    panels = max(1, math.ceil((hi - lo) / PANEL_LENGTH))
+    panels = quadrature_points(lo, hi) // PANEL_POINTS
     edges = np.linspace(lo, hi, panels + 1)
     half = 0.5 * np.diff(edges)
     q = (half[:, None] * x + (0.5 * (edges[1:] + edges[:-1]))[:, None]).ravel()
@@ -102,7 +115,32 @@ def parse_region(text: str | None, n_dof: int) -> Region:
             raise UserError(f"--region: bounds of {part.strip()!r} must be finite")
         if not lo < hi:
             raise UserError(f"--region: range {part.strip()!r} is empty or inverted (need low < high)")
+        if not math.isfinite(hi - lo):
+            raise UserError(f"--region: range {part.strip()!r} is too wide to average over (its width overflows)")
+        require_within(f"averaging over {part.strip()!r}", quadrature_points(lo, hi), QUADRATURE_POINTS_LIMIT,
+                       "quadrature points")
         if index in ranges:
             raise UserError(f"--region: coordinate {index + 1} is given twice")
         ranges[index] = (lo, hi)
     return Region(ranges)
+
+
+def limits_region(limits) -> Region:
+    """The box of a device's joint limits (``device.joint_limits()``); coordinates without limits span the torus."""
+    return Region({k: (float(span[0]), float(span[1])) for k, span in enumerate(limits) if span is not None})
+
+
+def resolve_region(text: str | None, limits) -> Region:
+    """The region of ``--region`` for a device with joint ``limits`` (one entry per coordinate, or None).
+
+    No text: the limits' box (:func:`limits_region`). ``torus``: the seed's full torus (eq. 3.4),
+    limits ignored. Ranges such as ``q2=-0.5:0.5``: those coordinates as given, the others keep
+    their limits.
+    """
+    n_dof = len(limits)
+    if text is None or not text.strip():
+        return limits_region(limits)
+    given = parse_region(text, n_dof)
+    if given.is_torus:
+        return given
+    return Region({**limits_region(limits).ranges, **given.ranges})

@@ -16,13 +16,14 @@ from hapticdesign.analysis.linearity.design_sets import DesignSet, Method, desig
 from hapticdesign.analysis.linearity.form import PARTS, LinearityForm, linearity_form
 from hapticdesign.analysis.linearity.linear_designs import find_linear_designs
 from hapticdesign.analysis.linearity.verdict import decide_linearizable, minimum_ln
-from hapticdesign.analysis.linearity.region import Region, parse_region
+from hapticdesign.analysis.linearity.region import Region, limits_region, resolve_region
 from hapticdesign.analysis.linearity.weights import Weights, read_weights
 from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
-from hapticdesign.interface.common import write_atomically
+from hapticdesign.files import write_atomically
 from hapticdesign.model.device import Device
 from hapticdesign.model.inertia import Realizability
+from hapticdesign.workload import require_designs
 
 
 @dataclass(frozen=True)
@@ -34,15 +35,19 @@ class LNResult:
 
 
 def device_form(device: Device, region: Region | None = None, weights: Weights | None = None) -> LinearityForm:
-    """The LN form of a device (cached per geometry when region and weights are the defaults)."""
-    if region is None and weights is None:
-        return _default_form(device.model)
+    """The LN form of a device (cached per geometry and region when the weights are the defaults).
+
+    The default region is the box of the device's joint limits, full turns where it has none.
+    """
+    region = limits_region(device.joint_limits()) if region is None else region
+    if weights is None:
+        return _default_form(device.model, tuple(sorted(region.ranges.items())))
     return linearity_form(device.model, region, weights)
 
 
 @lru_cache(maxsize=8)
-def _default_form(model) -> LinearityForm:
-    return linearity_form(model)
+def _default_form(model, ranges: tuple) -> LinearityForm:
+    return linearity_form(model, Region(dict(ranges)) if ranges else None)
 
 
 def evaluate_ln(
@@ -54,9 +59,9 @@ def evaluate_ln(
     weights_file: Path | None,
 ) -> LNResult:
     device = resolve_device(preset, device_file, params_file, strict)
-    region = parse_region(region_text, device.n_dof)
+    region = resolve_region(region_text, device.joint_limits())
     weights = read_weights(weights_file, device.n_dof) if weights_file is not None else None
-    form = device_form(device, None if region.is_torus else region, weights)
+    form = device_form(device, region, weights)
     parts = form.parts(device.standard_parameters())
     return LNResult(
         device.name,
@@ -79,10 +84,16 @@ def symbolic_ln(
 ) -> str:
     """The closed-form LN (Appendix B.1 / B.2 equivalent) as text, LaTeX or Python source."""
     device = resolve_device(preset, device_file, params_file, strict)
-    region = parse_region(region_text, device.n_dof)
+    region = resolve_region(region_text, device.joint_limits())
     weights = read_weights(weights_file, device.n_dof) if weights_file is not None else None
-    form = device_form(device, None if region.is_torus else region, weights)
+    form = device_form(device, region, weights)
     return closed_form(device, form, symbolic_gravity).export(fmt, part)
+
+
+def require_seed(seed: int) -> None:
+    """Random seeds are non-negative integers (NumPy's ``default_rng`` refuses others)."""
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise UserError(f"the random seed must be a non-negative integer, got {seed!r}")
 
 
 def parse_realizability(text: str) -> Realizability:
@@ -126,6 +137,8 @@ def linearize(
     kind = parse_realizability(realizability)
     if find < 0:
         raise UserError("--find: the number of designs must be >= 0")
+    require_seed(seed)
+    require_designs(f"finding {find:,} fully linear designs", find, "linear")
     device = resolve_device(preset, device_file, params_file, strict)
     form = device_form(device)
     conditions = linear_conditions(device, form)
@@ -231,6 +244,11 @@ def write_design_set(
         chosen = Method(method)
     except ValueError:
         raise UserError(f"--method: choose fast or de, got {method!r}") from None
+    if count < 1:
+        raise UserError("--count: the number of designs per level must be at least 1")
+    require_seed(seed)
+    require_designs(f"a design set of {count:,} designs at each of {len(levels)} levels ({chosen.value} method)",
+                    count * len(levels), chosen.value)
     device = resolve_device(preset, device_file, params_file, strict)
     form = device_form(device)
     conditions = linear_conditions(device, form)

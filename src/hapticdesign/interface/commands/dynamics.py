@@ -10,7 +10,7 @@ import typer
 
 from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
 from hapticdesign.devices.loading import resolve_device
-from hapticdesign.interface.common import parse_vector, print_json, user_errors
+from hapticdesign.interface.common import note as stderr_note, parse_vector, print_json, user_errors
 
 
 
@@ -25,13 +25,16 @@ def dynamics(
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
 ) -> None:
-    """H, C, C_cvt, G and tau at one pose, in SI units (seed 000 eq. 2.50-2.52)."""
+    """H, C, C_cvt, G and tau at one pose, in SI units (seed 000 eq. 2.50-2.52); H includes actuators' reflected
+    rotor inertia. A pose outside the joint limits is computed, with a warning line on stderr."""
     with user_errors(quiet=quiet):
         dev = resolve_device(preset, device, params, strict=strict)
         n = dev.n_dof
         qv = parse_vector(q, n, "q")
         qdv = parse_vector(qd, n, "qd")
         qddv = parse_vector(qdd, n, "qdd")
+        for message in dev.limit_warnings(qv):  # allowed (the equations hold there), but worth a line
+            stderr_note(f"warning: {message}", quiet)
         result = {
             "device": dev.name,
             "q": qv,

@@ -8,7 +8,8 @@ from typing import Optional
 import typer
 
 from hapticdesign.interface.common import activity, print_json, user_errors
-from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, SEED, STRICT
+from hapticdesign.interface.options import DEVICE, FORCE, FORCE_HINT, JSON_OUT, PARAMS, PRESET, QUIET, SEED, STRICT
+from hapticdesign.workload import allow_large
 
 
 def ln_command(
@@ -17,7 +18,8 @@ def ln_command(
     params: Optional[Path] = PARAMS,
     strict: bool = STRICT,
     region: Optional[str] = typer.Option(
-        None, "--region", help='Joint ranges in radians, e.g. "q2=-0.5:0.5,q3=0:1"; default the torus (eq. 3.4).'
+        None, "--region", help='Joint ranges in radians, e.g. "q2=-0.5:0.5,q3=0:1" (other joints keep their limits), or "torus" '
+        '(eq. 3.4); default: the joint limits, full turns where none are given.'
     ),
     weights: Optional[Path] = typer.Option(None, "--weights", help="Weights file with keys H, C, G (eq. 3.1)."),
     as_json: bool = JSON_OUT,
@@ -28,9 +30,10 @@ def ln_command(
     fmt: Optional[str] = typer.Option(None, "--format", help="With --symbolic: text (default), latex or python."),
     part: Optional[str] = typer.Option(None, "--part", help="With --symbolic: all (default), H, C or G."),
     symbolic_gravity: bool = typer.Option(False, "--symbolic-gravity", help="With --symbolic: keep g as a symbol."),
+    force: bool = FORCE,
 ) -> None:
     """Linearity Number of a device (seed 000 eq. 3.1-3.4) and its H, C, G parts, or its closed form."""
-    with user_errors(strict, quiet):
+    with user_errors(strict, quiet), allow_large(force, FORCE_HINT):
         from hapticdesign.analysis.linearity.service import evaluate_ln, symbolic_ln
         from hapticdesign.errors import UserError
 
@@ -65,9 +68,10 @@ def linearize_command(
     realizability: str = typer.Option("rigid-body", "--realizability", help="rigid-body or seed (eq. 3.28)."),
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
+    force: bool = FORCE,
 ) -> None:
     """Conditions for LN = 0 (seed 000 eq. 3.12-3.27), free parameters, constant H; verdict when impossible."""
-    with user_errors(strict, quiet), activity(not (quiet or json_out), "linearizing"):
+    with user_errors(strict, quiet), allow_large(force, FORCE_HINT), activity(not (quiet or json_out), "linearizing"):
         from hapticdesign.analysis.linearity.service import linearize, linearize_report
 
         result = linearize(preset, device, params, strict, find, seed, out, realizability)
@@ -91,9 +95,10 @@ def designs_command(
     realizability: str = typer.Option("rigid-body", "--realizability", help="rigid-body or seed (eq. 3.28 only)."),
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
+    force: bool = FORCE,
 ) -> None:
     """Designs at prescribed LN levels under eq. 3.35-3.38 (seed 000 §3.2.2), written to CSV."""
-    with user_errors(strict, quiet):
+    with user_errors(strict, quiet), allow_large(force, FORCE_HINT):
         from hapticdesign.analysis.linearity.service import write_design_set
 
         with activity(not (quiet or json_out), "designs"):

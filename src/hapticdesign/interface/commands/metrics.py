@@ -13,11 +13,11 @@ from typing import Optional
 import numpy as np
 import typer
 
-from hapticdesign.analysis.kinematics import jacobian
+from hapticdesign.analysis.kinematics import actuated_jacobian
 from hapticdesign.analysis.metrics import dynamic, kinematic
 from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
-from hapticdesign.interface.common import parse_vector, print_json, user_errors
+from hapticdesign.interface.common import note, parse_vector, print_json, user_errors
 from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
 from hapticdesign.model.device import Device
 
@@ -31,7 +31,7 @@ def task_jacobian(device: Device, q: np.ndarray) -> np.ndarray:
     (planar devices): the translational rows projected on the plane (or line) of motion, i.e. on
     the leading left singular vectors, which leaves every metric unchanged by the choice of axes.
     """
-    full = jacobian(device.mechanism, q)
+    full = actuated_jacobian(device.mechanism, q, solver=getattr(device.model, "solver", None))
     n = device.n_dof
     if n == 3:
         return full[:3]
@@ -80,7 +80,10 @@ def metrics(
     """Kinematic and dynamic metrics of any device at one pose (seed 001 eq. 4.24-4.38, 4.90-4.99)."""
     with user_errors(quiet=quiet):
         dev = resolve_device(preset, device, params, strict=strict)
-        result = device_metrics(dev, parse_vector(q, dev.n_dof, "q"))
+        qv = parse_vector(q, dev.n_dof, "q")
+        for message in dev.limit_warnings(qv):
+            note(f"warning: {message}", quiet)
+        result = device_metrics(dev, qv)
         if json_out:
             print_json(result)
             return

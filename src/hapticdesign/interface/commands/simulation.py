@@ -8,16 +8,36 @@ from typing import Optional
 import numpy as np
 import typer
 
-from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
+from hapticdesign.interface.options import DEVICE, FORCE, FORCE_HINT, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
 from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import print_json, progress_bar, user_errors, write_atomically
+from hapticdesign.workload import allow_large
 
+# Magnitudes the 1-DOF boundary is computed for (SI units); outside them exp(-b T / J) and the
+# stiffness search (up to 1e12) lose their meaning in double precision.
+SCALE_RANGE = (1e-12, 1e12)
+
+
+
+def _check_error_percent(value: float) -> None:
+    if not (np.isfinite(value) and -100 < value < 100):
+        raise UserError(f"--error-percent must be a finite number between -100 and 100 (exclusive), got {value}")
+
+
+def _check_wall_damping(value: float) -> None:
+    if not (np.isfinite(value) and value >= 0):
+        raise UserError(f"--wall-damping must be a finite number >= 0, got {value}")
 
 
 def _loop_config(period, step, duration, counts, delay, error_percent, inertial, coriolis, gravity,
                  wall_damping, hand_mass, hand_damping, hand_stiffness):
     from hapticdesign.simulation.config import Compensator, Hand, LoopConfig, Sensors, Wall
+
+    _check_error_percent(error_percent)
+    _check_wall_damping(wall_damping)
+    if delay < 0:
+        raise UserError(f"--delay must be a non-negative number of samples, got {delay}")
 
     hand = None
     if hand_mass or hand_damping or hand_stiffness:
@@ -62,7 +82,9 @@ def impedance_range_command(
     sim_type: int = typer.Option(1, "--type", help="1: other joints held at 0; 2: driven at 0.52 sin(3 pi t)."),
     joint: str = typer.Option("1", help="Joint carrying the virtual wall (1-based or coordinate name)."),
     equilibrium: float = typer.Option(0.01, help="Wall equilibrium [rad]; the joints start at 0."),
-    method: str = typer.Option("fast", help="fast (doubling + bisection) or linear (K = 1, 2, 3, ...)."),
+    method: str = typer.Option("fast", help="fast (doubling + bisection), linear (K = 1, 2, 3, ...) or analytic "
+                                            "(the exact linear response of the sampled loop at the start pose, "
+                                            "no ODE integration; exact for type 1 and LN = 0 designs)."),
     resolution: Optional[float] = typer.Option(
         None, help="Stiffness grid R, 2R, 3R ... [N m/rad, or N/m for a prismatic joint]; reports k_min and k_max "
                    "on it. Default: the seed's integer scan."),
@@ -80,18 +102,26 @@ def impedance_range_command(
     strict: bool = STRICT,
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
+    force: bool = FORCE,
 ) -> None:
     """Maximum stable impedance of one joint under a virtual spring (seed 000 §4.1.2-4.1.3)."""
-    from hapticdesign.simulation.impedance import Criteria, ImpedanceProblem, fast_search, grid_search, linear_scan
+    from hapticdesign.simulation.impedance import (Criteria, ImpedanceProblem, fast_search, grid_search,
+                                                   impedance_range, linear_scan, planned_simulations,
+                                                   require_search_workload)
     from hapticdesign.simulation.impedance import true_boundary as growth_boundary
     from hapticdesign.simulation.loop import joint_index
 
-    with user_errors(quiet=quiet):
+    with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
+        if not (np.isfinite(duration) and duration > 0):
+            raise UserError(f"--duration must be a positive number of seconds, got {duration}")
+        if not (np.isfinite(settle_window) and 0 < settle_window <= duration):
+            raise UserError(f"--settle-window ({settle_window:g} s) must be positive and not longer than --duration "
+                            f"({duration:g} s)")
         dev = resolve_device(preset, device, params, strict=strict)
         config = _loop_config(period, step, duration, counts, delay, error_percent, inertial, coriolis, gravity,
                               wall_damping, hand_mass, hand_damping, hand_stiffness)
-        if method not in ("fast", "linear"):
-            raise UserError(f"--method must be 'fast' or 'linear', got {method!r}")
+        if method not in ("fast", "linear", "analytic"):
+            raise UserError(f"--method must be 'fast', 'linear' or 'analytic', got {method!r}")
         if k_limit < 1:
             raise UserError("--k-limit must be at least 1")
         if resolution is not None and not (resolution > 0 and np.isfinite(resolution)):
@@ -99,8 +129,12 @@ def impedance_range_command(
         if resolution is not None and resolution > k_limit:
             raise UserError(f"--resolution {resolution} is above --k-limit {k_limit}")
         criteria = Criteria(overshoot, settle_tolerance, settle_window, safety)
+        require_search_workload(config, planned_simulations(method, k_limit, resolution, true_boundary))
         problem = ImpedanceProblem(dev, _sim_type(sim_type), joint_index(dev, joint), equilibrium, criteria, config)
-        if resolution is not None:
+        if method == "analytic":
+            result = impedance_range(dev, sim_type, "analytic", k_limit, criteria, config, problem.wall_joint,
+                                     equilibrium, resolution)
+        elif resolution is not None:
             result = grid_search(problem, resolution, k_limit)
         else:
             result = (fast_search if method == "fast" else linear_scan)(problem, k_limit)
@@ -137,13 +171,15 @@ def transparency_command(
     strict: bool = STRICT,
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
+    force: bool = FORCE,
 ) -> None:
     """Transparency bandwidth of one joint: G_T = Z_M / Z_D leaves +-3 dB (seed 000 §4.2.2, eq. 4.1-4.2)."""
     from hapticdesign.simulation.loop import joint_index
     from hapticdesign.simulation.paths import Chirp
     from hapticdesign.simulation.transparency import transparency
 
-    with user_errors(quiet=quiet):
+    with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
+        _check_chirp(amplitude, f0, f1, sweep, period)
         dev = resolve_device(preset, device, params, strict=strict)
         config = _loop_config(period, step, sweep, counts, delay, error_percent, inertial, coriolis, gravity,
                               wall_damping, 0.0, 0.0, 0.0)
@@ -164,6 +200,31 @@ def transparency_command(
                    f"transparency bandwidth {text}")
 
 
+def _check_chirp(amplitude: float, f0: float, f1: float, sweep: float, period: float) -> None:
+    """The chirp options of ``transparency``: a moving joint, 0 <= f0 < f1 <= Nyquist, a finite sweep."""
+    if not (np.isfinite(amplitude) and amplitude != 0):
+        raise UserError(f"--amplitude must be a finite, non-zero angle, got {amplitude}")
+    if not (np.isfinite(sweep) and sweep > 0):
+        raise UserError(f"--sweep must be a positive number of seconds, got {sweep}")
+    if not (np.isfinite(f0) and np.isfinite(f1) and 0 <= f0 < f1):
+        raise UserError(f"--f0 and --f1 must be finite with 0 <= f0 < f1, got {f0:g} and {f1:g}")
+    if period > 0 and np.isfinite(period) and f1 > 0.5 / period:
+        raise UserError(f"--f1 {f1:g} Hz is beyond the Nyquist frequency {0.5 / period:g} Hz of --period {period:g} s")
+
+
+def _check_scale(**values: float) -> None:
+    """Refuse magnitudes outside :data:`SCALE_RANGE` (zero allowed where a flag may be off)."""
+    lo, hi = SCALE_RANGE
+    for name, value in values.items():
+        if value != 0 and not (lo <= abs(value) <= hi):
+            raise UserError(f"--{name.replace('_', '-')} {value:g} is outside the range this model is computed for "
+                            f"({lo:g} to {hi:g} in SI units)")
+
+
+def _finite_or_none(value: float | None) -> float | None:
+    return value if value is None or np.isfinite(value) else None
+
+
 def stability_boundary_command(
     inertia: float = typer.Option(..., help="Inertia J [kg m^2]."),
     damping: float = typer.Option(..., help="Viscous damping b [N m s/rad]."),
@@ -177,15 +238,30 @@ def stability_boundary_command(
     samples: int = typer.Option(4000, help="Samples per simulation of the growth test."),
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
+    force: bool = FORCE,
 ) -> None:
     """Exact vs simulated stiffness limit of a 1-DOF mass-damper under a sampled spring (check of seed 000 ch. 4)."""
     from hapticdesign.simulation.boundary import MassDamper, compensated_boundary, exact_boundary, simulated_boundary
 
-    with user_errors(quiet=quiet):
+    with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
         if substeps < 1 or samples < 40:
             raise UserError("--substeps must be at least 1 and --samples at least 40")
-        if not (np.isfinite(error_percent) and error_percent <= 100):
-            raise UserError(f"--error-percent must be a finite number <= 100, got {error_percent}")
+        if not (np.isfinite(inertia) and inertia > 0 and np.isfinite(period) and period > 0):
+            raise UserError(f"--inertia and --period must be positive numbers, got {inertia:g} and {period:g}")
+        _check_scale(inertia=inertia, damping=damping, period=period, wall_damping=wall_damping)
+        _check_error_percent(error_percent)
+        _check_wall_damping(wall_damping)
+        if delay < 0:
+            raise UserError(f"--delay must be a non-negative number of samples, got {delay}")
+        if damping * period / substeps > inertia:
+            raise UserError(f"the plant step --period / --substeps = {period / substeps:.3g} s is longer than the "
+                            f"plant's time constant J/b = {inertia / damping:.3g} s; raise --substeps")
+        if 0 < damping * period / inertia < 1e-9:
+            raise UserError(f"the damping over one sample, b T / J = {damping * period / inertia:.3g}, is too small to "
+                            "resolve in double precision (below 1e-9); give --damping 0 for an undamped plant")
+        if delay >= samples // 4:
+            raise UserError(f"--delay ({delay} samples) must be shorter than a quarter of --samples ({samples}) "
+                            "for the growth test to see the loop respond")
         if error_percent and not compensate_inertia:
             raise UserError("--error-percent needs --compensate-inertia (it scales the compensator's inertia)")
         fraction = 1.0 - error_percent / 100.0
@@ -195,15 +271,26 @@ def stability_boundary_command(
         closed = (compensated_boundary(inertia, damping, period, fraction)
                   if compensate_inertia and delay == 0 and wall_damping == 0 else None)
         simulated = simulated_boundary(system, samples=samples, substeps=substeps)
-        out = {"k_max_exact": exact, "k_max_closed_form": closed, "k_max_simulated": simulated,
-               "relative_difference": (simulated - exact) / exact if exact not in (0.0, np.inf) else None,
+        unbounded = [name for name, v in (("exact", exact), ("closed_form", closed), ("simulated", simulated))
+                     if v is not None and not np.isfinite(v)]
+        out = {"k_max_exact": _finite_or_none(exact), "k_max_closed_form": _finite_or_none(closed),
+               "k_max_simulated": _finite_or_none(simulated),
+               "relative_difference": (simulated - exact) / exact
+               if np.isfinite(exact) and np.isfinite(simulated) and exact != 0 else None,
                "two_b_over_t": 2 * damping / period, "error_percent": error_percent}
+        if unbounded:
+            out["note"] = (f"k_max {', '.join(unbounded)}: no stiffness up to the search cap destabilizes the loop "
+                           "(unbounded; null in JSON)")
         if json_out:
             print_json(out)
             return
-        form = "" if closed is None else f", closed form {closed:.6g}"
-        typer.echo(f"exact {exact:.6g} N m/rad{form}, simulated {simulated:.6g} N m/rad "
+        form = "" if closed is None else f", closed form {_stiffness_text(closed)}"
+        typer.echo(f"exact {_stiffness_text(exact)}{form}, simulated {_stiffness_text(simulated)} "
                    f"(2b/T = {2 * damping / period:.6g})")
+
+
+def _stiffness_text(value: float) -> str:
+    return f"{value:.6g} N m/rad" if np.isfinite(value) else "unbounded (no stiffness destabilizes the loop)"
 
 
 def campaign_command(
@@ -219,22 +306,31 @@ def campaign_command(
     f1: float = typer.Option(15.0, help="Chirp end frequency [Hz] (seed: 15)."),
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
+    force: bool = FORCE,
 ) -> None:
     """Both criteria and both types over a design set; resumable (seed 000 §4.1.4, §4.2.4)."""
+    import os
+
     from hapticdesign.simulation.campaign import CampaignOptions, load_cases, read_designs, run_campaign, summarize
     from hapticdesign.simulation.paths import Chirp
 
-    with user_errors(quiet=quiet):
+    with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
         if workers is not None and workers < 1:
             raise UserError("--workers must be at least 1")
+        if workers is not None and workers > (os.cpu_count() or 1) and not force:
+            raise UserError(f"--workers {workers} is more than the {os.cpu_count() or 1} cores of this machine; "
+                            "add --force to start them anyway")
         if k_limit < 1:
             raise UserError("--k-limit must be at least 1")
-        if not (duration > 0 and stiffness > 0):
+        if not (np.isfinite(duration) and duration > 0 and np.isfinite(stiffness) and stiffness > 0):
             raise UserError("--duration and --stiffness must be positive")
+        _check_chirp(0.3, 0.1, f1, sweep, 1e-3)
+        if duration < 0.5:
+            raise UserError(f"--duration ({duration:g} s) must not be shorter than the 0.5 s settle window")
         options = CampaignOptions(preset or "phantom-3dof", k_limit, stiffness, Chirp(0.3, 0.1, f1, sweep), duration)
         with progress_bar(not (quiet or json_out)) as report:
             advance = (lambda done, total: report("cases", done, total)) if report else None
-            counts = run_campaign(designs, out, options, scheduler, workers, advance)
+            counts = run_campaign(designs, out, options, scheduler, workers, advance, quiet=quiet)
         if json_out:
             chosen = read_designs(designs, options.preset)
             print_json({**counts, "out": str(out),

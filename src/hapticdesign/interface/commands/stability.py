@@ -10,7 +10,7 @@ import typer
 
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import note, parse_vector, print_json, user_errors
-from hapticdesign.interface.options import JSON_OUT, QUIET
+from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, SEED, STRICT
 
 
 def _dampers(text: Optional[str]) -> Optional[list[float]]:
@@ -22,9 +22,29 @@ def _dampers(text: Optional[str]) -> Optional[list[float]]:
     return [float(v) for v in parse_vector(text, len(values), "b-values")]
 
 
+def _device_joint(preset, device, params, strict, q, joint, error_percent, compensate) -> tuple[float, float, float]:
+    """J = H_jj(q), b_j and the compensator fraction H_model,jj / H_jj of a device at a pose."""
+    from hapticdesign.devices.loading import resolve_device
+    from hapticdesign.simulation.config import model_device
+    from hapticdesign.simulation.loop import joint_index
+
+    dev = resolve_device(preset, device, params, strict=strict)
+    pose = parse_vector(q, dev.n_dof, "q")
+    j = joint_index(dev, joint)
+    inertia = float(dev.H(pose)[j, j])
+    fraction = float(model_device(dev, error_percent).H(pose)[j, j]) / inertia if compensate else 0.0
+    return inertia, float(dev.damping[j]), fraction
+
+
 def zwidth_command(
-    inertia: float = typer.Option(..., help="Inertia J of the joint [kg m^2]."),
-    damping: float = typer.Option(..., help="Physical viscous damping b [N m s/rad]."),
+    inertia: Optional[float] = typer.Option(None, help="Inertia J of the joint [kg m^2] (or take it from a device)."),
+    damping: Optional[float] = typer.Option(None, help="Physical viscous damping b [N m s/rad] (or from a device)."),
+    preset: Optional[str] = PRESET,
+    device: Optional[Path] = DEVICE,
+    params: Optional[Path] = PARAMS,
+    q: Optional[str] = typer.Option(None, help="Pose of the device [rad or m], comma-separated (default: zeros)."),
+    joint: str = typer.Option("1", help="The device's joint carrying the wall (1-based or coordinate name)."),
+    strict: bool = STRICT,
     period: float = typer.Option(1e-3, help="Sample period T [s]."),
     delay: int = typer.Option(0, help="Computation delay N [samples]: the torque of interval k uses the samples of k - N."),
     velocity: str = typer.Option("sampled", help="The damper's velocity: sampled (the seed's perfect sensor) or "
@@ -35,6 +55,9 @@ def zwidth_command(
     b_values: Optional[str] = typer.Option(None, help="Virtual dampers B1,B2,... [N m s/rad]; default: a grid up "
                                                       "to the largest usable damper."),
     points: int = typer.Option(25, help="Points of the default damper grid."),
+    map_joints: Optional[str] = typer.Option(None, help="Two other joints (e.g. 2,3): also map K_max at the first "
+                                                        "damper over their angles in [-pi, pi] (needs a device and --out)."),
+    map_points: int = typer.Option(21, help="Points per axis of the map."),
     out: Optional[Path] = typer.Option(None, help="Folder for the chart zwidth.png / zwidth.svg."),
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
@@ -42,7 +65,8 @@ def zwidth_command(
     """Exact Z-width of a 1-DOF haptic display, K_max for each virtual damper B (seed 000 ch. 5 future work).
 
     Exact for the sampled-data loop (zero-order hold, delay, compensator), with the passivity bound of
-    Colgate & Schenkel beside it (Colgate & Brown 1994)."""
+    Colgate & Schenkel beside it (Colgate & Brown 1994). J and b come from the options or from one
+    joint of a device at a pose (the other joints held)."""
     from hapticdesign.simulation.figures import zwidth_chart
     from hapticdesign.simulation.zwidth import DisplayLoop, zwidth
 
@@ -52,6 +76,16 @@ def zwidth_command(
         if error_percent and not compensate_inertia:
             raise UserError("--error-percent needs --compensate-inertia (it scales the compensator's inertia)")
         fraction = (1.0 - error_percent / 100.0) if compensate_inertia else 0.0
+        from_device = preset is not None or device is not None
+        if from_device == (inertia is not None or damping is not None):
+            raise UserError("give either --inertia and --damping, or a device (--preset or --device) with --q and --joint")
+        if from_device:
+            inertia, damping, fraction = _device_joint(preset, device, params, strict, q, joint, error_percent,
+                                                       compensate_inertia)
+        if map_joints is not None and not (from_device and out is not None):
+            raise UserError("--map-joints needs a device (--preset or --device) and --out")
+        elif inertia is None or damping is None:
+            raise UserError("--inertia and --damping go together")
         loop = DisplayLoop(inertia, damping, period, delay, velocity, fraction)
         result = zwidth(loop, _dampers(b_values), points)
         figures = []
@@ -59,6 +93,9 @@ def zwidth_command(
             title = (f"J = {inertia:g} kg m^2, b = {damping:g} N m s/rad, T = {period:g} s, N = {delay}, "
                      f"{velocity} velocity" + (f", compensator c = {fraction:g}" if compensate_inertia else ""))
             figures = [str(p) for p in zwidth_chart(result, title, Path(out) / "zwidth")]
+            if map_joints is not None:
+                figures += _map(preset, device, params, strict, joint, map_joints, map_points, loop, result.B[0],
+                                Path(out))
         payload = {**result.as_dict(), "loop": {"inertia": inertia, "damping": damping, "period": period,
                                                  "delay": delay, "velocity": velocity, "fraction": fraction},
                    "figures": figures}
@@ -66,11 +103,92 @@ def zwidth_command(
             print_json(payload)
             return
         typer.echo("B [N m s/rad]   K_max [N m/rad]   passivity K   linear approximation K")
-        for b, k, p, lin in zip(result.B, result.K, result.passivity, result.linear):
-            typer.echo(f"{b:13.5g}   {k:15.6g}   {p:11.6g}   {lin:22.6g}")
+        for i, (b, k) in enumerate(zip(result.B, result.K)):
+            p = "-" if result.passivity is None else f"{result.passivity[i]:.6g}"
+            lin = "-" if result.linear is None else f"{result.linear[i]:.6g}"
+            typer.echo(f"{b:13.5g}   {k:15.6g}   {p:>11}   {lin:>22}")
         for f in figures:
+            note(f"wrote {f}", quiet)
+
+
+def _map(preset, device, params, strict, joint, map_joints, points, loop, damper, out: Path) -> list[str]:
+    from hapticdesign.devices.loading import resolve_device
+    from hapticdesign.simulation.figures import stiffness_map_chart
+    from hapticdesign.simulation.loop import joint_index
+    from hapticdesign.simulation.zwidth import stiffness_map
+
+    dev = resolve_device(preset, device, params, strict=strict)
+    names = [v for v in map_joints.replace(" ", "").split(",") if v]
+    if len(names) != 2:
+        raise UserError(f"--map-joints: give two joints, got {map_joints!r}")
+    axes = (joint_index(dev, names[0]), joint_index(dev, names[1]))
+    wall = joint_index(dev, joint)
+    result = stiffness_map(dev, wall, axes, points, loop.period, loop.delay, loop.velocity, loop.fraction, damper)
+    coordinates = dev.mechanism.coordinates
+    return [str(p) for p in stiffness_map_chart(result, [coordinates[a] for a in axes], coordinates[wall],
+                                                out / "kmax_map")]
+
+
+def robustness_command(
+    designs: Path = typer.Option(..., help="Design CSV (as `designs` writes it): level, ln, ... and the inertial parameters."),
+    errors: str = typer.Option("0,1,5,10", help="Modelling errors of masses and inertias [%], comma-separated."),
+    per_level: Optional[int] = typer.Option(None, help="Use the first N designs of each LN level (default: all)."),
+    seed: int = SEED,
+    method: str = typer.Option("analytic", help="analytic (exact for type 1) or fast (the simulation)."),
+    out: Optional[Path] = typer.Option(None, help="Folder for robustness.csv and the chart robustness.png / .svg."),
+    json_out: bool = JSON_OUT,
+    quiet: bool = QUIET,
+) -> None:
+    """Stable impedance range under modelling error, per LN level (seed 000 ch. 5 future work).
+
+    Does a linear device keep its range better when the compensator's masses and inertias are wrong?
+    Design i draws its error signs from seed + i."""
+    import csv
+    import io
+
+    from hapticdesign.devices.registry import preset
+    from hapticdesign.files import write_atomically
+    from hapticdesign.interface.common import progress_bar
+    from hapticdesign.simulation.campaign import read_designs
+    from hapticdesign.simulation.figures import robustness_chart
+    from hapticdesign.simulation.robustness import error_cases, summarize_errors
+
+    with user_errors(quiet=quiet):
+        if method not in ("analytic", "fast"):
+            raise UserError(f"--method must be 'analytic' or 'fast', got {method!r}")
+        if per_level is not None and per_level < 1:
+            raise UserError(f"--per-level must be at least 1, got {per_level}")
+        levels = [float(v) for v in parse_vector(errors, len([v for v in errors.split(",") if v.strip()]), "errors")]
+        base = preset("phantom-3dof")
+        chosen, seen = [], {}
+        for d in read_designs(designs):
+            seen[d.level] = seen.get(d.level, 0) + 1
+            if per_level is None or seen[d.level] <= per_level:
+                chosen.append((d.name, d.level, base.with_params(d.params)))
+        with progress_bar(not (quiet or json_out)) as report:
+            advance = (lambda done, total: report("designs x errors", done, total)) if report else None
+            cases = error_cases(chosen, levels, seed, method=method, progress=advance)
+        rows = summarize_errors(cases)
+        files = []
+        if out is not None:
+            buffer = io.StringIO()
+            writer = csv.DictWriter(buffer, list(rows[0]))
+            writer.writeheader()
+            writer.writerows(rows)
+            write_atomically(Path(out) / "robustness.csv", buffer.getvalue())
+            files = [str(Path(out) / "robustness.csv"), *map(str, robustness_chart(rows, Path(out) / "robustness"))]
+        if json_out:
+            print_json({"rows": rows, "designs": len(chosen), "errors": levels, "seed": seed, "files": files})
+            return
+        typer.echo("LN level   error [%]   mean K_max [N m/rad]   mean |change| [%]   changed")
+        for r in rows:
+            change = "-" if r["mean_relative_change"] is None else f"{100 * r['mean_relative_change']:.1f}"
+            share = "-" if r["changed_share"] is None else f"{100 * r['changed_share']:.0f} %"
+            typer.echo(f"{r['level']:8g}   {r['error_percent']:9g}   {r['mean']:20.2f}   {change:>17}   {share:>7}")
+        for f in files:
             note(f"wrote {f}", quiet)
 
 
 def register(app: typer.Typer) -> None:
     app.command("zwidth")(zwidth_command)
+    app.command("robustness")(robustness_command)

@@ -75,7 +75,7 @@ def _step(step: StepResult, table_href, figure_stem) -> str:
     parts = [f'<h2 id="{escape(step.key)}">{escape(step.title)}</h2>',
              f"<p>{_status(step.status)} &middot; {step.seconds:.2f} s</p>"]
     if step.status != STATUS_DONE:
-        why = ("The engine this step needs is not part of this installation, so no numbers are shown."
+        why = ("This step builds on one that did not finish, so no numbers are shown."
                if step.status == STATUS_MISSING else "The engine raised an error; no numbers are shown.")
         parts.append(f"<p>{escape(why)}</p><pre>{escape(step.reason)}</pre>")
         return "\n".join(parts)

@@ -1,0 +1,115 @@
+"""Equations of motion of a closed-loop mechanism in its actuated coordinates (seed 000 eq. 2.44-2.52).
+
+``tau_a = H_a(q_a) qdd_a + C_a(q_a) qd_a^2 + G_a(q_a)`` with ``H_a = T^T H T``, ``G_a = T^T G`` and
+``C_a`` from ``T^T (H Tdot + C-terms T)`` (:mod:`.actuated_kernel`), where ``H, C, G`` are the
+loop-opened tree's (the same kernel as every tree device) and ``T`` comes from the loop solver
+(:mod:`hapticdesign.analysis.loops.solver`). Every entry stays linear in the standard inertial
+parameters, so this model is a :class:`~.model.DynamicsModel` whose entries come from a regressor
+evaluated pose by pose instead of an exact trigonometric basis: H, C (eq. 2.50's columns), C_cvt
+(eq. 2.52, from the Christoffel symbols of ``H_a``), G, inverse and forward dynamics are inherited.
+
+A batch of actuated poses is a motion (:meth:`LoopSolver.solve`): passive values are continued
+along it from the home assembly.
+"""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+
+from hapticdesign.analysis.dynamics.actuated_kernel import actuated_kernel
+from hapticdesign.analysis.dynamics.model import DynamicsModel, pair_index
+from hapticdesign.analysis.loops.solver import MESSAGES, SINGULAR_RATIO, LoopSolver
+from hapticdesign.analysis.loops.closure_kernel import SINGULAR
+from hapticdesign.errors import UserError
+from hapticdesign.model.mechanism import Mechanism
+
+CHUNK = 4096
+"""Poses per kernel call when a regressor (E x n_params per pose) is returned."""
+
+
+class ClosedLoopModel(DynamicsModel):
+    """Regressor model of a closed-loop mechanism in its actuated coordinates (see module docstring)."""
+
+    exact_basis = False
+
+    def __init__(self, mechanism: Mechanism):
+        if mechanism.loops is None:
+            raise UserError("ClosedLoopModel needs a mechanism with loops; use DynamicsModel for a tree")
+        self.mechanism = mechanism
+        self.compiled = mechanism.compiled
+        self.solver = LoopSolver(mechanism)
+        self.n_dof = mechanism.n_actuated
+        self.n_params = 10 * len(mechanism.bodies)
+        self.pairs = pair_index(self.n_dof)
+        n, m = self.n_dof, len(self.pairs)
+        self.slice_h = slice(0, m)
+        self.slice_c = slice(m, m + n * m)
+        self.slice_g = slice(m + n * m, m + n * m + n)
+        self.n_entries = m + n * m + n
+
+    # -- kernel -------------------------------------------------------------------------------
+    def _kernel(self, q_full: np.ndarray, params: np.ndarray, regressor: bool) -> np.ndarray:
+        c, a = self.compiled, self.solver.arrays
+        out, ratios = actuated_kernel(
+            np.ascontiguousarray(q_full, dtype=float), c.node_parent, c.node_axis, c.node_coef, c.node_offset,
+            c.body_node, c.body_path, c.gravity, a.frame_a, a.frame_b, a.row_loop, a.row_comp,
+            a.actuated, a.passive, np.ascontiguousarray(params, dtype=float), regressor,
+        )
+        bad = np.flatnonzero(ratios <= SINGULAR_RATIO)
+        if bad.size:
+            pose = ", ".join(f"{v:.6g}" for v in q_full[bad[0], a.actuated])
+            raise UserError(f"at q = ({pose}): {MESSAGES[SINGULAR]}")
+        return out
+
+    def full_coordinates(self, q: np.ndarray) -> np.ndarray:
+        """Actuated poses (n_a,) or a motion (P, n_a) -> closed full coordinates (continued from home)."""
+        out = self.solver.solve(self._poses(q))
+        return out[0] if np.asarray(q).ndim == 1 else out
+
+    def entries_at(self, q_full: np.ndarray, pi: np.ndarray) -> np.ndarray:
+        """Entries at closed full poses (P, N): (P, E), or (S, P, E) for parameter sets (S, n_params)."""
+        pi = self._params(pi)
+        sets = np.atleast_2d(pi)
+        out = self._kernel(np.atleast_2d(q_full), sets, False)  # (P, S, E)
+        if self.constant is not None:
+            out += self.constant
+        return out[:, 0, :] if pi.ndim == 1 else np.moveaxis(out, 1, 0)
+
+    def entries(self, q: np.ndarray, pi: np.ndarray) -> np.ndarray:
+        """All entries (unique H, C, G) at actuated poses: (P, E) or (S, P, E) for parameter sets (S, n)."""
+        return self.entries_at(self.full_coordinates(q), pi)
+
+    def regressor_at(self, q_full: np.ndarray) -> np.ndarray:
+        """Every entry as a row of the standard parameters at closed full poses: (P, E, n_params)."""
+        q_full = np.atleast_2d(q_full)
+        empty = np.zeros((0, self.n_params))
+        return np.concatenate([self._kernel(q_full[i:i + CHUNK], empty, True)
+                               for i in range(0, len(q_full), CHUNK)] or [np.zeros((0, self.n_entries, self.n_params))])
+
+    def entry_regressor(self, q: np.ndarray) -> np.ndarray:
+        return self.regressor_at(self.full_coordinates(q))
+
+    def with_constant_inertia(self, h: np.ndarray) -> "ClosedLoopModel":
+        """This model with a constant (N_a x N_a) matrix added to H_a (reflected rotor inertia of the motors)."""
+        h = np.asarray(h, dtype=float)
+        if h.shape != (self.n_dof, self.n_dof) or not np.allclose(h, h.T) or not np.all(np.isfinite(h)):
+            raise UserError(f"a constant inertia must be a finite symmetric {self.n_dof} x {self.n_dof} matrix")
+        out = copy.copy(self)
+        constant = np.zeros(self.n_entries)
+        iu, ju = np.triu_indices(self.n_dof)
+        constant[self.slice_h] = h[iu, ju]
+        out.constant = constant + (0.0 if self.constant is None else self.constant)
+        return out
+
+    # -- what a closed loop has not -------------------------------------------------------------
+    @property
+    def cyclic(self) -> tuple[bool, ...]:
+        return (False,) * self.n_dof
+
+    def basis(self, q: np.ndarray) -> np.ndarray:
+        raise UserError("a closed-loop device has no exact trigonometric basis (its LN uses quadrature)")
+
+    def coefficients_for(self, pi: np.ndarray) -> np.ndarray:
+        return self.basis(None)

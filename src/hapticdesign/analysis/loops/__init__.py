@@ -1,0 +1,1 @@
+"""Closed kinematic loops: the passive-joint solver every analysis consumes (:mod:`.solver`)."""

@@ -1,0 +1,338 @@
+"""Compiled (numba) kernels of loop closure: residual, constraint Jacobian, bias, Newton, continuation.
+
+Closure ``l`` asks frames ``A = frame_a[l]`` and ``B = frame_b[l]`` (tree nodes, ``-1`` the base)
+to coincide in chosen base-frame components (:mod:`hapticdesign.model.loops`). With ``rows`` the
+selected components of all closures:
+
+- residual ``phi``: ``p_A - p_B`` (x, y, z) and the vector of the skew part of ``R_A R_B^T``
+  (rx, ry, rz: ``sin(angle) axis``, zero at closure);
+- constraint Jacobian ``Phi = select(J_A - J_B)`` (m x N) with ``J`` the world-frame geometric
+  Jacobian of a frame origin (seed 000 eq. 2.20-2.26: rotation axis ``u`` through the node,
+  ``v = u x (p - p_node)``); it is the exact derivative of ``phi`` at closure;
+- bias ``Phidot qd = select(a_A - a_B)`` with ``a`` the accelerations of the frames at ``qdd = 0``
+  (:func:`node_motion`, the time derivative of eq. 2.38-2.41).
+
+Passive values follow by Newton on ``phi(q_a, q_p) = 0`` from a start near the branch, and along a
+motion by continuation with a tangent predictor ``dq_p = S dq_a``, ``S = -Phi_p^-1 Phi_a``.
+The sign of ``det Phi_p`` labels the assembly branch: it can only change through a singular
+``Phi_p``, so a change between two steps means the motion left the branch.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from hapticdesign.analysis.dynamics.kernel import _node_poses
+
+OK, NO_CLOSURE, SINGULAR, BRANCH_CHANGE = 0, 1, 2, 3
+MAX_NEWTON_STEP = 0.25
+"""Largest Newton update of a passive coordinate per iteration (rad or m)."""
+
+
+@njit(cache=True)
+def frame_jacobian(node, parent, axis, coef, rot, pos, jac):
+    """World-frame Jacobian (6 x N, rows v then w) of the origin of tree node ``node`` (-1: base)."""
+    for i in range(6):
+        for k in range(jac.shape[1]):
+            jac[i, k] = 0.0
+    if node < 0:
+        return
+    n = node
+    while n >= 0:
+        a = axis[n] % 3
+        u0, u1, u2 = rot[n, 0, a], rot[n, 1, a], rot[n, 2, a]
+        if axis[n] < 3:
+            r0 = pos[node, 0] - pos[n, 0]
+            r1 = pos[node, 1] - pos[n, 1]
+            r2 = pos[node, 2] - pos[n, 2]
+            v0, v1, v2 = u1 * r2 - u2 * r1, u2 * r0 - u0 * r2, u0 * r1 - u1 * r0
+            for k in range(jac.shape[1]):
+                c = coef[n, k]
+                if c != 0.0:
+                    jac[0, k] += c * v0
+                    jac[1, k] += c * v1
+                    jac[2, k] += c * v2
+                    jac[3, k] += c * u0
+                    jac[4, k] += c * u1
+                    jac[5, k] += c * u2
+        else:
+            for k in range(jac.shape[1]):
+                c = coef[n, k]
+                if c != 0.0:
+                    jac[0, k] += c * u0
+                    jac[1, k] += c * u1
+                    jac[2, k] += c * u2
+        n = parent[n]
+
+
+@njit(cache=True)
+def _cross(a0, a1, a2, b0, b1, b2):
+    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+
+
+@njit(cache=True)
+def node_motion(qd, qdd, parent, axis, coef, rot, pos, w, v, al, ac):
+    """World angular velocity ``w``, origin velocity ``v``, angular and origin acceleration of every node.
+
+    Rotation node (axis ``u``, rate ``s``): ``w = w_p + s u``, ``al = al_p + sd u + w_p x s u``, same
+    origin. Translation node (offset ``d = value u``): ``v = v_p + w_p x d + s u`` and
+    ``ac = ac_p + al_p x d + w_p x (w_p x d) + 2 w_p x s u + sd u``.
+    """
+    for n in range(parent.shape[0]):
+        p = parent[n]
+        s = 0.0
+        sd = 0.0
+        for k in range(qd.shape[0]):
+            c = coef[n, k]
+            if c != 0.0:
+                s += c * qd[k]
+                sd += c * qdd[k]
+        a = axis[n] % 3
+        u0, u1, u2 = rot[n, 0, a], rot[n, 1, a], rot[n, 2, a]
+        if p >= 0:
+            w0, w1, w2 = w[p, 0], w[p, 1], w[p, 2]
+            l0, l1, l2 = al[p, 0], al[p, 1], al[p, 2]
+            vp0, vp1, vp2 = v[p, 0], v[p, 1], v[p, 2]
+            a0, a1, a2 = ac[p, 0], ac[p, 1], ac[p, 2]
+            d0, d1, d2 = pos[n, 0] - pos[p, 0], pos[n, 1] - pos[p, 1], pos[n, 2] - pos[p, 2]
+        else:
+            w0 = w1 = w2 = l0 = l1 = l2 = vp0 = vp1 = vp2 = a0 = a1 = a2 = 0.0
+            d0, d1, d2 = pos[n, 0], pos[n, 1], pos[n, 2]
+        if axis[n] < 3:
+            x0, x1, x2 = _cross(w0, w1, w2, s * u0, s * u1, s * u2)
+            w[n, 0], w[n, 1], w[n, 2] = w0 + s * u0, w1 + s * u1, w2 + s * u2
+            al[n, 0], al[n, 1], al[n, 2] = l0 + sd * u0 + x0, l1 + sd * u1 + x1, l2 + sd * u2 + x2
+            v[n, 0], v[n, 1], v[n, 2] = vp0, vp1, vp2
+            ac[n, 0], ac[n, 1], ac[n, 2] = a0, a1, a2
+        else:
+            wd0, wd1, wd2 = _cross(w0, w1, w2, d0, d1, d2)
+            ww0, ww1, ww2 = _cross(w0, w1, w2, wd0, wd1, wd2)
+            ld0, ld1, ld2 = _cross(l0, l1, l2, d0, d1, d2)
+            ws0, ws1, ws2 = _cross(w0, w1, w2, s * u0, s * u1, s * u2)
+            w[n, 0], w[n, 1], w[n, 2] = w0, w1, w2
+            al[n, 0], al[n, 1], al[n, 2] = l0, l1, l2
+            v[n, 0], v[n, 1], v[n, 2] = vp0 + wd0 + s * u0, vp1 + wd1 + s * u1, vp2 + wd2 + s * u2
+            ac[n, 0] = a0 + ld0 + ww0 + 2.0 * ws0 + sd * u0
+            ac[n, 1] = a1 + ld1 + ww1 + 2.0 * ws1 + sd * u1
+            ac[n, 2] = a2 + ld2 + ww2 + 2.0 * ws2 + sd * u2
+
+
+@njit(cache=True)
+def closure_residual(frame_a, frame_b, row_loop, row_comp, rot, pos, out):
+    """``phi`` (m,): origin differences and the skew-part vector of ``R_A R_B^T`` in the base frame."""
+    for i in range(row_loop.shape[0]):
+        na = frame_a[row_loop[i]]
+        nb = frame_b[row_loop[i]]
+        c = row_comp[i]
+        if c < 3:
+            pa = pos[na, c] if na >= 0 else 0.0
+            pb = pos[nb, c] if nb >= 0 else 0.0
+            out[i] = pa - pb
+        else:
+            ra = rot[na] if na >= 0 else np.eye(3)
+            rb = rot[nb] if nb >= 0 else np.eye(3)
+            m = ra @ rb.T
+            if c == 3:
+                out[i] = 0.5 * (m[2, 1] - m[1, 2])
+            elif c == 4:
+                out[i] = 0.5 * (m[0, 2] - m[2, 0])
+            else:
+                out[i] = 0.5 * (m[1, 0] - m[0, 1])
+
+
+@njit(cache=True)
+def closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, coef, rot, pos, phi):
+    """``Phi = select(J_A - J_B)`` (m x N) at the current node poses."""
+    n_dof = coef.shape[1]
+    ja = np.empty((6, n_dof))
+    jb = np.empty((6, n_dof))
+    last = -1
+    for i in range(row_loop.shape[0]):
+        loop = row_loop[i]
+        if loop != last:
+            frame_jacobian(frame_a[loop], parent, axis, coef, rot, pos, ja)
+            frame_jacobian(frame_b[loop], parent, axis, coef, rot, pos, jb)
+            last = loop
+        for k in range(n_dof):
+            phi[i, k] = ja[row_comp[i], k] - jb[row_comp[i], k]
+
+
+@njit(cache=True)
+def closure_bias(frame_a, frame_b, row_loop, row_comp, al, ac, out):
+    """``Phidot qd = select(a_A - a_B)`` from node accelerations computed at ``qdd = 0``."""
+    for i in range(row_loop.shape[0]):
+        na = frame_a[row_loop[i]]
+        nb = frame_b[row_loop[i]]
+        c = row_comp[i]
+        src_a = ac if c < 3 else al
+        k = c % 3
+        va = src_a[na, k] if na >= 0 else 0.0
+        vb = src_a[nb, k] if nb >= 0 else 0.0
+        out[i] = va - vb
+
+
+@njit(cache=True)
+def lu_solve(a, b):
+    """Solve ``a x = b`` (m x m, m x k) by Gaussian elimination with partial pivoting, in place on copies.
+
+    Returns ``x``, the pivot ratio ``min |u_ii| / max |u_ii|`` (0 when singular) and the sign of ``det a``.
+    """
+    m = a.shape[0]
+    u = a.copy()
+    x = b.copy()
+    sign = 1.0
+    big, small = 0.0, np.inf
+    for c in range(m):
+        best = c
+        for r in range(c + 1, m):
+            if abs(u[r, c]) > abs(u[best, c]):
+                best = r
+        if best != c:
+            sign = -sign
+            for k in range(m):
+                u[c, k], u[best, k] = u[best, k], u[c, k]
+            for k in range(x.shape[1]):
+                x[c, k], x[best, k] = x[best, k], x[c, k]
+        pivot = u[c, c]
+        big = max(big, abs(pivot))
+        small = min(small, abs(pivot))
+        if pivot == 0.0:
+            return x, 0.0, 0.0
+        if pivot < 0.0:
+            sign = -sign
+        for r in range(c + 1, m):
+            f = u[r, c] / pivot
+            if f != 0.0:
+                for k in range(c, m):
+                    u[r, k] -= f * u[c, k]
+                for k in range(x.shape[1]):
+                    x[r, k] -= f * x[c, k]
+    for c in range(m - 1, -1, -1):
+        for k in range(x.shape[1]):
+            t = x[c, k]
+            for j in range(c + 1, m):
+                t -= u[c, j] * x[j, k]
+            x[c, k] = t / u[c, c]
+    return x, small / big, sign
+
+
+@njit(cache=True)
+def velocity_map(phi, actuated, passive):
+    """``S = -Phi_p^-1 Phi_a`` (n_p x n_a), the pivot ratio and the sign of ``det Phi_p``."""
+    m = passive.shape[0]
+    pa = np.empty((m, actuated.shape[0]))
+    pp = np.empty((m, m))
+    for i in range(m):
+        for j in range(actuated.shape[0]):
+            pa[i, j] = -phi[i, actuated[j]]
+        for j in range(m):
+            pp[i, j] = phi[i, passive[j]]
+    return lu_solve(pp, pa)
+
+
+@njit(cache=True)
+def newton(q, actuated, passive, parent, axis, coef, offset, frame_a, frame_b, row_loop, row_comp,
+           tol, max_iter, singular_ratio, rot, pos):
+    """Newton on the passive entries of ``q`` (in place). Returns (status, det sign, pivot ratio)."""
+    m = passive.shape[0]
+    res = np.empty(m)
+    phi = np.empty((m, coef.shape[1]))
+    rhs = np.empty((m, 1))
+    pp = np.empty((m, m))
+    for it in range(max_iter + 1):
+        _node_poses(q, parent, axis, coef, offset, rot, pos)
+        closure_residual(frame_a, frame_b, row_loop, row_comp, rot, pos, res)
+        closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, coef, rot, pos, phi)
+        for i in range(m):
+            rhs[i, 0] = -res[i]
+            for j in range(m):
+                pp[i, j] = phi[i, passive[j]]
+        dx, ratio, sign = lu_solve(pp, rhs)
+        if not np.isfinite(ratio) or ratio <= singular_ratio:
+            return SINGULAR, sign, ratio
+        if np.max(np.abs(res)) <= tol:
+            return OK, sign, ratio
+        if it == max_iter:
+            break
+        # damped: at most MAX_NEWTON_STEP per iteration, so that a rough start reaches its nearest branch
+        big = 0.0
+        for j in range(m):
+            big = max(big, abs(dx[j, 0]))
+        scale = 1.0 if big <= MAX_NEWTON_STEP else MAX_NEWTON_STEP / big
+        for j in range(m):
+            q[passive[j]] += scale * dx[j, 0]
+    return NO_CLOSURE, 0.0, 0.0
+
+
+@njit(cache=True)
+def solve_path(qa_path, q_start, sign0, actuated, passive, parent, axis, coef, offset, frame_a, frame_b,
+               row_loop, row_comp, max_step, tol, max_iter, singular_ratio, min_fraction):
+    """Continue the closure from ``q_start`` (full, closed) through the actuated poses ``qa_path`` in order.
+
+    Each segment is split into steps of at most ``max_step`` (actuated infinity norm); a step whose
+    Newton fails, lands on the other sign of ``det Phi_p`` or corrects the tangent predictor by more
+    than half the step (a jump), is halved down to ``min_fraction`` of the segment. Returns full poses (P, N), per-pose status (OK until the first failure) and the
+    index of the first failed pose (-1 if none).
+    """
+    n_pose = qa_path.shape[0]
+    n_dof = q_start.shape[0]
+    m = passive.shape[0]
+    n_node = max(parent.shape[0], 1)
+    rot = np.zeros((n_node, 3, 3))
+    pos = np.zeros((n_node, 3))
+    phi = np.empty((m, n_dof))
+    out = np.empty((n_pose, n_dof))
+    status = np.zeros(n_pose, dtype=np.int64)
+    q = q_start.copy()
+    trial = q.copy()
+    predicted = np.empty(m)
+    for p in range(n_pose):
+        start = np.empty(actuated.shape[0])
+        for j in range(actuated.shape[0]):
+            start[j] = q[actuated[j]]
+        dist = 0.0
+        for j in range(actuated.shape[0]):
+            dist = max(dist, abs(qa_path[p, j] - start[j]))
+        done = 0.0
+        step = 1.0 if dist <= max_step else max_step / dist
+        code = OK
+        while done < 1.0:
+            f = min(1.0, done + step)
+            # tangent predictor at the current closed pose
+            _node_poses(q, parent, axis, coef, offset, rot, pos)
+            closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, coef, rot, pos, phi)
+            s, _, _ = velocity_map(phi, actuated, passive)
+            for k in range(n_dof):
+                trial[k] = q[k]
+            for j in range(actuated.shape[0]):
+                delta = start[j] + f * (qa_path[p, j] - start[j]) - q[actuated[j]]
+                trial[actuated[j]] += delta
+                for r in range(m):
+                    trial[passive[r]] += s[r, j] * delta
+            for r in range(m):
+                predicted[r] = trial[passive[r]]
+            code, sign, _ = newton(trial, actuated, passive, parent, axis, coef, offset, frame_a, frame_b,
+                                   row_loop, row_comp, tol, max_iter, singular_ratio, rot, pos)
+            if code == OK and sign != sign0:
+                code = BRANCH_CHANGE
+            if code == OK:
+                # the corrector of a tangent predictor is second order in the step: a large one
+                # means Newton jumped (to another branch or by whole turns); retry with a smaller step
+                for r in range(m):
+                    if abs(trial[passive[r]] - predicted[r]) > 0.5 * step * dist + 1e-9:
+                        code = NO_CLOSURE
+            if code == OK:
+                for k in range(n_dof):
+                    q[k] = trial[k]
+                done = f
+            else:
+                step *= 0.5
+                if step < min_fraction:
+                    break
+        if code != OK:
+            status[p] = code
+            return out, status, p
+        for k in range(n_dof):
+            out[p, k] = q[k]
+    return out, status, -1

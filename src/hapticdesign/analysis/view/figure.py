@@ -1,0 +1,57 @@
+"""The device as a static PNG for papers: links, frame origins, mass centres at one pose (matplotlib 3D)."""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+
+from hapticdesign.analysis.view.skeleton import frame_poses, links, mass_centres
+from hapticdesign.model.device import Device
+
+
+def render_png(device: Device, q: np.ndarray, dpi: int = 150) -> bytes:
+    """PNG bytes of the device at pose ``q`` with equal axis scales (orthographic, z up)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    poses = frame_poses(device, q)
+    origins = {name: pose[:3, 3] for name, pose in poses.items()}
+    fig = plt.figure(figsize=(6.0, 5.0), dpi=dpi)
+    ax = fig.add_subplot(projection="3d", proj_type="ortho")
+    for parent, child in links(device):
+        a, b = origins[parent], origins[child]
+        ax.plot(*zip(a, b), color="#34495e", linewidth=2.0)
+    points = np.array(list(origins.values()))
+    ax.scatter(*points.T, s=6, color="#7f8c8d", depthshade=False)
+    bodies = mass_centres(device, poses)
+    if bodies:
+        masses = np.array([m for _, m, _ in bodies])
+        centres = np.array([p for _, _, p in bodies])
+        ax.scatter(*centres.T, s=20 + 160 * masses / masses.max(), color="#c82828", alpha=0.55, depthshade=False,
+                   label="mass centres (area ~ mass)")
+        points = np.vstack([points, centres])
+    end = device.mechanism.end_effector
+    if end is not None:
+        ax.scatter(*origins[end], s=40, color="#e67e22", depthshade=False, label=f"end effector ({end})")
+    low, high = points.min(axis=0), points.max(axis=0)
+    half = 0.55 * max(float((high - low).max()), 1e-3)
+    middle = 0.5 * (low + high)
+    ax.set_xlim(middle[0] - half, middle[0] + half)
+    ax.set_ylim(middle[1] - half, middle[1] + half)
+    ax.set_zlim(middle[2] - half, middle[2] + half)
+    ax.set_box_aspect((1, 1, 1))
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_zlabel("z [m]")
+    ax.tick_params(labelsize=7)
+    pose = ", ".join(f"{v:.3g}" for v in q)
+    ax.set_title(f"{device.name[:60]}\nq = ({pose})", fontsize=9)
+    if bodies or end is not None:
+        ax.legend(loc="upper left", fontsize=7)
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png")
+    plt.close(fig)
+    return buffer.getvalue()

@@ -1,0 +1,238 @@
+"""The stable impedance range without integrating an ODE: the sampled loop linearized about the pose.
+
+With the other joints held (type 1) the wall joint of any device is a 1-DOF system about the start
+pose ``q0``: inertia ``J = H_ww(q0)`` (plus a hand's mass ``m_h J_v^T J_v``), damping ``b_w`` (plus
+the hand's), a physical spring from a hand's stiffness, and a constant torque, the gravity the
+compensator leaves (``G_w - s_G G_model,w``). Coriolis terms vanish at rest. The compensator feeds
+``c J a`` forward with ``c = H_model,ww / J`` (its model has no hand; a modelling error lowers it).
+For joint 1 of the Phantom (vertical axis, cyclic) this is exact for every design; for a driven
+(type 2) wall joint it is exact when the wall joint's row of H, C, G does not depend on the
+driven joints (LN = 0 designs) and a frozen-pose approximation otherwise.
+
+The seed's criteria are then evaluated on the exact linear response: the closed loop of
+:mod:`.zwidth` (plant discretized exactly, digital side as a discrete state-space system) gives
+the state at every sample, and the exact sub-sample transition of the plant under the held torque
+gives the excursion at every plant step (as the simulation checks it). No ODE is integrated.
+Quantized encoders and Coulomb friction are not linear: the analytic method refuses them.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from functools import lru_cache
+
+import numpy as np
+from scipy.linalg import expm
+from threadpoolctl import ThreadpoolController
+
+from hapticdesign.analysis.kinematics import jacobian
+from hapticdesign.errors import UserError
+from hapticdesign.model.device import Device
+from hapticdesign.simulation.config import LoopConfig, compensator_device, plant_friction
+from hapticdesign.simulation.criteria import Criteria, Verdict, check_settle_window, type_paths
+from hapticdesign.simulation.zwidth import DisplayLoop, controller, plant
+
+
+@lru_cache(maxsize=1)
+def _threads() -> ThreadpoolController:
+    """The process's thread pools, found once (finding them reads the loaded libraries)."""
+    return ThreadpoolController()
+
+
+def one_blas_thread():
+    """A context with BLAS on one thread: the matrices here are of order 6 to 20, and on a shared
+    machine a BLAS thread pool costs 20 x the arithmetic (measured)."""
+    return _threads().limit(limits=1, user_api="blas")
+
+
+@dataclass(frozen=True)
+class WallJoint:
+    """The wall joint linearized at the start pose: the 1-DOF loop and the constant torque on it."""
+
+    loop: DisplayLoop
+    torque: float
+    exact: bool
+
+
+def linearize(device: Device, sim_type: int, wall_joint: int, config: LoopConfig) -> WallJoint:
+    """The 1-DOF sampled loop of the wall joint at the start pose (see the module docstring)."""
+    if config.sensors.counts_per_revolution is not None:
+        raise UserError("the analytic method has no encoder quantization (not linear): use the simulation")
+    if np.any(plant_friction(device, config) > 0):
+        raise UserError("the analytic method has no Coulomb friction (not linear): use the simulation")
+    paths = type_paths(sim_type, device.n_dof, wall_joint)
+    q0 = np.zeros(device.n_dof)
+    for j, path in paths.items():
+        q0[j] = float(path.sample(np.zeros(1))[0][0])
+    w = wall_joint
+    damping = np.asarray(config.damping if config.damping is not None else device.damping, dtype=float)
+    h, g = device.H(q0), device.G(q0)
+    model = compensator_device(device, config.compensator)
+    j_device = float(h[w, w])
+    j, b, spring = j_device, float(damping[w]), 0.0
+    if config.hand is not None:
+        jv = jacobian(device.mechanism, q0)[:3, w]
+        reach = float(jv @ jv)
+        j += config.hand.mass * reach
+        b += config.hand.damping * reach
+        spring = config.hand.stiffness * reach
+    comp = config.compensator
+    fraction = float(model.H(q0)[w, w]) / j_device if comp.inertial else 0.0
+    torque = -(float(g[w]) - comp.gravity * float(model.G(q0)[w]))
+    loop = DisplayLoop(j, b, config.sensors.period, config.sensors.delay_samples, "sampled", fraction, spring)
+    exact = sim_type == 1 or _decoupled(device, w, paths)
+    return WallJoint(loop, torque, exact)
+
+
+def _decoupled(device: Device, w: int, paths: dict) -> bool:
+    """True when the wall joint's row of H, C, G does not change along the driven motion."""
+    t = np.linspace(0.0, 2.0, 9)
+    qs = np.zeros((len(t), device.n_dof))
+    for j, path in paths.items():
+        qs[:, j] = path.sample(t)[0]
+    rows = [np.concatenate([device.H(q)[w], device.C(q)[w], [device.G(q)[w]]]) for q in qs]
+    scale = max(float(np.abs(rows[0]).max()), 1e-12)
+    return all(np.abs(r - rows[0]).max() <= 1e-9 * scale for r in rows)
+
+
+def _sub_steps(loop: DisplayLoop, step: float, count: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Exact transitions of ``(q, qd)`` over ``0, h, ..., (count - 1) h`` under a held torque:
+    ``(Phi_j, Gamma_j)`` from one matrix exponential, ``Phi_(j+1) = Phi_h Phi_j``,
+    ``Gamma_(j+1) = Phi_h Gamma_j + Gamma_h``."""
+    a = np.zeros((3, 3))
+    a[0, 1] = 1.0
+    a[1, 0] = -loop.plant_stiffness / loop.inertia
+    a[1, 1] = -loop.damping / loop.inertia
+    a[1, 2] = 1.0 / loop.inertia
+    e = expm(a * step)
+    phi_h, gamma_h = e[:2, :2], e[:2, 2]
+    steps = [(np.eye(2), np.zeros(2))]
+    for _ in range(count - 1):
+        phi, gamma = steps[-1]
+        steps.append((phi_h @ phi, phi_h @ gamma + gamma_h))
+    return steps
+
+
+def _powers(m: np.ndarray, s0: np.ndarray, samples: int) -> np.ndarray:
+    """``[s0, M s0, ..., M^samples s0]`` through the eigen-decomposition of ``M`` (one vectorized power
+    per eigenvalue), or sample by sample when ``M`` is close to defective."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        lam, vec = np.linalg.eig(m)
+        if np.linalg.cond(vec) < 1e8:
+            coef = np.linalg.solve(vec, s0.astype(complex))
+            powers = np.empty((samples + 1, len(lam)), dtype=complex)
+            powers[0] = 1.0
+            powers[1:] = lam
+            np.cumprod(powers, axis=0, out=powers)
+            return ((powers * coef[None, :]) @ vec.T).real
+        states = np.empty((samples + 1, len(s0)))
+        states[0] = s0
+        for k in range(samples):
+            states[k + 1] = m @ states[k]
+        return states
+
+
+@dataclass
+class AnalyticProblem:
+    """The analytic counterpart of :class:`~hapticdesign.simulation.impedance.ImpedanceProblem`:
+    the same ``verdict(K)`` and ``estimate()``, so the searches (fast, linear, grid) use it as is."""
+
+    device: Device
+    sim_type: int = 1
+    wall_joint: int = 0
+    equilibrium: float = 0.01
+    criteria: Criteria = field(default_factory=Criteria)
+    config: LoopConfig = field(default_factory=LoopConfig)
+
+    def __post_init__(self) -> None:
+        check_settle_window(self.criteria, self.config.duration)
+        self.wall = linearize(self.device, self.sim_type, self.wall_joint, self.config)
+        self.sub = self.config.steps_per_sample()
+        self.samples = int(round(self.config.duration / self.config.sensors.period))
+        loop = self.wall.loop
+        with one_blas_thread():
+            self._plant = plant(loop)
+            self._steps = _sub_steps(loop, self.config.step, self.sub)
+
+    @property
+    def exact(self) -> bool:
+        return self.wall.exact
+
+    def estimate(self) -> float:
+        loop = self.wall.loop
+        if loop.fraction > 0:
+            return loop.damping ** 2 / loop.inertia
+        return 2.0 * loop.damping / loop.period
+
+    def _augmented(self, stiffness: float) -> tuple[np.ndarray, np.ndarray, int]:
+        """One-sample map of ``s = [q - q_eq, qd, controller state, 1]`` and the row giving ``u``."""
+        loop, d = self.wall.loop, self.wall.torque
+        ctrl = controller(loop, stiffness, self.config.wall.damping)
+        phi, gamma = np.asarray(self._plant.A), np.asarray(self._plant.B)[:, 0]
+        ac, bc, cc, dc = (np.asarray(m) for m in (ctrl.A, ctrl.B, ctrl.C, ctrl.D))
+        nc = ac.shape[0]
+        n = loop.delay
+        u_line = (n + 1) + n
+        # the spring acts on q - q_eq; the rest of the hand's spring and the constant torque act on the plant
+        const = d - loop.plant_stiffness * self.equilibrium
+        comp = loop.fraction * const
+        size = 2 + nc + 1
+        m = np.zeros((size, size))
+        u_row = np.concatenate([dc[0], cc[0], [comp]])
+        m[:2] = np.outer(gamma, u_row)
+        m[:2, :2] += phi
+        m[:2, -1] += gamma * const
+        m[2:2 + nc, :2] = bc
+        m[2:2 + nc, 2:2 + nc] = ac
+        m[2 + u_line, -1] += comp
+        m[-1, -1] = 1.0
+        return m, u_row, u_line
+
+    def _initial(self, u_line: int) -> np.ndarray:
+        """The kernel's start: q = 0, qd = 0, the delay line holding the first sample, no acceleration."""
+        loop = self.wall.loop
+        n = loop.delay
+        nc = (n + 1) + n + (n + 1)
+        s = np.zeros(2 + nc + 1)
+        e0 = -self.equilibrium
+        s[0] = e0
+        s[2:2 + n + 1] = e0
+        const = self.wall.torque - loop.plant_stiffness * self.equilibrium
+        s[2 + u_line:2 + nc] = loop.plant_stiffness * e0 - const  # the compensator sees a = 0 until samples arrive
+        s[-1] = 1.0
+        return s
+
+    def response(self, stiffness: float) -> np.ndarray:
+        """``q - q0`` at every plant step (rows: samples, columns: plant steps within the period)."""
+        m, u_row, u_line = self._augmented(stiffness)
+        states = _powers(m, self._initial(u_line), self.samples)
+        u = states @ u_row
+        const = self.wall.torque - self.wall.loop.plant_stiffness * self.equilibrium
+        cols = [phi[0, 0] * states[:, 0] + phi[0, 1] * states[:, 1] + gamma[0] * (u + const)
+                for phi, gamma in self._steps]
+        return np.stack(cols, axis=1) + self.equilibrium
+
+    def verdict(self, stiffness: float) -> Verdict:
+        """The seed's criteria on the exact linear response (overshoot checked at every plant step)."""
+        with one_blas_thread():
+            q = self.response(stiffness)
+        flat = q.reshape(-1)[: self.samples * self.sub + 1]
+        finite = np.isfinite(flat)
+        excursion = np.abs(flat)
+        limit = min(self.criteria.overshoot_limit, self.criteria.safety_limit)
+        crossing = np.nonzero(~finite | (excursion >= limit))[0]
+        if crossing.size:
+            i = int(crossing[0])
+            peak = float(excursion[i]) if finite[i] else math.inf
+            cause = "diverged" if not finite[i] else (
+                "overshoot" if excursion[i] >= self.criteria.overshoot_limit else "safety switch")
+            return Verdict(stiffness, False, cause, peak, math.nan, i * self.config.step)
+        peak = float(excursion.max())
+        samples = q[:, 0]
+        t = np.arange(len(samples)) * self.config.sensors.period
+        tail = samples[t >= t[-1] - self.criteria.settle_window]
+        final = float(np.max(np.abs(tail - self.equilibrium)))
+        if final > self.criteria.settle_tolerance:
+            return Verdict(stiffness, False, "not settled", peak, final)
+        return Verdict(stiffness, True, "stable", peak, final)

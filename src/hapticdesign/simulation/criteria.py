@@ -1,0 +1,65 @@
+"""The seed's stability criteria and the motions of the other joints (seed 000 §4.1.2-4.1.3, Table 4.3).
+
+Shared by the simulated search (:mod:`.impedance`) and the analytic one (:mod:`.analytic`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from hapticdesign.errors import UserError
+from hapticdesign.simulation.paths import Held, Path, Sine
+
+
+@dataclass(frozen=True)
+class Criteria:
+    """Stability criteria of the seed's method (all configurable)."""
+
+    overshoot_limit: float = 0.012
+    settle_tolerance: float = 0.002
+    settle_window: float = 0.5
+    safety_limit: float = 0.06
+
+    def __post_init__(self) -> None:
+        for name in ("overshoot_limit", "settle_tolerance", "settle_window", "safety_limit"):
+            value = getattr(self, name)
+            if not (value > 0 and math.isfinite(value)):
+                raise UserError(f"{name.replace('_', ' ')} must be positive, got {value}")
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """Outcome of one gain: stable, or the criterion that failed first.
+
+    ``peak`` is the largest excursion from the start over every plant step; ``stopped_at`` is the
+    time a run ended early (excursion limit reached or diverged), ``None`` for a full run.
+    """
+
+    stiffness: float
+    stable: bool
+    criterion: str
+    peak: float
+    final_error: float
+    stopped_at: float | None = None
+
+    def as_dict(self) -> dict:
+        return {"k": float(self.stiffness), "stable": self.stable, "criterion": self.criterion,
+                "peak": self.peak, "final_error": self.final_error, "stopped_at": self.stopped_at}
+
+
+def type_paths(sim_type: int, n_dof: int, wall_joint: int = 0) -> dict[int, Path]:
+    """Motions of the other joints: type 1 held at 0, type 2 driven at 0.52 sin(3 pi t) (Table 4.3)."""
+    if sim_type not in (1, 2):
+        raise UserError(f"simulation type must be 1 or 2, got {sim_type}")
+    path: Path = Held(0.0) if sim_type == 1 else Sine(0.52, 3 * np.pi)
+    return {j: path for j in range(n_dof) if j != wall_joint}
+
+
+def check_settle_window(criteria: Criteria, duration: float) -> None:
+    """The settling test needs a window within the run, or every stiffness is "not settled"."""
+    if criteria.settle_window > duration:
+        raise UserError(f"the settle window ({criteria.settle_window:g} s) must not be longer than the simulated "
+                        f"time ({duration:g} s): every stiffness would count as not settled")

@@ -1,0 +1,271 @@
+"""Hostile and careless input (issue 11): one ``error:`` line on stderr, exit status 2, nothing written.
+
+A catalogue by class: work whose size the user sets (refused above the limits of
+:mod:`hapticdesign.workload` unless ``--force``), nonsense settings, inputs that would print NaN or
+Infinity as a result, wrong types through the API, and campaign robustness (hostile design names,
+corrupt or stray case files, overflowing designs, a second campaign in the same folder).
+"""
+
+from __future__ import annotations
+
+import csv
+import fcntl
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+import hapticdesign as hd
+from hapticdesign.errors import UserError
+from hapticdesign.interface.cli import app
+
+sys.path.insert(0, str(Path(__file__).parents[1] / "simulation"))
+from sim_designs import write_designs  # noqa: E402
+
+runner = CliRunner()
+BOUNDARY = ["stability-boundary", "--inertia", "0.04", "--damping", "0.5", "--period", "0.001"]
+
+
+def one_line_error(args: list[str], fragment: str) -> str:
+    """Run the CLI; assert exit 2 and exactly one ``error:`` line containing ``fragment``."""
+    result = runner.invoke(app, args)
+    assert result.exit_code == 2, (args, result.output)
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), (args, result.stderr)
+    assert fragment in lines[0], (fragment, lines[0])
+    assert result.stdout == ""
+    return lines[0]
+
+
+# -- work whose size the user sets ----------------------------------------------------------------
+WORKLOAD = [
+    (["designs", "--count", "100000000"], "above the limit of 100,000 designs; add --force"),
+    (["designs", "--count", "1000000", "--method", "de"], "above the limit of 1,000 designs"),
+    (["linearize", "--find", "100000000"], "above the limit of 50,000 designs"),
+    (["impedance-range", "--duration", "1e9"], "plant steps, above the limit"),
+    (["impedance-range", "--step", "1e-12"], "plant steps, above the limit"),
+    (["impedance-range", "--method", "linear", "--k-limit", "1000000000"], "plant steps, above the limit"),
+    (["impedance-range", "--duration", "1e308", "--step", "1e-308"], "not a finite amount of work"),
+    (["transparency", "--sweep", "1e9"], "plant steps, above the limit"),
+    (["transparency", "--sweep", "1000"], "of memory, above the limit of 2 GiB"),
+    ([*BOUNDARY, "--samples", "10000000000"], "plant steps, above the limit"),
+    ([*BOUNDARY, "--substeps", "100000000"], "plant steps, above the limit"),
+    ([*BOUNDARY, "--delay", "300", "--samples", "4000"], "rows, above the limit of 600 rows"),
+    (["ln", "--region", "q2=-1e7:1e7"], "quadrature points, above the limit"),
+    (["ln", "--region", "q2=-1e308:1e308"], "too wide to average over"),
+]
+
+
+@pytest.mark.parametrize("args, fragment", WORKLOAD, ids=[" ".join(a) for a, _ in WORKLOAD])
+def test_large_work_is_refused_before_it_starts(args, fragment, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.delenv("HAPTICDESIGN_FORCE", raising=False)
+    one_line_error(args, fragment)
+    assert list(tmp_path.iterdir()) == []  # nothing written
+
+
+def test_force_lifts_a_soft_limit_but_not_a_hard_one(monkeypatch):
+    from hapticdesign import workload
+
+    monkeypatch.setattr(workload, "QUADRATURE_POINTS_LIMIT", 10)
+    from hapticdesign.analysis.linearity import region
+
+    monkeypatch.setattr(region, "QUADRATURE_POINTS_LIMIT", 10)
+    one_line_error(["ln", "--region", "q2=-1:1", "--json"], "add --force")
+    ok = runner.invoke(app, ["ln", "--region", "q2=-1:1", "--json", "--force"])
+    assert ok.exit_code == 0, ok.output
+    assert json.loads(ok.stdout)["ln"] >= 0
+    one_line_error(["ln", "--region", "q2=-1e308:1e308", "--force"], "too wide")
+
+
+def _chain_urdf(path: Path, joints: int) -> Path:
+    """A serial chain of general revolute joints (no joint leaves the dynamics)."""
+    parts = ['<?xml version="1.0"?>', f'<robot name="chain{joints}">', '<link name="base"/>']
+    parent = "base"
+    for i in range(1, joints + 1):
+        axis = ["1 0 0", "0 1 0", "0 0 1"][i % 3]
+        parts.append(f'<joint name="j{i}" type="revolute"><parent link="{parent}"/><child link="l{i}"/>'
+                     f'<origin xyz="0.1 0.02 0.05" rpy="0.3 0.2 0.1"/><axis xyz="{axis}"/>'
+                     '<limit lower="-3" upper="3" effort="1" velocity="1"/></joint>')
+        parts.append(f'<link name="l{i}"><inertial><origin xyz="0.05 0.01 0"/><mass value="0.5"/>'
+                     '<inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial></link>')
+        parent = f"l{i}"
+    path.write_text("\n".join([*parts, "</robot>"]))
+    return path
+
+
+@pytest.mark.parametrize("joints, fragment", [(6, "above the limit of 2 GiB"), (7, "GiB of memory")])
+def test_device_whose_exact_basis_explodes_is_refused_before_building(tmp_path, monkeypatch, joints, fragment):
+    from hapticdesign import workload
+
+    monkeypatch.delenv("HAPTICDESIGN_FORCE", raising=False)
+    monkeypatch.setattr(workload, "physical_memory", lambda: 16 * 2**30)
+    urdf = _chain_urdf(tmp_path / "chain.urdf", joints)
+    line = one_line_error(["dynamics", "--device", str(urdf), "--q", ",".join(["0"] * joints)], fragment)
+    assert f"{joints}-joint device" in line
+
+
+def test_campaign_workers_are_capped_at_the_cores(tmp_path, monkeypatch):
+    monkeypatch.setattr("os.cpu_count", lambda: 2)
+    designs = write_designs(tmp_path / "d.csv", rows=[(0.0, {})])
+    one_line_error(["campaign", "--designs", str(designs), "--out", str(tmp_path / "o"), "--workers", "64"],
+                   "more than the 2 cores")
+    assert not (tmp_path / "o").exists()
+
+
+# -- nonsense settings ----------------------------------------------------------------------------
+NONSENSE = [
+    (["impedance-range", "--settle-window", "10"], "--settle-window (10 s) must be positive and not longer than --duration"),
+    (["impedance-range", "--wall-damping", "-1"], "--wall-damping must be a finite number >= 0"),
+    (["impedance-range", "--error-percent", "100"], "--error-percent must be a finite number between -100 and 100"),
+    (["impedance-range", "--error-percent", "-100"], "between -100 and 100"),
+    (["impedance-range", "--delay", "1000000000"], "must be shorter than the simulated time"),
+    (["transparency", "--f0", "5", "--f1", "2"], "0 <= f0 < f1"),
+    (["transparency", "--f1", "600"], "beyond the Nyquist frequency 500 Hz"),
+    (["transparency", "--f1", "inf"], "must be finite"),
+    (["transparency", "--amplitude", "0"], "--amplitude must be a finite, non-zero angle"),
+    (["transparency", "--amplitude", "nan"], "--amplitude must be a finite, non-zero angle"),
+    (["transparency", "--wall-damping", "-0.5"], "--wall-damping must be a finite number >= 0"),
+    ([*BOUNDARY, "--wall-damping", "-1"], "--wall-damping must be a finite number >= 0"),
+    ([*BOUNDARY, "--compensate-inertia", "--error-percent", "150"], "between -100 and 100"),
+    ([*BOUNDARY, "--delay", "2000", "--samples", "4000"], "shorter than a quarter of --samples"),
+    (["designs", "--seed", "-1"], "--seed"),
+    (["linearize", "--seed", "-1", "--find", "2"], "--seed"),
+    (["designs", "--count", "0"], "at least 1"),
+    (["study", "rcube", "--seed", "-1"], "--seed"),
+    (["study", "phantom", "--seed", "-1"], "--seed"),
+]
+
+
+@pytest.mark.parametrize("args, fragment", NONSENSE, ids=[" ".join(a) for a, _ in NONSENSE])
+def test_nonsense_settings_are_refused(args, fragment, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    one_line_error(args, fragment)
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("content, fragment", [("g: -9.81\n", "gravity must be >= 0"),
+                                               ("m2: -1\n", "negative mass"),
+                                               ("m2: .inf\n", "finite")])
+def test_nonsense_parameters_are_refused(tmp_path, content, fragment):
+    params = tmp_path / "p.yaml"
+    params.write_text(content)
+    one_line_error(["ln", "--params", str(params)], fragment)
+
+
+# -- no NaN or Infinity as a result ---------------------------------------------------------------
+@pytest.mark.parametrize("args, fragment", [
+    (["stability-boundary", "--inertia", "1e308", "--damping", "0.5", "--period", "0.001"], "--inertia 1e+308 is outside"),
+    (["stability-boundary", "--inertia", "1e12", "--damping", "1e-12", "--period", "1e-12"], "too small to resolve"),
+    (["stability-boundary", "--inertia", "1e-6", "--damping", "5", "--period", "0.001"], "raise --substeps"),
+    (["dynamics", "--q", "0,0,0", "--qd", "1e308,0,0", "--json"], "not finite"),
+])
+def test_inputs_that_overflow_are_refused(args, fragment):
+    one_line_error(args, fragment)
+
+
+def test_an_unbounded_boundary_is_null_with_a_note(monkeypatch):
+    from hapticdesign.simulation import boundary
+
+    monkeypatch.setattr(boundary, "simulated_boundary", lambda *a, **k: float("inf"))
+    result = runner.invoke(app, [*BOUNDARY, "--samples", "400", "--json"])
+    assert result.exit_code == 0, result.output
+    out = json.loads(result.stdout)  # strict JSON: no Infinity
+    assert out["k_max_simulated"] is None and out["relative_difference"] is None
+    assert "unbounded" in out["note"]
+
+
+@pytest.mark.parametrize("call, fragment", [
+    (lambda d: d.with_params({"m2": -1}).H(np.zeros(3)), "negative mass"),
+    (lambda d: d.with_params({"g": -1.0}), "gravity must be >= 0"),
+    (lambda d: d.with_params({"m2": float("nan")}), "finite"),
+    (lambda d: d.with_params([("m2", 1.0)]), "mapping"),
+    (lambda d: d.H(None), "got None"),
+    (lambda d: d.H(np.zeros((2, 2, 3))), "shape (2, 2, 3)"),
+    (lambda d: d.H("abc"), "must be numbers"),
+    (lambda d: d.C_cvt(np.zeros(3), None), "joint rates"),
+    (lambda d: hd.impedance_range("phantom-3dof", 1), "expected a Device"),
+    (lambda d: hd.impedance_range(d, 3), "simulation type must be 1 or 2"),
+    (lambda d: hd.impedance_range(d, 1, k_limit=None), "stiffness limit must be a number"),
+    (lambda d: hd.transparency(d, 1, "stiff"), "wall stiffness must be a number"),
+    (lambda d: hd.transparency(d, 1, config="fast"), "config must be a LoopConfig"),
+])
+def test_api_refuses_wrong_types_and_values_with_a_user_error(phantom3, call, fragment):
+    with pytest.raises(UserError) as caught:
+        call(phantom3)
+    assert fragment in str(caught.value)
+
+
+def test_standard_parameters_refuse_negative_masses_set_behind_with_params(phantom3):
+    from hapticdesign.model.device import Device
+
+    d = phantom3
+    broken = Device(d.name, d.description, d.kinematic, d.builder, {**d.params, "m2": -1.0}, d.damping)
+    with pytest.raises(UserError, match="negative mass"):
+        broken.H(np.zeros(3))
+
+
+# -- campaign robustness --------------------------------------------------------------------------
+def _rename(path: Path, name: str) -> Path:
+    rows = list(csv.DictReader(path.open()))
+    rows[0]["design"] = name
+    with path.open("w", newline="") as handle:
+        writer = csv.DictWriter(handle, list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    return path
+
+
+@pytest.mark.parametrize("name", ["../../escaped", "/tmp/escaped-abs", ".hidden", "a/b", "x" * 101, "a b"])
+def test_campaign_refuses_design_names_that_escape_or_are_not_file_names(tmp_path, name):
+    designs = _rename(write_designs(tmp_path / "d.csv", rows=[(0.0, {})]), name)
+    out = tmp_path / "deep" / "er" / "o"
+    one_line_error(["campaign", "--designs", str(designs), "--out", str(out)], "cannot name a file")
+    assert not (tmp_path / "deep").exists() and not Path("/tmp/escaped-abs__impedance__type1.json").exists()
+
+
+def test_campaign_refuses_a_design_whose_dynamics_overflow_up_front(tmp_path):
+    designs = write_designs(tmp_path / "d.csv", rows=[(0.0, {"m2": 1e308})])
+    one_line_error(["campaign", "--designs", str(designs), "--out", str(tmp_path / "o")], "overflow")
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("address", ["not an address", "tcp://", "http://x:1/y"])
+def test_campaign_scheduler_that_is_not_an_address_is_one_line(tmp_path, address):
+    designs = write_designs(tmp_path / "d.csv", rows=[(0.0, {})])
+    one_line_error(["campaign", "--designs", str(designs), "--out", str(tmp_path / "o"), "--scheduler", address],
+                   "is not a Dask scheduler address")
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_second_campaign_in_the_same_folder_is_refused(tmp_path):
+    designs = write_designs(tmp_path / "d.csv", rows=[(0.0, {})])
+    out = tmp_path / "o"
+    out.mkdir()
+    with (out / "campaign.lock").open("a") as held:
+        fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        one_line_error(["campaign", "--designs", str(designs), "--out", str(out)], "another campaign is running")
+    assert not (out / "cases").exists()
+
+
+def test_campaign_recomputes_empty_corrupt_and_stray_case_files_and_is_quiet(tmp_path):
+    designs = write_designs(tmp_path / "d.csv", rows=[(0.0, {})])
+    out = tmp_path / "o"
+    args = ["campaign", "--designs", str(designs), "--out", str(out), "--workers", "1", "--k-limit", "20",
+            "--duration", "1", "--sweep", "2", "--f1", "5", "--quiet"]
+    first = runner.invoke(app, args)
+    assert first.exit_code == 0, first.output
+    assert first.stderr == ""  # no Dask logs, no heartbeat tracebacks after the run
+    cases = out / "cases"
+    (cases / "x0__impedance__type1.json").write_text("")
+    (cases / "x0__impedance__type2.json").write_text('{"design": "x0", "ty')
+    record = json.loads((cases / "x0__transparency__type1.json").read_text())
+    (cases / "x0__transparency__type1.json").write_text(json.dumps({**record, "design": "stray"}))
+    second = runner.invoke(app, [*args[:-1], "--json"])
+    assert second.exit_code == 0, second.output
+    counts = json.loads(second.stdout)
+    assert (counts["run"], counts["skipped"]) == (3, 1)
+    assert json.loads((cases / "x0__transparency__type1.json").read_text())["design"] == "x0"
