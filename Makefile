@@ -11,14 +11,16 @@ SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 $(STAMP): pyproject.toml
 	test -d $(VENV) || $(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install -q --upgrade pip
-	$(BIN)/pip install -q -e '.[test]'
+	$(BIN)/pip install -q -e '.[test]' > $(VENV)/pip.log 2>&1 || (cat $(VENV)/pip.log && false)
 	touch $(STAMP)
 
-# Headless Chromium for the report test (Debian packages chromium and chromium-driver).
-APT_INSTALL = $(SUDO) apt-get update -qq && $(SUDO) env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium chromium-driver
+# Headless Chromium for the report test (Debian packages chromium and chromium-driver); apt's
+# output goes to .venv/apt.log, one line is printed.
+APT_INSTALL = ($(SUDO) apt-get update -qq && $(SUDO) env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium chromium-driver) >> $(VENV)/apt.log 2>&1
 browser:
 	@command -v chromium >/dev/null && command -v chromedriver >/dev/null || \
-	  ($(APT_INSTALL)) || (sleep 10 && $(APT_INSTALL))
+	  (echo "installing Debian's chromium and chromium-driver for the browser tests (log: $(VENV)/apt.log)" && \
+	   ($(APT_INSTALL) || (sleep 10 && $(APT_INSTALL)) || (echo "apt failed; see $(VENV)/apt.log" && false)))
 
 demo: $(STAMP)
 	$(BIN)/hapticdesign demo

@@ -6,6 +6,7 @@ import time
 
 import numpy as np
 
+from hapticdesign.analysis.dynamics.device import dynamics_of
 from hapticdesign.analysis.dynamics.model import DynamicsModel
 from hapticdesign.analysis.linearity.bounds import practical_bounds
 from hapticdesign.analysis.linearity.closed_form import closed_form
@@ -41,7 +42,7 @@ def main() -> None:
         print(f"{name}: closed-form LN from Q {build:.2f} s ({len(closed.terms())} terms); "
               f"LaTeX + Python export {time.perf_counter() - start:.2f} s")
     device = preset("phantom-3dof")
-    form = linearity_form(device.model)
+    form = linearity_form(dynamics_of(device))
     start = time.perf_counter()
     result = design_set(device, form, linear_conditions(device, form), practical_bounds(device), count=100, seed=1)
     print(f"phantom-3dof: 600-design set (6 levels x 100, fast method) {time.perf_counter() - start:.1f} s, "

@@ -97,7 +97,7 @@ def _campaign() -> None:
 
 
 def _full_campaign(realizability: str, out: Path | None, workers: int) -> None:
-    from hapticdesign.analysis.linearity.service import write_design_set
+    from hapticdesign.interface.commands.linearity_adapter import write_design_set
 
     with tempfile.TemporaryDirectory() as tmp:
         folder = out or Path(tmp) / "campaign"

@@ -16,6 +16,13 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
+from hapticdesign.analysis.dynamics.device import (
+    coriolis_centrifugal,
+    dynamics_of,
+    forward_dynamics,
+    gravity,
+    mass_matrix,
+)
 from hapticdesign.devices.device_file import device_from_mapping, load_device_file
 from hapticdesign.devices.registry import preset
 from hapticdesign.devices.urdf import device_from_urdf
@@ -83,13 +90,13 @@ def test_forward_dynamics_divides_by_links_plus_reflected_inertia(pendulum_file)
     device = load_device_file(pendulum_file)
     q, tau = np.array([0.4]), np.array([0.01])
     expected = (tau[0] - pendulum_g(0.4)) / pendulum_h()
-    assert device.forward_dynamics(q, np.zeros(1), tau)[0] == pytest.approx(expected, rel=1e-12)
+    assert forward_dynamics(device, q, np.zeros(1), tau)[0] == pytest.approx(expected, rel=1e-12)
 
 
 def test_simulation_tables_carry_the_reflected_inertia(pendulum_file):
     """The rendering simulation evaluates ``basis(q) @ coefficients_for(pi)`` (simulation/tables.py)."""
     device = load_device_file(pendulum_file)
-    model = device.model
+    model = dynamics_of(device)
     entries = model.basis(np.array([[0.25]])) @ model.coefficients_for(device.standard_parameters())
     assert entries[0, model.slice_h][0] == pytest.approx(pendulum_h(), rel=1e-12)
     assert entries[0, model.slice_g][0] == pytest.approx(pendulum_g(0.25), rel=1e-12)
@@ -103,7 +110,7 @@ def test_damping_adds_and_coulomb_is_carried(pendulum_file):
     assert device.joint_limits() == ((-1.0, 1.0),)
     overridden = device.with_params({"mhandle": 0.03})  # parameter overrides keep actuators and limits
     assert overridden.reflected_inertia == device.reflected_inertia and overridden.limits == device.limits
-    assert overridden.H(np.zeros(1))[0, 0] == pytest.approx(pendulum_h() + 0.01 * R_TIP**2, rel=1e-12)
+    assert mass_matrix(overridden, np.zeros(1))[0, 0] == pytest.approx(pendulum_h() + 0.01 * R_TIP**2, rel=1e-12)
 
 
 def test_symbolic_equations_include_the_reflected_inertia(pendulum_file):
@@ -180,7 +187,7 @@ def test_urdf_limits_are_read_and_make_the_default_region():
     assert device.joint_limits() == ((-0.7, 1.1), None, (0.0, 0.05))
     assert device.check(strict=True) == []  # link c is a point mass
     from hapticdesign.analysis.linearity.region import Region
-    from hapticdesign.analysis.linearity.service import device_form
+    from hapticdesign.analysis.linearity.form import device_form
 
     pi = device.standard_parameters()
     explicit = Region({0: (-0.7, 1.1), 2: (0.0, 0.05)})  # j2 continuous: the full turn
@@ -289,9 +296,9 @@ def test_phantom_motors_adds_the_reflected_inertia_to_the_preset():
     motors, plain = load_device_file(EXAMPLES / "phantom-3dof-motors.yaml"), preset("phantom-3dof")
     reflected = np.diag([13.3**2 * 1.08e-6, 11.2**2 * 1.08e-6, 11.2**2 * 1.08e-6])
     q = np.random.default_rng(5).uniform(-np.pi, np.pi, (20, 3))
-    np.testing.assert_allclose(motors.H(q) - plain.H(q), np.broadcast_to(reflected, (20, 3, 3)), rtol=0, atol=1e-15)
-    np.testing.assert_allclose(motors.C(q), plain.C(q), rtol=1e-13, atol=1e-16)
-    np.testing.assert_allclose(motors.G(q), plain.G(q), rtol=1e-13, atol=1e-16)
+    np.testing.assert_allclose(mass_matrix(motors, q) - mass_matrix(plain, q), np.broadcast_to(reflected, (20, 3, 3)), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(coriolis_centrifugal(motors, q), coriolis_centrifugal(plain, q), rtol=1e-13, atol=1e-16)
+    np.testing.assert_allclose(gravity(motors, q), gravity(plain, q), rtol=1e-13, atol=1e-16)
     assert motors.damping == pytest.approx((0.5005, 0.5005, 0.3505))
     assert motors.coulomb == pytest.approx((0.01, 0.01, 0.01))
     degrees = [(-90, 90), (-119, 124), (-214, 29)]
@@ -301,7 +308,7 @@ def test_phantom_motors_adds_the_reflected_inertia_to_the_preset():
 def test_phantom_motors_ln_on_the_torus_equals_the_preset():
     """A constant added to H has no variance: LN (eq. 3.1-3.4) cannot see the reflected inertia."""
     from hapticdesign.analysis.linearity.region import Region
-    from hapticdesign.analysis.linearity.service import device_form
+    from hapticdesign.analysis.linearity.form import device_form
 
     motors, plain = load_device_file(EXAMPLES / "phantom-3dof-motors.yaml"), preset("phantom-3dof").with_params(
         {"m2": 0.2, "r3z": -0.02})

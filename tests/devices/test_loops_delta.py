@@ -20,6 +20,14 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
+from hapticdesign.analysis.dynamics.device import (
+    coriolis_centrifugal,
+    coriolis_matrix,
+    dynamics_of,
+    forward_dynamics,
+    gravity,
+    mass_matrix,
+)
 from hapticdesign.analysis.kinematics import actuated_pose
 from hapticdesign.devices.device_file import load_device_file
 
@@ -101,7 +109,7 @@ def _samples(n: int, seed: int) -> np.ndarray:
 def test_forward_kinematics_is_the_trilateration(device):
     p = device.params
     for qa in _samples(20, 1):
-        pose = actuated_pose(device.mechanism, qa, solver=device.model.solver)
+        pose = actuated_pose(device.mechanism, qa, solver=dynamics_of(device).solver)
         handle = MOUNT @ (_platform(p, qa) + np.array([0.0, 0.0, -p["h"]]))
         np.testing.assert_allclose(pose[:3, 3], handle, atol=1e-13)
         np.testing.assert_allclose(pose[:3, :3], MOUNT, atol=1e-13)  # the handle only translates
@@ -111,7 +119,7 @@ def test_inverse_kinematics_closed_form(device):
     p = device.params
     for centre in ([0.0, 0.0, -0.10], [0.02, -0.01, -0.09], [-0.015, 0.02, -0.11], [0.01, 0.015, -0.08]):
         qa = _inverse(p, np.array(centre))
-        pose = actuated_pose(device.mechanism, qa, frame="platform", solver=device.model.solver)
+        pose = actuated_pose(device.mechanism, qa, frame="platform", solver=dynamics_of(device).solver)
         np.testing.assert_allclose(pose[:3, 3], MOUNT @ np.array(centre), atol=1e-13)
 
 
@@ -156,11 +164,11 @@ def test_mass_matrix_and_gravity_match_the_lagrangian(device):
     for qa in _samples(5, 2):
         mass = _lagrangian_mass(device, qa)
         # Jacobians by 4th-order differences: truncation ~h^4, round-off ~eps/h: ~1e-12 relative
-        np.testing.assert_allclose(device.H(qa), mass, rtol=1e-8, atol=1e-8 * np.abs(mass).max())
+        np.testing.assert_allclose(mass_matrix(device, qa), mass, rtol=1e-8, atol=1e-8 * np.abs(mass).max())
         grad = np.array([(-_potential(device, qa + 2 * h * e) + 8 * _potential(device, qa + h * e)
                           - 8 * _potential(device, qa - h * e) + _potential(device, qa - 2 * h * e)) / (12 * h)
                          for e in np.eye(3)])
-        np.testing.assert_allclose(device.G(qa), grad, rtol=1e-8, atol=1e-8 * np.abs(grad).max())
+        np.testing.assert_allclose(gravity(device, qa), grad, rtol=1e-8, atol=1e-8 * np.abs(grad).max())
 
 
 def test_coriolis_matches_the_christoffel_symbols_of_the_lagrangian(device):
@@ -176,13 +184,13 @@ def test_coriolis_matches_the_christoffel_symbols_of_the_lagrangian(device):
                 columns.append(gamma[:, j, j] if j == k else 2 * gamma[:, j, k])
         reference = np.stack(columns, axis=1)
         # H from 1e-12-accurate Jacobians differentiated with h = 1e-3 (4th order): ~1e-9 relative
-        np.testing.assert_allclose(device.C(qa), reference, rtol=1e-6, atol=1e-6 * np.abs(reference).max())
+        np.testing.assert_allclose(coriolis_centrifugal(device, qa), reference, rtol=1e-6, atol=1e-6 * np.abs(reference).max())
 
 
 # -- properties -------------------------------------------------------------------------------------
 def test_mass_matrix_positive_definite(device):
     for qa in _samples(30, 4):
-        assert np.linalg.eigvalsh(device.H(qa)).min() > 0.0
+        assert np.linalg.eigvalsh(mass_matrix(device, qa)).min() > 0.0
 
 
 def test_hdot_minus_two_c_cvt_is_skew_symmetric(device):
@@ -190,9 +198,9 @@ def test_hdot_minus_two_c_cvt_is_skew_symmetric(device):
     h = 1e-3
     for qa in _samples(5, 6):
         qd = rng.normal(size=3)
-        hdot = (-device.H(qa + 2 * h * qd) + 8 * device.H(qa + h * qd) - 8 * device.H(qa - h * qd)
-                + device.H(qa - 2 * h * qd)) / (12 * h)
-        n = hdot - 2 * device.C_cvt(qa, qd)
+        hdot = (-mass_matrix(device, qa + 2 * h * qd) + 8 * mass_matrix(device, qa + h * qd) - 8 * mass_matrix(device, qa - h * qd)
+                + mass_matrix(device, qa - 2 * h * qd)) / (12 * h)
+        n = hdot - 2 * coriolis_matrix(device, qa, qd)
         assert np.abs(n + n.T).max() <= 1e-8 * np.abs(hdot).max()
 
 
@@ -200,12 +208,12 @@ def test_energy_is_conserved_without_damping(device):
     qa0, qd0 = np.array([0.35, 0.30, 0.40]), np.array([2.0, -1.0, 0.5])
 
     def rhs(_t, x):
-        return np.concatenate([x[3:], device.forward_dynamics(x[:3], x[3:], np.zeros(3))])
+        return np.concatenate([x[3:], forward_dynamics(device, x[:3], x[3:], np.zeros(3))])
 
     sol = solve_ivp(rhs, (0.0, 0.1), np.concatenate([qa0, qd0]), method="DOP853", rtol=1e-11, atol=1e-12,
                     t_eval=np.linspace(0.0, 0.1, 21))
     assert sol.success
-    energies = [0.5 * x[3:] @ device.H(x[:3]) @ x[3:] + _potential(device, x[:3]) for x in sol.y.T]
-    kinetic = 0.5 * qd0 @ device.H(qa0) @ qd0
+    energies = [0.5 * x[3:] @ mass_matrix(device, x[:3]) @ x[3:] + _potential(device, x[:3]) for x in sol.y.T]
+    kinetic = 0.5 * qd0 @ mass_matrix(device, qa0) @ qd0
     assert np.ptp(energies) <= 1e-8 * kinetic
     assert np.ptp(sol.y[0]) > 0.05

@@ -20,6 +20,14 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
+from hapticdesign.analysis.dynamics.device import (
+    coriolis_matrix,
+    dynamics_of,
+    forward_dynamics,
+    gravity,
+    inverse_dynamics,
+    mass_matrix,
+)
 from hapticdesign.analysis.kinematics import actuated_jacobian, actuated_pose
 from hapticdesign.devices.device_file import load_device_file
 
@@ -67,7 +75,7 @@ def _samples(n: int, seed: int) -> np.ndarray:
 
 def test_forward_kinematics_is_the_circle_intersection(device):
     for qa in _samples(20, 1):
-        pose = actuated_pose(device.mechanism, qa, solver=device.model.solver)
+        pose = actuated_pose(device.mechanism, qa, solver=dynamics_of(device).solver)
         x, z = _handle(device, qa)
         np.testing.assert_allclose(pose[:3, 3], [x, 0.0, z], atol=1e-13)
 
@@ -80,20 +88,20 @@ def test_inverse_kinematics_law_of_cosines(device):
             rx, rz = x - base, z
             reach = np.hypot(rx, rz)
             qa.append(np.arctan2(rz, rx) + sign * np.arccos((l1**2 + reach**2 - l2**2) / (2 * l1 * reach)))
-        pose = actuated_pose(device.mechanism, np.array(qa), solver=device.model.solver)
+        pose = actuated_pose(device.mechanism, np.array(qa), solver=dynamics_of(device).solver)
         np.testing.assert_allclose(pose[:3, 3], [x, 0.0, z], atol=1e-13)
 
 
 def test_passive_angles_follow_the_closed_form(device):
     for qa in _samples(10, 2):
-        q = device.model.full_coordinates(qa)
+        q = dynamics_of(device).full_coordinates(qa)
         np.testing.assert_allclose(q[2:], _passive(device, qa), atol=1e-12)
 
 
 def test_handle_jacobian_is_the_derivative_of_the_closed_form(device):
     h = 1e-6
     for qa in _samples(5, 3):
-        jac = actuated_jacobian(device.mechanism, qa, solver=device.model.solver)
+        jac = actuated_jacobian(device.mechanism, qa, solver=dynamics_of(device).solver)
         fd = np.stack([(_handle(device, qa + h * e) - _handle(device, qa - h * e)) / (2 * h) for e in np.eye(2)], axis=1)
         np.testing.assert_allclose(jac[[0, 2]], fd, atol=1e-8)  # central differences: h^2 ~ 1e-12, eps/h ~ 1e-10
 
@@ -143,17 +151,17 @@ def test_dynamics_match_pinocchio_reduced_by_the_closed_form(device):
     rng = np.random.default_rng(5)
     for qa in _samples(8, 4):
         qda, qdda = rng.normal(size=2), rng.normal(size=2)
-        mass, gravity, tau = _reduced_reference(device, model, qa, qda, qdda)
+        mass, weight, tau = _reduced_reference(device, model, qa, qda, qdda)
         # finite differences of the closed form: first derivatives ~1e-10, second ~1e-8 relative
-        np.testing.assert_allclose(device.H(qa), mass, rtol=1e-7, atol=1e-7 * np.abs(mass).max())
-        np.testing.assert_allclose(device.G(qa), gravity, rtol=1e-7, atol=1e-7 * np.abs(gravity).max())
-        np.testing.assert_allclose(device.inverse_dynamics(qa, qda, qdda), tau, rtol=1e-6, atol=1e-6 * np.abs(tau).max())
+        np.testing.assert_allclose(mass_matrix(device, qa), mass, rtol=1e-7, atol=1e-7 * np.abs(mass).max())
+        np.testing.assert_allclose(gravity(device, qa), weight, rtol=1e-7, atol=1e-7 * np.abs(weight).max())
+        np.testing.assert_allclose(inverse_dynamics(device, qa, qda, qdda), tau, rtol=1e-6, atol=1e-6 * np.abs(tau).max())
 
 
 # -- properties -------------------------------------------------------------------------------------
 def test_mass_matrix_positive_definite(device):
     for qa in _samples(30, 6):
-        assert np.linalg.eigvalsh(device.H(qa)).min() > 0.0
+        assert np.linalg.eigvalsh(mass_matrix(device, qa)).min() > 0.0
 
 
 def test_hdot_minus_two_c_cvt_is_skew_symmetric(device):
@@ -162,9 +170,9 @@ def test_hdot_minus_two_c_cvt_is_skew_symmetric(device):
     for qa in _samples(6, 8):
         qd = rng.normal(size=2)
         # fourth-order central difference of H along qd: truncation ~h^4
-        hdot = (-device.H(qa + 2 * h * qd) + 8 * device.H(qa + h * qd) - 8 * device.H(qa - h * qd)
-                + device.H(qa - 2 * h * qd)) / (12 * h)
-        n = hdot - 2 * device.C_cvt(qa, qd)
+        hdot = (-mass_matrix(device, qa + 2 * h * qd) + 8 * mass_matrix(device, qa + h * qd) - 8 * mass_matrix(device, qa - h * qd)
+                + mass_matrix(device, qa - 2 * h * qd)) / (12 * h)
+        n = hdot - 2 * coriolis_matrix(device, qa, qd)
         assert np.abs(n + n.T).max() <= 1e-8 * np.abs(hdot).max()
 
 
@@ -192,12 +200,12 @@ def test_energy_is_conserved_without_damping(device):
     qa0, qd0 = np.array([2.0, 1.1]), np.array([1.5, -1.0])
 
     def rhs(_t, x):
-        return np.concatenate([x[2:], device.forward_dynamics(x[:2], x[2:], np.zeros(2))])
+        return np.concatenate([x[2:], forward_dynamics(device, x[:2], x[2:], np.zeros(2))])
 
     sol = solve_ivp(rhs, (0.0, 0.1), np.concatenate([qa0, qd0]), method="DOP853", rtol=1e-11, atol=1e-12,
                     t_eval=np.linspace(0.0, 0.1, 21))  # it falls under gravity towards the workspace border
     assert sol.success
-    energies = [0.5 * x[2:] @ device.H(x[:2]) @ x[2:] + _potential(device, x[:2]) for x in sol.y.T]
-    kinetic = 0.5 * qd0 @ device.H(qa0) @ qd0
+    energies = [0.5 * x[2:] @ mass_matrix(device, x[:2]) @ x[2:] + _potential(device, x[:2]) for x in sol.y.T]
+    kinetic = 0.5 * qd0 @ mass_matrix(device, qa0) @ qd0
     assert np.ptp(energies) <= 1e-8 * kinetic  # integration tolerance 1e-11 over the run
     assert np.ptp(sol.y[0]) > 0.1  # it actually moved

@@ -25,6 +25,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from hapticdesign.analysis.dynamics.device import dynamics_of
 from hapticdesign.model.inertia import BodyInertia, check_body
 
 
@@ -79,8 +80,8 @@ def _literature_terms(device, theta_c):
     theta = A @ np.asarray(theta_c, dtype=float)
     pi = device.standard_parameters()
     pi[10 * 0 + 5] += I_BASE_YY  # base: moment about the vertical axis (frame-1 y), massless
-    m = A.T @ device.model.H(theta, pi) @ A
-    n = A.T @ device.model.G(theta, pi)
+    m = A.T @ dynamics_of(device).H(theta, pi) @ A
+    n = A.T @ dynamics_of(device).G(theta, pi)
     return m, n
 
 

@@ -7,12 +7,13 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from tests.conftest import random_standard_parameters
+from hapticdesign.analysis.dynamics.device import dynamics_of, forward_dynamics, inverse_dynamics
 
 
 @pytest.mark.parametrize("name", ["phantom3", "phantom6"])
 def test_mass_matrix_positive_definite_and_passivity(name, request):
     device = request.getfixturevalue(name)
-    model = device.model
+    model = dynamics_of(device)
     rng = np.random.default_rng(7)
     n = model.n_dof
     for _ in range(5):
@@ -32,7 +33,7 @@ def test_mass_matrix_positive_definite_and_passivity(name, request):
 def test_christoffel_from_finite_differences(name, request):
     """C's columns hold Gamma_ijj and 2 Gamma_ijk built from dH/dq (eq. 2.50; Appendix A.2's code computes them so)."""
     device = request.getfixturevalue(name)
-    model = device.model
+    model = dynamics_of(device)
     rng = np.random.default_rng(3)
     n = model.n_dof
     pi = random_standard_parameters(rng, len(device.body_names))
@@ -52,7 +53,7 @@ def test_energy_balance_without_gravity(phantom3):
     device = phantom3.with_params({"g": 0.0})
     rng = np.random.default_rng(11)
     pi = random_standard_parameters(rng, len(device.body_names))
-    model = device.model
+    model = dynamics_of(device)
 
     def rhs(_t, x):
         q, qd = x[:3], x[3:]
@@ -67,7 +68,7 @@ def test_energy_balance_without_gravity(phantom3):
 def test_work_energy_with_gravity(phantom3):
     """d/dt (kinetic + potential) = 0 without torque: the gravity torque derives from a potential."""
     rng = np.random.default_rng(5)
-    model = phantom3.model
+    model = dynamics_of(phantom3)
     pi = random_standard_parameters(rng, 5)
     q0 = rng.uniform(-1, 1, 3)
     path = np.linspace(0, 1, 2001)[:, None] * rng.normal(size=3) + q0
@@ -81,7 +82,7 @@ def test_work_energy_with_gravity(phantom3):
 
 
 def test_vectorized_over_poses_and_parameter_sets(phantom6):
-    model = phantom6.model
+    model = dynamics_of(phantom6)
     rng = np.random.default_rng(2)
     pis = np.stack([random_standard_parameters(rng, 8) for _ in range(3)])
     qs = rng.uniform(-3, 3, (4, 6))
@@ -95,5 +96,5 @@ def test_vectorized_over_poses_and_parameter_sets(phantom6):
 def test_inverse_forward_roundtrip(phantom6):
     rng = np.random.default_rng(9)
     q, qd, qdd = rng.normal(size=(3, 6))
-    tau = phantom6.inverse_dynamics(q, qd, qdd)
-    assert np.allclose(phantom6.forward_dynamics(q, qd, tau), qdd, rtol=1e-9, atol=1e-9)
+    tau = inverse_dynamics(phantom6, q, qd, qdd)
+    assert np.allclose(forward_dynamics(phantom6, q, qd, tau), qdd, rtol=1e-9, atol=1e-9)

@@ -14,6 +14,7 @@ import sympy as sp
 import typer
 from typer.testing import CliRunner
 
+from hapticdesign.analysis.dynamics.device import gravity, mass_matrix
 from hapticdesign.interface.cli import CONTENTS, app
 
 runner = CliRunner()
@@ -140,7 +141,7 @@ def test_eom_json_equations_evaluate_to_the_numeric_model(phantom3):
     subs = {sp.Symbol(f"theta{k + 1}"): q[k] for k in range(3)}
     H = [[float(sp.sympify(text["equations"][f"H_{i}_{j}"]).subs(subs)) for j in (1, 2, 3)] for i in (1, 2, 3)]
     G = [float(sp.sympify(text["equations"][f"G_{i}"]).subs(subs)) for i in (1, 2, 3)]
-    assert np.allclose(H, phantom3.H(q), atol=1e-12) and np.allclose(G, phantom3.G(q), atol=1e-12)
+    assert np.allclose(H, mass_matrix(phantom3, q), atol=1e-12) and np.allclose(G, gravity(phantom3, q), atol=1e-12)
     python = json.loads(_invoke(["eom", "--format", "python", "--json"]).stdout)
     compile(python["source"], "eom", "exec")
 
@@ -151,7 +152,7 @@ def test_linearize_json_constant_h_and_found_designs(tmp_path, phantom3):
     out = json.loads(_invoke(["linearize", "--find", "2", "--seed", "3", "--json"]).stdout)
     assert out["linear_possible"] and len(out["conditions"]) == 15 and len(out["free_parameters"]) == 35
     for q in np.random.default_rng(0).uniform(0, 2 * np.pi, (3, 3)):
-        assert np.allclose(out["constant_H"], phantom3.H(q), atol=1e-12)
+        assert np.allclose(out["constant_H"], mass_matrix(phantom3, q), atol=1e-12)
     assert out["ln"] < 1e-12 and out["designs"]["count"] == 2 and out["designs"]["max_ln"] < 1e-12
     for k, design in enumerate(out["designs"]["values"]):
         path = tmp_path / f"d{k}.json"

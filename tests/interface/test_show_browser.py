@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
+from hapticdesign.analysis.dynamics.device import dynamics_of
 from hapticdesign.devices.device_file import load_device_file
 from hapticdesign.devices.registry import preset
 from hapticdesign.interface.cli import app
@@ -63,7 +64,7 @@ def _python_origins(device, q_full) -> dict[str, np.ndarray]:
 def _python_full(device, q) -> np.ndarray:
     """Every coordinate: passive joints of loops from the Python loop solver (analysis/loops)."""
     q = np.asarray(q, dtype=float)
-    return q if device.mechanism.loops is None else device.model.full_coordinates(q)
+    return q if device.mechanism.loops is None else dynamics_of(device).full_coordinates(q)
 
 
 def _clean_console(driver) -> None:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from hapticdesign.analysis.linearity.service import device_form
+from hapticdesign.analysis.linearity.form import device_form
 from hapticdesign.studies.seed_reference import appendix_c_designs
 
 

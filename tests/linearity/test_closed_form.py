@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
+from hapticdesign.analysis.dynamics.device import dynamics_of
 from hapticdesign.analysis.linearity.closed_form import closed_form
 from hapticdesign.analysis.linearity.form import PARTS, linearity_form
 from hapticdesign.analysis.linearity.region import parse_region
@@ -90,7 +91,7 @@ def test_latex_export_has_every_term(closed3):
 
 
 def test_box_region_closed_form(phantom3):
-    form = linearity_form(phantom3.model, parse_region("q2=-0.5:0.7,q3=0.2:1.9", 3))
+    form = linearity_form(dynamics_of(phantom3), parse_region("q2=-0.5:0.7,q3=0.2:1.9", 3))
     closed = closed_form(phantom3, form)
     x = np.random.default_rng(9).uniform(-0.3, 0.3, form.n_params)
     assert closed.evaluate(dict(zip(phantom3.inertial_names(), x))) == pytest.approx(float(form.ln_seed(x)), rel=1e-10)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from hapticdesign.analysis.dynamics.device import dynamics_of
 from hapticdesign.analysis.linearity.form import linearity_form
 from hapticdesign.analysis.linearity.region import parse_region
 from hapticdesign.analysis.linearity.weights import Weights
@@ -74,7 +75,7 @@ def test_appendix_b1_gravity_polynomial(form3, phantom3):
 
 def _brute_force_parts(device, pi, nodes_per_axis, weights=None):
     """Average over a tensor product of nodes: ``nodes_per_axis`` is a list of (points, weights)."""
-    model = device.model
+    model = dynamics_of(device)
     n = model.n_dof
     mesh = np.meshgrid(*[p for p, _ in nodes_per_axis], indexing="ij")
     wmesh = np.meshgrid(*[w for _, w in nodes_per_axis], indexing="ij")
@@ -128,7 +129,7 @@ def test_weighted_ln_matches_grid_average(phantom3):
     rng = np.random.default_rng(5)
     n = phantom3.n_dof
     weights = Weights(rng.uniform(0, 2, (n, n)), rng.uniform(0, 2, (n, n * (n + 1) // 2)), rng.uniform(0, 2, n))
-    form = linearity_form(phantom3.model, weights=weights)
+    form = linearity_form(dynamics_of(phantom3), weights=weights)
     pi = _random_standard(phantom3, rng, 1)[0]
     nodes = _torus_nodes(n)
     assert form.parts(pi) == pytest.approx(_brute_force_parts(phantom3, pi, nodes, weights), rel=1e-10)
@@ -143,7 +144,7 @@ def _gauss_nodes(lo, hi, points=16):
 def test_box_region_matches_fine_quadrature(request, fixture):
     device = request.getfixturevalue(f"phantom{fixture}")
     region = parse_region("q2=-0.5:0.7,q3=0.2:1.9", device.n_dof)
-    form = linearity_form(device.model, region)
+    form = linearity_form(dynamics_of(device), region)
     rng = np.random.default_rng(7)
     pi = _random_standard(device, rng, 1)[0]
     nodes = _torus_nodes(device.n_dof, points=5)
@@ -154,7 +155,7 @@ def test_box_region_matches_fine_quadrature(request, fixture):
 
 
 def test_box_of_full_turns_equals_torus(phantom3, form3):
-    form = linearity_form(phantom3.model, parse_region("q2=-3:9.566370614359172,q3=1:7.283185307179586", 3))
+    form = linearity_form(dynamics_of(phantom3), parse_region("q2=-3:9.566370614359172,q3=1:7.283185307179586", 3))
     pi = _random_standard(phantom3, np.random.default_rng(1), 1)[0]
     assert form.parts(pi) == pytest.approx(form3.parts(pi), rel=1e-12)
 
@@ -178,4 +179,4 @@ def test_bad_regions(text):
 
 def test_wrong_weight_shape(phantom3):
     with pytest.raises(UserError):
-        linearity_form(phantom3.model, weights=Weights(np.ones((2, 2)), np.ones((3, 6)), np.ones(3)))
+        linearity_form(dynamics_of(phantom3), weights=Weights(np.ones((2, 2)), np.ones((3, 6)), np.ones(3)))

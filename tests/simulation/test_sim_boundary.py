@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from scipy.signal import cont2discrete
 
+from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
 from hapticdesign.simulation.boundary import (
@@ -92,7 +93,7 @@ def test_hand_on_a_one_dof_device_meets_the_exact_discrete_analysis():
     (not to the compensator's model), b_h r^2 to its damping and a physical spring k_h r^2: the
     simulated growth boundary of the device equals the spectral-radius boundary of that 1-DOF loop."""
     device = resolve_device(None, Path(__file__).with_name("one_link.yaml"), None)
-    j = device.H(np.zeros(1))[0, 0]
+    j = mass_matrix(device, np.zeros(1))[0, 0]
     assert j == pytest.approx(0.007, rel=1e-12)
     r2 = 0.15 ** 2
     hand = Hand(mass=0.4, damping=2.0, stiffness=40.0)

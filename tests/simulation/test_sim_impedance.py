@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.devices.registry import preset
 from hapticdesign.errors import UserError
 from hapticdesign.devices.loading import resolve_device
@@ -52,7 +53,7 @@ def test_type_one_growth_boundary_is_b_squared_over_h11():
     """Type 1 holds joints 2, 3: joint 1 is a 1-DOF inertia H11(0) with damping b1, whose exact limit
     under full inertial compensation is b1^2 / H11 (see test_sim_boundary): within 0.05 %."""
     device = preset("phantom-3dof").with_params({"r3y": 0.01, "Ixy2": 4e-4, "m3": 0.05})
-    h11 = device.H(np.zeros(3))[0, 0]
+    h11 = mass_matrix(device, np.zeros(3))[0, 0]
     k = true_boundary(ImpedanceProblem(device, 1))
     assert k == pytest.approx(device.damping[0] ** 2 / h11, rel=5e-4)
 
@@ -66,8 +67,8 @@ def test_compensator_error_boundary_is_the_closed_form(error_percent):
     device = preset("phantom-3dof").with_params({"r3y": 0.01, "Ixy2": 4e-4, "m3": 0.05})
     model = device.with_params({k: device.params.get(k, 0.0) * (1 - error_percent / 100)
                                 for k in device.inertial_names()})
-    h11, b = device.H(np.zeros(3))[0, 0], device.damping[0]
-    c = model.H(np.zeros(3))[0, 0] / h11
+    h11, b = mass_matrix(device, np.zeros(3))[0, 0], device.damping[0]
+    c = mass_matrix(model, np.zeros(3))[0, 0] / h11
     config = LoopConfig(compensator=Compensator(error_percent=error_percent))
     k = true_boundary(ImpedanceProblem(device, 1, config=config))
     expected = compensated_boundary(h11, b, 1e-3, c)

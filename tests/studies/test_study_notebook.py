@@ -15,8 +15,12 @@ EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 # The top-level names the notebook uses and the engine objects they must be.
 TOP_LEVEL = {
     "preset": "hapticdesign.devices.registry:preset",
-    "Device": "hapticdesign.model.device:Device",
-    "linearity_form": "hapticdesign.analysis.linearity.service:device_form",
+    "load_device": "hapticdesign.devices.loading:load_device",
+    "mass_matrix": "hapticdesign.analysis.dynamics.device:mass_matrix",
+    "gravity": "hapticdesign.analysis.dynamics.device:gravity",
+    "inverse_dynamics": "hapticdesign.analysis.dynamics.device:inverse_dynamics",
+    "forward_dynamics": "hapticdesign.analysis.dynamics.device:forward_dynamics",
+    "linearity_form": "hapticdesign.analysis.linearity.form:device_form",
     "linear_conditions": "hapticdesign.analysis.linearity.conditions:linear_conditions",
     "impedance_range": "hapticdesign.simulation.impedance:impedance_range",
     "transparency": "hapticdesign.simulation.transparency:transparency",

@@ -1,4 +1,4 @@
-"""Resolve the device a command works on: a preset or a device file, plus parameter overrides."""
+"""Load a device from a file, and resolve the device a command works on (a preset or a file, plus overrides)."""
 
 from __future__ import annotations
 
@@ -8,6 +8,13 @@ from hapticdesign.devices.registry import DEFAULT_PRESET, preset
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.model.params_io import read_parameters
+
+
+def load_device(path: str | Path) -> Device:
+    """A device from a device file (YAML, TOML, JSON) or a URDF file (see docs/device-files.md)."""
+    from hapticdesign.devices.device_file import load_device_file
+
+    return load_device_file(Path(path))
 
 
 def resolve_device(

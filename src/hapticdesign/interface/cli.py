@@ -73,7 +73,7 @@ app = typer.Typer(
 
 def _version(value: bool) -> None:
     if value:
-        from hapticdesign import __version__
+        from hapticdesign.version import __version__
 
         typer.echo(f"hapticdesign {__version__}")
         raise typer.Exit()

@@ -8,6 +8,9 @@ Actuators and joint limits (:mod:`hapticdesign.model.actuators`) ride along: ``d
 total viscous damping per coordinate (joints plus actuators), ``coulomb`` the Coulomb friction per
 coordinate, ``reflected_inertia`` the constant ``n^2 J_r`` added to the diagonal of H
 (seed 000 eq. 2.50), ``limits`` each coordinate's range or ``None``.
+
+A device knows no file format and owns no analysis: :func:`hapticdesign.devices.loading.load_device`
+reads one from a file, and :mod:`hapticdesign.analysis.dynamics.device` gives its equations of motion.
 """
 
 from __future__ import annotations
@@ -48,19 +51,10 @@ class Device:
     actuators: tuple[Actuator, ...] = ()
     limits: tuple[Limits, ...] = ()
 
-    @classmethod
-    def from_file(cls, path) -> "Device":
-        """A device from a device file (YAML, TOML, JSON) or a URDF file (see docs/device-files.md)."""
-        from pathlib import Path
-
-        from hapticdesign.devices.device_file import load_device_file
-
-        return load_device_file(Path(path))
-
     # -- parameters ---------------------------------------------------------------------------
     @property
     def mechanism(self) -> Mechanism:
-        return _build(self.builder, self.kinematic_values())
+        return build_mechanism(self.builder, self.kinematic_values())
 
     @property
     def n_dof(self) -> int:
@@ -158,51 +152,8 @@ class Device:
         """One message per coordinate of ``q`` outside its limits (values outside are allowed)."""
         return limit_warnings(np.ravel(q), self.joint_limits(), self.mechanism.actuated_coordinates)
 
-    # -- dynamics -----------------------------------------------------------------------------
-    @property
-    def model(self):
-        """The compiled regressor model of the equations of motion (cached per geometry).
-
-        With actuators, H carries the constant reflected rotor inertia (seed 000 eq. 2.50 plus
-        ``diag(n^2 J_r)``); the regressor in the inertial parameters is the same object's.
-        """
-        from hapticdesign.analysis.dynamics.closed_loop import ClosedLoopModel
-        from hapticdesign.analysis.dynamics.model import DynamicsModel
-
-        kind = ClosedLoopModel if self.mechanism.loops is not None else DynamicsModel
-        base = _model(kind, self.builder, self.kinematic_values())
-        extra = self.reflected_inertia if self.actuators else ()
-        return _with_rotors(base, extra) if any(extra) else base
-
-    def H(self, q: np.ndarray) -> np.ndarray:
-        return self.model.H(q, self.standard_parameters())
-
-    def C(self, q: np.ndarray) -> np.ndarray:
-        return self.model.C(q, self.standard_parameters())
-
-    def C_cvt(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
-        return self.model.C_cvt(q, qd, self.standard_parameters())
-
-    def G(self, q: np.ndarray) -> np.ndarray:
-        return self.model.G(q, self.standard_parameters())
-
-    def inverse_dynamics(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
-        return self.model.inverse(q, qd, qdd, self.standard_parameters())
-
-    def forward_dynamics(self, q: np.ndarray, qd: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        return self.model.forward(q, qd, tau, self.standard_parameters())
-
 
 @lru_cache(maxsize=64)
-def _build(builder: MechanismBuilder, kinematic: tuple[tuple[str, float], ...]) -> Mechanism:
+def build_mechanism(builder: MechanismBuilder, kinematic: tuple[tuple[str, float], ...]) -> Mechanism:
+    """The mechanism of one geometry (cached: devices that differ only in inertial parameters share it)."""
     return builder(dict(kinematic))
-
-
-@lru_cache(maxsize=16)
-def _model(cls, builder: MechanismBuilder, kinematic: tuple[tuple[str, float], ...]):
-    return cls(_build(builder, kinematic))
-
-
-@lru_cache(maxsize=16)
-def _with_rotors(base, reflected: tuple[float, ...]):
-    return base.with_constant_inertia(np.diag(reflected))

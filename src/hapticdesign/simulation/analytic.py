@@ -26,6 +26,7 @@ import numpy as np
 from scipy.linalg import expm
 from threadpoolctl import ThreadpoolController
 
+from hapticdesign.analysis.dynamics.device import coriolis_centrifugal, gravity, mass_matrix
 from hapticdesign.analysis.kinematics import jacobian
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
@@ -67,7 +68,7 @@ def linearize(device: Device, sim_type: int, wall_joint: int, config: LoopConfig
         q0[j] = float(path.sample(np.zeros(1))[0][0])
     w = wall_joint
     damping = np.asarray(config.damping if config.damping is not None else device.damping, dtype=float)
-    h, g = device.H(q0), device.G(q0)
+    h, g = mass_matrix(device, q0), gravity(device, q0)
     model = compensator_device(device, config.compensator)
     j_device = float(h[w, w])
     j, b, spring = j_device, float(damping[w]), 0.0
@@ -78,8 +79,8 @@ def linearize(device: Device, sim_type: int, wall_joint: int, config: LoopConfig
         b += config.hand.damping * reach
         spring = config.hand.stiffness * reach
     comp = config.compensator
-    fraction = float(model.H(q0)[w, w]) / j_device if comp.inertial else 0.0
-    torque = -(float(g[w]) - comp.gravity * float(model.G(q0)[w]))
+    fraction = float(mass_matrix(model, q0)[w, w]) / j_device if comp.inertial else 0.0
+    torque = -(float(g[w]) - comp.gravity * float(gravity(model, q0)[w]))
     loop = DisplayLoop(j, b, config.sensors.period, config.sensors.delay_samples, "sampled", fraction, spring)
     exact = sim_type == 1 or _decoupled(device, w, paths)
     return WallJoint(loop, torque, exact)
@@ -91,7 +92,7 @@ def _decoupled(device: Device, w: int, paths: dict) -> bool:
     qs = np.zeros((len(t), device.n_dof))
     for j, path in paths.items():
         qs[:, j] = path.sample(t)[0]
-    rows = [np.concatenate([device.H(q)[w], device.C(q)[w], [device.G(q)[w]]]) for q in qs]
+    rows = [np.concatenate([mass_matrix(device, q)[w], coriolis_centrifugal(device, q)[w], [gravity(device, q)[w]]]) for q in qs]
     scale = max(float(np.abs(rows[0]).max()), 1e-12)
     return all(np.abs(r - rows[0]).max() <= 1e-9 * scale for r in rows)
 

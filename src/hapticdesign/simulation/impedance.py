@@ -20,6 +20,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation.analytic import AnalyticProblem
@@ -55,7 +56,7 @@ class ImpedanceProblem:
         pose (see :mod:`.boundary`), or ``2 b / T`` without it; only a guess, never the answer."""
         w = self.wall_joint
         b = (self.config.damping or self.device.damping)[w]
-        h = self.device.H(np.zeros(self.device.n_dof))[w, w]
+        h = mass_matrix(self.device, np.zeros(self.device.n_dof))[w, w]
         guess = b * b / h if self.config.compensator.inertial else 2 * b / self.config.sensors.period
         return guess if math.isfinite(guess) and guess > 0 else 1.0
 

@@ -17,6 +17,7 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from hapticdesign.analysis.dynamics.device import dynamics_of
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation.config import (
@@ -27,7 +28,7 @@ from hapticdesign.simulation.paths import Path
 
 
 def _terms(device: Device, pi: np.ndarray, q: np.ndarray):
-    model = device.model
+    model = dynamics_of(device)
     return model.H(q, pi), model.C(q, pi), model.G(q, pi)
 
 

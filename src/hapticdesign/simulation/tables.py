@@ -19,6 +19,7 @@ import numba as nb
 import numpy as np
 
 from hapticdesign.analysis.dynamics.basis import CoordinateKind
+from hapticdesign.analysis.dynamics.device import dynamics_of
 from hapticdesign.model.device import Device
 
 KIND_CODES = {CoordinateKind.CYCLIC: 0, CoordinateKind.REVOLUTE: 1, CoordinateKind.PRISMATIC: 2}
@@ -51,7 +52,7 @@ class DynamicsTables:
 
     @classmethod
     def from_device(cls, device: Device) -> "DynamicsTables":
-        model = device.model
+        model = dynamics_of(device)
         return cls(
             coef=np.ascontiguousarray(model.coefficients_for(device.standard_parameters())),
             index=np.ascontiguousarray(model.index, dtype=np.int64),

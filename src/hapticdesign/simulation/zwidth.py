@@ -35,6 +35,7 @@ import control
 import numpy as np
 from scipy.optimize import brentq
 
+from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.errors import UserError
 
 VELOCITIES = ("sampled", "difference")
@@ -221,7 +222,7 @@ def stiffness_map(device, joint: int, axes: tuple[int, int], n: int, period: flo
         for y in grid:
             q = np.zeros(device.n_dof)
             q[axes[0]], q[axes[1]] = x, y
-            loop = DisplayLoop(float(device.H(q)[joint, joint]), float(device.damping[joint]), period, delay,
+            loop = DisplayLoop(float(mass_matrix(device, q)[joint, joint]), float(device.damping[joint]), period, delay,
                                velocity, fraction)
             row.append(max_stiffness(loop, virtual_damping))
         values.append(row)

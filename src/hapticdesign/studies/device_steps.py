@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from hapticdesign.analysis.dynamics.device import gravity, inverse_dynamics, mass_matrix
 from hapticdesign.analysis.dynamics.symbolic import derive, export
 from hapticdesign.analysis.linearity.bounds import practical_bounds
 from hapticdesign.analysis.linearity.conditions import (
@@ -16,7 +17,7 @@ from hapticdesign.analysis.linearity.conditions import (
     seed_conditions,
 )
 from hapticdesign.analysis.linearity.linear_designs import find_linear_designs as find
-from hapticdesign.analysis.linearity.service import device_form
+from hapticdesign.analysis.linearity.form import device_form
 from hapticdesign.analysis.linearity.verdict import decide_linearizable as decide
 from hapticdesign.analysis.linearity.verdict import minimum_ln
 from hapticdesign.errors import UserError
@@ -43,10 +44,10 @@ def equations_of_motion(ctx: Context) -> Outcome:
     g_sym = sp.lambdify(numeric.theta, numeric.G, "numpy")
     rows, worst = [], 0.0
     for q in poses:
-        h, g = device.H(q), device.G(q)
+        h, g = mass_matrix(device, q), gravity(device, q)
         worst = max(worst, float(np.abs(np.array(h_sym(*q), dtype=float) - h).max()),
                     float(np.abs(np.array(g_sym(*q), dtype=float).ravel() - g).max()))
-        tau = device.inverse_dynamics(q, qd, qdd)
+        tau = inverse_dynamics(device, q, qd, qdd)
         rows.append([", ".join(f"{v:.4f}" for v in q), *np.diag(h), *g, *tau])
     columns = ["q", *[f"H{i}{i}" for i in range(1, n + 1)], *[f"G{i}" for i in range(1, n + 1)],
                *[f"tau{i}" for i in range(1, n + 1)]]
@@ -63,10 +64,10 @@ def equations_of_motion(ctx: Context) -> Outcome:
         ],
         listings=[("H, exact:", export(numeric, "text", "H")),
                   ("G, exact:", export(numeric, "text", "G")),
-                  ("H at q = 0 (compiled model):", matrix_text("H", device.H(np.zeros(n))))],
+                  ("H at q = 0 (compiled model):", matrix_text("H", mass_matrix(device, np.zeros(n))))],
         tables=[Table("evaluations", "H diagonal, G and tau at three poses", columns, rows)],
         numbers={"symbolic_terms": terms, "symbolic_characters": len(full_text), "max_symbolic_vs_compiled": worst,
-                 "H_at_zero": device.H(np.zeros(n))},
+                 "H_at_zero": mass_matrix(device, np.zeros(n))},
     )
 
 
@@ -133,7 +134,7 @@ def linearization(ctx: Context) -> Outcome:
     h_const = conditions.constant_h @ pi
     ln = float(form.ln(pi))
     rng = np.random.default_rng(ctx.settings.seed)
-    spread = max(float(np.abs(device.H(q) - h_const).max()) for q in rng.uniform(-np.pi, np.pi, (20, device.n_dof)))
+    spread = max(float(np.abs(mass_matrix(device, q) - h_const).max()) for q in rng.uniform(-np.pi, np.pi, (20, device.n_dof)))
     rows = link_table(device)
     realizable = all(r[5] and r[6] for r in rows)
     linear = ln < 1e-12

@@ -18,7 +18,7 @@ from hapticdesign.analysis.linearity.bounds import practical_bounds
 from hapticdesign.analysis.linearity.closed_form import closed_form
 from hapticdesign.analysis.linearity.conditions import linear_conditions
 from hapticdesign.analysis.linearity.design_sets import design_set
-from hapticdesign.analysis.linearity.service import device_form
+from hapticdesign.analysis.linearity.form import device_form
 from hapticdesign.devices.registry import preset
 from hapticdesign.errors import PhysicalConsistencyWarning, UserError
 from hapticdesign.studies import device_steps, phantom_rendering

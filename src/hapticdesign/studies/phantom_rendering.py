@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from hapticdesign.analysis.linearity.service import device_form
+from hapticdesign.analysis.linearity.form import device_form
 from hapticdesign.errors import PhysicalConsistencyWarning
 from hapticdesign.model.inertia import SEED_FIELDS, seed_parameter_name
 from hapticdesign.simulation.boundary import (

@@ -16,6 +16,7 @@ from fractions import Fraction
 import numpy as np
 import sympy as sp
 
+from hapticdesign.analysis.dynamics.device import dynamics_of
 from hapticdesign.analysis.linearity.form import LinearityForm
 from hapticdesign.analysis.linearity.symbols import seed_symbols, standard_expressions, standard_names
 from hapticdesign.model.device import Device
@@ -112,7 +113,7 @@ def linear_conditions(device: Device, form: LinearityForm, rel_tol: float = 1e-1
     a weighted C entry vanishes: these coefficient rows (orthonormalized by an SVD) span the
     conditions.
     """
-    model = device.model
+    model = dynamics_of(device)
     w_h, w_c, w_g = form.weights.per_entry()
     a = model.coefficients
     blocks = [

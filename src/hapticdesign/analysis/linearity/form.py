@@ -15,13 +15,16 @@ per device geometry, region and weights; designs are then evaluated in batches.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
+from hapticdesign.analysis.dynamics.device import dynamics_of
 from hapticdesign.analysis.dynamics.model import DynamicsModel
-from hapticdesign.analysis.linearity.region import Region
+from hapticdesign.analysis.linearity.region import Region, limits_region
 from hapticdesign.analysis.linearity.weights import Weights
 from hapticdesign.errors import UserError
+from hapticdesign.model.device import Device
 from hapticdesign.model.inertia import standard_from_seed
 
 PARTS = ("H", "C", "G")
@@ -140,3 +143,19 @@ def linearity_form(model: DynamicsModel, region: Region | None = None, weights: 
     q_c = _weighted_form(a[:, model.slice_c], w_c, cov + np.outer(mean, mean))
     q_g = _weighted_form(a[:, model.slice_g], w_g, cov)
     return LinearityForm(np.stack([q_h, q_c, q_g]), region, weights)
+
+
+def device_form(device: Device, region: Region | None = None, weights: Weights | None = None) -> LinearityForm:
+    """The LN form of a device (cached per geometry and region when the weights are the defaults).
+
+    The default region is the box of the device's joint limits, full turns where it has none.
+    """
+    region = limits_region(device.joint_limits()) if region is None else region
+    if weights is None:
+        return _default_form(dynamics_of(device), tuple(sorted(region.ranges.items())))
+    return linearity_form(dynamics_of(device), region, weights)
+
+
+@lru_cache(maxsize=8)
+def _default_form(model, ranges: tuple) -> LinearityForm:
+    return linearity_form(model, Region(dict(ranges)) if ranges else None)

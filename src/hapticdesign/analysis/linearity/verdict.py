@@ -199,3 +199,10 @@ def minimum_ln(
         within_bounds(design, bodies, bounds),
         realizable(design, standard, kind),
     )
+
+
+def scaled_minimum(device: Device, mins: MinimumLN) -> float:
+    """LN of the practical optimum scaled down until its smallest mass or moment is 1e-15 (eq. 3.40-3.42)."""
+    bodies = [k for k, b in enumerate(device.body_names)]
+    smallest = min(min(mins.design[k, 0], mins.design[k, 4:7].min()) for k in bodies if mins.design[k, 0] > 0)
+    return mins.ln * (1e-15 / smallest) ** 2

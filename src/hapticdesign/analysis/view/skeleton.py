@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hapticdesign.analysis.dynamics.device import dynamics_of
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.model.mechanism import JointType
@@ -75,7 +76,7 @@ def full_coordinates(device: Device, q: np.ndarray) -> np.ndarray:
     """Every tree coordinate for actuated values ``q``: passive joints solved on the assembly branch."""
     if device.mechanism.loops is None:
         return np.asarray(q, dtype=float)
-    return device.model.full_coordinates(np.asarray(q, dtype=float))
+    return dynamics_of(device).full_coordinates(np.asarray(q, dtype=float))
 
 
 def frame_poses(device: Device, q: np.ndarray) -> dict[str, np.ndarray]:

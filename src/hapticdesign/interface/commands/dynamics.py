@@ -8,6 +8,14 @@ from typing import Optional
 import numpy as np
 import typer
 
+from hapticdesign.analysis.dynamics.device import (
+    coriolis_centrifugal,
+    coriolis_matrix,
+    dynamics_of,
+    gravity,
+    inverse_dynamics,
+    mass_matrix,
+)
 from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
 from hapticdesign.devices.loading import resolve_device
 from hapticdesign.interface.common import note as stderr_note, parse_vector, print_json, user_errors
@@ -40,17 +48,17 @@ def dynamics(
             "q": qv,
             "qd": qdv,
             "qdd": qddv,
-            "H": dev.H(qv),
-            "C": dev.C(qv),
-            "C_cvt": dev.C_cvt(qv, qdv),
-            "G": dev.G(qv),
-            "tau": dev.inverse_dynamics(qv, qdv, qddv),
+            "H": mass_matrix(dev, qv),
+            "C": coriolis_centrifugal(dev, qv),
+            "C_cvt": coriolis_matrix(dev, qv, qdv),
+            "G": gravity(dev, qv),
+            "tau": inverse_dynamics(dev, qv, qdv, qddv),
         }
         if json_out:
             print_json(result)
             return
         typer.echo(f"{dev.name} at q = {_row(qv)}, qd = {_row(qdv)}, qdd = {_row(qddv)}")
-        pairs = ", ".join(f"({j + 1},{k + 1})" for j, k in dev.model.pairs)
+        pairs = ", ".join(f"({j + 1},{k + 1})" for j, k in dynamics_of(dev).pairs)
         for key, note in (
             ("H", "mass matrix [kg m^2]"),
             ("C", f"Coriolis/centrifugal, columns {pairs}"),

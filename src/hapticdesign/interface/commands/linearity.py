@@ -1,4 +1,7 @@
-"""Commands of the Linearity Number area (seed 000 chapter 3): ``ln``, ``linearize``, ``designs``."""
+"""Commands of the Linearity Number area (seed 000 chapter 3): ``ln``, ``linearize``, ``designs``.
+
+Their work (options, engines, files, text) is in :mod:`.linearity_adapter`, imported when a command runs.
+"""
 
 from __future__ import annotations
 
@@ -34,7 +37,7 @@ def ln_command(
 ) -> None:
     """Linearity Number of a device (seed 000 eq. 3.1-3.4) and its H, C, G parts, or its closed form."""
     with user_errors(strict, quiet), allow_large(force, FORCE_HINT):
-        from hapticdesign.analysis.linearity.service import evaluate_ln, symbolic_ln
+        from hapticdesign.interface.commands.linearity_adapter import evaluate_ln, symbolic_ln
         from hapticdesign.errors import UserError
 
         if symbolic:
@@ -72,7 +75,7 @@ def linearize_command(
 ) -> None:
     """Conditions for LN = 0 (seed 000 eq. 3.12-3.27), free parameters, constant H; verdict when impossible."""
     with user_errors(strict, quiet), allow_large(force, FORCE_HINT), activity(not (quiet or json_out), "linearizing"):
-        from hapticdesign.analysis.linearity.service import linearize, linearize_report
+        from hapticdesign.interface.commands.linearity_adapter import linearize, linearize_report
 
         result = linearize(preset, device, params, strict, find, seed, out, realizability)
         if json_out:
@@ -99,7 +102,7 @@ def designs_command(
 ) -> None:
     """Designs at prescribed LN levels under eq. 3.35-3.38 (seed 000 §3.2.2), written to CSV."""
     with user_errors(strict, quiet), allow_large(force, FORCE_HINT):
-        from hapticdesign.analysis.linearity.service import write_design_set
+        from hapticdesign.interface.commands.linearity_adapter import write_design_set
 
         with activity(not (quiet or json_out), "designs"):
             message = write_design_set(preset, device, params, strict, levels, count, seed, out, method, realizability)

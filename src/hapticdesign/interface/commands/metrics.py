@@ -13,6 +13,7 @@ from typing import Optional
 import numpy as np
 import typer
 
+from hapticdesign.analysis.dynamics.device import dynamics_of, mass_matrix
 from hapticdesign.analysis.kinematics import actuated_jacobian
 from hapticdesign.analysis.metrics import dynamic, kinematic
 from hapticdesign.devices.loading import resolve_device
@@ -31,7 +32,7 @@ def task_jacobian(device: Device, q: np.ndarray) -> np.ndarray:
     (planar devices): the translational rows projected on the plane (or line) of motion, i.e. on
     the leading left singular vectors, which leaves every metric unchanged by the choice of axes.
     """
-    full = actuated_jacobian(device.mechanism, q, solver=getattr(device.model, "solver", None))
+    full = actuated_jacobian(device.mechanism, q, solver=getattr(dynamics_of(device), "solver", None))
     n = device.n_dof
     if n == 3:
         return full[:3]
@@ -49,7 +50,7 @@ def device_metrics(device: Device, q: np.ndarray) -> dict:
     cond = float(kinematic.condition_number(J))
     if not np.isfinite(cond) or cond > SINGULAR_CONDITION:
         raise UserError(f"singular configuration at q = {np.round(q, 6).tolist()}: the Jacobian loses rank")
-    H = device.H(q)
+    H = mass_matrix(device, q)
     M_C = dynamic.cartesian_inertia(H, J)
     radii, _ = kinematic.velocity_ellipsoid(J)
     return {

@@ -15,7 +15,11 @@ import typer
 
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import parse_vector, print_json, progress_bar, user_errors
-from hapticdesign.interface.options import JSON_OUT, QUIET
+from hapticdesign.interface.options import FORCE, FORCE_HINT, JSON_OUT, QUIET
+from hapticdesign.workload import allow_large
+
+MAP_POINT_LIMIT = 3 * 201 * 201
+"""Poses the metric maps may evaluate without --force (3 planes of 201 x 201: about a minute)."""
 
 rcube_app = typer.Typer(help="Modified R-CUBE: kinematics, VJM stiffness, dynamics, metrics, optimization (seed 001 ch. 4-7).", no_args_is_help=True)
 
@@ -249,13 +253,16 @@ def maps(out: Path = typer.Option(..., "--out", help="Directory for the PNG imag
          l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[float] = L3,
          offset: Optional[float] = OFFSET, sigma: int = SIGMA, design: Optional[Path] = DESIGN,
          outer: Optional[str] = OUTER, inner: Optional[str] = INNER, plies: Optional[str] = PLIES,
-         density: Optional[float] = DENSITY, json_out: bool = JSON_OUT, quiet: bool = QUIET) -> None:
+         density: Optional[float] = DENSITY, json_out: bool = JSON_OUT, quiet: bool = QUIET,
+         force: bool = FORCE) -> None:
     """Metric maps on the planes z = home - side/2, home, home + side/2 (Figures 7.5-7.19)."""
     from hapticdesign.analysis.rcube.metrics import save_workspace_maps
+    from hapticdesign.workload import require_within
 
-    with user_errors(quiet=quiet):
+    with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
         if n < 2:
             raise UserError("--n must be at least 2")
+        require_within(f"maps of {n} x {n} points on 3 planes", 3.0 * n * n, MAP_POINT_LIMIT, "poses")
         if not side > 0.0:
             raise UserError("--side must be positive")
         dsg = _design(design, l1, l2, l3, offset, sigma, outer, inner, plies, density)

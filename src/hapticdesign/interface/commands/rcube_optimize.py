@@ -11,7 +11,8 @@ import typer
 
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import note, print_json, progress_bar, to_jsonable, user_errors
-from hapticdesign.interface.options import JSON_OUT, QUIET, SEED
+from hapticdesign.interface.options import FORCE, FORCE_HINT, JSON_OUT, QUIET, SEED
+from hapticdesign.workload import allow_large
 
 OUT = typer.Option(None, "--out", help="Directory for the CSV tables and PNG/SVG figures.")
 QUICK = typer.Option(False, "--quick", help="Small populations and few generations (tests, demos).")
@@ -23,10 +24,20 @@ SIDE = typer.Option(0.120, "--side", help="Workspace cube edge (m), 120 mm in th
 VIRTUAL = typer.Option(0.130, "--virtual-side", help="Virtual cube edge for the passive constraints (m), 130 mm.")
 
 
+EVALUATION_LIMIT = 2e6
+"""Objective evaluations an optimization command may plan without --force (the default chain plans
+about 1.4e5 and takes about a minute on 2 cores; docs/limits.md)."""
+
+
 def _settings(quick: bool, population: Optional[int], generations: Optional[int]):
     from hapticdesign.optimization.chain import Settings
+    from hapticdesign.workload import require_within
 
-    return (Settings.quick() if quick else Settings()).with_population(population, generations)
+    s = (Settings.quick() if quick else Settings()).with_population(population, generations)
+    planned = (3 * s.population * s.generations + s.cs_population * s.cs_generations
+               + s.ply_population * s.ply_generations)
+    require_within("the optimization", planned, EVALUATION_LIMIT, "objective evaluations")
+    return s
 
 
 def _bound_sets(text: Optional[str]):
@@ -74,12 +85,12 @@ def register(app: typer.Typer) -> None:
                  generations: Optional[int] = GENERATIONS, weight: float = WEIGHT, bounds: Optional[str] = BOUNDS,
                  side: float = SIDE, virtual_side: float = VIRTUAL,
                  max_deflection: Optional[float] = typer.Option(None, "--max-deflection", help="Ply choice: fewest plies with CF1 below this (m) under 20 N."),
-                 json_out: bool = JSON_OUT, quiet: bool = QUIET) -> None:
+                 json_out: bool = JSON_OUT, quiet: bool = QUIET, force: bool = FORCE) -> None:
         """The whole chain: synthesis, selection, swarm, cross-section and plies (seed 001 ch. 7)."""
         from hapticdesign.optimization.chain import chain_summary, run_chain, write_chain
         from hapticdesign.optimization.constraints import Workspace
 
-        with user_errors(quiet=quiet):
+        with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
             settings = _settings(quick, population, generations)
             with progress_bar(not (quiet or json_out)) as report:
                 result = run_chain(seed, settings, weight, _bound_sets(bounds), Workspace(side, virtual_side),
@@ -103,13 +114,14 @@ def register(app: typer.Typer) -> None:
     @rcube_app.command()
     def synthesize(seed: int = SEED, out: Optional[Path] = OUT, quick: bool = QUICK, population: Optional[int] = POPULATION,
                    generations: Optional[int] = GENERATIONS, weight: float = WEIGHT, bounds: Optional[str] = BOUNDS,
-                   side: float = SIDE, virtual_side: float = VIRTUAL, json_out: bool = JSON_OUT, quiet: bool = QUIET) -> None:
+                   side: float = SIDE, virtual_side: float = VIRTUAL, json_out: bool = JSON_OUT, quiet: bool = QUIET,
+                   force: bool = FORCE) -> None:
         """Kinematic synthesis by NSGA-II over Table 7.1's bounds, post-evaluation and selection (§7.1-7.2)."""
         from hapticdesign.optimization import chain
         from hapticdesign.optimization.constraints import Workspace
         from hapticdesign.optimization.synthesis import synthesize as run
 
-        with user_errors(quiet=quiet):
+        with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
             s = _settings(quick, population, generations)
             workspace = Workspace(side, virtual_side)
             sets = _bound_sets(bounds)
@@ -137,12 +149,12 @@ def register(app: typer.Typer) -> None:
                       population: Optional[int] = POPULATION, generations: Optional[int] = GENERATIONS,
                       lower: float = typer.Option(0.0, "--lower", help="Lower bound of d/D."),
                       upper: float = typer.Option(0.9, "--upper", help="Upper bound of d/D (thin-wall limit)."),
-                      json_out: bool = JSON_OUT, quiet: bool = QUIET) -> None:
+                      json_out: bool = JSON_OUT, quiet: bool = QUIET, force: bool = FORCE) -> None:
         """Inner/outer diameter ratio from CS1 = 1/S_l and CS2 = I_l (eq. 6.85-6.90, Figure 7.4)."""
         from hapticdesign.optimization import chain
         from hapticdesign.optimization.cross_section import exact_ratio, optimize_ratio
 
-        with user_errors(quiet=quiet):
+        with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
             s = _settings(quick, population, generations)
             result = optimize_ratio((lower, upper), s.cs_population, s.cs_generations, seed)
             if out is not None:
@@ -161,13 +173,13 @@ def register(app: typer.Typer) -> None:
               l3: float = typer.Option(0.1218, "--l3", help="Link length l3 (m)."),
               ratio: float = typer.Option(0.768, "--ratio", help="Diameter ratio d/D (eq. 7.5)."),
               max_deflection: Optional[float] = typer.Option(None, "--max-deflection", help="Fewest plies with CF1 below this (m)."),
-              json_out: bool = JSON_OUT, quiet: bool = QUIET) -> None:
+              json_out: bool = JSON_OUT, quiet: bool = QUIET, force: bool = FORCE) -> None:
         """Integer ply counts at 0, 90, +-45 deg per link under 20 N at full extension (eq. 6.91-6.96)."""
         from hapticdesign.model.rcube import RCubeGeometry
         from hapticdesign.optimization import chain
         from hapticdesign.optimization.plies import optimize_plies, ply_design
 
-        with user_errors(quiet=quiet):
+        with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
             s = _settings(quick, population, generations)
             geometry = RCubeGeometry(l1, l2, l3)
             with progress_bar(not (quiet or json_out)) as report:

@@ -304,6 +304,8 @@ def campaign_command(
     stiffness: float = typer.Option(4.0, help="Wall stiffness of the transparency runs [N m/rad] (seed: 4)."),
     sweep: float = typer.Option(10.0, help="Chirp sweep time [s] (seed: 10)."),
     f1: float = typer.Option(15.0, help="Chirp end frequency [Hz] (seed: 15)."),
+    method: str = typer.Option("simulation", help="Impedance cases by simulation or analytic (the exact linear "
+                                                  "response: exact for type 1 and LN = 0; transparency is simulated)."),
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
     force: bool = FORCE,
@@ -327,7 +329,10 @@ def campaign_command(
         _check_chirp(0.3, 0.1, f1, sweep, 1e-3)
         if duration < 0.5:
             raise UserError(f"--duration ({duration:g} s) must not be shorter than the 0.5 s settle window")
-        options = CampaignOptions(preset or "phantom-3dof", k_limit, stiffness, Chirp(0.3, 0.1, f1, sweep), duration)
+        if method not in ("simulation", "analytic"):
+            raise UserError(f"--method must be 'simulation' or 'analytic', got {method!r}")
+        options = CampaignOptions(preset or "phantom-3dof", k_limit, stiffness, Chirp(0.3, 0.1, f1, sweep), duration,
+                                  method=method)
         with progress_bar(not (quiet or json_out)) as report:
             advance = (lambda done, total: report("cases", done, total)) if report else None
             counts = run_campaign(designs, out, options, scheduler, workers, advance, quiet=quiet)

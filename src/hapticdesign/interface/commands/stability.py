@@ -8,6 +8,7 @@ from typing import Optional
 
 import typer
 
+from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import note, parse_vector, print_json, user_errors
 from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, SEED, STRICT
@@ -31,8 +32,8 @@ def _device_joint(preset, device, params, strict, q, joint, error_percent, compe
     dev = resolve_device(preset, device, params, strict=strict)
     pose = parse_vector(q, dev.n_dof, "q")
     j = joint_index(dev, joint)
-    inertia = float(dev.H(pose)[j, j])
-    fraction = float(model_device(dev, error_percent).H(pose)[j, j]) / inertia if compensate else 0.0
+    inertia = float(mass_matrix(dev, pose)[j, j])
+    fraction = float(mass_matrix(model_device(dev, error_percent), pose)[j, j]) / inertia if compensate else 0.0
     return inertia, float(dev.damping[j]), fraction
 
 

@@ -9,6 +9,7 @@ import typer
 from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
 
+from hapticdesign.analysis.dynamics.device import inverse_dynamics
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import print_json, user_errors
 from hapticdesign.interface.options import DEVICE, JSON_OUT, PRESET, QUIET, SEED
@@ -141,7 +142,7 @@ def _print_equations(echo) -> None:
          "parameters), so tau below does not depend on q.")
     for q in (np.zeros(3), np.array([0.3, -0.4, 0.7])):
         qd, qdd = np.full(3, 0.5), np.ones(3)
-        tau = device.inverse_dynamics(q, qd, qdd)
+        tau = inverse_dynamics(device, q, qd, qdd)
         echo(f"q = {q.tolist()}, qd = {qd.tolist()}, qdd = {qdd.tolist()}: tau = "
              + " ".join(f"{v:.6e}" for v in tau) + " N m")
 

@@ -1,10 +1,14 @@
-"""Front door for the command line: resolve a device, build its form, evaluate."""
+"""The Linearity Number commands' work: resolve the device, run the engines, shape and write the output.
+
+The engines live in :mod:`hapticdesign.analysis.linearity`; this module parses the command-line
+options (its errors name the flags), writes the files and formats the text. The commands in
+:mod:`.linearity` import it when they run, so ``hapticdesign --help`` does not load the solvers.
+"""
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -13,15 +17,14 @@ from hapticdesign.analysis.linearity.bounds import practical_bounds
 from hapticdesign.analysis.linearity.closed_form import closed_form
 from hapticdesign.analysis.linearity.conditions import linear_conditions, seed_conditions
 from hapticdesign.analysis.linearity.design_sets import DesignSet, Method, design_set
-from hapticdesign.analysis.linearity.form import PARTS, LinearityForm, linearity_form
+from hapticdesign.analysis.linearity.form import PARTS, LinearityForm, device_form
 from hapticdesign.analysis.linearity.linear_designs import find_linear_designs
-from hapticdesign.analysis.linearity.verdict import decide_linearizable, minimum_ln
-from hapticdesign.analysis.linearity.region import Region, limits_region, resolve_region
-from hapticdesign.analysis.linearity.weights import Weights, read_weights
+from hapticdesign.analysis.linearity.region import resolve_region
+from hapticdesign.analysis.linearity.verdict import decide_linearizable, minimum_ln, scaled_minimum
+from hapticdesign.analysis.linearity.weights import read_weights
 from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
 from hapticdesign.files import write_atomically
-from hapticdesign.model.device import Device
 from hapticdesign.model.inertia import Realizability
 from hapticdesign.workload import require_designs
 
@@ -32,22 +35,6 @@ class LNResult:
     region: str
     ln: float
     parts: dict[str, float]
-
-
-def device_form(device: Device, region: Region | None = None, weights: Weights | None = None) -> LinearityForm:
-    """The LN form of a device (cached per geometry and region when the weights are the defaults).
-
-    The default region is the box of the device's joint limits, full turns where it has none.
-    """
-    region = limits_region(device.joint_limits()) if region is None else region
-    if weights is None:
-        return _default_form(device.model, tuple(sorted(region.ranges.items())))
-    return linearity_form(device.model, region, weights)
-
-
-@lru_cache(maxsize=8)
-def _default_form(model, ranges: tuple) -> LinearityForm:
-    return linearity_form(model, Region(dict(ranges)) if ranges else None)
 
 
 def evaluate_ln(
@@ -217,13 +204,6 @@ def linearize_report(result: dict) -> list[str]:
         else:
             lines += ["", designs["csv"].rstrip()]
     return lines
-
-
-def scaled_minimum(device: Device, mins) -> float:
-    """LN of the practical optimum scaled down until its smallest mass or moment is 1e-15 (eq. 3.40-3.42)."""
-    bodies = [k for k, b in enumerate(device.body_names)]
-    smallest = min(min(mins.design[k, 0], mins.design[k, 4:7].min()) for k in bodies if mins.design[k, 0] > 0)
-    return mins.ln * (1e-15 / smallest) ** 2
 
 
 def write_design_set(

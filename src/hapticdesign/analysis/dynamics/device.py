@@ -1,0 +1,66 @@
+"""The equations of motion of a device: its compiled model and H, C, C_cvt, G, tau, qdd as free functions.
+
+:func:`dynamics_of` gives the regressor model of a device's geometry (cached per builder and
+kinematic parameters, so every device that differs only in inertial parameters shares it). With
+actuators, H carries the constant reflected rotor inertia (seed 000 eq. 2.50 plus ``diag(n^2 J_r)``);
+the regressor in the inertial parameters is the same object's. The other functions evaluate that
+model at the device's standard parameters (seed 000 eq. 2.50-2.52).
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+
+from hapticdesign.analysis.dynamics.closed_loop import ClosedLoopModel
+from hapticdesign.analysis.dynamics.model import DynamicsModel
+from hapticdesign.model.device import Device, MechanismBuilder, build_mechanism
+
+
+def dynamics_of(device: Device) -> DynamicsModel:
+    """The compiled regressor model of the device's equations of motion (cached per geometry)."""
+    kind = ClosedLoopModel if device.mechanism.loops is not None else DynamicsModel
+    base = _model(kind, device.builder, device.kinematic_values())
+    extra = device.reflected_inertia if device.actuators else ()
+    return _with_rotors(base, extra) if any(extra) else base
+
+
+def mass_matrix(device: Device, q: np.ndarray) -> np.ndarray:
+    """H (eq. 2.50) at one pose (N,) or many (P, N)."""
+    return dynamics_of(device).H(q, device.standard_parameters())
+
+
+def coriolis_centrifugal(device: Device, q: np.ndarray) -> np.ndarray:
+    """C of eq. 2.50, N x N(N+1)/2, the coefficients of the velocity products ``thetadot^2``."""
+    return dynamics_of(device).C(q, device.standard_parameters())
+
+
+def coriolis_matrix(device: Device, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    """C_cvt of eq. 2.51-2.52, N x N, with ``C_cvt qd`` the Coriolis and centrifugal torques."""
+    return dynamics_of(device).C_cvt(q, qd, device.standard_parameters())
+
+
+def gravity(device: Device, q: np.ndarray) -> np.ndarray:
+    """G, the gravity torques of eq. 2.50."""
+    return dynamics_of(device).G(q, device.standard_parameters())
+
+
+def inverse_dynamics(device: Device, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+    """``tau = H qdd + C qd^2 + G`` (eq. 2.50)."""
+    return dynamics_of(device).inverse(q, qd, qdd, device.standard_parameters())
+
+
+def forward_dynamics(device: Device, q: np.ndarray, qd: np.ndarray, tau: np.ndarray) -> np.ndarray:
+    """``qdd = H^-1 (tau - C qd^2 - G)``."""
+    return dynamics_of(device).forward(q, qd, tau, device.standard_parameters())
+
+
+@lru_cache(maxsize=16)
+def _model(cls, builder: MechanismBuilder, kinematic: tuple[tuple[str, float], ...]):
+    return cls(build_mechanism(builder, kinematic))
+
+
+@lru_cache(maxsize=16)
+def _with_rotors(base, reflected: tuple[float, ...]):
+    return base.with_constant_inertia(np.diag(reflected))
