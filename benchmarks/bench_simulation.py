@@ -61,6 +61,27 @@ def _wall_run() -> None:
           f"speed-up {t_slow2 / t_fast2:.0f}x")
 
 
+def _analytic_against_simulated() -> None:
+    """Impedance cases of the campaign answered analytically and by simulation, same designs, one process."""
+    from hapticdesign.simulation.campaign import CampaignOptions, read_designs, run_case
+
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "designs.csv"
+        _designs(path, 16)
+        designs = read_designs(path)
+    timings = {}
+    for method in ("analytic", "simulation"):
+        options = CampaignOptions(method=method)
+        run_case("phantom-3dof", designs[0].params, "impedance", 1, options)  # compile / warm up
+        t0 = time.perf_counter()
+        values = [run_case("phantom-3dof", d.params, "impedance", t, options)["value"] for d in designs for t in (1, 2)]
+        timings[method] = (time.perf_counter() - t0) / len(values), values
+    same = sum(a == b for a, b in zip(timings["analytic"][1], timings["simulation"][1]))
+    print(f"impedance case: analytic {timings['analytic'][0] * 1e3:.1f} ms, simulated {timings['simulation'][0] * 1e3:.1f} ms "
+          f"({timings['simulation'][0] / timings['analytic'][0]:.0f}x); same K_max in {same} of {len(values)} cases "
+          f"(type 1 is exact, type 2 a frozen-pose approximation)")
+
+
 def _designs(path: Path, count: int) -> None:
     device = preset("phantom-3dof")
     names = device.inertial_names()
@@ -126,6 +147,7 @@ def main(argv: list[str] | None = None) -> None:
         _full_campaign(args.realizability, args.out, args.workers)
         return
     _wall_run()
+    _analytic_against_simulated()
     _campaign()
 
 

@@ -247,3 +247,18 @@ def test_non_finite_results_are_not_printed_as_json():
     with pytest.raises(UserError, match=r"not finite \(H\[1\]\)"):
         dumps_json({"H": [1.0, float("nan")]})
     assert dumps_json({"H": [1.0, 2.0]}) == '{"H": [1.0, 2.0]}'
+
+
+@pytest.mark.parametrize("body, fragment", [
+    ("l1: abc", "l1 must be a number"),
+    ("sigma: x", "sigma must be -1 or 1"),
+    ("links: [{D: 0.02, d: 0.01, plies: 5}, {D: 0.02, d: 0.01, plies: 5}, {D: 0.02, d: 0.01, plies: 5}]",
+     "plies must be four whole numbers"),
+    ("colour: red", "unknown key(s) 'colour'"),
+    ("density: -5", "density must be a positive finite number"),
+    ("l2: .nan", "l2 must be a positive finite number"),
+    ("links: [1, 2, 3]", "a link entry is a mapping"),
+])
+def test_rcube_design_files_are_validated(tmp_path, body, fragment):
+    path = _write(tmp_path / "design.yaml", body + "\n")
+    _one_error(runner.invoke(app, ["rcube", "stiffness", "--design", str(path)]), fragment)

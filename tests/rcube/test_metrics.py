@@ -88,3 +88,16 @@ def test_rcube_metrics_at_home_and_maps(tmp_path):
     assert all(np.isnan(m[k][1]) for k in METRIC_NAMES)  # unreachable point
     paths = save_workspace_maps(design, tmp_path, n=3, names=("manipulability",))
     assert len(paths) == 3 and all(p.stat().st_size > 0 and p.read_bytes()[:4] == b"\x89PNG" for p in paths)
+
+
+def test_dynamic_manipulability_is_a_magnitude():
+    """A mirrored Jacobian (det J < 0) gives the same I_d: |det J| / det M (eq. 4.97)."""
+    import numpy as np
+
+    from hapticdesign.analysis.metrics.dynamic import dynamic_manipulability
+
+    J = np.array([[1.0, 0.2], [0.1, 0.5]])
+    M = np.array([[2.0, 0.3], [0.3, 1.0]])
+    mirrored = J[::-1]
+    assert np.linalg.det(mirrored) < 0
+    assert dynamic_manipulability(M, mirrored) == dynamic_manipulability(M, J) == abs(np.linalg.det(J)) / np.linalg.det(M)

@@ -79,3 +79,31 @@ def test_zwidth_chart_and_analytic_method(tmp_path):
     result = runner.invoke(app, ["impedance-range", "--method", "analytic", "--json"])
     out = json.loads(result.stdout)
     assert out["method"] == "analytic" and out["analytic_exact"] is True and out["k_max"] == 6.0
+
+
+PRISMATIC = """\
+name: slider
+joints:
+  - {name: x, type: prismatic, damping: 2.0}
+frames:
+  - {name: carriage, parent: base, transforms: [tx: x]}
+end_effector: carriage
+bodies:
+  - {name: c, frame: carriage, m: 0.5}
+"""
+
+
+def test_a_prismatic_wall_is_labelled_in_newtons(tmp_path):
+    """A 0.5 kg slider with 2 N s/m: compensated, the limit is b^2 / m = 8 N/m, reported in N/m."""
+    path = tmp_path / "slider.yaml"
+    path.write_text(PRISMATIC)
+    result = runner.invoke(app, ["impedance-range", "--device", str(path), "--method", "analytic", "--resolution",
+                                 "0.25", "--true-boundary", "--json"])
+    assert result.exit_code == 0, result.output
+    out = json.loads(result.stdout)
+    assert out["units"]["k_max"] == "N/m"
+    dyn = json.loads(runner.invoke(app, ["dynamics", "--device", str(path), "--q", "0.1", "--json"]).stdout)
+    assert dyn["units"]["joints"][0]["effort"] == "N" and dyn["H"] == [[0.5]]
+    zw = json.loads(runner.invoke(app, ["zwidth", "--device", str(path), "--compensate-inertia", "--b-values", "0",
+                                        "--json"]).stdout)
+    assert zw["K"][0] == pytest.approx(2.0 ** 2 / 0.5, rel=1e-8)

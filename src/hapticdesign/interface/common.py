@@ -106,3 +106,19 @@ def fail(message: str) -> None:
 
 __all__ = ["activity", "fail", "note", "parse_vector", "print_json", "progress_bar", "to_jsonable", "user_errors",
            "write_atomically"]
+
+
+def joint_units(device) -> list[dict[str, str]]:
+    """Per coordinate: its unit and those of its torque (force), stiffness and damping (revolute
+    joints in rad, N m, N m/rad, N m s/rad; prismatic joints in m, N, N/m, N s/m)."""
+    from hapticdesign.model.mechanism import JointType
+
+    types = device.mechanism.joint_types
+    coordinates = device.mechanism.coordinates
+    actuated = getattr(device.mechanism, "actuated_coordinates", coordinates)
+    out = []
+    for name in actuated:
+        prismatic = types[coordinates.index(name)] == JointType.PRISMATIC
+        out.append({"joint": name, "position": "m" if prismatic else "rad", "effort": "N" if prismatic else "N m",
+                    "stiffness": "N/m" if prismatic else "N m/rad", "damping": "N s/m" if prismatic else "N m s/rad"})
+    return out

@@ -25,8 +25,9 @@ def inertia_volume(M_C) -> np.ndarray:
 
 
 def dynamic_manipulability(M, J) -> np.ndarray:
-    """``I_d = det(J M^-1) = det J / det M`` (eq. 4.97)."""
-    return np.linalg.det(np.asarray(J, dtype=float)) / np.linalg.det(np.asarray(M, dtype=float))
+    """``I_d = |det(J M^-1)| = |det J| / det M`` (eq. 4.97; a magnitude, like the absolute
+    manipulability of eq. 4.38: the sign of det J only tells the branch, M is positive definite)."""
+    return np.abs(np.linalg.det(np.asarray(J, dtype=float))) / np.linalg.det(np.asarray(M, dtype=float))
 
 
 def inertia_frobenius(M_C) -> np.ndarray:

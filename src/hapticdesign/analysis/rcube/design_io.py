@@ -9,11 +9,12 @@ torsional}`` in N m/rad, N/m, N m/rad (any omitted: rigid; ``torsional`` default
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from hapticdesign.errors import UserError
-from hapticdesign.files import parse_structured, read_text
+from hapticdesign.files import parse_structured, quote, read_text
 from hapticdesign.model.rcube import RCubeGeometry
 from hapticdesign.analysis.rcube.design import FINAL_DENSITY, JOINT_NAMES, RIGID_JOINTS, RCubeDesign, final_design
 from hapticdesign.analysis.stiffness.joints import JointStiffness
@@ -22,25 +23,52 @@ from hapticdesign.analysis.stiffness.materials import isotropic, laminate
 from hapticdesign.analysis.stiffness.sections import Tube
 
 
-def _number(entry: Mapping, key: str, where: str) -> float:
+DESIGN_KEYS = ("l1", "l2", "l3", "offset", "sigma", "density", "links", "joints")
+LINK_KEYS = ("D", "d", "plies", "E", "G", "density")
+
+
+def _number(entry: Mapping, key: str, where: str, positive: bool = False) -> float:
     if key not in entry:
         raise UserError(f"{where}: missing {key!r}")
+    value = entry[key]
+    if isinstance(value, bool):
+        raise UserError(f"{where}: {key} must be a number, got {quote(value)}")
     try:
-        return float(entry[key])
+        number = float(value)
     except (TypeError, ValueError):
-        raise UserError(f"{where}: {key} must be a number, got {entry[key]!r}") from None
+        raise UserError(f"{where}: {key} must be a number, got {quote(value)}") from None
+    if not math.isfinite(number) or (positive and number <= 0):
+        raise UserError(f"{where}: {key} must be a {'positive ' if positive else ''}finite number, got {quote(value)}")
+    return number
+
+
+def _known(entry: Mapping, keys: tuple[str, ...], where: str) -> None:
+    unknown = sorted(map(str, set(entry) - set(keys)))
+    if unknown:
+        raise UserError(f"{where}: unknown key(s) {', '.join(quote(k) for k in unknown[:5])}; use {', '.join(keys)}")
+
+
+def _plies(value, where: str) -> tuple[int, int, int, int]:
+    if (not isinstance(value, Sequence) or isinstance(value, str) or len(value) != 4
+            or not all(isinstance(v, int) and not isinstance(v, bool) and 0 <= v <= 1000 for v in value)):
+        raise UserError(f"{where}: plies must be four whole numbers of plies at 0, 90, -45, 45 degrees, "
+                        f"got {quote(value)}")
+    return tuple(value)
 
 
 def link_from_mapping(entry: Mapping, density: float, where: str) -> LinkDesign:
     """One link: a tube plus either ply counts (M55J laminate) or isotropic ``E`` and ``G``."""
-    tube = Tube(_number(entry, "D", where), _number(entry, "d", where))
+    if not isinstance(entry, Mapping):
+        raise UserError(f"{where}: a link entry is a mapping of {', '.join(LINK_KEYS)}")
+    _known(entry, LINK_KEYS, where)
+    tube = Tube(_number(entry, "D", where, True), _number(entry, "d", where, True))
     if "plies" in entry:
-        moduli = laminate(tuple(entry["plies"]))
+        moduli = laminate(_plies(entry["plies"], where))
     elif "E" in entry:
         moduli = isotropic(_number(entry, "E", where), _number(entry, "G", where) if "G" in entry else None)
     else:
         raise UserError(f"{where}: give 'plies' (M55J laminate) or 'E' (isotropic material)")
-    return LinkDesign(tube, moduli, float(entry.get("density", density)))
+    return LinkDesign(tube, moduli, _number(entry, "density", where, True) if "density" in entry else density)
 
 
 JOINT_KEYS = ("rotational", "translational", "torsional")
@@ -72,15 +100,16 @@ def design_from_mapping(data: Mapping) -> RCubeDesign:
     """A design from a mapping; missing links take the final design's links (Table 7.8)."""
     if not isinstance(data, Mapping):
         raise UserError("a design file holds a mapping of l1, l2, l3, links, ...")
+    _known(data, DESIGN_KEYS, "design file")
     base = final_design()
-    geometry = RCubeGeometry(
-        float(data.get("l1", base.geometry.l1)),
-        float(data.get("l2", base.geometry.l2)),
-        float(data.get("l3", base.geometry.l3)),
-        None if data.get("offset") is None else float(data["offset"]),
-        int(data.get("sigma", -1)),
-    )
-    density = float(data.get("density", FINAL_DENSITY))
+    lengths = [_number(data, k, "design file", True) if k in data else getattr(base.geometry, k)
+               for k in ("l1", "l2", "l3")]
+    offset = None if data.get("offset") is None else _number(data, "offset", "design file")
+    sigma = data.get("sigma", -1)
+    if sigma not in (-1, 1) or isinstance(sigma, bool):
+        raise UserError(f"design file: sigma must be -1 or 1 (the passive configuration, eq. 5.42), got {quote(sigma)}")
+    geometry = RCubeGeometry(*lengths, offset, int(sigma))
+    density = _number(data, "density", "design file", True) if "density" in data else FINAL_DENSITY
     joints = joints_from_data(data.get("joints"))
     links = data.get("links")
     if links is None:

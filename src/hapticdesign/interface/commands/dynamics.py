@@ -18,7 +18,7 @@ from hapticdesign.analysis.dynamics.device import (
 )
 from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
 from hapticdesign.devices.loading import resolve_device
-from hapticdesign.interface.common import note as stderr_note, parse_vector, print_json, user_errors
+from hapticdesign.interface.common import joint_units, note as stderr_note, parse_vector, print_json, user_errors
 
 
 
@@ -53,6 +53,8 @@ def dynamics(
             "C_cvt": coriolis_matrix(dev, qv, qdv),
             "G": gravity(dev, qv),
             "tau": inverse_dynamics(dev, qv, qdv, qddv),
+            "units": {"joints": joint_units(dev),
+                      "note": "SI: q in rad or m, tau in N m or N; H, C, G in the units that make tau so"},
         }
         if json_out:
             print_json(result)

@@ -11,7 +11,7 @@ import typer
 from hapticdesign.interface.options import DEVICE, FORCE, FORCE_HINT, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
 from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
-from hapticdesign.interface.common import print_json, progress_bar, user_errors, write_atomically
+from hapticdesign.interface.common import joint_units, print_json, progress_bar, user_errors, write_atomically
 from hapticdesign.workload import allow_large
 
 # Magnitudes the 1-DOF boundary is computed for (SI units); outside them exp(-b T / J) and the
@@ -138,7 +138,10 @@ def impedance_range_command(
             result = grid_search(problem, resolution, k_limit)
         else:
             result = (fast_search if method == "fast" else linear_scan)(problem, k_limit)
-        out = {"device": dev.name, "type": sim_type, "joint": problem.wall_joint + 1, **result.as_dict()}
+        unit = joint_units(dev)[problem.wall_joint]
+        out = {"device": dev.name, "type": sim_type, "joint": problem.wall_joint + 1, **result.as_dict(),
+               "units": {"k_max": unit["stiffness"], "k_min": unit["stiffness"], "peak_at_first_unstable": unit["position"],
+                         "stopped_at_first_unstable": "s"}}
         if true_boundary:
             out["k_true_boundary"] = growth_boundary(problem)
         if json_out:
@@ -146,7 +149,7 @@ def impedance_range_command(
             return
         lowest = "" if out["k_min"] is None else f", lowest passing {out['k_min']:g}"
         typer.echo(f"{dev.name}, type {sim_type}, joint {out['joint']}: maximum stable impedance "
-                   f"{out['k_max']:g} N m/rad{lowest} (first failure: {out['criterion']}; "
+                   f"{out['k_max']:g} {unit['stiffness']}{lowest} (first failure: {out['criterion']}; "
                    f"{out['simulations']} simulations)")
         if true_boundary:
             typer.echo(f"oscillation-growth boundary: {out['k_true_boundary']:.4g} N m/rad")
@@ -189,8 +192,10 @@ def transparency_command(
                               joint_index(dev, joint), band_db=band)
         if response is not None:
             write_atomically(response, result.response_table())
+        unit = joint_units(dev)[joint_index(dev, joint)]
         out = {"device": dev.name, "type": sim_type, "joint": joint_index(dev, joint) + 1,
-               "stiffness": stiffness, **result.as_dict()}
+               "stiffness": stiffness, **result.as_dict(),
+               "units": {"stiffness": unit["stiffness"], "bandwidth_hz": "Hz", "band_db": "dB"}}
         if json_out:
             print_json(out)
             return
