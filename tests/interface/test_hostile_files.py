@@ -262,3 +262,20 @@ def test_non_finite_results_are_not_printed_as_json():
 def test_rcube_design_files_are_validated(tmp_path, body, fragment):
     path = _write(tmp_path / "design.yaml", body + "\n")
     _one_error(runner.invoke(app, ["rcube", "stiffness", "--design", str(path)]), fragment)
+
+
+def test_rcube_fk_refuses_a_pose_the_passive_links_cannot_reach():
+    args = ["rcube", "fk", "--q1", "1.5", "--q2", "-1.5", "--q3", "1.5", "--l2", "0.02", "--l3", "0.02"]
+    _one_error(runner.invoke(app, args), "cannot reach")
+    assert runner.invoke(app, ["rcube", "fk", "--q1", "0.1", "--q2", "0", "--q3", "-0.1"]).exit_code == 0
+
+
+def test_progress_lines_for_logs_print_each_tenth(capsys):
+    from hapticdesign.interface.common import progress_lines
+
+    assert progress_lines(False, "x") is None
+    report = progress_lines(True, "campaign cases")
+    for done in range(1, 101):
+        report(done, 100)
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 10 and lines[0] == "campaign cases: 10 of 100" and lines[-1] == "campaign cases: 100 of 100"

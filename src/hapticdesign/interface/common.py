@@ -122,3 +122,18 @@ def joint_units(device) -> list[dict[str, str]]:
         out.append({"joint": name, "position": "m" if prismatic else "rad", "effort": "N" if prismatic else "N m",
                     "stiffness": "N/m" if prismatic else "N m/rad", "damping": "N s/m" if prismatic else "N m s/rad"})
     return out
+
+
+def progress_lines(enabled: bool, label: str, steps: int = 10) -> Callable[[int, int], None] | None:
+    """Progress for a long run whose stderr is not a terminal (a log, CI): one line each tenth."""
+    if not enabled:
+        return None
+    shown = {-1}
+
+    def report(done: int, total: int) -> None:
+        tenth = (steps * done) // max(total, 1)
+        if tenth not in shown:
+            shown.add(tenth)
+            typer.echo(f"{label}: {done} of {total}", err=True)
+
+    return report

@@ -148,11 +148,20 @@ def fk(q1: float = typer.Option(..., "--q1", help="Active angle q11 (rad)."),
        offset: Optional[float] = OFFSET, sigma: int = SIGMA, design: Optional[Path] = DESIGN,
        json_out: bool = JSON_OUT, quiet: bool = QUIET) -> None:
     """Forward kinematics (eq. 5.28): platform position from the active angles."""
-    from hapticdesign.analysis.rcube.kinematics import forward_kinematics
+    from hapticdesign.analysis.rcube.kinematics import forward_kinematics, inverse_kinematics
 
     with user_errors(quiet=quiet):
         dsg = _design(design, l1, l2, l3, offset, sigma)
-        r = forward_kinematics(dsg.geometry, np.array([q1, q2, q3]))
+        angles = np.array([q1, q2, q3])
+        if not np.all(np.isfinite(angles)):
+            raise UserError("--q1, --q2 and --q3 must be finite angles")
+        r = forward_kinematics(dsg.geometry, angles)
+        try:  # eq. 5.28 places the platform from the active angles alone; the passive links must reach it
+            inverse_kinematics(dsg.geometry, r)
+        except UserError:
+            raise UserError(f"the active angles {q1:g}, {q2:g}, {q3:g} rad put the platform at "
+                            f"{', '.join(f'{v:.4g}' for v in r)} m, which the passive links "
+                            f"(l2 = {dsg.geometry.l2:g}, l3 = {dsg.geometry.l3:g} m) cannot reach") from None
         if json_out:
             print_json({"position": r})
             return

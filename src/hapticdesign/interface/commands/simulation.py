@@ -11,7 +11,8 @@ import typer
 from hapticdesign.interface.options import DEVICE, FORCE, FORCE_HINT, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
 from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
-from hapticdesign.interface.common import joint_units, print_json, progress_bar, user_errors, write_atomically
+from hapticdesign.interface.common import (joint_units, print_json, progress_bar, progress_lines, user_errors,
+                                           write_atomically)
 from hapticdesign.workload import allow_large
 
 # Magnitudes the 1-DOF boundary is computed for (SI units); outside them exp(-b T / J) and the
@@ -339,7 +340,8 @@ def campaign_command(
         options = CampaignOptions(preset or "phantom-3dof", k_limit, stiffness, Chirp(0.3, 0.1, f1, sweep), duration,
                                   method=method)
         with progress_bar(not (quiet or json_out)) as report:
-            advance = (lambda done, total: report("cases", done, total)) if report else None
+            advance = ((lambda done, total: report("cases", done, total)) if report
+                       else progress_lines(not (quiet or json_out), "campaign cases"))
             counts = run_campaign(designs, out, options, scheduler, workers, advance, quiet=quiet)
         if json_out:
             chosen = read_designs(designs, options.preset)
