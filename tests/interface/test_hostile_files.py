@@ -278,4 +278,5 @@ def test_progress_lines_for_logs_print_each_tenth(capsys):
     for done in range(1, 101):
         report(done, 100)
     lines = capsys.readouterr().err.strip().splitlines()
-    assert len(lines) == 10 and lines[0] == "campaign cases: 10 of 100" and lines[-1] == "campaign cases: 100 of 100"
+    assert lines[0] == "campaign cases: 1 of 100" and lines[1] == "campaign cases: 10 of 100"  # started, then tenths
+    assert len(lines) == 11 and lines[-1] == "campaign cases: 100 of 100"
