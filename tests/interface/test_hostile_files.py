@@ -280,3 +280,11 @@ def test_progress_lines_for_logs_print_each_tenth(capsys):
     lines = capsys.readouterr().err.strip().splitlines()
     assert lines[0] == "campaign cases: 1 of 100" and lines[1] == "campaign cases: 10 of 100"  # started, then tenths
     assert len(lines) == 11 and lines[-1] == "campaign cases: 100 of 100"
+
+
+@pytest.mark.parametrize("command", [["dynamics"], ["eom"], ["metrics"], ["show"], ["study", "device"], ["ln"],
+                                     ["impedance-range"], ["rcube", "optimize"], ["rcube", "maps"]])
+def test_commands_whose_work_can_grow_take_force(command):
+    """Every command whose work a user's numbers or files can make large lifts the limits with --force."""
+    result = runner.invoke(app, [*command, "--help"], env={"COLUMNS": "200"})
+    assert result.exit_code == 0 and "--force" in result.output

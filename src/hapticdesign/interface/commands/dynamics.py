@@ -16,7 +16,8 @@ from hapticdesign.analysis.dynamics.device import (
     inverse_dynamics,
     mass_matrix,
 )
-from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
+from hapticdesign.interface.options import DEVICE, FORCE, FORCE_HINT, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
+from hapticdesign.workload import allow_large
 from hapticdesign.devices.loading import resolve_device
 from hapticdesign.interface.common import joint_units, note as stderr_note, parse_vector, print_json, user_errors
 
@@ -32,10 +33,11 @@ def dynamics(
     strict: bool = STRICT,
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
+    force: bool = FORCE,
 ) -> None:
     """H, C, C_cvt, G and tau at one pose, in SI units (seed 000 eq. 2.50-2.52); H includes actuators' reflected
     rotor inertia. A pose outside the joint limits is computed, with a warning line on stderr."""
-    with user_errors(quiet=quiet):
+    with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
         dev = resolve_device(preset, device, params, strict=strict)
         n = dev.n_dof
         qv = parse_vector(q, n, "q")
@@ -89,11 +91,12 @@ def eom(
     strict: bool = STRICT,
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
+    force: bool = FORCE,
 ) -> None:
     """Equations of motion as LaTeX, Python or text, symbols as chosen (seed 000 eq. 2.50, Appendix A)."""
     from hapticdesign.analysis.dynamics.symbolic import derive, export
 
-    with user_errors(quiet=quiet):
+    with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
         dev = resolve_device(preset, device, params, strict=strict)
         text = export(derive(dev, symbolic), fmt, part)
         if not json_out:

@@ -19,7 +19,8 @@ from hapticdesign.analysis.metrics import dynamic, kinematic
 from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import note, parse_vector, print_json, user_errors
-from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
+from hapticdesign.interface.options import DEVICE, FORCE, FORCE_HINT, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
+from hapticdesign.workload import allow_large
 from hapticdesign.model.device import Device
 
 SINGULAR_CONDITION = 1e10
@@ -77,9 +78,10 @@ def metrics(
     strict: bool = STRICT,
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
+    force: bool = FORCE,
 ) -> None:
     """Kinematic and dynamic metrics of any device at one pose (seed 001 eq. 4.24-4.38, 4.90-4.99)."""
-    with user_errors(quiet=quiet):
+    with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
         dev = resolve_device(preset, device, params, strict=strict)
         qv = parse_vector(q, dev.n_dof, "q")
         for message in dev.limit_warnings(qv):

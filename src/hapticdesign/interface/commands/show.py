@@ -10,7 +10,8 @@ import typer
 from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import note, print_json, user_errors
-from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
+from hapticdesign.interface.options import DEVICE, FORCE, FORCE_HINT, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
+from hapticdesign.workload import allow_large
 
 
 def show(
@@ -23,6 +24,7 @@ def show(
     strict: bool = STRICT,
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
+    force: bool = FORCE,
 ) -> None:
     """Draw a device (frames and links of seed 000 §2.1-2.3): OUT/device.html and OUT/device.png.
 
@@ -32,7 +34,7 @@ def show(
     from hapticdesign.analysis.view.skeleton import export, parse_pose
     from hapticdesign.files import write_atomically
 
-    with user_errors(quiet=quiet):
+    with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
         dev = resolve_device(preset, device, params, strict=strict)
         pose = parse_pose(q, dev)
         for message in dev.limit_warnings(pose):

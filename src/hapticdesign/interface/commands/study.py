@@ -12,7 +12,8 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, SpinnerColumn
 from hapticdesign.analysis.dynamics.device import inverse_dynamics
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import print_json, user_errors
-from hapticdesign.interface.options import DEVICE, JSON_OUT, PRESET, QUIET, SEED
+from hapticdesign.interface.options import DEVICE, FORCE, FORCE_HINT, JSON_OUT, PRESET, QUIET, SEED
+from hapticdesign.workload import allow_large
 from hapticdesign.studies.steps import STATUS_DONE, StepResult
 
 study_app = typer.Typer(
@@ -113,11 +114,12 @@ def rcube(quick: bool = QUICK, out: Path = OUT, seed: int = SEED, quiet: bool = 
 
 
 def device(device_file: Optional[Path] = DEVICE, preset: Optional[str] = PRESET,
-           out: Path = OUT, seed: int = SEED, quiet: bool = QUIET, as_json: bool = JSON_OUT) -> None:
+           out: Path = OUT, seed: int = SEED, quiet: bool = QUIET, as_json: bool = JSON_OUT,
+           force: bool = FORCE) -> None:
     """Seed 000's analyses on your own device (--device FILE): dynamics, LN, linearization, rendering."""
     from hapticdesign.studies import device as study
 
-    with user_errors(quiet=True):
+    with user_errors(quiet=True), allow_large(force, FORCE_HINT):
         settings = study.DeviceSettings.for_device(device_file, preset, seed)
         _finish(_run(study, settings, _check_out(out), quiet, as_json), quiet, as_json)
 
