@@ -219,9 +219,9 @@ def _campaign(ctx: Context, designs_csv: Path, source: str) -> Outcome:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PhysicalConsistencyWarning)
         try:
-            counts = run_campaign(designs_csv, out, options, workers=s.workers, progress=ctx.update)
+            counts = run_campaign(designs_csv, out, options, workers=s.workers, progress=ctx.update, quiet=True)
         except RuntimeError:  # a local Dask worker that failed to start (seen under heavy load): resume once
-            counts = run_campaign(designs_csv, out, options, workers=s.workers, progress=ctx.update)
+            counts = run_campaign(designs_csv, out, options, workers=s.workers, progress=ctx.update, quiet=True)
         designs = read_designs(designs_csv, s.preset)
     summary = summarize(designs, load_cases(designs, out), options)
     tables = [_side_by_side(summary, "impedance", TABLE_4_4, "Table 4.4", "N m/rad"),
