@@ -19,7 +19,7 @@ Quantized encoders and Coulomb friction are not linear: the analytic method refu
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
@@ -31,7 +31,7 @@ from hapticdesign.analysis.kinematics import jacobian
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation.config import LoopConfig, compensator_device, plant_friction
-from hapticdesign.simulation.criteria import Criteria, Verdict, check_settle_window, type_paths
+from hapticdesign.simulation.criteria import Verdict, WallProblem, type_paths
 from hapticdesign.simulation.zwidth import DisplayLoop, controller, plant
 
 
@@ -135,19 +135,12 @@ def _powers(m: np.ndarray, s0: np.ndarray, samples: int) -> np.ndarray:
 
 
 @dataclass
-class AnalyticProblem:
+class AnalyticProblem(WallProblem):
     """The analytic counterpart of :class:`~hapticdesign.simulation.impedance.ImpedanceProblem`:
     the same ``verdict(K)`` and ``estimate()``, so the searches (fast, linear, grid) use it as is."""
 
-    device: Device
-    sim_type: int = 1
-    wall_joint: int = 0
-    equilibrium: float = 0.01
-    criteria: Criteria = field(default_factory=Criteria)
-    config: LoopConfig = field(default_factory=LoopConfig)
-
     def __post_init__(self) -> None:
-        check_settle_window(self.criteria, self.config.duration)
+        super().__post_init__()
         self.wall = linearize(self.device, self.sim_type, self.wall_joint, self.config)
         self.sub = self.config.steps_per_sample()
         self.samples = int(round(self.config.duration / self.config.sensors.period))

@@ -6,11 +6,13 @@ Shared by the simulated search (:mod:`.impedance`) and the analytic one (:mod:`.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from hapticdesign.errors import UserError
+from hapticdesign.model.device import Device
+from hapticdesign.simulation.config import LoopConfig
 from hapticdesign.simulation.paths import Held, Path, Sine
 
 
@@ -56,6 +58,25 @@ def type_paths(sim_type: int, n_dof: int, wall_joint: int = 0) -> dict[int, Path
         raise UserError(f"simulation type must be 1 or 2, got {sim_type}")
     path: Path = Held(0.0) if sim_type == 1 else Sine(0.52, 3 * np.pi)
     return {j: path for j in range(n_dof) if j != wall_joint}
+
+
+@dataclass
+class WallProblem:
+    """One device, one simulation type, the wall on one joint: what a stable-range search is asked.
+
+    :class:`~hapticdesign.simulation.impedance.ImpedanceProblem` answers each stiffness by
+    simulation, :class:`~hapticdesign.simulation.analytic.AnalyticProblem` from the exact linear
+    response; the searches take either."""
+
+    device: Device
+    sim_type: int = 1
+    wall_joint: int = 0
+    equilibrium: float = 0.01
+    criteria: Criteria = field(default_factory=Criteria)
+    config: LoopConfig = field(default_factory=LoopConfig)
+
+    def __post_init__(self) -> None:
+        check_settle_window(self.criteria, self.config.duration)
 
 
 def check_settle_window(criteria: Criteria, duration: float) -> None:

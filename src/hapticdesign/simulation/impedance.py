@@ -16,7 +16,7 @@ is ``{1, ..., K_max}`` (monotone criterion; the tests compare both on several de
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -27,24 +27,17 @@ from hapticdesign.simulation.analytic import AnalyticProblem
 from hapticdesign.simulation.boundary import envelope_grows
 from hapticdesign.simulation.config import LoopConfig, Wall, compensator_device, require_device, require_options
 from hapticdesign.simulation.loop import simulate
-from hapticdesign.simulation.criteria import Criteria, Verdict, check_settle_window, type_paths
+from hapticdesign.simulation.criteria import Criteria, Verdict, WallProblem, type_paths
 from hapticdesign.simulation.tables import DynamicsTables
 from hapticdesign.workload import require_plant_steps
 
 
 @dataclass
-class ImpedanceProblem:
+class ImpedanceProblem(WallProblem):
     """One device, one simulation type: runs single gains and caches the dynamics tables."""
 
-    device: Device
-    sim_type: int = 1
-    wall_joint: int = 0
-    equilibrium: float = 0.01
-    criteria: Criteria = field(default_factory=Criteria)
-    config: LoopConfig = field(default_factory=LoopConfig)
-
     def __post_init__(self) -> None:
-        check_settle_window(self.criteria, self.config.duration)
+        super().__post_init__()
         self.paths = type_paths(self.sim_type, self.device.n_dof, self.wall_joint)
         self.plant = DynamicsTables.from_device(self.device)
         self.model = DynamicsTables.from_device(compensator_device(self.device, self.config.compensator))
