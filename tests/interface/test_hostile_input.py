@@ -11,7 +11,6 @@ from __future__ import annotations
 import csv
 import fcntl
 import json
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -23,8 +22,7 @@ from hapticdesign.analysis.dynamics.device import coriolis_matrix, mass_matrix
 from hapticdesign.errors import UserError
 from hapticdesign.interface.cli import app
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "simulation"))
-from sim_designs import write_designs  # noqa: E402
+from tests.helpers.sim_designs import write_designs
 
 runner = CliRunner()
 BOUNDARY = ["stability-boundary", "--inertia", "0.04", "--damping", "0.5", "--period", "0.001"]

@@ -21,6 +21,8 @@ from hapticdesign.devices.device_file import load_device_file
 from hapticdesign.devices.registry import preset
 from hapticdesign.interface.cli import app
 
+pytestmark = pytest.mark.slow  # end to end: deselect with -m "not slow"
+
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
 DRIVER = shutil.which("chromedriver") or "/usr/bin/chromedriver"
 OPTIONS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",

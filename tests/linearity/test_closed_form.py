@@ -11,7 +11,7 @@ from hapticdesign.analysis.linearity.closed_form import closed_form
 from hapticdesign.analysis.linearity.form import PARTS, linearity_form
 from hapticdesign.analysis.linearity.region import parse_region
 from hapticdesign.errors import UserError
-from tests.linearity.appendix_b import appendix_b1_gravity
+from tests.helpers.appendix_b import appendix_b1_gravity
 
 
 @pytest.fixture(scope="module")

@@ -10,7 +10,7 @@ from hapticdesign.analysis.linearity.form import linearity_form
 from hapticdesign.analysis.linearity.region import parse_region
 from hapticdesign.analysis.linearity.weights import Weights
 from hapticdesign.errors import UserError
-from tests.linearity.appendix_b import appendix_b1_gravity
+from tests.helpers.appendix_b import appendix_b1_gravity
 
 
 def _seed_vector(device, values):

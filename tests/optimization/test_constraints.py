@@ -18,7 +18,7 @@ from hapticdesign.optimization.constraints import (
     link1_length,
     world_point,
 )
-from optimization_seed_tables import table, table_7_2_designs
+from tests.helpers.optimization_seed_tables import table, table_7_2_designs
 
 
 def test_constraint_1_reproduces_table_7_2_angles():

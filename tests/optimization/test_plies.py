@@ -12,7 +12,7 @@ from hapticdesign.analysis.stiffness.sections import tube_from_plies
 from hapticdesign.errors import UserError
 from hapticdesign.model.rcube import RCubeGeometry
 from hapticdesign.optimization.plies import PlyEvaluator, optimize_plies, ply_design, ply_tube
-from optimization_seed_tables import table
+from tests.helpers.optimization_seed_tables import table
 
 GEOMETRY = RCubeGeometry(0.1117, 0.0741, 0.1218)  # Table 7.8
 TABLE_RATIO = 0.75  # d/D of every row of Tables 7.7-7.8 (e.g. 11.25 / 15)

@@ -15,7 +15,7 @@ from hapticdesign.optimization.selection import (
     select,
     weighted_rms,
 )
-from optimization_seed_tables import table, table_7_2_designs
+from tests.helpers.optimization_seed_tables import table, table_7_2_designs
 
 
 def seed_metrics() -> dict[str, np.ndarray]:

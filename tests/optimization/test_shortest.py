@@ -11,7 +11,7 @@ from hapticdesign.errors import UserError
 from hapticdesign.optimization.constraints import Q_MAX_RANGE, Workspace, constraint_values
 from hapticdesign.optimization.shortest import FEASIBILITY_MARGIN, constrained_minimum
 from hapticdesign.optimization.synthesis import BOUND_SETS, synthesize
-from optimization_seed_tables import table, table_7_2_designs
+from tests.helpers.optimization_seed_tables import table, table_7_2_designs
 
 H, V = 0.060, 0.065  # half edges of the workspace and of the virtual cube (§6.1.3)
 

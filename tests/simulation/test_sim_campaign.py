@@ -11,8 +11,9 @@ from hapticdesign.errors import UserError
 from hapticdesign.interface.cli import app
 from hapticdesign.simulation.campaign import CampaignOptions, read_designs, run_campaign
 from hapticdesign.simulation.paths import Chirp
+from tests.helpers.sim_designs import write_designs
 
-from sim_designs import write_designs
+pytestmark = pytest.mark.slow  # end to end: deselect with -m "not slow"
 
 QUICK = CampaignOptions(k_limit=60, chirp=Chirp(0.3, 0.1, 6.0, 10.0), duration=3.0)
 

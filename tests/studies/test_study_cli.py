@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import sympy as sp
 from typer.testing import CliRunner
 
@@ -10,6 +11,8 @@ from hapticdesign.analysis.dynamics.device import inverse_dynamics
 from hapticdesign.analysis.dynamics.symbolic import derive
 from hapticdesign.devices.registry import preset
 from hapticdesign.interface.cli import app
+
+pytestmark = pytest.mark.slow  # end to end: deselect with -m "not slow"
 
 runner = CliRunner()
 

@@ -13,6 +13,8 @@ from hapticdesign.analysis.linearity.form import device_form
 from hapticdesign.devices.loading import load_device
 from hapticdesign.studies import device as study
 
+pytestmark = pytest.mark.slow  # end to end: deselect with -m "not slow"
+
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "devices"
 
 

@@ -6,9 +6,12 @@ import importlib
 from pathlib import Path
 
 import nbformat
+import pytest
 from nbclient import NotebookClient
 
 import hapticdesign
+
+pytestmark = pytest.mark.slow  # end to end: deselect with -m "not slow"
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 

@@ -15,6 +15,8 @@ from hapticdesign.devices.registry import preset
 from hapticdesign.simulation.impedance import impedance_range
 from hapticdesign.studies import phantom
 
+pytestmark = pytest.mark.slow  # end to end: deselect with -m "not slow"
+
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
 

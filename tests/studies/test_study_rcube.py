@@ -9,6 +9,8 @@ import pytest
 
 from hapticdesign.studies import rcube
 
+pytestmark = pytest.mark.slow  # end to end: deselect with -m "not slow"
+
 
 def _rows(path):
     with open(path, newline="") as handle:

@@ -5,12 +5,18 @@ from __future__ import annotations
 import csv
 import json
 
-import pytest
-
 from hapticdesign.interface.report import write_report
 from hapticdesign.studies.plots import plt
-from hapticdesign.studies.steps import (STATUS_DONE, STATUS_FAILED, STATUS_MISSING, NotAvailable, Outcome, Step, Table,
-                                        figure_from_matplotlib)
+from hapticdesign.studies.steps import (
+    STATUS_DONE,
+    STATUS_FAILED,
+    STATUS_MISSING,
+    NotAvailable,
+    Outcome,
+    Step,
+    Table,
+    figure_from_matplotlib,
+)
 from hapticdesign.studies.study import run_study
 
 

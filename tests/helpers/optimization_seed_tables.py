@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-HERE = Path(__file__).parent
+HERE = Path(__file__).parents[1] / "optimization"  # the seed tables sit beside the tests that use them
 
 
 def table(name: str) -> np.ndarray:
