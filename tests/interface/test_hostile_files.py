@@ -189,6 +189,8 @@ LATIN1 = "m2: 0.2  # caf\u00e9\n".encode("latin-1")
     (["ln", "--weights"], "w.yaml"),
     (["rcube", "stiffness", "--design"], "r.yaml"),
     (["study", "device", "--out", "OUT", "--device"], "s.yaml"),
+    (["campaign", "--out", "OUT", "--designs"], "c.csv"),
+    (["robustness", "--designs"], "r.csv"),
 ])
 def test_non_text_files_are_one_line_for_every_reader(tmp_path, content, fragment, args, name):
     path = tmp_path / name

@@ -34,15 +34,18 @@ def user_errors(strict: bool = False, quiet: bool = False) -> Iterator[None]:
                         typer.echo(f"warning: {w.message}", err=True)
 
 
-def parse_vector(text: str | None, n: int, name: str) -> np.ndarray:
-    """Parse ``"0.1,0.2,0.3"`` into a vector of length ``n`` (zeros when ``text`` is None)."""
+def parse_vector(text: str | None, n: int | None, name: str, most: int = 1000) -> np.ndarray:
+    """Parse ``"0.1,0.2,0.3"`` into a vector of length ``n`` (zeros when ``text`` is None), or of any
+    length from 1 to ``most`` when ``n`` is None."""
     if text is None:
-        return np.zeros(n)
+        return np.zeros(n or 0)
     try:
         values = [float(v) for v in text.replace(" ", "").split(",") if v != ""]
     except ValueError:
-        raise UserError(f"--{name}: expected comma-separated numbers, got {text!r}") from None
-    if len(values) != n:
+        raise UserError(f"--{name}: expected comma-separated numbers, got {text[:60]!r}") from None
+    if n is None and not 1 <= len(values) <= most:
+        raise UserError(f"--{name}: give 1 to {most} comma-separated numbers, got {len(values)}")
+    if n is not None and len(values) != n:
         raise UserError(f"--{name}: expected {n} values, got {len(values)}")
     if not all(math.isfinite(v) for v in values):
         raise UserError(f"--{name}: values must be finite (got {text!r})")

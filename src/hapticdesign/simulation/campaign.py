@@ -12,6 +12,7 @@ type 1 and type 2 results agree (``summary.csv``, ``summary.md``) and the figure
 from __future__ import annotations
 
 import csv
+import io
 import fcntl
 import json
 import logging
@@ -29,7 +30,7 @@ import numpy as np
 from hapticdesign.analysis.dynamics.device import coriolis_centrifugal, gravity, mass_matrix
 from hapticdesign.devices.registry import preset
 from hapticdesign.errors import PhysicalConsistencyWarning, UserError
-from hapticdesign.files import write_atomically
+from hapticdesign.files import read_text, write_atomically
 from hapticdesign.simulation.analytic import AnalyticProblem
 from hapticdesign.simulation.impedance import (ImpedanceProblem, fast_search, planned_simulations,
                                                require_search_workload)
@@ -93,11 +94,10 @@ def read_designs(path: Path, preset_name: str = "phantom-3dof") -> list[Design]:
     path = Path(path)
     device = preset(preset_name)
     try:
-        with path.open(newline="") as handle:
-            rows = list(csv.DictReader(handle))
-            header = rows[0].keys() if rows else []
-    except OSError as exc:
-        raise UserError(f"cannot read {path}: {exc.strerror or exc}") from None
+        rows = list(csv.DictReader(io.StringIO(read_text(path, "design file"), newline="")))
+    except csv.Error as exc:
+        raise UserError(f"{path}: malformed CSV ({exc})") from None
+    header = rows[0].keys() if rows else []
     if not rows:
         raise UserError(f"{path}: no designs")
     names = device.inertial_names()

@@ -37,6 +37,14 @@ class LNResult:
     parts: dict[str, float]
 
 
+def _device_and_form(preset, device_file, params_file, strict, region_text, weights_file):
+    """The device the options name, its LN region (default: its joint limits) and its LN form."""
+    device = resolve_device(preset, device_file, params_file, strict)
+    region = resolve_region(region_text, device.joint_limits())
+    weights = read_weights(weights_file, device.n_dof) if weights_file is not None else None
+    return device, region, device_form(device, region, weights)
+
+
 def evaluate_ln(
     preset: str | None,
     device_file: Path | None,
@@ -45,10 +53,7 @@ def evaluate_ln(
     region_text: str | None,
     weights_file: Path | None,
 ) -> LNResult:
-    device = resolve_device(preset, device_file, params_file, strict)
-    region = resolve_region(region_text, device.joint_limits())
-    weights = read_weights(weights_file, device.n_dof) if weights_file is not None else None
-    form = device_form(device, region, weights)
+    device, region, form = _device_and_form(preset, device_file, params_file, strict, region_text, weights_file)
     parts = form.parts(device.standard_parameters())
     return LNResult(
         device.name,
@@ -70,10 +75,7 @@ def symbolic_ln(
     symbolic_gravity: bool,
 ) -> str:
     """The closed-form LN (Appendix B.1 / B.2 equivalent) as text, LaTeX or Python source."""
-    device = resolve_device(preset, device_file, params_file, strict)
-    region = resolve_region(region_text, device.joint_limits())
-    weights = read_weights(weights_file, device.n_dof) if weights_file is not None else None
-    form = device_form(device, region, weights)
+    device, _, form = _device_and_form(preset, device_file, params_file, strict, region_text, weights_file)
     return closed_form(device, form, symbolic_gravity).export(fmt, part)
 
 

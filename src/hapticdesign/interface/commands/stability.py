@@ -15,12 +15,7 @@ from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUI
 
 
 def _dampers(text: Optional[str]) -> Optional[list[float]]:
-    if text is None:
-        return None
-    values = [v for v in text.replace(" ", "").split(",") if v]
-    if not 1 <= len(values) <= 1000:
-        raise UserError("--b-values: give 1 to 1000 comma-separated dampers")
-    return [float(v) for v in parse_vector(text, len(values), "b-values")]
+    return None if text is None else [float(v) for v in parse_vector(text, None, "b-values")]
 
 
 def _device_joint(preset, device, params, strict, q, joint, error_percent, compensate) -> tuple[float, float, float]:
@@ -159,7 +154,7 @@ def robustness_command(
             raise UserError(f"--method must be 'analytic' or 'fast', got {method!r}")
         if per_level is not None and per_level < 1:
             raise UserError(f"--per-level must be at least 1, got {per_level}")
-        levels = [float(v) for v in parse_vector(errors, len([v for v in errors.split(",") if v.strip()]), "errors")]
+        levels = [float(v) for v in parse_vector(errors, None, "errors", most=50)]
         base = preset("phantom-3dof")
         chosen, seen = [], {}
         for d in read_designs(designs):
