@@ -34,7 +34,14 @@ def test_device_file_study(tmp_path, cli):
     with open(tmp_path / "tables" / "linearization_found.csv") as handle:
         rows = [line.split(",") for line in handle.read().splitlines()[1:]]
     assert rows and all(float(r[1]) < 1e-12 and r[2] == "True" for r in rows)
-    assert (tmp_path / "report.html").read_text().count("<img ") == len(list((tmp_path / "figures").glob("*.png")))
+    report = (tmp_path / "report.html").read_text()
+    assert report.count("<img ") == len(list((tmp_path / "figures").glob("*.png")))
+    # the interactive device view sits beside the report, linked from it, with the file's frames in its data
+    assert 'href="pages/device_device.html"' in report
+    page = (tmp_path / "pages" / "device_device.html").read_text()
+    assert all(f'"name":"{frame.name}"' in page for frame in device.mechanism.frames)
+    assert numbers["device"] == {"frames": len(device.mechanism.frames), "bodies": len(device.mechanism.bodies),
+                                 "actuated": device.n_dof}
 
 
 def test_device_study_needs_a_device(tmp_path, cli):

@@ -31,6 +31,23 @@ def test_phantom_report_renders(browser, phantom_study):
     _check(browser, out / "report.html", summary)
 
 
+def test_report_opens_the_interactive_device_view(browser, phantom_study):
+    """The report links the device page; following the link shows the device with a slider per joint."""
+    out, _ = phantom_study
+    browser.get((out / "report.html").resolve().as_uri())
+    links = browser.execute_script(
+        "return Array.from(document.querySelectorAll('a')).map(a => a.href).filter(h => h.includes('/pages/'))")
+    assert len(links) == 1
+    browser.get(links[0])
+    assert browser.execute_script("return document.readyState") == "complete"
+    assert browser.find_element("tag name", "h1").text == "phantom-3dof"
+    sliders = browser.execute_script("return document.querySelectorAll('input[type=range]').length")
+    assert sliders == 3  # the 3-DOF Phantom's joints
+    assert len(browser.execute_script("return window.deviceView.pose()")) == 3
+    problems = [e for e in browser.get_log("browser") if e["level"] in ("SEVERE", "WARNING")]
+    assert problems == []
+
+
 def test_rcube_report_renders(browser, rcube_study):
     out, summary = rcube_study
     _check(browser, out / "report.html", summary)

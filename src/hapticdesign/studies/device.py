@@ -46,6 +46,7 @@ class DeviceSettings:
 
 def steps() -> list[Step]:
     return [
+        Step("device", "The device (seed 000 §2.1-2.3)", device_steps.device_view),
         Step("eom", "Equations of motion (seed 000 eq. 2.50-2.52)", device_steps.equations_of_motion),
         Step("ln", "Linearity Number (seed 000 eq. 3.1-3.4)", device_steps.linearity_number),
         Step("linearization", "Analytic linearization and realizable linear designs (seed 000 §3.2.1)",

@@ -20,13 +20,34 @@ from hapticdesign.analysis.linearity.linear_designs import find_linear_designs a
 from hapticdesign.analysis.linearity.form import device_form
 from hapticdesign.analysis.linearity.verdict import decide_linearizable as decide
 from hapticdesign.analysis.linearity.verdict import minimum_ln
+from hapticdesign.analysis.view.figure import device_figure
+from hapticdesign.analysis.view.page import render_page
+from hapticdesign.analysis.view.skeleton import export as view_data
+from hapticdesign.analysis.view.skeleton import home_pose
 from hapticdesign.errors import UserError
-from hapticdesign.studies.steps import Context, Outcome, Table
+from hapticdesign.studies.steps import Context, Outcome, Page, Table, figure_from_matplotlib
 
 
 def matrix_text(name: str, m: np.ndarray) -> str:
     rows = [" ".join(f"{v: .6e}" for v in row) for row in np.atleast_2d(m)]
     return f"{name} =\n  " + "\n  ".join(rows)
+
+
+def device_view(ctx: Context) -> Outcome:
+    """The device at its home pose (seed 000 §2.1-2.3: frames and links): a static figure and the interactive page."""
+    device = ctx.settings.device()
+    q = home_pose(device)
+    mech = device.mechanism
+    loops = "" if mech.loops is None else f", {len(mech.loops.closures)} loop closures"
+    return Outcome(
+        summary=f"{device.name}: {len(mech.frames)} frames, {len(mech.bodies)} bodies, "
+                f"{mech.n_actuated} actuated joints{loops}.",
+        paragraphs=["The figure shows the device at its home pose; the linked page is the same device in 3D with a "
+                    "slider per actuated joint (it runs its own script and needs no network)."],
+        figures=[figure_from_matplotlib(device_figure(device, q), "device", "The device at its home pose")],
+        pages=[Page("device", "Interactive 3D view", render_page(view_data(device, q)))],
+        numbers={"frames": len(mech.frames), "bodies": len(mech.bodies), "actuated": mech.n_actuated},
+    )
 
 
 def equations_of_motion(ctx: Context) -> Outcome:

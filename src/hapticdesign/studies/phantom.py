@@ -263,6 +263,7 @@ def design_sets(ctx: Context) -> Outcome:
 
 def steps() -> list[Step]:
     return [
+        Step("device", "The device (seed 000 §2.1-2.3, Figure 2.1)", device_steps.device_view),
         Step("eom", "Equations of motion (seed 000 §2.4, eq. 2.50-2.52)", device_steps.equations_of_motion),
         Step("ln", "Linearity Number (eq. 3.1-3.4, Appendices B-C)", linearity_number),
         Step("linearization", "Analytic linearization and a realizable linear design (§3.2.1)", linearization),

@@ -66,14 +66,24 @@ def figure_from_files(stem, name: str, title: str, caption: str = "") -> Figure:
 
 
 @dataclass
+class Page:
+    """A self-contained HTML page beside the report (``pages/<name>.html``), e.g. the interactive device view."""
+
+    name: str
+    title: str
+    html: str
+
+
+@dataclass
 class Outcome:
-    """What a finished step contributes: prose, equations or listings, tables, figures, key numbers."""
+    """What a finished step contributes: prose, equations or listings, tables, figures, pages, key numbers."""
 
     summary: str = ""
     paragraphs: list[str] = field(default_factory=list)
     listings: list[tuple[str, str]] = field(default_factory=list)
     tables: list[Table] = field(default_factory=list)
     figures: list[Figure] = field(default_factory=list)
+    pages: list[Page] = field(default_factory=list)
     numbers: dict[str, Any] = field(default_factory=dict)
 
 

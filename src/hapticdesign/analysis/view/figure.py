@@ -11,7 +11,18 @@ from hapticdesign.model.device import Device
 
 
 def render_png(device: Device, q: np.ndarray, dpi: int = 150) -> bytes:
-    """PNG bytes of the device at pose ``q`` with equal axis scales (orthographic, z up)."""
+    """PNG bytes of :func:`device_figure`."""
+    import matplotlib.pyplot as plt
+
+    fig = device_figure(device, q, dpi)
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png")
+    plt.close(fig)
+    return buffer.getvalue()
+
+
+def device_figure(device: Device, q: np.ndarray, dpi: int = 150):
+    """A matplotlib figure of the device at pose ``q`` with equal axis scales (orthographic, z up)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -51,7 +62,4 @@ def render_png(device: Device, q: np.ndarray, dpi: int = 150) -> bytes:
     ax.set_title(f"{device.name[:60]}\nq = ({pose})", fontsize=9)
     if bodies or end is not None:
         ax.legend(loc="upper left", fontsize=7)
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png")
-    plt.close(fig)
-    return buffer.getvalue()
+    return fig

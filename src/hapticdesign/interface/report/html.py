@@ -6,7 +6,7 @@ import base64
 from html import escape
 
 from hapticdesign.interface.report.tables import cell_text
-from hapticdesign.studies.steps import STATUS_DONE, STATUS_MISSING, Figure, StepResult, Table
+from hapticdesign.studies.steps import STATUS_DONE, STATUS_MISSING, Figure, Page, StepResult, Table
 from hapticdesign.studies.study import StudyResult
 
 STYLE = """
@@ -66,12 +66,17 @@ def _figure(figure: Figure, stem: str) -> str:
             f"<a href=\"{escape(stem)}.svg\">SVG</a>)</span></figcaption></figure>")
 
 
+def _page(page: Page, href: str) -> str:
+    """A link to a page beside the report: the report itself runs no scripts, the page carries its own."""
+    return f'<p class="files">{escape(page.title)}: <a href="{escape(href)}">{escape(href)}</a></p>'
+
+
 def _key_value_table(title: str, mapping: dict) -> str:
     rows = "".join(f"<tr><td>{escape(str(k))}</td><td>{escape(cell_text(v))}</td></tr>" for k, v in mapping.items())
     return f'<div class="table-wrap"><table><caption>{escape(title)}</caption><tbody>{rows}</tbody></table></div>'
 
 
-def _step(step: StepResult, table_href, figure_stem) -> str:
+def _step(step: StepResult, table_href, figure_stem, page_href) -> str:
     parts = [f'<h2 id="{escape(step.key)}">{escape(step.title)}</h2>',
              f"<p>{_status(step.status)} &middot; {step.seconds:.2f} s</p>"]
     if step.status != STATUS_DONE:
@@ -87,17 +92,19 @@ def _step(step: StepResult, table_href, figure_stem) -> str:
         parts.append(f"<p>{escape(title)}</p><pre>{escape(text)}</pre>")
     parts += [_table(t, table_href(step, t)) for t in out.tables]
     parts += [_figure(f, figure_stem(step, f)) for f in out.figures]
+    parts += [_page(p, page_href(step, p)) for p in out.pages]
     return "\n".join(parts)
 
 
-def render(study: StudyResult, versions: dict[str, str], table_href, figure_stem) -> str:
-    """The whole report. ``table_href(step, table)`` and ``figure_stem(step, figure)`` name the files."""
+def render(study: StudyResult, versions: dict[str, str], table_href, figure_stem, page_href) -> str:
+    """The whole report. ``table_href(step, table)``, ``figure_stem(step, figure)`` and ``page_href(step, page)``
+    name the files."""
     toc = "".join(
         f'<tr><td><a href="#{escape(s.key)}">{escape(s.title)}</a></td><td>{_status(s.status)}</td>'
         f"<td>{s.seconds:.2f}</td></tr>" for s in study.steps)
     overview = (f"<table><caption>Steps and timings (total {study.seconds:.1f} s)</caption><thead><tr><th>step</th>"
                 f"<th>status</th><th>time [s]</th></tr></thead><tbody>{toc}</tbody></table>")
-    body = "\n".join(_step(s, table_href, figure_stem) for s in study.steps)
+    body = "\n".join(_step(s, table_href, figure_stem, page_href) for s in study.steps)
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>{escape(study.title)}</title>
 <link rel="icon" href="data:,">

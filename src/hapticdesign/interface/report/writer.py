@@ -1,4 +1,4 @@
-"""Write a study's report folder: report.html, tables/*.csv, figures/*.png|svg, summary.json."""
+"""Write a study's report folder: report.html, tables/*.csv, figures/*.png|svg, pages/*.html, summary.json."""
 
 from __future__ import annotations
 
@@ -28,10 +28,13 @@ def write_report(study: StudyResult, out: Path) -> Path:
             stem = out / "figures" / _stem(step.key, figure.name)
             stem.with_suffix(".png").write_bytes(figure.png)
             write_atomically(stem.with_suffix(".svg"), figure.svg)
+        for page in step.outcome.pages:
+            write_atomically(out / "pages" / f"{_stem(step.key, page.name)}.html", page.html)
     found = versions()
     html = render(study, found,
                   lambda step, table: f"tables/{_stem(step.key, table.name)}.csv",
-                  lambda step, figure: f"figures/{_stem(step.key, figure.name)}")
+                  lambda step, figure: f"figures/{_stem(step.key, figure.name)}",
+                  lambda step, page: f"pages/{_stem(step.key, page.name)}.html")
     report = out / "report.html"
     write_atomically(report, html)
     write_atomically(out / "summary.json", json.dumps(to_jsonable(summary(study, report)), indent=2))
