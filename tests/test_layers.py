@@ -144,3 +144,15 @@ def test_the_checker_sees_function_level_and_relative_imports():
     source = "def f():\n    from hapticdesign.interface.cli import main\n    from ..devices import loading\n"
     found = {(target, top) for target, _, top in _imports("hapticdesign.model.device", path, source)}
     assert found == {("hapticdesign.interface.cli", False), ("hapticdesign.devices.loading", False)}
+
+
+def test_device_readers_share_the_builder_and_do_not_import_each_other():
+    readers = {"hapticdesign.devices.device_file", "hapticdesign.devices.schema", "hapticdesign.devices.urdf"}
+    yaml_reader, urdf_reader = readers - {"hapticdesign.devices.urdf"}, {"hapticdesign.devices.urdf"}
+    modules = _modules()
+    crossing = [f"{name} imports {target}" for name in readers for target, _, _ in _imports(name, modules[name])
+                if target in (urdf_reader if name in yaml_reader else yaml_reader)]
+    assert not crossing, "device readers import each other:\n" + "\n".join(crossing)
+    users = {name for name in readers
+             if any(t == "hapticdesign.devices.builder" for t, _, _ in _imports(name, modules[name]))}
+    assert users == {"hapticdesign.devices.device_file", "hapticdesign.devices.urdf", "hapticdesign.devices.schema"}

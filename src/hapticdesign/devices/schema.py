@@ -18,37 +18,23 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass
 from typing import Annotated, Literal
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
 
+from hapticdesign.devices.builder import (
+    BODY_NAME_PATTERN,
+    IDENTIFIER_PATTERN,
+    LinearExpr,
+    TransformSpec,
+)
 from hapticdesign.model.inertia import SEED_FIELDS, BodyInertia, check_body
 from hapticdesign.model.loops import component_indices
 from hapticdesign.model.transforms import Axis
 
 RESERVED = ("pi", "g", "base")
-IDENTIFIER_PATTERN = r"^[A-Za-z_][A-Za-z0-9_]*$"
-IDENTIFIER = re.compile(IDENTIFIER_PATTERN)
-BODY_NAME_PATTERN = r"^[A-Za-z0-9_]+$"
-BODY_NAME = re.compile(BODY_NAME_PATTERN)
-"""Coordinate and parameter names are identifiers; body names are letters, digits and ``_`` (they
-become the suffix of parameter names such as ``m2a``): no user string that reaches generated code
-(``eom --format python``, ``ln --symbolic``) can carry code or markup."""
 _NUMBER = r"(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
 _TOKEN = re.compile(rf"\s*(?:(?P<number>{_NUMBER})|(?P<name>[A-Za-z_]\w*)|(?P<op>[-+*/]))")
-
-
-@dataclass(frozen=True)
-class LinearExpr:
-    """``constant + sum(coefficient * value(name))``; names are parameters or coordinates."""
-
-    constant: float = 0.0
-    terms: tuple[tuple[str, float], ...] = ()
-
-    @property
-    def names(self) -> tuple[str, ...]:
-        return tuple(name for name, _ in self.terms)
 
 
 def _tokens(text: str) -> list[tuple[str, str]]:
@@ -137,14 +123,6 @@ Identifier = Annotated[str, Field(pattern=IDENTIFIER_PATTERN)]
 Name = Annotated[str, BeforeValidator(_name), Field(min_length=1, max_length=200)]
 BodyName = Annotated[str, BeforeValidator(_name), Field(pattern=BODY_NAME_PATTERN, max_length=64)]
 AXES = {"Rx": Axis.RX, "Ry": Axis.RY, "Rz": Axis.RZ, "tx": Axis.TX, "ty": Axis.TY, "tz": Axis.TZ}
-
-
-@dataclass(frozen=True)
-class TransformSpec:
-    """One elementary transform of a frame: ``axis`` and its affine value."""
-
-    axis: Axis
-    value: LinearExpr
 
 
 def _transform(value: object) -> TransformSpec:
