@@ -15,10 +15,12 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+from hapticdesign.analysis.stiffness.device import check_elasticity
 from hapticdesign.errors import UserError
 from hapticdesign.model.actuators import Actuator, Limits, per_joint
 from hapticdesign.model.device import Device
 from hapticdesign.model.dh import DHRow, dh_frames
+from hapticdesign.model.elastic import Elasticity
 from hapticdesign.model.inertia import SEED_FIELDS, BodyInertia, seed_parameter_name
 from hapticdesign.model.loops import ClosedLoops
 from hapticdesign.model.mechanism import BodyAttachment, Frame, JointType, Mechanism
@@ -134,10 +136,12 @@ def assemble_device(
     damping: tuple[float, ...],
     actuators: tuple[Actuator, ...] = (),
     limits: tuple[Limits, ...] = (),
+    elasticity: Elasticity | None = None,
 ) -> Device:
     """A Device whose ``params`` hold every kinematic and inertial name (``m2``, ``r2x``, ``Ixy2``...).
 
     ``damping`` is the joints' own; the actuators' viscous damping is added to it per coordinate.
+    ``elasticity`` (elastic links, joint springs) is checked against the geometry here.
     """
     params = dict(kinematic)
     for body, inertia in inertias.items():
@@ -149,6 +153,8 @@ def assemble_device(
     if actuators:
         damping = tuple(a + b for a, b in zip(damping, per_joint(actuators, len(damping), "damping")))
     device = Device(name, description, tuple(kinematic), builder, params, damping, tuple(actuators),
-                    tuple(limits) if any(span is not None for span in limits) else ())
-    device.mechanism  # build once: geometry errors surface at load time, not at first use
+                    tuple(limits) if any(span is not None for span in limits) else (), elasticity)
+    mechanism = device.mechanism  # build once: geometry errors surface at load time, not at first use
+    if elasticity is not None:
+        check_elasticity(mechanism, elasticity)
     return device

@@ -11,11 +11,13 @@ from pathlib import Path
 
 from pydantic import ValidationError
 
+from hapticdesign.analysis.stiffness.link import rigidities
 from hapticdesign.devices.builder import ChainBuilder, DHRowTemplate, FrameTemplate, assemble_device
 from hapticdesign.devices.schema import DeviceFileSpec
 from hapticdesign.errors import UserError
 from hapticdesign.model.actuators import Actuator
 from hapticdesign.model.device import Device
+from hapticdesign.model.elastic import Elasticity, ElasticLink
 from hapticdesign.model.loops import ClosedLoops, LoopClosure
 from hapticdesign.model.mechanism import JointType
 from hapticdesign.model.params_io import read_mapping
@@ -46,7 +48,17 @@ def device_from_spec(spec: DeviceFileSpec) -> Device:
         _actuators(spec),
         tuple(None if j.limits is None else (float(j.limits[0]), float(j.limits[1])) for j in spec.joints
               if j.actuated),
+        _elasticity(spec),
     )
+
+
+def _elasticity(spec: DeviceFileSpec) -> Elasticity | None:
+    """The file's elastic links (rigidities of their section and material, eq. 4.59) and joint springs."""
+    if not spec.links and not spec.joint_stiffness:
+        return None
+    links = tuple(ElasticLink(link.name, link.start, link.end, *rigidities(link.material, link.section))
+                  for link in spec.links)
+    return Elasticity(links, tuple((name, float(k)) for name, k in spec.joint_stiffness.items()))
 
 
 def _closed_loops(spec: DeviceFileSpec) -> ClosedLoops | None:
