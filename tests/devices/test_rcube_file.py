@@ -10,10 +10,12 @@ the per-chain closed forms beyond the link stiffness formula (eq. 4.59).
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
 import pytest
+from typer.testing import CliRunner
 
 from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.analysis.kinematics import actuated_jacobian, actuated_pose
@@ -24,6 +26,7 @@ from hapticdesign.analysis.rcube.design import final_design
 from hapticdesign.analysis.rcube.stiffness import cartesian_stiffness as rcube_stiffness
 from hapticdesign.analysis.stiffness.device import cartesian_stiffness
 from hapticdesign.devices.loading import load_device
+from hapticdesign.interface.cli import app
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "devices" / "rcube.yaml"
 OFFSETS_MM = [(0.0, 0.0, 0.0), (20.0, -30.0, 40.0), (-45.0, 35.0, -25.0), (55.0, 55.0, 55.0)]
@@ -79,3 +82,38 @@ def test_stiffness_equals_the_built_in(device, offset_mm):
     expected = rcube_stiffness(final_design(), r)
     scale = np.sqrt(np.outer(np.diag(expected), np.diag(expected)))
     assert np.max(np.abs(K - expected) / scale) < ROUND_OFF
+
+
+def test_cli_stiffness_json_and_deflection():
+    r, q = _pose((20.0, -30.0, 40.0))
+    args = ["stiffness", "--device", str(EXAMPLE), "--q", ",".join(repr(float(v)) for v in q[:, 0]), "--wrench", "1,-2,5"]
+    result = CliRunner().invoke(app, args + ["--json"])
+    assert result.exit_code == 0, result.output
+    out = json.loads(result.stdout)
+    K, expected = np.array(out["K_C"]), rcube_stiffness(final_design(), r)
+    scale = np.sqrt(np.outer(np.diag(expected), np.diag(expected)))
+    assert np.max(np.abs(K - expected) / scale) < ROUND_OFF
+    assert np.allclose(expected @ np.array(out["deflection"]), [1.0, -2.0, 5.0, 0.0, 0.0, 0.0], rtol=0, atol=1e-9)
+    text = CliRunner().invoke(app, args)
+    assert text.exit_code == 0 and "K_C of frame platform" in text.stdout and "deflection [m, m, m" in text.stdout
+
+
+@pytest.mark.parametrize(
+    "args, fragment",
+    [
+        (["--wrench", "1,2"], "--wrench: give Fx,Fy,Fz or Fx,Fy,Fz,Mx,My,Mz, got 2 values"),
+        (["--q", "0,0"], "--q: expected 3 values, got 2"),
+        (["--q", "3,3,3"], "the loops cannot close"),
+        (["--frame", "nowhere"], "--frame: unknown frame 'nowhere'"),
+    ],
+)
+def test_cli_stiffness_errors_are_one_line(args, fragment):
+    result = CliRunner().invoke(app, ["stiffness", "--device", str(EXAMPLE), *args])
+    assert result.exit_code == 2
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: ") and fragment in lines[0], result.stderr
+
+
+def test_cli_stiffness_of_a_device_without_links():
+    result = CliRunner().invoke(app, ["stiffness", "--preset", "phantom-3dof"])
+    assert result.exit_code == 2 and "has no elastic links or joint springs" in result.stderr
