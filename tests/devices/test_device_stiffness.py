@@ -135,7 +135,7 @@ def test_deflection_is_the_compliance_times_the_force():
     K = cartesian_stiffness(device, [0.0])
     assert np.allclose(K, K.T, rtol=0, atol=1e-9 * np.abs(K).max())
     assert np.all(np.linalg.eigvalsh(K) > 0)
-    d = deflection(device, [0.0], [0.0, -5.0, 0.0])
+    d = deflection(K, [0.0, -5.0, 0.0])
     assert d[1] == pytest.approx(-5.0 * 0.3**3 / (3 * E_AL * I_TUBE), rel=1e-12)
 
 
@@ -179,3 +179,8 @@ def test_a_device_without_elastic_links_has_no_stiffness():
     del data["links"]
     with pytest.raises(UserError, match="has no elastic links or joint springs"):
         cartesian_stiffness(device_from_mapping(data), [0.0])
+
+
+def test_a_frame_no_link_reaches_is_rigid_and_refused():
+    with pytest.raises(UserError, match="rigid in some direction"):
+        cartesian_stiffness(device_from_mapping(_cantilever()), [0.0], frame="arm")  # the link's root

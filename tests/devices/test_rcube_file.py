@@ -11,6 +11,7 @@ the per-chain closed forms beyond the link stiffness formula (eq. 4.59).
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -25,6 +26,7 @@ from hapticdesign.analysis.rcube import kinematics as rcube_kinematics
 from hapticdesign.analysis.rcube.design import final_design
 from hapticdesign.analysis.rcube.stiffness import cartesian_stiffness as rcube_stiffness
 from hapticdesign.analysis.stiffness.device import cartesian_stiffness
+from hapticdesign.analysis.stiffness.joints import JointStiffness
 from hapticdesign.devices.loading import load_device
 from hapticdesign.interface.cli import app
 
@@ -82,6 +84,20 @@ def test_stiffness_equals_the_built_in(device, offset_mm):
     expected = rcube_stiffness(final_design(), r)
     scale = np.sqrt(np.outer(np.diag(expected), np.diag(expected)))
     assert np.max(np.abs(K - expected) / scale) < ROUND_OFF
+
+
+def test_drive_springs_equal_the_built_in_joint_compliance(device):
+    """Drive springs on the actuated joints: the built-in adds them as joint springs in series
+    (:mod:`hapticdesign.analysis.stiffness.joints`), the file as one-coordinate virtual joints."""
+    k = 150.0  # N m/rad, soft enough to matter
+    r, q = _pose((20.0, -30.0, 40.0))
+    springy = replace(device, elasticity=replace(device.elasticity, joints=(("q1", k), ("q2", k), ("q3", k))))
+    drives = (JointStiffness(torsional=k),) + (JointStiffness(),) * 4
+    expected = rcube_stiffness(final_design().with_joints(drives), r)
+    K = cartesian_stiffness(springy, q[:, 0])
+    scale = np.sqrt(np.outer(np.diag(expected), np.diag(expected)))
+    assert np.max(np.abs(K - expected) / scale) < ROUND_OFF
+    assert K[0, 0] < 0.9 * rcube_stiffness(final_design(), r)[0, 0]  # the springs matter
 
 
 def test_cli_stiffness_json_and_deflection():

@@ -15,7 +15,6 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-from hapticdesign.analysis.stiffness.device import check_elasticity
 from hapticdesign.errors import UserError
 from hapticdesign.model.actuators import Actuator, Limits, per_joint
 from hapticdesign.model.device import Device
@@ -24,7 +23,12 @@ from hapticdesign.model.elastic import Elasticity
 from hapticdesign.model.inertia import SEED_FIELDS, BodyInertia, seed_parameter_name
 from hapticdesign.model.loops import ClosedLoops
 from hapticdesign.model.mechanism import BodyAttachment, Frame, JointType, Mechanism
-from hapticdesign.model.transforms import Axis, ElementaryTransform, JointValue, combination
+from hapticdesign.model.transforms import (
+    Axis,
+    ElementaryTransform,
+    JointValue,
+    combination,
+)
 
 IDENTIFIER_PATTERN = r"^[A-Za-z_][A-Za-z0-9_]*$"
 IDENTIFIER = re.compile(IDENTIFIER_PATTERN)
@@ -155,6 +159,8 @@ def assemble_device(
     device = Device(name, description, tuple(kinematic), builder, params, damping, tuple(actuators),
                     tuple(limits) if any(span is not None for span in limits) else (), elasticity)
     mechanism = device.mechanism  # build once: geometry errors surface at load time, not at first use
-    if elasticity is not None:
+    if elasticity is not None:  # import the solvers only for elastic devices
+        from hapticdesign.analysis.stiffness.device import check_elasticity
+
         check_elasticity(mechanism, elasticity)
     return device

@@ -39,7 +39,7 @@ from hapticdesign.analysis.stiffness.link import beam_stiffness
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.model.elastic import Elasticity, ElasticLink
-from hapticdesign.model.mechanism import Frame, JointType, Mechanism
+from hapticdesign.model.mechanism import JointType, Mechanism
 from hapticdesign.model.transforms import Rx, Ry, Rz, joint, tx, ty, tz
 
 _LENGTH_TOLERANCE = 1e-12
@@ -154,16 +154,15 @@ def cartesian_stiffness(device: Device, q_a, frame: str | None = None) -> np.nda
     return K[:6, :6]
 
 
-def deflection(device: Device, q_a, wrench, frame: str | None = None) -> np.ndarray:
-    """Twist-like deflection ``(dx, dphi)`` (6,) of the end effector under ``wrench`` ``(F, M)`` or ``F``:
-    ``K_C^-1 F`` (eq. 5.117-5.123, unloaded mode)."""
+def deflection(stiffness: np.ndarray, wrench) -> np.ndarray:
+    """Deflection ``(dx, dphi)`` (6,) of the end effector with stiffness ``K_C`` under ``wrench`` ``(F, M)``
+    or ``F`` (moments zero): ``K_C^-1 F`` (eq. 5.117-5.123, unloaded mode)."""
     w = np.asarray(wrench, dtype=float)
     if w.shape == (3,):
         w = np.concatenate([w, np.zeros(3)])
     if w.shape != (6,) or not np.all(np.isfinite(w)):
         raise UserError(f"a wrench is 3 forces or 6 forces and moments, finite, got {np.ravel(wrench).tolist()}")
-    K = cartesian_stiffness(device, q_a, frame)
     try:
-        return np.linalg.solve(K, w)
+        return np.linalg.solve(stiffness, w)
     except np.linalg.LinAlgError:
         raise UserError("K_C is singular at this pose: the end effector moves freely in some direction") from None

@@ -16,7 +16,14 @@ import typer
 from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import note, parse_vector, print_json, user_errors
-from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
+from hapticdesign.interface.options import (
+    DEVICE,
+    JSON_OUT,
+    PARAMS,
+    PRESET,
+    QUIET,
+    STRICT,
+)
 
 UNITS = {"K_C": "rows and columns (x, y, z, rx, ry, rz): N/m, N/rad, N m/rad", "deflection": "m, m, m, rad, rad, rad",
          "wrench": "N, N, N, N m, N m, N m", "q": "rad or m"}
@@ -42,7 +49,7 @@ def stiffness(
 ) -> None:
     """Cartesian stiffness K_C of a device's end effector by the virtual joint method (seed 001 eq. 5.98-5.123):
     elastic links and joint springs from the device file, passive joints free, loops closed."""
-    from hapticdesign.analysis.stiffness.device import cartesian_stiffness
+    from hapticdesign.analysis.stiffness.device import cartesian_stiffness, deflection
 
     with user_errors(quiet=quiet):
         dev = resolve_device(preset, device, params, strict=strict)
@@ -59,10 +66,7 @@ def stiffness(
             if len(w) not in (3, 6):
                 raise UserError(f"--wrench: give Fx,Fy,Fz or Fx,Fy,Fz,Mx,My,Mz, got {len(w)} values")
             w = np.concatenate([w, np.zeros(6 - len(w))])
-            try:
-                result["wrench"], result["deflection"] = w, np.linalg.solve(K, w)
-            except np.linalg.LinAlgError:
-                raise UserError("K_C is singular at this pose: the end effector moves freely in some direction") from None
+            result["wrench"], result["deflection"] = w, deflection(K, w)
         result["units"] = UNITS
         if json_out:
             print_json(result)
