@@ -112,6 +112,9 @@ def test_cli_stiffness_json_and_deflection():
     assert np.allclose(expected @ np.array(out["deflection"]), [1.0, -2.0, 5.0, 0.0, 0.0, 0.0], rtol=0, atol=1e-9)
     text = CliRunner().invoke(app, args)
     assert text.exit_code == 0 and "K_C of frame platform" in text.stdout and "deflection [m, m, m" in text.stdout
+    block = json.loads(CliRunner().invoke(app, args + ["--translational", "--json"]).stdout)
+    assert np.allclose(block["K_C"], expected[:3, :3], rtol=0, atol=ROUND_OFF * np.abs(expected[:3, :3]).max())
+    assert np.allclose(block["deflection"], out["deflection"], rtol=0, atol=1e-15)  # the full K_C deflects
 
 
 @pytest.mark.parametrize(

@@ -27,6 +27,7 @@ from hapticdesign.interface.options import (
 
 UNITS = {"K_C": "rows and columns (x, y, z, rx, ry, rz): N/m, N/rad, N m/rad", "deflection": "m, m, m, rad, rad, rad",
          "wrench": "N, N, N, N m, N m, N m", "q": "rad or m"}
+TRANSLATIONAL = "rows and columns (x, y, z): N/m, rotations held"
 
 
 def _row(values) -> str:
@@ -43,6 +44,8 @@ def stiffness(
                                          "also print the deflection."),
     frame: Optional[str] = typer.Option(None, "--frame", help="Frame whose stiffness to compute (default: the end "
                                         "effector)."),
+    translational: bool = typer.Option(False, "--translational", help="Print the translational 3 x 3 block of K_C "
+                                       "(N/m; rotations held), as the R-CUBE's K_CA."),
     strict: bool = STRICT,
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
@@ -60,20 +63,21 @@ def stiffness(
         if frame is not None and frame not in dev.mechanism.compiled.frame_node:
             raise UserError(f"--frame: unknown frame {frame!r} (frames: {', '.join(f.name for f in dev.mechanism.frames)})")
         K = cartesian_stiffness(dev, qv, frame)
-        result = {"device": dev.name, "frame": frame or dev.mechanism.end_effector, "q": qv, "K_C": K}
+        result = {"device": dev.name, "frame": frame or dev.mechanism.end_effector, "q": qv,
+                  "K_C": K[:3, :3] if translational else K}
         if wrench is not None:
             w = parse_vector(wrench, None, "wrench", most=6)
             if len(w) not in (3, 6):
                 raise UserError(f"--wrench: give Fx,Fy,Fz or Fx,Fy,Fz,Mx,My,Mz, got {len(w)} values")
             w = np.concatenate([w, np.zeros(6 - len(w))])
             result["wrench"], result["deflection"] = w, deflection(K, w)
-        result["units"] = UNITS
+        result["units"] = {**UNITS, "K_C": TRANSLATIONAL} if translational else UNITS
         if json_out:
             print_json(result)
             return
         typer.echo(f"{dev.name}: K_C of frame {result['frame']} at q = {', '.join(f'{v:.6g}' for v in qv)} "
-                   f"[{UNITS['K_C']}]")
-        for row in K:
+                   f"[{result['units']['K_C']}]")
+        for row in result["K_C"]:
             typer.echo("  " + _row(row))
         if "deflection" in result:
             typer.echo(f"deflection [{UNITS['deflection']}]: " + ", ".join(f"{v:.6g}" for v in result["deflection"]))
