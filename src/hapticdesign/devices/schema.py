@@ -22,14 +22,9 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, InstanceOf, model_validator
 
-from hapticdesign.devices.builder import (
-    BODY_NAME_PATTERN,
-    IDENTIFIER_PATTERN,
-    LinearExpr,
-    TransformSpec,
-)
 from hapticdesign.analysis.stiffness.materials import MATERIALS, LinkModuli, isotropic, laminate
 from hapticdesign.analysis.stiffness.sections import Tube
+from hapticdesign.devices.builder import BODY_NAME_PATTERN, IDENTIFIER_PATTERN, LinearExpr, TransformSpec
 from hapticdesign.errors import UserError
 from hapticdesign.model.inertia import SEED_FIELDS, BodyInertia, check_body
 from hapticdesign.model.loops import component_indices
