@@ -147,12 +147,16 @@ def test_the_checker_sees_function_level_and_relative_imports():
 
 
 def test_device_readers_share_the_builder_and_do_not_import_each_other():
-    readers = {"hapticdesign.devices.device_file", "hapticdesign.devices.schema", "hapticdesign.devices.urdf"}
-    yaml_reader, urdf_reader = readers - {"hapticdesign.devices.urdf"}, {"hapticdesign.devices.urdf"}
+    """Issue 12: the device-file reader (device_file, schema) and the URDF reader (urdf) both build through
+    devices.builder and never import each other."""
+    sides = {"hapticdesign.devices.device_file": "file", "hapticdesign.devices.schema": "file",
+             "hapticdesign.devices.urdf": "urdf"}
     modules = _modules()
-    crossing = [f"{name} imports {target}" for name in readers for target, _, _ in _imports(name, modules[name])
-                if target in (urdf_reader if name in yaml_reader else yaml_reader)]
+    crossing, users = [], set()
+    for name, side in sides.items():
+        targets = {target for target, _, _ in _imports(name, modules[name])}
+        crossing += [f"{name} imports {t}" for t in targets if sides.get(t, side) != side]
+        if "hapticdesign.devices.builder" in targets:
+            users.add(name)
     assert not crossing, "device readers import each other:\n" + "\n".join(crossing)
-    users = {name for name in readers
-             if any(t == "hapticdesign.devices.builder" for t, _, _ in _imports(name, modules[name]))}
-    assert users == {"hapticdesign.devices.device_file", "hapticdesign.devices.urdf", "hapticdesign.devices.schema"}
+    assert users == set(sides)
