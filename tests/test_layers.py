@@ -144,3 +144,19 @@ def test_the_checker_sees_function_level_and_relative_imports():
     source = "def f():\n    from hapticdesign.interface.cli import main\n    from ..devices import loading\n"
     found = {(target, top) for target, _, top in _imports("hapticdesign.model.device", path, source)}
     assert found == {("hapticdesign.interface.cli", False), ("hapticdesign.devices.loading", False)}
+
+
+def test_device_readers_share_the_builder_and_do_not_import_each_other():
+    """Issue 12: the device-file reader (device_file, schema) and the URDF reader (urdf) both build through
+    devices.builder and never import each other."""
+    sides = {"hapticdesign.devices.device_file": "file", "hapticdesign.devices.schema": "file",
+             "hapticdesign.devices.urdf": "urdf"}
+    modules = _modules()
+    crossing, users = [], set()
+    for name, side in sides.items():
+        targets = {target for target, _, _ in _imports(name, modules[name])}
+        crossing += [f"{name} imports {t}" for t in targets if sides.get(t, side) != side]
+        if "hapticdesign.devices.builder" in targets:
+            users.add(name)
+    assert not crossing, "device readers import each other:\n" + "\n".join(crossing)
+    assert users == set(sides)

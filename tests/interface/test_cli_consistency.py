@@ -21,6 +21,8 @@ runner = CliRunner()
 
 SEED_DESIGN = {"Ixx2": 0.00982641}  # eq. 3.33's link 2: breaks the triangle inequality (a consistency warning)
 
+RCUBE_FILE = Path(__file__).resolve().parents[2] / "examples" / "devices" / "rcube.yaml"
+
 
 def _commands(group=None, path=()):
     """Every leaf command of the application as (path, click command), sub-apps included."""
@@ -101,6 +103,7 @@ def _json_cases(tmp: Path) -> dict[tuple[str, ...], list]:
         ("transparency",): ["--sweep", "1", "--f1", "2"],
         ("stability-boundary",): ["--inertia", "0.01", "--damping", "0.1", "--period", "0.001", "--samples", "400"],
         ("metrics",): ["--q", "0.1,0.5,0.3"],
+        ("stiffness",): ["--device", RCUBE_FILE, "--wrench", "0,0,-5"],
         ("rcube", "ik"): ["--position", "0.11,0.1,0.12"],
         ("rcube", "fk"): ["--q1", "0.1", "--q2", "0", "--q3", "-0.1"],
         ("rcube", "stiffness"): [],
@@ -253,6 +256,7 @@ def _bad_inputs(tmp: Path) -> dict[tuple[str, ...], list]:
         ("stability-boundary",): ["--inertia", "1", "--damping", "1", "--period", "0.001", "--samples", "10"],
         ("campaign",): ["--designs", tmp / "missing.csv", "--out", tmp / "c"],
         ("metrics",): ["--q", "0,0,1.5707963267948966"],
+        ("stiffness",): ["--device", RCUBE_FILE, "--wrench", "1,2"],
         ("demo",): ["--out", a_file],
         ("rcube", "ik"): ["--position", "1,2"],
         ("rcube", "fk"): ["--q1", "0", "--q2", "0", "--q3", "0", "--l1", "-0.1"],

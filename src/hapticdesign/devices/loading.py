@@ -11,10 +11,15 @@ from hapticdesign.model.params_io import read_parameters
 
 
 def load_device(path: str | Path) -> Device:
-    """A device from a device file (YAML, TOML, JSON) or a URDF file (see docs/device-files.md)."""
+    """A device from a device file (YAML, TOML, JSON) or a URDF file (``.urdf``; see docs/device-files.md)."""
+    path = Path(path)
+    if path.suffix.lower() == ".urdf":
+        from hapticdesign.devices.urdf import load_urdf
+
+        return load_urdf(path)
     from hapticdesign.devices.device_file import load_device_file
 
-    return load_device_file(Path(path))
+    return load_device_file(path)
 
 
 def resolve_device(
@@ -32,9 +37,7 @@ def resolve_device(
     if preset_name and device_file:
         raise UserError("give either --preset or --device, not both")
     if device_file is not None:
-        from hapticdesign.devices.device_file import load_device_file
-
-        device = load_device_file(Path(device_file))
+        device = load_device(device_file)
     else:
         device = preset(preset_name or DEFAULT_PRESET)
     if params_file is not None:

@@ -18,37 +18,21 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, InstanceOf, model_validator
 
+from hapticdesign.analysis.stiffness.materials import MATERIALS, LinkModuli, isotropic, laminate
+from hapticdesign.analysis.stiffness.sections import Tube
+from hapticdesign.devices.builder import BODY_NAME_PATTERN, IDENTIFIER_PATTERN, LinearExpr, TransformSpec
+from hapticdesign.errors import UserError
 from hapticdesign.model.inertia import SEED_FIELDS, BodyInertia, check_body
 from hapticdesign.model.loops import component_indices
 from hapticdesign.model.transforms import Axis
 
 RESERVED = ("pi", "g", "base")
-IDENTIFIER_PATTERN = r"^[A-Za-z_][A-Za-z0-9_]*$"
-IDENTIFIER = re.compile(IDENTIFIER_PATTERN)
-BODY_NAME_PATTERN = r"^[A-Za-z0-9_]+$"
-BODY_NAME = re.compile(BODY_NAME_PATTERN)
-"""Coordinate and parameter names are identifiers; body names are letters, digits and ``_`` (they
-become the suffix of parameter names such as ``m2a``): no user string that reaches generated code
-(``eom --format python``, ``ln --symbolic``) can carry code or markup."""
 _NUMBER = r"(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
 _TOKEN = re.compile(rf"\s*(?:(?P<number>{_NUMBER})|(?P<name>[A-Za-z_]\w*)|(?P<op>[-+*/]))")
-
-
-@dataclass(frozen=True)
-class LinearExpr:
-    """``constant + sum(coefficient * value(name))``; names are parameters or coordinates."""
-
-    constant: float = 0.0
-    terms: tuple[tuple[str, float], ...] = ()
-
-    @property
-    def names(self) -> tuple[str, ...]:
-        return tuple(name for name, _ in self.terms)
 
 
 def _tokens(text: str) -> list[tuple[str, str]]:
@@ -137,14 +121,6 @@ Identifier = Annotated[str, Field(pattern=IDENTIFIER_PATTERN)]
 Name = Annotated[str, BeforeValidator(_name), Field(min_length=1, max_length=200)]
 BodyName = Annotated[str, BeforeValidator(_name), Field(pattern=BODY_NAME_PATTERN, max_length=64)]
 AXES = {"Rx": Axis.RX, "Ry": Axis.RY, "Rz": Axis.RZ, "tx": Axis.TX, "ty": Axis.TY, "tz": Axis.TZ}
-
-
-@dataclass(frozen=True)
-class TransformSpec:
-    """One elementary transform of a frame: ``axis`` and its affine value."""
-
-    axis: Axis
-    value: LinearExpr
 
 
 def _transform(value: object) -> TransformSpec:
@@ -240,6 +216,62 @@ class BodySpec(_FileModel):
         return BodyInertia(**{f: getattr(self, f) for f in SEED_FIELDS})
 
 
+SECTIONS = {"tube": ("D", "d"), "rod": ("D",)}
+"""Cross-section shapes of a link and their dimensions (m): a tube's outer and inner diameters, a rod's
+diameter (eq. 5.162-5.165; a rod is a tube with ``d = 0``)."""
+_MATERIAL_USAGE = (f"a material is one of {', '.join(MATERIALS)}, {{E: ..., G: ...}} (or {{E: ..., nu: ...}}, Pa) "
+                   "or {laminate: [a, b, c, d]} (M55J plies at 0, 90, -45, 45 degrees)")
+
+
+def _section(value: object) -> Tube:
+    if isinstance(value, Tube):
+        return value
+    if not isinstance(value, dict) or value.get("shape") not in SECTIONS:
+        shape = value.get("shape") if isinstance(value, dict) else None
+        known = ", ".join(SECTIONS)
+        raise ValueError(f"unknown section shape {shape!r}; use {known}: {{shape: tube, D: 0.02, d: 0.016}} or "
+                         "{shape: rod, D: 0.01} (diameters in m)")
+    wanted = SECTIONS[value["shape"]]
+    extra = [k for k in value if k != "shape" and k not in wanted]
+    missing = [k for k in wanted if k not in value]
+    if extra or missing:
+        problem = f"unknown key {extra[0]!r}" if extra else f"missing {missing[0]!r}"
+        raise ValueError(f"{problem}: a {value['shape']} section takes {', '.join(wanted)} (m)")
+    try:
+        return Tube(_constant(value["D"]), _constant(value.get("d", 0.0)))
+    except UserError as exc:
+        raise ValueError(str(exc)) from None
+
+
+def _material(value: object) -> LinkModuli:
+    if isinstance(value, LinkModuli):
+        return value
+    if isinstance(value, str):
+        if value not in MATERIALS:
+            raise ValueError(f"unknown material {value!r}; {_MATERIAL_USAGE}")
+        return MATERIALS[value]
+    try:
+        if isinstance(value, dict) and set(value) == {"laminate"} and isinstance(value["laminate"], list):
+            return laminate(tuple(_constant(n) for n in value["laminate"]))
+        if isinstance(value, dict) and "E" in value and set(value) <= {"E", "G", "nu"}:
+            G = _constant(value["G"]) if "G" in value else None
+            return isotropic(_constant(value["E"]), G, _constant(value.get("nu", 0.3)))
+    except UserError as exc:
+        raise ValueError(str(exc)) from None
+    raise ValueError(_MATERIAL_USAGE)
+
+
+class LinkSpec(_FileModel):
+    """An elastic link (seed 001 §5.2): a straight beam from frame ``from`` to frame ``to`` (no joint
+    between them) with a cross-section and a material (:mod:`hapticdesign.model.elastic`)."""
+
+    name: BodyName
+    start: Name = Field(alias="from")
+    end: Name = Field(alias="to")
+    section: Annotated[InstanceOf[Tube], BeforeValidator(_section)]
+    material: Annotated[InstanceOf[LinkModuli], BeforeValidator(_material)]
+
+
 class DeviceFileSpec(_FileModel):
     """A whole device file; cross references are checked after the fields (:func:`_check`)."""
 
@@ -256,6 +288,8 @@ class DeviceFileSpec(_FileModel):
     loops: list[LoopSpec] = []
     assembly: dict[Identifier, Number] = {}
     home: dict[Identifier, Number] = {}
+    links: list[LinkSpec] = []
+    joint_stiffness: dict[Identifier, Annotated[Number, Field(gt=0.0)]] = {}
 
     def dh_names(self) -> list[str]:
         return [row.name or str(i + 1) for i, row in enumerate(self.dh)]
@@ -329,6 +363,22 @@ def _check(spec: DeviceFileSpec) -> None:
         raise ValueError(f"end_effector: unknown frame {spec.end_effector!r}")
     _check_limits_and_actuators(spec, coordinates)
     _check_loops(spec, frames)
+    _check_links(spec, frames)
+
+
+def _check_links(spec: DeviceFileSpec, frames: list[str]) -> None:
+    """Link names and frames, joint springs on actuated joints (the geometry is checked when built)."""
+    for i, link in enumerate(spec.links):
+        if any(other.name == link.name for other in spec.links[:i]):
+            raise ValueError(f"links[{i}]: link name {link.name!r} is used twice")
+        for key, frame in (("from", link.start), ("to", link.end)):
+            if frame not in frames:
+                raise ValueError(f"links[{i}].{key}: unknown frame {frame!r} (frames: {', '.join(frames)})")
+    actuated = [j.name for j in spec.joints if j.actuated]
+    for name in spec.joint_stiffness:
+        if name not in actuated:
+            raise ValueError(f"joint_stiffness: {name!r} is not an actuated joint (actuated: {', '.join(actuated)}; "
+                             "passive joints are free)")
 
 
 def _check_loops(spec: DeviceFileSpec, frames: list[str]) -> None:

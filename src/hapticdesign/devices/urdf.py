@@ -33,8 +33,15 @@ from pathlib import Path
 
 import numpy as np
 
-from hapticdesign.devices.device_file import ChainBuilder, FrameTemplate, assemble_device
-from hapticdesign.devices.schema import BODY_NAME, IDENTIFIER, LinearExpr, TransformSpec
+from hapticdesign.devices.builder import (
+    BODY_NAME,
+    IDENTIFIER,
+    ChainBuilder,
+    FrameTemplate,
+    LinearExpr,
+    TransformSpec,
+    assemble_device,
+)
 from hapticdesign.errors import UserError
 from hapticdesign.files import quote, read_text
 from hapticdesign.model.device import Device

@@ -7,7 +7,8 @@ Overrides by name return a new device; unknown names and non-finite values are r
 Actuators and joint limits (:mod:`hapticdesign.model.actuators`) ride along: ``damping`` is the
 total viscous damping per coordinate (joints plus actuators), ``coulomb`` the Coulomb friction per
 coordinate, ``reflected_inertia`` the constant ``n^2 J_r`` added to the diagonal of H
-(seed 000 eq. 2.50), ``limits`` each coordinate's range or ``None``.
+(seed 000 eq. 2.50), ``limits`` each coordinate's range or ``None``. ``elasticity``
+(:mod:`hapticdesign.model.elastic`) names the elastic links and joint springs, when given.
 
 A device knows no file format and owns no analysis: :func:`hapticdesign.devices.loading.load_device`
 reads one from a file, and :mod:`hapticdesign.analysis.dynamics.device` gives its equations of motion.
@@ -25,6 +26,7 @@ import numpy as np
 
 from hapticdesign.errors import PhysicalConsistencyWarning, UserError
 from hapticdesign.model.actuators import Actuator, Limits, full_turn, limit_warnings, per_joint
+from hapticdesign.model.elastic import Elasticity
 from hapticdesign.model.inertia import (
     SEED_FIELDS,
     BodyInertia,
@@ -50,6 +52,7 @@ class Device:
     damping: tuple[float, ...] = ()
     actuators: tuple[Actuator, ...] = ()
     limits: tuple[Limits, ...] = ()
+    elasticity: Elasticity | None = None
 
     # -- parameters ---------------------------------------------------------------------------
     @property

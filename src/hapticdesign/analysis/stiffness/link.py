@@ -34,23 +34,39 @@ def bending_modulus(moduli: LinkModuli, bending: str = "E_x") -> float:
     return moduli.E_x if bending == "E_x" else moduli.E_y
 
 
+def beam_stiffness(axial: float, bending: float, torsion: float, length: float) -> np.ndarray:
+    """6 x 6 end stiffness of a straight cantilever with an axisymmetric section (eq. 4.58-4.59).
+
+    ``axial = E A`` (N), ``bending = E I`` and ``torsion = G J`` (N m^2): ``E A / L`` along the link,
+    ``12 E I / L^3`` with the ``-+6 E I / L^2`` couplings and ``4 E I / L`` in bending, ``G J / L``
+    in torsion. Coordinates ``(psi_1, psi_2, psi_3, phi_1, phi_2, phi_3)`` of eq. 5.76, x along the
+    link; with ``I_y = I_z`` the matrix does not change when the section turns about x.
+    """
+    if not isfinite(length) or length <= 0.0:
+        raise UserError(f"link length must be positive, got {length!r}")
+    L = length
+    K = np.zeros((6, 6))
+    K[0, 0] = axial / L
+    K[1, 1] = K[2, 2] = 12.0 * bending / L**3
+    K[1, 5] = K[5, 1] = -6.0 * bending / L**2
+    K[2, 4] = K[4, 2] = 6.0 * bending / L**2
+    K[3, 3] = torsion / L
+    K[4, 4] = K[5, 5] = 4.0 * bending / L
+    return K
+
+
+def rigidities(moduli: LinkModuli, section: Tube, bending: str = "E_x") -> tuple[float, float, float]:
+    """``(E_x A, E_b I, G_xy J)`` of a tube; ``E_b`` from :func:`bending_modulus` (eq. 4.59, 5.162-5.165)."""
+    return (moduli.E_x * section.area, bending_modulus(moduli, bending) * section.second_moment,
+            moduli.G_xy * section.polar_moment)
+
+
 def link_stiffness(moduli: LinkModuli, section: Tube, length: float, bending: str = "E_x") -> np.ndarray:
     """6 x 6 virtual-joint stiffness of a straight link (eq. 4.59; eq. 4.58 when isotropic).
 
     The bending terms use :func:`bending_modulus` (``E_x`` unless ``bending="eq. 4.59"``).
     """
-    if not isfinite(length) or length <= 0.0:
-        raise UserError(f"link length must be positive, got {length!r}")
-    L, A, I, J = length, section.area, section.second_moment, section.polar_moment
-    Ex, Eb, G = moduli.E_x, bending_modulus(moduli, bending), moduli.G_xy
-    K = np.zeros((6, 6))
-    K[0, 0] = Ex * A / L
-    K[1, 1] = K[2, 2] = 12.0 * Eb * I / L**3
-    K[1, 5] = K[5, 1] = -6.0 * Eb * I / L**2
-    K[2, 4] = K[4, 2] = 6.0 * Eb * I / L**2
-    K[3, 3] = G * J / L
-    K[4, 4] = K[5, 5] = 4.0 * Eb * I / L
-    return K
+    return beam_stiffness(*rigidities(moduli, section, bending), length)
 
 
 @dataclass(frozen=True)

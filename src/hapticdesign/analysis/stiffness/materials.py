@@ -36,6 +36,13 @@ def isotropic(E: float, G: float | None = None, nu: float = 0.3) -> LinkModuli:
 
 
 STRUCTURAL_STEEL = isotropic(200e9, nu=0.3)
+"""Structural steel as in the seed's verification cases (§5.2.1, §5.2.5): E = 200 GPa, nu = 0.3."""
+
+ALUMINIUM_6061 = isotropic(68.9e9, G=26.0e9)
+"""Aluminium 6061-T6: E = 68.9 GPa, G = 26 GPa (ASM Aerospace Specification Metals data sheet)."""
+
+MATERIALS = {"steel": STRUCTURAL_STEEL, "aluminium_6061": ALUMINIUM_6061}
+"""Named materials a device file's links may use (docs/device-files.md)."""
 
 
 @dataclass(frozen=True)

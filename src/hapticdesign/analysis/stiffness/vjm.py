@@ -34,21 +34,23 @@ def locked_stiffness(J_theta: np.ndarray, C_theta: np.ndarray, joints: np.ndarra
 
 def chain_stiffness(J_theta: np.ndarray, C_theta: np.ndarray, J_p: np.ndarray,
                     joints: np.ndarray | None = None) -> np.ndarray:
-    """``K_Ci``: the 6 x 6 block of the inverse bordered compliance matrix (eq. 5.121-5.122).
+    """``K_Ci``: the leading block of the inverse bordered compliance matrix (eq. 5.121-5.122).
 
     The passive joints (Jacobian ``J_p``, columns carry no load, eq. 5.118) make the result rank
     deficient: it annihilates every passive twist, ``K_Ci J_p = 0``. ``joints`` adds the joint
-    springs' Cartesian compliance to the links' (see :func:`compliance`).
+    springs' Cartesian compliance to the links' (see :func:`compliance`). The rows of ``J_theta`` and
+    ``J_p`` are the end point's twist (6) and, for a closed-loop device, the linearized loop closures
+    below it (:mod:`hapticdesign.analysis.stiffness.device`); the block has the size of those rows.
     """
     C = compliance(J_theta, C_theta, joints)
-    n_p = J_p.shape[-1]
+    n, n_p = C.shape[-1], J_p.shape[-1]
     lead = np.broadcast_shapes(C.shape[:-2], J_p.shape[:-2])
-    B = np.zeros(lead + (6 + n_p, 6 + n_p))
-    B[..., :6, :6] = C
-    B[..., :6, 6:] = J_p
-    B[..., 6:, :6] = np.swapaxes(J_p, -1, -2)
+    B = np.zeros(lead + (n + n_p, n + n_p))
+    B[..., :n, :n] = C
+    B[..., :n, n:] = J_p
+    B[..., n:, :n] = np.swapaxes(J_p, -1, -2)
     try:
-        return np.linalg.inv(B)[..., :6, :6]
+        return np.linalg.inv(B)[..., :n, :n]
     except np.linalg.LinAlgError:
         raise UserError("the passive-joint Jacobian is rank deficient (singular pose)") from None
 
