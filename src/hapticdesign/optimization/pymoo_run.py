@@ -1,10 +1,10 @@
 """One way to set up, run and filter pymoo's ``minimize`` (Problem, Algorithm, minimize, Result).
 
-The R-CUBE synthesis (seed 001 §6.4, §7.1), the weighted-sum swarm (ch. 6 introduction), the
-cross-section ratio (§6.5, §7.3) and the ply counts (§6.6, §7.4) all run through :func:`run`:
-an :class:`AlgorithmSpec` names the algorithm and its size, ``minimize`` runs it with a seed (the
-same seed gives the same numbers), and the final population comes back as a plain
-:class:`RunResult` whose :meth:`RunResult.feasible` and :meth:`RunResult.front` do the filtering.
+The searches of :mod:`~hapticdesign.optimization.synthesis`, :mod:`~hapticdesign.optimization.swarm`,
+:mod:`~hapticdesign.optimization.cross_section` and :mod:`~hapticdesign.optimization.plies` all run
+through :func:`run`: an :class:`AlgorithmSpec` names the algorithm and its size, ``minimize`` runs
+it with a seed (the same seed gives the same numbers), and the final population comes back as a
+plain :class:`RunResult` whose :meth:`RunResult.feasible` and :meth:`RunResult.front` filter it.
 
 Expensive objectives of one design vector are a :class:`RowObjective`, pymoo's
 ``ElementwiseProblem``: its rows go through pymoo's element-wise runner, in a loop by default or
