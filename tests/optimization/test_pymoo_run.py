@@ -57,6 +57,8 @@ def test_spec_is_checked():
         AlgorithmSpec(generations=0)
     with pytest.raises(UserError, match="method"):
         AlgorithmSpec("simplex")
+    with pytest.raises(UserError, match="integer"):
+        AlgorithmSpec("pso", integer=True)
 
 
 def test_row_objective_matches_direct_evaluation():

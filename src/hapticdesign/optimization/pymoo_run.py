@@ -38,8 +38,8 @@ METHODS = ("nsga2", "pso")
 @dataclass(frozen=True)
 class AlgorithmSpec:
     """The algorithm of one run: ``method`` (NSGA-II or particle swarm), ``population`` and
-    ``generations``. ``integer``: integer variables (integer sampling, SBX and polynomial mutation
-    with distribution index 3 and rounding repair, duplicates eliminated). ``initial``: the first
+    ``generations``. ``integer``: integer variables, NSGA-II only (integer sampling, SBX and polynomial
+    mutation with distribution index 3 and rounding repair, duplicates eliminated). ``initial``: the first
     population's rows; without it pymoo's own seeded random sampling is used."""
 
     method: str = "nsga2"
@@ -51,6 +51,8 @@ class AlgorithmSpec:
     def __post_init__(self) -> None:
         if self.method not in METHODS:
             raise UserError(f"unknown optimization method {self.method!r}; choose one of {', '.join(METHODS)}")
+        if self.integer and self.method != "nsga2":
+            raise UserError("integer variables need the nsga2 method")
         if self.population < 2:
             raise UserError(f"population must be at least 2, got {self.population}")
         if self.generations < 1:
@@ -59,9 +61,9 @@ class AlgorithmSpec:
 
 def build_algorithm(spec: AlgorithmSpec) -> Algorithm:
     """The pymoo algorithm of ``spec``."""
-    if spec.method == "pso":
-        return PSO(pop_size=spec.population)
     options = {} if spec.initial is None else {"sampling": spec.initial}
+    if spec.method == "pso":
+        return PSO(pop_size=spec.population, **options)
     if spec.integer:
         options = {"sampling": IntegerRandomSampling(),
                    "crossover": SBX(prob=1.0, eta=3.0, vtype=float, repair=RoundingRepair()),
