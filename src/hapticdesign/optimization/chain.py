@@ -151,10 +151,11 @@ class ChainResult:
 
 def run_chain(seed: int = 1, settings: Settings = Settings(), weight: float = 0.0, bound_sets=BOUND_SETS,
               workspace: Workspace = Workspace(), ratio_bounds=RATIO_BOUNDS, max_deflection: float | None = None,
-              progress: Callable[[str, int, int], None] | None = None) -> ChainResult:
+              progress: Callable[[str, int, int], None] | None = None, client=None) -> ChainResult:
     """Synthesis, selection, swarm, cross-section and plies, all seeded from ``seed``.
 
-    ``progress(step, done, total)`` reports generations.
+    ``progress(step, done, total)`` reports generations; ``client`` (a ``dask.distributed.Client``,
+    none by default) evaluates the synthesis, swarm and ply objectives on its workers.
     """
     s = settings
     n_sets = len(bound_sets)
@@ -164,15 +165,15 @@ def run_chain(seed: int = 1, settings: Settings = Settings(), weight: float = 0.
             return None
         return lambda *a: progress(step, offset(*a) + a[-1], total)
 
-    synthesis = synthesize(bound_sets, s.population, s.generations, seed, workspace,
+    synthesis = synthesize(bound_sets, s.population, s.generations, seed, workspace, client=client,
                            progress=report("synthesis", n_sets * s.generations, lambda k, gen: k * s.generations))
     selection = select_solution(synthesis, weight, workspace)
     swarm = weighted_sum_swarm(synthesis.front, bounds=bound_sets[-1], population=s.swarm_population,
-                               generations=s.swarm_generations, seed=seed, workspace=workspace)
+                               generations=s.swarm_generations, seed=seed, workspace=workspace, client=client)
     cross = optimize_ratio(ratio_bounds, s.cs_population, s.cs_generations, seed, report("cross-section", s.cs_generations))
     geometry = geometry_of(synthesis.front.X[selection.selected], workspace)
     plies = optimize_plies(geometry, cross.ratio, s.ply_population, s.ply_generations, seed,
-                           progress=report("plies", s.ply_generations))
+                           progress=report("plies", s.ply_generations), client=client)
     k = choose_plies(plies, max_deflection)
     design = ply_design(geometry, plies.counts[k], cross.ratio)
     return ChainResult(synthesis, selection, swarm, cross, plies, k, design, specifications(design, workspace),

@@ -21,14 +21,12 @@ from dataclasses import dataclass
 from math import isfinite, pi
 
 import numpy as np
-from pymoo.algorithms.moo.nsga2 import NSGA2
-from scipy.optimize import minimize_scalar
 from pymoo.core.problem import Problem
-from pymoo.optimize import minimize
+from scipy.optimize import minimize_scalar
 
 from hapticdesign.errors import UserError
 from hapticdesign.optimization.selection import normalize, weighted_rms
-from hapticdesign.optimization.synthesis import _Progress, pareto_filter
+from hapticdesign.optimization.pymoo_run import AlgorithmSpec, run
 
 RATIO_BOUNDS = (0.0, 0.9)
 
@@ -87,15 +85,8 @@ def optimize_ratio(bounds=RATIO_BOUNDS, population: int = 100, generations: int 
                    progress: Callable[[int], None] | None = None) -> CrossSectionResult:
     """NSGA-II (pymoo) on ``(CS1, CS2)`` over ``d / D``, then the minimum-RMS front point (§7.3)."""
     lo, hi = _check(bounds)
-    if population < 2 or generations < 1:
-        raise UserError(f"population must be at least 2 and generations at least 1, got {population}, {generations}")
-    options = {"callback": _Progress(progress)} if progress else {}
-    result = minimize(CrossSectionProblem((lo, hi)), NSGA2(pop_size=population), ("n_gen", generations),
-                      seed=seed, verbose=False, **options)
-    X, F = result.pop.get("X"), result.pop.get("F")
-    keep = pareto_filter(X, F)
-    order = np.argsort(X[keep, 0])
-    ratios = X[keep, 0][order]
+    result = run(CrossSectionProblem((lo, hi)), AlgorithmSpec("nsga2", population, generations), seed, progress)
+    ratios = np.sort(result.X[result.front(), 0])
     best, rms = min_rms_ratio(ratios)
     return CrossSectionResult(ratios, cs1(ratios), cs2(ratios), rms, float(ratios[best]))
 

@@ -17,13 +17,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from pymoo.algorithms.moo.nsga2 import NSGA2
 from pymoo.core.problem import Problem
-from pymoo.operators.crossover.sbx import SBX
-from pymoo.operators.mutation.pm import PM
-from pymoo.operators.repair.rounding import RoundingRepair
-from pymoo.operators.sampling.rnd import IntegerRandomSampling
-from pymoo.optimize import minimize
 
 from hapticdesign.errors import UserError
 from hapticdesign.model.rcube import RCubeGeometry
@@ -34,7 +28,7 @@ from hapticdesign.analysis.stiffness import vjm
 from hapticdesign.analysis.stiffness.link import LinkDesign
 from hapticdesign.analysis.stiffness.materials import PLY_THICKNESS, Lamina, M55J, laminate
 from hapticdesign.analysis.stiffness.sections import Tube
-from hapticdesign.optimization.synthesis import _Progress, pareto_filter
+from hapticdesign.optimization.pymoo_run import AlgorithmSpec, RowObjective, run
 
 MAX_PLIES = 10
 DESIGN_FORCE = 20.0
@@ -97,21 +91,18 @@ class PlyEvaluator:
 
 
 class PlyProblem(Problem):
-    def __init__(self, evaluator: PlyEvaluator, max_plies: int):
+    """Ply counts of the three links, rows of 9 integers; a link without plies gets infinite
+    objectives, the others are evaluated row by row (a loop, or the Dask ``client``'s workers)."""
+
+    def __init__(self, evaluator: PlyEvaluator, max_plies: int, client=None):
         super().__init__(n_var=9, n_obj=3, xl=np.zeros(9), xu=np.full(9, max_plies), vtype=int)
-        self.evaluator = evaluator
-        self.evaluations = 0
+        self.objective = RowObjective(evaluator.objectives, 9, 3, client)
 
     def _evaluate(self, X, out, *args, **kwargs):
         X = np.round(X).astype(int)
-        F = np.empty((len(X), 3))
-        for k, x in enumerate(X):
-            rows = x.reshape(3, 3)
-            if np.any(rows.sum(axis=1) == 0):
-                F[k] = np.inf
-                continue
-            F[k] = self.evaluator.objectives(rows)
-            self.evaluations += 1
+        ok = np.all(X.reshape(-1, 3, 3).sum(axis=2) > 0, axis=1)
+        F = np.full((len(X), 3), np.inf)
+        F[ok] = self.objective(X[ok])
         out["F"] = F
 
 
@@ -127,26 +118,18 @@ class PlyResult:
 
 def optimize_plies(geometry: RCubeGeometry, ratio: float, population: int = 100, generations: int = 100,
                    seed: int = 1, max_plies: int = MAX_PLIES, force: float = DESIGN_FORCE,
-                   progress: Callable[[int], None] | None = None) -> PlyResult:
-    """NSGA-II with integer variables (pymoo: integer sampling, rounded SBX and polynomial mutation)."""
-    if population < 2 or generations < 1:
-        raise UserError(f"population must be at least 2 and generations at least 1, got {population}, {generations}")
+                   progress: Callable[[int], None] | None = None, client=None) -> PlyResult:
+    """NSGA-II with integer variables (pymoo: integer sampling, rounded SBX and polynomial mutation);
+    ``client``: a ``dask.distributed.Client`` whose workers evaluate the designs."""
+    spec = AlgorithmSpec("nsga2", population, generations, integer=True)
     if max_plies < 1:
         raise UserError(f"the ply limit must be at least 1, got {max_plies}")
     evaluator = PlyEvaluator(geometry, ratio, force=force)
-    problem = PlyProblem(evaluator, max_plies)
-    algorithm = NSGA2(pop_size=population, sampling=IntegerRandomSampling(),
-                      crossover=SBX(prob=1.0, eta=3.0, vtype=float, repair=RoundingRepair()),
-                      mutation=PM(prob=1.0, eta=3.0, vtype=float, repair=RoundingRepair()),
-                      eliminate_duplicates=True)
-    options = {"callback": _Progress(progress)} if progress else {}
-    result = minimize(problem, algorithm, ("n_gen", generations), seed=seed, verbose=False, **options)
-    X, F = np.round(result.pop.get("X")).astype(int), result.pop.get("F")
-    ok = np.all(np.isfinite(F), axis=1)
-    X, F = X[ok], F[ok]
-    keep = pareto_filter(X.astype(float), F)
-    order = keep[np.argsort(F[keep, 0])]
-    return PlyResult(X[order].reshape(-1, 3, 3), F[order], evaluator, problem.evaluations)
+    problem = PlyProblem(evaluator, max_plies, client)
+    result = run(problem, spec, seed, progress)
+    keep = result.front()
+    order = keep[np.argsort(result.F[keep, 0])]
+    return PlyResult(result.X[order].reshape(-1, 3, 3), result.F[order], evaluator, problem.objective.evaluations)
 
 
 def choose(F: np.ndarray, max_deflection: float) -> int:

@@ -14,20 +14,18 @@ shortest design minimizes ``O3`` on the front, so NSGA-II's elitism keeps it.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from functools import partial
 from math import isfinite
 
 import numpy as np
-from pymoo.algorithms.moo.nsga2 import NSGA2
-from pymoo.core.callback import Callback
 from pymoo.core.problem import Problem
 from pymoo.indicators.hv import HV
-from pymoo.optimize import minimize
-from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
 from hapticdesign.errors import UserError
 from hapticdesign.optimization.constraints import Q_MAX_RANGE, Workspace, constraint_values, link1_length
 from hapticdesign.optimization.objectives import EvaluationLinks, objectives
+from hapticdesign.optimization.pymoo_run import AlgorithmSpec, RowObjective, pareto_filter, run
 from hapticdesign.optimization.shortest import ConstrainedMinimum, constrained_minimum, design_summary, inside
 
 INFEASIBLE_OBJECTIVE = 1e30
@@ -66,31 +64,22 @@ BOUND_SETS = (
 
 
 class SynthesisProblem(Problem):
-    """Three objectives, seven inequality constraints; objectives are evaluated on feasible rows only."""
+    """Three objectives, seven inequality constraints. The constraints are evaluated for the whole
+    population at once; the objectives, row by row (a loop, or the Dask ``client``'s workers), on
+    feasible rows only."""
 
-    def __init__(self, bounds: Bounds, workspace: Workspace, links: EvaluationLinks):
+    def __init__(self, bounds: Bounds, workspace: Workspace, links: EvaluationLinks, client=None):
         super().__init__(n_var=3, n_obj=3, n_ieq_constr=7, xl=np.array(bounds.lower), xu=np.array(bounds.upper))
         self.workspace = workspace
-        self.links = links
-        self.evaluations = 0
+        self.objective = RowObjective(partial(objectives, workspace=workspace, links=links), 3, 3, client)
 
     def _evaluate(self, X, out, *args, **kwargs):
         G = constraint_values(X, self.workspace)
+        ok = np.all(G <= 0.0, axis=1)
         F = np.full((len(X), 3), INFEASIBLE_OBJECTIVE)
-        for k in np.flatnonzero(np.all(G <= 0.0, axis=1)):
-            F[k] = objectives(X[k], self.workspace, self.links)
-            self.evaluations += 1
+        F[ok] = self.objective(X[ok])
         out["F"] = F
         out["G"] = G
-
-
-class _Progress(Callback):
-    def __init__(self, report: Callable[[int], None]):
-        super().__init__()
-        self.report = report
-
-    def notify(self, algorithm):
-        self.report(algorithm.n_gen)
 
 
 @dataclass(frozen=True)
@@ -129,33 +118,18 @@ def initial_population(bounds: Bounds, population: int, seed: int, designs: np.n
 
 def run_nsga2(bounds: Bounds, population: int, generations: int, seed: int, workspace: Workspace = Workspace(),
               links: EvaluationLinks = EvaluationLinks(), progress: Callable[[int], None] | None = None,
-              initial: np.ndarray | None = None) -> tuple[Front, int]:
-    """One NSGA-II run (pymoo) over one bound set; returns its feasible front and the number of
-    objective evaluations. ``initial``: designs placed in the first population (see
-    :func:`initial_population`); without them pymoo's own seeded random sampling is used."""
-    if population < 2:
-        raise UserError(f"population must be at least 2, got {population}")
-    if generations < 1:
-        raise UserError(f"generations must be at least 1, got {generations}")
-    problem = SynthesisProblem(bounds, workspace, links)
-    options = {"callback": _Progress(progress)} if progress else {}
-    sampling = {} if initial is None else {"sampling": initial_population(bounds, population, seed, initial)}
-    result = minimize(problem, NSGA2(pop_size=population, **sampling), ("n_gen", generations), seed=seed,
-                      verbose=False, **options)
-    pop = result.pop
-    X, F, G = pop.get("X"), pop.get("F"), pop.get("G")
-    ok = np.all(G <= 0.0, axis=1)
-    return Front(X[ok], F[ok], workspace), problem.evaluations
-
-
-def pareto_filter(X: np.ndarray, F: np.ndarray) -> np.ndarray:
-    """Indices of the non-dominated rows of ``F`` (minimization), duplicates removed."""
-    if len(F) == 0:
-        return np.zeros(0, dtype=int)
-    _, unique = np.unique(np.round(X, 12), axis=0, return_index=True)
-    unique = np.sort(unique)
-    first = NonDominatedSorting().do(F[unique], only_non_dominated_front=True)
-    return unique[np.sort(first)]
+              initial: np.ndarray | None = None, client=None) -> tuple[Front, int]:
+    """One NSGA-II run (pymoo) over one bound set; returns its feasible final population and the
+    number of objective evaluations. ``initial``: designs placed in the first population (see
+    :func:`initial_population`); without them pymoo's own seeded random sampling is used.
+    ``client``: a ``dask.distributed.Client`` whose workers evaluate the objectives."""
+    spec = AlgorithmSpec("nsga2", population, generations)
+    if initial is not None:
+        spec = replace(spec, initial=initial_population(bounds, population, seed, initial))
+    problem = SynthesisProblem(bounds, workspace, links, client)
+    result = run(problem, spec, seed, progress)
+    ok = result.feasible()
+    return Front(result.X[ok], result.F[ok], workspace), problem.objective.evaluations
 
 
 def merge_fronts(fronts: list[Front], length_limit: float = TOTAL_LENGTH_LIMIT) -> Front:
@@ -199,12 +173,13 @@ MINIMIZATION_STARTS = 32
 def synthesize(bound_sets=BOUND_SETS, population: int = 100, generations: int = 150, seed: int = 1,
                workspace: Workspace = Workspace(), links: EvaluationLinks = EvaluationLinks(),
                length_limit: float = TOTAL_LENGTH_LIMIT, progress: Callable[[int, int], None] | None = None,
-               starts: int = MINIMIZATION_STARTS) -> SynthesisResult:
+               starts: int = MINIMIZATION_STARTS, client=None) -> SynthesisResult:
     """NSGA-II over each bound set (seed ``seed + k`` for set ``k``), merged as in §7.1.
 
     The shortest feasible design (:func:`hapticdesign.optimization.shortest.constrained_minimum`,
     ``starts`` starts drawn with ``seed``; 0 skips it) joins the initial population of every bound
-    set that holds it. ``progress(set_index, generation)`` is called after each generation. Raises
+    set that holds it. ``progress(set_index, generation)`` is called after each generation; ``client``
+    (a ``dask.distributed.Client``, none by default) evaluates the objectives on its workers. Raises
     :class:`UserError` when no design meets the constraints (an infeasible workspace for the bounds).
     """
     minimum = constrained_minimum(bound_sets, workspace, starts, seed) if starts != 0 else None
@@ -212,7 +187,7 @@ def synthesize(bound_sets=BOUND_SETS, population: int = 100, generations: int = 
     for k, bounds in enumerate(bound_sets):
         report = (lambda gen, k=k: progress(k, gen)) if progress else None
         initial = minimum.x[None] if minimum is not None and inside(minimum.x, bounds) else None
-        front, n = run_nsga2(bounds, population, generations, seed + k, workspace, links, report, initial)
+        front, n = run_nsga2(bounds, population, generations, seed + k, workspace, links, report, initial, client)
         fronts.append(front)
         evaluations += n
     merged = merge_fronts(fronts, length_limit)

@@ -1,0 +1,153 @@
+"""One way to set up, run and filter pymoo's ``minimize`` (Problem, Algorithm, minimize, Result).
+
+The searches of :mod:`~hapticdesign.optimization.synthesis`, :mod:`~hapticdesign.optimization.swarm`,
+:mod:`~hapticdesign.optimization.cross_section` and :mod:`~hapticdesign.optimization.plies` all run
+through :func:`run`: an :class:`AlgorithmSpec` names the algorithm and its size, ``minimize`` runs
+it with a seed (the same seed gives the same numbers), and the final population comes back as a
+plain :class:`RunResult` whose :meth:`RunResult.feasible` and :meth:`RunResult.front` filter it.
+
+Expensive objectives of one design vector are a :class:`RowObjective`, pymoo's
+``ElementwiseProblem``: its rows go through pymoo's element-wise runner, in a loop by default or
+on the workers of a Dask client that the caller passes (none is started here).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from pymoo.algorithms.moo.nsga2 import NSGA2
+from pymoo.algorithms.soo.nonconvex.pso import PSO
+from pymoo.core.algorithm import Algorithm
+from pymoo.core.callback import Callback
+from pymoo.core.problem import ElementwiseProblem, LoopedElementwiseEvaluation, Problem
+from pymoo.operators.crossover.sbx import SBX
+from pymoo.operators.mutation.pm import PM
+from pymoo.operators.repair.rounding import RoundingRepair
+from pymoo.operators.sampling.rnd import IntegerRandomSampling
+from pymoo.optimize import minimize
+from pymoo.parallelization import DaskParallelization
+from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
+
+from hapticdesign.errors import UserError
+
+METHODS = ("nsga2", "pso")
+
+
+@dataclass(frozen=True)
+class AlgorithmSpec:
+    """The algorithm of one run: ``method`` (NSGA-II or particle swarm), ``population`` and
+    ``generations``. ``integer``: integer variables, NSGA-II only (integer sampling, SBX and polynomial
+    mutation with distribution index 3 and rounding repair, duplicates eliminated). ``initial``: the first
+    population's rows; without it pymoo's own seeded random sampling is used."""
+
+    method: str = "nsga2"
+    population: int = 100
+    generations: int = 100
+    integer: bool = False
+    initial: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        if self.method not in METHODS:
+            raise UserError(f"unknown optimization method {self.method!r}; choose one of {', '.join(METHODS)}")
+        if self.integer and self.method != "nsga2":
+            raise UserError("integer variables need the nsga2 method")
+        if self.population < 2:
+            raise UserError(f"population must be at least 2, got {self.population}")
+        if self.generations < 1:
+            raise UserError(f"generations must be at least 1, got {self.generations}")
+
+
+def build_algorithm(spec: AlgorithmSpec) -> Algorithm:
+    """The pymoo algorithm of ``spec``."""
+    options = {} if spec.initial is None else {"sampling": spec.initial}
+    if spec.method == "pso":
+        return PSO(pop_size=spec.population, **options)
+    if spec.integer:
+        options = {"sampling": IntegerRandomSampling(),
+                   "crossover": SBX(prob=1.0, eta=3.0, vtype=float, repair=RoundingRepair()),
+                   "mutation": PM(prob=1.0, eta=3.0, vtype=float, repair=RoundingRepair()),
+                   "eliminate_duplicates": True, **options}
+    return NSGA2(pop_size=spec.population, **options)
+
+
+def pareto_filter(X: np.ndarray, F: np.ndarray) -> np.ndarray:
+    """Indices of the non-dominated rows of ``F`` (minimization), duplicates of ``X`` removed."""
+    if len(F) == 0:
+        return np.zeros(0, dtype=int)
+    _, unique = np.unique(np.round(X, 12), axis=0, return_index=True)
+    unique = np.sort(unique)
+    first = NonDominatedSorting().do(F[unique], only_non_dominated_front=True)
+    return unique[np.sort(first)]
+
+
+@dataclass(frozen=True)
+class RunResult:
+    """The final population of a run: designs ``X``, objectives ``F``, constraints ``G`` (``g <= 0``;
+    no columns for an unconstrained problem) and pymoo's optimum ``best`` (the best feasible design
+    of a single-objective run, None when there is none)."""
+
+    X: np.ndarray
+    F: np.ndarray
+    G: np.ndarray
+    best: np.ndarray | None
+
+    def feasible(self) -> np.ndarray:
+        """Rows that meet every constraint and have finite objectives (NaN and inf rows are dropped)."""
+        return np.all(self.G <= 0.0, axis=1) & np.all(np.isfinite(self.F), axis=1)
+
+    def front(self) -> np.ndarray:
+        """Indices of the feasible, non-dominated rows, duplicates removed, in population order."""
+        ok = np.flatnonzero(self.feasible())
+        return ok[pareto_filter(self.X[ok].astype(float), self.F[ok])]
+
+
+class _Progress(Callback):
+    def __init__(self, report: Callable[[int], None]):
+        super().__init__()
+        self.report = report
+
+    def notify(self, algorithm):
+        self.report(algorithm.n_gen)
+
+
+def run(problem: Problem, spec: AlgorithmSpec, seed: int, progress: Callable[[int], None] | None = None) -> RunResult:
+    """``minimize`` ``problem`` with the algorithm of ``spec`` for ``spec.generations`` generations,
+    seeded with ``seed``; ``progress(generation)`` is called after each generation."""
+    options = {"callback": _Progress(progress)} if progress else {}
+    result = minimize(problem, build_algorithm(spec), ("n_gen", spec.generations), seed=seed, verbose=False,
+                      **options)
+    pop = result.pop
+    X, F = pop.get("X"), pop.get("F")
+    X = np.round(X).astype(int) if spec.integer else X
+    G = pop.get("G") if problem.n_ieq_constr else np.zeros((len(X), 0))
+    best = None if result.X is None else np.asarray(result.X, dtype=float)
+    return RunResult(X, F, G, best)
+
+
+def elementwise_runner(client=None):
+    """pymoo's element-wise runner: a plain loop, or the workers of the Dask ``client``
+    (``dask.distributed.Client``) when one is given."""
+    return LoopedElementwiseEvaluation() if client is None else DaskParallelization(client)
+
+
+class RowObjective(ElementwiseProblem):
+    """An expensive objective ``function(x) -> (n_obj,)`` of one design vector, as pymoo's
+    ``ElementwiseProblem``: calling it on rows ``X (m, n_var)`` evaluates them through the
+    element-wise runner (a loop, or the Dask ``client``'s workers) and counts them in ``evaluations``."""
+
+    def __init__(self, function: Callable[[np.ndarray], np.ndarray], n_var: int, n_obj: int, client=None):
+        super().__init__(n_var=n_var, n_obj=n_obj, elementwise_runner=elementwise_runner(client))
+        self.function = function
+        self.evaluations = 0
+
+    def _evaluate(self, x, out, *args, **kwargs):
+        out["F"] = self.function(x)
+
+    def __call__(self, X: np.ndarray) -> np.ndarray:
+        """Objective rows ``(m, n_obj)`` of ``X``."""
+        if len(X) == 0:
+            return np.zeros((0, self.n_obj))
+        self.evaluations += len(X)
+        return self.evaluate(X)
