@@ -27,7 +27,7 @@ from hapticdesign.analysis.dynamics.model import pair_index
 from hapticdesign.errors import UserError
 from hapticdesign.escape import docstring_text, python_identifier
 from hapticdesign.model.device import Device
-from hapticdesign.model.inertia import SEED_FIELDS
+from hapticdesign.model.inertia import SEED_FIELDS, seed_parameter_name, standard_terms
 from hapticdesign.model.transforms import Axis
 
 
@@ -231,16 +231,11 @@ def derive(device: Device, symbolic: str = "all") -> SymbolicEquations:
                         jac[i][k] += ckp * v[i]
                         jac[3 + i][k] += ckp * w[i]
         jac = [[reduce(x) for x in row] for row in jac]
-        m, rx, ry, rz, ixx, iyy, izz, ixy, ixz, iyz = (
-            param(f"m{body}") if f == "m" else param(f"r{body}{f[1]}") if f.startswith("r") else param(f"{f}{body}")
-            for f in SEED_FIELDS
+        m, hx, hy, hz, jxx, jyy, jzz, jxy, jxz, jyz = standard_terms(
+            *(param(seed_parameter_name(f, body)) for f in SEED_FIELDS)
         )
-        h = [m * rx, m * ry, m * rz]
-        jo = [
-            [ixx + m * (ry**2 + rz**2), -ixy - m * rx * ry, -ixz - m * rx * rz],
-            [-ixy - m * rx * ry, iyy + m * (rx**2 + rz**2), -iyz - m * ry * rz],
-            [-ixz - m * rx * rz, -iyz - m * ry * rz, izz + m * (rx**2 + ry**2)],
-        ]
+        h = [hx, hy, hz]
+        jo = [[jxx, jxy, jxz], [jxy, jyy, jyz], [jxz, jyz, jzz]]
         jv, jw = jac[:3], jac[3:]
         gb = [reduce(sum((rb[r][i] * gravity[r] for r in range(3)), R(0))) for i in range(3)]
         for i in range(n):
