@@ -21,7 +21,7 @@ from enum import Enum
 
 import numpy as np
 
-from hapticdesign.errors import UserError
+from hapticdesign.errors import InputError, UserError
 
 SEED_FIELDS = ("m", "rx", "ry", "rz", "Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz")
 STANDARD_FIELDS = ("m", "hx", "hy", "hz", "Jxx", "Jyy", "Jzz", "Jxy", "Jxz", "Jyz")
@@ -197,5 +197,5 @@ def require_consistent(reports: list[ConsistencyReport], strict: bool) -> list[s
         if rep.error:
             raise UserError(rep.error)
         if strict and rep.warning:
-            raise UserError(rep.warning + "; drop --strict to accept it")
+            raise InputError(rep.warning + "; the strict check refuses it", "strict")
     return [rep.warning for rep in reports if rep.warning]

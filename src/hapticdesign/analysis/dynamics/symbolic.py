@@ -24,7 +24,7 @@ from sympy.polys.domains import QQ, RR
 from sympy.polys.rings import ring
 
 from hapticdesign.analysis.dynamics.model import pair_index
-from hapticdesign.errors import UserError
+from hapticdesign.errors import InputError, UserError
 from hapticdesign.escape import docstring_text, python_identifier
 from hapticdesign.model.device import Device
 from hapticdesign.model.mechanism import CompiledMechanism
@@ -64,7 +64,7 @@ def _symbolic_names(device: Device, spec: str) -> list[str]:
     chosen = [s.strip() for s in spec.split(",") if s.strip()]
     unknown = [s for s in chosen if s not in names]
     if unknown:
-        raise UserError(f"--symbolic: unknown parameter name {unknown[0]!r} for device {device.name}")
+        raise InputError(f"symbolic: unknown parameter name {unknown[0]!r} for device {device.name}", "symbolic")
     return chosen
 
 
@@ -139,7 +139,7 @@ class _Ring:
     reducers: list
 
     @classmethod
-    def build(cls, aff: _AffineKinematics, inertial: list[str]) -> "_Ring":
+    def build(cls, aff: _AffineKinematics, inertial: list[str]) -> _Ring:
         comp = aff.compiled
         n = comp.n_dof
         prismatic = [bool(p) for p in comp.prismatic]
@@ -401,7 +401,7 @@ def export(eqs: SymbolicEquations, fmt: str, part: str = "tau") -> str:
     """The equations as LaTeX, Python source (a function with common subexpressions) or text."""
     parts = {"tau": eqs.tau, "H": eqs.H, "C": eqs.C, "G": eqs.G}
     if part not in (*parts, "all"):
-        raise UserError(f"--part: expected tau, H, C, G or all, got {part!r}")
+        raise InputError(f"part: expected tau, H, C, G or all, got {part!r}", "part")
     chosen = parts if part == "all" else {part: parts[part]}
     if fmt == "latex":
         lines = []
@@ -415,7 +415,7 @@ def export(eqs: SymbolicEquations, fmt: str, part: str = "tau") -> str:
         return "\n".join(f"{name}[{','.join(str(i + 1) for i in idx)}] = {mat[idx]}" for name, mat in chosen.items() for idx in np.ndindex(mat.shape))
     if fmt == "python":
         return _python_source(eqs, chosen)
-    raise UserError(f"--format: expected latex, python or text, got {fmt!r}")
+    raise InputError(f"format: expected latex, python or text, got {fmt!r}", "format")
 
 
 def _python_source(eqs: SymbolicEquations, chosen: dict[str, sp.Matrix]) -> str:
