@@ -10,3 +10,13 @@ class UserError(ValueError):
 
 class PhysicalConsistencyWarning(UserWarning):
     """Positive definite inertia that no rigid body can have (triangle inequality violated)."""
+
+
+class InputError(UserError):
+    """Bad value of named inputs (``samples``, ``region``, ``q``): the message says the input in
+    words and names no command-line flag; ``inputs`` lets a command line name the flags that carry
+    them (the first input leads the message when the message begins with its name)."""
+
+    def __init__(self, message: str, *inputs: str) -> None:
+        super().__init__(message)
+        self.inputs = inputs

@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from hapticdesign.devices.registry import DEFAULT_PRESET, preset
-from hapticdesign.errors import UserError
+from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.device import Device
 from hapticdesign.model.params_io import read_parameters
 
@@ -35,7 +35,7 @@ def resolve_device(
     break the triangle inequality warn (``strict`` makes them errors).
     """
     if preset_name and device_file:
-        raise UserError("give either --preset or --device, not both")
+        raise InputError("give either a preset or a device file, not both", "preset", "device")
     if device_file is not None:
         device = load_device(device_file)
     else:

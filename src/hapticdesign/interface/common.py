@@ -1,7 +1,9 @@
 """Shared command-line plumbing: one-line errors with exit status 2, JSON output, vectors.
 
 Every command body runs inside :func:`user_errors`: a :class:`~hapticdesign.errors.UserError`
-(or a malformed file) becomes one line on stderr and exit status 2, never a traceback.
+(or a malformed file) becomes one line on stderr and exit status 2, never a traceback. Library
+errors name no flag; :func:`flagged` adds the flags of the running command's options to an
+:class:`~hapticdesign.errors.InputError`.
 """
 
 from __future__ import annotations
@@ -10,10 +12,12 @@ import math
 import warnings
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+
 import numpy as np
 import typer
+from typer._click.globals import get_current_context
 
-from hapticdesign.errors import PhysicalConsistencyWarning, UserError
+from hapticdesign.errors import InputError, PhysicalConsistencyWarning, UserError
 from hapticdesign.files import dumps_json, to_jsonable, write_atomically
 
 
@@ -25,13 +29,30 @@ def user_errors(strict: bool = False, quiet: bool = False) -> Iterator[None]:
         try:
             yield
         except UserError as exc:
-            typer.echo(f"error: {exc}", err=True)
+            typer.echo(f"error: {flagged(exc)}", err=True)
             raise typer.Exit(2) from None
         finally:
             if not quiet:
                 for w in caught:
                     if issubclass(w.category, PhysicalConsistencyWarning):
                         typer.echo(f"warning: {w.message}", err=True)
+
+
+def flagged(exc: UserError) -> str:
+    """The message of ``exc`` for the command line: an :class:`InputError`'s inputs that are options
+    of the running command (input ``allow_long`` is ``--allow-long``) are named by their flags, the
+    leading input in place of its name, the others appended in parentheses."""
+    message = str(exc)
+    context = get_current_context(silent=True)
+    if not isinstance(exc, InputError) or context is None:
+        return message
+    options = {opt for param in context.command.params for opt in param.opts}
+    flags = {name: f"--{name.replace('_', '-')}" for name in exc.inputs}
+    flags = {name: flag for name, flag in flags.items() if flag in options}
+    lead = exc.inputs[0] if exc.inputs else None
+    if lead in flags and message.startswith(lead):
+        message = flags.pop(lead) + message[len(lead):]
+    return f"{message} ({', '.join(flags.values())})" if flags else message
 
 
 def parse_vector(text: str | None, n: int | None, name: str, most: int = 1000) -> np.ndarray:

@@ -21,7 +21,7 @@ from enum import Enum
 
 import numpy as np
 
-from hapticdesign.errors import UserError
+from hapticdesign.errors import InputError, UserError
 
 SEED_FIELDS = ("m", "rx", "ry", "rz", "Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz")
 STANDARD_FIELDS = ("m", "hx", "hy", "hz", "Jxx", "Jyy", "Jzz", "Jxy", "Jxz", "Jyz")
@@ -83,23 +83,50 @@ class BodyInertia:
         return standard_from_seed(np.array([getattr(self, f) for f in SEED_FIELDS]))
 
 
+def standard_terms(m, rx, ry, rz, ixx, iyy, izz, ixy, ixz, iyz) -> tuple:
+    """The ten standard parameters of one body from its ten seed parameters.
+
+    The one statement of the seed -> standard map (seed 000 Table 2.3, eq. 2.30, eq. 2.44).
+    The seed gives the mass centre ``r`` resolved in the body's frame and the inertia tensor
+    about the mass centre with the products entering with a minus sign; the standard
+    parameters are the first moment ``h = m r`` and the tensor ``J`` about the frame origin
+    (parallel-axis theorem ``J = I_c + m (r.r 1 - r r^T)``), whose off-diagonal entries are::
+
+        Jxx = Ixx + m (ry^2 + rz^2)    Jxy = -Ixy - m rx ry
+        Jyy = Iyy + m (rx^2 + rz^2)    Jxz = -Ixz - m rx rz
+        Jzz = Izz + m (rx^2 + ry^2)    Jyz = -Iyz - m ry rz
+
+    Only ``+``, ``-`` and ``*`` are used, so the arguments may be floats, NumPy arrays (the
+    same entry of many bodies), SymPy symbols or exact polynomial-ring elements.
+    """
+    return (
+        m, m * rx, m * ry, m * rz,
+        ixx + m * (ry**2 + rz**2), iyy + m * (rx**2 + rz**2), izz + m * (rx**2 + ry**2),
+        -ixy - m * rx * ry, -ixz - m * rx * rz, -iyz - m * ry * rz,
+    )
+
+
+def seed_terms(m, hx, hy, hz, jxx, jyy, jzz, jxy, jxz, jyz) -> tuple:
+    """The inverse of :func:`standard_terms` (the mass must be non-zero): ``r = h / m``, then
+    the same parallel-axis terms subtracted and the products' sign turned back."""
+    rx, ry, rz = hx / m, hy / m, hz / m
+    return (
+        m, rx, ry, rz,
+        jxx - m * (ry**2 + rz**2), jyy - m * (rx**2 + rz**2), jzz - m * (rx**2 + ry**2),
+        -(jxy + m * rx * ry), -(jxz + m * rx * rz), -(jyz + m * ry * rz),
+    )
+
+
 def standard_from_seed(seed: np.ndarray) -> np.ndarray:
-    """Map seed parameters ``(..., 10)`` to standard parameters ``(..., 10)`` (vectorized)."""
+    """Map seed parameters ``(..., 10)`` to standard parameters ``(..., 10)`` (:func:`standard_terms`)."""
     seed = np.asarray(seed, dtype=float)
-    m = seed[..., 0]
-    r = seed[..., 1:4]
-    ixx, iyy, izz, ixy, ixz, iyz = (seed[..., 4 + k] for k in range(6))
-    rx, ry, rz = r[..., 0], r[..., 1], r[..., 2]
-    out = np.empty_like(seed)
-    out[..., 0] = m
-    out[..., 1:4] = m[..., None] * r
-    out[..., 4] = ixx + m * (ry**2 + rz**2)
-    out[..., 5] = iyy + m * (rx**2 + rz**2)
-    out[..., 6] = izz + m * (rx**2 + ry**2)
-    out[..., 7] = -ixy - m * rx * ry
-    out[..., 8] = -ixz - m * rx * rz
-    out[..., 9] = -iyz - m * ry * rz
-    return out
+    return np.stack(standard_terms(*np.moveaxis(seed, -1, 0)), axis=-1)
+
+
+def seed_from_standard(standard: np.ndarray) -> np.ndarray:
+    """Map standard parameters ``(..., 10)`` to seed parameters ``(..., 10)`` (:func:`seed_terms`)."""
+    standard = np.asarray(standard, dtype=float)
+    return np.stack(seed_terms(*np.moveaxis(standard, -1, 0)), axis=-1)
 
 
 def pseudo_inertia(standard: np.ndarray) -> np.ndarray:
@@ -170,5 +197,5 @@ def require_consistent(reports: list[ConsistencyReport], strict: bool) -> list[s
         if rep.error:
             raise UserError(rep.error)
         if strict and rep.warning:
-            raise UserError(rep.warning + "; drop --strict to accept it")
+            raise InputError(rep.warning + "; the strict check refuses it", "strict")
     return [rep.warning for rep in reports if rep.warning]

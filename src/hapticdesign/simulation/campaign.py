@@ -29,7 +29,7 @@ import numpy as np
 
 from hapticdesign.analysis.dynamics.device import coriolis_centrifugal, gravity, mass_matrix
 from hapticdesign.devices.registry import preset
-from hapticdesign.errors import PhysicalConsistencyWarning, UserError
+from hapticdesign.errors import InputError, PhysicalConsistencyWarning, UserError
 from hapticdesign.files import read_text, write_atomically
 from hapticdesign.simulation.analytic import AnalyticProblem
 from hapticdesign.simulation.impedance import (ImpedanceProblem, fast_search, planned_simulations,
@@ -284,7 +284,7 @@ def _run_locked(designs: list[Design], out: Path, options: CampaignOptions, sche
     settings = json.dumps({**asdict(options), "designs": [asdict(d) for d in designs]}, sort_keys=True)
     stamp = out / "campaign.json"
     if stamp.exists() and stamp.read_text() != settings:
-        raise UserError(f"{out} holds a campaign with other designs or settings; choose another --out")
+        raise InputError(f"{out} holds a campaign with other designs or settings; choose another output folder", "out")
     write_atomically(stamp, settings)
     todo = [(d, c, t) for d in designs for c in CRITERIA for t in TYPES
             if not case_done(cases_dir / f"{case_key(d.name, c, t)}.json", d.name, c, t)]

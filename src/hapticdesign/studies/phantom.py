@@ -20,7 +20,7 @@ from hapticdesign.analysis.linearity.conditions import linear_conditions
 from hapticdesign.analysis.linearity.design_sets import design_set
 from hapticdesign.analysis.linearity.form import device_form
 from hapticdesign.devices.registry import preset
-from hapticdesign.errors import PhysicalConsistencyWarning, UserError
+from hapticdesign.errors import InputError, PhysicalConsistencyWarning, UserError
 from hapticdesign.studies import device_steps, phantom_rendering
 from hapticdesign.studies.plots import plt
 from hapticdesign.studies.seed_reference import (
@@ -58,7 +58,7 @@ class PhantomSettings:
         if scale not in SCALES:
             raise UserError(f"unknown scale {scale!r}; choose one of {', '.join(SCALES)}")
         if workers < 1:
-            raise UserError(f"--workers must be at least 1, got {workers}")
+            raise InputError(f"workers must be at least 1, got {workers}", "workers")
         per_level = {"full": 100, "quick": 10, "smoke": 1}[scale]
         return cls(scale=scale, seed=seed, designs_per_level=per_level, appendix_c_per_level=min(per_level, 5),
                    workers=workers)

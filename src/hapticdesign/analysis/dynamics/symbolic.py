@@ -24,10 +24,11 @@ from sympy.polys.domains import QQ, RR
 from sympy.polys.rings import ring
 
 from hapticdesign.analysis.dynamics.model import pair_index
-from hapticdesign.errors import UserError
+from hapticdesign.errors import InputError, UserError
 from hapticdesign.escape import docstring_text, python_identifier
 from hapticdesign.model.device import Device
-from hapticdesign.model.inertia import SEED_FIELDS
+from hapticdesign.model.mechanism import CompiledMechanism
+from hapticdesign.model.inertia import SEED_FIELDS, seed_parameter_name, standard_terms
 from hapticdesign.model.transforms import Axis
 
 
@@ -63,7 +64,7 @@ def _symbolic_names(device: Device, spec: str) -> list[str]:
     chosen = [s.strip() for s in spec.split(",") if s.strip()]
     unknown = [s for s in chosen if s not in names]
     if unknown:
-        raise UserError(f"--symbolic: unknown parameter name {unknown[0]!r} for device {device.name}")
+        raise InputError(f"symbolic: unknown parameter name {unknown[0]!r} for device {device.name}", "symbolic")
     return chosen
 
 
@@ -72,7 +73,21 @@ def _exact(value: float):
     return Fraction(repr(float(value))) if np.isfinite(value) else None
 
 
-def _affine_offsets(device: Device, kin_symbolic: list[str]):
+@dataclass(frozen=True)
+class _AffineKinematics:
+    """The compiled frame tree at the device's values, with node offsets and gravity as affine
+    functions of the symbolic kinematic parameters ``names`` (exact rational slopes)."""
+
+    compiled: CompiledMechanism
+    base: dict[str, float]
+    names: list[str]
+    offsets: np.ndarray
+    slopes: list[list[Fraction]]
+    gravity: np.ndarray
+    gravity_slopes: list[list[Fraction]]
+
+
+def _affine_offsets(device: Device, kin_symbolic: list[str]) -> _AffineKinematics:
     """Node offsets and gravity as affine functions of the symbolic kinematic parameters."""
     base = dict(device.kinematic_values())
     mech = device.builder(base)
@@ -100,191 +115,272 @@ def _affine_offsets(device: Device, kin_symbolic: list[str]):
     if not np.allclose(cc.node_offset, predicted, rtol=1e-9, atol=1e-12):
         raise UserError("the symbolic kinematic parameters do not enter the mechanism affinely; keep them numeric")
     round_slope = lambda s: [Fraction(x).limit_denominator(1000) for x in s]  # noqa: E731
-    return c0, offsets0, [round_slope(s) for s in slopes], gravity0, [round_slope(s) for s in gslopes]
+    return _AffineKinematics(
+        c0, base, list(kin_symbolic), offsets0, [round_slope(s) for s in slopes], gravity0, [round_slope(s) for s in gslopes]
+    )
+
+
+@dataclass(frozen=True)
+class _Ring:
+    """The polynomial ring of one derivation and its reduction modulo ``s_k^2 + c_k^2 = 1``.
+
+    Generators: ``s_k, c_k`` for every joint, ``q_k`` for the prismatic ones, then the symbolic
+    parameters. Coefficients are exact rationals (``QQ``) when every constant angle is a
+    multiple of pi/2, floating-point (``RR``) otherwise.
+    """
+
+    ring: object
+    domain: object
+    names: list[str]
+    gens: dict[str, object]
+    s: list
+    c: list
+    prismatic: list[bool]
+    reducers: list
+
+    @classmethod
+    def build(cls, aff: _AffineKinematics, inertial: list[str]) -> _Ring:
+        comp = aff.compiled
+        n = comp.n_dof
+        prismatic = [bool(p) for p in comp.prismatic]
+        names = [f"s{k + 1}" for k in range(n)] + [f"c{k + 1}" for k in range(n)]
+        names += [f"q{k + 1}" for k in range(n) if prismatic[k]] + aff.names + inertial
+        domain = QQ if _right_angles_only(aff) else RR
+        R, *gens = ring(",".join(names), domain)
+        g = dict(zip(names, gens))
+        s = [g[f"s{k + 1}"] for k in range(n)]
+        c = [g[f"c{k + 1}"] for k in range(n)]
+        return cls(R, domain, names, g, s, c, prismatic, [s[k] ** 2 + c[k] ** 2 - 1 for k in range(n)])
+
+    @property
+    def exact(self) -> bool:
+        return self.domain is QQ
+
+    def num(self, x: float):
+        """A constant of the ring (a float taken as its exact decimal rational over ``QQ``)."""
+        return self.ring(self.domain.convert(_exact(x) if self.exact else x))
+
+    def const(self, x: Fraction):
+        return self.ring(self.domain.convert(x))
+
+    def reduce(self, p):
+        """The canonical form of ``p`` modulo ``s_k^2 + c_k^2 - 1``."""
+        return p.rem(self.reducers)
+
+    def d_dq(self, p, k: int):
+        """``dp/dq_k``: ``ds_k/dq_k = c_k``, ``dc_k/dq_k = -s_k`` for a revolute joint."""
+        if self.prismatic[k]:
+            return p.diff(self.gens[f"q{k + 1}"])
+        return self.reduce(p.diff(self.s[k]) * self.c[k] - p.diff(self.c[k]) * self.s[k])
+
+
+def _right_angles_only(aff: _AffineKinematics) -> bool:
+    """Whether every rotation's constant angle is a multiple of pi/2 (exact rational arithmetic)."""
+    return all(
+        abs(o / (pi / 2) - round(o / (pi / 2))) < 1e-12
+        for o, a in zip(aff.offsets, aff.compiled.node_axis)
+        if a < 3
+    )
+
+
+def _affine_poly(R: _Ring, aff: _AffineKinematics, value: float, slopes: list[Fraction]):
+    """``value + sum_k slope_k (p_k - p_k0)`` over the symbolic kinematic parameters ``p_k``."""
+    out = R.num(value - sum(aff.base[name] * float(sl) for name, sl in zip(aff.names, slopes)))
+    for name, sl in zip(aff.names, slopes):
+        if sl != 0:
+            out += R.const(sl) * R.gens[name]
+    return out
+
+
+def _rotation_cos_sin(R: _Ring, comp: CompiledMechanism, node: int) -> tuple:
+    """Cosine and sine of a rotation node's angle ``offset + sum_k coef_k q_k`` as polynomials
+    in ``s_k, c_k`` (angle-sum formulas; the couplings must be integers)."""
+    offset = comp.node_offset[node]
+    if R.exact:
+        quarter = int(round(offset / (pi / 2))) % 4
+        cs = (R.num([1, 0, -1, 0][quarter]), R.num([0, 1, 0, -1][quarter]))
+    else:
+        cs = (R.num(np.cos(offset)), R.num(np.sin(offset)))
+    coef = comp.node_coef[node]
+    for k in range(comp.n_dof):
+        if coef[k] == 0:
+            continue
+        if R.prismatic[k] or coef[k] != round(coef[k]):
+            raise UserError("symbolic derivation needs integer couplings between revolute joints")
+        m = int(round(coef[k]))
+        ck, sk = R.ring(1), R.ring(0)
+        for _ in range(abs(m)):
+            ck, sk = ck * R.c[k] - sk * R.s[k], sk * R.c[k] + ck * R.s[k]
+        if m < 0:
+            sk = -sk
+        cs = (cs[0] * ck - cs[1] * sk, cs[1] * ck + cs[0] * sk)
+    return cs
+
+
+def _node_poses(R: _Ring, aff: _AffineKinematics) -> tuple[list, list]:
+    """Exact world rotation and position of every node of the compiled frame tree.
+
+    The same walk over ``node_parent``, ``node_axis``, ``node_coef``, ``node_offset`` as the
+    numeric kernel: a rotation node turns its parent's frame (orientations, seed 000
+    eq. 2.20-2.23), a translation node moves the origin along its parent's axis (link
+    origins, eq. 2.24-2.26).
+    """
+    comp = aff.compiled
+    n_nodes = comp.node_parent.shape[0]
+    rot: list = [None] * n_nodes
+    pos: list = [None] * n_nodes
+    eye = [[R.ring(1) if i == j else R.ring(0) for j in range(3)] for i in range(3)]
+    for node in range(n_nodes):
+        parent = comp.node_parent[node]
+        rp = eye if parent < 0 else rot[parent]
+        pp = [R.ring(0)] * 3 if parent < 0 else pos[parent]
+        axis = Axis(int(comp.node_axis[node]))
+        a = axis.unit
+        if axis.is_rotation:
+            cv, sv = _rotation_cos_sin(R, comp, node)
+            b, d = (a + 1) % 3, (a + 2) % 3
+            new = [row[:] for row in rp]
+            for i in range(3):
+                new[i][b] = R.reduce(rp[i][b] * cv + rp[i][d] * sv)
+                new[i][d] = R.reduce(-rp[i][b] * sv + rp[i][d] * cv)
+            rot[node], pos[node] = new, pp
+        else:
+            value = _affine_poly(R, aff, aff.offsets[node], [sl[node] for sl in aff.slopes])
+            for k in range(comp.n_dof):
+                if comp.node_coef[node, k] != 0:
+                    value += R.num(comp.node_coef[node, k]) * R.gens[f"q{k + 1}"]
+            rot[node] = rp
+            pos[node] = [R.reduce(pp[i] + rp[i][a] * value) for i in range(3)]
+    return rot, pos
+
+
+def _body_jacobian(R: _Ring, comp: CompiledMechanism, rot: list, pos: list, b: int) -> tuple[list, list]:
+    """World rotation of body ``b`` and its body-frame Jacobian ``[Jv; Jw]`` (6 x N).
+
+    Each variable node on ``body_path[b]`` contributes its unit twist moved to the body frame,
+    times its joint coefficients: the angular velocity of eq. 2.20-2.23 and the velocity of the
+    frame origin obtained by differentiating eq. 2.24-2.26.
+    """
+    n = comp.n_dof
+    nb = comp.body_node[b]
+    rb = [[R.ring(1) if i == j else R.ring(0) for j in range(3)] for i in range(3)] if nb < 0 else rot[nb]
+    pb = [R.ring(0)] * 3 if nb < 0 else pos[nb]
+    jac = [[R.ring(0)] * n for _ in range(6)]
+    for e in comp.body_path[b]:
+        if e < 0:
+            break
+        axis = Axis(int(comp.node_axis[e]))
+        a = axis.unit
+        u = [R.reduce(sum((rb[r][i] * rot[e][r][a] for r in range(3)), R.ring(0))) for i in range(3)]
+        if axis.is_rotation:
+            d = [pos[e][r] - pb[r] for r in range(3)]
+            rr = [R.reduce(sum((rb[r][i] * d[r] for r in range(3)), R.ring(0))) for i in range(3)]
+            v = [rr[1] * u[2] - rr[2] * u[1], rr[2] * u[0] - rr[0] * u[2], rr[0] * u[1] - rr[1] * u[0]]
+            w = u
+        else:
+            v, w = u, [R.ring(0)] * 3
+        for k in range(n):
+            ck = comp.node_coef[e, k]
+            if ck != 0:
+                ckp = R.num(ck)
+                for i in range(3):
+                    jac[i][k] += ckp * v[i]
+                    jac[3 + i][k] += ckp * w[i]
+    return rb, [[R.reduce(x) for x in row] for row in jac]
+
+
+def _body_parameters(R: _Ring, device: Device, body: str) -> tuple:
+    """Mass, first moment ``h`` and inertia tensor about the frame origin of one body, each a
+    ring generator when symbolic, else the device's value (:func:`standard_terms`)."""
+
+    def param(name: str):
+        return R.gens[name] if name in R.gens else R.num(device.params.get(name, 0.0))
+
+    m, hx, hy, hz, jxx, jyy, jzz, jxy, jxz, jyz = standard_terms(
+        *(param(seed_parameter_name(f, body)) for f in SEED_FIELDS)
+    )
+    return m, [hx, hy, hz], [[jxx, jxy, jxz], [jxy, jyy, jyz], [jxz, jyz, jzz]]
+
+
+def _add_body(R: _Ring, body: tuple, rb: list, jac: list, gravity: list, H: list, G: list) -> None:
+    """Add one body's share to the upper triangle of ``H`` and to ``G``.
+
+    Kinetic energy eq. 2.44 in the body frame gives
+    ``H_ij += m Jv_i.Jv_j + h.(Jv_j x Jw_i + Jv_i x Jw_j) + Jw_i^T J Jw_j``; the potential of
+    eq. 2.46 gives ``G_i -= (R_b^T g).(m Jv_i + Jw_i x h)`` (Lagrange, eq. 2.49).
+    """
+    m, h, jo = body
+    n = len(G)
+    jv, jw = jac[:3], jac[3:]
+    gb = [R.reduce(sum((rb[r][i] * gravity[r] for r in range(3)), R.ring(0))) for i in range(3)]
+    for i in range(n):
+        wi = [jw[0][i], jw[1][i], jw[2][i]]
+        vi = [jv[0][i], jv[1][i], jv[2][i]]
+        wxh = [wi[1] * h[2] - wi[2] * h[1], wi[2] * h[0] - wi[0] * h[2], wi[0] * h[1] - wi[1] * h[0]]
+        G[i] -= sum((gb[r] * (m * vi[r] + wxh[r]) for r in range(3)), R.ring(0))
+        for j in range(i, n):
+            wj = [jw[0][j], jw[1][j], jw[2][j]]
+            vj = [jv[0][j], jv[1][j], jv[2][j]]
+            term = m * sum((vi[r] * vj[r] for r in range(3)), R.ring(0))
+            # h . (Jv_j x Jw_i) + h . (Jv_i x Jw_j): the first-moment coupling A + A^T
+            x1 = [vj[1] * wi[2] - vj[2] * wi[1], vj[2] * wi[0] - vj[0] * wi[2], vj[0] * wi[1] - vj[1] * wi[0]]
+            x2 = [vi[1] * wj[2] - vi[2] * wj[1], vi[2] * wj[0] - vi[0] * wj[2], vi[0] * wj[1] - vi[1] * wj[0]]
+            term += sum((h[r] * (x1[r] + x2[r]) for r in range(3)), R.ring(0))
+            term += sum((wi[r] * jo[r][t] * wj[t] for r in range(3) for t in range(3)), R.ring(0))
+            H[i][j] += term
+
+
+def _mass_and_gravity(R: _Ring, device: Device, aff: _AffineKinematics) -> tuple[list, list]:
+    """``H`` and ``G`` of eq. 2.50 (seed 000 eq. 2.44-2.49), summed over the bodies, with the
+    actuators' reflected rotor inertia ``n^2 J_r`` on the diagonal of ``H``."""
+    comp = aff.compiled
+    n = comp.n_dof
+    rot, pos = _node_poses(R, aff)
+    gravity = [_affine_poly(R, aff, aff.gravity[i], [gs[i] for gs in aff.gravity_slopes]) for i in range(3)]
+    H = [[R.ring(0)] * n for _ in range(n)]
+    G = [R.ring(0)] * n
+    for b, body in enumerate(device.body_names):
+        rb, jac = _body_jacobian(R, comp, rot, pos, b)
+        _add_body(R, _body_parameters(R, device, body), rb, jac, gravity, H, G)
+    H = [[R.reduce(H[min(i, j)][max(i, j)]) for j in range(n)] for i in range(n)]
+    G = [R.reduce(x) for x in G]
+    for k, reflected in enumerate(device.reflected_inertia):
+        if reflected:
+            H[k][k] = H[k][k] + R.num(reflected)
+    return H, G
+
+
+def _christoffel(R: _Ring, H: list) -> list:
+    """``C`` of eq. 2.50: the column of the pair ``(j, k)`` holds ``Gamma_ijk`` when ``j = k`` and
+    ``2 Gamma_ijk`` when ``j < k``, ``Gamma_ijk = (dH_ij/dq_k + dH_ik/dq_j - dH_jk/dq_i) / 2``."""
+    n = len(H)
+    dH = [[[R.d_dq(H[i][j], k) for k in range(n)] for j in range(n)] for i in range(n)]
+    pairs = pair_index(n)
+    C = [[R.ring(0)] * len(pairs) for _ in range(n)]
+    for i in range(n):
+        for col, (j, k) in enumerate(pairs):
+            gamma2 = dH[i][j][k] + dH[i][k][j] - dH[j][k][i]
+            C[i][col] = gamma2 * R.domain.convert(Fraction(1, 2)) if j == k else gamma2
+    return C
 
 
 def derive(device: Device, symbolic: str = "all") -> SymbolicEquations:
     """Exact H, C, G of ``device`` with the parameters named in ``symbolic`` kept as symbols."""
     keep = _symbolic_names(device, symbolic)
-    kin_sym = [k for k in device.kinematic if k in keep]
-    mech = device.mechanism
-    n = mech.n_dof
-    comp, offsets0, slopes, gravity0, gslopes = _affine_offsets(device, kin_sym)
-    base = dict(device.kinematic_values())
-    prismatic = list(comp.prismatic)
-    inertial = [f"{name}" for name in device.inertial_names() if name in keep]
+    aff = _affine_offsets(device, [k for k in device.kinematic if k in keep])
+    inertial = [name for name in device.inertial_names() if name in keep]
+    R = _Ring.build(aff, inertial)
+    H, G = _mass_and_gravity(R, device, aff)
+    C = _christoffel(R, H)
 
-    gen_names = [f"s{k + 1}" for k in range(n)] + [f"c{k + 1}" for k in range(n)]
-    gen_names += [f"q{k + 1}" for k in range(n) if prismatic[k]] + kin_sym + inertial
-    angles_exact = all(
-        abs(o / (pi / 2) - round(o / (pi / 2))) < 1e-12
-        for o, a in zip(offsets0, comp.node_axis)
-        if a < 3
-    )
-    domain = QQ if angles_exact else RR
-    R, *gens = ring(",".join(gen_names), domain)
-    g = dict(zip(gen_names, gens))
-    s = [g[f"s{k + 1}"] for k in range(n)]
-    c = [g[f"c{k + 1}"] for k in range(n)]
-
-    def num(x: float):
-        return R(domain.convert(_exact(x) if domain is QQ else x))
-
-    def const_cos_sin(angle: float):
-        if angles_exact:
-            k = int(round(angle / (pi / 2))) % 4
-            return num([1, 0, -1, 0][k]), num([0, 1, 0, -1][k])
-        return num(np.cos(angle)), num(np.sin(angle))
-
-    def offset_poly(node: int):
-        value = num(offsets0[node] - sum(base[kn] * float(sl[node]) for kn, sl in zip(kin_sym, slopes)))
-        for kn, sl in zip(kin_sym, slopes):
-            if sl[node] != 0:
-                value += R(domain.convert(sl[node])) * g[kn]
-        return value
-
-    def angle_cos_sin(node: int):
-        coef = comp.node_coef[node]
-        cs = const_cos_sin(comp.node_offset[node])
-        for k in range(n):
-            if coef[k] == 0:
-                continue
-            if prismatic[k] or coef[k] != round(coef[k]):
-                raise UserError("symbolic derivation needs integer couplings between revolute joints")
-            m = int(round(coef[k]))
-            ck, sk = R(1), R(0)
-            for _ in range(abs(m)):
-                ck, sk = ck * c[k] - sk * s[k], sk * c[k] + ck * s[k]
-            if m < 0:
-                sk = -sk
-            cs = (cs[0] * ck - cs[1] * sk, cs[1] * ck + cs[0] * sk)
-        return cs
-
-    reducers = [s[k] ** 2 + c[k] ** 2 - 1 for k in range(n)]
-
-    def reduce(p):
-        return p.rem(reducers)
-
-    # node poses
-    n_nodes = comp.node_parent.shape[0]
-    rot: list = [None] * n_nodes
-    pos: list = [None] * n_nodes
-    eye = [[R(1) if i == j else R(0) for j in range(3)] for i in range(3)]
-    for node in range(n_nodes):
-        parent = comp.node_parent[node]
-        rp = eye if parent < 0 else rot[parent]
-        pp = [R(0)] * 3 if parent < 0 else pos[parent]
-        axis = Axis(int(comp.node_axis[node]))
-        a = axis.unit
-        if axis.is_rotation:
-            cv, sv = angle_cos_sin(node)
-            b, d = (a + 1) % 3, (a + 2) % 3
-            new = [row[:] for row in rp]
-            for i in range(3):
-                new[i][b] = reduce(rp[i][b] * cv + rp[i][d] * sv)
-                new[i][d] = reduce(-rp[i][b] * sv + rp[i][d] * cv)
-            rot[node], pos[node] = new, pp
-        else:
-            value = offset_poly(node)
-            for k in range(n):
-                if comp.node_coef[node, k] != 0:
-                    value += num(comp.node_coef[node, k]) * g[f"q{k + 1}"]
-            rot[node] = rp
-            pos[node] = [reduce(pp[i] + rp[i][a] * value) for i in range(3)]
-
-    gravity = []
-    for i in range(3):
-        gv = num(gravity0[i] - sum(base[kn] * float(gs[i]) for kn, gs in zip(kin_sym, gslopes)))
-        for kn, gs in zip(kin_sym, gslopes):
-            if gs[i] != 0:
-                gv += R(domain.convert(gs[i])) * g[kn]
-        gravity.append(gv)
-
-    def param(name: str):
-        return g[name] if name in g else num(device.params.get(name, 0.0))
-
-    H = [[R(0)] * n for _ in range(n)]
-    G = [R(0)] * n
-    for b, body in enumerate(device.body_names):
-        nb = comp.body_node[b]
-        rb = eye if nb < 0 else rot[nb]
-        pb = [R(0)] * 3 if nb < 0 else pos[nb]
-        jac = [[R(0)] * n for _ in range(6)]
-        for e in comp.body_path[b]:
-            if e < 0:
-                break
-            axis = Axis(int(comp.node_axis[e]))
-            a = axis.unit
-            u = [reduce(sum((rb[r][i] * rot[e][r][a] for r in range(3)), R(0))) for i in range(3)]
-            if axis.is_rotation:
-                d = [pos[e][r] - pb[r] for r in range(3)]
-                rr = [reduce(sum((rb[r][i] * d[r] for r in range(3)), R(0))) for i in range(3)]
-                v = [rr[1] * u[2] - rr[2] * u[1], rr[2] * u[0] - rr[0] * u[2], rr[0] * u[1] - rr[1] * u[0]]
-                w = u
-            else:
-                v, w = u, [R(0)] * 3
-            for k in range(n):
-                ck = comp.node_coef[e, k]
-                if ck != 0:
-                    ckp = num(ck)
-                    for i in range(3):
-                        jac[i][k] += ckp * v[i]
-                        jac[3 + i][k] += ckp * w[i]
-        jac = [[reduce(x) for x in row] for row in jac]
-        m, rx, ry, rz, ixx, iyy, izz, ixy, ixz, iyz = (
-            param(f"m{body}") if f == "m" else param(f"r{body}{f[1]}") if f.startswith("r") else param(f"{f}{body}")
-            for f in SEED_FIELDS
-        )
-        h = [m * rx, m * ry, m * rz]
-        jo = [
-            [ixx + m * (ry**2 + rz**2), -ixy - m * rx * ry, -ixz - m * rx * rz],
-            [-ixy - m * rx * ry, iyy + m * (rx**2 + rz**2), -iyz - m * ry * rz],
-            [-ixz - m * rx * rz, -iyz - m * ry * rz, izz + m * (rx**2 + ry**2)],
-        ]
-        jv, jw = jac[:3], jac[3:]
-        gb = [reduce(sum((rb[r][i] * gravity[r] for r in range(3)), R(0))) for i in range(3)]
-        for i in range(n):
-            wi = [jw[0][i], jw[1][i], jw[2][i]]
-            vi = [jv[0][i], jv[1][i], jv[2][i]]
-            wxh = [wi[1] * h[2] - wi[2] * h[1], wi[2] * h[0] - wi[0] * h[2], wi[0] * h[1] - wi[1] * h[0]]
-            G[i] -= sum((gb[r] * (m * vi[r] + wxh[r]) for r in range(3)), R(0))
-            for j in range(i, n):
-                wj = [jw[0][j], jw[1][j], jw[2][j]]
-                vj = [jv[0][j], jv[1][j], jv[2][j]]
-                term = m * sum((vi[r] * vj[r] for r in range(3)), R(0))
-                # h . (Jv_j x Jw_i) + h . (Jv_i x Jw_j): the first-moment coupling A + A^T
-                x1 = [vj[1] * wi[2] - vj[2] * wi[1], vj[2] * wi[0] - vj[0] * wi[2], vj[0] * wi[1] - vj[1] * wi[0]]
-                x2 = [vi[1] * wj[2] - vi[2] * wj[1], vi[2] * wj[0] - vi[0] * wj[2], vi[0] * wj[1] - vi[1] * wj[0]]
-                term += sum((h[r] * (x1[r] + x2[r]) for r in range(3)), R(0))
-                term += sum((wi[r] * jo[r][t] * wj[t] for r in range(3) for t in range(3)), R(0))
-                H[i][j] += term
-    H = [[reduce(H[min(i, j)][max(i, j)]) for j in range(n)] for i in range(n)]
-    G = [reduce(x) for x in G]
-    for k, reflected in enumerate(device.reflected_inertia):  # actuators: constant n^2 J_r on the diagonal
-        if reflected:
-            H[k][k] = H[k][k] + num(reflected)
-
-    def d_dq(p, k: int):
-        if prismatic[k]:
-            return p.diff(g[f"q{k + 1}"])
-        return reduce(p.diff(s[k]) * c[k] - p.diff(c[k]) * s[k])
-
-    dH = [[[d_dq(H[i][j], k) for k in range(n)] for j in range(n)] for i in range(n)]
-    pairs = pair_index(n)
-    C = [[R(0)] * len(pairs) for _ in range(n)]
-    for i in range(n):
-        for col, (j, k) in enumerate(pairs):
-            gamma2 = dH[i][j][k] + dH[i][k][j] - dH[j][k][i]
-            C[i][col] = gamma2 * domain.convert(Fraction(1, 2)) if j == k else gamma2
-
-    theta = [sp.Symbol(name, real=True) for name in mech.coordinates]
-    thetad = [sp.Symbol(f"{name}d", real=True) for name in mech.coordinates]
-    thetadd = [sp.Symbol(f"{name}dd", real=True) for name in mech.coordinates]
-    sym = {name: sp.Symbol(name, real=True) for name in gen_names}
+    coordinates = device.mechanism.coordinates
+    n = len(coordinates)
+    theta = [sp.Symbol(name, real=True) for name in coordinates]
+    sym = {name: sp.Symbol(name, real=True) for name in R.names}
     back = {sym[f"s{k + 1}"]: sp.sin(theta[k]) for k in range(n)}
     back.update({sym[f"c{k + 1}"]: sp.cos(theta[k]) for k in range(n)})
-    back.update({sym[f"q{k + 1}"]: theta[k] for k in range(n) if prismatic[k]})
-    symbols_in_order = [sym[nm] for nm in gen_names]
+    back.update({sym[f"q{k + 1}"]: theta[k] for k in range(n) if R.prismatic[k]})
+    symbols_in_order = [sym[nm] for nm in R.names]
 
     def to_expr(p):
         return p.as_expr(*symbols_in_order).xreplace(back)
@@ -294,10 +390,10 @@ def derive(device: Device, symbolic: str = "all") -> SymbolicEquations:
         H=sp.Matrix([[to_expr(x) for x in row] for row in H]),
         C=sp.Matrix([[to_expr(x) for x in row] for row in C]),
         G=sp.Matrix([to_expr(x) for x in G]),
-        theta=list(theta),
-        thetad=list(thetad),
-        thetadd=list(thetadd),
-        parameters=[sym[nm] for nm in kin_sym + inertial],
+        theta=theta,
+        thetad=[sp.Symbol(f"{name}d", real=True) for name in coordinates],
+        thetadd=[sp.Symbol(f"{name}dd", real=True) for name in coordinates],
+        parameters=[sym[nm] for nm in aff.names + inertial],
     )
 
 
@@ -305,7 +401,7 @@ def export(eqs: SymbolicEquations, fmt: str, part: str = "tau") -> str:
     """The equations as LaTeX, Python source (a function with common subexpressions) or text."""
     parts = {"tau": eqs.tau, "H": eqs.H, "C": eqs.C, "G": eqs.G}
     if part not in (*parts, "all"):
-        raise UserError(f"--part: expected tau, H, C, G or all, got {part!r}")
+        raise InputError(f"part: expected tau, H, C, G or all, got {part!r}", "part")
     chosen = parts if part == "all" else {part: parts[part]}
     if fmt == "latex":
         lines = []
@@ -319,7 +415,7 @@ def export(eqs: SymbolicEquations, fmt: str, part: str = "tau") -> str:
         return "\n".join(f"{name}[{','.join(str(i + 1) for i in idx)}] = {mat[idx]}" for name, mat in chosen.items() for idx in np.ndindex(mat.shape))
     if fmt == "python":
         return _python_source(eqs, chosen)
-    raise UserError(f"--format: expected latex, python or text, got {fmt!r}")
+    raise InputError(f"format: expected latex, python or text, got {fmt!r}", "format")
 
 
 def _python_source(eqs: SymbolicEquations, chosen: dict[str, sp.Matrix]) -> str:

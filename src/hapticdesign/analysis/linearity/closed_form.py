@@ -29,7 +29,7 @@ from sympy.polys.rings import ring
 
 from hapticdesign.analysis.linearity.form import PARTS, LinearityForm
 from hapticdesign.analysis.linearity.symbols import seed_symbols, standard_expressions
-from hapticdesign.errors import UserError
+from hapticdesign.errors import InputError, UserError
 from hapticdesign.escape import docstring_text, python_identifier
 from hapticdesign.model.device import Device
 from hapticdesign.model.inertia import SEED_FIELDS
@@ -69,7 +69,7 @@ class ClosedForm:
         if part == "all":
             return self.total
         if part not in self.parts:
-            raise UserError(f"--part: choose all, H, C or G, got {part!r}")
+            raise InputError(f"part: choose all, H, C or G, got {part!r}", "part")
         return self.parts[part]
 
     def polynomial(self, part: str = "all") -> sp.Poly:
@@ -126,7 +126,7 @@ class ClosedForm:
 
     def export(self, fmt: str, part: str = "all") -> str:
         if fmt not in FORMATS:
-            raise UserError(f"--format: choose {', '.join(FORMATS)}, got {fmt!r}")
+            raise InputError(f"format: choose {', '.join(FORMATS)}, got {fmt!r}", "format")
         return getattr(self, fmt)(part)
 
     def _sorted(self, part: str) -> list[tuple[tuple[int, ...], float]]:

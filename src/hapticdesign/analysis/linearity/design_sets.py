@@ -28,12 +28,11 @@ from scipy.optimize import brentq, differential_evolution, minimize
 
 from hapticdesign.analysis.linearity.bounds import BodyBounds, within_bounds
 from hapticdesign.analysis.linearity.conditions import LinearConditions
-from hapticdesign.analysis.linearity.convert import seed_from_standard
 from hapticdesign.analysis.linearity.form import LinearityForm
 from hapticdesign.analysis.linearity.linear_designs import find_linear_designs, realizable
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
-from hapticdesign.model.inertia import Realizability, standard_from_seed
+from hapticdesign.model.inertia import Realizability, seed_from_standard, standard_from_seed
 
 DEFAULT_LEVELS = (0.0, 0.001, 0.01, 0.1, 1.0, 2.0)
 LEVEL_TOLERANCE = 1e-6

@@ -24,7 +24,7 @@ import numpy as np
 
 from hapticdesign.analysis.linearity.region import PANEL_LENGTH, Region
 from hapticdesign.analysis.linearity.weights import Weights
-from hapticdesign.errors import UserError
+from hapticdesign.errors import InputError, UserError
 
 REL_TOL = 1e-9
 LEVELS = (4, 8, 16, 32)
@@ -97,8 +97,8 @@ def quadrature_form(model, region: Region | None = None, weights: Weights | None
         try:
             q_full = model.full_coordinates(poses)
         except UserError as exc:
-            raise UserError(f"LN region {region.describe(model.mechanism.actuated_coordinates)}: {exc} "
-                            "(give joint limits or --region inside the workspace)") from None
+            raise InputError(f"LN region {region.describe(model.mechanism.actuated_coordinates)}: {exc} "
+                             "(give joint limits or a region inside the workspace)", "region") from None
         q = _moments(model, q_full, w, entry_weights)
         q = 0.5 * (q + np.swapaxes(q, 1, 2))
         if previous is not None:

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from hapticdesign.analysis.dynamics.basis import CoordinateBasis, CoordinateKind
-from hapticdesign.errors import UserError
+from hapticdesign.errors import InputError, UserError
 from hapticdesign.workload import QUADRATURE_POINTS_LIMIT, require_within
 
 PANEL_POINTS = 24
@@ -50,8 +50,8 @@ class Region:
             lo, hi = self.ranges[k]
             return _box_moments(basis, lo, hi)
         if basis.kind is CoordinateKind.PRISMATIC:
-            raise UserError(
-                f"coordinate {k + 1} is prismatic: give its range with --region (the torus needs revolute joints)"
+            raise InputError(
+                f"coordinate {k + 1} is prismatic: give its range in the region (the torus needs revolute joints)", "region"
             )
         w = np.zeros(basis.size)
         w[0] = 1.0
@@ -103,24 +103,24 @@ def parse_region(text: str | None, n_dof: int) -> Region:
     for part in text.split(","):
         match = _RANGE.match(part)
         if not match:
-            raise UserError(f"--region: cannot read {part.strip()!r}; expected e.g. q2=-0.5:0.5")
+            raise InputError(f"region: cannot read {part.strip()!r}; expected e.g. q2=-0.5:0.5", "region")
         index = int(match.group(1)) - 1
         if not 0 <= index < n_dof:
-            raise UserError(f"--region: coordinate {index + 1} does not exist (the device has {n_dof})")
+            raise InputError(f"region: coordinate {index + 1} does not exist (the device has {n_dof})", "region")
         try:
             lo, hi = float(match.group(2)), float(match.group(3))
         except ValueError:
-            raise UserError(f"--region: bounds of {part.strip()!r} are not numbers") from None
+            raise InputError(f"region: bounds of {part.strip()!r} are not numbers", "region") from None
         if not (math.isfinite(lo) and math.isfinite(hi)):
-            raise UserError(f"--region: bounds of {part.strip()!r} must be finite")
+            raise InputError(f"region: bounds of {part.strip()!r} must be finite", "region")
         if not lo < hi:
-            raise UserError(f"--region: range {part.strip()!r} is empty or inverted (need low < high)")
+            raise InputError(f"region: range {part.strip()!r} is empty or inverted (need low < high)", "region")
         if not math.isfinite(hi - lo):
-            raise UserError(f"--region: range {part.strip()!r} is too wide to average over (its width overflows)")
+            raise InputError(f"region: range {part.strip()!r} is too wide to average over (its width overflows)", "region")
         require_within(f"averaging over {part.strip()!r}", quadrature_points(lo, hi), QUADRATURE_POINTS_LIMIT,
                        "quadrature points")
         if index in ranges:
-            raise UserError(f"--region: coordinate {index + 1} is given twice")
+            raise InputError(f"region: coordinate {index + 1} is given twice", "region")
         ranges[index] = (lo, hi)
     return Region(ranges)
 

@@ -20,13 +20,12 @@ import cvxpy as cp
 import numpy as np
 
 from hapticdesign.analysis.linearity.bounds import BodyBounds, clip_to_bounds, within_bounds
-from hapticdesign.analysis.linearity.convert import seed_from_standard
 from hapticdesign.analysis.linearity.convex import SCALE, body_constraints, bounds_scale, realizability_lmi, solve
 from hapticdesign.analysis.linearity.form import LinearityForm
 from hapticdesign.analysis.linearity.linear_designs import realizable
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
-from hapticdesign.model.inertia import Realizability, standard_from_seed
+from hapticdesign.model.inertia import Realizability, seed_from_standard, standard_from_seed
 
 
 @dataclass(frozen=True)

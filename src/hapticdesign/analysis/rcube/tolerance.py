@@ -28,7 +28,7 @@ from math import isfinite
 
 import numpy as np
 
-from hapticdesign.errors import UserError
+from hapticdesign.errors import InputError, UserError
 from hapticdesign.analysis.rcube.batch_kinematics import poses_and_jacobians
 from hapticdesign.analysis.rcube.design import RCubeDesign
 from hapticdesign.analysis.rcube.kinematics import chain_angles, chain_jacobian, cube_grid, passive_reach
@@ -70,7 +70,7 @@ class SampleErrors:
 def draw_errors(tolerances: Tolerances, samples: int, seed: int) -> SampleErrors:
     """Uniform errors within the tolerance bands from ``numpy.random.default_rng(seed)``."""
     if samples < 1:
-        raise UserError(f"--samples must be at least 1, got {samples}")
+        raise InputError(f"samples must be at least 1, got {samples}", "samples")
     rng = np.random.default_rng(seed)
     t = np.asarray(tolerances.lengths, dtype=float)
     lengths = rng.uniform(-1.0, 1.0, (samples, 3, 3)) * t
@@ -87,9 +87,10 @@ def check_budget(samples: int, grid: int, max_seconds: float = DEFAULT_MAX_SECON
     """Refuse a run estimated above ``max_seconds`` unless ``allow``; returns the estimate."""
     seconds = estimate_seconds(samples, grid)
     if seconds > max_seconds and not allow:
-        raise UserError(
+        raise InputError(
             f"{samples} samples on a {grid}^3 grid would take about {seconds:.0f} s (limit {max_seconds:.0f} s); "
-            "lower --samples or --grid, or pass --allow-long"
+            "lower the samples or the grid, or allow the long run",
+            "samples", "grid", "allow_long",
         )
     return seconds
 
@@ -233,9 +234,9 @@ def monte_carlo(design: RCubeDesign, tolerances: Tolerances, samples: int, seed:
                 side: float = 0.12, grid: int = 7, report=None) -> list[SampleResult]:
     """Evaluate ``samples`` mechanisms with errors from ``default_rng(seed)``."""
     if grid < 2:
-        raise UserError(f"--grid must be at least 2, got {grid}")
+        raise InputError(f"grid must be at least 2, got {grid}", "grid")
     if not (isfinite(side) and side > 0.0):
-        raise UserError(f"--side must be a positive length, got {side!r}")
+        raise InputError(f"side must be a positive length, got {side!r}", "side")
     errors = draw_errors(tolerances, samples, seed)
     out = []
     for k in range(samples):

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from hapticdesign.analysis.dynamics.device import dynamics_of
-from hapticdesign.errors import UserError
+from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.device import Device
 from hapticdesign.model.mechanism import JointType
 from hapticdesign.model.transforms import Axis, elementary_matrix
@@ -114,11 +114,11 @@ def parse_pose(text: str | None, device: Device) -> np.ndarray:
     try:
         values = [float(v) for v in text.replace(" ", "").split(",") if v != ""]
     except ValueError:
-        raise UserError(f"--q: expected comma-separated numbers, got {text[:80]!r}") from None
+        raise InputError(f"q: expected comma-separated numbers, got {text[:80]!r}", "q") from None
     if len(values) != device.n_dof:
-        raise UserError(f"--q: expected {device.n_dof} values, got {len(values)}")
+        raise InputError(f"q: expected {device.n_dof} values, got {len(values)}", "q")
     if not all(math.isfinite(v) for v in values):
-        raise UserError("--q: values must be finite")
+        raise InputError("q: values must be finite", "q")
     return np.array(values)
 
 
