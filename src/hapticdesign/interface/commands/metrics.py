@@ -13,6 +13,7 @@ from typing import Optional
 import numpy as np
 import typer
 
+from hapticdesign.analysis.dynamics.cartesian import cartesian_inertia
 from hapticdesign.analysis.dynamics.device import dynamics_of, mass_matrix
 from hapticdesign.analysis.kinematics import actuated_jacobian
 from hapticdesign.analysis.metrics import dynamic, kinematic
@@ -52,7 +53,7 @@ def device_metrics(device: Device, q: np.ndarray) -> dict:
     if not np.isfinite(cond) or cond > SINGULAR_CONDITION:
         raise UserError(f"singular configuration at q = {np.round(q, 6).tolist()}: the Jacobian loses rank")
     H = mass_matrix(device, q)
-    M_C = dynamic.cartesian_inertia(H, J)
+    M_C = cartesian_inertia(H, J)
     radii, _ = kinematic.velocity_ellipsoid(J)
     return {
         "device": device.name,
