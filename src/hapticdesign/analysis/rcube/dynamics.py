@@ -68,13 +68,11 @@ def chain_devices(design: RCubeDesign) -> tuple[Device, ...]:
 
 @lru_cache(maxsize=64)
 def _chain_parameters(design: RCubeDesign) -> tuple[tuple[Device, np.ndarray], ...]:
-    """Each chain's device and its standard inertial parameters (read-only)."""
-    out = []
-    for device in chain_devices(design):
-        parameters = device.standard_parameters()
-        parameters.flags.writeable = False
-        out.append((device, parameters))
-    return tuple(out)
+    """Each chain's device and its standard inertial parameters (read-only; the chains carry the same bodies)."""
+    devices = chain_devices(design)
+    parameters = devices[0].standard_parameters()
+    parameters.flags.writeable = False
+    return tuple((device, parameters) for device in devices)
 
 
 def _joint_inertia(device: Device, parameters: np.ndarray, q: np.ndarray) -> np.ndarray:
