@@ -48,7 +48,7 @@ def test_phantom_metrics_against_finite_differences_and_kinetic_energy(phantom3)
         v = rng.normal(size=3)
         qd = np.linalg.solve(J, v)
         assert 0.5 * v @ M_C @ v == pytest.approx(0.5 * qd @ H @ qd, rel=1e-6)
-    assert out["inertia_volume"] == pytest.approx(np.linalg.det(M_C), rel=1e-9)
+    assert out["I_m"] == pytest.approx(np.linalg.det(M_C), rel=1e-9)
 
 
 def test_planar_device_metrics_do_not_depend_on_axes():

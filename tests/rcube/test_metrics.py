@@ -8,6 +8,7 @@ from scipy.linalg import eigh
 
 from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.analysis.kinematics import jacobian
+from hapticdesign.analysis.dynamics.cartesian import cartesian_inertia
 from hapticdesign.analysis.metrics import dynamic, kinematic, stiffness
 from hapticdesign.analysis.metrics.globalization import global_index
 from hapticdesign.analysis.rcube.design import final_design
@@ -41,7 +42,7 @@ def test_phantom_metrics_from_the_core_jacobian_and_device_inertia(phantom3):
     q = np.array([0.2, 0.5, -0.4])
     J = jacobian(mech, q)[:3]
     H = mass_matrix(phantom3, q)
-    M_C = dynamic.cartesian_inertia(H, J)
+    M_C = cartesian_inertia(H, J)
     assert np.allclose(J.T @ M_C @ J, H)
     assert dynamic.inertia_volume(M_C) == pytest.approx(np.linalg.det(H) / np.linalg.det(J.T @ J))  # eq. 4.93
     assert dynamic.dynamic_manipulability(H, J) == pytest.approx(np.linalg.det(J) / np.linalg.det(H))  # eq. 4.97
@@ -101,3 +102,18 @@ def test_dynamic_manipulability_is_a_magnitude():
     mirrored = J[::-1]
     assert np.linalg.det(mirrored) < 0
     assert dynamic_manipulability(M, mirrored) == dynamic_manipulability(M, J) == abs(np.linalg.det(J)) / np.linalg.det(M)
+
+
+def test_every_metric_key_is_in_the_one_vocabulary(phantom3):
+    """R-CUBE metrics, Table 7.3's indices and the metrics command name each metric by the same key."""
+    from hapticdesign.analysis.metrics.names import METRICS
+    from hapticdesign.analysis.rcube.design import final_design
+    from hapticdesign.analysis.rcube.metrics import METRIC_NAMES, metrics_at
+    from hapticdesign.interface.commands.metrics import device_metrics
+    from hapticdesign.optimization import selection
+
+    design = final_design()
+    assert set(metrics_at(design, design.geometry.home[None])) == set(METRIC_NAMES) <= set(METRICS)
+    assert set(selection.METRIC_NAMES) <= set(METRICS)
+    shared = set(device_metrics(phantom3, np.array([0.2, 0.5, -0.4]))) & set(METRICS)
+    assert shared == {"manipulability", "condition_number", "I_m", "I_f", "I_e", "I_d", "acceleration_radius"}

@@ -88,3 +88,28 @@ def test_stiffness_with_joint_stiffness_adds_the_bearing_compliance(tmp_path):
     assert np.allclose(json.loads(res.stdout)["K_C"], out["K_C"], rtol=1e-12)
     res = run("stiffness", "--joint-stiffness", "-5")
     assert res.exit_code == 2 and res.stderr.startswith("error:") and res.stderr.count("\n") == 1
+
+
+def test_geometry_options_keep_the_design_file_and_sigma_has_no_sentinel(tmp_path):
+    """A design file's sigma = +1 stays unless --sigma is given; --sigma -1 given explicitly wins over it;
+    --outer keeps each link's bending rule. The branch shows in the elbow angle: sign(sin q_i3) = sigma (eq. 5.42)."""
+    from hapticdesign.analysis.rcube.design_io import load_design
+    from hapticdesign.interface.commands.rcube import _design
+
+    path = tmp_path / "d.yaml"
+    path.write_text("l2: 0.08\nsigma: 1\n")
+    assert _design(path, None, None, None, None, None).geometry.sigma == 1
+    assert _design(path, None, None, None, None, -1).geometry.sigma == -1
+    changed = _design(path, 0.12, None, None, 0.11, None)
+    assert (changed.geometry.l1, changed.geometry.l2, changed.geometry.S, changed.geometry.sigma) == (0.12, 0.08, 0.11, 1)
+    assert changed.links == load_design(path).links
+    for sigma in (-1, 1):
+        res = run("ik", "--design", str(path), "--sigma", str(sigma), "--position", "0.12,0.1,0.13", "--json")
+        assert res.exit_code == 0, res.output
+        q = np.array(json.loads(res.stdout)["q"])
+        assert np.all(np.sign(np.sin(q[:, 2])) == sigma)
+    from hapticdesign.analysis.rcube.design import seed_final_design
+    from hapticdesign.interface.commands.rcube import _override_links
+
+    outer = _override_links(seed_final_design(), "0.04,0.04,0.04", None, None, None)
+    assert all(link.section.D == 0.04 and link.bending == "eq. 4.59" for link in outer.links)

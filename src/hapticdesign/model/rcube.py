@@ -20,14 +20,15 @@ Mass-centre frames ``com1..com3`` sit ``lg_j`` along each link (eq. 5.139-5.141,
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from functools import lru_cache
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+from functools import lru_cache, partial
 from math import isfinite, pi
 
 import numpy as np
 
 from hapticdesign.errors import UserError
-from hapticdesign.model.mechanism import Frame, JointType, Mechanism
+from hapticdesign.model.mechanism import BodyAttachment, Frame, JointType, Mechanism
 from hapticdesign.model.transforms import (
     ElementaryTransform,
     Rx,
@@ -157,6 +158,32 @@ def chain_mechanism(
         end_effector="platform",
         metadata={"device": "rcube", "chain": chain},
     )
+
+
+CHAIN_KINEMATIC = ("l1", "l2", "l3", "S")
+"""Kinematic parameters of a chain's equations of motion (:data:`CHAIN_BUILDERS`)."""
+
+CHAIN_BODIES = (("1", "link1"), ("2", "link2"), ("3", "link3"), ("p", "platform"))
+"""Bodies of a chain's equations of motion and their frames: the three tubes on the joint frames
+``link1..link3`` (x along the link, mass centre at ``(lg_j, 0, 0)``, eq. 5.182-5.184) and the chain's
+share of the platform at the platform frame's origin."""
+
+
+def _chain_dynamics_mechanism(chain: int, params: Mapping[str, float]) -> Mechanism:
+    mech = chain_mechanism(RCubeGeometry(params["l1"], params["l2"], params["l3"], params["S"]), chain)
+    return replace(
+        mech,
+        bodies=tuple(BodyAttachment(name, frame) for name, frame in CHAIN_BODIES),
+        gravity=(0.0, 0.0, 0.0),
+        metadata=dict(mech.metadata),
+    )
+
+
+CHAIN_BUILDERS = tuple(partial(_chain_dynamics_mechanism, chain) for chain in range(N_CHAINS))
+"""Mechanism builders of the chains' equations of motion (seed 001 eq. 5.199-5.209), one per chain:
+:func:`chain_mechanism` of the parameters :data:`CHAIN_KINEMATIC` with the bodies :data:`CHAIN_BODIES`
+and no gravity (the seed leaves it out, §5.3). One object per chain, so that models cached per
+builder and geometry are shared."""
 
 
 @lru_cache(maxsize=128)

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from hapticdesign.errors import UserError
+from hapticdesign.analysis.metrics import names
 from hapticdesign.analysis.rcube.design import RCubeDesign
 from hapticdesign.analysis.rcube.dynamics import cartesian_mass_matrix
 from hapticdesign.analysis.rcube.kinematics import dexterous_cube
@@ -89,8 +90,9 @@ def select_solution(synthesis: SynthesisResult, weight: float = 0.0, workspace: 
     weighted RMS with ``weight`` on ``mu_vn*`` (the seed picks weight 0, Sol. 1, §7.2)."""
     metrics = post_evaluate(synthesis.front.X, workspace, links)
     n = normalized_indices(metrics)
-    rms = weighted_rms(n["omega_n"], n["mu_v"])
-    weighted = {float(w): weighted_rms(n["omega_n"], n["mu_v"], w) for w in sorted(set(WEIGHTS) | {weight})}
+    rms = weighted_rms(n[names.FREQUENCY_INDEX], n[names.CRITICAL_MANIPULABILITY])
+    weighted = {float(w): weighted_rms(n[names.FREQUENCY_INDEX], n[names.CRITICAL_MANIPULABILITY], w)
+                for w in sorted(set(WEIGHTS) | {weight})}
     choices = {w: int(np.argmin(v)) for w, v in weighted.items()}
     return Selection(metrics, n, rms, weighted, int(np.argmin(rms)), choices, choices[float(weight)], float(weight),
                      links.settings())
@@ -209,7 +211,7 @@ def write_synthesis(out: Path, synthesis: SynthesisResult) -> list[Path]:
 def write_selection(out: Path, selection: Selection) -> list[Path]:
     """Tables 7.3-7.5 and Figures 7.1-7.3."""
     m, n = selection.metrics, selection.normalized
-    count = len(m["I_f"])
+    count = len(m[names.INERTIA_FROBENIUS])
     paths = [
         _write_csv(out / "table_7_3_post_evaluation.csv", ["solution", *METRIC_NAMES],
                    ([k + 1, *(m[name][k] for name in METRIC_NAMES)] for k in range(count))),
@@ -218,8 +220,8 @@ def write_selection(out: Path, selection: Selection) -> list[Path]:
         _write_csv(out / "table_7_5_weighted_rms.csv", ["weight_mu_vn", "solution"],
                    ([w, c + 1] for w, c in selection.weighted_choice.items())),
     ]
-    paths += figures.frequency_vs_manipulability(n["omega_n"], n["mu_v"], selection.rms_choice, selection.selected,
-                                                 selection.weight, out)
+    paths += figures.frequency_vs_manipulability(n[names.FREQUENCY_INDEX], n[names.CRITICAL_MANIPULABILITY],
+                                                 selection.rms_choice, selection.selected, selection.weight, out)
     paths += figures.rms_curves({"RMS, eq. 7.2-7.4": selection.rms}, out, "figure_7_2_rms",
                                 "Figure 7.2: RMS of omega_nn* and mu_vn*", selection.selected, selection.weight)
     paths += figures.rms_curves({f"weight {w:g}": v for w, v in selection.weighted.items()}, out,

@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from hapticdesign.errors import UserError
+from hapticdesign.analysis.metrics import names
 from hapticdesign.analysis.metrics.dynamic import inertia_frobenius, natural_frequency_index
 from hapticdesign.analysis.metrics.stiffness import frobenius, translational_block
 from hapticdesign.analysis.rcube.dynamics import chain_cartesian_mass
@@ -23,8 +24,10 @@ from hapticdesign.analysis.rcube.stiffness import chain_stiffness_matrices
 from hapticdesign.optimization.constraints import Workspace
 from hapticdesign.optimization.objectives import EvaluationLinks, geometry_of
 
-METRIC_NAMES = ("I_f", "S_f", "omega_n", "mu_v", "c_v")
-LARGER_IS_BETTER = ("S_f", "omega_n", "mu_v")
+METRIC_NAMES = (names.INERTIA_FROBENIUS, names.STIFFNESS_FROBENIUS, names.FREQUENCY_INDEX,
+                names.CRITICAL_MANIPULABILITY, names.CRITICAL_CONDITION_NUMBER)
+"""Table 7.3's five indices, keyed as in :mod:`hapticdesign.analysis.metrics.names`."""
+LARGER_IS_BETTER = (names.STIFFNESS_FROBENIUS, names.FREQUENCY_INDEX, names.CRITICAL_MANIPULABILITY)
 """Indices flipped by eq. 7.2-7.4 so that 0 is the best value of every normalized index."""
 
 
@@ -39,11 +42,11 @@ def post_evaluate(X, workspace: Workspace = Workspace(), links: EvaluationLinks 
         q = inverse_kinematics(geometry, home)
         M = chain_cartesian_mass(design, 0, q[0])
         K = chain_stiffness_matrices(design, home, passive=links.passive_eliminated)[0]
-        out["I_f"][k] = inertia_frobenius(M)
-        out["S_f"][k] = frobenius(K)
-        out["omega_n"][k] = natural_frequency_index(M, translational_block(K))
-        out["mu_v"][k] = critical_manipulability(geometry, x[0])
-        out["c_v"][k] = critical_condition_number(x[0])
+        out[names.INERTIA_FROBENIUS][k] = inertia_frobenius(M)
+        out[names.STIFFNESS_FROBENIUS][k] = frobenius(K)
+        out[names.FREQUENCY_INDEX][k] = natural_frequency_index(M, translational_block(K))
+        out[names.CRITICAL_MANIPULABILITY][k] = critical_manipulability(geometry, x[0])
+        out[names.CRITICAL_CONDITION_NUMBER][k] = critical_condition_number(x[0])
     return out
 
 
@@ -83,6 +86,6 @@ def select(metrics: dict[str, np.ndarray], weights=(0.0, 0.25, 0.5, 0.75)) -> di
     for each weight on ``mu_vn*`` (Fig. 7.3, Table 7.5)."""
     n = normalized_indices(metrics)
     return {
-        "rms": int(np.argmin(weighted_rms(n["omega_n"], n["mu_v"]))),
-        "weighted": {float(w): int(np.argmin(weighted_rms(n["omega_n"], n["mu_v"], w))) for w in weights},
+        "rms": int(np.argmin(weighted_rms(n[names.FREQUENCY_INDEX], n[names.CRITICAL_MANIPULABILITY]))),
+        "weighted": {float(w): int(np.argmin(weighted_rms(n[names.FREQUENCY_INDEX], n[names.CRITICAL_MANIPULABILITY], w))) for w in weights},
     }

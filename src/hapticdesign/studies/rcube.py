@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hapticdesign.analysis.metrics import names
 from hapticdesign.analysis.metrics.dynamic import modes
 from hapticdesign.analysis.metrics.globalization import global_indices
 from hapticdesign.analysis.rcube import dynamics as rcube_dynamics
@@ -28,6 +29,7 @@ from hapticdesign.optimization.chain import (
 )
 from hapticdesign.optimization.constraints import Workspace, constraint_values
 from hapticdesign.optimization.plies import ply_design
+from hapticdesign.optimization.selection import METRIC_NAMES as TABLE_7_3_METRICS
 from hapticdesign.studies.plots import plt
 from hapticdesign.studies.seed_reference import (
     RCUBE_FINAL,
@@ -44,28 +46,8 @@ from hapticdesign.studies.steps import (
 )
 
 SCALES = ("full", "quick", "smoke")
-MAP_METRICS = ("manipulability", "condition_number", "I_f", "S_f", "S_d", "omega_n")
-
-METRIC_INFO = {
-    "manipulability": ("absolute manipulability |det J_m| (eq. 4.38)", "m^3/rad^3"),
-    "condition_number": ("condition number of J_m (eq. 4.33)", "dimensionless"),
-    "positioning_resolution": ("positioning resolution ||J_m|| (eq. 4.30)", "m/rad"),
-    "I_m": ("inertia volume det M_C (eq. 4.92-4.93)", "kg^3"),
-    "I_f": ("inertia norm ||M_C||_F (eq. 4.98)", "kg"),
-    "I_e": ("inertia uniformity ||M_C|| ||M_C^-1|| (eq. 4.99)", "dimensionless"),
-    "I_d": ("dynamic manipulability det(J_m M^-1) (eq. 4.97)", "1/(kg^3 m^3)"),
-    "acceleration_radius": ("acceleration radius (eq. 4.96)", "1/(kg m)"),
-    "S_e": ("stiffness uniformity ||K_C|| ||K_C^-1|| (eq. 4.72)", "dimensionless (of the mixed-unit K_C in SI)"),
-    "S_f": ("stiffness norm ||K_C||_F (eq. 4.73)", "mixed: N/m, N and N m/rad entries, in SI"),
-    "S_d": ("stiffness volume det K_C (eq. 4.74)", "N^6/rad^3"),
-    "S_et": ("translational stiffness uniformity (eq. 6.55)", "dimensionless"),
-    "S_er": ("rotational stiffness uniformity (eq. 6.56)", "dimensionless"),
-    "S_da": ("translational stiffness volume det K_CA (eq. 6.74)", "N^3/m^3"),
-    "S_dd": ("rotational stiffness volume det K_CD (eq. 6.75)", "N^3 m^3/rad^3"),
-    "omega_n": ("natural frequency index ||M_C^-1 K_CA||_F (eq. 4.107)", "1/s^2"),
-}
-"""Each metric's description and unit: ``J_m`` maps joint rates (rad/s) to platform velocity (m/s),
-``M_C`` is in kg, ``K_C`` has N/m, N and N m/rad blocks (seed 001 §4, eq. 6.54)."""
+MAP_METRICS = (names.MANIPULABILITY, names.CONDITION_NUMBER, names.INERTIA_FROBENIUS, names.STIFFNESS_FROBENIUS,
+               names.STIFFNESS_VOLUME, names.FREQUENCY_INDEX)
 
 
 @dataclass(frozen=True)
@@ -197,15 +179,15 @@ def maps_step(ctx: Context) -> Outcome:
             ax.set_title(f"plane z {o * 1e3:+.0f} mm")
             ax.set_xlabel("x [mm]")
             ax.set_ylabel("y [mm]")
-            fig.colorbar(image, ax=ax, shrink=0.8, label=f"{name} [{METRIC_INFO[name][1]}]")
-        label, unit = METRIC_INFO[name]
+            fig.colorbar(image, ax=ax, shrink=0.8, label=f"{name} [{names.METRICS[name].unit}]")
+        label, unit = names.METRICS[name]
         figures.append(figure_from_matplotlib(
             fig, f"map_{name}", f"{label[0].upper()}{label[1:]} over the workspace of the final design",
             f"Table 7.8's design on the planes z = -60, 0, +60 mm through the 120 mm cube (§7.5), {n} x {n} points "
             f"per plane; colour: {name} in {unit}; blank cells are unreachable or singular poses."))
     merged = {k: np.concatenate([p[k].ravel() for p in planes]) for k in planes[0]}
     glob = global_indices(merged)
-    rows = [[k, float(v), METRIC_INFO.get(k, ("", ""))[1], METRIC_INFO.get(k, ("", ""))[0]] for k, v in glob.items()]
+    rows = [[k, float(v), names.METRICS[k].unit, names.METRICS[k].description] for k, v in glob.items()]
     return Outcome(
         summary=f"{len(planes[0])} metrics on 3 planes of {n} x {n} points; {len(MAP_METRICS)} shown.",
         tables=[Table("global", "Global indices over the three planes (eq. 4.108)",
@@ -221,7 +203,7 @@ def _chain_settings(effort: str):
 
 COLUMN_NAMES = {
     "O1": "O1 = tan q_max [-]", "O2": "O2 = det M_C [kg^3]", "O3": "O3 = 1/det K_CA [m^3/N^3]",
-    "I_f": "I_f [kg]", "S_f": "S_f [mixed SI]", "omega_n": "omega_n [1/s^2]", "mu_v": "mu_v [m/rad]", "c_v": "c_v [-]",
+    **{name: f"{name} [{names.METRICS[name].unit}]" for name in TABLE_7_3_METRICS},
 }
 """Display names with units of the optimization CSV columns (eq. 6.82-6.84, Table 7.3)."""
 

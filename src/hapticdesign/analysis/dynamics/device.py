@@ -4,7 +4,8 @@
 kinematic parameters, so every device that differs only in inertial parameters shares it). With
 actuators, H carries the constant reflected rotor inertia (seed 000 eq. 2.50 plus ``diag(n^2 J_r)``);
 the regressor in the inertial parameters is the same object's. The other functions evaluate that
-model at the device's standard parameters (seed 000 eq. 2.50-2.52).
+model at the device's standard parameters (seed 000 eq. 2.50-2.52); :func:`tree_mass_matrix` gives
+H of a tree straight from the compiled kernel, without fitting that model.
 """
 
 from __future__ import annotations
@@ -14,8 +15,11 @@ from functools import lru_cache
 import numpy as np
 
 from hapticdesign.analysis.dynamics.closed_loop import ClosedLoopModel
+from hapticdesign.analysis.dynamics.kernel import regressor_kernel
 from hapticdesign.analysis.dynamics.model import DynamicsModel
+from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device, MechanismBuilder, build_mechanism
+from hapticdesign.model.mechanism import Mechanism
 
 
 def dynamics_of(device: Device) -> DynamicsModel:
@@ -29,6 +33,25 @@ def dynamics_of(device: Device) -> DynamicsModel:
 def mass_matrix(device: Device, q: np.ndarray) -> np.ndarray:
     """H (eq. 2.50) at one pose (N,) or many (P, N)."""
     return dynamics_of(device).H(q, device.standard_parameters())
+
+
+def tree_mass_matrix(mechanism: Mechanism, q: np.ndarray, parameters: np.ndarray) -> np.ndarray:
+    """H (eq. 2.50) of a tree mechanism at poses ``(..., N)`` for standard inertial parameters
+    ``(10 x bodies,)``, straight from the compiled regressor kernel.
+
+    Exact like :func:`mass_matrix`, without fitting the regressor model of :func:`dynamics_of`: the
+    cheaper choice for a geometry evaluated at a few poses (one candidate of an optimization).
+    """
+    if mechanism.loops is not None:
+        raise UserError("a mechanism with closed loops needs the loop solver: use mass_matrix")
+    q = np.asarray(q, dtype=float)
+    n = mechanism.n_dof
+    if q.shape[-1:] != (n,) or not np.all(np.isfinite(q)):
+        raise UserError(f"expected finite joint coordinates (..., {n}), got an array of shape {q.shape}")
+    c = mechanism.compiled
+    yh, _ = regressor_kernel(np.ascontiguousarray(q.reshape(-1, n)), c.node_parent, c.node_axis,
+                             c.node_coef, c.node_offset, c.body_node, c.body_path, c.gravity)
+    return (yh @ parameters).reshape(q.shape + (n,))
 
 
 def coriolis_centrifugal(device: Device, q: np.ndarray) -> np.ndarray:

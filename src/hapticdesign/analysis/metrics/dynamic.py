@@ -1,6 +1,7 @@
 """Dynamic metrics (seed 001 §4.3): inertia indices and the dynamic matrix.
 
-``M`` is a joint-space inertia and ``J`` a square Jacobian, or ``M_C`` a Cartesian inertia.
+``M`` is a joint-space inertia and ``J`` a square Jacobian, or ``M_C`` a Cartesian inertia
+(:func:`hapticdesign.analysis.dynamics.cartesian.cartesian_inertia`, eq. 4.90, 4.106).
 """
 
 from __future__ import annotations
@@ -11,12 +12,6 @@ import numpy as np
 from scipy.linalg import eigh
 
 from hapticdesign.analysis.metrics.stiffness import euclidean_condition, frobenius
-
-
-def cartesian_inertia(M, J) -> np.ndarray:
-    """``M_C = J^-T M J^-1`` (eq. 4.90, 4.106)."""
-    Jinv = np.linalg.inv(np.asarray(J, dtype=float))
-    return np.swapaxes(Jinv, -1, -2) @ np.asarray(M, dtype=float) @ Jinv
 
 
 def inertia_volume(M_C) -> np.ndarray:

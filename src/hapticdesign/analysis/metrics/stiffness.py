@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from hapticdesign.analysis.metrics import names
 from hapticdesign.errors import UserError
 
 
@@ -73,12 +74,13 @@ def rotational_volume(K) -> np.ndarray:
 def all_stiffness_metrics(K) -> dict[str, np.ndarray]:
     """Every stiffness metric of a 6 x 6 ``K_C`` (or only the 3 x 3 ones for a translational matrix)."""
     K = _matrix(K)
-    out = {"S_e": stiffness_uniformity(K), "S_f": frobenius(K), "S_d": determinant(K)}
+    out = {names.STIFFNESS_UNIFORMITY: stiffness_uniformity(K), names.STIFFNESS_FROBENIUS: frobenius(K),
+           names.STIFFNESS_VOLUME: determinant(K)}
     if K.shape[-1] == 6:
-        out.update(
-            S_et=translational_condition(K),
-            S_er=rotational_condition(K),
-            S_da=translational_volume(K),
-            S_dd=rotational_volume(K),
-        )
+        out |= {
+            names.TRANSLATIONAL_UNIFORMITY: translational_condition(K),
+            names.ROTATIONAL_UNIFORMITY: rotational_condition(K),
+            names.TRANSLATIONAL_VOLUME: translational_volume(K),
+            names.ROTATIONAL_VOLUME: rotational_volume(K),
+        }
     return out

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from hapticdesign.analysis.metrics import dynamic, kinematic, stiffness
+from hapticdesign.analysis.metrics import dynamic, kinematic, names, stiffness
 from hapticdesign.analysis.metrics.maps import evaluate_planes, plane_grid, save_map
 from hapticdesign.analysis.rcube.design import RCubeDesign
 from hapticdesign.analysis.rcube.dynamics import cartesian_mass_matrix
@@ -17,10 +17,13 @@ from hapticdesign.analysis.rcube.kinematics import active_jacobian, inverse_kine
 from hapticdesign.analysis.rcube.stiffness import cartesian_stiffness
 
 METRIC_NAMES = (
-    "manipulability", "condition_number", "positioning_resolution",
-    "I_m", "I_f", "I_e", "I_d", "acceleration_radius",
-    "S_e", "S_f", "S_d", "S_et", "S_er", "S_da", "S_dd", "omega_n",
+    names.MANIPULABILITY, names.CONDITION_NUMBER, names.POSITIONING_RESOLUTION,
+    names.INERTIA_VOLUME, names.INERTIA_FROBENIUS, names.INERTIA_UNIFORMITY, names.DYNAMIC_MANIPULABILITY,
+    names.ACCELERATION_RADIUS, names.STIFFNESS_UNIFORMITY, names.STIFFNESS_FROBENIUS, names.STIFFNESS_VOLUME,
+    names.TRANSLATIONAL_UNIFORMITY, names.ROTATIONAL_UNIFORMITY, names.TRANSLATIONAL_VOLUME,
+    names.ROTATIONAL_VOLUME, names.FREQUENCY_INDEX,
 )
+"""The metrics of :func:`metrics_at`, keyed as in :mod:`hapticdesign.analysis.metrics.names`."""
 
 
 def metrics_at(design: RCubeDesign, positions) -> dict[str, np.ndarray]:
@@ -44,16 +47,16 @@ def metrics_at(design: RCubeDesign, positions) -> dict[str, np.ndarray]:
             K_C = cartesian_stiffness(design, rr)
             M = np.swapaxes(Jm, -1, -2) @ M_C @ Jm
             values = {
-                "manipulability": kinematic.absolute_manipulability(Jm),
-                "condition_number": kinematic.condition_number(Jm),
-                "positioning_resolution": kinematic.positioning_resolution(Jm),
-                "I_m": dynamic.inertia_volume(M_C),
-                "I_f": dynamic.inertia_frobenius(M_C),
-                "I_e": dynamic.inertia_uniformity(M_C),
-                "I_d": dynamic.dynamic_manipulability(M, Jm),
-                "acceleration_radius": dynamic.acceleration_radius(M, Jm),
+                names.MANIPULABILITY: kinematic.absolute_manipulability(Jm),
+                names.CONDITION_NUMBER: kinematic.condition_number(Jm),
+                names.POSITIONING_RESOLUTION: kinematic.positioning_resolution(Jm),
+                names.INERTIA_VOLUME: dynamic.inertia_volume(M_C),
+                names.INERTIA_FROBENIUS: dynamic.inertia_frobenius(M_C),
+                names.INERTIA_UNIFORMITY: dynamic.inertia_uniformity(M_C),
+                names.DYNAMIC_MANIPULABILITY: dynamic.dynamic_manipulability(M, Jm),
+                names.ACCELERATION_RADIUS: dynamic.acceleration_radius(M, Jm),
                 **stiffness.all_stiffness_metrics(K_C),
-                "omega_n": dynamic.natural_frequency_index(M_C, stiffness.translational_block(K_C)),
+                names.FREQUENCY_INDEX: dynamic.natural_frequency_index(M_C, stiffness.translational_block(K_C)),
             }
             for name in METRIC_NAMES:
                 out[name][ok_idx] = values[name]

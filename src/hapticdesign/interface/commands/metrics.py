@@ -13,9 +13,10 @@ from typing import Optional
 import numpy as np
 import typer
 
+from hapticdesign.analysis.dynamics.cartesian import cartesian_inertia
 from hapticdesign.analysis.dynamics.device import dynamics_of, mass_matrix
 from hapticdesign.analysis.kinematics import actuated_jacobian
-from hapticdesign.analysis.metrics import dynamic, kinematic
+from hapticdesign.analysis.metrics import dynamic, kinematic, names
 from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import note, parse_vector, print_json, user_errors
@@ -46,27 +47,28 @@ def task_jacobian(device: Device, q: np.ndarray) -> np.ndarray:
 
 
 def device_metrics(device: Device, q: np.ndarray) -> dict:
-    """Kinematic (eq. 4.24-4.38) and dynamic (eq. 4.90-4.99) metrics at pose ``q``."""
+    """Kinematic (eq. 4.24-4.38) and dynamic (eq. 4.90-4.99) metrics at pose ``q``, keyed as in
+    :mod:`hapticdesign.analysis.metrics.names`."""
     J = task_jacobian(device, q)
     cond = float(kinematic.condition_number(J))
     if not np.isfinite(cond) or cond > SINGULAR_CONDITION:
         raise UserError(f"singular configuration at q = {np.round(q, 6).tolist()}: the Jacobian loses rank")
     H = mass_matrix(device, q)
-    M_C = dynamic.cartesian_inertia(H, J)
+    M_C = cartesian_inertia(H, J)
     radii, _ = kinematic.velocity_ellipsoid(J)
     return {
         "device": device.name,
         "q": q,
         "jacobian": J,
-        "manipulability": kinematic.manipulability(J),
-        "condition_number": cond,
+        names.MANIPULABILITY: kinematic.manipulability(J),
+        names.CONDITION_NUMBER: cond,
         "velocity_ellipsoid_radii": radii,
         "cartesian_inertia": M_C,
-        "inertia_volume": dynamic.inertia_volume(M_C),
-        "dynamic_manipulability": dynamic.dynamic_manipulability(H, J),
-        "inertia_frobenius": dynamic.inertia_frobenius(M_C),
-        "inertia_uniformity": dynamic.inertia_uniformity(M_C),
-        "acceleration_radius": dynamic.acceleration_radius(H, J),
+        names.INERTIA_VOLUME: dynamic.inertia_volume(M_C),
+        names.DYNAMIC_MANIPULABILITY: dynamic.dynamic_manipulability(H, J),
+        names.INERTIA_FROBENIUS: dynamic.inertia_frobenius(M_C),
+        names.INERTIA_UNIFORMITY: dynamic.inertia_uniformity(M_C),
+        names.ACCELERATION_RADIUS: dynamic.acceleration_radius(H, J),
     }
 
 

@@ -27,7 +27,7 @@ L1 = typer.Option(None, "--l1", help="Active link length l1 (m); default 0.1117 
 L2 = typer.Option(None, "--l2", help="Passive link length l2 (m); default 0.0741.")
 L3 = typer.Option(None, "--l3", help="Passive link length l3 (m); default 0.1218.")
 OFFSET = typer.Option(None, "--offset", help="Chain offset S (m); default S = l1 (eq. 6.39).")
-SIGMA = typer.Option(-1, "--sigma", help="Passive configuration, -1 or +1 (eq. 5.42).")
+SIGMA = typer.Option(None, "--sigma", help="Passive configuration, -1 or +1 (eq. 5.42); default the design file's, else -1.")
 DESIGN = typer.Option(None, "--design", help="Design file (YAML/JSON: l1, l2, l3, links with D, d, plies).")
 OUTER = typer.Option(None, "--outer", help="Outer diameters D of links 1-3 (m), comma-separated.")
 INNER = typer.Option(None, "--inner", help="Inner diameters d of links 1-3 (m), comma-separated.")
@@ -37,20 +37,14 @@ POSITION = typer.Option(None, "--position", help="Platform position x,y,z (m); d
 
 
 def _design(design_file, l1, l2, l3, offset, sigma, outer=None, inner=None, plies=None, density=None):
-    from hapticdesign.analysis.rcube.design_io import design_from_mapping, load_design
+    """The design file's design (else the final design, Table 7.8) with the geometry options given."""
+    from hapticdesign.analysis.rcube.design import final_design
+    from hapticdesign.analysis.rcube.design_io import load_design
 
-    base = load_design(design_file) if design_file else None
-    data: dict = {}
-    if base is not None:
-        g = base.geometry
-        data.update(l1=g.l1, l2=g.l2, l3=g.l3, offset=g.offset, sigma=g.sigma)
-    for key, value in (("l1", l1), ("l2", l2), ("l3", l3), ("offset", offset)):
-        if value is not None:
-            data[key] = value
-    data["sigma"] = sigma if sigma != -1 or "sigma" not in data else data["sigma"]
-    design = design_from_mapping(data)
-    if base is not None:
-        design = replace(base, geometry=design.geometry)
+    design = load_design(design_file) if design_file else final_design()
+    given = {k: v for k, v in (("l1", l1), ("l2", l2), ("l3", l3), ("offset", offset), ("sigma", sigma)) if v is not None}
+    if given:
+        design = design.with_geometry(replace(design.geometry, **given))
     if outer or inner or plies or density is not None:
         design = _override_links(design, outer, inner, plies, density)
     return design
@@ -75,10 +69,9 @@ def _override_links(design, outer, inner, plies, density):
             entry["plies"] = counts[k]
             links.append(link_from_mapping(entry, entry["density"], f"link {k + 1}"))
         else:
-            from hapticdesign.analysis.stiffness.link import LinkDesign
             from hapticdesign.analysis.stiffness.sections import Tube
 
-            links.append(LinkDesign(Tube(float(D[k]), float(d[k])), link.moduli, float(entry["density"])))
+            links.append(replace(link, section=Tube(float(D[k]), float(d[k])), density=float(entry["density"])))
     return replace(design, links=tuple(links))
 
 
@@ -124,7 +117,7 @@ def _matrix_text(name: str, M: np.ndarray, unit: str) -> str:
 
 @rcube_app.command()
 def ik(l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[float] = L3,
-       offset: Optional[float] = OFFSET, sigma: int = SIGMA, design: Optional[Path] = DESIGN,
+       offset: Optional[float] = OFFSET, sigma: Optional[int] = SIGMA, design: Optional[Path] = DESIGN,
        position: str = typer.Option(..., "--position", help="Platform position x,y,z (m)."),
        json_out: bool = JSON_OUT, quiet: bool = QUIET) -> None:
     """Inverse kinematics (eq. 5.30-5.45): angles q_i1, q_i2, q_i3 of chains i = 1, 2, 3 (rad), one row per chain."""
@@ -145,7 +138,7 @@ def fk(q1: float = typer.Option(..., "--q1", help="Active angle q11 (rad)."),
        q2: float = typer.Option(..., "--q2", help="Active angle q21 (rad)."),
        q3: float = typer.Option(..., "--q3", help="Active angle q31 (rad)."),
        l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[float] = L3,
-       offset: Optional[float] = OFFSET, sigma: int = SIGMA, design: Optional[Path] = DESIGN,
+       offset: Optional[float] = OFFSET, sigma: Optional[int] = SIGMA, design: Optional[Path] = DESIGN,
        json_out: bool = JSON_OUT, quiet: bool = QUIET) -> None:
     """Forward kinematics (eq. 5.28): platform position from the active angles."""
     from hapticdesign.analysis.rcube.kinematics import forward_kinematics, inverse_kinematics
@@ -170,7 +163,7 @@ def fk(q1: float = typer.Option(..., "--q1", help="Active angle q11 (rad)."),
 
 @rcube_app.command()
 def stiffness(l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[float] = L3,
-              offset: Optional[float] = OFFSET, sigma: int = SIGMA, design: Optional[Path] = DESIGN,
+              offset: Optional[float] = OFFSET, sigma: Optional[int] = SIGMA, design: Optional[Path] = DESIGN,
               outer: Optional[str] = OUTER, inner: Optional[str] = INNER, plies: Optional[str] = PLIES,
               density: Optional[float] = DENSITY, position: Optional[str] = POSITION,
               locked: bool = typer.Option(False, "--locked", help="K_C* with passive joints locked (eq. 6.60-6.61)."),
@@ -210,7 +203,7 @@ def stiffness(l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[f
 
 @rcube_app.command()
 def mass(l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[float] = L3,
-         offset: Optional[float] = OFFSET, sigma: int = SIGMA, design: Optional[Path] = DESIGN,
+         offset: Optional[float] = OFFSET, sigma: Optional[int] = SIGMA, design: Optional[Path] = DESIGN,
          outer: Optional[str] = OUTER, inner: Optional[str] = INNER, density: Optional[float] = DENSITY,
          position: Optional[str] = POSITION, json_out: bool = JSON_OUT, quiet: bool = QUIET) -> None:
     """Cartesian inertia M_C (eq. 5.223, 5.227) and the total link mass (eq. 5.230)."""
@@ -229,7 +222,7 @@ def mass(l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[float]
 
 @rcube_app.command()
 def metrics(l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[float] = L3,
-            offset: Optional[float] = OFFSET, sigma: int = SIGMA, design: Optional[Path] = DESIGN,
+            offset: Optional[float] = OFFSET, sigma: Optional[int] = SIGMA, design: Optional[Path] = DESIGN,
             outer: Optional[str] = OUTER, inner: Optional[str] = INNER, plies: Optional[str] = PLIES,
             density: Optional[float] = DENSITY, position: Optional[str] = POSITION, json_out: bool = JSON_OUT,
             quiet: bool = QUIET) -> None:
@@ -260,7 +253,7 @@ def maps(out: Path = typer.Option(..., "--out", help="Directory for the PNG imag
          n: int = typer.Option(21, "--n", help="Points per side of each plane."),
          side: float = typer.Option(0.12, "--side", help="Workspace cube edge (m)."),
          l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[float] = L3,
-         offset: Optional[float] = OFFSET, sigma: int = SIGMA, design: Optional[Path] = DESIGN,
+         offset: Optional[float] = OFFSET, sigma: Optional[int] = SIGMA, design: Optional[Path] = DESIGN,
          outer: Optional[str] = OUTER, inner: Optional[str] = INNER, plies: Optional[str] = PLIES,
          density: Optional[float] = DENSITY, json_out: bool = JSON_OUT, quiet: bool = QUIET,
          force: bool = FORCE) -> None:

@@ -1,0 +1,55 @@
+"""Cartesian (operational-space) inertia of any device: the one place it is computed.
+
+With task velocities ``v = J qd`` the kinetic energy ``1/2 qd^T H qd`` is ``1/2 v^T M_C v`` for
+
+    M_C = J^-T H J^-1                 (square J; seed 001 eq. 4.90, 4.106, 5.223)
+    M_C = (J H^-1 J^T)^-1             (J with fewer rows than columns; Khatib's operational-space inertia)
+
+and the two agree for a square ``J``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hapticdesign.errors import UserError
+
+SINGULAR_CONDITION = 1.0 / np.finfo(float).eps
+"""Condition estimate ``max|A_ij| max|(A^-1)_ij|`` (within a factor ``n^2`` of the infinity-norm
+condition number) above which a matrix counts as singular to working precision."""
+
+
+def _inverse(A: np.ndarray, what: str) -> np.ndarray:
+    """Batched inverse of square matrices; a singular one (exactly or to working precision) is a :class:`UserError`."""
+    try:
+        inv = np.linalg.inv(A)
+    except np.linalg.LinAlgError:
+        raise UserError(f"{what} is singular: no Cartesian inertia at this pose (the Jacobian loses rank)") from None
+    magnitude, inverse_magnitude = np.abs(A), np.abs(inv)
+    if magnitude.max() * inverse_magnitude.max() < SINGULAR_CONDITION:  # bounds every matrix's estimate
+        return inv
+    condition = magnitude.max(axis=(-2, -1)) * inverse_magnitude.max(axis=(-2, -1))
+    if not np.all(condition < SINGULAR_CONDITION):
+        raise UserError(f"{what} is singular: no Cartesian inertia at this pose (the Jacobian loses rank)")
+    return inv
+
+
+def cartesian_inertia(mass_matrix, jacobian) -> np.ndarray:
+    """Cartesian inertia ``M_C`` (..., m, m) of a joint-space inertia ``H`` (..., n, n) and a task
+    Jacobian ``J`` (..., m, n), batched over the leading axes.
+
+    ``J^-T H J^-1`` for a square ``J`` (seed 001 eq. 4.90, 4.106, 5.223); ``(J H^-1 J^T)^-1`` for
+    ``m < n``. A ``J`` that loses rank (or ``m > n``) raises :class:`UserError`.
+    """
+    H = np.asarray(mass_matrix, dtype=float)
+    J = np.asarray(jacobian, dtype=float)
+    if H.ndim < 2 or J.ndim < 2 or H.shape[-1] != H.shape[-2] or J.shape[-1] != H.shape[-1]:
+        raise UserError(f"a mass matrix (..., n, n) and a Jacobian (..., m, n) are needed, got shapes {H.shape} and {J.shape}")
+    m, n = J.shape[-2:]
+    if m > n:
+        raise UserError(f"a task of {m} coordinates has no Cartesian inertia with {n} joints (J loses rank)")
+    if m == n:
+        Jinv = _inverse(J, "the Jacobian")
+        return np.swapaxes(Jinv, -1, -2) @ H @ Jinv
+    mobility = J @ np.linalg.solve(H, np.swapaxes(J, -1, -2))
+    return _inverse(mobility, "J H^-1 J^T")
