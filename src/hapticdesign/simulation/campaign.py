@@ -70,9 +70,10 @@ class CampaignOptions:
     duration: float = 5.0
     bandwidth_agreement_hz: float = 0.1
     method: str = "simulation"
-    """How the impedance cases are answered: ``simulation`` (the numba loop) or ``analytic`` (the exact
-    linear response of :mod:`.analytic`: exact for type 1, and for type 2 when LN = 0). Transparency
-    cases are simulated either way."""
+    """How the cases are answered: ``simulation`` (the numba loop) or ``analytic`` (the loop linearized at the
+    start pose, no loop run: the impedance range from the exact linear response of :mod:`.analytic`, the
+    bandwidth from the linear transmitted torque of :mod:`.analytic_transparency`; exact for type 1, and
+    for type 2 when LN = 0)."""
 
     def __post_init__(self) -> None:
         if self.method not in ("simulation", "analytic"):
@@ -166,13 +167,15 @@ def run_case(preset_name: str, params: dict[str, float], criterion: str, sim_typ
         found = result.as_dict()
         found["limiting_criterion"] = found.pop("criterion")  # "criterion" names the campaign's (impedance)
         return {"value": float(result.k_max), **found, "method": options.method}
-    result = transparency(device, sim_type, options.stiffness, options.chirp)
+    result = transparency(device, sim_type, options.stiffness, options.chirp, method=options.method)
     keep = result.frequency <= options.chirp.f1
     return {
+        **{k: v for k, v in result.as_dict().items() if k in ("steady_bandwidth_hz", "analytic_exact")},
         "value": result.bandwidth_hz,
         "bandwidth_hz": result.bandwidth_hz,
         "frequency": result.frequency[keep].tolist(),
         "g_t_db": (20 * np.log10(np.abs(result.g_t[keep]))).tolist(),
+        "method": options.method,
     }
 
 
