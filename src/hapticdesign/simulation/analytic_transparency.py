@@ -92,18 +92,13 @@ def moving_joints(n_dof: int, sim_type: int, wall_joint: int) -> np.ndarray:
     return m
 
 
-@dataclass(frozen=True)
 class _Row:
     """One device's equations of motion (its compiled model and parameters, looked up once) along the
     motion ``q = s m`` of the wall joint ``w``."""
 
-    device: Device
-    w: int
-    m: np.ndarray
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "model", dynamics_of(self.device))
-        object.__setattr__(self, "pi", self.device.standard_parameters())
+    def __init__(self, device: Device, w: int, m: np.ndarray) -> None:
+        self.model, self.pi = dynamics_of(device), device.standard_parameters()
+        self.w, self.m = w, m
 
     def poses(self, s: np.ndarray) -> np.ndarray:
         return np.multiply.outer(np.ravel(s), self.m)
