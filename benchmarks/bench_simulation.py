@@ -12,6 +12,10 @@
    eq. 3.28 only, as the seed's were; ``--out DIR`` keeps the campaign folder.
 
    python benchmarks/bench_simulation.py --full [--realizability rigid-body|seed] [--out DIR]
+4. With ``--compare SIM_DIR AN_DIR``: two finished campaigns on the same designs (``campaign --method
+   simulation`` and ``--method analytic``) side by side per LN level and type: means of K_max and of the
+   bandwidth, the share of equal results (K_max equal, bandwidths within 0.05 Hz) and the mean
+   difference; ``--figure PATH`` plots the analytic against the simulated bandwidths.
 """
 
 from __future__ import annotations
@@ -136,13 +140,61 @@ def _full_campaign(realizability: str, out: Path | None, workers: int) -> None:
           f"{elapsed / 60:.1f} min ({counts['run'] / elapsed:.2f} cases/s; goal < 15 min)")
 
 
+def _compare(simulated: Path, analytic: Path, figure: Path | None) -> None:
+    """Per level and type: means, share of equal results and mean difference (analytic - simulated)."""
+    rows = {name: {r["design"]: r for r in csv.DictReader((folder / "results.csv").open())}
+            for name, folder in (("sim", simulated), ("an", analytic))}
+
+    def column(name: str, key: str, designs: list[str]) -> np.ndarray:
+        return np.array([float(rows[name][d][key]) if rows[name][d][key] else np.nan for d in designs])
+
+    print("| LN | type | K_max simulated | K_max analytic | same K_max | mean difference | bandwidth simulated [Hz] "
+          "| bandwidth analytic [Hz] | within 0.05 Hz | mean difference [Hz] | largest difference [Hz] |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    levels = sorted({float(r["level"]) for r in rows["sim"].values()})
+    for level in levels:
+        designs = [d for d, r in rows["sim"].items() if float(r["level"]) == level]
+        for t in (1, 2):
+            ks, ka = column("sim", f"k_max_type{t}", designs), column("an", f"k_max_type{t}", designs)
+            bs, ba = column("sim", f"bandwidth_hz_type{t}", designs), column("an", f"bandwidth_hz_type{t}", designs)
+            print(f"| {level:g} | {t} | {ks.mean():.2f} | {ka.mean():.2f} | {100 * np.mean(ks == ka):.0f} % | "
+                  f"{np.mean(ka - ks):+.2f} | {np.nanmean(bs):.4f} | {np.nanmean(ba):.4f} | "
+                  f"{100 * np.mean(np.abs(ba - bs) < 0.05):.0f} % | {np.nanmean(ba - bs):+.4f} | "
+                  f"{np.nanmax(np.abs(ba - bs)):.4f} |")
+    if figure is None:
+        return
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(5.5, 4.5))
+    for level in levels:
+        designs = [d for d, r in rows["sim"].items() if float(r["level"]) == level]
+        ax.scatter(column("sim", "bandwidth_hz_type2", designs), column("an", "bandwidth_hz_type2", designs), s=10,
+                   label=f"LN = {level:g}")
+    lo, hi = ax.get_xlim()
+    ax.plot([lo, hi], [lo, hi], "k:", lw=0.8)
+    ax.set_xlabel("simulated bandwidth, type 2 [Hz]")
+    ax.set_ylabel("analytic bandwidth, type 2 [Hz]")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(figure, dpi=120)
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--full", action="store_true", help="run the seed's whole 2400-case campaign")
     parser.add_argument("--realizability", default="rigid-body", choices=("rigid-body", "seed"))
     parser.add_argument("--out", type=Path, default=None, help="keep the full campaign in this folder")
     parser.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1))
+    parser.add_argument("--compare", nargs=2, type=Path, metavar=("SIM_DIR", "AN_DIR"),
+                        help="compare a simulated and an analytic campaign of the same designs")
+    parser.add_argument("--figure", type=Path, default=None, help="with --compare: the bandwidth scatter (PNG)")
     args = parser.parse_args([] if argv is None else argv)
+    if args.compare:
+        _compare(*args.compare, args.figure)
+        return
     if args.full:
         _full_campaign(args.realizability, args.out, args.workers)
         return

@@ -2,6 +2,7 @@
 
 import csv
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -66,3 +67,20 @@ def test_campaign_on_local_cluster_resumes_and_summarizes(tmp_path, cluster):
     assert case["bandwidth_hz"] == pytest.approx(4 / (2 * np.pi * 0.5), rel=0.05)
     with pytest.raises(UserError, match="other designs or settings"):
         run_campaign(designs, out, CampaignOptions(k_limit=10), scheduler=cluster.scheduler_address)
+
+
+def test_analytic_campaign_equals_the_simulated_one_where_exact(tmp_path, cluster):
+    """``method="analytic"``: no loop is run; on the LN = 0 designs (x0, x1) both criteria equal the
+    simulated campaign's in both types, and every type-1 case too (joint 1: exact for any design)."""
+    designs = write_designs(tmp_path / "designs.csv")
+    simulated, analytic = tmp_path / "sim", tmp_path / "an"
+    run_campaign(designs, simulated, QUICK, scheduler=cluster.scheduler_address)
+    run_campaign(designs, analytic, replace(QUICK, method="analytic"), scheduler=cluster.scheduler_address)
+    for design in ("x0", "x1", "x2", "x3"):
+        for criterion in ("impedance", "transparency"):
+            for sim_type in (1, 2) if design in ("x0", "x1") else (1,):
+                name = f"{design}__{criterion}__type{sim_type}.json"
+                a, s = (json.loads((out / "cases" / name).read_text()) for out in (analytic, simulated))
+                assert a["method"] == "analytic" and a["value"] == pytest.approx(s["value"], abs=1e-6)
+    case = json.loads((analytic / "cases" / "x2__transparency__type2.json").read_text())
+    assert case["analytic_exact"] is False and case["steady_bandwidth_hz"] > 0

@@ -107,3 +107,23 @@ def test_a_prismatic_wall_is_labelled_in_newtons(tmp_path):
     zw = json.loads(runner.invoke(app, ["zwidth", "--device", str(path), "--compensate-inertia", "--b-values", "0",
                                         "--json"]).stdout)
     assert zw["K"][0] == pytest.approx(2.0 ** 2 / 0.5, rel=1e-8)
+
+
+def test_transparency_analytic_method():
+    """``transparency --method analytic``: the simulated estimate (a 5 % modelling error, type 1: exact) and the
+    steady-state bandwidth beside it; encoder quantization is refused in one line."""
+    args = ["transparency", "--error-percent", "5", "--f1", "5", "--json"]
+    simulated = json.loads(runner.invoke(app, args).stdout)
+    result = runner.invoke(app, [*args, "--method", "analytic"])
+    assert result.exit_code == 0, result.output
+    out = json.loads(result.stdout)
+    assert out["bandwidth_hz"] == pytest.approx(simulated["bandwidth_hz"], abs=1e-6)
+    assert out["analytic_exact"] is True
+    full_sweep = json.loads(runner.invoke(app, ["transparency", "--error-percent", "5", "--json", "--method",
+                                                "analytic"]).stdout)
+    # the steady state does not depend on the excitation (the estimate does: the chirp ends slower)
+    assert out["steady_bandwidth_hz"] == pytest.approx(full_sweep["steady_bandwidth_hz"], rel=1e-12)
+    assert abs(out["bandwidth_hz"] - full_sweep["bandwidth_hz"]) > 0.1
+    assert "steady_bandwidth_hz" not in simulated
+    refused = runner.invoke(app, ["transparency", "--method", "analytic", "--counts", "4096"])
+    assert refused.exit_code == 2 and "quantization" in refused.output and "Traceback" not in refused.output

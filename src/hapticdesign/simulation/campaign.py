@@ -3,8 +3,8 @@
 Design files are CSV with the columns ``level, ln, ln_H, ln_C, ln_G`` and every inertial
 parameter of the device in the seed's names (``m1 ... Iyz3a``); an optional ``design`` column
 names the rows. The LN columns are carried along (``nan`` allowed where unknown); ``level`` groups. Every case (design x criterion x type) runs on Dask workers (local processes by
-default, or a cluster at ``--scheduler``) and is written to ``cases/<key>.json`` the moment it
-finishes; a rerun skips the cases already written. The aggregation writes the per-design table
+default, or a cluster at ``--scheduler``; one task per design) and is written to ``cases/<key>.json``
+the moment its design's task finishes; a rerun skips the cases already written. The aggregation writes the per-design table
 (``results.csv``), per-level range, mean and standard deviation with the share of designs whose
 type 1 and type 2 results agree (``summary.csv``, ``summary.md``) and the figures.
 """
@@ -70,9 +70,10 @@ class CampaignOptions:
     duration: float = 5.0
     bandwidth_agreement_hz: float = 0.1
     method: str = "simulation"
-    """How the impedance cases are answered: ``simulation`` (the numba loop) or ``analytic`` (the exact
-    linear response of :mod:`.analytic`: exact for type 1, and for type 2 when LN = 0). Transparency
-    cases are simulated either way."""
+    """How the cases are answered: ``simulation`` (the numba loop) or ``analytic`` (the loop linearized at the
+    start pose, no loop run: the impedance range from the exact linear response of :mod:`.analytic`, the
+    bandwidth from the linear transmitted torque of :mod:`.analytic_transparency`; exact for type 1, and
+    for type 2 when LN = 0)."""
 
     def __post_init__(self) -> None:
         if self.method not in ("simulation", "analytic"):
@@ -166,14 +167,23 @@ def run_case(preset_name: str, params: dict[str, float], criterion: str, sim_typ
         found = result.as_dict()
         found["limiting_criterion"] = found.pop("criterion")  # "criterion" names the campaign's (impedance)
         return {"value": float(result.k_max), **found, "method": options.method}
-    result = transparency(device, sim_type, options.stiffness, options.chirp)
+    result = transparency(device, sim_type, options.stiffness, options.chirp, method=options.method)
     keep = result.frequency <= options.chirp.f1
     return {
+        **{k: v for k, v in result.as_dict().items() if k in ("steady_bandwidth_hz", "analytic_exact")},
         "value": result.bandwidth_hz,
         "bandwidth_hz": result.bandwidth_hz,
         "frequency": result.frequency[keep].tolist(),
         "g_t_db": (20 * np.log10(np.abs(result.g_t[keep]))).tolist(),
+        "method": options.method,
     }
+
+
+def run_design_cases(preset_name: str, params: dict[str, float], cases: list[tuple[str, int]],
+                     options: CampaignOptions) -> list[dict]:
+    """Several cases of one design on a worker, in one task (an analytic case takes milliseconds: one task
+    per case would spend most of the time scheduling)."""
+    return [run_case(preset_name, params, criterion, sim_type, options) for criterion, sim_type in cases]
 
 
 SCHEDULER_ADDRESS = re.compile(r"^(?:(?:tcp|tls|inproc|ucx|ws|wss)://)?[A-Za-z0-9.\-\[\]:]+:\d{1,5}$")
@@ -294,19 +304,20 @@ def _run_locked(designs: list[Design], out: Path, options: CampaignOptions, sche
 
         client = _client(scheduler, workers, quiet)
         try:
-            futures = {}
+            by_design: dict[str, tuple[Design, list[tuple[str, int]]]] = {}
             for d, c, t in todo:
-                fut = client.submit(run_case, options.preset, d.params, c, t, options, key=f"case-{case_key(d.name, c, t)}",
-                                    pure=False)
-                futures[fut] = (d, c, t)
+                by_design.setdefault(d.name, (d, []))[1].append((c, t))
+            futures = {client.submit(run_design_cases, options.preset, d.params, cases, options, key=f"cases-{d.name}",
+                                     pure=False): (d, cases) for d, cases in by_design.values()}
             done = total - len(todo)
             for fut in as_completed(futures):
-                d, c, t = futures[fut]
-                record = {"design": d.name, "level": d.level, "criterion": c, "type": t, **fut.result()}
-                write_atomically(cases_dir / f"{case_key(d.name, c, t)}.json", json.dumps(record))
-                done += 1
-                if progress is not None:
-                    progress(done, total)
+                d, cases = futures[fut]
+                for (c, t), result in zip(cases, fut.result()):
+                    record = {"design": d.name, "level": d.level, "criterion": c, "type": t, **result}
+                    write_atomically(cases_dir / f"{case_key(d.name, c, t)}.json", json.dumps(record))
+                    done += 1
+                    if progress is not None:
+                        progress(done, total)
         finally:
             _close(client, own_cluster=not scheduler)
     aggregate(designs, out, options)

@@ -76,24 +76,14 @@ def first_exit(frequency: np.ndarray, gain_db: np.ndarray, band_db: float) -> fl
     return float(frequency[i - 1] + (target - g0) / (g1 - g0) * (frequency[i] - frequency[i - 1]))
 
 
-def transparency(
-    device: Device,
-    sim_type: int = 1,
-    stiffness: float = 4.0,
-    chirp: Chirp | None = None,
-    config: LoopConfig | None = None,
-    wall_joint: int = 0,
-    equilibrium: float = 0.0,
-    segment_seconds: float | None = None,
-    window: str = "boxcar",
-    band_db: float = 3.0,
-) -> TransparencyResult:
-    """Transparency bandwidth of ``wall_joint`` for simulation type 1 or 2 (seed §4.2.2).
+def chirp_paths(n_dof: int, sim_type: int, wall_joint: int, chirp: Chirp) -> dict[int, Path]:
+    """Type 1: the chirp on the wall joint, the others held at 0; type 2: the chirp on every joint (Table 4.5)."""
+    return {j: (chirp if (j == wall_joint or sim_type == 2) else Held(0.0)) for j in range(n_dof)}
 
-    By default the spectra use one rectangular segment spanning the whole sweep (0.1 Hz
-    resolution): a chirp is not stationary, and tapered, overlapping Welch segments under-weight
-    the low frequencies swept near the ends of the record.
-    """
+
+def check_request(device: Device, sim_type: int, stiffness: float, chirp: Chirp | None,
+                  config: LoopConfig | None) -> tuple[Chirp, LoopConfig]:
+    """Validate a transparency request; the chirp and configuration it runs with (the seed's by default)."""
     require_device(device)
     require_options(sim_type, config, LoopConfig)
     if chirp is not None and not isinstance(chirp, Chirp):
@@ -111,22 +101,62 @@ def transparency(
     if not chirp.f1 <= nyquist:
         raise UserError(f"the chirp's end frequency {chirp.f1:g} Hz is beyond the Nyquist frequency {nyquist:g} Hz "
                         f"of the {base.sensors.period:g} s sample period")
+    return chirp, base
+
+
+def segment_length(seconds: float | None, chirp: Chirp, fs: float, samples: int) -> tuple[float, int]:
+    """The spectral segment in seconds (default: the whole sweep) and in samples at ``fs`` (at most the record)."""
+    seconds = chirp.sweep_time if seconds is None else seconds
+    if not (seconds > 0 and math.isfinite(seconds)):
+        raise UserError(f"the spectral segment must be positive, got {seconds}")
+    return seconds, min(samples, int(round(seconds * fs)))
+
+
+def band_of(f: np.ndarray, chirp: Chirp, seconds: float) -> np.ndarray:
+    """The bins reported: from the chirp's start (or the segment's first bin) to its end frequency."""
+    return (f >= max(chirp.f0, 1.0 / seconds)) & (f <= chirp.f1)
+
+
+def transparency(
+    device: Device,
+    sim_type: int = 1,
+    stiffness: float = 4.0,
+    chirp: Chirp | None = None,
+    config: LoopConfig | None = None,
+    wall_joint: int = 0,
+    equilibrium: float = 0.0,
+    segment_seconds: float | None = None,
+    window: str = "boxcar",
+    band_db: float = 3.0,
+    method: str = "simulation",
+) -> TransparencyResult:
+    """Transparency bandwidth of ``wall_joint`` for simulation type 1 or 2 (seed §4.2.2).
+
+    By default the spectra use one rectangular segment spanning the whole sweep (0.1 Hz
+    resolution): a chirp is not stationary, and tapered, overlapping Welch segments under-weight
+    the low frequencies swept near the ends of the record. ``method="analytic"`` answers from the
+    wall joint's loop linearized at the start pose, with the same estimate, band and bins
+    (:mod:`.analytic_transparency`: no loop is run; exact for type 1 and for LN = 0).
+    """
+    if method not in ("simulation", "analytic"):
+        raise UserError(f"the transparency method must be 'simulation' or 'analytic', got {method!r}")
+    if method == "analytic":
+        from hapticdesign.simulation.analytic_transparency import analytic_transparency
+
+        return analytic_transparency(device, sim_type, stiffness, chirp, config, wall_joint, equilibrium,
+                                     segment_seconds, window, band_db)
+    chirp, base = check_request(device, sim_type, stiffness, chirp, config)
     cfg = replace(base, duration=chirp.sweep_time, safety_limit=None, stop_excursion=None, record_stride=1,
                   wall=Wall(wall_joint, stiffness, base.wall.damping, equilibrium))
-    n = device.n_dof
-    paths: dict[int, Path] = {j: (chirp if (j == wall_joint or sim_type == 2) else Held(0.0)) for j in range(n)}
-    trace = simulate(device, cfg, paths)
+    trace = simulate(device, cfg, chirp_paths(device.n_dof, sim_type, wall_joint, chirp))
     q = trace.q[:, wall_joint]
     tau_m = trace.tau_c[:, wall_joint]
     tau_d = stiffness * (q - equilibrium) + cfg.wall.damping * trace.qd[:, wall_joint]
     fs = 1.0 / cfg.step
-    seconds = chirp.sweep_time if segment_seconds is None else segment_seconds
-    if not (seconds > 0 and math.isfinite(seconds)):
-        raise UserError(f"the spectral segment must be positive, got {seconds}")
-    nperseg = min(len(q), int(round(seconds * fs)))
+    seconds, nperseg = segment_length(segment_seconds, chirp, fs, len(q))
     f, z_d = impedance(q, tau_d, fs, nperseg, window)
     _, z_m = impedance(q, tau_m, fs, nperseg, window)
-    keep = (f >= max(chirp.f0, 1.0 / seconds)) & (f <= chirp.f1)
+    keep = band_of(f, chirp, seconds)
     f, z_d, z_m = f[keep], z_d[keep], z_m[keep]
     gain_db = 20 * np.log10(np.abs(z_m / z_d))
     signals = {

@@ -169,6 +169,8 @@ def transparency_command(
     sweep: float = typer.Option(10.0, help="Chirp sweep time [s] (linear sweep)."),
     band: float = typer.Option(3.0, help="Transparency band [dB]."),
     response: Optional[Path] = typer.Option(None, help="Write the frequency response (CSV) here."),
+    method: str = typer.Option("simulation", help="simulation (run the loop) or analytic (the loop linearized at the "
+                                                  "start pose: the same estimate, plus the steady-state response)."),
     period: float = PERIOD, step: float = STEP, counts: Optional[int] = COUNTS, delay: int = DELAY,
     error_percent: float = ERROR, inertial: bool = INERTIAL, coriolis: bool = CORIOLIS, gravity: bool = GRAVITY,
     wall_damping: float = WALL_DAMPING,
@@ -189,8 +191,10 @@ def transparency_command(
                               wall_damping, 0.0, 0.0, 0.0)
         if not (band > 0):
             raise UserError(f"--band must be positive, got {band}")
+        if method not in ("simulation", "analytic"):
+            raise UserError(f"--method must be 'simulation' or 'analytic', got {method!r}")
         result = transparency(dev, _sim_type(sim_type), stiffness, Chirp(amplitude, f0, f1, sweep), config,
-                              joint_index(dev, joint), band_db=band)
+                              joint_index(dev, joint), band_db=band, method=method)
         if response is not None:
             write_atomically(response, result.response_table())
         unit = joint_units(dev)[joint_index(dev, joint)]
@@ -202,8 +206,12 @@ def transparency_command(
             return
         bw = out["bandwidth_hz"]
         text = f"{bw:.3f} Hz" if bw is not None else f"beyond {f1:g} Hz"
+        extra = ""
+        if "steady_bandwidth_hz" in out:
+            steady = out["steady_bandwidth_hz"]
+            extra = f" (steady state: {f'{steady:.3f} Hz' if steady is not None else f'beyond {f1:g} Hz'})"
         typer.echo(f"{dev.name}, type {sim_type}, joint {out['joint']}, K = {stiffness:g} N m/rad: "
-                   f"transparency bandwidth {text}")
+                   f"transparency bandwidth {text}{extra}")
 
 
 def _check_chirp(amplitude: float, f0: float, f1: float, sweep: float, period: float) -> None:
@@ -310,8 +318,8 @@ def campaign_command(
     stiffness: float = typer.Option(4.0, help="Wall stiffness of the transparency runs [N m/rad] (seed: 4)."),
     sweep: float = typer.Option(10.0, help="Chirp sweep time [s] (seed: 10)."),
     f1: float = typer.Option(15.0, help="Chirp end frequency [Hz] (seed: 15)."),
-    method: str = typer.Option("simulation", help="Impedance cases by simulation or analytic (the exact linear "
-                                                  "response: exact for type 1 and LN = 0; transparency is simulated)."),
+    method: str = typer.Option("simulation", help="Cases by simulation or analytic (the loop linearized at the start "
+                                                  "pose, no loop run: exact for type 1 and LN = 0)."),
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
     force: bool = FORCE,
