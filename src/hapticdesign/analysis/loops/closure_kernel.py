@@ -72,38 +72,30 @@ def _cross(a0, a1, a2, b0, b1, b2):
 
 
 @njit(cache=True)
-def node_motion(qd, qdd, parent, axis, coef, rot, pos, w, v, al, ac):
-    """World angular velocity ``w``, origin velocity ``v``, angular and origin acceleration of every node.
+def node_motion(rate, parent, axis, rot, pos, w, al, ac):
+    """World angular velocity ``w`` and, at zero joint accelerations, the angular and origin accelerations
+    ``al``, ``ac`` of every node, for the rate ``rate[n]`` of each node's joint value.
 
-    Rotation node (axis ``u``, rate ``s``): ``w = w_p + s u``, ``al = al_p + sd u + w_p x s u``, same
-    origin. Translation node (offset ``d = value u``): ``v = v_p + w_p x d + s u`` and
-    ``ac = ac_p + al_p x d + w_p x (w_p x d) + 2 w_p x s u + sd u``.
+    Rotation node (axis ``u``, rate ``s``): ``w = w_p + s u``, ``al = al_p + w_p x s u``, same origin.
+    Translation node (offset ``d = value u``): ``ac = ac_p + al_p x d + w_p x (w_p x d) + 2 w_p x s u``.
     """
     for n in range(parent.shape[0]):
         p = parent[n]
-        s = 0.0
-        sd = 0.0
-        for k in range(qd.shape[0]):
-            c = coef[n, k]
-            if c != 0.0:
-                s += c * qd[k]
-                sd += c * qdd[k]
+        s = rate[n]
         a = axis[n] % 3
         u0, u1, u2 = rot[n, 0, a], rot[n, 1, a], rot[n, 2, a]
         if p >= 0:
             w0, w1, w2 = w[p, 0], w[p, 1], w[p, 2]
             l0, l1, l2 = al[p, 0], al[p, 1], al[p, 2]
-            vp0, vp1, vp2 = v[p, 0], v[p, 1], v[p, 2]
             a0, a1, a2 = ac[p, 0], ac[p, 1], ac[p, 2]
             d0, d1, d2 = pos[n, 0] - pos[p, 0], pos[n, 1] - pos[p, 1], pos[n, 2] - pos[p, 2]
         else:
-            w0 = w1 = w2 = l0 = l1 = l2 = vp0 = vp1 = vp2 = a0 = a1 = a2 = 0.0
+            w0 = w1 = w2 = l0 = l1 = l2 = a0 = a1 = a2 = 0.0
             d0, d1, d2 = pos[n, 0], pos[n, 1], pos[n, 2]
         if axis[n] < 3:
             x0, x1, x2 = _cross(w0, w1, w2, s * u0, s * u1, s * u2)
             w[n, 0], w[n, 1], w[n, 2] = w0 + s * u0, w1 + s * u1, w2 + s * u2
-            al[n, 0], al[n, 1], al[n, 2] = l0 + sd * u0 + x0, l1 + sd * u1 + x1, l2 + sd * u2 + x2
-            v[n, 0], v[n, 1], v[n, 2] = vp0, vp1, vp2
+            al[n, 0], al[n, 1], al[n, 2] = l0 + x0, l1 + x1, l2 + x2
             ac[n, 0], ac[n, 1], ac[n, 2] = a0, a1, a2
         else:
             wd0, wd1, wd2 = _cross(w0, w1, w2, d0, d1, d2)
@@ -112,10 +104,9 @@ def node_motion(qd, qdd, parent, axis, coef, rot, pos, w, v, al, ac):
             ws0, ws1, ws2 = _cross(w0, w1, w2, s * u0, s * u1, s * u2)
             w[n, 0], w[n, 1], w[n, 2] = w0, w1, w2
             al[n, 0], al[n, 1], al[n, 2] = l0, l1, l2
-            v[n, 0], v[n, 1], v[n, 2] = vp0 + wd0 + s * u0, vp1 + wd1 + s * u1, vp2 + wd2 + s * u2
-            ac[n, 0] = a0 + ld0 + ww0 + 2.0 * ws0 + sd * u0
-            ac[n, 1] = a1 + ld1 + ww1 + 2.0 * ws1 + sd * u1
-            ac[n, 2] = a2 + ld2 + ww2 + 2.0 * ws2 + sd * u2
+            ac[n, 0] = a0 + ld0 + ww0 + 2.0 * ws0
+            ac[n, 1] = a1 + ld1 + ww1 + 2.0 * ws1
+            ac[n, 2] = a2 + ld2 + ww2 + 2.0 * ws2
 
 
 @njit(cache=True)
@@ -173,14 +164,13 @@ def closure_bias(frame_a, frame_b, row_loop, row_comp, al, ac, out):
 
 
 @njit(cache=True)
-def lu_solve(a, b):
-    """Solve ``a x = b`` (m x m, m x k) by Gaussian elimination with partial pivoting, in place on copies.
+def lu_in_place(u, x):
+    """Solve ``u x = b`` (m x m, m x k) by Gaussian elimination with partial pivoting: ``x`` holds ``b`` on entry
+    and the solution on return, ``u`` is overwritten (no allocation).
 
-    Returns ``x``, the pivot ratio ``min |u_ii| / max |u_ii|`` (0 when singular) and the sign of ``det a``.
+    Returns the pivot ratio ``min |u_ii| / max |u_ii|`` (0 when singular) and the sign of ``det u``.
     """
-    m = a.shape[0]
-    u = a.copy()
-    x = b.copy()
+    m = u.shape[0]
     sign = 1.0
     big, small = 0.0, np.inf
     for c in range(m):
@@ -198,7 +188,7 @@ def lu_solve(a, b):
         big = max(big, abs(pivot))
         small = min(small, abs(pivot))
         if pivot == 0.0:
-            return x, 0.0, 0.0
+            return 0.0, 0.0
         if pivot < 0.0:
             sign = -sign
         for r in range(c + 1, m):
@@ -214,7 +204,18 @@ def lu_solve(a, b):
             for j in range(c + 1, m):
                 t -= u[c, j] * x[j, k]
             x[c, k] = t / u[c, c]
-    return x, small / big, sign
+    return small / big, sign
+
+
+@njit(cache=True)
+def lu_solve(a, b):
+    """Solve ``a x = b`` (m x m, m x k) on copies (:func:`lu_in_place`).
+
+    Returns ``x``, the pivot ratio ``min |u_ii| / max |u_ii|`` (0 when singular) and the sign of ``det a``.
+    """
+    x = b.copy()
+    ratio, sign = lu_in_place(a.copy(), x)
+    return x, ratio, sign
 
 
 @njit(cache=True)
