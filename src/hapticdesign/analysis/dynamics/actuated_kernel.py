@@ -77,11 +77,10 @@ def _wrench_regressor(w, al, acc, out):
 def workspace(n_node, n_dof, na, npas, n_body):
     """Scratch arrays of :func:`reduce_pose` and :func:`velocity_state` (one set per caller).
 
-    ``(rot, pos, w, al, ac, phi, lu, pinv, t, node_t, rate, jp, ja, bias, gamma, motion)``: node poses
+    ``(rot, pos, w, al, ac, phi, lu, pinv, t, node_t, rate, jp, ja, bias, gamma)``: node poses
     and motions, ``Phi``, an LU scratch, ``Phi_p^-1``, ``T``, every node's joint-value rate per actuated
     rate (``coef T``) and for one rate vector, per body the world Jacobian of its origin over the passive
-    rates (6 x n_p) and over the actuated ones (``J_b T``, 6 x n_a), ``Phidot qd``, ``gamma`` and the
-    world ``(w, al, acc)`` of every body origin (n_body, 3, 3).
+    rates (6 x n_p) and over the actuated ones (``J_b T``, 6 x n_a), ``Phidot qd`` and ``gamma``.
     """
     n_node = max(n_node, 1)
     return (
@@ -90,7 +89,7 @@ def workspace(n_node, n_dof, na, npas, n_body):
         np.zeros((npas, n_dof)), np.zeros((npas, npas)), np.zeros((npas, npas)),
         np.zeros((n_dof, na)), np.zeros((n_node, na)), np.zeros(n_node),
         np.zeros((n_body, 6, npas)), np.zeros((n_body, 6, na)),
-        np.zeros(npas), np.zeros(npas), np.zeros((n_body, 3, 3)),
+        np.zeros(npas), np.zeros(npas),
     )
 
 
@@ -104,7 +103,7 @@ def reduce_pose(q, parent, axis, coef, offset, body_node, body_path, frame_a, fr
     A body Jacobian column is the unit twist of a path node at the body origin: ``(u x (p_b - p_e), u)``
     for a rotation, ``(u, 0)`` for a translation (seed 000 eq. 2.20-2.26).
     """
-    rot, pos, _, _, _, phi, lu, pinv, t, node_t, _, jp, ja, _, _, _ = ws
+    rot, pos, _, _, _, phi, lu, pinv, t, node_t, _, jp, ja, _, _ = ws
     na = actuated.shape[0]
     npas = passive.shape[0]
     n_dof = q.shape[0]
@@ -178,12 +177,13 @@ def reduce_pose(q, parent, axis, coef, offset, body_node, body_path, frame_a, fr
 
 
 @njit(cache=True, inline="always")
-def velocity_state(qd_a, j, k, parent, axis, body_node, frame_a, frame_b, row_loop, row_comp, passive, ws):
-    """World ``(w, al, acc)`` of every body origin into ``ws`` at ``qd = T qd_a``, ``qdd = [0; gamma]``.
+def velocity_state(qd_a, j, k, parent, axis, frame_a, frame_b, row_loop, row_comp, passive, ws):
+    """Node motions at ``qd = T qd_a``, ``qdd = 0`` and ``gamma = -Phi_p^-1 (Phidot qd)`` into ``ws``.
 
-    ``j >= 0`` takes the rate vector ``e_j`` (plus ``e_k`` when ``k != j``) instead of ``qd_a``.
+    ``j >= 0`` takes the rate vector ``e_j`` (plus ``e_k`` when ``k != j``) instead of ``qd_a``. The body
+    accelerations of ``qdd = [0; gamma]`` add ``J_p gamma`` (``jp`` of :func:`reduce_pose`) to the nodes'.
     """
-    rot, pos, w, al, ac, _, _, pinv, _, node_t, rate, jp, _, bias, gamma, motion = ws
+    rot, pos, w, al, ac, _, _, pinv, _, node_t, rate, _, _, bias, gamma = ws
     npas = passive.shape[0]
     for n in range(rate.shape[0]):
         if j >= 0:
@@ -200,20 +200,6 @@ def velocity_state(qd_a, j, k, parent, axis, body_node, frame_a, frame_b, row_lo
         for i in range(npas):
             acc -= pinv[r, i] * bias[i]
         gamma[r] = acc
-    for b in range(body_node.shape[0]):
-        nb = body_node[b]
-        for i in range(3):
-            if nb < 0:
-                motion[b, 0, i] = motion[b, 1, i] = motion[b, 2, i] = 0.0
-                continue
-            lb = al[nb, i]
-            ab = ac[nb, i]
-            for r in range(npas):
-                ab += jp[b, i, r] * gamma[r]
-                lb += jp[b, 3 + i, r] * gamma[r]
-            motion[b, 0, i] = w[nb, i]
-            motion[b, 1, i] = lb
-            motion[b, 2, i] = ab
 
 
 @njit(cache=True, inline="always")
@@ -228,45 +214,48 @@ def _rotation(rot, nb, i, k):
 def world_parameters(rot, body_node, params, s, out):
     """Parameter set ``s`` (10 B) in world axes at the current poses: ``out[s, b] = (m, R h, R J R^T)``.
 
-    The inertia ``J`` (about the body origin) is stored as ``Jxx, Jyy, Jzz, Jxy, Jxz, Jyz``.
+    The inertia ``J`` (about the body origin) is stored as ``Jxx, Jyy, Jzz, Jxy, Jxz, Jyz``; a body on the
+    base keeps its parameters.
     """
-    jb = np.empty((3, 3))
-    rj = np.empty((3, 3))
     for b in range(body_node.shape[0]):
         nb = body_node[b]
         c = 10 * b
+        if nb < 0:
+            for i in range(10):
+                out[s, b, i] = params[s, c + i]
+            continue
+        r = rot[nb]
         out[s, b, 0] = params[s, c]
+        h0, h1, h2 = params[s, c + 1], params[s, c + 2], params[s, c + 3]
         for i in range(3):
-            acc = 0.0
-            for k in range(3):
-                acc += _rotation(rot, nb, i, k) * params[s, c + 1 + k]
-            out[s, b, 1 + i] = acc
-        jb[0, 0], jb[1, 1], jb[2, 2] = params[s, c + 4], params[s, c + 5], params[s, c + 6]
-        jb[0, 1] = jb[1, 0] = params[s, c + 7]
-        jb[0, 2] = jb[2, 0] = params[s, c + 8]
-        jb[1, 2] = jb[2, 1] = params[s, c + 9]
-        for i in range(3):
-            for k in range(3):
-                acc = 0.0
-                for r in range(3):
-                    acc += _rotation(rot, nb, i, r) * jb[r, k]
-                rj[i, k] = acc
-        for e, (i, k) in enumerate(((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))):
-            acc = 0.0
-            for r in range(3):
-                acc += rj[i, r] * _rotation(rot, nb, k, r)
-            out[s, b, 4 + e] = acc
+            out[s, b, 1 + i] = r[i, 0] * h0 + r[i, 1] * h1 + r[i, 2] * h2
+        jxx, jyy, jzz = params[s, c + 4], params[s, c + 5], params[s, c + 6]
+        jxy, jxz, jyz = params[s, c + 7], params[s, c + 8], params[s, c + 9]
+        # rows of R J
+        a00 = r[0, 0] * jxx + r[0, 1] * jxy + r[0, 2] * jxz
+        a01 = r[0, 0] * jxy + r[0, 1] * jyy + r[0, 2] * jyz
+        a02 = r[0, 0] * jxz + r[0, 1] * jyz + r[0, 2] * jzz
+        a10 = r[1, 0] * jxx + r[1, 1] * jxy + r[1, 2] * jxz
+        a11 = r[1, 0] * jxy + r[1, 1] * jyy + r[1, 2] * jyz
+        a12 = r[1, 0] * jxz + r[1, 1] * jyz + r[1, 2] * jzz
+        a20 = r[2, 0] * jxx + r[2, 1] * jxy + r[2, 2] * jxz
+        a21 = r[2, 0] * jxy + r[2, 1] * jyy + r[2, 2] * jyz
+        a22 = r[2, 0] * jxz + r[2, 1] * jyz + r[2, 2] * jzz
+        out[s, b, 4] = a00 * r[0, 0] + a01 * r[0, 1] + a02 * r[0, 2]
+        out[s, b, 5] = a10 * r[1, 0] + a11 * r[1, 1] + a12 * r[1, 2]
+        out[s, b, 6] = a20 * r[2, 0] + a21 * r[2, 1] + a22 * r[2, 2]
+        out[s, b, 7] = a00 * r[1, 0] + a01 * r[1, 1] + a02 * r[1, 2]
+        out[s, b, 8] = a00 * r[2, 0] + a01 * r[2, 1] + a02 * r[2, 2]
+        out[s, b, 9] = a10 * r[2, 0] + a11 * r[2, 1] + a12 * r[2, 2]
 
 
 @njit(cache=True, inline="always")
-def body_wrench(motion, b, pw, s):
-    """World wrench ``[f; n]`` about body ``b``'s origin from its ``(w, al, acc)``, world parameters ``pw[s, b]``.
-
-    ``f = m acc + al x h + w x (w x h)``, ``n = J al + w x (J w) + h x acc``.
-    """
-    w0, w1, w2 = motion[b, 0, 0], motion[b, 0, 1], motion[b, 0, 2]
-    l0, l1, l2 = motion[b, 1, 0], motion[b, 1, 1], motion[b, 1, 2]
-    a0, a1, a2 = motion[b, 2, 0], motion[b, 2, 1], motion[b, 2, 2]
+def body_wrench(w, al, ac, nb, pw, s, b):
+    """World wrench ``[f; n]`` about body ``b``'s origin (node ``nb``) from the node's ``(w, al, acc)``, world
+    parameters ``pw[s, b]``: ``f = m acc + al x h + w x (w x h)``, ``n = J al + w x (J w) + h x acc``."""
+    w0, w1, w2 = w[nb, 0], w[nb, 1], w[nb, 2]
+    l0, l1, l2 = al[nb, 0], al[nb, 1], al[nb, 2]
+    a0, a1, a2 = ac[nb, 0], ac[nb, 1], ac[nb, 2]
     m, h0, h1, h2 = pw[s, b, 0], pw[s, b, 1], pw[s, b, 2], pw[s, b, 3]
     jxx, jyy, jzz, jxy, jxz, jyz = pw[s, b, 4], pw[s, b, 5], pw[s, b, 6], pw[s, b, 7], pw[s, b, 8], pw[s, b, 9]
     x0, x1, x2 = w1 * h2 - w2 * h1, w2 * h0 - w0 * h2, w0 * h1 - w1 * h0
@@ -283,9 +272,10 @@ def body_wrench(motion, b, pw, s):
 
 
 @njit(cache=True, inline="always")
-def mass_and_gravity(ja, b, gravity, pw, s, h, g):
-    """Add body ``b``'s ``(J_b T)^T M (J_b T)`` to ``h`` (n x n) and ``-(J_b T)^T`` of its weight's wrench to
-    ``g`` (eq. 2.44, 2.46), world parameters ``pw[s, b]``: ``M [v; w] = [m v + w x h; h x v + J w]``."""
+def mass_and_gravity(ja, jp, b, gravity, pw, s, h, g, kp):
+    """Add body ``b``'s ``(J_b T)^T M (J_b T)`` to ``h`` (n x n), ``-(J_b T)^T`` of its weight's wrench to
+    ``g`` (eq. 2.44, 2.46) and ``(J_b T)^T M J_p`` to ``kp`` (n x n_p; ``kp gamma`` is the velocity term of
+    ``qdd = [0; gamma]``), world parameters ``pw[s, b]``: ``M [v; w] = [m v + w x h; h x v + J w]``."""
     m, h0, h1, h2 = pw[s, b, 0], pw[s, b, 1], pw[s, b, 2], pw[s, b, 3]
     jxx, jyy, jzz, jxy, jxz, jyz = pw[s, b, 4], pw[s, b, 5], pw[s, b, 6], pw[s, b, 7], pw[s, b, 8], pw[s, b, 9]
     for j in range(ja.shape[2]):
@@ -298,6 +288,9 @@ def mass_and_gravity(ja, b, gravity, pw, s, h, g):
         mw1 = h2 * v0 - h0 * v2 + jxy * w0 + jyy * w1 + jyz * w2
         mw2 = h0 * v1 - h1 * v0 + jxz * w0 + jyz * w1 + jzz * w2
         g[j] -= gravity[0] * mv0 + gravity[1] * mv1 + gravity[2] * mv2
+        for r in range(jp.shape[2]):
+            kp[j, r] += (jp[b, 0, r] * mv0 + jp[b, 1, r] * mv1 + jp[b, 2, r] * mv2
+                         + jp[b, 3, r] * mw0 + jp[b, 4, r] * mw1 + jp[b, 5, r] * mw2)
         for i in range(j + 1):
             e = (ja[b, 0, i] * mv0 + ja[b, 1, i] * mv1 + ja[b, 2, i] * mv2
                  + ja[b, 3, i] * mw0 + ja[b, 4, i] * mw1 + ja[b, 5, i] * mw2)
@@ -332,18 +325,18 @@ def actuated_entries(qs, parent, axis, coef, offset, body_node, body_path, gravi
     sets ``params`` (K, 10 B): (P, K, E), and the pivot ratio of ``Phi_p`` per pose (0: singular)."""
     n_pose, n_dof = qs.shape
     na = actuated.shape[0]
+    npas = passive.shape[0]
     n_body = body_node.shape[0]
     n_sets = params.shape[0]
     m = na * (na + 1) // 2
     out = np.zeros((n_pose, n_sets, m + na * m + na))
     ratios = np.zeros(n_pose)
-    ws = workspace(parent.shape[0], n_dof, na, passive.shape[0], n_body)
-    rot, ja, motion = ws[0], ws[12], ws[15]
+    ws = workspace(parent.shape[0], n_dof, na, npas, n_body)
+    rot, w, al, ac, jp, ja, gamma = ws[0], ws[2], ws[3], ws[4], ws[11], ws[12], ws[14]
     active = active_bodies(params)
     pw = np.zeros((n_sets, n_body, 10))
-    h = np.zeros((na, na))
-    g = np.zeros(na)
-    cs = np.zeros((m, n_sets, na))
+    h = np.zeros((n_sets, na, na))
+    kp = np.zeros((n_sets, na, npas))
     empty = np.zeros(0)
     for p in range(n_pose):
         ratio, _ = reduce_pose(qs[p], parent, axis, coef, offset, body_node, body_path, frame_a, frame_b, row_loop,
@@ -351,45 +344,68 @@ def actuated_entries(qs, parent, axis, coef, offset, body_node, body_path, gravi
         ratios[p] = ratio
         if ratio == 0.0:
             continue
+        h[:] = 0.0
+        kp[:] = 0.0
         for s in range(n_sets):
             world_parameters(rot, body_node, params, s, pw)
-        st = 0
-        for j in range(na):
-            for k in range(j, na):
-                velocity_state(empty, j, k, parent, axis, body_node, frame_a, frame_b, row_loop, row_comp, passive, ws)
-                for s in range(n_sets):
-                    for i in range(na):
-                        cs[st, s, i] = 0.0
-                    for b in range(n_body):
-                        if not active[b]:
-                            continue
-                        f0, f1, f2, n0, n1, n2 = body_wrench(motion, b, pw, s)
-                        for i in range(na):
-                            cs[st, s, i] += (ja[b, 0, i] * f0 + ja[b, 1, i] * f1 + ja[b, 2, i] * f2
-                                             + ja[b, 3, i] * n0 + ja[b, 4, i] * n1 + ja[b, 5, i] * n2)
-                st += 1
-        for s in range(n_sets):
-            h[:] = 0.0
-            g[:] = 0.0
+            g = out[p, s, m + na * m:]
             for b in range(n_body):
-                if active[b]:
-                    mass_and_gravity(ja, b, gravity, pw, s, h, g)
+                if active[b] and body_node[b] >= 0:
+                    mass_and_gravity(ja, jp, b, gravity, pw, s, h[s], g, kp[s])
             e = 0
             for i in range(na):
                 for j in range(i, na):
-                    out[p, s, e] = h[i, j]
+                    out[p, s, e] = h[s, i, j]
                     e += 1
+        st = 0
+        for j in range(na):
+            for k in range(j, na):
+                velocity_state(empty, j, k, parent, axis, frame_a, frame_b, row_loop, row_comp, passive, ws)
+                for s in range(n_sets):
+                    for i in range(na):
+                        acc = 0.0
+                        for r in range(npas):
+                            acc += kp[s, i, r] * gamma[r]
+                        out[p, s, m + i * m + st] = acc
+                    for b in range(n_body):
+                        nb = body_node[b]
+                        if not active[b] or nb < 0:
+                            continue
+                        f0, f1, f2, n0, n1, n2 = body_wrench(w, al, ac, nb, pw, s, b)
+                        for i in range(na):
+                            out[p, s, m + i * m + st] += (ja[b, 0, i] * f0 + ja[b, 1, i] * f1 + ja[b, 2, i] * f2
+                                                          + ja[b, 3, i] * n0 + ja[b, 4, i] * n1 + ja[b, 5, i] * n2)
+                st += 1
+        # polarization: the state (j, k), j < k, held C(e_j + e_k); the cross term is what exceeds (j, j) + (k, k)
+        for s in range(n_sets):
             for i in range(na):
                 st = 0
                 for j in range(na):
                     for k in range(j, na):
-                        value = cs[st, s, i]
                         if k != j:
-                            value -= cs[_state(j, na), s, i] + cs[_state(k, na), s, i]
-                        out[p, s, m + i * m + st] = value
+                            out[p, s, m + i * m + st] -= (out[p, s, m + i * m + _state(j, na)]
+                                                          + out[p, s, m + i * m + _state(k, na)])
                         st += 1
-                out[p, s, m + na * m + i] = g[i]
     return out, ratios
+
+
+@njit(cache=True, inline="always")
+def _body_motion(w, al, ac, jp, gamma, nb, b, rb, out):
+    """Body-axis ``(w, al, acc)`` of body ``b`` (node ``nb``, rotation ``rb``) at ``qdd = [0; gamma]`` into ``out``."""
+    for i in range(3):
+        for r in range(3):
+            out[r, i] = 0.0
+        if nb < 0:
+            continue
+        for c in range(3):
+            lc = al[nb, c]
+            acc = ac[nb, c]
+            for r in range(gamma.shape[0]):
+                acc += jp[b, c, r] * gamma[r]
+                lc += jp[b, 3 + c, r] * gamma[r]
+            out[0, i] += rb[c, i] * w[nb, c]
+            out[1, i] += rb[c, i] * lc
+            out[2, i] += rb[c, i] * acc
 
 
 @njit(cache=True)
@@ -405,7 +421,7 @@ def actuated_regressor(qs, parent, axis, coef, offset, body_node, body_path, gra
     out = np.zeros((n_pose, n_entries, 10 * n_body))
     ratios = np.zeros(n_pose)
     ws = workspace(parent.shape[0], n_dof, na, passive.shape[0], n_body)
-    rot, ja, motion = ws[0], ws[12], ws[15]
+    rot, w, al, ac, jp, ja, gamma = ws[0], ws[2], ws[3], ws[4], ws[11], ws[12], ws[14]
     jab = np.zeros((n_body, 6, na))
     rb = np.zeros((n_body, 3, 3))
     mb = np.zeros((3, 3))
@@ -432,11 +448,9 @@ def actuated_regressor(qs, parent, axis, coef, offset, body_node, body_path, gra
         st = 0
         for j in range(na):
             for k in range(j, na):
-                velocity_state(empty, j, k, parent, axis, body_node, frame_a, frame_b, row_loop, row_comp, passive, ws)
+                velocity_state(empty, j, k, parent, axis, frame_a, frame_b, row_loop, row_comp, passive, ws)
                 for b in range(n_body):
-                    for r in range(3):
-                        for i in range(3):
-                            mb[r, i] = rb[b, 0, i] * motion[b, r, 0] + rb[b, 1, i] * motion[b, r, 1] + rb[b, 2, i] * motion[b, r, 2]
+                    _body_motion(w, al, ac, jp, gamma, body_node[b], b, rb[b], mb)
                     _wrench_regressor(mb[0], mb[1], mb[2], wrench)
                     for i in range(na):
                         for c in range(10):

@@ -237,10 +237,19 @@ def newton(q, actuated, passive, parent, axis, coef, offset, frame_a, frame_b, r
            tol, max_iter, singular_ratio, rot, pos):
     """Newton on the passive entries of ``q`` (in place). Returns (status, det sign, pivot ratio)."""
     m = passive.shape[0]
-    res = np.empty(m)
-    phi = np.empty((m, coef.shape[1]))
-    rhs = np.empty((m, 1))
-    pp = np.empty((m, m))
+    return newton_into(q, actuated, passive, parent, axis, coef, offset, frame_a, frame_b, row_loop, row_comp,
+                       tol, max_iter, singular_ratio, rot, pos, np.empty(m), np.empty((m, coef.shape[1])),
+                       np.empty((m, 1)), np.empty((m, m)))
+
+
+@njit(cache=True)
+def newton_into(q, actuated, passive, parent, axis, coef, offset, frame_a, frame_b, row_loop, row_comp,
+                tol, max_iter, singular_ratio, rot, pos, res, phi, rhs, pp):
+    """:func:`newton` on the caller's scratch ``res`` (m), ``phi`` (m x N), ``rhs`` (m x 1), ``pp`` (m x m).
+
+    On success ``rot``, ``pos`` and ``phi`` hold the node poses and the constraint Jacobian of the returned ``q``.
+    """
+    m = passive.shape[0]
     for it in range(max_iter + 1):
         _node_poses(q, parent, axis, coef, offset, rot, pos)
         closure_residual(frame_a, frame_b, row_loop, row_comp, rot, pos, res)
@@ -249,7 +258,7 @@ def newton(q, actuated, passive, parent, axis, coef, offset, frame_a, frame_b, r
             rhs[i, 0] = -res[i]
             for j in range(m):
                 pp[i, j] = phi[i, passive[j]]
-        dx, ratio, sign = lu_solve(pp, rhs)
+        ratio, sign = lu_in_place(pp, rhs)
         if not np.isfinite(ratio) or ratio <= singular_ratio:
             return SINGULAR, sign, ratio
         if np.max(np.abs(res)) <= tol:
@@ -259,10 +268,10 @@ def newton(q, actuated, passive, parent, axis, coef, offset, frame_a, frame_b, r
         # damped: at most MAX_NEWTON_STEP per iteration, so that a rough start reaches its nearest branch
         big = 0.0
         for j in range(m):
-            big = max(big, abs(dx[j, 0]))
+            big = max(big, abs(rhs[j, 0]))
         scale = 1.0 if big <= MAX_NEWTON_STEP else MAX_NEWTON_STEP / big
         for j in range(m):
-            q[passive[j]] += scale * dx[j, 0]
+            q[passive[j]] += scale * rhs[j, 0]
     return NO_CLOSURE, 0.0, 0.0
 
 
