@@ -222,14 +222,20 @@ def lu_solve(a, b):
 def velocity_map(phi, actuated, passive):
     """``S = -Phi_p^-1 Phi_a`` (n_p x n_a), the pivot ratio and the sign of ``det Phi_p``."""
     m = passive.shape[0]
-    pa = np.empty((m, actuated.shape[0]))
-    pp = np.empty((m, m))
-    for i in range(m):
+    s = np.empty((m, actuated.shape[0]))
+    ratio, sign = velocity_map_into(phi, actuated, passive, np.empty((m, m)), s)
+    return s, ratio, sign
+
+
+@njit(cache=True)
+def velocity_map_into(phi, actuated, passive, pp, s):
+    """:func:`velocity_map` into ``s`` (n_p x n_a) with the scratch ``pp`` (n_p x n_p); returns (ratio, sign)."""
+    for i in range(passive.shape[0]):
         for j in range(actuated.shape[0]):
-            pa[i, j] = -phi[i, actuated[j]]
-        for j in range(m):
+            s[i, j] = -phi[i, actuated[j]]
+        for j in range(passive.shape[0]):
             pp[i, j] = phi[i, passive[j]]
-    return lu_solve(pp, pa)
+    return lu_in_place(pp, s)
 
 
 @njit(cache=True)
@@ -289,16 +295,23 @@ def solve_path(qa_path, q_start, sign0, actuated, passive, parent, axis, coef, o
     n_dof = q_start.shape[0]
     m = passive.shape[0]
     n_node = max(parent.shape[0], 1)
+    na = actuated.shape[0]
     rot = np.zeros((n_node, 3, 3))
     pos = np.zeros((n_node, 3))
     phi = np.empty((m, n_dof))
+    res, rhs, pp = np.empty(m), np.empty((m, 1)), np.empty((m, m))
+    s = np.empty((m, na))
+    start = np.empty(na)
     out = np.empty((n_pose, n_dof))
     status = np.zeros(n_pose, dtype=np.int64)
     q = q_start.copy()
     trial = q.copy()
     predicted = np.empty(m)
+    # tangent at the current closed pose; after each accepted step, from Newton's last Jacobian there
+    _node_poses(q, parent, axis, coef, offset, rot, pos)
+    closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, coef, rot, pos, phi)
+    velocity_map_into(phi, actuated, passive, pp, s)
     for p in range(n_pose):
-        start = np.empty(actuated.shape[0])
         for j in range(actuated.shape[0]):
             start[j] = q[actuated[j]]
         dist = 0.0
@@ -309,10 +322,6 @@ def solve_path(qa_path, q_start, sign0, actuated, passive, parent, axis, coef, o
         code = OK
         while done < 1.0:
             f = min(1.0, done + step)
-            # tangent predictor at the current closed pose
-            _node_poses(q, parent, axis, coef, offset, rot, pos)
-            closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, coef, rot, pos, phi)
-            s, _, _ = velocity_map(phi, actuated, passive)
             for k in range(n_dof):
                 trial[k] = q[k]
             for j in range(actuated.shape[0]):
@@ -322,8 +331,8 @@ def solve_path(qa_path, q_start, sign0, actuated, passive, parent, axis, coef, o
                     trial[passive[r]] += s[r, j] * delta
             for r in range(m):
                 predicted[r] = trial[passive[r]]
-            code, sign, _ = newton(trial, actuated, passive, parent, axis, coef, offset, frame_a, frame_b,
-                                   row_loop, row_comp, tol, max_iter, singular_ratio, rot, pos)
+            code, sign, _ = newton_into(trial, actuated, passive, parent, axis, coef, offset, frame_a, frame_b,
+                                        row_loop, row_comp, tol, max_iter, singular_ratio, rot, pos, res, phi, rhs, pp)
             if code == OK and sign != sign0:
                 code = BRANCH_CHANGE
             if code == OK:
@@ -336,6 +345,7 @@ def solve_path(qa_path, q_start, sign0, actuated, passive, parent, axis, coef, o
                 for k in range(n_dof):
                     q[k] = trial[k]
                 done = f
+                velocity_map_into(phi, actuated, passive, pp, s)
             else:
                 step *= 0.5
                 if step < min_fraction:
