@@ -208,17 +208,6 @@ def lu_in_place(u, x):
 
 
 @njit(cache=True)
-def lu_solve(a, b):
-    """Solve ``a x = b`` (m x m, m x k) on copies (:func:`lu_in_place`).
-
-    Returns ``x``, the pivot ratio ``min |u_ii| / max |u_ii|`` (0 when singular) and the sign of ``det a``.
-    """
-    x = b.copy()
-    ratio, sign = lu_in_place(a.copy(), x)
-    return x, ratio, sign
-
-
-@njit(cache=True)
 def velocity_map(phi, actuated, passive):
     """``S = -Phi_p^-1 Phi_a`` (n_p x n_a), the pivot ratio and the sign of ``det Phi_p``."""
     m = passive.shape[0]
