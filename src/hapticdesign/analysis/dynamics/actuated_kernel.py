@@ -392,20 +392,24 @@ def actuated_entries(qs, parent, axis, coef, offset, body_node, body_path, gravi
 @njit(cache=True, inline="always")
 def _body_motion(w, al, ac, jp, gamma, nb, b, rb, out):
     """Body-axis ``(w, al, acc)`` of body ``b`` (node ``nb``, rotation ``rb``) at ``qdd = [0; gamma]`` into ``out``."""
-    for i in range(3):
+    if nb < 0:
         for r in range(3):
-            out[r, i] = 0.0
-        if nb < 0:
-            continue
-        for c in range(3):
-            lc = al[nb, c]
-            acc = ac[nb, c]
-            for r in range(gamma.shape[0]):
-                acc += jp[b, c, r] * gamma[r]
-                lc += jp[b, 3 + c, r] * gamma[r]
-            out[0, i] += rb[c, i] * w[nb, c]
-            out[1, i] += rb[c, i] * lc
-            out[2, i] += rb[c, i] * acc
+            for i in range(3):
+                out[r, i] = 0.0
+        return
+    l0, l1, l2 = al[nb, 0], al[nb, 1], al[nb, 2]
+    a0, a1, a2 = ac[nb, 0], ac[nb, 1], ac[nb, 2]
+    for r in range(gamma.shape[0]):
+        a0 += jp[b, 0, r] * gamma[r]
+        a1 += jp[b, 1, r] * gamma[r]
+        a2 += jp[b, 2, r] * gamma[r]
+        l0 += jp[b, 3, r] * gamma[r]
+        l1 += jp[b, 4, r] * gamma[r]
+        l2 += jp[b, 5, r] * gamma[r]
+    for i in range(3):
+        out[0, i] = rb[0, i] * w[nb, 0] + rb[1, i] * w[nb, 1] + rb[2, i] * w[nb, 2]
+        out[1, i] = rb[0, i] * l0 + rb[1, i] * l1 + rb[2, i] * l2
+        out[2, i] = rb[0, i] * a0 + rb[1, i] * a1 + rb[2, i] * a2
 
 
 @njit(cache=True)
