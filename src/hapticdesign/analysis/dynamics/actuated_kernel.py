@@ -1,4 +1,4 @@
-"""Compiled (numba) kernel: H, C, G of a closed-loop mechanism in its actuated coordinates, as a regressor.
+"""Compiled (numba) kernel: H, C, G of a closed-loop mechanism in its actuated coordinates.
 
 On the loop-opened tree (all joints are coordinates ``q``, seed 000 eq. 2.44-2.50) the passive rates
 follow the actuated ones, ``qd = T qd_a`` with ``T = [I; S]``, ``S = -Phi_p^-1 Phi_a``
@@ -6,18 +6,24 @@ follow the actuated ones, ``qd = T qd_a`` with ``T = [I; S]``, ``S = -Phi_p^-1 P
 (d'Alembert) on the admissible motions gives the reduced equations ``T^T (H qdd + c(q, qd) + G) = tau_a``
 with ``qdd = T qdd_a + [0; gamma]`` and ``gamma = -Phi_p^-1 (Phidot qd)``:
 
-- ``H_a = T^T H T``: the body regressor of :func:`.kernel.body_regressor` fed with the reduced
-  body Jacobians ``J_b T`` (eq. 2.44);
-- ``G_a = T^T G``: likewise (eq. 2.46);
+- ``H_a = T^T H T = sum_b (J_b T)^T M_b (J_b T)`` with ``J_b T`` the reduced Jacobian of body ``b``'s
+  origin and ``M_b [v; w] = [m v + w x h; h x v + J w]`` its spatial inertia about that origin (eq. 2.44);
+- ``G_a = T^T G``: the weight ``-g (m, m c)`` projected likewise (eq. 2.46);
 - the velocity terms ``T^T (H [0; gamma] + c(q, T qd_a))`` (``T^T (H Tdot + C-terms T)``): per body the
   Newton-Euler wrench ``f = m a + al x h + w x (w x h)``, ``n = J al + w x (J w) + h x a`` at the body
-  velocities of ``qd = T qd_a`` and accelerations of ``qdd = [0; gamma]``, which is linear in the ten
-  standard parameters ``(m, h, J)``, projected by ``(J_b T)^T``. It is a quadratic form in ``qd_a``;
-  its coefficients (the columns of eq. 2.50's ``C``: ``Gamma_ijj`` and ``2 Gamma_ijk``) follow by
-  polarization from ``n_a (n_a + 1) / 2`` rate vectors ``e_j`` and ``e_j + e_k``.
+  velocities of ``qd = T qd_a`` and accelerations of ``qdd = [0; gamma]``, projected by ``(J_b T)^T``.
+  It is a quadratic form in ``qd_a``; its coefficients (the columns of eq. 2.50's ``C``: ``Gamma_ijj``
+  and ``2 Gamma_ijk``) follow by polarization from ``n_a (n_a + 1) / 2`` rate vectors ``e_j`` and
+  ``e_j + e_k``.
 
-Everything is linear in the standard inertial parameters, so the kernel returns a regressor (or its
-product with given parameter sets), entry by entry in :class:`.model.DynamicsModel`'s order.
+Everything is linear in the standard inertial parameters ``(m, h, J)``: :func:`actuated_regressor`
+returns the regressor (ten columns per body, in body axes, via :func:`.kernel.body_regressor`), entry
+by entry in :class:`.model.DynamicsModel`'s order; :func:`actuated_entries` evaluates the entries for
+given parameter sets directly, in world axes (each body's ``h`` and ``J`` rotated once per pose), and
+skips bodies whose parameters are all zero. Both share :func:`reduce_pose` (``Phi_p^-1``, ``T`` and the
+reduced Jacobians at one closed pose) and :func:`velocity_state` (body motions of one rate vector),
+which allocate nothing: their scratch arrays come from :func:`workspace`. The closed-loop plant of the
+simulation (:mod:`.closed_loop_plant`) calls them too.
 """
 
 from __future__ import annotations
@@ -25,12 +31,12 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from hapticdesign.analysis.dynamics.kernel import _body_jacobian, _node_poses, body_regressor
-from hapticdesign.analysis.loops.closure_kernel import closure_bias, closure_jacobian, lu_solve, node_motion
+from hapticdesign.analysis.dynamics.kernel import _node_poses, body_regressor
+from hapticdesign.analysis.loops.closure_kernel import closure_bias, closure_jacobian, lu_in_place, node_motion
 
 
 @njit(cache=True)
-def _wrench_regressor(w, vel, al, acc, out):
+def _wrench_regressor(w, al, acc, out):
     """Body-axis wrench ``[f; n]`` (6 x 10) about the body origin per standard parameter (m, h, J).
 
     ``f = m acc + al x h + w x (w x h)``, ``n = J al + w x (J w) + h x acc``; no allocation (inner loop).
@@ -68,165 +74,417 @@ def _wrench_regressor(w, vel, al, acc, out):
 
 
 @njit(cache=True)
-def actuated_kernel(qs, parent, axis, coef, offset, body_node, body_path, gravity,
-                    frame_a, frame_b, row_loop, row_comp, actuated, passive, params, regressor):
-    """Entries (unique H, C, G) in actuated coordinates at closed full poses ``qs`` (P, N).
+def workspace(n_node, n_dof, na, npas, n_body):
+    """Scratch arrays of :func:`reduce_pose` and :func:`velocity_state` (one set per caller).
 
-    ``regressor``: returns (P, E, 10 B), the regressor; otherwise (P, K, E) for parameter sets
-    ``params`` (K, 10 B). The second output is the pivot ratio of ``Phi_p`` per pose (0: singular).
+    ``(rot, pos, w, al, ac, phi, lu, pinv, t, node_t, rate, jp, ja, bias, gamma)``: node poses
+    and motions, ``Phi``, an LU scratch, ``Phi_p^-1``, ``T``, every node's joint-value rate per actuated
+    rate (``coef T``) and for one rate vector, per body the world Jacobian of its origin over the passive
+    rates (6 x n_p) and over the actuated ones (``J_b T``, 6 x n_a), ``Phidot qd`` and ``gamma``.
     """
+    n_node = max(n_node, 1)
+    return (
+        np.zeros((n_node, 3, 3)), np.zeros((n_node, 3)),
+        np.zeros((n_node, 3)), np.zeros((n_node, 3)), np.zeros((n_node, 3)),
+        np.zeros((npas, n_dof)), np.zeros((npas, npas)), np.zeros((npas, npas)),
+        np.zeros((n_dof, na)), np.zeros((n_node, na)), np.zeros(n_node),
+        np.zeros((n_body, 6, npas)), np.zeros((n_body, 6, na)),
+        np.zeros(npas), np.zeros(npas),
+    )
+
+
+@njit(cache=True, inline="always")
+def reduce_pose(q, parent, axis, coef, offset, body_node, body_path, frame_a, frame_b, row_loop, row_comp,
+                actuated, passive, ws, poses_ready):
+    """At a closed full pose ``q``: ``Phi_p^-1``, ``T = [I; S]``, ``coef T`` and every body's Jacobians into ``ws``.
+
+    ``poses_ready``: the node poses and ``Phi`` in ``ws`` are already those of ``q`` (after Newton).
+    Returns the pivot ratio of ``Phi_p`` (0: singular, nothing else computed) and the sign of its determinant.
+    A body Jacobian column is the unit twist of a path node at the body origin: ``(u x (p_b - p_e), u)``
+    for a rotation, ``(u, 0)`` for a translation (seed 000 eq. 2.20-2.26).
+    """
+    rot, pos, _, _, _, phi, lu, pinv, t, node_t, _, jp, ja, _, _ = ws
+    na = actuated.shape[0]
+    npas = passive.shape[0]
+    n_dof = q.shape[0]
+    if not poses_ready:
+        _node_poses(q, parent, axis, coef, offset, rot, pos)
+        closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, coef, rot, pos, phi)
+    for i in range(npas):
+        for j in range(npas):
+            lu[i, j] = phi[i, passive[j]]
+            pinv[i, j] = 1.0 if i == j else 0.0
+    ratio, sign = lu_in_place(lu, pinv)
+    if ratio == 0.0:
+        return ratio, sign
+    for i in range(n_dof):
+        for j in range(na):
+            t[i, j] = 0.0
+    for j in range(na):
+        t[actuated[j], j] = 1.0
+    for r in range(npas):
+        for j in range(na):
+            acc = 0.0
+            for i in range(npas):
+                acc -= pinv[r, i] * phi[i, actuated[j]]
+            t[passive[r], j] = acc
+    for n in range(parent.shape[0]):
+        for j in range(na):
+            node_t[n, j] = 0.0
+        for k in range(n_dof):
+            c = coef[n, k]
+            if c != 0.0:
+                for j in range(na):
+                    node_t[n, j] += c * t[k, j]
+    for b in range(body_node.shape[0]):
+        nb = body_node[b]
+        for r in range(6):
+            for j in range(na):
+                ja[b, r, j] = 0.0
+            for j in range(npas):
+                jp[b, r, j] = 0.0
+        for step in range(body_path.shape[1]):
+            e = body_path[b, step]
+            if e < 0:
+                break
+            a = axis[e] % 3
+            u0, u1, u2 = rot[e, 0, a], rot[e, 1, a], rot[e, 2, a]
+            if axis[e] < 3:
+                r0, r1, r2 = pos[nb, 0] - pos[e, 0], pos[nb, 1] - pos[e, 1], pos[nb, 2] - pos[e, 2]
+                v0, v1, v2 = u1 * r2 - u2 * r1, u2 * r0 - u0 * r2, u0 * r1 - u1 * r0
+                w0, w1, w2 = u0, u1, u2
+            else:
+                v0, v1, v2 = u0, u1, u2
+                w0 = w1 = w2 = 0.0
+            for j in range(na):
+                c = node_t[e, j]
+                ja[b, 0, j] += c * v0
+                ja[b, 1, j] += c * v1
+                ja[b, 2, j] += c * v2
+                ja[b, 3, j] += c * w0
+                ja[b, 4, j] += c * w1
+                ja[b, 5, j] += c * w2
+            for j in range(npas):
+                c = coef[e, passive[j]]
+                if c != 0.0:
+                    jp[b, 0, j] += c * v0
+                    jp[b, 1, j] += c * v1
+                    jp[b, 2, j] += c * v2
+                    jp[b, 3, j] += c * w0
+                    jp[b, 4, j] += c * w1
+                    jp[b, 5, j] += c * w2
+    return ratio, sign
+
+
+@njit(cache=True, inline="always")
+def velocity_state(qd_a, j, k, parent, axis, frame_a, frame_b, row_loop, row_comp, passive, ws):
+    """Node motions at ``qd = T qd_a``, ``qdd = 0`` and ``gamma = -Phi_p^-1 (Phidot qd)`` into ``ws``.
+
+    ``j >= 0`` takes the rate vector ``e_j`` (plus ``e_k`` when ``k != j``) instead of ``qd_a``. The body
+    accelerations of ``qdd = [0; gamma]`` add ``J_p gamma`` (``jp`` of :func:`reduce_pose`) to the nodes'.
+    """
+    rot, pos, w, al, ac, _, _, pinv, _, node_t, rate, _, _, bias, gamma = ws
+    npas = passive.shape[0]
+    for n in range(rate.shape[0]):
+        if j >= 0:
+            rate[n] = node_t[n, j] + (node_t[n, k] if k != j else 0.0)
+        else:
+            acc = 0.0
+            for c in range(qd_a.shape[0]):
+                acc += node_t[n, c] * qd_a[c]
+            rate[n] = acc
+    node_motion(rate, parent, axis, rot, pos, w, al, ac)
+    closure_bias(frame_a, frame_b, row_loop, row_comp, al, ac, bias)
+    for r in range(npas):
+        acc = 0.0
+        for i in range(npas):
+            acc -= pinv[r, i] * bias[i]
+        gamma[r] = acc
+
+
+@njit(cache=True, inline="always")
+def _rotation(rot, nb, i, k):
+    """Entry ``(i, k)`` of the world rotation of node ``nb`` (the identity for the base, ``nb < 0``)."""
+    if nb >= 0:
+        return rot[nb, i, k]
+    return 1.0 if i == k else 0.0
+
+
+@njit(cache=True)
+def world_parameters(rot, body_node, params, s, out):
+    """Parameter set ``s`` (10 B) in world axes at the current poses: ``out[s, b] = (m, R h, R J R^T)``.
+
+    The inertia ``J`` (about the body origin) is stored as ``Jxx, Jyy, Jzz, Jxy, Jxz, Jyz``; a body on the
+    base keeps its parameters.
+    """
+    for b in range(body_node.shape[0]):
+        nb = body_node[b]
+        c = 10 * b
+        if nb < 0:
+            for i in range(10):
+                out[s, b, i] = params[s, c + i]
+            continue
+        r = rot[nb]
+        out[s, b, 0] = params[s, c]
+        h0, h1, h2 = params[s, c + 1], params[s, c + 2], params[s, c + 3]
+        for i in range(3):
+            out[s, b, 1 + i] = r[i, 0] * h0 + r[i, 1] * h1 + r[i, 2] * h2
+        jxx, jyy, jzz = params[s, c + 4], params[s, c + 5], params[s, c + 6]
+        jxy, jxz, jyz = params[s, c + 7], params[s, c + 8], params[s, c + 9]
+        # rows of R J
+        a00 = r[0, 0] * jxx + r[0, 1] * jxy + r[0, 2] * jxz
+        a01 = r[0, 0] * jxy + r[0, 1] * jyy + r[0, 2] * jyz
+        a02 = r[0, 0] * jxz + r[0, 1] * jyz + r[0, 2] * jzz
+        a10 = r[1, 0] * jxx + r[1, 1] * jxy + r[1, 2] * jxz
+        a11 = r[1, 0] * jxy + r[1, 1] * jyy + r[1, 2] * jyz
+        a12 = r[1, 0] * jxz + r[1, 1] * jyz + r[1, 2] * jzz
+        a20 = r[2, 0] * jxx + r[2, 1] * jxy + r[2, 2] * jxz
+        a21 = r[2, 0] * jxy + r[2, 1] * jyy + r[2, 2] * jyz
+        a22 = r[2, 0] * jxz + r[2, 1] * jyz + r[2, 2] * jzz
+        out[s, b, 4] = a00 * r[0, 0] + a01 * r[0, 1] + a02 * r[0, 2]
+        out[s, b, 5] = a10 * r[1, 0] + a11 * r[1, 1] + a12 * r[1, 2]
+        out[s, b, 6] = a20 * r[2, 0] + a21 * r[2, 1] + a22 * r[2, 2]
+        out[s, b, 7] = a00 * r[1, 0] + a01 * r[1, 1] + a02 * r[1, 2]
+        out[s, b, 8] = a00 * r[2, 0] + a01 * r[2, 1] + a02 * r[2, 2]
+        out[s, b, 9] = a10 * r[2, 0] + a11 * r[2, 1] + a12 * r[2, 2]
+
+
+@njit(cache=True, inline="always")
+def body_wrench(w, al, ac, nb, pw, s, b):
+    """World wrench ``[f; n]`` about body ``b``'s origin (node ``nb``) from the node's ``(w, al, acc)``, world
+    parameters ``pw[s, b]``: ``f = m acc + al x h + w x (w x h)``, ``n = J al + w x (J w) + h x acc``."""
+    w0, w1, w2 = w[nb, 0], w[nb, 1], w[nb, 2]
+    l0, l1, l2 = al[nb, 0], al[nb, 1], al[nb, 2]
+    a0, a1, a2 = ac[nb, 0], ac[nb, 1], ac[nb, 2]
+    m, h0, h1, h2 = pw[s, b, 0], pw[s, b, 1], pw[s, b, 2], pw[s, b, 3]
+    jxx, jyy, jzz, jxy, jxz, jyz = pw[s, b, 4], pw[s, b, 5], pw[s, b, 6], pw[s, b, 7], pw[s, b, 8], pw[s, b, 9]
+    x0, x1, x2 = w1 * h2 - w2 * h1, w2 * h0 - w0 * h2, w0 * h1 - w1 * h0
+    f0 = m * a0 + l1 * h2 - l2 * h1 + w1 * x2 - w2 * x1
+    f1 = m * a1 + l2 * h0 - l0 * h2 + w2 * x0 - w0 * x2
+    f2 = m * a2 + l0 * h1 - l1 * h0 + w0 * x1 - w1 * x0
+    jw0 = jxx * w0 + jxy * w1 + jxz * w2
+    jw1 = jxy * w0 + jyy * w1 + jyz * w2
+    jw2 = jxz * w0 + jyz * w1 + jzz * w2
+    n0 = jxx * l0 + jxy * l1 + jxz * l2 + w1 * jw2 - w2 * jw1 + h1 * a2 - h2 * a1
+    n1 = jxy * l0 + jyy * l1 + jyz * l2 + w2 * jw0 - w0 * jw2 + h2 * a0 - h0 * a2
+    n2 = jxz * l0 + jyz * l1 + jzz * l2 + w0 * jw1 - w1 * jw0 + h0 * a1 - h1 * a0
+    return f0, f1, f2, n0, n1, n2
+
+
+@njit(cache=True, inline="always")
+def mass_and_gravity(ja, jp, b, gravity, pw, s, h, g, kp):
+    """Add body ``b``'s ``(J_b T)^T M (J_b T)`` to ``h`` (n x n), ``-(J_b T)^T`` of its weight's wrench to
+    ``g`` (eq. 2.44, 2.46) and ``(J_b T)^T M J_p`` to ``kp`` (n x n_p; ``kp gamma`` is the velocity term of
+    ``qdd = [0; gamma]``), world parameters ``pw[s, b]``: ``M [v; w] = [m v + w x h; h x v + J w]``."""
+    m, h0, h1, h2 = pw[s, b, 0], pw[s, b, 1], pw[s, b, 2], pw[s, b, 3]
+    jxx, jyy, jzz, jxy, jxz, jyz = pw[s, b, 4], pw[s, b, 5], pw[s, b, 6], pw[s, b, 7], pw[s, b, 8], pw[s, b, 9]
+    for j in range(ja.shape[2]):
+        v0, v1, v2 = ja[b, 0, j], ja[b, 1, j], ja[b, 2, j]
+        w0, w1, w2 = ja[b, 3, j], ja[b, 4, j], ja[b, 5, j]
+        mv0 = m * v0 + w1 * h2 - w2 * h1
+        mv1 = m * v1 + w2 * h0 - w0 * h2
+        mv2 = m * v2 + w0 * h1 - w1 * h0
+        mw0 = h1 * v2 - h2 * v1 + jxx * w0 + jxy * w1 + jxz * w2
+        mw1 = h2 * v0 - h0 * v2 + jxy * w0 + jyy * w1 + jyz * w2
+        mw2 = h0 * v1 - h1 * v0 + jxz * w0 + jyz * w1 + jzz * w2
+        g[j] -= gravity[0] * mv0 + gravity[1] * mv1 + gravity[2] * mv2
+        for r in range(jp.shape[2]):
+            kp[j, r] += (jp[b, 0, r] * mv0 + jp[b, 1, r] * mv1 + jp[b, 2, r] * mv2
+                         + jp[b, 3, r] * mw0 + jp[b, 4, r] * mw1 + jp[b, 5, r] * mw2)
+        for i in range(j + 1):
+            e = (ja[b, 0, i] * mv0 + ja[b, 1, i] * mv1 + ja[b, 2, i] * mv2
+                 + ja[b, 3, i] * mw0 + ja[b, 4, i] * mw1 + ja[b, 5, i] * mw2)
+            h[i, j] += e
+            if i != j:
+                h[j, i] += e
+
+
+@njit(cache=True)
+def active_bodies(params):
+    """Bodies with a non-zero parameter in some set (the others add nothing)."""
+    n_body = params.shape[1] // 10
+    out = np.zeros(n_body, dtype=np.bool_)
+    for b in range(n_body):
+        for s in range(params.shape[0]):
+            for c in range(10):
+                if params[s, 10 * b + c] != 0.0:
+                    out[b] = True
+    return out
+
+
+@njit(cache=True)
+def _state(j, na):
+    """Index of the rate vector ``e_j`` among the states (j, k), j <= k, in order."""
+    return j * na - j * (j - 1) // 2
+
+
+@njit(cache=True)
+def actuated_entries(qs, parent, axis, coef, offset, body_node, body_path, gravity,
+                     frame_a, frame_b, row_loop, row_comp, actuated, passive, params):
+    """Entries (unique H, C, G) in actuated coordinates at closed full poses ``qs`` (P, N) for parameter
+    sets ``params`` (K, 10 B): (P, K, E), and the pivot ratio of ``Phi_p`` per pose (0: singular)."""
     n_pose, n_dof = qs.shape
     na = actuated.shape[0]
     npas = passive.shape[0]
     n_body = body_node.shape[0]
-    n_node = max(parent.shape[0], 1)
+    n_sets = params.shape[0]
     m = na * (na + 1) // 2
-    n_entries = m + na * m + na
-    n_states = m
-    if regressor:
-        out = np.zeros((n_pose, n_entries, 10 * n_body))
-    else:
-        out = np.zeros((n_pose, params.shape[0], n_entries))
+    out = np.zeros((n_pose, n_sets, m + na * m + na))
     ratios = np.zeros(n_pose)
-    rot = np.zeros((n_node, 3, 3))
-    pos = np.zeros((n_node, 3))
-    w = np.zeros((n_node, 3))
-    v = np.zeros((n_node, 3))
-    al = np.zeros((n_node, 3))
-    ac = np.zeros((n_node, 3))
-    phi = np.empty((npas, n_dof))
-    bias = np.empty(npas)
-    t = np.zeros((n_dof, na))
-    jb = np.zeros((n_body, 6, n_dof))
-    ja = np.zeros((n_body, 6, na))
-    rbs = np.zeros((n_body, 3, 3))
-    jac = np.zeros((6, n_dof))
-    yh = np.zeros((na, na, 10))
-    yg = np.zeros((na, 10))
-    cs = np.zeros((n_states, n_body, na, 10))
-    wrench = np.zeros((6, 10))
-    buf = np.zeros((n_entries, 10))
-    zero = np.zeros(n_dof)
-    qd = np.zeros(n_dof)
-    eye = np.eye(npas)
-    state_j = np.empty(n_states, dtype=np.int64)
-    state_k = np.empty(n_states, dtype=np.int64)
-    col = 0
-    for j in range(na):
-        for k in range(j, na):
-            state_j[col], state_k[col] = j, k
-            col += 1
-    pp = np.empty((npas, npas))
-    pa = np.empty((npas, na))
-    s = np.empty((npas, na))
-    gamma = np.empty(npas)
-    wb = np.empty(3)
-    vb = np.empty(3)
-    lb = np.empty(3)
-    ab = np.empty(3)
+    ws = workspace(parent.shape[0], n_dof, na, npas, n_body)
+    rot, w, al, ac, jp, ja, gamma = ws[0], ws[2], ws[3], ws[4], ws[11], ws[12], ws[14]
+    active = active_bodies(params)
+    pw = np.zeros((n_sets, n_body, 10))
+    h = np.zeros((n_sets, na, na))
+    kp = np.zeros((n_sets, na, npas))
+    empty = np.zeros(0)
     for p in range(n_pose):
-        _node_poses(qs[p], parent, axis, coef, offset, rot, pos)
-        closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, coef, rot, pos, phi)
-        for i in range(npas):
-            for j in range(npas):
-                pp[i, j] = phi[i, passive[j]]
-            for j in range(na):
-                pa[i, j] = -phi[i, actuated[j]]
-        pinv, ratio, _ = lu_solve(pp, eye)
+        ratio, _ = reduce_pose(qs[p], parent, axis, coef, offset, body_node, body_path, frame_a, frame_b, row_loop,
+                               row_comp, actuated, passive, ws, False)
         ratios[p] = ratio
         if ratio == 0.0:
             continue
-        for r in range(npas):
-            for j in range(na):
-                acc = 0.0
-                for i in range(npas):
-                    acc += pinv[r, i] * pa[i, j]
-                s[r, j] = acc
-        for i in range(n_dof):
-            for j in range(na):
-                t[i, j] = 0.0
-        for j in range(na):
-            t[actuated[j], j] = 1.0
-        for r in range(npas):
-            for j in range(na):
-                t[passive[r], j] = s[r, j]
-        for b in range(n_body):
-            rbs[b] = _body_jacobian(b, body_node, body_path, axis, coef, rot, pos, jac)
-            for r in range(6):
-                for k in range(n_dof):
-                    jb[b, r, k] = jac[r, k]
-                for j in range(na):
-                    acc = 0.0
-                    for k in range(n_dof):
-                        acc += jac[r, k] * t[k, j]
-                    ja[b, r, j] = acc
-        # velocity terms: one rate vector e_j (+ e_k) per state
-        for st in range(n_states):
-            for k in range(n_dof):
-                qd[k] = t[k, state_j[st]] + (t[k, state_k[st]] if state_k[st] != state_j[st] else 0.0)
-            node_motion(qd, zero, parent, axis, coef, rot, pos, w, v, al, ac)
-            closure_bias(frame_a, frame_b, row_loop, row_comp, al, ac, bias)
-            for r in range(npas):
-                acc = 0.0
-                for i in range(npas):
-                    acc -= pinv[r, i] * bias[i]
-                gamma[r] = acc
+        h[:] = 0.0
+        kp[:] = 0.0
+        for s in range(n_sets):
+            world_parameters(rot, body_node, params, s, pw)
+            g = out[p, s, m + na * m:]
             for b in range(n_body):
-                nb = body_node[b]
-                if nb < 0:
+                if active[b] and body_node[b] >= 0:
+                    mass_and_gravity(ja, jp, b, gravity, pw, s, h[s], g, kp[s])
+            e = 0
+            for i in range(na):
+                for j in range(i, na):
+                    out[p, s, e] = h[s, i, j]
+                    e += 1
+        st = 0
+        for j in range(na):
+            for k in range(j, na):
+                velocity_state(empty, j, k, parent, axis, frame_a, frame_b, row_loop, row_comp, passive, ws)
+                for s in range(n_sets):
+                    for i in range(na):
+                        acc = 0.0
+                        for r in range(npas):
+                            acc += kp[s, i, r] * gamma[r]
+                        out[p, s, m + i * m + st] = acc
+                    for b in range(n_body):
+                        nb = body_node[b]
+                        if not active[b] or nb < 0:
+                            continue
+                        f0, f1, f2, n0, n1, n2 = body_wrench(w, al, ac, nb, pw, s, b)
+                        for i in range(na):
+                            out[p, s, m + i * m + st] += (ja[b, 0, i] * f0 + ja[b, 1, i] * f1 + ja[b, 2, i] * f2
+                                                          + ja[b, 3, i] * n0 + ja[b, 4, i] * n1 + ja[b, 5, i] * n2)
+                st += 1
+        # polarization: the state (j, k), j < k, held C(e_j + e_k); the cross term is what exceeds (j, j) + (k, k)
+        for s in range(n_sets):
+            for i in range(na):
+                st = 0
+                for j in range(na):
+                    for k in range(j, na):
+                        if k != j:
+                            out[p, s, m + i * m + st] -= (out[p, s, m + i * m + _state(j, na)]
+                                                          + out[p, s, m + i * m + _state(k, na)])
+                        st += 1
+    return out, ratios
+
+
+@njit(cache=True, inline="always")
+def _body_motion(w, al, ac, jp, gamma, nb, b, rb, out):
+    """Body-axis ``(w, al, acc)`` of body ``b`` (node ``nb``, rotation ``rb``) at ``qdd = [0; gamma]`` into ``out``."""
+    if nb < 0:
+        for r in range(3):
+            for i in range(3):
+                out[r, i] = 0.0
+        return
+    l0, l1, l2 = al[nb, 0], al[nb, 1], al[nb, 2]
+    a0, a1, a2 = ac[nb, 0], ac[nb, 1], ac[nb, 2]
+    for r in range(gamma.shape[0]):
+        a0 += jp[b, 0, r] * gamma[r]
+        a1 += jp[b, 1, r] * gamma[r]
+        a2 += jp[b, 2, r] * gamma[r]
+        l0 += jp[b, 3, r] * gamma[r]
+        l1 += jp[b, 4, r] * gamma[r]
+        l2 += jp[b, 5, r] * gamma[r]
+    for i in range(3):
+        out[0, i] = rb[0, i] * w[nb, 0] + rb[1, i] * w[nb, 1] + rb[2, i] * w[nb, 2]
+        out[1, i] = rb[0, i] * l0 + rb[1, i] * l1 + rb[2, i] * l2
+        out[2, i] = rb[0, i] * a0 + rb[1, i] * a1 + rb[2, i] * a2
+
+
+@njit(cache=True)
+def actuated_regressor(qs, parent, axis, coef, offset, body_node, body_path, gravity,
+                       frame_a, frame_b, row_loop, row_comp, actuated, passive):
+    """Regressor of the entries (unique H, C, G) in actuated coordinates at closed full poses ``qs`` (P, N):
+    (P, E, 10 B), and the pivot ratio of ``Phi_p`` per pose (0: singular). Body axes throughout."""
+    n_pose, n_dof = qs.shape
+    na = actuated.shape[0]
+    n_body = body_node.shape[0]
+    m = na * (na + 1) // 2
+    n_entries = m + na * m + na
+    out = np.zeros((n_pose, n_entries, 10 * n_body))
+    ratios = np.zeros(n_pose)
+    ws = workspace(parent.shape[0], n_dof, na, passive.shape[0], n_body)
+    rot, w, al, ac, jp, ja, gamma = ws[0], ws[2], ws[3], ws[4], ws[11], ws[12], ws[14]
+    jab = np.zeros((n_body, 6, na))
+    rb = np.zeros((n_body, 3, 3))
+    mb = np.zeros((3, 3))
+    yh = np.zeros((na, na, 10))
+    yg = np.zeros((na, 10))
+    cs = np.zeros((m, n_body, na, 10))
+    wrench = np.zeros((6, 10))
+    empty = np.zeros(0)
+    for p in range(n_pose):
+        ratio, _ = reduce_pose(qs[p], parent, axis, coef, offset, body_node, body_path, frame_a, frame_b, row_loop,
+                               row_comp, actuated, passive, ws, False)
+        ratios[p] = ratio
+        if ratio == 0.0:
+            continue
+        for b in range(n_body):
+            nb = body_node[b]
+            for i in range(3):
+                for k in range(3):
+                    rb[b, i, k] = _rotation(rot, nb, i, k)
+            for i in range(3):
+                for j in range(na):
+                    jab[b, i, j] = rb[b, 0, i] * ja[b, 0, j] + rb[b, 1, i] * ja[b, 1, j] + rb[b, 2, i] * ja[b, 2, j]
+                    jab[b, 3 + i, j] = rb[b, 0, i] * ja[b, 3, j] + rb[b, 1, i] * ja[b, 4, j] + rb[b, 2, i] * ja[b, 5, j]
+        st = 0
+        for j in range(na):
+            for k in range(j, na):
+                velocity_state(empty, j, k, parent, axis, frame_a, frame_b, row_loop, row_comp, passive, ws)
+                for b in range(n_body):
+                    _body_motion(w, al, ac, jp, gamma, body_node[b], b, rb[b], mb)
+                    _wrench_regressor(mb[0], mb[1], mb[2], wrench)
                     for i in range(na):
                         for c in range(10):
-                            cs[st, b, i, c] = 0.0
-                    continue
-                rb = rbs[b]
-                for i in range(3):
-                    wb[i] = rb[0, i] * w[nb, 0] + rb[1, i] * w[nb, 1] + rb[2, i] * w[nb, 2]
-                    vb[i] = rb[0, i] * v[nb, 0] + rb[1, i] * v[nb, 1] + rb[2, i] * v[nb, 2]
-                    lb[i] = rb[0, i] * al[nb, 0] + rb[1, i] * al[nb, 1] + rb[2, i] * al[nb, 2]
-                    ab[i] = rb[0, i] * ac[nb, 0] + rb[1, i] * ac[nb, 1] + rb[2, i] * ac[nb, 2]
-                    for r in range(npas):
-                        ab[i] += jb[b, i, passive[r]] * gamma[r]
-                        lb[i] += jb[b, 3 + i, passive[r]] * gamma[r]
-                _wrench_regressor(wb, vb, lb, ab, wrench)
-                for i in range(na):
-                    for c in range(10):
-                        acc = 0.0
-                        for r in range(6):
-                            acc += ja[b, r, i] * wrench[r, c]
-                        cs[st, b, i, c] = acc
+                            acc = 0.0
+                            for r in range(6):
+                                acc += jab[b, r, i] * wrench[r, c]
+                            cs[st, b, i, c] = acc
+                st += 1
         for b in range(n_body):
             yh[:] = 0.0
             yg[:] = 0.0
-            body_regressor(ja[b], rbs[b], gravity, yh, yg, 0)
+            body_regressor(jab[b], rb[b], gravity, yh, yg, 0)
+            col = 10 * b
             e = 0
             for i in range(na):
                 for j in range(i, na):
                     for c in range(10):
-                        buf[e, c] = yh[i, j, c]
+                        out[p, e, col + c] = yh[i, j, c]
                     e += 1
             for i in range(na):
-                for st in range(n_states):
-                    j, k = state_j[st], state_k[st]
-                    for c in range(10):
-                        if j == k:
-                            buf[m + i * m + st, c] = cs[st, b, i, c]
-                        else:
-                            sj = j * na - j * (j - 1) // 2  # state of (j, j)
-                            sk = k * na - k * (k - 1) // 2  # state of (k, k)
-                            buf[m + i * m + st, c] = cs[st, b, i, c] - cs[sj, b, i, c] - cs[sk, b, i, c]
+                st = 0
+                for j in range(na):
+                    for k in range(j, na):
+                        for c in range(10):
+                            value = cs[st, b, i, c]
+                            if k != j:
+                                value -= cs[_state(j, na), b, i, c] + cs[_state(k, na), b, i, c]
+                            out[p, m + i * m + st, col + c] = value
+                        st += 1
             for i in range(na):
                 for c in range(10):
-                    buf[m + na * m + i, c] = yg[i, c]
-            col = 10 * b
-            if regressor:
-                for e in range(n_entries):
-                    for c in range(10):
-                        out[p, e, col + c] += buf[e, c]
-            else:
-                for kset in range(params.shape[0]):
-                    for e in range(n_entries):
-                        acc = 0.0
-                        for c in range(10):
-                            acc += buf[e, c] * params[kset, col + c]
-                        out[p, kset, e] += acc
+                    out[p, m + na * m + i, col + c] = yg[i, c]
     return out, ratios

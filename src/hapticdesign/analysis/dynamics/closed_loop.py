@@ -18,7 +18,7 @@ import copy
 
 import numpy as np
 
-from hapticdesign.analysis.dynamics.actuated_kernel import actuated_kernel
+from hapticdesign.analysis.dynamics.actuated_kernel import actuated_entries, actuated_regressor
 from hapticdesign.analysis.dynamics.model import DynamicsModel, pair_index
 from hapticdesign.analysis.loops.solver import MESSAGES, SINGULAR_RATIO, LoopSolver
 from hapticdesign.analysis.loops.closure_kernel import SINGULAR
@@ -50,13 +50,15 @@ class ClosedLoopModel(DynamicsModel):
         self.n_entries = m + n * m + n
 
     # -- kernel -------------------------------------------------------------------------------
-    def _kernel(self, q_full: np.ndarray, params: np.ndarray, regressor: bool) -> np.ndarray:
+    def _kernel(self, q_full: np.ndarray, params: np.ndarray | None) -> np.ndarray:
+        """Entries for parameter sets (P, S, E), or the regressor (P, E, n_params) when ``params`` is None."""
         c, a = self.compiled, self.solver.arrays
-        out, ratios = actuated_kernel(
-            np.ascontiguousarray(q_full, dtype=float), c.node_parent, c.node_axis, c.node_coef, c.node_offset,
-            c.body_node, c.body_path, c.gravity, a.frame_a, a.frame_b, a.row_loop, a.row_comp,
-            a.actuated, a.passive, np.ascontiguousarray(params, dtype=float), regressor,
-        )
+        args = (np.ascontiguousarray(q_full, dtype=float), c.node_parent, c.node_axis, c.node_coef, c.node_offset,
+                c.body_node, c.body_path, c.gravity, a.frame_a, a.frame_b, a.row_loop, a.row_comp, a.actuated, a.passive)
+        if params is None:
+            out, ratios = actuated_regressor(*args)
+        else:
+            out, ratios = actuated_entries(*args, np.ascontiguousarray(params, dtype=float))
         bad = np.flatnonzero(ratios <= SINGULAR_RATIO)
         if bad.size:
             pose = ", ".join(f"{v:.6g}" for v in q_full[bad[0], a.actuated])
@@ -72,7 +74,7 @@ class ClosedLoopModel(DynamicsModel):
         """Entries at closed full poses (P, N): (P, E), or (S, P, E) for parameter sets (S, n_params)."""
         pi = self._params(pi)
         sets = np.atleast_2d(pi)
-        out = self._kernel(np.atleast_2d(q_full), sets, False)  # (P, S, E)
+        out = self._kernel(np.atleast_2d(q_full), sets)  # (P, S, E)
         if self.constant is not None:
             out += self.constant
         return out[:, 0, :] if pi.ndim == 1 else np.moveaxis(out, 1, 0)
@@ -84,8 +86,7 @@ class ClosedLoopModel(DynamicsModel):
     def regressor_at(self, q_full: np.ndarray) -> np.ndarray:
         """Every entry as a row of the standard parameters at closed full poses: (P, E, n_params)."""
         q_full = np.atleast_2d(q_full)
-        empty = np.zeros((0, self.n_params))
-        return np.concatenate([self._kernel(q_full[i:i + CHUNK], empty, True)
+        return np.concatenate([self._kernel(q_full[i:i + CHUNK], None)
                                for i in range(0, len(q_full), CHUNK)] or [np.zeros((0, self.n_entries, self.n_params))])
 
     def entry_regressor(self, q: np.ndarray) -> np.ndarray:

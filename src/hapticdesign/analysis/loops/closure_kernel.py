@@ -72,38 +72,30 @@ def _cross(a0, a1, a2, b0, b1, b2):
 
 
 @njit(cache=True)
-def node_motion(qd, qdd, parent, axis, coef, rot, pos, w, v, al, ac):
-    """World angular velocity ``w``, origin velocity ``v``, angular and origin acceleration of every node.
+def node_motion(rate, parent, axis, rot, pos, w, al, ac):
+    """World angular velocity ``w`` and, at zero joint accelerations, the angular and origin accelerations
+    ``al``, ``ac`` of every node, for the rate ``rate[n]`` of each node's joint value.
 
-    Rotation node (axis ``u``, rate ``s``): ``w = w_p + s u``, ``al = al_p + sd u + w_p x s u``, same
-    origin. Translation node (offset ``d = value u``): ``v = v_p + w_p x d + s u`` and
-    ``ac = ac_p + al_p x d + w_p x (w_p x d) + 2 w_p x s u + sd u``.
+    Rotation node (axis ``u``, rate ``s``): ``w = w_p + s u``, ``al = al_p + w_p x s u``, same origin.
+    Translation node (offset ``d = value u``): ``ac = ac_p + al_p x d + w_p x (w_p x d) + 2 w_p x s u``.
     """
     for n in range(parent.shape[0]):
         p = parent[n]
-        s = 0.0
-        sd = 0.0
-        for k in range(qd.shape[0]):
-            c = coef[n, k]
-            if c != 0.0:
-                s += c * qd[k]
-                sd += c * qdd[k]
+        s = rate[n]
         a = axis[n] % 3
         u0, u1, u2 = rot[n, 0, a], rot[n, 1, a], rot[n, 2, a]
         if p >= 0:
             w0, w1, w2 = w[p, 0], w[p, 1], w[p, 2]
             l0, l1, l2 = al[p, 0], al[p, 1], al[p, 2]
-            vp0, vp1, vp2 = v[p, 0], v[p, 1], v[p, 2]
             a0, a1, a2 = ac[p, 0], ac[p, 1], ac[p, 2]
             d0, d1, d2 = pos[n, 0] - pos[p, 0], pos[n, 1] - pos[p, 1], pos[n, 2] - pos[p, 2]
         else:
-            w0 = w1 = w2 = l0 = l1 = l2 = vp0 = vp1 = vp2 = a0 = a1 = a2 = 0.0
+            w0 = w1 = w2 = l0 = l1 = l2 = a0 = a1 = a2 = 0.0
             d0, d1, d2 = pos[n, 0], pos[n, 1], pos[n, 2]
         if axis[n] < 3:
             x0, x1, x2 = _cross(w0, w1, w2, s * u0, s * u1, s * u2)
             w[n, 0], w[n, 1], w[n, 2] = w0 + s * u0, w1 + s * u1, w2 + s * u2
-            al[n, 0], al[n, 1], al[n, 2] = l0 + sd * u0 + x0, l1 + sd * u1 + x1, l2 + sd * u2 + x2
-            v[n, 0], v[n, 1], v[n, 2] = vp0, vp1, vp2
+            al[n, 0], al[n, 1], al[n, 2] = l0 + x0, l1 + x1, l2 + x2
             ac[n, 0], ac[n, 1], ac[n, 2] = a0, a1, a2
         else:
             wd0, wd1, wd2 = _cross(w0, w1, w2, d0, d1, d2)
@@ -112,10 +104,9 @@ def node_motion(qd, qdd, parent, axis, coef, rot, pos, w, v, al, ac):
             ws0, ws1, ws2 = _cross(w0, w1, w2, s * u0, s * u1, s * u2)
             w[n, 0], w[n, 1], w[n, 2] = w0, w1, w2
             al[n, 0], al[n, 1], al[n, 2] = l0, l1, l2
-            v[n, 0], v[n, 1], v[n, 2] = vp0 + wd0 + s * u0, vp1 + wd1 + s * u1, vp2 + wd2 + s * u2
-            ac[n, 0] = a0 + ld0 + ww0 + 2.0 * ws0 + sd * u0
-            ac[n, 1] = a1 + ld1 + ww1 + 2.0 * ws1 + sd * u1
-            ac[n, 2] = a2 + ld2 + ww2 + 2.0 * ws2 + sd * u2
+            ac[n, 0] = a0 + ld0 + ww0 + 2.0 * ws0
+            ac[n, 1] = a1 + ld1 + ww1 + 2.0 * ws1
+            ac[n, 2] = a2 + ld2 + ww2 + 2.0 * ws2
 
 
 @njit(cache=True)
@@ -173,14 +164,13 @@ def closure_bias(frame_a, frame_b, row_loop, row_comp, al, ac, out):
 
 
 @njit(cache=True)
-def lu_solve(a, b):
-    """Solve ``a x = b`` (m x m, m x k) by Gaussian elimination with partial pivoting, in place on copies.
+def lu_in_place(u, x):
+    """Solve ``u x = b`` (m x m, m x k) by Gaussian elimination with partial pivoting: ``x`` holds ``b`` on entry
+    and the solution on return, ``u`` is overwritten (no allocation).
 
-    Returns ``x``, the pivot ratio ``min |u_ii| / max |u_ii|`` (0 when singular) and the sign of ``det a``.
+    Returns the pivot ratio ``min |u_ii| / max |u_ii|`` (0 when singular) and the sign of ``det u``.
     """
-    m = a.shape[0]
-    u = a.copy()
-    x = b.copy()
+    m = u.shape[0]
     sign = 1.0
     big, small = 0.0, np.inf
     for c in range(m):
@@ -198,7 +188,7 @@ def lu_solve(a, b):
         big = max(big, abs(pivot))
         small = min(small, abs(pivot))
         if pivot == 0.0:
-            return x, 0.0, 0.0
+            return 0.0, 0.0
         if pivot < 0.0:
             sign = -sign
         for r in range(c + 1, m):
@@ -214,21 +204,27 @@ def lu_solve(a, b):
             for j in range(c + 1, m):
                 t -= u[c, j] * x[j, k]
             x[c, k] = t / u[c, c]
-    return x, small / big, sign
+    return small / big, sign
 
 
 @njit(cache=True)
 def velocity_map(phi, actuated, passive):
     """``S = -Phi_p^-1 Phi_a`` (n_p x n_a), the pivot ratio and the sign of ``det Phi_p``."""
     m = passive.shape[0]
-    pa = np.empty((m, actuated.shape[0]))
-    pp = np.empty((m, m))
-    for i in range(m):
+    s = np.empty((m, actuated.shape[0]))
+    ratio, sign = velocity_map_into(phi, actuated, passive, np.empty((m, m)), s)
+    return s, ratio, sign
+
+
+@njit(cache=True)
+def velocity_map_into(phi, actuated, passive, pp, s):
+    """:func:`velocity_map` into ``s`` (n_p x n_a) with the scratch ``pp`` (n_p x n_p); returns (ratio, sign)."""
+    for i in range(passive.shape[0]):
         for j in range(actuated.shape[0]):
-            pa[i, j] = -phi[i, actuated[j]]
-        for j in range(m):
+            s[i, j] = -phi[i, actuated[j]]
+        for j in range(passive.shape[0]):
             pp[i, j] = phi[i, passive[j]]
-    return lu_solve(pp, pa)
+    return lu_in_place(pp, s)
 
 
 @njit(cache=True)
@@ -236,10 +232,19 @@ def newton(q, actuated, passive, parent, axis, coef, offset, frame_a, frame_b, r
            tol, max_iter, singular_ratio, rot, pos):
     """Newton on the passive entries of ``q`` (in place). Returns (status, det sign, pivot ratio)."""
     m = passive.shape[0]
-    res = np.empty(m)
-    phi = np.empty((m, coef.shape[1]))
-    rhs = np.empty((m, 1))
-    pp = np.empty((m, m))
+    return newton_into(q, actuated, passive, parent, axis, coef, offset, frame_a, frame_b, row_loop, row_comp,
+                       tol, max_iter, singular_ratio, rot, pos, np.empty(m), np.empty((m, coef.shape[1])),
+                       np.empty((m, 1)), np.empty((m, m)))
+
+
+@njit(cache=True)
+def newton_into(q, actuated, passive, parent, axis, coef, offset, frame_a, frame_b, row_loop, row_comp,
+                tol, max_iter, singular_ratio, rot, pos, res, phi, rhs, pp):
+    """:func:`newton` on the caller's scratch ``res`` (m), ``phi`` (m x N), ``rhs`` (m x 1), ``pp`` (m x m).
+
+    On success ``rot``, ``pos`` and ``phi`` hold the node poses and the constraint Jacobian of the returned ``q``.
+    """
+    m = passive.shape[0]
     for it in range(max_iter + 1):
         _node_poses(q, parent, axis, coef, offset, rot, pos)
         closure_residual(frame_a, frame_b, row_loop, row_comp, rot, pos, res)
@@ -248,7 +253,7 @@ def newton(q, actuated, passive, parent, axis, coef, offset, frame_a, frame_b, r
             rhs[i, 0] = -res[i]
             for j in range(m):
                 pp[i, j] = phi[i, passive[j]]
-        dx, ratio, sign = lu_solve(pp, rhs)
+        ratio, sign = lu_in_place(pp, rhs)
         if not np.isfinite(ratio) or ratio <= singular_ratio:
             return SINGULAR, sign, ratio
         if np.max(np.abs(res)) <= tol:
@@ -258,10 +263,10 @@ def newton(q, actuated, passive, parent, axis, coef, offset, frame_a, frame_b, r
         # damped: at most MAX_NEWTON_STEP per iteration, so that a rough start reaches its nearest branch
         big = 0.0
         for j in range(m):
-            big = max(big, abs(dx[j, 0]))
+            big = max(big, abs(rhs[j, 0]))
         scale = 1.0 if big <= MAX_NEWTON_STEP else MAX_NEWTON_STEP / big
         for j in range(m):
-            q[passive[j]] += scale * dx[j, 0]
+            q[passive[j]] += scale * rhs[j, 0]
     return NO_CLOSURE, 0.0, 0.0
 
 
@@ -279,16 +284,23 @@ def solve_path(qa_path, q_start, sign0, actuated, passive, parent, axis, coef, o
     n_dof = q_start.shape[0]
     m = passive.shape[0]
     n_node = max(parent.shape[0], 1)
+    na = actuated.shape[0]
     rot = np.zeros((n_node, 3, 3))
     pos = np.zeros((n_node, 3))
     phi = np.empty((m, n_dof))
+    res, rhs, pp = np.empty(m), np.empty((m, 1)), np.empty((m, m))
+    s = np.empty((m, na))
+    start = np.empty(na)
     out = np.empty((n_pose, n_dof))
     status = np.zeros(n_pose, dtype=np.int64)
     q = q_start.copy()
     trial = q.copy()
     predicted = np.empty(m)
+    # tangent at the current closed pose; after each accepted step, from Newton's last Jacobian there
+    _node_poses(q, parent, axis, coef, offset, rot, pos)
+    closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, coef, rot, pos, phi)
+    velocity_map_into(phi, actuated, passive, pp, s)
     for p in range(n_pose):
-        start = np.empty(actuated.shape[0])
         for j in range(actuated.shape[0]):
             start[j] = q[actuated[j]]
         dist = 0.0
@@ -299,10 +311,6 @@ def solve_path(qa_path, q_start, sign0, actuated, passive, parent, axis, coef, o
         code = OK
         while done < 1.0:
             f = min(1.0, done + step)
-            # tangent predictor at the current closed pose
-            _node_poses(q, parent, axis, coef, offset, rot, pos)
-            closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, coef, rot, pos, phi)
-            s, _, _ = velocity_map(phi, actuated, passive)
             for k in range(n_dof):
                 trial[k] = q[k]
             for j in range(actuated.shape[0]):
@@ -312,8 +320,8 @@ def solve_path(qa_path, q_start, sign0, actuated, passive, parent, axis, coef, o
                     trial[passive[r]] += s[r, j] * delta
             for r in range(m):
                 predicted[r] = trial[passive[r]]
-            code, sign, _ = newton(trial, actuated, passive, parent, axis, coef, offset, frame_a, frame_b,
-                                   row_loop, row_comp, tol, max_iter, singular_ratio, rot, pos)
+            code, sign, _ = newton_into(trial, actuated, passive, parent, axis, coef, offset, frame_a, frame_b,
+                                        row_loop, row_comp, tol, max_iter, singular_ratio, rot, pos, res, phi, rhs, pp)
             if code == OK and sign != sign0:
                 code = BRANCH_CHANGE
             if code == OK:
@@ -326,6 +334,7 @@ def solve_path(qa_path, q_start, sign0, actuated, passive, parent, axis, coef, o
                 for k in range(n_dof):
                     q[k] = trial[k]
                 done = f
+                velocity_map_into(phi, actuated, passive, pp, s)
             else:
                 step *= 0.5
                 if step < min_fraction:

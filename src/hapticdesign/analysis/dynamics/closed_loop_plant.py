@@ -1,0 +1,163 @@
+"""A compiled closed-loop plant: H, C(q, qd) qd and G in actuated coordinates, pose after pose (seed 000 eq. 2.44-2.50).
+
+A closed-loop device has no exact basis tables (:mod:`hapticdesign.simulation.tables`): its equations of
+motion in the actuated coordinates ``tau_a = H_a qdd_a + c_a(q_a, qd_a) + G_a`` come from the loop-opened
+tree reduced by ``T = [I; S]`` (:mod:`.actuated_kernel`), at the passive values that close the loops.
+:func:`closed_loop_terms` gives them inside numba for one parameter set, at one actuated pose and rate:
+
+- the passive values follow by Newton (:func:`hapticdesign.analysis.loops.closure_kernel.newton_into`)
+  from a tangent predictor ``q_p + S dq_a`` at the last pose solved, which the workspace carries (a
+  fixed-step integrator moves little between calls, so one or two iterations close the loops);
+- ``H_a`` (n_a x n_a, with the constant reflected rotor inertia), ``c_a = C(q, qd) qd^2`` (the velocity
+  terms for the given rates, one tree pass instead of the ``n_a (n_a + 1) / 2`` of eq. 2.50's columns)
+  and ``G_a``;
+- a status: ``OK``, ``NO_CLOSURE`` (Newton fails, or its correction exceeds half the actuated step: it
+  jumped), ``SINGULAR`` (``Phi_p`` singular) or ``BRANCH_CHANGE`` (``det Phi_p`` changed sign). On any
+  failure the outputs are left as they were and the workspace keeps the last closed pose.
+
+:class:`ClosedLoopPlant` builds the arrays (``structure``) and the workspace from a
+:class:`~.closed_loop.ClosedLoopModel` and starts on the assembly branch at a given actuated pose.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from hapticdesign.analysis.dynamics.actuated_kernel import (
+    active_bodies,
+    body_wrench,
+    mass_and_gravity,
+    reduce_pose,
+    velocity_state,
+    workspace,
+    world_parameters,
+)
+from hapticdesign.analysis.dynamics.closed_loop import ClosedLoopModel
+from hapticdesign.analysis.loops import closure_kernel as ck
+from hapticdesign.analysis.loops.solver import MAX_ITER, MESSAGES, SINGULAR_RATIO
+from hapticdesign.errors import UserError
+
+OK, NO_CLOSURE, SINGULAR, BRANCH_CHANGE = ck.OK, ck.NO_CLOSURE, ck.SINGULAR, ck.BRANCH_CHANGE
+
+
+@njit(cache=True)
+def plant_workspace(n_node, n_dof, na, npas, n_body):
+    """Scratch of :func:`closed_loop_terms`: ``(kernel workspace, q, q_last, res, rhs, pp, pw, kp, predicted)``.
+
+    ``q`` is the warm start (full coordinates of the last closed pose), ``q_last`` a copy to fall back to.
+    """
+    return (
+        workspace(n_node, n_dof, na, npas, n_body), np.zeros(n_dof), np.zeros(n_dof), np.zeros(npas),
+        np.zeros((npas, 1)), np.zeros((npas, npas)), np.zeros((1, n_body, 10)), np.zeros((1, na, npas)),
+        np.zeros(npas),
+    )
+
+
+@njit(cache=True)
+def closed_loop_terms(qa, qda, structure, ws, h, cqd, g):
+    """``H_a`` (n_a x n_a), ``c_a = C(q, qd) qd^2`` (n_a) and ``G_a`` (n_a) at actuated ``qa``, rates ``qda``.
+
+    ``structure``: ``(parent, axis, coef, offset, body_node, body_path, gravity, frame_a, frame_b, row_loop,
+    row_comp, actuated, passive, params (1, 10 B), active (B,), constant (n_a x n_a), tol, max_iter,
+    singular_ratio, branch)``; ``ws``: :func:`plant_workspace`. Returns the status (module docstring).
+    """
+    (parent, axis, coef, offset, body_node, body_path, gravity, frame_a, frame_b, row_loop, row_comp,
+     actuated, passive, params, active, constant, tol, max_iter, singular_ratio, branch) = structure
+    dyn, q, q_last, res, rhs, pp, pw, kp, predicted = ws
+    rot, pos, w, al, ac, phi, t, jp, ja, gamma = dyn[0], dyn[1], dyn[2], dyn[3], dyn[4], dyn[5], dyn[8], dyn[11], dyn[12], dyn[14]
+    na = actuated.shape[0]
+    npas = passive.shape[0]
+    dist = 0.0
+    for k in range(q.shape[0]):
+        q_last[k] = q[k]
+    # tangent predictor from T at the last closed pose
+    for j in range(na):
+        delta = qa[j] - q[actuated[j]]
+        dist = max(dist, abs(delta))
+        for r in range(npas):
+            q[passive[r]] += t[passive[r], j] * delta
+        q[actuated[j]] = qa[j]
+    for r in range(npas):
+        predicted[r] = q[passive[r]]
+    status, sign, _ = ck.newton_into(q, actuated, passive, parent, axis, coef, offset, frame_a, frame_b, row_loop,
+                                     row_comp, tol, max_iter, singular_ratio, rot, pos, res, phi, rhs, pp)
+    if status == OK and sign != branch:
+        status = BRANCH_CHANGE
+    if status == OK:
+        for r in range(npas):
+            if abs(q[passive[r]] - predicted[r]) > 0.5 * dist + 1e-9:
+                status = NO_CLOSURE
+    if status != OK:
+        for k in range(q.shape[0]):
+            q[k] = q_last[k]
+        return status
+    reduce_pose(q, parent, axis, coef, offset, body_node, body_path, frame_a, frame_b, row_loop, row_comp,
+                actuated, passive, dyn, True)
+    world_parameters(rot, body_node, params, 0, pw)
+    for i in range(na):
+        g[i] = 0.0
+        for j in range(na):
+            h[i, j] = constant[i, j]
+        for r in range(npas):
+            kp[0, i, r] = 0.0
+    for b in range(body_node.shape[0]):
+        if active[b] and body_node[b] >= 0:
+            mass_and_gravity(ja, jp, b, gravity, pw, 0, h, g, kp[0])
+    velocity_state(qda, -1, -1, parent, axis, frame_a, frame_b, row_loop, row_comp, passive, dyn)
+    for i in range(na):
+        acc = 0.0
+        for r in range(npas):
+            acc += kp[0, i, r] * gamma[r]
+        cqd[i] = acc
+    for b in range(body_node.shape[0]):
+        nb = body_node[b]
+        if not active[b] or nb < 0:
+            continue
+        f0, f1, f2, n0, n1, n2 = body_wrench(w, al, ac, nb, pw, 0, b)
+        for i in range(na):
+            cqd[i] += (ja[b, 0, i] * f0 + ja[b, 1, i] * f1 + ja[b, 2, i] * f2
+                       + ja[b, 3, i] * n0 + ja[b, 4, i] * n1 + ja[b, 5, i] * n2)
+    return OK
+
+
+class ClosedLoopPlant:
+    """:func:`closed_loop_terms` for one device geometry and parameter set, started at an actuated pose.
+
+    ``structure`` and ``workspace`` are what a numba caller passes; :meth:`terms` is the Python entry.
+    """
+
+    def __init__(self, model: ClosedLoopModel, pi: np.ndarray, q_a0: np.ndarray):
+        solver, c, a = model.solver, model.compiled, model.solver.arrays
+        params = np.ascontiguousarray(np.atleast_2d(model._params(pi)), dtype=float)
+        if params.shape[0] != 1:
+            raise UserError("a plant takes one set of standard inertial parameters")
+        n = model.n_dof
+        constant = np.zeros((n, n))
+        if model.constant is not None:
+            iu, ju = np.triu_indices(n)
+            constant[iu, ju] = constant[ju, iu] = model.constant[model.slice_h]
+        self.n_dof = n
+        self.structure = (
+            c.node_parent, c.node_axis, c.node_coef, c.node_offset, c.body_node, c.body_path, c.gravity,
+            a.frame_a, a.frame_b, a.row_loop, a.row_comp, a.actuated, a.passive, params, active_bodies(params),
+            constant, float(solver.tol), int(MAX_ITER), float(SINGULAR_RATIO), float(solver.branch),
+        )
+        self.workspace = plant_workspace(len(c.node_parent), solver.n_dof, n, len(a.passive), len(c.body_node))
+        self.workspace[1][:] = solver.solve(q_a0)
+        self.terms(q_a0, np.zeros(n))  # T at the start pose, for the first tangent predictor
+
+    def terms(self, q_a: np.ndarray, qd_a: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(H_a, C(q, qd) qd^2, G_a)`` at the next actuated pose and rates (continued from the last one)."""
+        n = self.n_dof
+        h, cqd, g = np.zeros((n, n)), np.zeros(n), np.zeros(n)
+        q_a = np.asarray(q_a, dtype=float)
+        status = closed_loop_terms(q_a, np.asarray(qd_a, dtype=float), self.structure, self.workspace, h, cqd, g)
+        if status != OK:
+            raise UserError(f"at q = ({', '.join(f'{v:.6g}' for v in q_a)}): {MESSAGES[status]}")
+        return h, cqd, g
+
+    @property
+    def q_full(self) -> np.ndarray:
+        """Full coordinates of the last closed pose (the warm start)."""
+        return self.workspace[1].copy()
