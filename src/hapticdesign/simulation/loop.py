@@ -14,7 +14,7 @@ import numpy as np
 
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
-from hapticdesign.simulation import kernel
+from hapticdesign.simulation import kernel, records
 from hapticdesign.simulation.config import LoopConfig, Trace, compensator_device, hand_matrices, plant_friction
 from hapticdesign.simulation.paths import Path
 from hapticdesign.simulation.tables import DynamicsTables, workspace_size
@@ -32,6 +32,10 @@ def joint_index(device: Device, joint: int | str) -> int:
     if not 1 <= j <= len(names):
         raise UserError(f"unknown joint {joint}; the device has joints 1..{len(names)}")
     return j - 1
+
+
+def _workspace(tables: DynamicsTables) -> records.Workspace:
+    return records.workspace(tables.n_dof, workspace_size(tables), tables.index.shape[0], tables.n_entries)
 
 
 def simulate(
@@ -117,21 +121,23 @@ def simulate_tables(
     hand_mass, hand_damping, hand_stiffness = hand if hand is not None else (np.zeros((n, n)),) * 3
     comp = config.compensator
     n_rec = n_steps // stride + 1
-    rec = [np.zeros((n_rec, n)) for _ in range(6)]
+    rec = records.Records(*(np.zeros((n_rec, n)) for _ in range(6)))
     switches = np.array([comp.inertial, comp.coriolis, comp.gravity], dtype=float)
-    written, status, trip, peak, end_time = kernel.run_loop(
-        (*plant.sparse, plant.index, plant.kinds, plant.degrees),
-        (*model.sparse, model.index, model.kinds, model.degrees),
-        kernel.make_workspace(n, workspace_size(plant), plant.index.shape[0], plant.n_entries),
-        kernel.make_workspace(n, workspace_size(model), model.index.shape[0], model.n_entries),
-        np.diag(damping) + hand_damping, np.zeros(n) if coulomb is None else np.asarray(coulomb, dtype=float),
-        hand_mass, hand_stiffness, q_start.copy(), prescribed,
-        path_q, path_qd, path_qdd, q_start, np.zeros(n), config.step, sub, n_steps,
-        wall.joint, float(wall.stiffness), float(wall.damping), float(wall.equilibrium), switches, quant,
-        int(sensors.delay_samples),
-        math.inf if config.safety_limit is None else float(config.safety_limit), float(q_start[wall.joint]),
-        math.inf if config.stop_excursion is None else float(config.stop_excursion), stride, *rec,
+    damping_matrix = np.diag(damping) + hand_damping
+    friction = np.zeros(n) if coulomb is None else np.asarray(coulomb, dtype=float)
+    plant_record = records.Plant(records.table(plant), _workspace(plant), damping_matrix, friction,
+                                 hand_mass, hand_stiffness, q_start.copy())
+    controller = records.Controller(records.table(model), _workspace(model), switches, quant,
+                                    int(sensors.delay_samples))
+    motion = records.Motion(prescribed, path_q, path_qd, path_qdd, q_start, np.zeros(n))
+    timing = records.Timing(float(config.step), sub, n_steps, stride)
+    law = records.WallLaw(
+        joint=wall.joint, stiffness=float(wall.stiffness), damping=float(wall.damping), rest=float(wall.equilibrium),
+        reference=float(q_start[wall.joint]),
+        safety_limit=math.inf if config.safety_limit is None else float(config.safety_limit),
+        stop_excursion=math.inf if config.stop_excursion is None else float(config.stop_excursion),
     )
+    written, status, trip, peak, end_time = kernel.run_loop(plant_record, controller, motion, timing, law, rec)
     t = np.arange(written) * stride * config.step
     q, qd, u, tau_f, tau_imp, tau_c = (r[:written] for r in rec)
     return Trace(t, q, qd, u, tau_f, tau_imp, tau_c, int(status), None if trip < 0 else float(trip),
