@@ -10,9 +10,12 @@ Digital side, every ``sub`` steps (period ``T = sub h``): sensors read position,
 acceleration (the acceleration just before the instant, i.e. under the previous held torque,
 which avoids an algebraic loop; zero at t = 0 as the seed's initial conditions), optionally quantized (positions) and delayed; the compensator
 computes the model's inverse dynamics ``tau_f`` with its inertial, Coriolis and gravity terms
-switchable; the virtual wall computes ``tau_imp = K (q_w - q_eq) + B qd_w``; the actuators hold
-``u = tau_f - tau_imp`` (zero-order hold). The safety switch of Figure 4.7 cuts both torques off
-once the wall joint leaves its reference by ``safety_limit``.
+switchable; the virtual wall computes ``tau_imp = K (q_w - q_eq) + B qd_w`` on a joint, or for a
+Cartesian wall along the unit direction n at the handle ``tau_imp = J_n^T (K (n.p - x_eq) + B J_n qd)``
+(``tau = J^T F``, ``J_n = n^T J_v`` from the compiled frame tree at the sensed pose); the actuators
+hold ``u = tau_f - tau_imp`` (zero-order hold). The safety switch of Figure 4.7 cuts both torques
+off once the wall coordinate (the wall joint, or the handle along n) leaves its reference by
+``safety_limit``.
 """
 
 from __future__ import annotations
@@ -20,6 +23,8 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
+from hapticdesign.analysis.dynamics.kernel import _node_poses
+from hapticdesign.analysis.loops.closure_kernel import frame_jacobian
 from hapticdesign.simulation.config import FRICTION_VELOCITY, STATUS_COMPLETED, STATUS_DIVERGED, STATUS_EXCURSION
 from hapticdesign.simulation.tables import evaluate_entries, unpack_entries, velocity_products
 
@@ -156,19 +161,61 @@ def compensator_torque(q, qd, qdd, ctrl, out):
         out[i] = switches[0] * s_h + switches[1] * s_c + switches[2] * g[i]
 
 
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _handle_normal(q, handle):
+    """The handle's position along the wall direction, ``n . p(q)``; leaves the node poses in ``handle``."""
+    pos, n, node = handle.pos, handle.direction, handle.node
+    _node_poses(q, handle.parent, handle.axis, handle.coef, handle.offset, handle.rot, pos)
+    return n[0] * pos[node, 0] + n[1] * pos[node, 1] + n[2] * pos[node, 2]
+
+
 @nb.njit(cache=True, error_model="numpy")
-def run_loop(plant, ctrl, motion, timing, wall, rec):
+def handle_normal(q, handle):
+    """:func:`_handle_normal` callable from Python (the wall's reference at the start pose)."""
+    return _handle_normal(q, handle)
+
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _wall_coordinate(q, wall, handle):
+    """The wall coordinate: the wall joint's position, or the handle's along a Cartesian wall's direction."""
+    if wall.cartesian:
+        return _handle_normal(q, handle)
+    return q[wall.joint]
+
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _wall_torque(q, qd, wall, handle, out):
+    """``tau_imp`` of the wall at the sensed state: ``K (q_j - q_eq) + B qd_j`` on the wall joint, or
+    ``J_n^T (K (n.p - x_eq) + B J_n qd)`` with ``J_n = n^T J_v`` the handle's Jacobian along n."""
+    if not wall.cartesian:
+        for i in range(q.shape[0]):
+            out[i] = 0.0
+        out[wall.joint] = wall.stiffness * (q[wall.joint] - wall.rest) + wall.damping * qd[wall.joint]
+        return
+    x = _handle_normal(q, handle)
+    jac, n = handle.jac, handle.direction
+    frame_jacobian(handle.node, handle.parent, handle.axis, handle.coef, handle.rot, handle.pos, jac)
+    v = 0.0
+    for k in range(q.shape[0]):
+        out[k] = n[0] * jac[0, k] + n[1] * jac[1, k] + n[2] * jac[2, k]
+        v += out[k] * qd[k]
+    force = wall.stiffness * (x - wall.rest) + wall.damping * v
+    for k in range(q.shape[0]):
+        out[k] *= force
+
+
+@nb.njit(cache=True, error_model="numpy")
+def run_loop(plant, ctrl, motion, timing, wall, handle, rec):
     """Run the loop (records of :mod:`.records`); returns (records written, status, time the safety
-    switch tripped or -1, peak excursion of the wall joint from ``wall.reference`` over every plant
-    step, time the run ended).
+    switch tripped or -1, peak excursion of the wall coordinate from ``wall.reference`` over every
+    plant step, time the run ended).
 
     The excursion is checked at every plant step, so a run stopped at ``wall.stop_excursion``
     reports a peak at or above it even when no recorded row (every ``timing.stride`` steps) shows it."""
     prescribed, path_q, path_qd, path_qdd = motion.prescribed, motion.path_q, motion.path_qd, motion.path_qdd
     step, sub, n_steps, stride = timing.step, timing.sub, timing.n_steps, timing.stride
     delay, quant = ctrl.delay, ctrl.quant
-    rec_q, rec_qd, rec_u, rec_f, rec_imp, rec_c = rec.q, rec.qd, rec.u, rec.tau_f, rec.tau_imp, rec.tau_c
-    wall_joint = wall.joint
+    rec_q, rec_qd, rec_u, rec_f, rec_imp, rec_c, rec_w = rec.q, rec.qd, rec.u, rec.tau_f, rec.tau_imp, rec.tau_c, rec.wall
     n = motion.q0.shape[0]
     q = motion.q0.copy()
     qd = motion.qd0.copy()
@@ -196,6 +243,7 @@ def run_loop(plant, ctrl, motion, timing, wall, rec):
     written = 0
     status = STATUS_COMPLETED
     peak = 0.0
+    coord = _wall_coordinate(q, wall, handle)
     end_time = 0.0
     for it in range(n_steps + 1):
         t = it * step
@@ -220,9 +268,7 @@ def run_loop(plant, ctrl, motion, timing, wall, rec):
                 sensed[1, i] = buf[old, 1, i]
                 sensed[2, i] = buf[old, 2, i]
             compensator_torque(sensed[0], sensed[1], sensed[2], ctrl, tau_f)
-            for i in range(n):
-                tau_imp[i] = 0.0
-            tau_imp[wall_joint] = wall.stiffness * (sensed[0, wall_joint] - wall.rest) + wall.damping * sensed[1, wall_joint]
+            _wall_torque(sensed[0], sensed[1], wall, handle, tau_imp)
             if tripped:
                 for i in range(n):
                     tau_f[i] = 0.0
@@ -240,6 +286,7 @@ def run_loop(plant, ctrl, motion, timing, wall, rec):
                 rec_f[r, i] = tau_f[i]
                 rec_imp[r, i] = tau_imp[i]
                 rec_c[r, i] = c1[i]
+            rec_w[r] = coord
             written = r + 1
         finite = True
         for i in range(n):
@@ -249,7 +296,7 @@ def run_loop(plant, ctrl, motion, timing, wall, rec):
         if not finite:
             status = STATUS_DIVERGED
             break
-        excursion = abs(q[wall_joint] - wall.reference)
+        excursion = abs(coord - wall.reference)
         if excursion > peak:
             peak = excursion
         if excursion >= wall.stop_excursion:
@@ -280,7 +327,8 @@ def run_loop(plant, ctrl, motion, timing, wall, rec):
                 else:
                     q[i] += step / 6.0 * (k1q[i] + 2.0 * k2q[i] + 2.0 * k3q[i] + k4q[i])
                     qd[i] += step / 6.0 * (a1[i] + 2.0 * a2[i] + 2.0 * a3[i] + a4[i])
-        if not tripped and abs(q[wall_joint] - wall.reference) >= wall.safety_limit:
+        coord = _wall_coordinate(q, wall, handle)
+        if not tripped and abs(coord - wall.reference) >= wall.safety_limit:
             tripped = True
             trip_time = t + step
             for i in range(n):

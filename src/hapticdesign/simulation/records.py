@@ -82,10 +82,13 @@ class Timing(NamedTuple):
 
 
 class WallLaw(NamedTuple):
-    """The virtual wall on one joint: ``tau_imp[joint] = stiffness (q - rest) + damping qd``; the
-    run stops once ``|q - reference|`` reaches ``stop_excursion`` and the safety switch cuts the
-    torques once it reaches ``safety_limit``."""
+    """The virtual wall on one joint, ``tau_imp[joint] = stiffness (q - rest) + damping qd``, or, when
+    ``cartesian``, along the handle's direction n: ``tau_imp = J_n^T (stiffness (n.p - rest) + damping
+    J_n qd)``. The wall coordinate is ``q[joint]`` or ``n.p``; the run stops once its distance from
+    ``reference`` reaches ``stop_excursion`` and the safety switch cuts the torques once it reaches
+    ``safety_limit``."""
 
+    cartesian: bool
     joint: int
     stiffness: float
     damping: float
@@ -95,8 +98,24 @@ class WallLaw(NamedTuple):
     stop_excursion: float
 
 
+class Handle(NamedTuple):
+    """The frame tree (:class:`~hapticdesign.model.mechanism.CompiledMechanism`), the handle's node,
+    the wall's unit direction and scratch for node poses and the handle's Jacobian."""
+
+    parent: np.ndarray
+    axis: np.ndarray
+    coef: np.ndarray
+    offset: np.ndarray
+    node: int
+    direction: np.ndarray
+    rot: np.ndarray
+    pos: np.ndarray
+    jac: np.ndarray
+
+
 class Records(NamedTuple):
-    """Recorded rows: positions, velocities, held torque, compensator, wall and constraint torques."""
+    """Recorded rows: positions, velocities, held torque, compensator, wall and constraint torques,
+    and the wall coordinate."""
 
     q: np.ndarray
     qd: np.ndarray
@@ -104,6 +123,7 @@ class Records(NamedTuple):
     tau_f: np.ndarray
     tau_imp: np.ndarray
     tau_c: np.ndarray
+    wall: np.ndarray
 
 
 def table(tables) -> Table:
@@ -119,3 +139,19 @@ def workspace(n: int, n_values: int, n_basis: int, n_entries: int) -> Workspace:
         np.zeros((n, n)), np.zeros((n, m)), np.zeros(n), np.zeros(m), np.zeros((n, n)), np.zeros(n),
         np.zeros(n, dtype=np.int64),
     )
+
+
+def handle(mechanism, direction: np.ndarray) -> Handle:
+    """The kernel's view of a mechanism's handle (end-effector frame) for a wall along ``direction``."""
+    c = mechanism.compiled
+    n_node = max(len(c.node_parent), 1)
+    node = c.frame_node[mechanism.end_effector]
+    return Handle(c.node_parent, c.node_axis, np.ascontiguousarray(c.node_coef), c.node_offset, int(node),
+                  np.ascontiguousarray(direction, dtype=float), np.zeros((n_node, 3, 3)), np.zeros((n_node, 3)),
+                  np.zeros((6, mechanism.n_dof)))
+
+
+def no_handle(n: int) -> Handle:
+    """A placeholder :class:`Handle` for a joint wall (same array types, so one compiled loop)."""
+    return Handle(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros((0, n)), np.zeros(0), -1,
+                  np.zeros(3), np.zeros((1, 3, 3)), np.zeros((1, 3)), np.zeros((6, n)))
