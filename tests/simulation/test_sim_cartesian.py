@@ -1,5 +1,6 @@
 """The Cartesian virtual wall: F = -(K (x.n - x_eq) + B v.n) n at the handle, tau = J^T F."""
 
+import json
 from dataclasses import replace
 from pathlib import Path
 
@@ -123,3 +124,48 @@ def test_api_direction_and_refusals(gantry):
         impedance_range(gantry, 1, method="analytic", wall_direction=(0, 0, 0))
     with pytest.raises(UserError, match="does not move the handle"):
         impedance_range(gantry, 1, method="analytic", wall_direction=(0, 1, 0))
+
+
+SLIDER = """\
+name: slider
+joints:
+  - {name: x, type: prismatic, damping: 2.0}
+frames:
+  - {name: carriage, parent: base, transforms: [tx: x]}
+end_effector: carriage
+bodies:
+  - {name: c, frame: carriage, m: 0.5}
+"""
+
+
+def test_cli_cartesian_wall(tmp_path):
+    """``--wall-direction``: the Z-width along n is the joint's with J / J_n^2 and b / J_n^2 (compensated,
+    b^2 / (m J_n^2) = 16 N/m at J_n = 1/sqrt 2, the closed form of :mod:`.boundary`), and the analytic
+    impedance range is reported in N/m."""
+    from typer.testing import CliRunner
+
+    from hapticdesign.interface.cli import app
+    from hapticdesign.simulation.boundary import compensated_boundary
+
+    runner = CliRunner()
+    path = tmp_path / "slider.yaml"
+    path.write_text(SLIDER)
+    zw = runner.invoke(app, ["zwidth", "--device", str(path), "--wall-direction", "1,0,1", "--compensate-inertia",
+                             "--b-values", "0", "--json"])
+    assert zw.exit_code == 0, zw.output
+    out = json.loads(zw.stdout)
+    assert out["units"] == {"B": "N s/m", "K": "N/m"}
+    assert out["K"][0] == pytest.approx(compensated_boundary(0.5 * 2, 2.0 * 2, 1e-3), rel=1e-8)
+    assert out["K"][0] == pytest.approx(16.0, rel=1e-8)
+    result = runner.invoke(app, ["impedance-range", "--device", str(path), "--method", "analytic", "--resolution",
+                                 "0.25", "--wall-direction", "1,0,1", "--json"])
+    assert result.exit_code == 0, result.output
+    out = json.loads(result.stdout)
+    assert out["units"]["k_max"] == "N/m" and out["wall_direction"] == pytest.approx([2 ** -0.5, 0, 2 ** -0.5])
+    api = impedance_range(resolve_device(None, path, None), 1, "analytic", resolution=0.25, wall_direction=(1, 0, 1))
+    assert out["k_max"] == api.k_max
+    bad = runner.invoke(app, ["impedance-range", "--device", str(path), "--wall-direction", "0,1,0", "--method",
+                              "analytic"])
+    assert bad.exit_code == 2 and "does not move the handle" in bad.output
+    bad = runner.invoke(app, ["zwidth", "--inertia", "1", "--damping", "1", "--wall-direction", "1,0,0"])
+    assert bad.exit_code == 2 and "--wall-direction needs a device" in bad.output
