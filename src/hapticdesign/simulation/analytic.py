@@ -14,6 +14,13 @@ The seed's criteria are then evaluated on the exact linear response: the closed 
 the state at every sample, and the exact sub-sample transition of the plant under the held torque
 gives the excursion at every plant step (as the simulation checks it). No ODE is integrated.
 Quantized encoders and Coulomb friction are not linear: the analytic method refuses them.
+
+A Cartesian wall (spring K in N/m, damper B in N s/m along n at the handle) acts on the free joint w
+as the joint wall ``K J_n,w^2``, ``B J_n,w^2`` (the joint-space stiffness ``J_n^T K J_n`` of the
+held chain, ``J_n = n^T J_v`` at the start pose), and its criteria apply to the wall-normal output
+``J_n,w (q_w - q_w0)``. That is exact when the handle moves linearly along n with the free joint
+(``J_n,w`` constant over its travel and the driven motion, e.g. a prismatic joint); otherwise a
+small-displacement approximation, and ``exact`` says so.
 """
 
 from __future__ import annotations
@@ -30,7 +37,7 @@ from hapticdesign.analysis.dynamics.device import coriolis_centrifugal, gravity,
 from hapticdesign.analysis.kinematics import jacobian
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
-from hapticdesign.simulation.config import LoopConfig, compensator_device, plant_friction
+from hapticdesign.simulation.config import LoopConfig, compensator_device, normal_jacobian, plant_friction
 from hapticdesign.simulation.criteria import Verdict, WallProblem, type_paths
 from hapticdesign.simulation.zwidth import DisplayLoop, controller, plant
 
@@ -49,11 +56,14 @@ def one_blas_thread():
 
 @dataclass(frozen=True)
 class WallJoint:
-    """The wall joint linearized at the start pose: the 1-DOF loop and the constant torque on it."""
+    """The wall joint linearized at the start pose: the 1-DOF loop, the constant torque on it, and
+    ``scale``, the wall coordinate per unit of the joint (1 for a joint wall, ``J_n,w`` for a
+    Cartesian wall: its spring and damper act on the joint as ``K J_n,w^2`` and ``B J_n,w^2``)."""
 
     loop: DisplayLoop
     torque: float
     exact: bool
+    scale: float = 1.0
 
 
 def linearize(device: Device, sim_type: int, wall_joint: int, config: LoopConfig) -> WallJoint:
@@ -83,7 +93,24 @@ def linearize(device: Device, sim_type: int, wall_joint: int, config: LoopConfig
     torque = -(float(g[w]) - comp.gravity * float(gravity(model, q0)[w]))
     loop = DisplayLoop(j, b, config.sensors.period, config.sensors.delay_samples, "sampled", fraction, spring)
     exact = sim_type == 1 or _decoupled(device, w, paths)
-    return WallJoint(loop, torque, exact)
+    if not config.wall.cartesian:
+        return WallJoint(loop, torque, exact)
+    scale = float(normal_jacobian(device, config.wall, q0)[w])
+    if abs(scale) < 1e-12:
+        raise UserError(f"joint {w + 1} does not move the handle along the wall direction at the start pose")
+    return WallJoint(loop, torque, exact and _linear_along_wall(device, config, w, q0, paths), scale)
+
+
+def _linear_along_wall(device: Device, config: LoopConfig, w: int, q0: np.ndarray, paths: dict) -> bool:
+    """True when ``J_n = n^T J_v`` of the free joint is the same over its travel and the driven motion,
+    i.e. the handle moves linearly along the wall direction (a prismatic joint along it)."""
+    t = np.linspace(0.0, 2.0, 9)
+    qs = np.tile(q0, (len(t), 1))
+    for j, path in paths.items():
+        qs[:, j] = path.sample(t)[0]
+    qs[:, w] += np.linspace(-0.1, 0.1, len(t))
+    rows = np.array([normal_jacobian(device, config.wall, q)[w] for q in qs])
+    return bool(np.all(np.abs(rows - rows[0]) <= 1e-9 * max(abs(rows[0]), 1e-12)))
 
 
 def _decoupled(device: Device, w: int, paths: dict) -> bool:
@@ -142,6 +169,7 @@ class AnalyticProblem(WallProblem):
     def __post_init__(self) -> None:
         super().__post_init__()
         self.wall = linearize(self.device, self.sim_type, self.wall_joint, self.config)
+        self.rest = self.equilibrium / self.wall.scale  # the spring's rest in joint units
         self.sub = self.config.steps_per_sample()
         self.samples = int(round(self.config.duration / self.config.sensors.period))
         loop = self.wall.loop
@@ -155,21 +183,21 @@ class AnalyticProblem(WallProblem):
 
     def estimate(self) -> float:
         loop = self.wall.loop
-        if loop.fraction > 0:
-            return loop.damping ** 2 / loop.inertia
-        return 2.0 * loop.damping / loop.period
+        joint = loop.damping ** 2 / loop.inertia if loop.fraction > 0 else 2.0 * loop.damping / loop.period
+        return joint / self.wall.scale ** 2
 
     def _augmented(self, stiffness: float) -> tuple[np.ndarray, np.ndarray, int]:
         """One-sample map of ``s = [q - q_eq, qd, controller state, 1]`` and the row giving ``u``."""
         loop, d = self.wall.loop, self.wall.torque
-        ctrl = controller(loop, stiffness, self.config.wall.damping)
+        s2 = self.wall.scale ** 2
+        ctrl = controller(loop, stiffness * s2, self.config.wall.damping * s2)
         phi, gamma = np.asarray(self._plant.A), np.asarray(self._plant.B)[:, 0]
         ac, bc, cc, dc = (np.asarray(m) for m in (ctrl.A, ctrl.B, ctrl.C, ctrl.D))
         nc = ac.shape[0]
         n = loop.delay
         u_line = (n + 1) + n
         # the spring acts on q - q_eq; the rest of the hand's spring and the constant torque act on the plant
-        const = d - loop.plant_stiffness * self.equilibrium
+        const = d - loop.plant_stiffness * self.rest
         comp = loop.fraction * const
         size = 2 + nc + 1
         m = np.zeros((size, size))
@@ -189,23 +217,24 @@ class AnalyticProblem(WallProblem):
         n = loop.delay
         nc = (n + 1) + n + (n + 1)
         s = np.zeros(2 + nc + 1)
-        e0 = -self.equilibrium
+        e0 = -self.rest
         s[0] = e0
         s[2:2 + n + 1] = e0
-        const = self.wall.torque - loop.plant_stiffness * self.equilibrium
+        const = self.wall.torque - loop.plant_stiffness * self.rest
         s[2 + u_line:2 + nc] = loop.plant_stiffness * e0 - const  # the compensator sees a = 0 until samples arrive
         s[-1] = 1.0
         return s
 
     def response(self, stiffness: float) -> np.ndarray:
-        """``q - q0`` at every plant step (rows: samples, columns: plant steps within the period)."""
+        """The wall coordinate from its start (``q - q0``, or ``J_n,w (q - q0)`` along a Cartesian wall) at
+        every plant step (rows: samples, columns: plant steps within the period)."""
         m, u_row, u_line = self._augmented(stiffness)
         states = _powers(m, self._initial(u_line), self.samples)
         u = states @ u_row
-        const = self.wall.torque - self.wall.loop.plant_stiffness * self.equilibrium
+        const = self.wall.torque - self.wall.loop.plant_stiffness * self.rest
         cols = [phi[0, 0] * states[:, 0] + phi[0, 1] * states[:, 1] + gamma[0] * (u + const)
                 for phi, gamma in self._steps]
-        return np.stack(cols, axis=1) + self.equilibrium
+        return (np.stack(cols, axis=1) + self.rest) * self.wall.scale
 
     def verdict(self, stiffness: float) -> Verdict:
         """The seed's criteria on the exact linear response (overshoot checked at every plant step)."""

@@ -29,12 +29,49 @@ made smooth enough for a fixed-step integrator; above 3 v_f it is within 0.5 % o
 
 @dataclass(frozen=True)
 class Wall:
-    """Virtual wall on one joint: spring ``stiffness`` (N m/rad), optional ``damping``, ``equilibrium``."""
+    """The virtual wall: a joint wall, or a Cartesian wall when ``direction`` is given.
+
+    Joint wall: ``tau_imp = K (q_j - q_eq) + B qd_j`` on joint ``joint`` (K in N m/rad, B in N m s/rad,
+    ``equilibrium`` the angle q_eq; N/m, N s/m and m for a prismatic joint).
+
+    Cartesian wall: a spring K (N/m) and damper B (N s/m) along the unit ``direction`` n at the
+    device's handle (its end-effector frame), ``F = -(K (x.n - x_eq) + B v.n) n`` on the handle,
+    ``tau = J^T F`` on the joints with the frame's geometric Jacobian (so ``tau_imp = J_n^T (K (x.n -
+    x_eq) + B J_n qd)``, ``J_n = n^T J_v``). ``equilibrium`` is then the rest of the spring in metres
+    along n from the handle's start, and ``joint`` only names the joint the seed's experiments leave
+    free (:func:`~.criteria.type_paths`). Like the joint wall it pulls from both sides of its rest.
+    """
 
     joint: int = 0
     stiffness: float = 1.0
     damping: float = 0.0
     equilibrium: float = 0.01
+    direction: tuple[float, float, float] | None = None
+
+    @property
+    def cartesian(self) -> bool:
+        return self.direction is not None
+
+    @property
+    def units(self) -> dict[str, str]:
+        """Units of the stiffness and damping (Cartesian, or of a revolute joint)."""
+        if self.cartesian:
+            return {"K": "N/m", "B": "N s/m"}
+        return {"K": "N m/rad", "B": "N m s/rad"}
+
+
+def unit_direction(direction) -> np.ndarray:
+    """A wall direction as a unit 3-vector; anything else is a :class:`UserError`."""
+    try:
+        n = np.asarray(direction, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise UserError(f"the wall direction must be three numbers, got {direction!r}") from None
+    if n.shape != (3,) or not np.all(np.isfinite(n)):
+        raise UserError(f"the wall direction must be three finite numbers, got {np.atleast_1d(n).tolist()[:6]}")
+    norm = float(np.linalg.norm(n))
+    if norm == 0.0:
+        raise UserError("the wall direction must not be the zero vector")
+    return n / norm
 
 
 @dataclass(frozen=True)
@@ -113,9 +150,10 @@ class LoopConfig:
 class Trace:
     """Recorded signals (rows every ``stride`` plant steps) and how the run ended.
 
-    ``peak`` is the largest excursion of the wall joint from its start, checked at every plant
-    step (not only at the recorded rows); ``end_time`` is when the run ended (early when it
-    diverged or reached the excursion stop)."""
+    ``wall_position`` is the wall coordinate at the recorded rows: the wall joint's position, or the handle's
+    position along a Cartesian wall's direction (m). ``peak`` is its largest excursion from the
+    start, checked at every plant step (not only at the recorded rows); ``end_time`` is when the run
+    ended (early when it diverged or reached the excursion stop)."""
 
     t: np.ndarray
     q: np.ndarray
@@ -128,6 +166,7 @@ class Trace:
     trip_time: float | None
     peak: float = math.nan
     end_time: float = math.nan
+    wall_position: np.ndarray | None = None
 
     @property
     def diverged(self) -> bool:
@@ -204,6 +243,11 @@ def plant_friction(device: Device, config: LoopConfig) -> np.ndarray:
         raise UserError(f"expected {device.n_dof} finite, non-negative Coulomb friction values, got "
                         f"{np.atleast_1d(friction).tolist()[:8]}")
     return friction
+
+
+def normal_jacobian(device: Device, wall: Wall, q: np.ndarray) -> np.ndarray:
+    """``J_n = n^T J_v`` (1 x N): the handle's velocity along a Cartesian wall's direction per joint velocity."""
+    return unit_direction(wall.direction) @ jacobian(device.mechanism, np.asarray(q, dtype=float))[:3]
 
 
 def hand_matrices(device: Device, hand: Hand | None, q0: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

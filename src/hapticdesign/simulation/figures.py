@@ -146,9 +146,10 @@ def write_all(designs, cases, summary, folder: Path) -> None:
     frequency_responses(designs, cases, folder / "transparency_frequency_response")
 
 
-def zwidth_chart(zw, title: str, path: Path) -> list[Path]:
+def zwidth_chart(zw, title: str, path: Path, units: tuple[str, str] = ("N m s/rad", "N m/rad")) -> list[Path]:
     """The Z-width (Colgate & Brown 1994): stable (B, K) below the exact boundary, with the passivity
-    bound and the short-delay linear approximation beside it; written atomically as PNG and SVG."""
+    bound and the short-delay linear approximation beside it; written atomically as PNG and SVG.
+    ``units`` of B and K (a joint's by default; N s/m and N/m at a Cartesian wall)."""
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
     ax.fill_between(zw.B, 0, zw.K, color="tab:blue", alpha=0.15, label="stable (exact, discrete time)")
     ax.plot(zw.B, zw.K, "-", color="tab:blue", lw=1.8, label="K_max(B), exact")
@@ -157,8 +158,8 @@ def zwidth_chart(zw, title: str, path: Path) -> list[Path]:
         ax.plot(zw.B, zw.linear, ":", color="k", label="linear approximation 2 (b + B) / (T (1 + 2 N))")
     top = max(max(zw.K), 1e-12)
     ax.set_ylim(0, 1.15 * top)
-    ax.set_xlabel("virtual damping B [N m s/rad]")
-    ax.set_ylabel("virtual stiffness K [N m/rad]")
+    ax.set_xlabel(f"virtual damping B [{units[0]}]")
+    ax.set_ylabel(f"virtual stiffness K [{units[1]}]")
     ax.set_title(title, fontsize=10)
     ax.legend(fontsize=8)
     return _save_atomically(fig, path)

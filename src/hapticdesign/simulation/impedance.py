@@ -25,11 +25,19 @@ from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation.analytic import AnalyticProblem
 from hapticdesign.simulation.boundary import envelope_grows
-from hapticdesign.simulation.config import LoopConfig, Wall, compensator_device, require_device, require_options
+from hapticdesign.simulation.config import (
+    LoopConfig, Wall, compensator_device, normal_jacobian, require_device, require_options, unit_direction,
+)
 from hapticdesign.simulation.loop import simulate
 from hapticdesign.simulation.criteria import Criteria, Verdict, WallProblem, type_paths
 from hapticdesign.simulation.tables import DynamicsTables
 from hapticdesign.workload import require_plant_steps
+
+
+def wall_rest(trace, wall: Wall) -> float:
+    """Where the wall's spring rests: the joint angle ``equilibrium``, or ``equilibrium`` metres along a
+    Cartesian wall's direction from the handle's start (the first recorded row)."""
+    return float(trace.wall_position[0]) + wall.equilibrium if wall.cartesian else wall.equilibrium
 
 
 @dataclass
@@ -46,11 +54,15 @@ class ImpedanceProblem(WallProblem):
 
     def estimate(self) -> float:
         """Starting guess: the 1-DOF limit ``b^2 / H_ww`` of full inertial compensation at the start
-        pose (see :mod:`.boundary`), or ``2 b / T`` without it; only a guess, never the answer."""
+        pose (see :mod:`.boundary`), or ``2 b / T`` without it, divided by ``J_n,w^2`` for a Cartesian
+        wall; only a guess, never the answer."""
         w = self.wall_joint
+        q0 = np.zeros(self.device.n_dof)
         b = (self.config.damping or self.device.damping)[w]
-        h = mass_matrix(self.device, np.zeros(self.device.n_dof))[w, w]
+        h = mass_matrix(self.device, q0)[w, w]
         guess = b * b / h if self.config.compensator.inertial else 2 * b / self.config.sensors.period
+        if self.config.wall.cartesian:
+            guess /= float(normal_jacobian(self.device, self.config.wall, q0)[w]) ** 2
         return guess if math.isfinite(guess) and guess > 0 else 1.0
 
     def verdict(self, stiffness: float) -> Verdict:
@@ -64,9 +76,8 @@ class ImpedanceProblem(WallProblem):
         if trace.stopped_at_excursion or peak >= self.criteria.overshoot_limit:
             stopped = trace.end_time if trace.stopped_at_excursion else None
             return Verdict(stiffness, False, "overshoot", peak, math.nan, stopped)
-        q = trace.q[:, self.wall_joint]
-        tail = q[trace.t >= trace.t[-1] - self.criteria.settle_window]
-        final = float(np.max(np.abs(tail - self.equilibrium)))
+        tail = trace.wall_position[trace.t >= trace.t[-1] - self.criteria.settle_window]
+        final = float(np.max(np.abs(tail - wall_rest(trace, cfg.wall))))
         if trace.tripped:
             return Verdict(stiffness, False, "safety switch", peak, final)
         if final > self.criteria.settle_tolerance:
@@ -263,7 +274,7 @@ def true_boundary(problem: ImpedanceProblem, rel_tol: float = 1e-4, margin: floa
                          model=problem.model)
         if trace.status != 0:
             return True
-        return envelope_grows(trace.q[:, problem.wall_joint] - problem.equilibrium, margin)
+        return envelope_grows(trace.wall_position - wall_rest(trace, wall), margin)
 
     lo, hi = 0.0, 1.0
     while not grows(hi):
@@ -282,8 +293,12 @@ def true_boundary(problem: ImpedanceProblem, rel_tol: float = 1e-4, margin: floa
 def impedance_range(device: Device, sim_type: int = 1, method: str = "fast", k_limit: int = 200,
                     criteria: Criteria | None = None, config: LoopConfig | None = None,
                     wall_joint: int = 0, equilibrium: float = 0.01,
-                    resolution: float | None = None) -> RangeResult:
+                    resolution: float | None = None, wall_direction=None) -> RangeResult:
     """Maximum stable impedance of ``wall_joint`` for simulation type 1 or 2 (seed §4.1.2).
+
+    With ``wall_direction`` (x, y, z) the wall is Cartesian: K in N/m along that direction at the
+    handle, ``equilibrium`` in metres from the handle's start, the criteria on the handle's
+    wall-normal displacement, ``wall_joint`` the joint the experiment leaves free (:class:`.Wall`).
 
     Without ``resolution`` the seed's integer scan K = 1, 2, 3 ... (``method`` "linear", or "fast"
     for the same answer in fewer runs); with it, :func:`grid_search` on ``R, 2R, 3R ...``.
@@ -299,8 +314,10 @@ def impedance_range(device: Device, sim_type: int = 1, method: str = "fast", k_l
     if isinstance(k_limit, bool) or not isinstance(k_limit, (int, float)) or not math.isfinite(k_limit):
         raise UserError(f"the stiffness limit must be a number, got {k_limit!r}")
     if k_limit < 1:
-        raise UserError("the stiffness limit must be at least 1 N m/rad")
+        raise UserError("the stiffness limit must be at least 1 (N m/rad, or N/m)")
     config = config or LoopConfig(wall=Wall())
+    if wall_direction is not None:
+        config = replace(config, wall=replace(config.wall, direction=tuple(unit_direction(wall_direction).tolist())))
     require_search_workload(config, planned_simulations(method, k_limit, resolution))
     if method == "analytic":
         analytic = AnalyticProblem(device, sim_type, wall_joint, equilibrium, criteria or Criteria(), config)

@@ -10,9 +10,12 @@ Digital side, every ``sub`` steps (period ``T = sub h``): sensors read position,
 acceleration (the acceleration just before the instant, i.e. under the previous held torque,
 which avoids an algebraic loop; zero at t = 0 as the seed's initial conditions), optionally quantized (positions) and delayed; the compensator
 computes the model's inverse dynamics ``tau_f`` with its inertial, Coriolis and gravity terms
-switchable; the virtual wall computes ``tau_imp = K (q_w - q_eq) + B qd_w``; the actuators hold
-``u = tau_f - tau_imp`` (zero-order hold). The safety switch of Figure 4.7 cuts both torques off
-once the wall joint leaves its reference by ``safety_limit``.
+switchable; the virtual wall computes ``tau_imp = K (q_w - q_eq) + B qd_w`` on a joint, or for a
+Cartesian wall along the unit direction n at the handle ``tau_imp = J_n^T (K (n.p - x_eq) + B J_n qd)``
+(``tau = J^T F``, ``J_n = n^T J_v`` from the compiled frame tree at the sensed pose); the actuators
+hold ``u = tau_f - tau_imp`` (zero-order hold). The safety switch of Figure 4.7 cuts both torques
+off once the wall coordinate (the wall joint, or the handle along n) leaves its reference by
+``safety_limit``.
 """
 
 from __future__ import annotations
@@ -20,6 +23,8 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
+from hapticdesign.analysis.dynamics.kernel import _node_poses
+from hapticdesign.analysis.loops.closure_kernel import frame_jacobian
 from hapticdesign.simulation.config import FRICTION_VELOCITY, STATUS_COMPLETED, STATUS_DIVERGED, STATUS_EXCURSION
 from hapticdesign.simulation.tables import evaluate_entries, unpack_entries, velocity_products
 
@@ -49,9 +54,11 @@ def _solve_in_place(a, b, n):
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
-def _plant_terms(q, table, hand_mass, ws_values, ws_phi, ws_entries, cache_q, cache_valid, h, c, g):
-    """H + M_hand, C, G of the plant at q, reusing the last evaluation when the non-cyclic q is unchanged."""
-    rows, cols, vals, index, kinds, degrees = table
+def _plant_terms(q, plant):
+    """H + M_hand, C, G of the plant at q into its workspace, reusing the last evaluation when the
+    non-cyclic q is unchanged."""
+    t, ws = plant.table, plant.ws
+    kinds, cache_q, cache_valid, h, hand_mass = t.kinds, ws.cache_q, ws.cache_valid, ws.h, plant.hand_mass
     n = q.shape[0]
     same = cache_valid[0] == 1
     if same:
@@ -60,8 +67,8 @@ def _plant_terms(q, table, hand_mass, ws_values, ws_phi, ws_entries, cache_q, ca
                 same = False
                 break
     if not same:
-        evaluate_entries(q, rows, cols, vals, index, kinds, degrees, ws_values, ws_phi, ws_entries)
-        unpack_entries(ws_entries, n, h, c, g)
+        evaluate_entries(q, t.rows, t.cols, t.vals, t.index, kinds, t.degrees, ws.values, ws.phi, ws.entries)
+        unpack_entries(ws.entries, n, h, ws.c, ws.g)
         for i in range(n):
             for j in range(n):
                 h[i, j] += hand_mass[i, j]
@@ -71,13 +78,14 @@ def _plant_terms(q, table, hand_mass, ws_values, ws_phi, ws_entries, cache_q, ca
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
-def accelerations(q, qd, qdd_path, u, prescribed, table, damping, coulomb, hand_mass, hand_stiffness, hand_rest, ws,
-                  qdd, tau_c, want_tau_c=True):
+def accelerations(q, qd, qdd_path, u, prescribed, plant, qdd, tau_c, want_tau_c=True):
     """Joint accelerations (free joints solved, prescribed taken from the path) and, when
     ``want_tau_c``, the constraint torques (``tau_c`` is scratch otherwise)."""
-    ws_values, ws_phi, ws_entries, cache_q, cache_valid, h, c, g, qd2, a, rhs, free = ws
+    ws = plant.ws
+    h, c, g, qd2, a, rhs, free = ws.h, ws.c, ws.g, ws.qd2, ws.a, ws.rhs, ws.free
+    damping, coulomb, hand_stiffness, hand_rest = plant.damping, plant.coulomb, plant.hand_stiffness, plant.hand_rest
     n = q.shape[0]
-    _plant_terms(q, table, hand_mass, ws_values, ws_phi, ws_entries, cache_q, cache_valid, h, c, g)
+    _plant_terms(q, plant)
     velocity_products(qd, qd2)
     bias = tau_c
     for i in range(n):
@@ -135,12 +143,13 @@ def _stage_state(q, qd, kq, a, h, prescribed, path_q_row, path_qd_row, qs, qds):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def compensator_torque(q, qd, qdd, table, switches, ws_values, ws_phi, ws_entries, h, c, g, qd2, out):
+def compensator_torque(q, qd, qdd, ctrl, out):
     """Model-based feedforward ``tau_f = s_H H qdd + s_C C qd^2 + s_G G`` (seed §4.1.1.2)."""
-    rows, cols, vals, index, kinds, degrees = table
+    t, ws, switches = ctrl.table, ctrl.ws, ctrl.switches
+    h, c, g, qd2 = ws.h, ws.c, ws.g, ws.qd2
     n = q.shape[0]
-    evaluate_entries(q, rows, cols, vals, index, kinds, degrees, ws_values, ws_phi, ws_entries)
-    unpack_entries(ws_entries, n, h, c, g)
+    evaluate_entries(q, t.rows, t.cols, t.vals, t.index, t.kinds, t.degrees, ws.values, ws.phi, ws.entries)
+    unpack_entries(ws.entries, n, h, c, g)
     velocity_products(qd, qd2)
     for i in range(n):
         s_h = 0.0
@@ -152,29 +161,64 @@ def compensator_torque(q, qd, qdd, table, switches, ws_values, ws_phi, ws_entrie
         out[i] = switches[0] * s_h + switches[1] * s_c + switches[2] * g[i]
 
 
-def make_workspace(n: int, n_values: int, n_basis: int, n_entries: int):
-    """Scratch arrays for :func:`accelerations` (one set per plant)."""
-    m = n * (n + 1) // 2
-    return (
-        np.zeros((n, n_values)), np.zeros(n_basis), np.zeros(n_entries), np.zeros(n), np.zeros(1, dtype=np.int64),
-        np.zeros((n, n)), np.zeros((n, m)), np.zeros(n), np.zeros(m), np.zeros((n, n)), np.zeros(n),
-        np.zeros(n, dtype=np.int64),
-    )
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _handle_normal(q, handle):
+    """The handle's position along the wall direction, ``n . p(q)``; leaves the node poses in ``handle``."""
+    pos, n, node = handle.pos, handle.direction, handle.node
+    _node_poses(q, handle.parent, handle.axis, handle.coef, handle.offset, handle.rot, pos)
+    return n[0] * pos[node, 0] + n[1] * pos[node, 1] + n[2] * pos[node, 2]
 
 
 @nb.njit(cache=True, error_model="numpy")
-def run_loop(plant, model, ws_plant, ws_model, damping, coulomb, hand_mass, hand_stiffness, hand_rest, prescribed,
-             path_q, path_qd, path_qdd, q0, qd0, step, sub, n_steps, wall_joint, wall_k, wall_b, wall_eq,
-             switches, quant, delay, safety_limit, reference, stop_excursion, stride,
-             rec_q, rec_qd, rec_u, rec_f, rec_imp, rec_c):
-    """Run the loop; returns (records written, status, time the safety switch tripped or -1, peak
-    excursion of the wall joint from ``reference`` over every plant step, time the run ended).
+def handle_normal(q, handle):
+    """:func:`_handle_normal` callable from Python (the wall's reference at the start pose)."""
+    return _handle_normal(q, handle)
 
-    The excursion is checked at every plant step, so a run stopped at ``stop_excursion`` reports a
-    peak at or above it even when no recorded row (every ``stride`` steps) shows it."""
-    n = q0.shape[0]
-    q = q0.copy()
-    qd = qd0.copy()
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _wall_coordinate(q, wall, handle):
+    """The wall coordinate: the wall joint's position, or the handle's along a Cartesian wall's direction."""
+    if wall.cartesian:
+        return _handle_normal(q, handle)
+    return q[wall.joint]
+
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _wall_torque(q, qd, wall, handle, out):
+    """``tau_imp`` of the wall at the sensed state: ``K (q_j - q_eq) + B qd_j`` on the wall joint, or
+    ``J_n^T (K (n.p - x_eq) + B J_n qd)`` with ``J_n = n^T J_v`` the handle's Jacobian along n."""
+    if not wall.cartesian:
+        for i in range(q.shape[0]):
+            out[i] = 0.0
+        out[wall.joint] = wall.stiffness * (q[wall.joint] - wall.rest) + wall.damping * qd[wall.joint]
+        return
+    x = _handle_normal(q, handle)
+    jac, n = handle.jac, handle.direction
+    frame_jacobian(handle.node, handle.parent, handle.axis, handle.coef, handle.rot, handle.pos, jac)
+    v = 0.0
+    for k in range(q.shape[0]):
+        out[k] = n[0] * jac[0, k] + n[1] * jac[1, k] + n[2] * jac[2, k]
+        v += out[k] * qd[k]
+    force = wall.stiffness * (x - wall.rest) + wall.damping * v
+    for k in range(q.shape[0]):
+        out[k] *= force
+
+
+@nb.njit(cache=True, error_model="numpy")
+def run_loop(plant, ctrl, motion, timing, wall, handle, rec):
+    """Run the loop (records of :mod:`.records`); returns (records written, status, time the safety
+    switch tripped or -1, peak excursion of the wall coordinate from ``wall.reference`` over every
+    plant step, time the run ended).
+
+    The excursion is checked at every plant step, so a run stopped at ``wall.stop_excursion``
+    reports a peak at or above it even when no recorded row (every ``timing.stride`` steps) shows it."""
+    prescribed, path_q, path_qd, path_qdd = motion.prescribed, motion.path_q, motion.path_qd, motion.path_qdd
+    step, sub, n_steps, stride = timing.step, timing.sub, timing.n_steps, timing.stride
+    delay, quant = ctrl.delay, ctrl.quant
+    rec_q, rec_qd, rec_u, rec_f, rec_imp, rec_c, rec_w = rec.q, rec.qd, rec.u, rec.tau_f, rec.tau_imp, rec.tau_c, rec.wall
+    n = motion.q0.shape[0]
+    q = motion.q0.copy()
+    qd = motion.qd0.copy()
     for i in range(n):
         if prescribed[i]:
             q[i] = path_q[0, i]
@@ -190,7 +234,6 @@ def run_loop(plant, model, ws_plant, ws_model, damping, coulomb, hand_mass, hand
     qs = np.zeros(n); qds = np.zeros(n)
     buf = np.zeros((delay + 1, 3, n))
     sensed = np.zeros((3, n))
-    m_values, m_phi, m_entries, _, _, m_h, m_c, m_g, m_qd2, _, _, _ = ws_model
     n_free = 0
     for i in range(n):
         if not prescribed[i]:
@@ -200,12 +243,12 @@ def run_loop(plant, model, ws_plant, ws_model, damping, coulomb, hand_mass, hand
     written = 0
     status = STATUS_COMPLETED
     peak = 0.0
+    coord = _wall_coordinate(q, wall, handle)
     end_time = 0.0
     for it in range(n_steps + 1):
         t = it * step
         if it % sub == 0:
-            accelerations(q, qd, path_qdd[2 * it], u, prescribed, plant, damping, coulomb,
-                          hand_mass, hand_stiffness, hand_rest, ws_plant, qdd, c1)
+            accelerations(q, qd, path_qdd[2 * it], u, prescribed, plant, qdd, c1)
             if it == 0:
                 for i in range(n):
                     if not prescribed[i]:
@@ -224,11 +267,8 @@ def run_loop(plant, model, ws_plant, ws_model, damping, coulomb, hand_mass, hand
                 sensed[0, i] = pos
                 sensed[1, i] = buf[old, 1, i]
                 sensed[2, i] = buf[old, 2, i]
-            compensator_torque(sensed[0], sensed[1], sensed[2], model, switches,
-                               m_values, m_phi, m_entries, m_h, m_c, m_g, m_qd2, tau_f)
-            for i in range(n):
-                tau_imp[i] = 0.0
-            tau_imp[wall_joint] = wall_k * (sensed[0, wall_joint] - wall_eq) + wall_b * sensed[1, wall_joint]
+            compensator_torque(sensed[0], sensed[1], sensed[2], ctrl, tau_f)
+            _wall_torque(sensed[0], sensed[1], wall, handle, tau_imp)
             if tripped:
                 for i in range(n):
                     tau_f[i] = 0.0
@@ -236,8 +276,7 @@ def run_loop(plant, model, ws_plant, ws_model, damping, coulomb, hand_mass, hand
             for i in range(n):
                 u[i] = tau_f[i] - tau_imp[i]
         # stage 1 (also gives the recorded constraint torque)
-        accelerations(q, qd, path_qdd[2 * it], u, prescribed, plant, damping, coulomb,
-                      hand_mass, hand_stiffness, hand_rest, ws_plant, a1, c1)
+        accelerations(q, qd, path_qdd[2 * it], u, prescribed, plant, a1, c1)
         if it % stride == 0:
             r = it // stride
             for i in range(n):
@@ -247,6 +286,7 @@ def run_loop(plant, model, ws_plant, ws_model, damping, coulomb, hand_mass, hand
                 rec_f[r, i] = tau_f[i]
                 rec_imp[r, i] = tau_imp[i]
                 rec_c[r, i] = c1[i]
+            rec_w[r] = coord
             written = r + 1
         finite = True
         for i in range(n):
@@ -256,10 +296,10 @@ def run_loop(plant, model, ws_plant, ws_model, damping, coulomb, hand_mass, hand
         if not finite:
             status = STATUS_DIVERGED
             break
-        excursion = abs(q[wall_joint] - reference)
+        excursion = abs(coord - wall.reference)
         if excursion > peak:
             peak = excursion
-        if excursion >= stop_excursion:
+        if excursion >= wall.stop_excursion:
             status = STATUS_EXCURSION
             break
         if it == n_steps:
@@ -273,16 +313,13 @@ def run_loop(plant, model, ws_plant, ws_model, damping, coulomb, hand_mass, hand
             k1q[:] = qd
             _stage_state(q, qd, k1q, a1, 0.5 * step, prescribed, path_q[2 * it + 1], path_qd[2 * it + 1], qs, qds)
             k2q[:] = qds
-            accelerations(qs, qds, path_qdd[2 * it + 1], u, prescribed, plant, damping, coulomb,
-                          hand_mass, hand_stiffness, hand_rest, ws_plant, a2, tau_c, False)
+            accelerations(qs, qds, path_qdd[2 * it + 1], u, prescribed, plant, a2, tau_c, False)
             _stage_state(q, qd, k2q, a2, 0.5 * step, prescribed, path_q[2 * it + 1], path_qd[2 * it + 1], qs, qds)
             k3q[:] = qds
-            accelerations(qs, qds, path_qdd[2 * it + 1], u, prescribed, plant, damping, coulomb,
-                          hand_mass, hand_stiffness, hand_rest, ws_plant, a3, tau_c, False)
+            accelerations(qs, qds, path_qdd[2 * it + 1], u, prescribed, plant, a3, tau_c, False)
             _stage_state(q, qd, k3q, a3, step, prescribed, path_q[2 * it + 2], path_qd[2 * it + 2], qs, qds)
             k4q[:] = qds
-            accelerations(qs, qds, path_qdd[2 * it + 2], u, prescribed, plant, damping, coulomb,
-                          hand_mass, hand_stiffness, hand_rest, ws_plant, a4, tau_c, False)
+            accelerations(qs, qds, path_qdd[2 * it + 2], u, prescribed, plant, a4, tau_c, False)
             for i in range(n):
                 if prescribed[i]:
                     q[i] = path_q[2 * it + 2, i]
@@ -290,7 +327,8 @@ def run_loop(plant, model, ws_plant, ws_model, damping, coulomb, hand_mass, hand
                 else:
                     q[i] += step / 6.0 * (k1q[i] + 2.0 * k2q[i] + 2.0 * k3q[i] + k4q[i])
                     qd[i] += step / 6.0 * (a1[i] + 2.0 * a2[i] + 2.0 * a3[i] + a4[i])
-        if not tripped and abs(q[wall_joint] - reference) >= safety_limit:
+        coord = _wall_coordinate(q, wall, handle)
+        if not tripped and abs(coord - wall.reference) >= wall.safety_limit:
             tripped = True
             trip_time = t + step
             for i in range(n):

@@ -14,8 +14,10 @@ import numpy as np
 
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
-from hapticdesign.simulation import kernel
-from hapticdesign.simulation.config import LoopConfig, Trace, compensator_device, hand_matrices, plant_friction
+from hapticdesign.simulation import kernel, records
+from hapticdesign.simulation.config import (
+    LoopConfig, Trace, Wall, compensator_device, hand_matrices, plant_friction, unit_direction,
+)
 from hapticdesign.simulation.paths import Path
 from hapticdesign.simulation.tables import DynamicsTables, workspace_size
 from hapticdesign.workload import loop_bytes, require_memory
@@ -32,6 +34,10 @@ def joint_index(device: Device, joint: int | str) -> int:
     if not 1 <= j <= len(names):
         raise UserError(f"unknown joint {joint}; the device has joints 1..{len(names)}")
     return j - 1
+
+
+def _workspace(tables: DynamicsTables) -> records.Workspace:
+    return records.workspace(tables.n_dof, workspace_size(tables), tables.index.shape[0], tables.n_entries)
 
 
 def simulate(
@@ -55,7 +61,18 @@ def simulate(
     plant = plant or DynamicsTables.from_device(device)
     model = model or DynamicsTables.from_device(compensator_device(device, config.compensator))
     damping = config.damping if config.damping is not None else device.damping
-    return simulate_tables(plant, model, config, damping, paths, q_start, hand, plant_friction(device, config))
+    return simulate_tables(plant, model, config, damping, paths, q_start, hand, plant_friction(device, config),
+                           handle_of(device, config.wall) if config.wall.cartesian else None)
+
+
+def handle_of(device: Device, wall: Wall) -> records.Handle:
+    """The kernel's handle kinematics for a Cartesian ``wall`` on ``device`` (its end-effector frame)."""
+    mech = device.mechanism
+    if mech.loops is not None:
+        raise UserError("a Cartesian wall needs an open-chain device (closed loops are not simulated at the handle)")
+    if mech.end_effector is None:
+        raise UserError("a Cartesian wall needs a device that names its end-effector (handle) frame")
+    return records.handle(mech, unit_direction(wall.direction))
 
 
 def simulate_tables(
@@ -67,8 +84,10 @@ def simulate_tables(
     q0: np.ndarray | None = None,
     hand: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
     coulomb: np.ndarray | None = None,
+    handle: records.Handle | None = None,
 ) -> Trace:
-    """Simulate the loop for plant and compensator tables directly (any number of joints)."""
+    """Simulate the loop for plant and compensator tables directly (any number of joints);
+    a Cartesian wall needs the device's ``handle`` (:func:`handle_of`)."""
     n = plant.n_dof
     sub = config.steps_per_sample()
     if not (config.duration > 0 and math.isfinite(config.duration)):
@@ -80,6 +99,8 @@ def simulate_tables(
         raise UserError("the wall stiffness, damping and equilibrium must be finite")
     if wall.damping < 0:
         raise UserError(f"the virtual wall damping must be non-negative, got {wall.damping}")
+    if wall.cartesian and handle is None:
+        raise UserError("a Cartesian wall needs the device's handle kinematics")
     paths = dict(paths or {})
     for j in paths:
         if not 0 <= j < n:
@@ -117,22 +138,27 @@ def simulate_tables(
     hand_mass, hand_damping, hand_stiffness = hand if hand is not None else (np.zeros((n, n)),) * 3
     comp = config.compensator
     n_rec = n_steps // stride + 1
-    rec = [np.zeros((n_rec, n)) for _ in range(6)]
+    rec = records.Records(*(np.zeros((n_rec, n)) for _ in range(6)), np.zeros(n_rec))
     switches = np.array([comp.inertial, comp.coriolis, comp.gravity], dtype=float)
-    written, status, trip, peak, end_time = kernel.run_loop(
-        (*plant.sparse, plant.index, plant.kinds, plant.degrees),
-        (*model.sparse, model.index, model.kinds, model.degrees),
-        kernel.make_workspace(n, workspace_size(plant), plant.index.shape[0], plant.n_entries),
-        kernel.make_workspace(n, workspace_size(model), model.index.shape[0], model.n_entries),
-        np.diag(damping) + hand_damping, np.zeros(n) if coulomb is None else np.asarray(coulomb, dtype=float),
-        hand_mass, hand_stiffness, q_start.copy(), prescribed,
-        path_q, path_qd, path_qdd, q_start, np.zeros(n), config.step, sub, n_steps,
-        wall.joint, float(wall.stiffness), float(wall.damping), float(wall.equilibrium), switches, quant,
-        int(sensors.delay_samples),
-        math.inf if config.safety_limit is None else float(config.safety_limit), float(q_start[wall.joint]),
-        math.inf if config.stop_excursion is None else float(config.stop_excursion), stride, *rec,
+    damping_matrix = np.diag(damping) + hand_damping
+    friction = np.zeros(n) if coulomb is None else np.asarray(coulomb, dtype=float)
+    plant_record = records.Plant(records.table(plant), _workspace(plant), damping_matrix, friction,
+                                 hand_mass, hand_stiffness, q_start.copy())
+    controller = records.Controller(records.table(model), _workspace(model), switches, quant,
+                                    int(sensors.delay_samples))
+    motion = records.Motion(prescribed, path_q, path_qd, path_qdd, q_start, np.zeros(n))
+    timing = records.Timing(float(config.step), sub, n_steps, stride)
+    handle = handle if wall.cartesian else records.no_handle(n)
+    reference = float(kernel.handle_normal(q_start, handle)) if wall.cartesian else float(q_start[wall.joint])
+    rest = reference + float(wall.equilibrium) if wall.cartesian else float(wall.equilibrium)
+    law = records.WallLaw(
+        cartesian=wall.cartesian, joint=wall.joint, stiffness=float(wall.stiffness), damping=float(wall.damping),
+        rest=rest, reference=reference,
+        safety_limit=math.inf if config.safety_limit is None else float(config.safety_limit),
+        stop_excursion=math.inf if config.stop_excursion is None else float(config.stop_excursion),
     )
+    written, status, trip, peak, end_time = kernel.run_loop(plant_record, controller, motion, timing, law, handle, rec)
     t = np.arange(written) * stride * config.step
-    q, qd, u, tau_f, tau_imp, tau_c = (r[:written] for r in rec)
+    q, qd, u, tau_f, tau_imp, tau_c, position = (r[:written] for r in rec)
     return Trace(t, q, qd, u, tau_f, tau_imp, tau_c, int(status), None if trip < 0 else float(trip),
-                 float(peak), float(end_time))
+                 float(peak), float(end_time), position)

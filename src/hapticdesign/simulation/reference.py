@@ -7,7 +7,8 @@ adaptive integrator, the cross-check of the numba kernel, and the speed baseline
 benchmark. It shares only the configuration types with the fast loop (:mod:`.config`), none of
 its code. Records are taken at the sample instants; the excursion stop and the safety switch are
 checked at every plant-step instant (``config.step``) from the dense output of each period, as the
-fast loop checks them, and a tripped switch removes the torques from that instant on.
+fast loop checks them, and a tripped switch removes the torques from that instant on. A Cartesian
+wall takes the handle's position and Jacobian from :mod:`hapticdesign.analysis.kinematics`.
 """
 
 from __future__ import annotations
@@ -18,11 +19,12 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from hapticdesign.analysis.dynamics.device import dynamics_of
+from hapticdesign.analysis.kinematics import forward_kinematics, jacobian
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation.config import (
     FRICTION_VELOCITY, STATUS_COMPLETED, STATUS_DIVERGED, STATUS_EXCURSION, LoopConfig, Trace, compensator_device,
-    hand_matrices, plant_friction,
+    hand_matrices, plant_friction, unit_direction,
 )
 from hapticdesign.simulation.paths import Path
 
@@ -102,7 +104,24 @@ def simulate_adaptive(
     rec = {k: [] for k in ("q", "qd", "u", "f", "imp", "c")}
     tripped_at = None
     status = STATUS_COMPLETED
-    reference = q_start[wall.joint]
+    direction = unit_direction(wall.direction) if wall.cartesian else None
+
+    def coordinate(q_t: np.ndarray) -> float:
+        """The wall coordinate: the wall joint, or the handle along the Cartesian wall's direction."""
+        if direction is None:
+            return float(q_t[wall.joint])
+        return float(direction @ forward_kinematics(device.mechanism, q_t)[:3, 3])
+
+    def wall_torque(qs: np.ndarray, qds: np.ndarray) -> np.ndarray:
+        tau = np.zeros(n)
+        if direction is None:
+            tau[wall.joint] = wall.stiffness * (qs[wall.joint] - wall.equilibrium) + wall.damping * qds[wall.joint]
+            return tau
+        j_n = direction @ jacobian(device.mechanism, qs)[:3]
+        return j_n * (wall.stiffness * (coordinate(qs) - rest) + wall.damping * (j_n @ qds))
+
+    reference = coordinate(q_start)
+    rest = reference + wall.equilibrium
     peak, end_time = 0.0, 0.0
     j_, k_ = np.triu_indices(n)
 
@@ -118,7 +137,7 @@ def simulate_adaptive(
         end_time = t
         if not (np.all(np.isfinite(q_t)) and np.all(np.isfinite(qd_t))) or np.max(np.abs(qd_t)) > 1e8:
             return STATUS_DIVERGED
-        excursion = abs(q_t[wall.joint] - reference)
+        excursion = abs(coordinate(q_t) - reference)
         peak = max(peak, excursion)
         return STATUS_EXCURSION if excursion >= stop else None
 
@@ -138,8 +157,7 @@ def simulate_adaptive(
             qs = np.round(qs / quant) * quant
         h_m, c_m, g_m = _terms(device, pi_model, qs)
         tau_f = comp.inertial * (h_m @ qdds) + comp.coriolis * (c_m @ (qds[j_] * qds[k_])) + comp.gravity * g_m
-        tau_imp = np.zeros(n)
-        tau_imp[wall.joint] = wall.stiffness * (qs[wall.joint] - wall.equilibrium) + wall.damping * qds[wall.joint]
+        tau_imp = wall_torque(qs, qds)
         if tripped_at is not None:
             tau_f, tau_imp = np.zeros(n), np.zeros(n)
         u = tau_f - tau_imp
@@ -163,7 +181,7 @@ def simulate_adaptive(
                 ended = plant_step_check(t_j, q_j, qd_j)
                 if ended is not None:
                     break
-                if tripped_at is None and abs(q_j[wall.joint] - reference) >= safety:
+                if tripped_at is None and abs(coordinate(q_j) - reference) >= safety:
                     tripped_at = t_j
                     u = np.zeros(n)
                     start, y = t_j, y_j
@@ -177,4 +195,4 @@ def simulate_adaptive(
     arrays = {k: np.array(v).reshape(-1, n) for k, v in rec.items()}
     times = np.arange(len(arrays["q"])) * period
     return Trace(times, arrays["q"], arrays["qd"], arrays["u"], arrays["f"], arrays["imp"], arrays["c"],
-                 status, tripped_at, peak, end_time)
+                 status, tripped_at, peak, end_time, np.array([coordinate(q_k) for q_k in arrays["q"]]))

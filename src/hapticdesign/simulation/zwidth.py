@@ -152,6 +152,21 @@ def linear_approximation(loop: DisplayLoop, virtual_damping: float) -> float:
     return max(0.0, 2.0 * (loop.damping + virtual_damping) / (loop.period * (1 + 2 * loop.delay)))
 
 
+def along_wall(loop: DisplayLoop, reach: float) -> DisplayLoop:
+    """The joint's loop seen along a Cartesian wall (K in N/m, B in N s/m along n at the handle).
+
+    With the other joints held the wall acts on the joint as ``K J_n^2`` and ``B J_n^2`` (``reach =
+    J_n = n^T J_v`` of the joint, m/rad), so dividing the joint's equation by ``J_n^2`` gives the same
+    loop in the handle's wall-normal coordinate ``x = J_n q``: inertia ``J / J_n^2`` (kg), damping
+    ``b / J_n^2`` (N s/m) and a plant spring ``k_p / J_n^2`` (N/m); its Z-width is in N/m over N s/m.
+    """
+    if not (math.isfinite(reach) and abs(reach) > 1e-12):
+        raise UserError("the joint does not move the handle along the wall direction at this pose")
+    r2 = reach * reach
+    return DisplayLoop(loop.inertia / r2, loop.damping / r2, loop.period, loop.delay, loop.velocity, loop.fraction,
+                       loop.plant_stiffness / r2)
+
+
 @dataclass(frozen=True)
 class ZWidth:
     """The boundary ``K_max(B)`` at the given virtual dampers, with the two approximations beside it

@@ -11,8 +11,8 @@ import typer
 from hapticdesign.interface.options import DEVICE, FORCE, FORCE_HINT, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
 from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
-from hapticdesign.interface.common import (joint_units, print_json, progress_bar, progress_lines, user_errors,
-                                           write_atomically)
+from hapticdesign.interface.common import (joint_units, parse_vector, print_json, progress_bar, progress_lines,
+                                           user_errors, write_atomically)
 from hapticdesign.workload import allow_large
 
 # Magnitudes the 1-DOF boundary is computed for (SI units); outside them exp(-b T / J) and the
@@ -70,7 +70,24 @@ ERROR = typer.Option(0.0, help="Compensator modelling error in percent (scales i
 INERTIAL = typer.Option(True, "--inertial/--no-inertial", help="Compensate the inertial term H qdd.")
 CORIOLIS = typer.Option(True, "--coriolis/--no-coriolis", help="Compensate the Coriolis term C qd^2.")
 GRAVITY = typer.Option(True, "--gravity/--no-gravity", help="Compensate gravity G.")
-WALL_DAMPING = typer.Option(0.0, help="Virtual wall damper [N m s/rad].")
+WALL_DAMPING = typer.Option(0.0, help="Virtual wall damper [N m s/rad; N s/m for a Cartesian wall].")
+WALL_DIRECTION = typer.Option(
+    None, help="Cartesian wall: its direction x,y,z at the handle (K in N/m, damper in N s/m, equilibrium and "
+               "criteria in m along it; --joint is the joint left free). Default: a wall on --joint.")
+
+
+def _with_direction(config, text: str | None):
+    """The configuration with a Cartesian wall along ``--wall-direction`` (unchanged without it)."""
+    from dataclasses import replace
+
+    from hapticdesign.simulation.config import unit_direction
+
+    if text is None:
+        return config
+    vector = parse_vector(text, 3, "wall-direction")
+    if not vector.any():
+        raise UserError("--wall-direction must not be the zero vector")
+    return replace(config, wall=replace(config.wall, direction=tuple(unit_direction(vector).tolist())))
 HAND_MASS = typer.Option(0.0, help="Hand mass at the handle [kg] (off by default).")
 HAND_DAMPING = typer.Option(0.0, help="Hand damping at the handle [N s/m].")
 HAND_STIFFNESS = typer.Option(0.0, help="Hand stiffness at the handle [N/m].")
@@ -82,7 +99,9 @@ def impedance_range_command(
     params: Optional[Path] = PARAMS,
     sim_type: int = typer.Option(1, "--type", help="1: other joints held at 0; 2: driven at 0.52 sin(3 pi t)."),
     joint: str = typer.Option("1", help="Joint carrying the virtual wall (1-based or coordinate name)."),
-    equilibrium: float = typer.Option(0.01, help="Wall equilibrium [rad]; the joints start at 0."),
+    equilibrium: float = typer.Option(0.01, help="Wall equilibrium [rad]; the joints start at 0. With "
+                                                  "--wall-direction: metres along it from the handle's start."),
+    wall_direction: Optional[str] = WALL_DIRECTION,
     method: str = typer.Option("fast", help="fast (doubling + bisection), linear (K = 1, 2, 3, ...) or analytic "
                                             "(the exact linear response of the sampled loop at the start pose, "
                                             "no ODE integration; exact for type 1 and LN = 0 designs)."),
@@ -119,8 +138,9 @@ def impedance_range_command(
             raise UserError(f"--settle-window ({settle_window:g} s) must be positive and not longer than --duration "
                             f"({duration:g} s)")
         dev = resolve_device(preset, device, params, strict=strict)
-        config = _loop_config(period, step, duration, counts, delay, error_percent, inertial, coriolis, gravity,
-                              wall_damping, hand_mass, hand_damping, hand_stiffness)
+        config = _with_direction(_loop_config(period, step, duration, counts, delay, error_percent, inertial, coriolis,
+                                              gravity, wall_damping, hand_mass, hand_damping, hand_stiffness),
+                                 wall_direction)
         if method not in ("fast", "linear", "analytic"):
             raise UserError(f"--method must be 'fast', 'linear' or 'analytic', got {method!r}")
         if k_limit < 1:
@@ -140,7 +160,10 @@ def impedance_range_command(
         else:
             result = (fast_search if method == "fast" else linear_scan)(problem, k_limit)
         unit = joint_units(dev)[problem.wall_joint]
-        out = {"device": dev.name, "type": sim_type, "joint": problem.wall_joint + 1, **result.as_dict(),
+        if config.wall.cartesian:
+            unit = {"stiffness": "N/m", "position": "m"}
+        wall = {"wall_direction": list(config.wall.direction)} if config.wall.cartesian else {}
+        out = {"device": dev.name, "type": sim_type, "joint": problem.wall_joint + 1, **wall, **result.as_dict(),
                "units": {"k_max": unit["stiffness"], "k_min": unit["stiffness"], "peak_at_first_unstable": unit["position"],
                          "stopped_at_first_unstable": "s"}}
         if true_boundary:
@@ -153,7 +176,7 @@ def impedance_range_command(
                    f"{out['k_max']:g} {unit['stiffness']}{lowest} (first failure: {out['criterion']}; "
                    f"{out['simulations']} simulations)")
         if true_boundary:
-            typer.echo(f"oscillation-growth boundary: {out['k_true_boundary']:.4g} N m/rad")
+            typer.echo(f"oscillation-growth boundary: {out['k_true_boundary']:.4g} {unit['stiffness']}")
 
 
 def transparency_command(

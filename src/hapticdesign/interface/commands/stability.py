@@ -18,10 +18,12 @@ def _dampers(text: Optional[str]) -> Optional[list[float]]:
     return None if text is None else [float(v) for v in parse_vector(text, None, "b-values")]
 
 
-def _device_joint(preset, device, params, strict, q, joint, error_percent, compensate) -> tuple[float, float, float]:
-    """J = H_jj(q), b_j and the compensator fraction H_model,jj / H_jj of a device at a pose."""
+def _device_joint(preset, device, params, strict, q, joint, error_percent, compensate,
+                  direction=None) -> tuple[float, float, float, float | None]:
+    """J = H_jj(q), b_j, the compensator fraction H_model,jj / H_jj of a device at a pose, and
+    ``J_n = n^T J_v`` of the joint along a Cartesian wall's ``direction`` (None without one)."""
     from hapticdesign.devices.loading import resolve_device
-    from hapticdesign.simulation.config import model_device
+    from hapticdesign.simulation.config import Wall, model_device, normal_jacobian
     from hapticdesign.simulation.loop import joint_index
 
     dev = resolve_device(preset, device, params, strict=strict)
@@ -29,7 +31,13 @@ def _device_joint(preset, device, params, strict, q, joint, error_percent, compe
     j = joint_index(dev, joint)
     inertia = float(mass_matrix(dev, pose)[j, j])
     fraction = float(mass_matrix(model_device(dev, error_percent), pose)[j, j]) / inertia if compensate else 0.0
-    return inertia, float(dev.damping[j]), fraction
+    reach = None
+    if direction is not None:
+        vector = parse_vector(direction, 3, "wall-direction")
+        if not vector.any():
+            raise UserError("--wall-direction must not be the zero vector")
+        reach = float(normal_jacobian(dev, Wall(direction=tuple(vector.tolist())), pose)[j])
+    return inertia, float(dev.damping[j]), fraction, reach
 
 
 def zwidth_command(
@@ -40,6 +48,9 @@ def zwidth_command(
     params: Optional[Path] = PARAMS,
     q: Optional[str] = typer.Option(None, help="Pose of the device [rad or m], comma-separated (default: zeros)."),
     joint: str = typer.Option("1", help="The device's joint carrying the wall (1-based or coordinate name)."),
+    wall_direction: Optional[str] = typer.Option(
+        None, help="Device mode: a Cartesian wall along x,y,z at the handle, moved by --joint (the others held); "
+                   "K in N/m, B in N s/m."),
     strict: bool = STRICT,
     period: float = typer.Option(1e-3, help="Sample period T [s]."),
     delay: int = typer.Option(0, help="Computation delay N [samples]: the torque of interval k uses the samples of k - N."),
@@ -64,7 +75,7 @@ def zwidth_command(
     Colgate & Schenkel beside it (Colgate & Brown 1994). J and b come from the options or from one
     joint of a device at a pose (the other joints held)."""
     from hapticdesign.simulation.figures import zwidth_chart
-    from hapticdesign.simulation.zwidth import DisplayLoop, zwidth
+    from hapticdesign.simulation.zwidth import DisplayLoop, along_wall, zwidth
 
     with user_errors(quiet=quiet):
         if not (math.isfinite(error_percent) and 0.0 <= error_percent < 100.0):
@@ -75,30 +86,42 @@ def zwidth_command(
         from_device = preset is not None or device is not None
         if from_device == (inertia is not None or damping is not None):
             raise UserError("give either --inertia and --damping, or a device (--preset or --device) with --q and --joint")
+        if wall_direction is not None and not from_device:
+            raise UserError("--wall-direction needs a device (--preset or --device)")
+        if wall_direction is not None and map_joints is not None:
+            raise UserError("--map-joints charts a joint wall; leave out --wall-direction")
+        reach = None
         if from_device:
-            inertia, damping, fraction = _device_joint(preset, device, params, strict, q, joint, error_percent,
-                                                       compensate_inertia)
+            inertia, damping, fraction, reach = _device_joint(preset, device, params, strict, q, joint, error_percent,
+                                                              compensate_inertia, wall_direction)
         if map_joints is not None and not (from_device and out is not None):
             raise UserError("--map-joints needs a device (--preset or --device) and --out")
         elif inertia is None or damping is None:
             raise UserError("--inertia and --damping go together")
         loop = DisplayLoop(inertia, damping, period, delay, velocity, fraction)
+        if reach is not None:
+            loop = along_wall(loop, reach)
         result = zwidth(loop, _dampers(b_values), points)
+        units = ("kg", "N s/m", "N/m") if reach is not None else ("kg m^2", "N m s/rad", "N m/rad")
         figures = []
         if out is not None:
-            title = (f"J = {inertia:g} kg m^2, b = {damping:g} N m s/rad, T = {period:g} s, N = {delay}, "
-                     f"{velocity} velocity" + (f", compensator c = {fraction:g}" if compensate_inertia else ""))
-            figures = [str(p) for p in zwidth_chart(result, title, Path(out) / "zwidth")]
+            title = (f"J = {loop.inertia:g} {units[0]}, b = {loop.damping:g} {units[1]}, T = {period:g} s, N = {delay}, "
+                     f"{velocity} velocity" + (f", compensator c = {fraction:g}" if compensate_inertia else "")
+                     + (" (Cartesian wall)" if reach is not None else ""))
+            figures = [str(p) for p in zwidth_chart(result, title, Path(out) / "zwidth", units[1:])]
             if map_joints is not None:
                 figures += _map(preset, device, params, strict, joint, map_joints, map_points, loop, result.B[0],
                                 Path(out))
-        payload = {**result.as_dict(), "loop": {"inertia": inertia, "damping": damping, "period": period,
+        payload = {**result.as_dict(), "loop": {"inertia": loop.inertia, "damping": loop.damping, "period": period,
                                                  "delay": delay, "velocity": velocity, "fraction": fraction},
                    "figures": figures}
+        if reach is not None:
+            payload["units"] = {"B": units[1], "K": units[2]}
+            payload["loop"]["wall_reach"] = reach
         if json_out:
             print_json(payload)
             return
-        typer.echo("B [N m s/rad]   K_max [N m/rad]   passivity K   linear approximation K")
+        typer.echo(f"B [{units[1]}]   K_max [{units[2]}]   passivity K   linear approximation K")
         for i, (b, k) in enumerate(zip(result.B, result.K)):
             p = "-" if result.passivity is None else f"{result.passivity[i]:.6g}"
             lin = "-" if result.linear is None else f"{result.linear[i]:.6g}"

@@ -1,0 +1,157 @@
+"""The typed records the numba loop (:mod:`.kernel`) takes, built in one place (:mod:`.loop`).
+
+Each is a ``typing.NamedTuple`` of arrays and scalars, which numba compiles to a struct whose
+fields the kernel reads by name: a stiffness cannot pass for a damping by its position.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+
+class Table(NamedTuple):
+    """Sparse basis coefficients of H, C, G (:class:`~.tables.DynamicsTables`) for :func:`~.tables.evaluate_entries`."""
+
+    rows: np.ndarray
+    cols: np.ndarray
+    vals: np.ndarray
+    index: np.ndarray
+    kinds: np.ndarray
+    degrees: np.ndarray
+
+
+class Workspace(NamedTuple):
+    """Scratch arrays of one set of dynamics tables (basis values, entries, H, C, G, linear solve)."""
+
+    values: np.ndarray
+    phi: np.ndarray
+    entries: np.ndarray
+    cache_q: np.ndarray
+    cache_valid: np.ndarray
+    h: np.ndarray
+    c: np.ndarray
+    g: np.ndarray
+    qd2: np.ndarray
+    a: np.ndarray
+    rhs: np.ndarray
+    free: np.ndarray
+
+
+class Plant(NamedTuple):
+    """The continuous side: dynamics tables, joint damping (with the hand's), Coulomb friction and the hand."""
+
+    table: Table
+    ws: Workspace
+    damping: np.ndarray
+    coulomb: np.ndarray
+    hand_mass: np.ndarray
+    hand_stiffness: np.ndarray
+    hand_rest: np.ndarray
+
+
+class Controller(NamedTuple):
+    """The digital side: the compensator's tables and switches ``(s_H, s_C, s_G)``, encoder step, delay."""
+
+    table: Table
+    ws: Workspace
+    switches: np.ndarray
+    quant: float
+    delay: int
+
+
+class Motion(NamedTuple):
+    """Which joints follow a path, the paths at every half plant step, and the start state."""
+
+    prescribed: np.ndarray
+    path_q: np.ndarray
+    path_qd: np.ndarray
+    path_qdd: np.ndarray
+    q0: np.ndarray
+    qd0: np.ndarray
+
+
+class Timing(NamedTuple):
+    """Plant step (s), plant steps per sample, plant steps of the run and between recorded rows."""
+
+    step: float
+    sub: int
+    n_steps: int
+    stride: int
+
+
+class WallLaw(NamedTuple):
+    """The virtual wall on one joint, ``tau_imp[joint] = stiffness (q - rest) + damping qd``, or, when
+    ``cartesian``, along the handle's direction n: ``tau_imp = J_n^T (stiffness (n.p - rest) + damping
+    J_n qd)``. The wall coordinate is ``q[joint]`` or ``n.p``; the run stops once its distance from
+    ``reference`` reaches ``stop_excursion`` and the safety switch cuts the torques once it reaches
+    ``safety_limit``."""
+
+    cartesian: bool
+    joint: int
+    stiffness: float
+    damping: float
+    rest: float
+    reference: float
+    safety_limit: float
+    stop_excursion: float
+
+
+class Handle(NamedTuple):
+    """The frame tree (:class:`~hapticdesign.model.mechanism.CompiledMechanism`), the handle's node,
+    the wall's unit direction and scratch for node poses and the handle's Jacobian."""
+
+    parent: np.ndarray
+    axis: np.ndarray
+    coef: np.ndarray
+    offset: np.ndarray
+    node: int
+    direction: np.ndarray
+    rot: np.ndarray
+    pos: np.ndarray
+    jac: np.ndarray
+
+
+class Records(NamedTuple):
+    """Recorded rows: positions, velocities, held torque, compensator, wall and constraint torques,
+    and the wall coordinate."""
+
+    q: np.ndarray
+    qd: np.ndarray
+    u: np.ndarray
+    tau_f: np.ndarray
+    tau_imp: np.ndarray
+    tau_c: np.ndarray
+    wall: np.ndarray
+
+
+def table(tables) -> Table:
+    """The kernel's view of :class:`~.tables.DynamicsTables`."""
+    return Table(*tables.sparse, tables.index, tables.kinds, tables.degrees)
+
+
+def workspace(n: int, n_values: int, n_basis: int, n_entries: int) -> Workspace:
+    """Scratch arrays for one set of tables of ``n`` joints."""
+    m = n * (n + 1) // 2
+    return Workspace(
+        np.zeros((n, n_values)), np.zeros(n_basis), np.zeros(n_entries), np.zeros(n), np.zeros(1, dtype=np.int64),
+        np.zeros((n, n)), np.zeros((n, m)), np.zeros(n), np.zeros(m), np.zeros((n, n)), np.zeros(n),
+        np.zeros(n, dtype=np.int64),
+    )
+
+
+def handle(mechanism, direction: np.ndarray) -> Handle:
+    """The kernel's view of a mechanism's handle (end-effector frame) for a wall along ``direction``."""
+    c = mechanism.compiled
+    n_node = max(len(c.node_parent), 1)
+    node = c.frame_node[mechanism.end_effector]
+    return Handle(c.node_parent, c.node_axis, np.ascontiguousarray(c.node_coef), c.node_offset, int(node),
+                  np.ascontiguousarray(direction, dtype=float), np.zeros((n_node, 3, 3)), np.zeros((n_node, 3)),
+                  np.zeros((6, mechanism.n_dof)))
+
+
+def no_handle(n: int) -> Handle:
+    """A placeholder :class:`Handle` for a joint wall (same array types, so one compiled loop)."""
+    return Handle(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros((0, n)), np.zeros(0), -1,
+                  np.zeros(3), np.zeros((1, 3, 3)), np.zeros((1, 3)), np.zeros((6, n)))
