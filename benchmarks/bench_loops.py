@@ -22,6 +22,7 @@ POSES = textwrap.dedent(
     """
     import time
     import numpy as np
+    from hapticdesign.analysis.dynamics.device import dynamics_of
     from hapticdesign.devices.device_file import load_device_file
     from hapticdesign.devices.registry import preset
 
@@ -34,11 +35,11 @@ POSES = textwrap.dedent(
     n = {poses}
     tree = preset("phantom-3dof")
     qs = np.random.default_rng(0).uniform(-np.pi, np.pi, (n, 3))
-    tree.model.entries(qs[:10], tree.standard_parameters())
-    print("phantom-3dof", n / best(lambda: tree.model.entries(qs, tree.standard_parameters())), "nan")
+    dynamics_of(tree).entries(qs[:10], tree.standard_parameters())
+    print("phantom-3dof", n / best(lambda: dynamics_of(tree).entries(qs, tree.standard_parameters())), "nan")
     for name, amplitude in (("five-bar", 0.3), ("delta", 0.2)):
         device = load_device_file("{examples}/" + name + ".yaml")
-        model, pi = device.model, device.standard_parameters()
+        model, pi = dynamics_of(device), device.standard_parameters()
         home = model.solver.home[model.solver.arrays.actuated]
         t = np.arange(n)[:, None] * 1e-3  # a 1 kHz sampled motion, 2-3 Hz per joint
         path = home + amplitude * np.sin(2 * np.pi * (2.0 + np.arange(len(home))[None, :] * 0.5) * t)
@@ -65,9 +66,9 @@ SETUP = textwrap.dedent(
         region = None
     else:
         device = load_device_file("{examples}/" + name + ".yaml")
-        home = device.model.solver.home[device.model.solver.arrays.actuated]
+        home = dynamics_of(device).solver.home[dynamics_of(device).solver.arrays.actuated]
         region = Region({{k: (h - {half}, h + {half}) for k, h in enumerate(home)}})
-    form = linearity_form(device.model, region)
+    form = linearity_form(dynamics_of(device), region)
     print(time.perf_counter() - t0, form.accuracy, float(form.ln(device.standard_parameters())))
     """
 )
