@@ -56,6 +56,7 @@ SETUP = textwrap.dedent(
     import time
     t0 = time.perf_counter()
     import numpy as np
+    from hapticdesign.analysis.dynamics.device import dynamics_of
     from hapticdesign.analysis.linearity.form import linearity_form
     from hapticdesign.analysis.linearity.region import Region
     from hapticdesign.devices.device_file import load_device_file

@@ -20,8 +20,9 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
+from hapticdesign.analysis.dynamics.model import velocity_products_into as velocity_products
 from hapticdesign.simulation.config import FRICTION_VELOCITY, STATUS_COMPLETED, STATUS_DIVERGED, STATUS_EXCURSION
-from hapticdesign.simulation.tables import evaluate_entries, unpack_entries, velocity_products
+from hapticdesign.simulation.tables import evaluate_entries, unpack_entries
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")

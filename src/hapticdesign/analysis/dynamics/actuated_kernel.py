@@ -25,8 +25,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from hapticdesign.analysis.dynamics.kernel import _body_jacobian, _node_poses, body_regressor
+from hapticdesign.analysis.dynamics.kernel import body_jacobian, body_regressor
 from hapticdesign.analysis.loops.closure_kernel import closure_bias, closure_jacobian, lu_solve, node_motion
+from hapticdesign.model.walk import node_poses
 
 
 @njit(cache=True)
@@ -68,10 +69,11 @@ def _wrench_regressor(w, vel, al, acc, out):
 
 
 @njit(cache=True)
-def actuated_kernel(qs, parent, axis, coef, offset, body_node, body_path, gravity,
+def actuated_kernel(qs, parent, axis, coef, offset, const_rot, const_pos, body_node, gravity,
                     frame_a, frame_b, row_loop, row_comp, actuated, passive, params, regressor):
     """Entries (unique H, C, G) in actuated coordinates at closed full poses ``qs`` (P, N).
 
+    The tree is a :class:`~hapticdesign.model.walk.KinematicTree` (``parent .. const_pos``, ``body_node``).
     ``regressor``: returns (P, E, 10 B), the regressor; otherwise (P, K, E) for parameter sets
     ``params`` (K, 10 B). The second output is the pivot ratio of ``Phi_p`` per pose (0: singular).
     """
@@ -109,6 +111,7 @@ def actuated_kernel(qs, parent, axis, coef, offset, body_node, body_path, gravit
     zero = np.zeros(n_dof)
     qd = np.zeros(n_dof)
     eye = np.eye(npas)
+    eye3 = np.eye(3)
     state_j = np.empty(n_states, dtype=np.int64)
     state_k = np.empty(n_states, dtype=np.int64)
     col = 0
@@ -125,7 +128,7 @@ def actuated_kernel(qs, parent, axis, coef, offset, body_node, body_path, gravit
     lb = np.empty(3)
     ab = np.empty(3)
     for p in range(n_pose):
-        _node_poses(qs[p], parent, axis, coef, offset, rot, pos)
+        node_poses(qs[p], parent, axis, coef, offset, const_rot, const_pos, parent.shape[0] - 1, rot, pos)
         closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, coef, rot, pos, phi)
         for i in range(npas):
             for j in range(npas):
@@ -151,7 +154,7 @@ def actuated_kernel(qs, parent, axis, coef, offset, body_node, body_path, gravit
             for j in range(na):
                 t[passive[r], j] = s[r, j]
         for b in range(n_body):
-            rbs[b] = _body_jacobian(b, body_node, body_path, axis, coef, rot, pos, jac)
+            rbs[b] = body_jacobian(b, body_node, parent, axis, coef, rot, pos, eye3, jac)
             for r in range(6):
                 for k in range(n_dof):
                     jb[b, r, k] = jac[r, k]

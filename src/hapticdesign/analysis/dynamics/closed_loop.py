@@ -53,8 +53,7 @@ class ClosedLoopModel(DynamicsModel):
     def _kernel(self, q_full: np.ndarray, params: np.ndarray, regressor: bool) -> np.ndarray:
         c, a = self.compiled, self.solver.arrays
         out, ratios = actuated_kernel(
-            np.ascontiguousarray(q_full, dtype=float), c.node_parent, c.node_axis, c.node_coef, c.node_offset,
-            c.body_node, c.body_path, c.gravity, a.frame_a, a.frame_b, a.row_loop, a.row_comp,
+            np.ascontiguousarray(q_full, dtype=float), *c.tree.arrays, c.tree.body_node, c.gravity, a.frame_a, a.frame_b, a.row_loop, a.row_comp,
             a.actuated, a.passive, np.ascontiguousarray(params, dtype=float), regressor,
         )
         bad = np.flatnonzero(ratios <= SINGULAR_RATIO)
