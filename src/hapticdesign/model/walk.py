@@ -119,10 +119,16 @@ def node_poses(q, parent, axis, coef, offset, const_rot, const_pos, last, rot, p
         v = offset[n]
         for k in range(q.shape[0]):
             v += coef[n, k] * q[k]
-        for i in range(3):
-            for j in range(3):
-                rot[n, i, j] = 1.0 if (pn < 0 and i == j) else (rot[pn, i, j] if pn >= 0 else 0.0)
-            pos[n, i] = pos[pn, i] if pn >= 0 else 0.0
+        if pn >= 0:
+            for i in range(3):
+                for j in range(3):
+                    rot[n, i, j] = rot[pn, i, j]
+                pos[n, i] = pos[pn, i]
+        else:
+            for i in range(3):
+                for j in range(3):
+                    rot[n, i, j] = 1.0 if i == j else 0.0
+                pos[n, i] = 0.0
         a = axis[n] % 3
         if axis[n] < 3:
             b = (a + 1) % 3
