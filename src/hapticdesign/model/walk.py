@@ -161,35 +161,36 @@ def frame_jacobian(node, parent, axis, coef, rot, pos, body, jac):
     while n >= 0:
         if axis[n] != CONSTANT:
             a = axis[n] % 3
+            rotation = axis[n] < 3
             u0, u1, u2 = rot[n, 0, a], rot[n, 1, a], rot[n, 2, a]
-            if axis[n] < 3:
+            v0, v1, v2 = u0, u1, u2
+            if rotation:
                 r0 = pos[node, 0] - pos[n, 0]
                 r1 = pos[node, 1] - pos[n, 1]
                 r2 = pos[node, 2] - pos[n, 2]
                 v0, v1, v2 = u1 * r2 - u2 * r1, u2 * r0 - u0 * r2, u0 * r1 - u1 * r0
-                for k in range(n_dof):
-                    c = coef[n, k]
-                    if c != 0.0:
-                        jac[0, k] += c * v0
-                        jac[1, k] += c * v1
-                        jac[2, k] += c * v2
+            if body:
+                v0, v1, v2 = _to_node(rot, node, v0, v1, v2)
+                u0, u1, u2 = _to_node(rot, node, u0, u1, u2)
+            for k in range(n_dof):
+                c = coef[n, k]
+                if c != 0.0:
+                    jac[0, k] += c * v0
+                    jac[1, k] += c * v1
+                    jac[2, k] += c * v2
+                    if rotation:
                         jac[3, k] += c * u0
                         jac[4, k] += c * u1
                         jac[5, k] += c * u2
-            else:
-                for k in range(n_dof):
-                    c = coef[n, k]
-                    if c != 0.0:
-                        jac[0, k] += c * u0
-                        jac[1, k] += c * u1
-                        jac[2, k] += c * u2
         n = parent[n]
-    if body:
-        for k in range(n_dof):
-            for h in (0, 3):
-                x0, x1, x2 = jac[h, k], jac[h + 1, k], jac[h + 2, k]
-                for i in range(3):
-                    jac[h + i, k] = rot[node, 0, i] * x0 + rot[node, 1, i] * x1 + rot[node, 2, i] * x2
+
+
+@njit(cache=True, inline="always")
+def _to_node(rot, node, x0, x1, x2):
+    """``R^T x`` with ``R`` the world rotation of ``node``: a base-frame vector in the node's axes."""
+    return (rot[node, 0, 0] * x0 + rot[node, 1, 0] * x1 + rot[node, 2, 0] * x2,
+            rot[node, 0, 1] * x0 + rot[node, 1, 1] * x1 + rot[node, 2, 1] * x2,
+            rot[node, 0, 2] * x0 + rot[node, 1, 2] * x1 + rot[node, 2, 2] * x2)
 
 
 @njit(cache=True)
