@@ -2,7 +2,8 @@
 
 :class:`KinematicTree` is the compiled frame tree with its constant transforms folded: within a frame,
 each run of consecutive constant elementary transforms becomes one constant node carrying its
-rotation and translation (computed once, as Robotics Toolbox's ``ETS.compile`` does); variable
+rotation and translation (computed once, as Robotics Toolbox's ``ETS.compile`` does; a lone constant
+translation stays as it is, three multiply-adds being cheaper than a constant 4x4); variable
 transforms keep their :class:`~hapticdesign.model.transforms.Axis` code and affine value
 ``offset + coef . q``. Named frames always end on a node, so bodies and closures attach to nodes.
 
@@ -72,7 +73,11 @@ class KinematicTree:
             pending.append(n)
             if n not in ends and n + 1 < len(parent) and parent[n + 1] == n and not variable[n + 1]:
                 continue  # the run of constants goes on inside this frame
-            rows.append((mapped[int(parent[pending[0]])], CONSTANT, np.zeros(n_dof), 0.0, run[:3, :3], run[:3, 3]))
+            start = mapped[int(parent[pending[0]])]
+            if len(pending) == 1 and axis[n] >= Axis.TX:  # a lone translation is cheaper unfolded
+                rows.append((start, int(axis[n]), np.zeros(n_dof), float(offset[n]), np.eye(3), np.zeros(3)))
+            else:
+                rows.append((start, CONSTANT, np.zeros(n_dof), 0.0, run[:3, :3], run[:3, 3]))
             mapped.update({m: len(rows) - 1 for m in pending})
             pending = []
         nodes = {name: mapped[node] for name, node in frame_node.items()}
