@@ -24,9 +24,10 @@ BUILD = textwrap.dedent(
     import time
     t0 = time.perf_counter()
     import numpy as np
+    from hapticdesign.analysis.dynamics.device import dynamics_of
     from hapticdesign.devices.registry import preset
     device = preset("{name}")
-    model = device.model
+    model = dynamics_of(device)
     pi = device.standard_parameters()
     model.H(np.zeros(model.n_dof), pi); model.C(np.zeros(model.n_dof), pi); model.G(np.zeros(model.n_dof), pi)
     print(time.perf_counter() - t0)
@@ -89,8 +90,9 @@ BATCH = textwrap.dedent(
     import sympy as sp
     from hapticdesign.devices.registry import preset
     from hapticdesign.analysis.dynamics.symbolic import derive
+    from hapticdesign.analysis.dynamics.device import dynamics_of
     device = preset("phantom-3dof")
-    model = device.model
+    model = dynamics_of(device)
     pi = device.standard_parameters()
     rng = np.random.default_rng(0)
     qs = rng.uniform(-np.pi, np.pi, ({poses}, 3))

@@ -1,9 +1,11 @@
-"""Forward kinematics and geometric Jacobians of any frame of a mechanism.
+"""Forward kinematics and geometric Jacobians of any frame of a mechanism, one pose or a batch.
 
 Positions follow seed 000 eq. 2.24-2.26, angular velocities eq. 2.20-2.23: the Jacobian
 column of a variable elementary transform is its unit twist (rotation axis through the frame
 origin, or translation axis) at the current pose, weighted by the coupling coefficients of
-dependent coordinates. Closed loops (passive joints) are solved by
+dependent coordinates. The walk itself is the compiled one of :mod:`hapticdesign.model.walk`
+(seed 001 eq. 5.61-5.66 and 5.87-5.92 for the R-CUBE chains, whose stiffness model needs a 6 x 23
+Jacobian per chain and pose, eq. 5.93). Closed loops (passive joints) are solved by
 :mod:`hapticdesign.analysis.loops.solver`; :func:`actuated_pose` and :func:`actuated_jacobian` take
 the actuated coordinates of any device and, for loops, map velocities by ``qd = T qd_a``.
 """
@@ -13,8 +15,8 @@ from __future__ import annotations
 import numpy as np
 
 from hapticdesign.errors import UserError
+from hapticdesign.model import walk
 from hapticdesign.model.mechanism import Mechanism
-from hapticdesign.model.transforms import Axis, elementary_matrix
 
 
 def _check_q(mech: Mechanism, q: np.ndarray) -> np.ndarray:
@@ -26,45 +28,42 @@ def _check_q(mech: Mechanism, q: np.ndarray) -> np.ndarray:
     return q
 
 
-def _node_poses(mech: Mechanism, q: np.ndarray, frame: str | None) -> tuple[list[int], list[np.ndarray]]:
-    """Nodes from the base to ``frame`` (default: the end effector) and their world poses."""
+def _frame(mech: Mechanism, frame: str | None) -> str:
     frame = frame or mech.end_effector
     if frame is None:
         raise UserError("the mechanism names no end-effector frame")
-    q = _check_q(mech, q)
-    c = mech.compiled
-    path = c.path_to(frame)
-    poses, t = [], np.eye(4)
-    for n in path:
-        t = t @ elementary_matrix(Axis(c.node_axis[n]), c.node_offset[n] + c.node_coef[n] @ q)
-        poses.append(t)
-    return path, poses
+    return frame
 
 
 def forward_kinematics(mech: Mechanism, q: np.ndarray, frame: str | None = None) -> np.ndarray:
     """World pose (4x4) of ``frame`` (default: the end effector) at coordinates ``q``."""
-    _, poses = _node_poses(mech, q, frame)
-    return poses[-1] if poses else np.eye(4)
+    frame = _frame(mech, frame)
+    return poses_and_jacobians(mech, _check_q(mech, q), frame)[0]
 
 
 def jacobian(mech: Mechanism, q: np.ndarray, frame: str | None = None) -> np.ndarray:
     """Geometric Jacobian (6 x N) of ``frame``'s origin in the base frame: rows ``v`` then ``w``."""
-    path, poses = _node_poses(mech, q, frame)
-    c = mech.compiled
-    p_end = poses[-1][:3, 3] if poses else np.zeros(3)
-    jac = np.zeros((6, mech.n_dof))
-    for n, pose in zip(path, poses):
-        coef = c.node_coef[n]
-        if not np.any(coef):
-            continue
-        axis = Axis(c.node_axis[n])
-        u = pose[:3, axis.unit]
-        if axis.is_rotation:
-            jac[:3] += np.outer(np.cross(u, p_end - pose[:3, 3]), coef)
-            jac[3:] += np.outer(u, coef)
-        else:
-            jac[:3] += np.outer(u, coef)
-    return jac
+    frame = _frame(mech, frame)
+    return poses_and_jacobians(mech, _check_q(mech, q), frame)[1]
+
+
+def poses_and_jacobians(mech: Mechanism, Q: np.ndarray, frame: str | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """World poses ``(..., 4, 4)`` and geometric Jacobians ``(..., 6, N)`` of ``frame`` at ``Q (..., N)``.
+
+    The Jacobians are those of :func:`jacobian` (base frame, rows ``v`` then ``w``), for many
+    coordinate vectors at once.
+    """
+    Q = np.asarray(Q, dtype=float)
+    if Q.shape[-1:] != (mech.n_dof,):
+        raise UserError(f"expected {mech.n_dof} coordinates per pose, got shape {Q.shape}")
+    compiled = mech.compiled
+    node = compiled.frame_node_of(_frame(mech, frame))
+    flat = np.ascontiguousarray(Q.reshape(-1, mech.n_dof))
+    poses = np.empty((flat.shape[0], 4, 4))
+    jac = np.empty((flat.shape[0], 6, mech.n_dof))
+    walk.poses_and_jacobians(flat, *compiled.tree.arrays, node, False, poses, jac)
+    lead = Q.shape[:-1]
+    return poses.reshape(lead + (4, 4)), jac.reshape(lead + (6, mech.n_dof))
 
 
 def actuated_pose(mech: Mechanism, q_a: np.ndarray, frame: str | None = None, solver=None) -> np.ndarray:

@@ -18,7 +18,8 @@ import numpy as np
 
 from hapticdesign.errors import UserError
 from hapticdesign.model.loops import ClosedLoops
-from hapticdesign.model.transforms import Axis, ElementaryTransform, elementary_matrix
+from hapticdesign.model.transforms import ElementaryTransform
+from hapticdesign.model.walk import KinematicTree, poses_and_jacobians
 
 
 class JointType(str, Enum):
@@ -114,9 +115,11 @@ class CompiledMechanism:
     """Flat arrays of the frame tree: one node per elementary transform.
 
     ``node_parent[n]`` is the previous node (``-1`` for the base), ``node_axis[n]`` the
-    :class:`Axis` code, ``node_coef[n]`` and ``node_offset[n]`` the affine joint value,
-    ``body_node[b]`` the node whose frame body ``b`` is attached to, and ``body_path[b]`` the
-    variable nodes from the base to that body (padded with ``-1``).
+    :class:`~hapticdesign.model.transforms.Axis` code, ``node_coef[n]`` and ``node_offset[n]`` the
+    affine joint value, ``body_node[b]`` the node whose frame body ``b`` is attached to, and
+    ``body_path[b]`` the variable nodes from the base to that body (padded with ``-1``). These exact
+    elementary transforms serve the symbolic derivation and drawing; numeric walks take ``tree``, the
+    same tree with its constant transforms folded (:class:`~hapticdesign.model.walk.KinematicTree`).
     """
 
     n_dof: int
@@ -129,6 +132,7 @@ class CompiledMechanism:
     body_path: np.ndarray
     gravity: np.ndarray
     prismatic: np.ndarray
+    tree: KinematicTree
 
     @classmethod
     def from_mechanism(cls, mech: Mechanism) -> "CompiledMechanism":
@@ -158,17 +162,22 @@ class CompiledMechanism:
         for i, p in enumerate(paths):
             body_path[i, : len(p)] = p
         prismatic = np.array([t == JointType.PRISMATIC for t in mech.joint_types], dtype=bool)
+        node_parent = np.array(parent, dtype=np.int64)
+        node_axis = np.array(axis, dtype=np.int64)
+        node_offset = np.array(offset, dtype=float)
         return cls(
             n_dof=mech.n_dof,
-            node_parent=np.array(parent, dtype=np.int64),
-            node_axis=np.array(axis, dtype=np.int64),
+            node_parent=node_parent,
+            node_axis=node_axis,
             node_coef=node_coef,
-            node_offset=np.array(offset, dtype=float),
+            node_offset=node_offset,
             frame_node=frame_node,
             body_node=np.array([frame_node[b.frame] for b in mech.bodies], dtype=np.int64),
             body_path=body_path,
             gravity=np.array(mech.gravity, dtype=float),
             prismatic=prismatic,
+            tree=KinematicTree.fold(node_parent, node_axis, node_coef, node_offset, frame_node,
+                                    [b.frame for b in mech.bodies]),
         )
 
     def path_to(self, frame: str) -> list[int]:
@@ -181,8 +190,15 @@ class CompiledMechanism:
             n = int(self.node_parent[n])
         return path[::-1]
 
+    def frame_node_of(self, frame: str) -> int:
+        """Node of the folded ``tree`` on which ``frame`` ends (-1: the base)."""
+        if frame not in self.tree.frame_node:
+            raise UserError(f"unknown frame {frame!r}; frames: {', '.join(sorted(self.tree.frame_node))}")
+        return self.tree.frame_node[frame]
+
     def frame_pose(self, q: np.ndarray, frame: str) -> np.ndarray:
-        t = np.eye(4)
-        for n in self.path_to(frame):
-            t = t @ elementary_matrix(Axis(self.node_axis[n]), self.node_offset[n] + self.node_coef[n] @ q)
-        return t
+        """World pose (4x4) of ``frame`` at coordinates ``q`` (N,), by the compiled walk."""
+        poses = np.empty((1, 4, 4))
+        poses_and_jacobians(np.ascontiguousarray(q, dtype=float).reshape(1, -1), *self.tree.arrays,
+                            self.frame_node_of(frame), False, poses, np.empty((1, 6, self.n_dof)))
+        return poses[0]

@@ -23,10 +23,10 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from hapticdesign.analysis.dynamics.kernel import _node_poses
-from hapticdesign.analysis.loops.closure_kernel import frame_jacobian
+from hapticdesign.analysis.dynamics.model import velocity_products_into as velocity_products
+from hapticdesign.model.walk import frame_jacobian, node_poses
 from hapticdesign.simulation.config import FRICTION_VELOCITY, STATUS_COMPLETED, STATUS_DIVERGED, STATUS_EXCURSION
-from hapticdesign.simulation.tables import evaluate_entries, unpack_entries, velocity_products
+from hapticdesign.simulation.tables import evaluate_entries, unpack_entries
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
@@ -165,7 +165,8 @@ def compensator_torque(q, qd, qdd, ctrl, out):
 def _handle_normal(q, handle):
     """The handle's position along the wall direction, ``n . p(q)``; leaves the node poses in ``handle``."""
     pos, n, node = handle.pos, handle.direction, handle.node
-    _node_poses(q, handle.parent, handle.axis, handle.coef, handle.offset, handle.rot, pos)
+    node_poses(q, handle.parent, handle.axis, handle.coef, handle.offset, handle.const_rot, handle.const_pos, node,
+               handle.rot, pos)
     return n[0] * pos[node, 0] + n[1] * pos[node, 1] + n[2] * pos[node, 2]
 
 
@@ -194,7 +195,7 @@ def _wall_torque(q, qd, wall, handle, out):
         return
     x = _handle_normal(q, handle)
     jac, n = handle.jac, handle.direction
-    frame_jacobian(handle.node, handle.parent, handle.axis, handle.coef, handle.rot, handle.pos, jac)
+    frame_jacobian(handle.node, handle.parent, handle.axis, handle.coef, handle.rot, handle.pos, False, jac)
     v = 0.0
     for k in range(q.shape[0]):
         out[k] = n[0] * jac[0, k] + n[1] * jac[1, k] + n[2] * jac[2, k]

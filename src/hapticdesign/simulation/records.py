@@ -99,13 +99,15 @@ class WallLaw(NamedTuple):
 
 
 class Handle(NamedTuple):
-    """The frame tree (:class:`~hapticdesign.model.mechanism.CompiledMechanism`), the handle's node,
+    """The folded frame tree (:class:`~hapticdesign.model.walk.KinematicTree`), the handle's node,
     the wall's unit direction and scratch for node poses and the handle's Jacobian."""
 
     parent: np.ndarray
     axis: np.ndarray
     coef: np.ndarray
     offset: np.ndarray
+    const_rot: np.ndarray
+    const_pos: np.ndarray
     node: int
     direction: np.ndarray
     rot: np.ndarray
@@ -143,15 +145,16 @@ def workspace(n: int, n_values: int, n_basis: int, n_entries: int) -> Workspace:
 
 def handle(mechanism, direction: np.ndarray) -> Handle:
     """The kernel's view of a mechanism's handle (end-effector frame) for a wall along ``direction``."""
-    c = mechanism.compiled
-    n_node = max(len(c.node_parent), 1)
-    node = c.frame_node[mechanism.end_effector]
-    return Handle(c.node_parent, c.node_axis, np.ascontiguousarray(c.node_coef), c.node_offset, int(node),
-                  np.ascontiguousarray(direction, dtype=float), np.zeros((n_node, 3, 3)), np.zeros((n_node, 3)),
+    tree = mechanism.compiled.tree
+    rot, pos = tree.workspace()
+    parent, axis, coef, offset, const_rot, const_pos = tree.arrays
+    return Handle(parent, axis, np.ascontiguousarray(coef), offset, const_rot, const_pos,
+                  int(tree.frame_node[mechanism.end_effector]), np.ascontiguousarray(direction, dtype=float), rot, pos,
                   np.zeros((6, mechanism.n_dof)))
 
 
 def no_handle(n: int) -> Handle:
     """A placeholder :class:`Handle` for a joint wall (same array types, so one compiled loop)."""
-    return Handle(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros((0, n)), np.zeros(0), -1,
-                  np.zeros(3), np.zeros((1, 3, 3)), np.zeros((1, 3)), np.zeros((6, n)))
+    return Handle(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros((0, n)), np.zeros(0),
+                  np.zeros((0, 3, 3)), np.zeros((0, 3)), -1, np.zeros(3), np.zeros((1, 3, 3)), np.zeros((1, 3)),
+                  np.zeros((6, n)))

@@ -18,11 +18,9 @@ from functools import cached_property
 import numba as nb
 import numpy as np
 
-from hapticdesign.analysis.dynamics.basis import CoordinateKind
+from hapticdesign.analysis.dynamics.basis import basis_functions, basis_width
 from hapticdesign.analysis.dynamics.device import dynamics_of
 from hapticdesign.model.device import Device
-
-KIND_CODES = {CoordinateKind.CYCLIC: 0, CoordinateKind.REVOLUTE: 1, CoordinateKind.PRISMATIC: 2}
 
 
 @dataclass(frozen=True)
@@ -31,7 +29,7 @@ class DynamicsTables:
 
     coef: np.ndarray  # (n_basis, E)
     index: np.ndarray  # (n_basis, N), int64
-    kinds: np.ndarray  # (N,), int64 codes of KIND_CODES
+    kinds: np.ndarray  # (N,), int64 kind codes (analysis.dynamics.basis.KIND_CODES)
     degrees: np.ndarray  # (N,), int64
 
     @property
@@ -53,12 +51,8 @@ class DynamicsTables:
     @classmethod
     def from_device(cls, device: Device) -> "DynamicsTables":
         model = dynamics_of(device)
-        return cls(
-            coef=np.ascontiguousarray(model.coefficients_for(device.standard_parameters())),
-            index=np.ascontiguousarray(model.index, dtype=np.int64),
-            kinds=np.array([KIND_CODES[b.kind] for b in model.bases], dtype=np.int64),
-            degrees=np.array([b.degree for b in model.bases], dtype=np.int64),
-        )
+        kinds, degrees, index = model.basis_tables
+        return cls(np.ascontiguousarray(model.coefficients_for(device.standard_parameters())), index, kinds, degrees)
 
     @classmethod
     def constant_inertia(cls, inertia: float) -> "DynamicsTables":
@@ -74,26 +68,8 @@ class DynamicsTables:
 @nb.njit(cache=True, error_model="numpy", inline="always")
 def evaluate_entries(q, rows, cols, vals, index, kinds, degrees, values, phi, out):
     """All entries at ``q`` into ``out`` (E,) from the sparse table ``(rows, cols, vals)``;
-    ``values`` (N, max basis size) and ``phi`` (n_basis,) are workspace."""
-    n = q.shape[0]
-    for k in range(n):
-        values[k, 0] = 1.0
-        if kinds[k] == 1 and degrees[k] > 0:
-            c1, s1 = np.cos(q[k]), np.sin(q[k])
-            values[k, 1] = c1
-            values[k, 2] = s1
-            for j in range(2, degrees[k] + 1):  # angle addition: two libm calls per joint, not 2 x degree
-                cj, sj = values[k, 2 * j - 3], values[k, 2 * j - 2]
-                values[k, 2 * j - 1] = c1 * cj - s1 * sj
-                values[k, 2 * j] = s1 * cj + c1 * sj
-        elif kinds[k] == 2:
-            for j in range(1, degrees[k] + 1):
-                values[k, j] = values[k, j - 1] * q[k]
-    for b in range(index.shape[0]):
-        p = 1.0
-        for k in range(n):
-            p *= values[k, index[b, k]]
-        phi[b] = p
+    ``values`` (N, max basis size) and ``phi`` (n_basis,) are workspace (:func:`.basis.basis_functions`)."""
+    basis_functions(q, kinds, degrees, index, values, phi)
     out[:] = 0.0
     for t in range(rows.shape[0]):
         out[cols[t]] += phi[rows[t]] * vals[t]
@@ -116,18 +92,6 @@ def unpack_entries(entries, n, h, c, g):
         g[i] = entries[m + n * m + i]
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
-def velocity_products(qd, out):
-    """``thetadot^2`` of eq. 2.50: (1,1), (1,2), ..., (N,N)."""
-    n = qd.shape[0]
-    u = 0
-    for j in range(n):
-        for k in range(j, n):
-            out[u] = qd[j] * qd[k]
-            u += 1
-
-
 def workspace_size(tables: DynamicsTables) -> int:
     """Columns of the per-coordinate basis workspace."""
-    sizes = [2 * d + 1 if k == 1 else (d + 1 if k == 2 else 1) for k, d in zip(tables.kinds, tables.degrees)]
-    return max(sizes)
+    return int(basis_width(tables.kinds, tables.degrees))

@@ -31,8 +31,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from hapticdesign.analysis.dynamics.kernel import _node_poses, body_regressor
+from hapticdesign.analysis.dynamics.kernel import body_regressor
 from hapticdesign.analysis.loops.closure_kernel import closure_bias, closure_jacobian, lu_in_place, node_motion
+from hapticdesign.model.walk import CONSTANT, node_poses
 
 
 @njit(cache=True)
@@ -94,13 +95,14 @@ def workspace(n_node, n_dof, na, npas, n_body):
 
 
 @njit(cache=True, inline="always")
-def reduce_pose(q, parent, axis, coef, offset, body_node, body_path, frame_a, frame_b, row_loop, row_comp,
+def reduce_pose(q, parent, axis, coef, offset, const_rot, const_pos, body_node, frame_a, frame_b, row_loop, row_comp,
                 actuated, passive, ws, poses_ready):
     """At a closed full pose ``q``: ``Phi_p^-1``, ``T = [I; S]``, ``coef T`` and every body's Jacobians into ``ws``.
 
     ``poses_ready``: the node poses and ``Phi`` in ``ws`` are already those of ``q`` (after Newton).
     Returns the pivot ratio of ``Phi_p`` (0: singular, nothing else computed) and the sign of its determinant.
-    A body Jacobian column is the unit twist of a path node at the body origin: ``(u x (p_b - p_e), u)``
+    A body Jacobian column is the unit twist of a variable node on the path from the body to the base
+    (folded constant nodes, :data:`~hapticdesign.model.walk.CONSTANT`, carry none) at the body origin: ``(u x (p_b - p_e), u)``
     for a rotation, ``(u, 0)`` for a translation (seed 000 eq. 2.20-2.26).
     """
     rot, pos, _, _, _, phi, lu, pinv, t, node_t, _, jp, ja, _, _ = ws
@@ -108,7 +110,7 @@ def reduce_pose(q, parent, axis, coef, offset, body_node, body_path, frame_a, fr
     npas = passive.shape[0]
     n_dof = q.shape[0]
     if not poses_ready:
-        _node_poses(q, parent, axis, coef, offset, rot, pos)
+        node_poses(q, parent, axis, coef, offset, const_rot, const_pos, parent.shape[0] - 1, rot, pos)
         closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, coef, rot, pos, phi)
     for i in range(npas):
         for j in range(npas):
@@ -143,10 +145,11 @@ def reduce_pose(q, parent, axis, coef, offset, body_node, body_path, frame_a, fr
                 ja[b, r, j] = 0.0
             for j in range(npas):
                 jp[b, r, j] = 0.0
-        for step in range(body_path.shape[1]):
-            e = body_path[b, step]
-            if e < 0:
-                break
+        e = nb
+        while e >= 0:
+            if axis[e] == CONSTANT:
+                e = parent[e]
+                continue
             a = axis[e] % 3
             u0, u1, u2 = rot[e, 0, a], rot[e, 1, a], rot[e, 2, a]
             if axis[e] < 3:
@@ -173,6 +176,7 @@ def reduce_pose(q, parent, axis, coef, offset, body_node, body_path, frame_a, fr
                     jp[b, 3, j] += c * w0
                     jp[b, 4, j] += c * w1
                     jp[b, 5, j] += c * w2
+            e = parent[e]
     return ratio, sign
 
 
@@ -319,7 +323,7 @@ def _state(j, na):
 
 
 @njit(cache=True)
-def actuated_entries(qs, parent, axis, coef, offset, body_node, body_path, gravity,
+def actuated_entries(qs, parent, axis, coef, offset, const_rot, const_pos, body_node, gravity,
                      frame_a, frame_b, row_loop, row_comp, actuated, passive, params):
     """Entries (unique H, C, G) in actuated coordinates at closed full poses ``qs`` (P, N) for parameter
     sets ``params`` (K, 10 B): (P, K, E), and the pivot ratio of ``Phi_p`` per pose (0: singular)."""
@@ -339,7 +343,7 @@ def actuated_entries(qs, parent, axis, coef, offset, body_node, body_path, gravi
     kp = np.zeros((n_sets, na, npas))
     empty = np.zeros(0)
     for p in range(n_pose):
-        ratio, _ = reduce_pose(qs[p], parent, axis, coef, offset, body_node, body_path, frame_a, frame_b, row_loop,
+        ratio, _ = reduce_pose(qs[p], parent, axis, coef, offset, const_rot, const_pos, body_node, frame_a, frame_b, row_loop,
                                row_comp, actuated, passive, ws, False)
         ratios[p] = ratio
         if ratio == 0.0:
@@ -413,7 +417,7 @@ def _body_motion(w, al, ac, jp, gamma, nb, b, rb, out):
 
 
 @njit(cache=True)
-def actuated_regressor(qs, parent, axis, coef, offset, body_node, body_path, gravity,
+def actuated_regressor(qs, parent, axis, coef, offset, const_rot, const_pos, body_node, gravity,
                        frame_a, frame_b, row_loop, row_comp, actuated, passive):
     """Regressor of the entries (unique H, C, G) in actuated coordinates at closed full poses ``qs`` (P, N):
     (P, E, 10 B), and the pivot ratio of ``Phi_p`` per pose (0: singular). Body axes throughout."""
@@ -435,7 +439,7 @@ def actuated_regressor(qs, parent, axis, coef, offset, body_node, body_path, gra
     wrench = np.zeros((6, 10))
     empty = np.zeros(0)
     for p in range(n_pose):
-        ratio, _ = reduce_pose(qs[p], parent, axis, coef, offset, body_node, body_path, frame_a, frame_b, row_loop,
+        ratio, _ = reduce_pose(qs[p], parent, axis, coef, offset, const_rot, const_pos, body_node, frame_a, frame_b, row_loop,
                                row_comp, actuated, passive, ws, False)
         ratios[p] = ratio
         if ratio == 0.0:

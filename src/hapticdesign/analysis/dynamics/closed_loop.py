@@ -53,8 +53,8 @@ class ClosedLoopModel(DynamicsModel):
     def _kernel(self, q_full: np.ndarray, params: np.ndarray | None) -> np.ndarray:
         """Entries for parameter sets (P, S, E), or the regressor (P, E, n_params) when ``params`` is None."""
         c, a = self.compiled, self.solver.arrays
-        args = (np.ascontiguousarray(q_full, dtype=float), c.node_parent, c.node_axis, c.node_coef, c.node_offset,
-                c.body_node, c.body_path, c.gravity, a.frame_a, a.frame_b, a.row_loop, a.row_comp, a.actuated, a.passive)
+        args = (np.ascontiguousarray(q_full, dtype=float), *c.tree.arrays, c.tree.body_node, c.gravity,
+                a.frame_a, a.frame_b, a.row_loop, a.row_comp, a.actuated, a.passive)
         if params is None:
             out, ratios = actuated_regressor(*args)
         else:

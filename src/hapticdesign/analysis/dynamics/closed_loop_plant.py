@@ -58,11 +58,11 @@ def plant_workspace(n_node, n_dof, na, npas, n_body):
 def closed_loop_terms(qa, qda, structure, ws, h, cqd, g):
     """``H_a`` (n_a x n_a), ``c_a = C(q, qd) qd^2`` (n_a) and ``G_a`` (n_a) at actuated ``qa``, rates ``qda``.
 
-    ``structure``: ``(parent, axis, coef, offset, body_node, body_path, gravity, frame_a, frame_b, row_loop,
+    ``structure``: ``(parent, axis, coef, offset, const_rot, const_pos, body_node, gravity, frame_a, frame_b, row_loop,
     row_comp, actuated, passive, params (1, 10 B), active (B,), constant (n_a x n_a), tol, max_iter,
     singular_ratio, branch)``; ``ws``: :func:`plant_workspace`. Returns the status (module docstring).
     """
-    (parent, axis, coef, offset, body_node, body_path, gravity, frame_a, frame_b, row_loop, row_comp,
+    (parent, axis, coef, offset, const_rot, const_pos, body_node, gravity, frame_a, frame_b, row_loop, row_comp,
      actuated, passive, params, active, constant, tol, max_iter, singular_ratio, branch) = structure
     dyn, q, q_last, res, rhs, pp, pw, kp, predicted = ws
     rot, pos, w, al, ac, phi, t, jp, ja, gamma = dyn[0], dyn[1], dyn[2], dyn[3], dyn[4], dyn[5], dyn[8], dyn[11], dyn[12], dyn[14]
@@ -80,8 +80,9 @@ def closed_loop_terms(qa, qda, structure, ws, h, cqd, g):
         q[actuated[j]] = qa[j]
     for r in range(npas):
         predicted[r] = q[passive[r]]
-    status, sign, _ = ck.newton_into(q, actuated, passive, parent, axis, coef, offset, frame_a, frame_b, row_loop,
-                                     row_comp, tol, max_iter, singular_ratio, rot, pos, res, phi, rhs, pp)
+    status, sign, _ = ck.newton_into(q, actuated, passive, parent, axis, coef, offset, const_rot, const_pos, frame_a,
+                                     frame_b, row_loop, row_comp, tol, max_iter, singular_ratio, rot, pos, res, phi,
+                                     rhs, pp)
     if status == OK and sign != branch:
         status = BRANCH_CHANGE
     if status == OK:
@@ -92,7 +93,7 @@ def closed_loop_terms(qa, qda, structure, ws, h, cqd, g):
         for k in range(q.shape[0]):
             q[k] = q_last[k]
         return status
-    reduce_pose(q, parent, axis, coef, offset, body_node, body_path, frame_a, frame_b, row_loop, row_comp,
+    reduce_pose(q, parent, axis, coef, offset, const_rot, const_pos, body_node, frame_a, frame_b, row_loop, row_comp,
                 actuated, passive, dyn, True)
     world_parameters(rot, body_node, params, 0, pw)
     for i in range(na):
@@ -139,11 +140,11 @@ class ClosedLoopPlant:
             constant[iu, ju] = constant[ju, iu] = model.constant[model.slice_h]
         self.n_dof = n
         self.structure = (
-            c.node_parent, c.node_axis, c.node_coef, c.node_offset, c.body_node, c.body_path, c.gravity,
+            *c.tree.arrays, c.tree.body_node, c.gravity,
             a.frame_a, a.frame_b, a.row_loop, a.row_comp, a.actuated, a.passive, params, active_bodies(params),
             constant, float(solver.tol), int(MAX_ITER), float(SINGULAR_RATIO), float(solver.branch),
         )
-        self.workspace = plant_workspace(len(c.node_parent), solver.n_dof, n, len(a.passive), len(c.body_node))
+        self.workspace = plant_workspace(len(c.tree.parent), solver.n_dof, n, len(a.passive), len(c.tree.body_node))
         self.workspace[1][:] = solver.solve(q_a0)
         self.terms(q_a0, np.zeros(n))  # T at the start pose, for the first tangent predictor
 

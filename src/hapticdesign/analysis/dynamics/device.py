@@ -49,8 +49,7 @@ def tree_mass_matrix(mechanism: Mechanism, q: np.ndarray, parameters: np.ndarray
     if q.shape[-1:] != (n,) or not np.all(np.isfinite(q)):
         raise UserError(f"expected finite joint coordinates (..., {n}), got an array of shape {q.shape}")
     c = mechanism.compiled
-    yh, _ = regressor_kernel(np.ascontiguousarray(q.reshape(-1, n)), c.node_parent, c.node_axis,
-                             c.node_coef, c.node_offset, c.body_node, c.body_path, c.gravity)
+    yh, _ = regressor_kernel(np.ascontiguousarray(q.reshape(-1, n)), *c.tree.arrays, c.tree.body_node, c.gravity)
     return (yh @ parameters).reshape(q.shape + (n,))
 
 

@@ -9,7 +9,8 @@ For every body ``b`` with body-frame Jacobian ``J_b = [Jv; Jw]`` (6 x N), the ki
 and the gravity torque of the potential of seed 000 eq. 2.46 is
 ``G_k = -(R_b^T g) . (m Jv_k + Jw_k x h)``. This is the regressor form of eq. 2.44-2.49.
 The Jacobian column of a variable elementary transform ``e`` is its unit twist moved to the
-body frame; dependent coordinates contribute through their affine coefficients.
+body frame; dependent coordinates contribute through their affine coefficients (the walk of
+:mod:`hapticdesign.model.walk`).
 """
 
 from __future__ import annotations
@@ -17,87 +18,19 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-
-@njit(cache=True)
-def _node_poses(q, parent, axis, coef, offset, rot, pos):
-    for n in range(parent.shape[0]):
-        v = offset[n]
-        for k in range(q.shape[0]):
-            v += coef[n, k] * q[k]
-        pn = parent[n]
-        for i in range(3):
-            for j in range(3):
-                rot[n, i, j] = 1.0 if (pn < 0 and i == j) else (rot[pn, i, j] if pn >= 0 else 0.0)
-            pos[n, i] = pos[pn, i] if pn >= 0 else 0.0
-        a = axis[n] % 3
-        if axis[n] < 3:
-            b = (a + 1) % 3
-            c = (a + 2) % 3
-            cv = np.cos(v)
-            sv = np.sin(v)
-            for i in range(3):
-                rb = rot[n, i, b]
-                rc = rot[n, i, c]
-                rot[n, i, b] = rb * cv + rc * sv
-                rot[n, i, c] = -rb * sv + rc * cv
-        else:
-            for i in range(3):
-                pos[n, i] += rot[n, i, a] * v
+from hapticdesign.model.walk import frame_jacobian, node_poses
 
 
 @njit(cache=True)
-def _body_jacobian(b, body_node, body_path, axis, coef, rot, pos, jac):
+def body_jacobian(b, body_node, parent, axis, coef, rot, pos, eye, jac):
     """Body-frame Jacobian of body slot ``b`` into ``jac`` (6 x N); returns the body's world rotation.
 
-    The rotation returned is a view of ``rot`` (valid until the next pose); no allocation unless the
-    body sits on the base.
+    The rotation returned is a view of ``rot`` (valid until the next pose), or ``eye`` for a body on
+    the base; no allocation.
     """
-    n_dof = jac.shape[1]
     nb = body_node[b]
-    if nb >= 0:
-        rb = rot[nb]
-        pb0, pb1, pb2 = pos[nb, 0], pos[nb, 1], pos[nb, 2]
-    else:
-        rb = np.eye(3)
-        pb0 = pb1 = pb2 = 0.0
-    for i in range(6):
-        for k in range(n_dof):
-            jac[i, k] = 0.0
-    for t in range(body_path.shape[1]):
-        e = body_path[b, t]
-        if e < 0:
-            break
-        a = axis[e] % 3
-        u0 = rb[0, 0] * rot[e, 0, a] + rb[1, 0] * rot[e, 1, a] + rb[2, 0] * rot[e, 2, a]
-        u1 = rb[0, 1] * rot[e, 0, a] + rb[1, 1] * rot[e, 1, a] + rb[2, 1] * rot[e, 2, a]
-        u2 = rb[0, 2] * rot[e, 0, a] + rb[1, 2] * rot[e, 1, a] + rb[2, 2] * rot[e, 2, a]
-        if axis[e] < 3:
-            d0 = pos[e, 0] - pb0
-            d1 = pos[e, 1] - pb1
-            d2 = pos[e, 2] - pb2
-            r0 = rb[0, 0] * d0 + rb[1, 0] * d1 + rb[2, 0] * d2
-            r1 = rb[0, 1] * d0 + rb[1, 1] * d1 + rb[2, 1] * d2
-            r2 = rb[0, 2] * d0 + rb[1, 2] * d1 + rb[2, 2] * d2
-            v0 = r1 * u2 - r2 * u1
-            v1 = r2 * u0 - r0 * u2
-            v2 = r0 * u1 - r1 * u0
-            for k in range(n_dof):
-                c = coef[e, k]
-                if c != 0.0:
-                    jac[0, k] += c * v0
-                    jac[1, k] += c * v1
-                    jac[2, k] += c * v2
-                    jac[3, k] += c * u0
-                    jac[4, k] += c * u1
-                    jac[5, k] += c * u2
-        else:
-            for k in range(n_dof):
-                c = coef[e, k]
-                if c != 0.0:
-                    jac[0, k] += c * u0
-                    jac[1, k] += c * u1
-                    jac[2, k] += c * u2
-    return rb
+    frame_jacobian(nb, parent, axis, coef, rot, pos, True, jac)
+    return rot[nb] if nb >= 0 else eye
 
 
 @njit(cache=True)
@@ -146,8 +79,8 @@ def body_regressor(jac, rb, gravity, yh, yg, col):
 
 
 @njit(cache=True)
-def regressor_kernel(qs, parent, axis, coef, offset, body_node, body_path, gravity):
-    """H and G regressors at poses ``qs`` (P, N).
+def regressor_kernel(qs, parent, axis, coef, offset, const_rot, const_pos, body_node, gravity):
+    """H and G regressors at poses ``qs`` (P, N) on a :class:`~hapticdesign.model.walk.KinematicTree`.
 
     Returns ``YH`` (P, N, N, 10 B) and ``YG`` (P, N, 10 B), with the standard parameters of
     body ``b`` in columns ``10 b .. 10 b + 9`` ordered ``m, hx, hy, hz, Jxx, Jyy, Jzz, Jxy, Jxz, Jyz``.
@@ -160,60 +93,10 @@ def regressor_kernel(qs, parent, axis, coef, offset, body_node, body_path, gravi
     rot = np.zeros((max(n_node, 1), 3, 3))
     pos = np.zeros((max(n_node, 1), 3))
     jac = np.zeros((6, n_dof))
+    eye = np.eye(3)
     for p in range(n_pose):
-        _node_poses(qs[p], parent, axis, coef, offset, rot, pos)
+        node_poses(qs[p], parent, axis, coef, offset, const_rot, const_pos, n_node - 1, rot, pos)
         for b in range(n_body):
-            rb = _body_jacobian(b, body_node, body_path, axis, coef, rot, pos, jac)
+            rb = body_jacobian(b, body_node, parent, axis, coef, rot, pos, eye, jac)
             body_regressor(jac, rb, gravity, yh[p], yg[p], 10 * b)
     return yh, yg
-
-
-@njit(cache=True)
-def jacobian_kernel(q, parent, axis, coef, offset, body_node, body_path, b):
-    """World pose ``(R, p)`` and body-frame Jacobian (6 x N, rows v then w) of body slot ``b``."""
-    n_node = parent.shape[0]
-    rot = np.zeros((max(n_node, 1), 3, 3))
-    pos = np.zeros((max(n_node, 1), 3))
-    jac = np.zeros((6, q.shape[0]))
-    _node_poses(q, parent, axis, coef, offset, rot, pos)
-    rb = _body_jacobian(b, body_node, body_path, axis, coef, rot, pos, jac).copy()
-    nb = body_node[b]
-    pb = pos[nb].copy() if nb >= 0 else np.zeros(3)
-    return rb, pb, jac
-
-
-@njit(cache=True)
-def basis_kernel(qs, kinds, degrees, index):
-    """Tensor-product basis functions (see :mod:`.basis`) at poses ``qs`` (P, N) -> (P, B).
-
-    ``kinds``: 0 cyclic, 1 revolute (1, cos q, sin q, cos 2q, sin 2q, ...), 2 prismatic
-    (1, q, q^2, ...); multiples of the angle come from the angle-addition recurrence.
-    """
-    n_pose, n_dof = qs.shape
-    n_basis = index.shape[0]
-    width = 1
-    for k in range(n_dof):
-        width = max(width, 2 * degrees[k] + 1)
-    values = np.empty((n_dof, width))
-    out = np.empty((n_pose, n_basis))
-    for p in range(n_pose):
-        for k in range(n_dof):
-            values[k, 0] = 1.0
-            if kinds[k] == 1:
-                c = np.cos(qs[p, k])
-                s = np.sin(qs[p, k])
-                cj, sj = 1.0, 0.0
-                for j in range(1, degrees[k] + 1):
-                    cj, sj = cj * c - sj * s, sj * c + cj * s
-                    values[k, 2 * j - 1] = cj
-                    values[k, 2 * j] = sj
-            elif kinds[k] == 2:
-                for j in range(1, degrees[k] + 1):
-                    values[k, j] = values[k, j - 1] * qs[p, k]
-        for b in range(n_basis):
-            v = 1.0
-            for k in range(n_dof):
-                if kinds[k] != 0:
-                    v *= values[k, index[b, k]]
-            out[p, b] = v
-    return out

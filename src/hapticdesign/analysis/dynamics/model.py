@@ -19,15 +19,18 @@ import copy
 from functools import cached_property
 
 import numpy as np
+from numba import njit
 
 from hapticdesign.analysis.dynamics.basis import (
+    KIND_CODES,
     CoordinateBasis,
     CoordinateKind,
     apply_along,
+    basis_kernel,
     grid,
     tensor_values,
 )
-from hapticdesign.analysis.dynamics.kernel import basis_kernel, regressor_kernel
+from hapticdesign.analysis.dynamics.kernel import regressor_kernel
 from hapticdesign.errors import UserError
 from hapticdesign.model.mechanism import CompiledMechanism, Mechanism
 
@@ -37,11 +40,31 @@ def pair_index(n: int) -> list[tuple[int, int]]:
     return [(j, k) for j in range(n) for k in range(j, n)]
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def velocity_products_into(qd, out):
+    """``thetadot^2`` of eq. 2.50 for one velocity vector (N,) into ``out``: (1,1), (1,2), ..., (N,N)."""
+    n = qd.shape[0]
+    u = 0
+    for j in range(n):
+        for k in range(j, n):
+            out[u] = qd[j] * qd[k]
+            u += 1
+
+
+@njit(cache=True)
+def _velocity_products_rows(qd, out):
+    for p in range(qd.shape[0]):
+        velocity_products_into(qd[p], out[p])
+
+
 def velocity_products(qd: np.ndarray) -> np.ndarray:
     """``thetadot^2`` of eq. 2.50 for velocities (..., N) -> (..., N(N+1)/2)."""
     qd = np.asarray(qd, dtype=float)
-    j, k = np.triu_indices(qd.shape[-1])
-    return qd[..., j] * qd[..., k]
+    n = qd.shape[-1]
+    flat = np.ascontiguousarray(qd.reshape(-1, n))
+    out = np.empty((flat.shape[0], n * (n + 1) // 2))
+    _velocity_products_rows(flat, out)
+    return out.reshape(qd.shape[:-1] + (out.shape[1],))
 
 
 def _float_array(value, what: str, n: int) -> np.ndarray:
@@ -109,11 +132,8 @@ class DynamicsModel:
 
     # -- construction -----------------------------------------------------------------------
     def _regressors(self, qs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        c = self.compiled
-        return regressor_kernel(
-            np.ascontiguousarray(qs, dtype=float), c.node_parent, c.node_axis, c.node_coef,
-            c.node_offset, c.body_node, c.body_path, c.gravity,
-        )
+        tree = self.compiled.tree
+        return regressor_kernel(np.ascontiguousarray(qs, dtype=float), *tree.arrays, tree.body_node, self.compiled.gravity)
 
     def _coordinate_kinds(self, rng: np.random.Generator) -> list[CoordinateKind]:
         q0 = rng.uniform(-np.pi, np.pi, (3, self.n_dof))
@@ -196,13 +216,14 @@ class DynamicsModel:
         return self.index.shape[0]
 
     def basis(self, q: np.ndarray) -> np.ndarray:
-        """Basis functions at poses (P, N) -> (P, n_basis), compiled (:func:`.kernel.basis_kernel`)."""
-        return basis_kernel(np.ascontiguousarray(self._poses(q)), *self._basis_tables)
+        """Basis functions at poses (P, N) -> (P, n_basis), compiled (:func:`.basis.basis_kernel`)."""
+        return basis_kernel(np.ascontiguousarray(self._poses(q)), *self.basis_tables)
 
     @cached_property
-    def _basis_tables(self) -> tuple[np.ndarray, ...]:
-        codes = {CoordinateKind.CYCLIC: 0, CoordinateKind.REVOLUTE: 1, CoordinateKind.PRISMATIC: 2}
-        kinds = np.array([codes[b.kind] for b in self.bases], dtype=np.int64)
+    def basis_tables(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(kinds, degrees, index)`` of the basis as int64 arrays: kind codes (:data:`.basis.KIND_CODES`)
+        and degree per coordinate, multi-index per basis function; what the compiled evaluations take."""
+        kinds = np.array([KIND_CODES[b.kind] for b in self.bases], dtype=np.int64)
         degrees = np.array([b.degree for b in self.bases], dtype=np.int64)
         return kinds, degrees, np.ascontiguousarray(self.index, dtype=np.int64)
 

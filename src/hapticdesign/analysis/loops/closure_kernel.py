@@ -8,7 +8,8 @@ selected components of all closures:
   (rx, ry, rz: ``sin(angle) axis``, zero at closure);
 - constraint Jacobian ``Phi = select(J_A - J_B)`` (m x N) with ``J`` the world-frame geometric
   Jacobian of a frame origin (seed 000 eq. 2.20-2.26: rotation axis ``u`` through the node,
-  ``v = u x (p - p_node)``); it is the exact derivative of ``phi`` at closure;
+  ``v = u x (p - p_node)``; :func:`hapticdesign.model.walk.frame_jacobian`); it is the exact
+  derivative of ``phi`` at closure;
 - bias ``Phidot qd = select(a_A - a_B)`` with ``a`` the accelerations of the frames at ``qdd = 0``
   (:func:`node_motion`, the time derivative of eq. 2.38-2.41).
 
@@ -23,47 +24,11 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from hapticdesign.analysis.dynamics.kernel import _node_poses
+from hapticdesign.model.walk import frame_jacobian, node_poses
 
 OK, NO_CLOSURE, SINGULAR, BRANCH_CHANGE = 0, 1, 2, 3
 MAX_NEWTON_STEP = 0.25
 """Largest Newton update of a passive coordinate per iteration (rad or m)."""
-
-
-@njit(cache=True)
-def frame_jacobian(node, parent, axis, coef, rot, pos, jac):
-    """World-frame Jacobian (6 x N, rows v then w) of the origin of tree node ``node`` (-1: base)."""
-    for i in range(6):
-        for k in range(jac.shape[1]):
-            jac[i, k] = 0.0
-    if node < 0:
-        return
-    n = node
-    while n >= 0:
-        a = axis[n] % 3
-        u0, u1, u2 = rot[n, 0, a], rot[n, 1, a], rot[n, 2, a]
-        if axis[n] < 3:
-            r0 = pos[node, 0] - pos[n, 0]
-            r1 = pos[node, 1] - pos[n, 1]
-            r2 = pos[node, 2] - pos[n, 2]
-            v0, v1, v2 = u1 * r2 - u2 * r1, u2 * r0 - u0 * r2, u0 * r1 - u1 * r0
-            for k in range(jac.shape[1]):
-                c = coef[n, k]
-                if c != 0.0:
-                    jac[0, k] += c * v0
-                    jac[1, k] += c * v1
-                    jac[2, k] += c * v2
-                    jac[3, k] += c * u0
-                    jac[4, k] += c * u1
-                    jac[5, k] += c * u2
-        else:
-            for k in range(jac.shape[1]):
-                c = coef[n, k]
-                if c != 0.0:
-                    jac[0, k] += c * u0
-                    jac[1, k] += c * u1
-                    jac[2, k] += c * u2
-        n = parent[n]
 
 
 @njit(cache=True)
@@ -142,8 +107,8 @@ def closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, coef, r
     for i in range(row_loop.shape[0]):
         loop = row_loop[i]
         if loop != last:
-            frame_jacobian(frame_a[loop], parent, axis, coef, rot, pos, ja)
-            frame_jacobian(frame_b[loop], parent, axis, coef, rot, pos, jb)
+            frame_jacobian(frame_a[loop], parent, axis, coef, rot, pos, False, ja)
+            frame_jacobian(frame_b[loop], parent, axis, coef, rot, pos, False, jb)
             last = loop
         for k in range(n_dof):
             phi[i, k] = ja[row_comp[i], k] - jb[row_comp[i], k]
@@ -228,17 +193,17 @@ def velocity_map_into(phi, actuated, passive, pp, s):
 
 
 @njit(cache=True)
-def newton(q, actuated, passive, parent, axis, coef, offset, frame_a, frame_b, row_loop, row_comp,
+def newton(q, actuated, passive, parent, axis, coef, offset, const_rot, const_pos, frame_a, frame_b, row_loop, row_comp,
            tol, max_iter, singular_ratio, rot, pos):
     """Newton on the passive entries of ``q`` (in place). Returns (status, det sign, pivot ratio)."""
     m = passive.shape[0]
-    return newton_into(q, actuated, passive, parent, axis, coef, offset, frame_a, frame_b, row_loop, row_comp,
+    return newton_into(q, actuated, passive, parent, axis, coef, offset, const_rot, const_pos, frame_a, frame_b, row_loop, row_comp,
                        tol, max_iter, singular_ratio, rot, pos, np.empty(m), np.empty((m, coef.shape[1])),
                        np.empty((m, 1)), np.empty((m, m)))
 
 
 @njit(cache=True)
-def newton_into(q, actuated, passive, parent, axis, coef, offset, frame_a, frame_b, row_loop, row_comp,
+def newton_into(q, actuated, passive, parent, axis, coef, offset, const_rot, const_pos, frame_a, frame_b, row_loop, row_comp,
                 tol, max_iter, singular_ratio, rot, pos, res, phi, rhs, pp):
     """:func:`newton` on the caller's scratch ``res`` (m), ``phi`` (m x N), ``rhs`` (m x 1), ``pp`` (m x m).
 
@@ -246,7 +211,7 @@ def newton_into(q, actuated, passive, parent, axis, coef, offset, frame_a, frame
     """
     m = passive.shape[0]
     for it in range(max_iter + 1):
-        _node_poses(q, parent, axis, coef, offset, rot, pos)
+        node_poses(q, parent, axis, coef, offset, const_rot, const_pos, parent.shape[0] - 1, rot, pos)
         closure_residual(frame_a, frame_b, row_loop, row_comp, rot, pos, res)
         closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, coef, rot, pos, phi)
         for i in range(m):
@@ -271,7 +236,7 @@ def newton_into(q, actuated, passive, parent, axis, coef, offset, frame_a, frame
 
 
 @njit(cache=True)
-def solve_path(qa_path, q_start, sign0, actuated, passive, parent, axis, coef, offset, frame_a, frame_b,
+def solve_path(qa_path, q_start, sign0, actuated, passive, parent, axis, coef, offset, const_rot, const_pos, frame_a, frame_b,
                row_loop, row_comp, max_step, tol, max_iter, singular_ratio, min_fraction):
     """Continue the closure from ``q_start`` (full, closed) through the actuated poses ``qa_path`` in order.
 
@@ -297,7 +262,7 @@ def solve_path(qa_path, q_start, sign0, actuated, passive, parent, axis, coef, o
     trial = q.copy()
     predicted = np.empty(m)
     # tangent at the current closed pose; after each accepted step, from Newton's last Jacobian there
-    _node_poses(q, parent, axis, coef, offset, rot, pos)
+    node_poses(q, parent, axis, coef, offset, const_rot, const_pos, parent.shape[0] - 1, rot, pos)
     closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, coef, rot, pos, phi)
     velocity_map_into(phi, actuated, passive, pp, s)
     for p in range(n_pose):
@@ -320,7 +285,7 @@ def solve_path(qa_path, q_start, sign0, actuated, passive, parent, axis, coef, o
                     trial[passive[r]] += s[r, j] * delta
             for r in range(m):
                 predicted[r] = trial[passive[r]]
-            code, sign, _ = newton_into(trial, actuated, passive, parent, axis, coef, offset, frame_a, frame_b,
+            code, sign, _ = newton_into(trial, actuated, passive, parent, axis, coef, offset, const_rot, const_pos, frame_a, frame_b,
                                         row_loop, row_comp, tol, max_iter, singular_ratio, rot, pos, res, phi, rhs, pp)
             if code == OK and sign != sign0:
                 code = BRANCH_CHANGE

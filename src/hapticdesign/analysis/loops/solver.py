@@ -24,11 +24,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hapticdesign.analysis.dynamics.kernel import _node_poses
 from hapticdesign.analysis.loops import closure_kernel as ck
 from hapticdesign.errors import UserError
 from hapticdesign.model.loops import ClosedLoops
 from hapticdesign.model.mechanism import Mechanism
+from hapticdesign.model.walk import node_poses
 
 MAX_STEP = 0.1
 """Largest continuation step in the actuated coordinates (rad or m) before Newton."""
@@ -59,7 +59,7 @@ class LoopArrays:
     @classmethod
     def from_mechanism(cls, mech: Mechanism) -> "LoopArrays":
         loops: ClosedLoops = mech.loops
-        nodes = mech.compiled.frame_node
+        nodes = mech.compiled.tree.frame_node
         rows = [(i, c) for i, closure in enumerate(loops.closures) for c in closure.components]
         return cls(
             frame_a=np.array([nodes[c.frames[0]] for c in loops.closures], dtype=np.int64),
@@ -105,13 +105,12 @@ class LoopSolver:
     # -- kernels ------------------------------------------------------------------------------
     def _kinematic_args(self) -> tuple:
         c, a = self.compiled, self.arrays
-        return (c.node_parent, c.node_axis, c.node_coef, c.node_offset, a.frame_a, a.frame_b, a.row_loop, a.row_comp)
+        return (*c.tree.arrays, a.frame_a, a.frame_b, a.row_loop, a.row_comp)
 
     def _newton(self, q: np.ndarray) -> tuple[int, float, float]:
-        c, a = self.compiled, self.arrays
-        n_node = max(len(c.node_parent), 1)
+        a = self.arrays
         return ck.newton(q, a.actuated, a.passive, *self._kinematic_args(), self.tol, MAX_ITER, SINGULAR_RATIO,
-                         np.zeros((n_node, 3, 3)), np.zeros((n_node, 3)))
+                         *self.compiled.tree.workspace())
 
     def _actuated(self, q_a: np.ndarray) -> np.ndarray:
         q_a = np.asarray(q_a, dtype=float)
@@ -151,10 +150,9 @@ class LoopSolver:
         return out
 
     def _poses(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        c = self.compiled
-        n_node = max(len(c.node_parent), 1)
-        rot, pos = np.zeros((n_node, 3, 3)), np.zeros((n_node, 3))
-        _node_poses(np.asarray(q, dtype=float), c.node_parent, c.node_axis, c.node_coef, c.node_offset, rot, pos)
+        tree = self.compiled.tree
+        rot, pos = tree.workspace()
+        node_poses(np.asarray(q, dtype=float), *tree.arrays, len(tree.parent) - 1, rot, pos)
         return rot, pos
 
     # -- velocities ---------------------------------------------------------------------------
@@ -163,7 +161,7 @@ class LoopSolver:
         rot, pos = self._poses(q)
         c, a = self.compiled, self.arrays
         phi = np.empty((len(a.row_loop), self.n_dof))
-        ck.closure_jacobian(a.frame_a, a.frame_b, a.row_loop, a.row_comp, c.node_parent, c.node_axis, c.node_coef,
+        ck.closure_jacobian(a.frame_a, a.frame_b, a.row_loop, a.row_comp, c.tree.parent, c.tree.axis, c.tree.coef,
                             rot, pos, phi)
         return phi
 

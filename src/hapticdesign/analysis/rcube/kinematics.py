@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from hapticdesign.analysis.kinematics import poses_and_jacobians
 from hapticdesign.errors import UserError
 from hapticdesign.model.rcube import RCubeGeometry, axis_permutation, chain_mechanism
-from hapticdesign.analysis.rcube.batch_kinematics import poses_and_jacobians
 
 SINGULAR_TOLERANCE = 1e-9
 

@@ -19,6 +19,11 @@ from functools import lru_cache
 import numpy as np
 from scipy.linalg import block_diag
 
+from hapticdesign.analysis.kinematics import poses_and_jacobians
+from hapticdesign.analysis.rcube.design import RCubeDesign
+from hapticdesign.analysis.rcube.kinematics import inverse_kinematics, require_regular
+from hapticdesign.analysis.stiffness import vjm
+from hapticdesign.analysis.stiffness.joints import spring_compliance
 from hapticdesign.errors import UserError
 from hapticdesign.model.rcube import (
     ACTIVE_INDEX,
@@ -27,11 +32,6 @@ from hapticdesign.model.rcube import (
     stiffness_chain_mechanism,
     stiffness_coordinates,
 )
-from hapticdesign.analysis.rcube.batch_kinematics import poses_and_jacobians
-from hapticdesign.analysis.rcube.design import RCubeDesign
-from hapticdesign.analysis.rcube.kinematics import inverse_kinematics, require_regular
-from hapticdesign.analysis.stiffness import vjm
-from hapticdesign.analysis.stiffness.joints import spring_compliance
 
 JOINT_FRAMES = ("link1", "k1", "link2", "link3", "k3")
 """Frames of the stiffness chain whose z axis is the axis of joints ``phi_i1 .. phi_i5`` (eq. 5.5-5.14)."""

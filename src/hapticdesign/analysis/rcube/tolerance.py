@@ -28,11 +28,12 @@ from math import isfinite
 
 import numpy as np
 
+from hapticdesign.analysis.kinematics import poses_and_jacobians
 from hapticdesign.errors import InputError, UserError
-from hapticdesign.analysis.rcube.batch_kinematics import poses_and_jacobians
 from hapticdesign.analysis.rcube.design import RCubeDesign
 from hapticdesign.analysis.rcube.kinematics import chain_angles, chain_jacobian, cube_grid, passive_reach
 from hapticdesign.analysis.rcube.stiffness import chain_stiffness_matrices
+from hapticdesign.errors import UserError
 from hapticdesign.model.rcube import RCubeGeometry, axis_permutation, chain_mechanism
 
 SECONDS_PER_SAMPLE = 0.012

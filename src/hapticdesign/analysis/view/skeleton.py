@@ -24,7 +24,7 @@ from hapticdesign.analysis.dynamics.device import dynamics_of
 from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.device import Device
 from hapticdesign.model.mechanism import JointType
-from hapticdesign.model.transforms import Axis, elementary_matrix
+from hapticdesign.model.walk import node_poses
 
 PRISMATIC_SPAN = 0.1
 """Slider half range [m] of a prismatic joint without limits."""
@@ -81,15 +81,16 @@ def full_coordinates(device: Device, q: np.ndarray) -> np.ndarray:
 
 def frame_poses(device: Device, q: np.ndarray) -> dict[str, np.ndarray]:
     """World pose (4x4) of every frame, ``base`` included, at actuated coordinates ``q``."""
-    compiled = device.mechanism.compiled
-    q = full_coordinates(device, q)
-    node_pose = []
-    for n in range(len(compiled.node_parent)):
-        parent = compiled.node_parent[n]
-        start = np.eye(4) if parent < 0 else node_pose[parent]
-        value = compiled.node_offset[n] + compiled.node_coef[n] @ q
-        node_pose.append(start @ elementary_matrix(Axis(int(compiled.node_axis[n])), value))
-    return {name: (np.eye(4) if node < 0 else node_pose[node]) for name, node in compiled.frame_node.items()}
+    tree = device.mechanism.compiled.tree
+    rot, pos = tree.workspace()
+    q = np.ascontiguousarray(full_coordinates(device, q), dtype=float)
+    node_poses(q, *tree.arrays, len(tree.parent) - 1, rot, pos)
+    poses = {}
+    for name, node in tree.frame_node.items():
+        poses[name] = np.eye(4)
+        if node >= 0:
+            poses[name][:3, :3], poses[name][:3, 3] = rot[node], pos[node]
+    return poses
 
 
 def links(device: Device) -> list[tuple[str, str]]:

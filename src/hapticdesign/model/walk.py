@@ -1,0 +1,215 @@
+"""The one walk over a mechanism's frame tree: node poses and frame Jacobians, compiled with Numba.
+
+:class:`KinematicTree` is the compiled frame tree with its constant transforms folded: within a frame,
+each run of consecutive constant elementary transforms becomes one constant node carrying its
+rotation and translation (computed once, as Robotics Toolbox's ``ETS.compile`` does; a lone constant
+translation stays as it is, three multiply-adds being cheaper than a constant 4x4); variable
+transforms keep their :class:`~hapticdesign.model.transforms.Axis` code and affine value
+``offset + coef . q``. Named frames always end on a node, so bodies and closures attach to nodes.
+
+- :func:`node_poses`: world rotation and origin of every node up to a given one (seed 000
+  eq. 2.4-2.7 and 2.24-2.26, one elementary transform at a time);
+- :func:`frame_jacobian`: geometric Jacobian (6 x N, rows ``v`` then ``w``) of a node's origin,
+  in the base frame or in the node's own frame. The column of a variable transform is its unit
+  twist at the current pose (rotation axis ``u`` through the node: ``v = u x (p - p_node)``,
+  ``w = u``; translation: ``v = u``; seed 000 eq. 2.20-2.26, seed 001 eq. 5.61-5.66 and
+  5.87-5.92), weighted by the coupling coefficients of dependent coordinates (eq. 2.38-2.43);
+- :func:`poses_and_jacobians`: both for a batch of coordinate vectors (a single pose is a batch of one).
+
+Forward kinematics, the dynamics regressors, the loop-closure kernels and the R-CUBE stiffness model
+all call these.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from hapticdesign.model.transforms import Axis, elementary_matrix
+
+CONSTANT = 6
+"""Node code of a folded constant transform (after the six :class:`Axis` codes)."""
+
+
+@dataclass(frozen=True)
+class KinematicTree:
+    """Frame tree with constant transforms folded; the arrays every compiled walk takes.
+
+    ``parent[n]`` is the previous node (``-1`` for the base), ``axis[n]`` an :class:`Axis` code or
+    :data:`CONSTANT`, ``coef[n]`` and ``offset[n]`` the affine value of a variable node,
+    ``const_rot[n]`` and ``const_pos[n]`` the transform of a constant node, ``frame_node`` the node
+    each named frame ends on (``base``: -1) and ``body_node[b]`` the node body ``b`` is attached to.
+    """
+
+    parent: np.ndarray
+    axis: np.ndarray
+    coef: np.ndarray
+    offset: np.ndarray
+    const_rot: np.ndarray
+    const_pos: np.ndarray
+    frame_node: dict[str, int]
+    body_node: np.ndarray
+
+    @classmethod
+    def fold(cls, parent: np.ndarray, axis: np.ndarray, coef: np.ndarray, offset: np.ndarray,
+             frame_node: dict[str, int], body_frames: list[str]) -> "KinematicTree":
+        """Fold the elementary-transform tree (one node per transform, named frames ending on ``frame_node``)."""
+        ends = set(frame_node.values())
+        variable = np.any(coef != 0.0, axis=1)
+        n_dof = coef.shape[1]
+        rows: list[tuple] = []  # (parent, axis, coef, offset, rotation, translation) per folded node
+        mapped: dict[int, int] = {-1: -1}
+        pending: list[int] = []
+        run = np.eye(4)
+        for n in range(len(parent)):
+            if variable[n]:
+                rows.append((mapped[int(parent[n])], int(axis[n]), coef[n], float(offset[n]), np.eye(3), np.zeros(3)))
+                mapped[n] = len(rows) - 1
+                continue
+            matrix = elementary_matrix(Axis(int(axis[n])), float(offset[n]))
+            run = matrix if not pending else run @ matrix
+            pending.append(n)
+            if n not in ends and n + 1 < len(parent) and parent[n + 1] == n and not variable[n + 1]:
+                continue  # the run of constants goes on inside this frame
+            start = mapped[int(parent[pending[0]])]
+            if len(pending) == 1 and axis[n] >= Axis.TX:  # a lone translation is cheaper unfolded
+                rows.append((start, int(axis[n]), np.zeros(n_dof), float(offset[n]), np.eye(3), np.zeros(3)))
+            else:
+                rows.append((start, CONSTANT, np.zeros(n_dof), 0.0, run[:3, :3], run[:3, 3]))
+            mapped.update({m: len(rows) - 1 for m in pending})
+            pending = []
+        nodes = {name: mapped[node] for name, node in frame_node.items()}
+        return cls(
+            parent=np.array([r[0] for r in rows], dtype=np.int64),
+            axis=np.array([r[1] for r in rows], dtype=np.int64),
+            coef=np.array([r[2] for r in rows], dtype=float).reshape(len(rows), n_dof),
+            offset=np.array([r[3] for r in rows], dtype=float),
+            const_rot=np.array([r[4] for r in rows], dtype=float).reshape(len(rows), 3, 3),
+            const_pos=np.array([r[5] for r in rows], dtype=float).reshape(len(rows), 3),
+            frame_node=nodes,
+            body_node=np.array([nodes[f] for f in body_frames], dtype=np.int64),
+        )
+
+    @property
+    def arrays(self) -> tuple[np.ndarray, ...]:
+        """``(parent, axis, coef, offset, const_rot, const_pos)``, the leading arguments of the kernels."""
+        return self.parent, self.axis, self.coef, self.offset, self.const_rot, self.const_pos
+
+    def workspace(self) -> tuple[np.ndarray, np.ndarray]:
+        """Zeroed node rotations (M, 3, 3) and origins (M, 3) for :func:`node_poses`."""
+        n_node = max(len(self.parent), 1)
+        return np.zeros((n_node, 3, 3)), np.zeros((n_node, 3))
+
+
+@njit(cache=True)
+def node_poses(q, parent, axis, coef, offset, const_rot, const_pos, last, rot, pos):
+    """World rotation ``rot[n]`` and origin ``pos[n]`` of nodes ``0 .. last`` at coordinates ``q``."""
+    for n in range(last + 1):
+        pn = parent[n]
+        if axis[n] == CONSTANT:
+            for i in range(3):
+                if pn < 0:
+                    for j in range(3):
+                        rot[n, i, j] = const_rot[n, i, j]
+                    pos[n, i] = const_pos[n, i]
+                else:
+                    for j in range(3):
+                        rot[n, i, j] = (rot[pn, i, 0] * const_rot[n, 0, j] + rot[pn, i, 1] * const_rot[n, 1, j]
+                                        + rot[pn, i, 2] * const_rot[n, 2, j])
+                    pos[n, i] = (pos[pn, i] + rot[pn, i, 0] * const_pos[n, 0] + rot[pn, i, 1] * const_pos[n, 1]
+                                 + rot[pn, i, 2] * const_pos[n, 2])
+            continue
+        v = offset[n]
+        for k in range(q.shape[0]):
+            v += coef[n, k] * q[k]
+        if pn >= 0:
+            for i in range(3):
+                for j in range(3):
+                    rot[n, i, j] = rot[pn, i, j]
+                pos[n, i] = pos[pn, i]
+        else:
+            for i in range(3):
+                for j in range(3):
+                    rot[n, i, j] = 1.0 if i == j else 0.0
+                pos[n, i] = 0.0
+        a = axis[n] % 3
+        if axis[n] < 3:
+            b = (a + 1) % 3
+            c = (a + 2) % 3
+            cv = np.cos(v)
+            sv = np.sin(v)
+            for i in range(3):
+                rb = rot[n, i, b]
+                rc = rot[n, i, c]
+                rot[n, i, b] = rb * cv + rc * sv
+                rot[n, i, c] = -rb * sv + rc * cv
+        else:
+            for i in range(3):
+                pos[n, i] += rot[n, i, a] * v
+
+
+@njit(cache=True)
+def frame_jacobian(node, parent, axis, coef, rot, pos, body, jac):
+    """Jacobian (6 x N, rows v then w) of the origin of node ``node`` (-1: the base) at the poses ``rot, pos``.
+
+    In the base frame, or with ``body`` in the node's own frame (``R^T v``, ``R^T w``).
+    """
+    n_dof = jac.shape[1]
+    for i in range(6):
+        for k in range(n_dof):
+            jac[i, k] = 0.0
+    if node < 0:
+        return
+    n = node
+    while n >= 0:
+        if axis[n] != CONSTANT:
+            a = axis[n] % 3
+            rotation = axis[n] < 3
+            u0, u1, u2 = rot[n, 0, a], rot[n, 1, a], rot[n, 2, a]
+            v0, v1, v2 = u0, u1, u2
+            if rotation:
+                r0 = pos[node, 0] - pos[n, 0]
+                r1 = pos[node, 1] - pos[n, 1]
+                r2 = pos[node, 2] - pos[n, 2]
+                v0, v1, v2 = u1 * r2 - u2 * r1, u2 * r0 - u0 * r2, u0 * r1 - u1 * r0
+            if body:
+                v0, v1, v2 = _to_node(rot, node, v0, v1, v2)
+                u0, u1, u2 = _to_node(rot, node, u0, u1, u2)
+            for k in range(n_dof):
+                c = coef[n, k]
+                if c != 0.0:
+                    jac[0, k] += c * v0
+                    jac[1, k] += c * v1
+                    jac[2, k] += c * v2
+                    if rotation:
+                        jac[3, k] += c * u0
+                        jac[4, k] += c * u1
+                        jac[5, k] += c * u2
+        n = parent[n]
+
+
+@njit(cache=True, inline="always")
+def _to_node(rot, node, x0, x1, x2):
+    """``R^T x`` with ``R`` the world rotation of ``node``: a base-frame vector in the node's axes."""
+    return (rot[node, 0, 0] * x0 + rot[node, 1, 0] * x1 + rot[node, 2, 0] * x2,
+            rot[node, 0, 1] * x0 + rot[node, 1, 1] * x1 + rot[node, 2, 1] * x2,
+            rot[node, 0, 2] * x0 + rot[node, 1, 2] * x1 + rot[node, 2, 2] * x2)
+
+
+@njit(cache=True)
+def poses_and_jacobians(qs, parent, axis, coef, offset, const_rot, const_pos, node, body, poses, jac):
+    """World poses (P, 4, 4) and Jacobians (P, 6, N) of node ``node`` at coordinates ``qs`` (P, N), into the outputs."""
+    n_node = max(node + 1, 1)
+    rot = np.zeros((n_node, 3, 3))
+    pos = np.zeros((n_node, 3))
+    for p in range(qs.shape[0]):
+        node_poses(qs[p], parent, axis, coef, offset, const_rot, const_pos, node, rot, pos)
+        for i in range(3):
+            for j in range(3):
+                poses[p, i, j] = rot[node, i, j] if node >= 0 else (1.0 if i == j else 0.0)
+            poses[p, i, 3] = pos[node, i] if node >= 0 else 0.0
+            poses[p, 3, i] = 0.0
+        poses[p, 3, 3] = 1.0
+        frame_jacobian(node, parent, axis, coef, rot, pos, body, jac[p])
