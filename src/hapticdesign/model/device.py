@@ -20,7 +20,7 @@ import math
 import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
-from functools import lru_cache
+from functools import cached_property, lru_cache
 
 import numpy as np
 
@@ -111,9 +111,14 @@ class Device:
         return np.array([[float(self.params.get(seed_parameter_name(f, b), 0.0)) for f in SEED_FIELDS] for b in self.body_names])
 
     def standard_parameters(self) -> np.ndarray:
-        """Standard inertial parameters, flat (10 x bodies,), in the regressor's column order.
+        """Standard inertial parameters, flat (10 x bodies,), in the regressor's column order (a fresh copy).
 
         Refuses parameters whose standard form overflows or holds a negative mass."""
+        return self._standard.copy()
+
+    @cached_property
+    def _standard(self) -> np.ndarray:
+        """:meth:`standard_parameters`, computed once per device value (the analyses ask for it often)."""
         seed = self.seed_parameters()
         with np.errstate(over="ignore", invalid="ignore"):
             standard = standard_from_seed(seed).ravel()
