@@ -126,16 +126,7 @@ def test_api_direction_and_refusals(gantry):
         impedance_range(gantry, 1, method="analytic", wall_direction=(0, 1, 0))
 
 
-SLIDER = """\
-name: slider
-joints:
-  - {name: x, type: prismatic, damping: 2.0}
-frames:
-  - {name: carriage, parent: base, transforms: [tx: x]}
-end_effector: carriage
-bodies:
-  - {name: c, frame: carriage, m: 0.5}
-"""
+SLIDER = Path(__file__).with_name("slider.yaml")
 
 
 def test_cli_cartesian_wall(tmp_path):
@@ -148,8 +139,7 @@ def test_cli_cartesian_wall(tmp_path):
     from hapticdesign.simulation.boundary import compensated_boundary
 
     runner = CliRunner()
-    path = tmp_path / "slider.yaml"
-    path.write_text(SLIDER)
+    path = SLIDER
     zw = runner.invoke(app, ["zwidth", "--device", str(path), "--wall-direction", "1,0,1", "--compensate-inertia",
                              "--b-values", "0", "--json"])
     assert zw.exit_code == 0, zw.output

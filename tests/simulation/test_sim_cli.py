@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 import math
 
 import pytest
@@ -81,22 +82,12 @@ def test_zwidth_chart_and_analytic_method(tmp_path):
     assert out["method"] == "analytic" and out["analytic_exact"] is True and out["k_max"] == 6.0
 
 
-PRISMATIC = """\
-name: slider
-joints:
-  - {name: x, type: prismatic, damping: 2.0}
-frames:
-  - {name: carriage, parent: base, transforms: [tx: x]}
-end_effector: carriage
-bodies:
-  - {name: c, frame: carriage, m: 0.5}
-"""
+PRISMATIC = Path(__file__).with_name("slider.yaml")
 
 
 def test_a_prismatic_wall_is_labelled_in_newtons(tmp_path):
     """A 0.5 kg slider with 2 N s/m: compensated, the limit is b^2 / m = 8 N/m, reported in N/m."""
-    path = tmp_path / "slider.yaml"
-    path.write_text(PRISMATIC)
+    path = PRISMATIC
     result = runner.invoke(app, ["impedance-range", "--device", str(path), "--method", "analytic", "--resolution",
                                  "0.25", "--true-boundary", "--json"])
     assert result.exit_code == 0, result.output
