@@ -84,3 +84,40 @@ def test_analytic_campaign_equals_the_simulated_one_where_exact(tmp_path, cluste
                 assert a["method"] == "analytic" and a["value"] == pytest.approx(s["value"], abs=1e-6)
     case = json.loads((analytic / "cases" / "x2__transparency__type2.json").read_text())
     assert case["analytic_exact"] is False and case["steady_bandwidth_hz"] > 0
+
+
+def test_realistic_conditions_reach_every_case(tmp_path, cluster):
+    """``CampaignOptions(conditions=...)``: delay and per-group modelling error with seeded signs apply to
+    every case. Each case equals the engine called directly under the same conditions, and a sample of
+    delay lowers every stable range (the Z-width shrinks with delay, Gil et al. 2004)."""
+    from hapticdesign.devices.registry import preset
+    from hapticdesign.simulation.config import Compensator, LoopConfig, Sensors
+    from hapticdesign.simulation.impedance import impedance_range
+
+    designs = write_designs(tmp_path / "designs.csv")
+    conditions = LoopConfig(sensors=Sensors(delay_samples=1),
+                            compensator=Compensator(group_errors=(("mass", 5.0), ("inertia", 5.0)), error_seed=3))
+    real = replace(QUICK, method="analytic", conditions=conditions)
+    run_campaign(designs, tmp_path / "real", real, scheduler=cluster.scheduler_address)
+    run_campaign(designs, tmp_path / "ideal", replace(QUICK, method="analytic"), scheduler=cluster.scheduler_address)
+    for d in read_designs(designs):
+        device = preset("phantom-3dof").with_params(d.params)
+        for sim_type in (1, 2):
+            name = f"{d.name}__impedance__type{sim_type}.json"
+            got, ideal = (json.loads((tmp_path / run / "cases" / name).read_text()) for run in ("real", "ideal"))
+            direct = impedance_range(device, sim_type, config=replace(conditions, duration=QUICK.duration),
+                                     k_limit=QUICK.k_limit, method="analytic")
+            assert got["value"] == direct.k_max
+            assert got["value"] < ideal["value"]
+    with pytest.raises(UserError, match="no encoder quantization"):
+        CampaignOptions(method="analytic", conditions=LoopConfig(sensors=Sensors(counts_per_revolution=4096)))
+
+
+def test_campaign_command_takes_the_conditions(tmp_path):
+    designs = write_designs(tmp_path / "designs.csv")
+    bad = CliRunner().invoke(app, ["campaign", "--designs", str(designs), "--out", str(tmp_path / "o"),
+                                   "--group-errors", "masses=5"])
+    assert bad.exit_code == 2 and "unknown error group 'masses'" in bad.output
+    bad = CliRunner().invoke(app, ["campaign", "--designs", str(designs), "--out", str(tmp_path / "o"),
+                                   "--method", "analytic", "--coulomb", "0.01,0.01,0.01"])
+    assert bad.exit_code == 2 and "no Coulomb friction" in bad.output

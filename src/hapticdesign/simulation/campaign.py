@@ -22,7 +22,7 @@ import re
 import warnings
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -32,6 +32,7 @@ from hapticdesign.devices.registry import preset
 from hapticdesign.errors import InputError, PhysicalConsistencyWarning, UserError
 from hapticdesign.files import read_text, write_atomically
 from hapticdesign.simulation.analytic import AnalyticProblem
+from hapticdesign.simulation.config import LoopConfig
 from hapticdesign.simulation.impedance import (ImpedanceProblem, fast_search, planned_simulations,
                                                require_search_workload)
 from hapticdesign.simulation.paths import Chirp
@@ -75,9 +76,19 @@ class CampaignOptions:
     bandwidth from the linear transmitted torque of :mod:`.analytic_transparency`; exact for type 1, and
     for type 2 when LN = 0)."""
 
+    conditions: LoopConfig = field(default_factory=LoopConfig)
+    """Realistic conditions for every case (seed 000 ch. 5's first future-work item): sensors (period,
+    encoder quantization, delay), the compensator (its terms, its modelling error, per group with seeded
+    signs), Coulomb friction in the plant and the hand. The seed's ideal loop by default; ``duration`` above
+    sets the impedance runs' length, the campaign sets the wall."""
+
     def __post_init__(self) -> None:
         if self.method not in ("simulation", "analytic"):
             raise UserError(f"the campaign method must be 'simulation' or 'analytic', got {self.method!r}")
+        if self.method == "analytic" and self.conditions.sensors.counts_per_revolution is not None:
+            raise UserError("the analytic method has no encoder quantization (not linear): use the simulation")
+        if self.method == "analytic" and self.conditions.coulomb is not None and any(self.conditions.coulomb):
+            raise UserError("the analytic method has no Coulomb friction (not linear): use the simulation")
 
 
 def _number(text: str, where: str, allow_nan: bool = False) -> float:
@@ -159,15 +170,14 @@ def run_case(preset_name: str, params: dict[str, float], criterion: str, sim_typ
         warnings.simplefilter("ignore", PhysicalConsistencyWarning)
         device = preset(preset_name).with_params(params)
     if criterion == "impedance":
-        from hapticdesign.simulation.config import LoopConfig
-
-        config = LoopConfig(duration=options.duration)
+        config = replace(options.conditions, duration=options.duration)
         kind = AnalyticProblem if options.method == "analytic" else ImpedanceProblem
         result = fast_search(kind(device, sim_type, config=config), options.k_limit)
         found = result.as_dict()
         found["limiting_criterion"] = found.pop("criterion")  # "criterion" names the campaign's (impedance)
         return {"value": float(result.k_max), **found, "method": options.method}
-    result = transparency(device, sim_type, options.stiffness, options.chirp, method=options.method)
+    result = transparency(device, sim_type, options.stiffness, options.chirp, config=options.conditions,
+                          method=options.method)
     keep = result.frequency <= options.chirp.f1
     return {
         **{k: v for k, v in result.as_dict().items() if k in ("steady_bandwidth_hz", "analytic_exact")},

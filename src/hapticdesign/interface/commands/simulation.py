@@ -330,6 +330,22 @@ def _stiffness_text(value: float) -> str:
     return f"{value:.6g} N m/rad" if np.isfinite(value) else "unbounded (no stiffness destabilizes the loop)"
 
 
+def _group_errors(text: str | None) -> tuple[tuple[str, float], ...]:
+    """``--group-errors "mass=5,centre=2,inertia=5"`` as ``(("mass", 5.0), ...)``."""
+    if not text:
+        return ()
+    pairs = []
+    for item in text.replace(" ", "").split(","):
+        name, sep, value = item.partition("=")
+        try:
+            pairs.append((name, float(value)))
+        except ValueError:
+            raise UserError(f"--group-errors: expected group=percent pairs such as mass=5,inertia=5, got {item[:40]!r}") from None
+        if not sep:
+            raise UserError(f"--group-errors: expected group=percent pairs such as mass=5,inertia=5, got {item[:40]!r}")
+    return tuple(pairs)
+
+
 def campaign_command(
     designs: Path = typer.Option(..., help="Design CSV: level, ln, ln_H, ln_C, ln_G and every inertial parameter."),
     out: Path = typer.Option(..., help="Output folder (cases/, results.csv, summary.csv, summary.md, figures/)."),
@@ -343,6 +359,16 @@ def campaign_command(
     f1: float = typer.Option(15.0, help="Chirp end frequency [Hz] (seed: 15)."),
     method: str = typer.Option("simulation", help="Cases by simulation or analytic (the loop linearized at the start "
                                                   "pose, no loop run: exact for type 1 and LN = 0)."),
+    counts: Optional[int] = COUNTS,
+    delay: int = DELAY,
+    error_percent: float = ERROR,
+    group_errors: Optional[str] = typer.Option(
+        None, help="Compensator error per parameter group [%], e.g. mass=5,centre=2,inertia=5 (groups: mass, "
+                   "centre, inertia)."),
+    error_seed: Optional[int] = typer.Option(
+        None, help="Random sign per parameter for --group-errors (numpy default_rng seed); all -1 without."),
+    coulomb: Optional[str] = typer.Option(None, help="Coulomb friction in the plant per joint [N m], comma-separated; "
+                                                     "the device's by default."),
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
     force: bool = FORCE,
@@ -350,7 +376,11 @@ def campaign_command(
     """Both criteria and both types over a design set; resumable (seed 000 §4.1.4, §4.2.4)."""
     import os
 
+    from dataclasses import replace
+
+    from hapticdesign.devices.registry import preset as preset_device
     from hapticdesign.simulation.campaign import CampaignOptions, load_cases, read_designs, run_campaign, summarize
+    from hapticdesign.simulation.config import compensator_device
     from hapticdesign.simulation.paths import Chirp
 
     with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
@@ -368,8 +398,18 @@ def campaign_command(
             raise UserError(f"--duration ({duration:g} s) must not be shorter than the 0.5 s settle window")
         if method not in ("simulation", "analytic"):
             raise UserError(f"--method must be 'simulation' or 'analytic', got {method!r}")
+        if counts is not None and counts < 1:
+            raise UserError(f"--counts must be at least 1, got {counts}")
+        friction = None if coulomb is None else tuple(float(v) for v in parse_vector(coulomb, None, "coulomb"))
+        if friction is not None and any(v < 0 for v in friction):
+            raise UserError("--coulomb: friction torques must be >= 0")
+        conditions = replace(_loop_config(1e-3, 1e-4, duration, counts, delay, error_percent, True, True, True,
+                                          0.0, 0.0, 0.0, 0.0), coulomb=friction)
+        conditions = replace(conditions, compensator=replace(conditions.compensator, group_errors=_group_errors(
+            group_errors), error_seed=error_seed))
+        compensator_device(preset_device(preset or "phantom-3dof"), conditions.compensator)  # bad groups fail now
         options = CampaignOptions(preset or "phantom-3dof", k_limit, stiffness, Chirp(0.3, 0.1, f1, sweep), duration,
-                                  method=method)
+                                  method=method, conditions=conditions)
         with progress_bar(not (quiet or json_out)) as report:
             advance = ((lambda done, total: report("cases", done, total)) if report
                        else progress_lines(not (quiet or json_out), "campaign cases"))
