@@ -311,6 +311,9 @@ def impedance_range(device: Device, sim_type: int = 1, method: str = "fast", k_l
     for the same answer in fewer runs); with it, :func:`grid_search` on ``R, 2R, 3R ...``.
     ``method="analytic"`` answers the same searches from the exact linear response of the sampled
     loop at the start pose (:mod:`.analytic`; no ODE integration; exact for type 1 and for LN = 0).
+    For a closed-loop device the joints start at, and move about, its home pose and a joint wall's
+    ``equilibrium`` is measured from there (:func:`~.config.rest_pose`); a run whose loops stop closing on
+    the assembly branch is a :class:`~hapticdesign.errors.UserError`.
     """
     require_device(device)
     require_options(sim_type, config, LoopConfig)

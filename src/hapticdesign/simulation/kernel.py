@@ -114,6 +114,12 @@ def _loop_plant_terms(q, qd, plant):
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
+def _loop_model_terms(q, qd, ctrl):
+    """:func:`_loop_terms` of the compensator's model."""
+    _loop_terms(q, qd, ctrl)
+
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def _tree_model_terms(q, qd, ctrl):
     """H, C, G of the compensator's tables at q and the velocity products of qd."""
     t, ws = ctrl.table, ctrl.ws
@@ -154,7 +160,7 @@ def _plant_terms_impl(q, qd, plant):
 
 @overload(_model_terms, inline="always")
 def _model_terms_impl(q, qd, ctrl):
-    return (_loop_terms if _is_loop(ctrl) else _tree_model_terms).py_func
+    return (_loop_model_terms if _is_loop(ctrl) else _tree_model_terms).py_func
 
 
 @overload(_status, inline="always")
