@@ -77,6 +77,17 @@ def test_stable_and_unstable_stiffness_bracket_the_limit(device):
     assert found.first_unstable is not None and not found.first_unstable.stable
 
 
+def test_analytic_search_equals_the_simulated_one(device):
+    """Type 1: the wall joint's loop linearized at home (H and G of the closed loop at home) gives the
+    simulated search's k_max on the same grid (the 0.01-rad step keeps the loop near its linearization)."""
+    w = WALL_JOINT[device.name]
+    limit = device.damping[w] ** 2 / hd.mass_matrix(device, rest_pose(device))[w, w]
+    found = {method: hd.impedance_range(device, 1, method=method, wall_joint=w, resolution=limit / 10, k_limit=1)
+             for method in ("fast", "analytic")}
+    assert found["fast"].k_max > 0
+    assert found["fast"].k_max == found["analytic"].k_max
+
+
 def test_free_undamped_motion_conserves_energy(device):
     """Every joint free from home, no damping, wall or compensation: the device falls under gravity (for
     0.1 s, before it reaches a singular pose) and
