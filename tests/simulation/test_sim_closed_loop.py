@@ -20,7 +20,13 @@ import hapticdesign as hd
 from hapticdesign.devices.device_file import load_device_file
 from hapticdesign.interface.cli import app
 from hapticdesign.simulation.boundary import envelope_grows
-from hapticdesign.simulation.config import Compensator, LoopConfig, Sensors, Wall, rest_pose
+from hapticdesign.simulation.config import (
+    Compensator,
+    LoopConfig,
+    Sensors,
+    Wall,
+    rest_pose,
+)
 from hapticdesign.simulation.loop import simulate
 from hapticdesign.simulation.paths import Held, Sine
 from hapticdesign.simulation.reference import simulate_adaptive
