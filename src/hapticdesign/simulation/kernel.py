@@ -16,6 +16,12 @@ Cartesian wall along the unit direction n at the handle ``tau_imp = J_n^T (K (n.
 hold ``u = tau_f - tau_imp`` (zero-order hold). The safety switch of Figure 4.7 cuts both torques
 off once the wall coordinate (the wall joint, or the handle along n) leaves its reference by
 ``safety_limit``.
+
+H, C and G come from a tree's exact basis tables (:mod:`.tables`) or, for a closed-loop device, in its
+actuated coordinates from the compiled closed-loop plant (seed 000 eq. 2.44-2.50 on the loop-opened
+tree, :mod:`hapticdesign.analysis.dynamics.closed_loop_plant`), the plant and the compensator's model
+each with its own warm start; which one is inlined follows the record's type (:mod:`.records`). A
+closed-loop run whose loops stop closing on the assembly branch ends with ``STATUS_LOOP_LOST``.
 """
 
 from __future__ import annotations
