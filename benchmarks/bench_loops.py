@@ -5,13 +5,11 @@
    continued from pose to pose by the loop solver (kernel + solver).
 2. LN set-up (model + quadratic form by converged quadrature) for the closed-loop devices (goal < 10 s),
    next to the Phantom's exact-basis set-up.
-3. A 5-s rendering simulation of the delta with the compiled closed-loop plant
-   (:func:`hapticdesign.analysis.dynamics.closed_loop_plant.closed_loop_terms`) in a plain numba loop:
-   classical RK4 at the plant step of :class:`hapticdesign.simulation.config.LoopConfig` (1e-4 s),
-   1 kHz sampling, a virtual wall (spring) on joint 1, the model's Coriolis and gravity compensation
-   (C, G at the sampled state, its own warm-started workspace; the inertial term fed with the previous
-   acceleration makes this undamped-wall loop unstable, so it is off) and the joints' viscous damping;
-   real-time factor = 5 s / run time (goal >= 20).
+3. A 5-s rendering simulation of the delta through :func:`hapticdesign.simulation.loop.simulate` (the
+   numba loop with the compiled closed-loop plant and compensator,
+   :func:`hapticdesign.analysis.dynamics.closed_loop_plant.closed_loop_terms`): type 1 (joints 2 and 3
+   held at home), classical RK4 at 1e-4 s, 1 kHz sampling, a stable virtual wall on joint 1, full
+   model compensation; real-time factor = 5 s / run time (goal >= 20).
 
 Times are CPU time of the benchmark process (``time.process_time``), so that a shared machine does not
 count other processes' time against one core.
@@ -27,6 +25,9 @@ from pathlib import Path
 
 ONE_CORE = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1", "NUMBA_NUM_THREADS": "1"}
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "devices"
+WALL_K = 0.01
+"""N m/rad: the delta's maximum stable impedance on one joint (type 1, seed criteria, ``impedance-range
+--resolution 0.002``), so that the benchmarked run is a stable wall held for the whole 5 s."""
 
 POSES = textwrap.dedent(
     """
@@ -89,61 +90,20 @@ SETUP = textwrap.dedent(
 SIMULATION = textwrap.dedent(
     """
     import time
-    import numpy as np
-    from numba import njit
-    from hapticdesign.analysis.dynamics.closed_loop_plant import OK, ClosedLoopPlant, closed_loop_terms
-    from hapticdesign.analysis.dynamics.device import dynamics_of
     from hapticdesign.devices.device_file import load_device_file
-    from hapticdesign.simulation.config import LoopConfig
-
-    @njit
-    def accelerations(q, qd, u, damping, structure, ws, h, cqd, g, out):
-        status = closed_loop_terms(q, qd, structure, ws, h, cqd, g)
-        out[:] = np.linalg.solve(h, u - cqd - g - damping * qd)
-        return status
-
-    @njit
-    def run(q0, structure, plant_ws, model_ws, damping, step, sub, n_steps, wall_k, wall_eq):
-        n = q0.shape[0]
-        q, qd, u = q0.copy(), np.zeros(n), np.zeros(n)
-        h, cqd, g = np.zeros((n, n)), np.zeros(n), np.zeros(n)
-        a1, a2, a3, a4 = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
-        for it in range(n_steps):
-            if it % sub == 0:
-                status = closed_loop_terms(q, qd, structure, model_ws, h, cqd, g)
-                if status != OK:
-                    return it, status
-                u[:] = cqd + g
-                u[0] -= wall_k * (q[0] - wall_eq)
-            s1 = accelerations(q, qd, u, damping, structure, plant_ws, h, cqd, g, a1)
-            s2 = accelerations(q + 0.5 * step * qd, qd + 0.5 * step * a1, u, damping, structure, plant_ws, h, cqd, g, a2)
-            s3 = accelerations(q + 0.5 * step * (qd + 0.5 * step * a1), qd + 0.5 * step * a2, u, damping, structure,
-                               plant_ws, h, cqd, g, a3)
-            s4 = accelerations(q + step * (qd + 0.5 * step * a2), qd + step * a3, u, damping, structure, plant_ws,
-                               h, cqd, g, a4)
-            if max(s1, s2, s3, s4) != OK:
-                return it, max(s1, s2, s3, s4)
-            q += step / 6.0 * (qd + 2.0 * (qd + 0.5 * step * a1) + 2.0 * (qd + 0.5 * step * a2) + qd + step * a3)
-            qd += step / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
-        return n_steps, OK
+    from hapticdesign.simulation.config import LoopConfig, Wall, rest_pose
+    from hapticdesign.simulation.criteria import type_paths
+    from hapticdesign.simulation.loop import simulate
 
     device = load_device_file("{examples}/delta.yaml")
-    model, pi = dynamics_of(device), device.standard_parameters()
-    config = LoopConfig()
-    q0 = model.solver.home[model.solver.arrays.actuated].copy()
-    damping = np.array(device.damping, dtype=float)
-    sub, n_steps = config.steps_per_sample(), int(round(config.duration / config.step))
-
-    def simulate(steps):
-        plant, sensor_model = ClosedLoopPlant(model, pi, q0), ClosedLoopPlant(model, pi, q0)
-        return run(q0, plant.structure, plant.workspace, sensor_model.workspace, damping, config.step, sub, steps,
-                   config.wall.stiffness, q0[0] + config.wall.equilibrium)
-
-    simulate(sub)
+    home = rest_pose(device)
+    paths = type_paths(1, device.n_dof, 0, home)
+    config = LoopConfig(duration=5.0, wall=Wall(0, {stiffness}, 0.0, home[0] + 0.01))
+    simulate(device, LoopConfig(duration=0.01, wall=config.wall), paths)  # compile / load the numba cache
     t0 = time.process_time()
-    done, status = simulate(n_steps)
+    trace = simulate(device, config, paths)
     seconds = time.process_time() - t0
-    print(config.duration, seconds, done, n_steps, status)
+    print(config.duration, seconds, trace.status)
     """
 )
 
@@ -167,9 +127,9 @@ def main() -> None:
         seconds, accuracy, ln = (float(v) for v in _run(SETUP.format(name=name, examples=EXAMPLES, half=half), ONE_CORE))
         region = "torus, exact basis" if name == "phantom-3dof" else f"home +- {half} rad, quadrature to {accuracy:.0e}"
         print(f"{name:13s} LN set-up (process, model and form; {region}): {seconds:.2f} s (goal < 10 s), LN = {ln:.4g}")
-    duration, seconds, done, n_steps, status = (float(v) for v in _run(SIMULATION.format(examples=EXAMPLES), ONE_CORE))
-    print(f"delta         simulation of {duration:g} s (RK4 at 1e-4 s, 1 kHz wall on joint 1, closed-loop plant): "
-          f"{seconds:.2f} s, {duration / seconds:.1f} x real time (goal >= 20); {int(done)} of {int(n_steps)} steps, "
+    duration, seconds, status = (float(v) for v in _run(SIMULATION.format(examples=EXAMPLES, stiffness=WALL_K), ONE_CORE))
+    print(f"delta         simulation of {duration:g} s through simulate (type 1, RK4 at 1e-4 s, 1 kHz, wall K = {WALL_K:g} "
+          f"N m/rad on joint 1, full compensation): {seconds:.2f} s, {duration / seconds:.1f} x real time (goal >= 20), "
           f"status {int(status)}")
 
 

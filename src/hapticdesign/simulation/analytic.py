@@ -37,7 +37,7 @@ from hapticdesign.analysis.dynamics.device import coriolis_centrifugal, gravity,
 from hapticdesign.analysis.kinematics import jacobian
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
-from hapticdesign.simulation.config import LoopConfig, compensator_device, normal_jacobian, plant_friction
+from hapticdesign.simulation.config import LoopConfig, compensator_device, normal_jacobian, plant_friction, rest_pose
 from hapticdesign.simulation.criteria import Verdict, WallProblem, type_paths
 from hapticdesign.simulation.zwidth import DisplayLoop, controller, plant
 
@@ -72,8 +72,9 @@ def linearize(device: Device, sim_type: int, wall_joint: int, config: LoopConfig
         raise UserError("the analytic method has no encoder quantization (not linear): use the simulation")
     if np.any(plant_friction(device, config) > 0):
         raise UserError("the analytic method has no Coulomb friction (not linear): use the simulation")
-    paths = type_paths(sim_type, device.n_dof, wall_joint)
-    q0 = np.zeros(device.n_dof)
+    rest = rest_pose(device)
+    paths = type_paths(sim_type, device.n_dof, wall_joint, rest)
+    q0 = rest.copy()
     for j, path in paths.items():
         q0[j] = float(path.sample(np.zeros(1))[0][0])
     w = wall_joint
@@ -83,6 +84,8 @@ def linearize(device: Device, sim_type: int, wall_joint: int, config: LoopConfig
     j_device = float(h[w, w])
     j, b, spring = j_device, float(damping[w]), 0.0
     if config.hand is not None:
+        if device.mechanism.loops is not None:
+            raise UserError("a hand model needs an open-chain device (the hand is not coupled to closed loops)")
         jv = jacobian(device.mechanism, q0)[:3, w]
         reach = float(jv @ jv)
         j += config.hand.mass * reach
@@ -92,7 +95,7 @@ def linearize(device: Device, sim_type: int, wall_joint: int, config: LoopConfig
     fraction = float(mass_matrix(model, q0)[w, w]) / j_device if comp.inertial else 0.0
     torque = -(float(g[w]) - comp.gravity * float(gravity(model, q0)[w]))
     loop = DisplayLoop(j, b, config.sensors.period, config.sensors.delay_samples, "sampled", fraction, spring)
-    exact = sim_type == 1 or _decoupled(device, w, paths)
+    exact = sim_type == 1 or _decoupled(device, w, paths, rest)
     if not config.wall.cartesian:
         return WallJoint(loop, torque, exact)
     scale = float(normal_jacobian(device, config.wall, q0)[w])
@@ -113,10 +116,10 @@ def _linear_along_wall(device: Device, config: LoopConfig, w: int, q0: np.ndarra
     return bool(np.all(np.abs(rows - rows[0]) <= 1e-9 * max(abs(rows[0]), 1e-12)))
 
 
-def _decoupled(device: Device, w: int, paths: dict) -> bool:
+def _decoupled(device: Device, w: int, paths: dict, rest: np.ndarray) -> bool:
     """True when the wall joint's row of H, C, G does not change along the driven motion."""
     t = np.linspace(0.0, 2.0, 9)
-    qs = np.zeros((len(t), device.n_dof))
+    qs = np.tile(rest, (len(t), 1))
     for j, path in paths.items():
         qs[:, j] = path.sample(t)[0]
     rows = [np.concatenate([mass_matrix(device, q)[w], coriolis_centrifugal(device, q)[w], [gravity(device, q)[w]]]) for q in qs]

@@ -51,7 +51,7 @@ import numpy as np
 from hapticdesign.analysis.dynamics.device import dynamics_of
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
-from hapticdesign.simulation.config import LoopConfig, compensator_device, hand_matrices, plant_friction
+from hapticdesign.simulation.config import LoopConfig, compensator_device, hand_matrices, plant_friction, rest_pose
 from hapticdesign.simulation.paths import Chirp
 from hapticdesign.simulation.transparency import (TransparencyResult, band_of, check_request, first_exit, impedance,
                                                   segment_length)
@@ -94,14 +94,14 @@ def moving_joints(n_dof: int, sim_type: int, wall_joint: int) -> np.ndarray:
 
 class _Row:
     """One device's equations of motion (its compiled model and parameters, looked up once) along the
-    motion ``q = s m`` of the wall joint ``w``."""
+    motion ``q = rest + s m`` of the wall joint ``w`` (``rest``: :func:`~.config.rest_pose`)."""
 
-    def __init__(self, device: Device, w: int, m: np.ndarray) -> None:
+    def __init__(self, device: Device, w: int, m: np.ndarray, rest: np.ndarray) -> None:
         self.model, self.pi = dynamics_of(device), device.standard_parameters()
-        self.w, self.m = w, m
+        self.w, self.m, self.rest = w, m, rest
 
     def poses(self, s: np.ndarray) -> np.ndarray:
-        return np.multiply.outer(np.ravel(s), self.m)
+        return self.rest + np.multiply.outer(np.ravel(s), self.m)
 
     def inertia(self, s: np.ndarray) -> np.ndarray:
         """``H_w(q) m`` at each ``s``."""
@@ -149,8 +149,9 @@ def transparency_loop(device: Device, sim_type: int, wall_joint: int, config: Lo
     m = moving_joints(n, sim_type, w)
     comp = config.compensator
     switches = np.array([comp.inertial, comp.coriolis, comp.gravity], dtype=float)
-    plant, model = _Row(device, w, m), _Row(compensator_device(device, comp), w, m)
-    hand_mass, hand_damping, hand_stiffness = hand_matrices(device, config.hand, np.zeros(n))
+    rest = rest_pose(device)
+    plant, model = _Row(device, w, m, rest), _Row(compensator_device(device, comp), w, m, rest)
+    hand_mass, hand_damping, hand_stiffness = hand_matrices(device, config.hand, rest)
     damping = np.diag(np.asarray(config.damping if config.damping is not None else device.damping, dtype=float))
     zero = np.zeros(1)
     j, c = float(plant.inertia(zero)[0]), switches[0] * float(model.inertia(zero)[0])

@@ -21,6 +21,9 @@ from hapticdesign.model.inertia import SEED_FIELDS
 STATUS_COMPLETED = 0
 STATUS_EXCURSION = 1
 STATUS_DIVERGED = 2
+STATUS_LOOP_LOST = 3
+"""A closed-loop device's loops stopped closing on the assembly branch (no closure, a singular or a
+changed branch), in the plant or in the compensator's model: the run ends at the last closed pose."""
 
 FRICTION_VELOCITY = 1e-3
 """Coulomb friction acts as ``F_c tanh(qd / v_f)`` with ``v_f`` = 1e-3 rad/s (or m/s): the sign function
@@ -153,7 +156,8 @@ class Trace:
     ``wall_position`` is the wall coordinate at the recorded rows: the wall joint's position, or the handle's
     position along a Cartesian wall's direction (m). ``peak`` is its largest excursion from the
     start, checked at every plant step (not only at the recorded rows); ``end_time`` is when the run
-    ended (early when it diverged or reached the excursion stop)."""
+    ended (early when it diverged, reached the excursion stop or, for a closed-loop device, left the
+    assembly branch)."""
 
     t: np.ndarray
     q: np.ndarray
@@ -175,6 +179,11 @@ class Trace:
     @property
     def stopped_at_excursion(self) -> bool:
         return self.status == STATUS_EXCURSION
+
+    @property
+    def loop_lost(self) -> bool:
+        """A closed-loop device's loops stopped closing on the assembly branch (:data:`STATUS_LOOP_LOST`)."""
+        return self.status == STATUS_LOOP_LOST
 
     @property
     def tripped(self) -> bool:
@@ -235,6 +244,13 @@ def compensator_device(device: Device, compensator: Compensator) -> Device:
     return model_device(device, compensator.error_percent, compensator.group_errors, compensator.error_seed)
 
 
+def rest_pose(device: Device) -> np.ndarray:
+    """Where the experiments start and the joint paths are centred: q = 0 for an open chain (the seed's),
+    the file's ``home`` actuated pose for a closed-loop device (whose loops need not close at 0)."""
+    loops = device.mechanism.loops
+    return np.zeros(device.n_dof) if loops is None else np.array(loops.home, dtype=float)
+
+
 def plant_friction(device: Device, config: LoopConfig) -> np.ndarray:
     """Coulomb friction per joint: the configuration's, else the device's actuators' (``device.coulomb``), else 0."""
     values = config.coulomb if config.coulomb is not None else getattr(device, "coulomb", None)
@@ -255,6 +271,8 @@ def hand_matrices(device: Device, hand: Hand | None, q0: np.ndarray) -> tuple[np
     n = len(q0)
     if hand is None:
         return np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n))
+    if device.mechanism.loops is not None:
+        raise UserError("a hand model needs an open-chain device (the hand is not coupled to closed loops)")
     if min(hand.mass, hand.damping, hand.stiffness) < 0:
         raise UserError("hand mass, damping and stiffness must be non-negative")
     jv = jacobian(device.mechanism, q0)[:3]

@@ -52,12 +52,25 @@ class Verdict:
                 "peak": self.peak, "final_error": self.final_error, "stopped_at": self.stopped_at}
 
 
-def type_paths(sim_type: int, n_dof: int, wall_joint: int = 0) -> dict[int, Path]:
-    """Motions of the other joints: type 1 held at 0, type 2 driven at 0.52 sin(3 pi t) (Table 4.3)."""
+def type_paths(sim_type: int, n_dof: int, wall_joint: int = 0, rest: np.ndarray | None = None) -> dict[int, Path]:
+    """Motions of the other joints: type 1 held at 0, type 2 driven at 0.52 sin(3 pi t) (Table 4.3);
+    about ``rest`` instead of 0 when given (a closed-loop device's home, :func:`~.config.rest_pose`)."""
     if sim_type not in (1, 2):
         raise UserError(f"simulation type must be 1 or 2, got {sim_type}")
-    path: Path = Held(0.0) if sim_type == 1 else Sine(0.52, 3 * np.pi)
-    return {j: path for j in range(n_dof) if j != wall_joint}
+    centre = np.zeros(n_dof) if rest is None else np.asarray(rest, dtype=float)
+
+    def path(j: int) -> Path:
+        return Held(float(centre[j])) if sim_type == 1 else Sine(0.52, 3 * np.pi, float(centre[j]))
+
+    return {j: path(j) for j in range(n_dof) if j != wall_joint}
+
+
+def require_closed(trace, what: str) -> None:
+    """A closed-loop device's run that left the assembly branch is a user error (one line), not a verdict."""
+    if trace.loop_lost:
+        raise UserError(f"{what}: the loops stopped closing on the assembly branch at t = {trace.end_time:.4g} s "
+                        "(the motion reaches a singular pose or another branch; try a smaller motion or a pose "
+                        "nearer home)")
 
 
 @dataclass

@@ -26,11 +26,10 @@ from hapticdesign.model.device import Device
 from hapticdesign.simulation.analytic import AnalyticProblem
 from hapticdesign.simulation.boundary import envelope_grows
 from hapticdesign.simulation.config import (
-    LoopConfig, Wall, compensator_device, normal_jacobian, require_device, require_options, unit_direction,
+    LoopConfig, Wall, compensator_device, normal_jacobian, require_device, require_options, rest_pose, unit_direction,
 )
-from hapticdesign.simulation.loop import simulate
-from hapticdesign.simulation.criteria import Criteria, Verdict, WallProblem, type_paths
-from hapticdesign.simulation.tables import DynamicsTables
+from hapticdesign.simulation.loop import simulate, tables_of
+from hapticdesign.simulation.criteria import Criteria, Verdict, WallProblem, require_closed, type_paths
 from hapticdesign.workload import require_plant_steps
 
 
@@ -46,9 +45,10 @@ class ImpedanceProblem(WallProblem):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        self.paths = type_paths(self.sim_type, self.device.n_dof, self.wall_joint)
-        self.plant = DynamicsTables.from_device(self.device)
-        self.model = DynamicsTables.from_device(compensator_device(self.device, self.config.compensator))
+        self.rest = rest_pose(self.device)
+        self.paths = type_paths(self.sim_type, self.device.n_dof, self.wall_joint, self.rest)
+        self.plant = tables_of(self.device)
+        self.model = tables_of(compensator_device(self.device, self.config.compensator))
         self.config = replace(self.config, safety_limit=self.criteria.safety_limit,
                               stop_excursion=self.criteria.overshoot_limit)
 
@@ -57,7 +57,7 @@ class ImpedanceProblem(WallProblem):
         pose (see :mod:`.boundary`), or ``2 b / T`` without it, divided by ``J_n,w^2`` for a Cartesian
         wall; only a guess, never the answer."""
         w = self.wall_joint
-        q0 = np.zeros(self.device.n_dof)
+        q0 = self.rest
         b = (self.config.damping or self.device.damping)[w]
         h = mass_matrix(self.device, q0)[w, w]
         guess = b * b / h if self.config.compensator.inertial else 2 * b / self.config.sensors.period
@@ -65,11 +65,18 @@ class ImpedanceProblem(WallProblem):
             guess /= float(normal_jacobian(self.device, self.config.wall, q0)[w]) ** 2
         return guess if math.isfinite(guess) and guess > 0 else 1.0
 
+    @property
+    def wall_equilibrium(self) -> float:
+        """Where a joint wall's spring rests: ``equilibrium`` from the rest pose (absolute for an open chain,
+        whose rest pose is 0); a Cartesian wall's equilibrium is already relative to the handle's start."""
+        return self.equilibrium + (0.0 if self.config.wall.cartesian else float(self.rest[self.wall_joint]))
+
     def verdict(self, stiffness: float) -> Verdict:
         """Simulate the wall at ``stiffness`` and apply the criteria."""
         cfg = replace(self.config, wall=replace(self.config.wall, joint=self.wall_joint, stiffness=float(stiffness),
-                                                equilibrium=self.equilibrium))
+                                                equilibrium=self.wall_equilibrium))
         trace = simulate(self.device, cfg, self.paths, plant=self.plant, model=self.model)
+        require_closed(trace, f"type {self.sim_type} at K = {stiffness:g}")
         peak = trace.peak
         if trace.diverged or not math.isfinite(peak):
             return Verdict(stiffness, False, "diverged", peak, math.nan, trace.end_time)
@@ -269,7 +276,7 @@ def true_boundary(problem: ImpedanceProblem, rel_tol: float = 1e-4, margin: floa
     cfg = replace(problem.config, safety_limit=None, stop_excursion=1.0)
 
     def grows(k: float) -> bool:
-        wall = replace(cfg.wall, joint=problem.wall_joint, stiffness=k, equilibrium=problem.equilibrium)
+        wall = replace(cfg.wall, joint=problem.wall_joint, stiffness=k, equilibrium=problem.wall_equilibrium)
         trace = simulate(problem.device, replace(cfg, wall=wall), problem.paths, plant=problem.plant,
                          model=problem.model)
         if trace.status != 0:
@@ -304,6 +311,9 @@ def impedance_range(device: Device, sim_type: int = 1, method: str = "fast", k_l
     for the same answer in fewer runs); with it, :func:`grid_search` on ``R, 2R, 3R ...``.
     ``method="analytic"`` answers the same searches from the exact linear response of the sampled
     loop at the start pose (:mod:`.analytic`; no ODE integration; exact for type 1 and for LN = 0).
+    For a closed-loop device the joints start at, and move about, its home pose and a joint wall's
+    ``equilibrium`` is measured from there (:func:`~.config.rest_pose`); a run whose loops stop closing on
+    the assembly branch is a :class:`~hapticdesign.errors.UserError`.
     """
     require_device(device)
     require_options(sim_type, config, LoopConfig)

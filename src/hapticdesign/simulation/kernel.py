@@ -16,16 +16,31 @@ Cartesian wall along the unit direction n at the handle ``tau_imp = J_n^T (K (n.
 hold ``u = tau_f - tau_imp`` (zero-order hold). The safety switch of Figure 4.7 cuts both torques
 off once the wall coordinate (the wall joint, or the handle along n) leaves its reference by
 ``safety_limit``.
+
+H, C and G come from a tree's exact basis tables (:mod:`.tables`) or, for a closed-loop device, in its
+actuated coordinates from the compiled closed-loop plant (seed 000 eq. 2.44-2.50 on the loop-opened
+tree, :mod:`hapticdesign.analysis.dynamics.closed_loop_plant`), the plant and the compensator's model
+each with its own warm start; which one is inlined follows the record's type (:mod:`.records`). A
+closed-loop run whose loops stop closing on the assembly branch ends with ``STATUS_LOOP_LOST``.
 """
 
 from __future__ import annotations
 
+import warnings
+
 import numba as nb
 import numpy as np
+from numba.core import types
+from numba.core.errors import NumbaIRAssumptionWarning
+from numba.extending import overload
 
+from hapticdesign.analysis.dynamics.closed_loop_plant import closed_loop_terms
 from hapticdesign.analysis.dynamics.model import velocity_products_into as velocity_products
 from hapticdesign.model.walk import frame_jacobian, node_poses
-from hapticdesign.simulation.config import FRICTION_VELOCITY, STATUS_COMPLETED, STATUS_DIVERGED, STATUS_EXCURSION
+from hapticdesign.simulation import records
+from hapticdesign.simulation.config import (
+    FRICTION_VELOCITY, STATUS_COMPLETED, STATUS_DIVERGED, STATUS_EXCURSION, STATUS_LOOP_LOST,
+)
 from hapticdesign.simulation.tables import evaluate_entries, unpack_entries
 
 
@@ -54,9 +69,9 @@ def _solve_in_place(a, b, n):
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
-def _plant_terms(q, plant):
-    """H + M_hand, C, G of the plant at q into its workspace, reusing the last evaluation when the
-    non-cyclic q is unchanged."""
+def _tree_plant_terms(q, qd, plant):
+    """H + M_hand, C, G of a tree's tables at q into the plant's workspace, reusing the last evaluation
+    when the non-cyclic q is unchanged; the velocity products of qd."""
     t, ws = plant.table, plant.ws
     kinds, cache_q, cache_valid, h, hand_mass = t.kinds, ws.cache_q, ws.cache_valid, ws.h, plant.hand_mass
     n = q.shape[0]
@@ -75,6 +90,90 @@ def _plant_terms(q, plant):
         for k in range(n):
             cache_q[k] = q[k]
         cache_valid[0] = 1
+    velocity_products(qd, ws.qd2)
+
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _loop_terms(q, qd, record):
+    """H, C(q, qd) qd^2 and G of a closed-loop record (plant or compensator) at (q, qd) into its
+    workspace, ``C qd^2`` as the one column of ``ws.c`` (its velocity product ``ws.qd2`` is 1); a failed
+    closure leaves them as they were and keeps the first failure's status."""
+    ws = record.ws
+    status = closed_loop_terms(q, qd, record.structure, record.loop_ws, ws.h, record.cqd, ws.g)
+    if status != 0:
+        if record.status[0] == 0:
+            record.status[0] = status
+        return status
+    for i in range(q.shape[0]):
+        ws.c[i, 0] = record.cqd[i]
+    return status
+
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _loop_plant_terms(q, qd, plant):
+    """:func:`_loop_terms` of the plant, plus the hand's mass."""
+    if _loop_terms(q, qd, plant) == 0:
+        h, hand_mass = plant.ws.h, plant.hand_mass
+        for i in range(q.shape[0]):
+            for j in range(q.shape[0]):
+                h[i, j] += hand_mass[i, j]
+
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _loop_model_terms(q, qd, ctrl):
+    """:func:`_loop_terms` of the compensator's model."""
+    _loop_terms(q, qd, ctrl)
+
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _tree_model_terms(q, qd, ctrl):
+    """H, C, G of the compensator's tables at q and the velocity products of qd."""
+    t, ws = ctrl.table, ctrl.ws
+    evaluate_entries(q, t.rows, t.cols, t.vals, t.index, t.kinds, t.degrees, ws.values, ws.phi, ws.entries)
+    unpack_entries(ws.entries, q.shape[0], ws.h, ws.c, ws.g)
+    velocity_products(qd, ws.qd2)
+
+
+# The plant and the compensator are inlined into the loop by their record type (a tree's tables or a
+# closed-loop plant), which keeps the tree path as fast as a direct call; numba's SSA pass then reports
+# an internal, pedantic scope check on the twice-inlined helpers (its message says so), once per compile.
+warnings.filterwarnings("ignore", category=NumbaIRAssumptionWarning)
+
+
+def _is_loop(record) -> bool:
+    """Whether a numba record type is a closed-loop plant or compensator (:mod:`.records`)."""
+    return isinstance(record, types.NamedTuple) and record.instance_class in (records.LoopPlant,
+                                                                              records.LoopController)
+
+
+def _plant_terms(q, qd, plant):
+    """H + M_hand, C with its velocity products (``C qd^2 = ws.c @ ws.qd2``) and G of the plant at (q, qd)
+    into its workspace (numba only: a tree's tables or the closed-loop plant, by the record's type)."""
+
+
+def _model_terms(q, qd, ctrl):
+    """H, C with its velocity products and G of the compensator's model at (q, qd) into its workspace (numba only)."""
+
+
+def _status(record):
+    """0 while a closed-loop record's loops close on the assembly branch; always 0 for a tree (numba only)."""
+
+
+@overload(_plant_terms, inline="always")
+def _plant_terms_impl(q, qd, plant):
+    return (_loop_plant_terms if _is_loop(plant) else _tree_plant_terms).py_func
+
+
+@overload(_model_terms, inline="always")
+def _model_terms_impl(q, qd, ctrl):
+    return (_loop_model_terms if _is_loop(ctrl) else _tree_model_terms).py_func
+
+
+@overload(_status, inline="always")
+def _status_impl(record):
+    if _is_loop(record):
+        return lambda record: record.status[0]
+    return lambda record: 0
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
@@ -85,8 +184,7 @@ def accelerations(q, qd, qdd_path, u, prescribed, plant, qdd, tau_c, want_tau_c=
     h, c, g, qd2, a, rhs, free = ws.h, ws.c, ws.g, ws.qd2, ws.a, ws.rhs, ws.free
     damping, coulomb, hand_stiffness, hand_rest = plant.damping, plant.coulomb, plant.hand_stiffness, plant.hand_rest
     n = q.shape[0]
-    _plant_terms(q, plant)
-    velocity_products(qd, qd2)
+    _plant_terms(q, qd, plant)
     bias = tau_c
     for i in range(n):
         if prescribed[i] and not want_tau_c:
@@ -144,13 +242,12 @@ def _stage_state(q, qd, kq, a, h, prescribed, path_q_row, path_qd_row, qs, qds):
 
 @nb.njit(cache=True, error_model="numpy")
 def compensator_torque(q, qd, qdd, ctrl, out):
-    """Model-based feedforward ``tau_f = s_H H qdd + s_C C qd^2 + s_G G`` (seed §4.1.1.2)."""
-    t, ws, switches = ctrl.table, ctrl.ws, ctrl.switches
+    """Model-based feedforward ``tau_f = s_H H qdd + s_C C qd^2 + s_G G`` (seed §4.1.1.2); for a
+    closed-loop device the model's loops must close at the sensed pose (:func:`_status`)."""
+    ws, switches = ctrl.ws, ctrl.switches
     h, c, g, qd2 = ws.h, ws.c, ws.g, ws.qd2
     n = q.shape[0]
-    evaluate_entries(q, t.rows, t.cols, t.vals, t.index, t.kinds, t.degrees, ws.values, ws.phi, ws.entries)
-    unpack_entries(ws.entries, n, h, c, g)
-    velocity_products(qd, qd2)
+    _model_terms(q, qd, ctrl)
     for i in range(n):
         s_h = 0.0
         for j in range(n):
@@ -278,6 +375,11 @@ def run_loop(plant, ctrl, motion, timing, wall, handle, rec):
                 u[i] = tau_f[i] - tau_imp[i]
         # stage 1 (also gives the recorded constraint torque)
         accelerations(q, qd, path_qdd[2 * it], u, prescribed, plant, a1, c1)
+        if _status(plant) != 0 or _status(ctrl) != 0:
+            # a closed-loop plant or model left its assembly branch here or in the last step's stages
+            status = STATUS_LOOP_LOST
+            end_time = t
+            break
         if it % stride == 0:
             r = it // stride
             for i in range(n):

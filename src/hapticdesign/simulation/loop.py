@@ -12,20 +12,27 @@ import math
 
 import numpy as np
 
+from hapticdesign.analysis.dynamics.closed_loop_plant import ClosedLoopPlant
+from hapticdesign.analysis.dynamics.device import dynamics_of
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation import kernel, records
 from hapticdesign.simulation.config import (
-    LoopConfig, Trace, Wall, compensator_device, hand_matrices, plant_friction, unit_direction,
+    LoopConfig, Trace, Wall, compensator_device, hand_matrices, plant_friction, rest_pose, unit_direction,
 )
 from hapticdesign.simulation.paths import Path
 from hapticdesign.simulation.tables import DynamicsTables, workspace_size
 from hapticdesign.workload import loop_bytes, require_memory
 
 
+Dynamics = DynamicsTables | ClosedLoopPlant
+"""What a simulation evaluates H, C qd^2 and G with: a tree's exact basis tables, or a closed-loop
+device's compiled plant (its own warm-started workspace, so one per run and per side)."""
+
+
 def joint_index(device: Device, joint: int | str) -> int:
-    """0-based index of a joint given 1-based (``1``) or by coordinate name (``theta1``)."""
-    names = device.mechanism.coordinates
+    """0-based index of an actuated joint given 1-based (``1``) or by coordinate name (``theta1``)."""
+    names = device.mechanism.actuated_coordinates
     if isinstance(joint, str) and not joint.strip().lstrip("-").isdigit():
         if joint not in names:
             raise UserError(f"unknown joint {joint!r}; joints: {', '.join(names)}")
@@ -36,8 +43,25 @@ def joint_index(device: Device, joint: int | str) -> int:
     return j - 1
 
 
-def _workspace(tables: DynamicsTables) -> records.Workspace:
-    return records.workspace(tables.n_dof, workspace_size(tables), tables.index.shape[0], tables.n_entries)
+def _workspace(dynamics: Dynamics) -> records.Workspace:
+    if isinstance(dynamics, ClosedLoopPlant):
+        return records.loop_workspace(dynamics.n_dof)
+    return records.workspace(dynamics.n_dof, workspace_size(dynamics), dynamics.index.shape[0], dynamics.n_entries)
+
+
+def tables_of(device: Device) -> DynamicsTables | None:
+    """The exact basis tables of an open-chain device, to reuse across runs; ``None`` for a closed-loop
+    device, whose compiled plant :func:`simulate` builds for each run at its start pose."""
+    return None if device.mechanism.loops is not None else DynamicsTables.from_device(device)
+
+
+def _dynamics(device: Device, tables: DynamicsTables | None, q_start: np.ndarray) -> Dynamics:
+    """The given tables, or the device's own: its tables, or its closed-loop plant started at ``q_start``."""
+    if tables is not None:
+        return tables
+    if device.mechanism.loops is None:
+        return DynamicsTables.from_device(device)
+    return ClosedLoopPlant(dynamics_of(device), device.standard_parameters(), q_start)
 
 
 def simulate(
@@ -50,16 +74,19 @@ def simulate(
 ) -> Trace:
     """Simulate the loop; ``paths`` maps 0-based joint indices to prescribed paths (others are free).
 
-    ``plant``/``model`` tables may be passed to skip rebuilding them (campaign searches).
+    ``plant``/``model`` tables of an open chain may be passed to skip rebuilding them (campaign
+    searches). Without ``q0`` the free joints start at :func:`~.config.rest_pose` (0, or a closed-loop
+    device's home); a closed-loop device's plant and model are its compiled closed-loop plants
+    (:class:`~hapticdesign.analysis.dynamics.closed_loop_plant.ClosedLoopPlant`), started there.
     """
     n = device.n_dof
-    q_start = np.zeros(n) if q0 is None else np.asarray(q0, dtype=float).copy()
+    q_start = rest_pose(device) if q0 is None else np.asarray(q0, dtype=float).copy()
     for j, path in (paths or {}).items():
         if 0 <= j < n:
             q_start[j] = float(path.sample(np.zeros(1))[0][0])
     hand = hand_matrices(device, config.hand, q_start)
-    plant = plant or DynamicsTables.from_device(device)
-    model = model or DynamicsTables.from_device(compensator_device(device, config.compensator))
+    plant = _dynamics(device, plant, q_start)
+    model = _dynamics(compensator_device(device, config.compensator), model, q_start)
     damping = config.damping if config.damping is not None else device.damping
     return simulate_tables(plant, model, config, damping, paths, q_start, hand, plant_friction(device, config),
                            handle_of(device, config.wall) if config.wall.cartesian else None)
@@ -76,8 +103,8 @@ def handle_of(device: Device, wall: Wall) -> records.Handle:
 
 
 def simulate_tables(
-    plant: DynamicsTables,
-    model: DynamicsTables,
+    plant: Dynamics,
+    model: Dynamics,
     config: LoopConfig,
     damping,
     paths: dict[int, Path] | None = None,
@@ -86,8 +113,9 @@ def simulate_tables(
     coulomb: np.ndarray | None = None,
     handle: records.Handle | None = None,
 ) -> Trace:
-    """Simulate the loop for plant and compensator tables directly (any number of joints);
-    a Cartesian wall needs the device's ``handle`` (:func:`handle_of`)."""
+    """Simulate the loop for plant and compensator dynamics directly (any number of joints): exact
+    basis tables, or closed-loop plants started at ``q0`` (each used by one run only); a Cartesian
+    wall needs the device's ``handle`` (:func:`handle_of`)."""
     n = plant.n_dof
     sub = config.steps_per_sample()
     if not (config.duration > 0 and math.isfinite(config.duration)):
@@ -142,10 +170,8 @@ def simulate_tables(
     switches = np.array([comp.inertial, comp.coriolis, comp.gravity], dtype=float)
     damping_matrix = np.diag(damping) + hand_damping
     friction = np.zeros(n) if coulomb is None else np.asarray(coulomb, dtype=float)
-    plant_record = records.Plant(records.table(plant), _workspace(plant), damping_matrix, friction,
-                                 hand_mass, hand_stiffness, q_start.copy())
-    controller = records.Controller(records.table(model), _workspace(model), switches, quant,
-                                    int(sensors.delay_samples))
+    plant_record = _plant_record(plant, damping_matrix, friction, hand_mass, hand_stiffness, q_start.copy())
+    controller = _controller_record(model, switches, quant, int(sensors.delay_samples))
     motion = records.Motion(prescribed, path_q, path_qd, path_qdd, q_start, np.zeros(n))
     timing = records.Timing(float(config.step), sub, n_steps, stride)
     handle = handle if wall.cartesian else records.no_handle(n)
@@ -162,3 +188,20 @@ def simulate_tables(
     q, qd, u, tau_f, tau_imp, tau_c, position = (r[:written] for r in rec)
     return Trace(t, q, qd, u, tau_f, tau_imp, tau_c, int(status), None if trip < 0 else float(trip),
                  float(peak), float(end_time), position)
+
+
+def _plant_record(plant: Dynamics, damping, friction, hand_mass, hand_stiffness, hand_rest):
+    """The kernel's plant: :class:`~.records.Plant` of tables or :class:`~.records.LoopPlant`."""
+    if isinstance(plant, ClosedLoopPlant):
+        return records.LoopPlant(plant.structure, plant.workspace, _workspace(plant), np.zeros(plant.n_dof),
+                                 np.zeros(1, dtype=np.int64), damping, friction, hand_mass, hand_stiffness, hand_rest)
+    return records.Plant(records.table(plant), _workspace(plant), damping, friction, hand_mass, hand_stiffness,
+                         hand_rest)
+
+
+def _controller_record(model: Dynamics, switches: np.ndarray, quant: float, delay: int):
+    """The kernel's compensator: :class:`~.records.Controller` of tables or :class:`~.records.LoopController`."""
+    if isinstance(model, ClosedLoopPlant):
+        return records.LoopController(model.structure, model.workspace, _workspace(model), np.zeros(model.n_dof),
+                                      np.zeros(1, dtype=np.int64), switches, quant, delay)
+    return records.Controller(records.table(model), _workspace(model), switches, quant, delay)

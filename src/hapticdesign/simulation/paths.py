@@ -43,19 +43,21 @@ class Sine:
 class Chirp:
     """Linear chirp ``A sin(phi(t))``, ``phi = 2 pi (f0 t + (f1 - f0) t^2 / (2 T_s))`` (seed §4.2.3).
 
-    The sine form starts at rest position 0, matching the seed's zero initial conditions.
+    The sine form starts at rest position 0 (or ``offset``, a closed-loop device's home), matching the
+    seed's zero initial conditions.
     """
 
     amplitude: float = 0.3
     f0: float = 0.1
     f1: float = 15.0
     sweep_time: float = 10.0
+    offset: float = 0.0
 
     def __post_init__(self) -> None:
         if not (self.sweep_time > 0 and self.f0 >= 0 and self.f1 > 0):
             raise UserError("chirp: frequencies must be non-negative and the sweep time positive")
-        if not all(math.isfinite(v) for v in (self.amplitude, self.f0, self.f1, self.sweep_time)):
-            raise UserError("chirp: amplitude, frequencies and sweep time must be finite numbers")
+        if not all(math.isfinite(v) for v in (self.amplitude, self.f0, self.f1, self.sweep_time, self.offset)):
+            raise UserError("chirp: amplitude, frequencies, sweep time and offset must be finite numbers")
         if self.amplitude == 0:
             raise UserError("chirp: the amplitude must not be zero (the joint would not move)")
         if not self.f0 < self.f1:
@@ -68,7 +70,7 @@ class Chirp:
         ddphase = 2 * np.pi * rate
         a = self.amplitude
         s, c = np.sin(phase), np.cos(phase)
-        return a * s, a * c * dphase, a * (c * ddphase - s * dphase * dphase)
+        return self.offset + a * s, a * c * dphase, a * (c * ddphase - s * dphase * dphase)
 
 
 Path = Held | Sine | Chirp

@@ -51,11 +51,43 @@ class Plant(NamedTuple):
     hand_rest: np.ndarray
 
 
+class LoopPlant(NamedTuple):
+    """The continuous side of a closed-loop device: the compiled closed-loop plant
+    (:func:`~hapticdesign.analysis.dynamics.closed_loop_plant.closed_loop_terms`, its ``structure`` and
+    warm-started ``loop_ws``), ``C(q, qd) qd^2`` as a vector, the plant's status (0 while the loops
+    close on the assembly branch) and the fields of :class:`Plant` the loop reads."""
+
+    structure: tuple
+    loop_ws: tuple
+    ws: Workspace
+    cqd: np.ndarray
+    status: np.ndarray
+    damping: np.ndarray
+    coulomb: np.ndarray
+    hand_mass: np.ndarray
+    hand_stiffness: np.ndarray
+    hand_rest: np.ndarray
+
+
 class Controller(NamedTuple):
     """The digital side: the compensator's tables and switches ``(s_H, s_C, s_G)``, encoder step, delay."""
 
     table: Table
     ws: Workspace
+    switches: np.ndarray
+    quant: float
+    delay: int
+
+
+class LoopController(NamedTuple):
+    """The digital side of a closed-loop device: the compensator's own closed-loop plant and
+    workspace, ``C(q, qd) qd^2``, its status, and the fields of :class:`Controller` the loop reads."""
+
+    structure: tuple
+    loop_ws: tuple
+    ws: Workspace
+    cqd: np.ndarray
+    status: np.ndarray
     switches: np.ndarray
     quant: float
     delay: int
@@ -140,6 +172,15 @@ def workspace(n: int, n_values: int, n_basis: int, n_entries: int) -> Workspace:
         np.zeros((n, n_values)), np.zeros(n_basis), np.zeros(n_entries), np.zeros(n), np.zeros(1, dtype=np.int64),
         np.zeros((n, n)), np.zeros((n, m)), np.zeros(n), np.zeros(m), np.zeros((n, n)), np.zeros(n),
         np.zeros(n, dtype=np.int64),
+    )
+
+
+def loop_workspace(n: int) -> Workspace:
+    """Scratch for a closed-loop plant of ``n`` actuated joints: no basis tables; ``C qd^2`` is the one
+    column of ``c`` and its velocity product ``qd2`` the constant 1, so the loop reads it as ``c @ qd2``."""
+    return Workspace(
+        np.zeros((n, 1)), np.zeros(1), np.zeros(1), np.zeros(n), np.zeros(1, dtype=np.int64), np.zeros((n, n)),
+        np.zeros((n, 1)), np.zeros(n), np.ones(1), np.zeros((n, n)), np.zeros(n), np.zeros(n, dtype=np.int64),
     )
 
 

@@ -23,7 +23,8 @@ from scipy.signal import csd, welch
 
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
-from hapticdesign.simulation.config import LoopConfig, Wall, require_device, require_options
+from hapticdesign.simulation.config import LoopConfig, Wall, require_device, require_options, rest_pose
+from hapticdesign.simulation.criteria import require_closed
 from hapticdesign.simulation.loop import simulate
 from hapticdesign.simulation.paths import Chirp, Held, Path
 from hapticdesign.workload import require_plant_steps
@@ -76,9 +77,13 @@ def first_exit(frequency: np.ndarray, gain_db: np.ndarray, band_db: float) -> fl
     return float(frequency[i - 1] + (target - g0) / (g1 - g0) * (frequency[i] - frequency[i - 1]))
 
 
-def chirp_paths(n_dof: int, sim_type: int, wall_joint: int, chirp: Chirp) -> dict[int, Path]:
-    """Type 1: the chirp on the wall joint, the others held at 0; type 2: the chirp on every joint (Table 4.5)."""
-    return {j: (chirp if (j == wall_joint or sim_type == 2) else Held(0.0)) for j in range(n_dof)}
+def chirp_paths(n_dof: int, sim_type: int, wall_joint: int, chirp: Chirp,
+                rest: np.ndarray | None = None) -> dict[int, Path]:
+    """Type 1: the chirp on the wall joint, the others held at 0; type 2: the chirp on every joint (Table 4.5);
+    about ``rest`` instead of 0 when given (a closed-loop device's home, :func:`~.config.rest_pose`)."""
+    centre = np.zeros(n_dof) if rest is None else np.asarray(rest, dtype=float)
+    return {j: (replace(chirp, offset=float(centre[j])) if (j == wall_joint or sim_type == 2) else Held(float(centre[j])))
+            for j in range(n_dof)}
 
 
 def check_request(device: Device, sim_type: int, stiffness: float, chirp: Chirp | None,
@@ -137,6 +142,9 @@ def transparency(
     the low frequencies swept near the ends of the record. ``method="analytic"`` answers from the
     wall joint's loop linearized at the start pose, with the same estimate, band and bins
     (:mod:`.analytic_transparency`: no loop is run; exact for type 1 and for LN = 0).
+
+    The joints move about :func:`~.config.rest_pose` (0, or a closed-loop device's home) and the wall's
+    spring rests at ``equilibrium`` from it.
     """
     if method not in ("simulation", "analytic"):
         raise UserError(f"the transparency method must be 'simulation' or 'analytic', got {method!r}")
@@ -146,12 +154,15 @@ def transparency(
         return analytic_transparency(device, sim_type, stiffness, chirp, config, wall_joint, equilibrium,
                                      segment_seconds, window, band_db)
     chirp, base = check_request(device, sim_type, stiffness, chirp, config)
+    rest = rest_pose(device)
+    spring_rest = float(rest[wall_joint]) + equilibrium
     cfg = replace(base, duration=chirp.sweep_time, safety_limit=None, stop_excursion=None, record_stride=1,
-                  wall=Wall(wall_joint, stiffness, base.wall.damping, equilibrium))
-    trace = simulate(device, cfg, chirp_paths(device.n_dof, sim_type, wall_joint, chirp))
+                  wall=Wall(wall_joint, stiffness, base.wall.damping, spring_rest))
+    trace = simulate(device, cfg, chirp_paths(device.n_dof, sim_type, wall_joint, chirp, rest))
+    require_closed(trace, f"the type {sim_type} chirp")
     q = trace.q[:, wall_joint]
     tau_m = trace.tau_c[:, wall_joint]
-    tau_d = stiffness * (q - equilibrium) + cfg.wall.damping * trace.qd[:, wall_joint]
+    tau_d = stiffness * (q - spring_rest) + cfg.wall.damping * trace.qd[:, wall_joint]
     fs = 1.0 / cfg.step
     seconds, nperseg = segment_length(segment_seconds, chirp, fs, len(q))
     f, z_d = impedance(q, tau_d, fs, nperseg, window)
