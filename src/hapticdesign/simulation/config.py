@@ -263,6 +263,8 @@ def plant_friction(device: Device, config: LoopConfig) -> np.ndarray:
 
 def normal_jacobian(device: Device, wall: Wall, q: np.ndarray) -> np.ndarray:
     """``J_n = n^T J_v`` (1 x N): the handle's velocity along a Cartesian wall's direction per joint velocity."""
+    if device.mechanism.loops is not None:
+        raise UserError("a Cartesian wall needs an open-chain device (closed loops are not simulated at the handle)")
     return unit_direction(wall.direction) @ jacobian(device.mechanism, np.asarray(q, dtype=float))[:3]
 
 
