@@ -183,7 +183,8 @@ def simulate_tables(
         safety_limit=math.inf if config.safety_limit is None else float(config.safety_limit),
         stop_excursion=math.inf if config.stop_excursion is None else float(config.stop_excursion),
     )
-    written, status, trip, peak, end_time = kernel.run_loop(plant_record, controller, motion, timing, law, handle, rec)
+    written, status, trip, peak, end_time = kernel.run_loop(plant_record, controller, motion, timing, law, handle, rec,
+                                                            records.scratch(n, controller.delay))
     t = np.arange(written) * stride * config.step
     q, qd, u, tau_f, tau_imp, tau_c, position = (r[:written] for r in rec)
     return Trace(t, q, qd, u, tau_f, tau_imp, tau_c, int(status), None if trip < 0 else float(trip),

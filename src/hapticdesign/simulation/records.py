@@ -160,6 +160,38 @@ class Records(NamedTuple):
     wall: np.ndarray
 
 
+class Scratch(NamedTuple):
+    """The loop's own state and scratch (the kernel allocates nothing): state ``q, qd``, held torque
+    ``u`` and its parts, accelerations and constraint torques, RK4 slopes and stage state, the sensor
+    delay line ``buf`` (delay + 1, 3, n) and the sensed ``(q, qd, qdd)``."""
+
+    q: np.ndarray
+    qd: np.ndarray
+    u: np.ndarray
+    tau_f: np.ndarray
+    tau_imp: np.ndarray
+    qdd: np.ndarray
+    tau_c: np.ndarray
+    k1q: np.ndarray
+    k2q: np.ndarray
+    k3q: np.ndarray
+    k4q: np.ndarray
+    a1: np.ndarray
+    a2: np.ndarray
+    a3: np.ndarray
+    a4: np.ndarray
+    c1: np.ndarray
+    qs: np.ndarray
+    qds: np.ndarray
+    buf: np.ndarray
+    sensed: np.ndarray
+
+
+def scratch(n: int, delay: int) -> Scratch:
+    """The loop's state and scratch for ``n`` joints and a sensor delay of ``delay`` samples."""
+    return Scratch(*(np.zeros(n) for _ in range(18)), np.zeros((delay + 1, 3, n)), np.zeros((3, n)))
+
+
 def table(tables) -> Table:
     """The kernel's view of :class:`~.tables.DynamicsTables`."""
     return Table(*tables.sparse, tables.index, tables.kinds, tables.degrees)
