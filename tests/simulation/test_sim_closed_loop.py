@@ -138,13 +138,3 @@ def test_cli_impedance_range_and_transparency_on_the_five_bar(joint):
     result = runner.invoke(app, ["transparency", "--device", five_bar, "--joint", joint, "--stiffness", "0.1",
                                  "--sweep", "2", "--f1", "10", "--json"])
     assert result.exit_code == 0, result.output
-
-
-@pytest.mark.parametrize("method", ["fast", "analytic"])
-def test_a_cartesian_wall_on_a_closed_loop_is_one_line(method):
-    """Both searches refuse a Cartesian wall on a closed-loop device before touching its kinematics."""
-    result = CliRunner().invoke(app, ["impedance-range", "--device", str(EXAMPLES / "five-bar.yaml"), "--method",
-                                      method, "--wall-direction", "1,0,0"])
-    assert result.exit_code == 2
-    assert result.output.strip() == ("error: a Cartesian wall needs an open-chain device (closed loops are not "
-                                     "simulated at the handle)")

@@ -34,10 +34,11 @@ from scipy.linalg import expm
 from threadpoolctl import ThreadpoolController
 
 from hapticdesign.analysis.dynamics.device import coriolis_centrifugal, gravity, mass_matrix
-from hapticdesign.analysis.kinematics import jacobian
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
-from hapticdesign.simulation.config import LoopConfig, compensator_device, normal_jacobian, plant_friction, rest_pose
+from hapticdesign.simulation.config import (
+    LoopConfig, compensator_device, handle_jacobian, normal_jacobian, plant_friction, rest_pose,
+)
 from hapticdesign.simulation.criteria import Verdict, WallProblem, type_paths
 from hapticdesign.simulation.zwidth import DisplayLoop, controller, plant
 
@@ -84,9 +85,7 @@ def linearize(device: Device, sim_type: int, wall_joint: int, config: LoopConfig
     j_device = float(h[w, w])
     j, b, spring = j_device, float(damping[w]), 0.0
     if config.hand is not None:
-        if device.mechanism.loops is not None:
-            raise UserError("a hand model needs an open-chain device (the hand is not coupled to closed loops)")
-        jv = jacobian(device.mechanism, q0)[:3, w]
+        jv = handle_jacobian(device, q0)[:3, w]
         reach = float(jv @ jv)
         j += config.hand.mass * reach
         b += config.hand.damping * reach

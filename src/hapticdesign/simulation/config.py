@@ -13,7 +13,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from hapticdesign.analysis.kinematics import jacobian
+from hapticdesign.analysis.dynamics.device import dynamics_of
+from hapticdesign.analysis.kinematics import actuated_jacobian
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.model.inertia import SEED_FIELDS
@@ -261,22 +262,26 @@ def plant_friction(device: Device, config: LoopConfig) -> np.ndarray:
     return friction
 
 
+def handle_jacobian(device: Device, q: np.ndarray) -> np.ndarray:
+    """The handle's geometric Jacobian (6 x n) over the actuated coordinates at ``q``: ``J`` of a tree,
+    ``J T`` of a closed-loop device at its closed pose on the assembly branch."""
+    solver = getattr(dynamics_of(device), "solver", None)
+    return actuated_jacobian(device.mechanism, np.asarray(q, dtype=float), solver=solver)
+
+
 def normal_jacobian(device: Device, wall: Wall, q: np.ndarray) -> np.ndarray:
-    """``J_n = n^T J_v`` (1 x N): the handle's velocity along a Cartesian wall's direction per joint velocity."""
-    if device.mechanism.loops is not None:
-        raise UserError("a Cartesian wall needs an open-chain device (closed loops are not simulated at the handle)")
-    return unit_direction(wall.direction) @ jacobian(device.mechanism, np.asarray(q, dtype=float))[:3]
+    """``J_n = n^T J_v`` (1 x n): the handle's velocity along a Cartesian wall's direction per actuated joint velocity."""
+    return unit_direction(wall.direction) @ handle_jacobian(device, q)[:3]
 
 
 def hand_matrices(device: Device, hand: Hand | None, q0: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Hand mass, damping and stiffness in joint space: ``x J_v^T J_v`` at the start pose ``q0``."""
+    """Hand mass, damping and stiffness in (actuated) joint space: ``x J_v^T J_v`` at the start pose ``q0``,
+    ``J_v`` of :func:`handle_jacobian` (``J_v T`` for a closed-loop device)."""
     n = len(q0)
     if hand is None:
         return np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n))
-    if device.mechanism.loops is not None:
-        raise UserError("a hand model needs an open-chain device (the hand is not coupled to closed loops)")
     if min(hand.mass, hand.damping, hand.stiffness) < 0:
         raise UserError("hand mass, damping and stiffness must be non-negative")
-    jv = jacobian(device.mechanism, q0)[:3]
+    jv = handle_jacobian(device, q0)[:3]
     jtj = jv.T @ jv
     return hand.mass * jtj, hand.damping * jtj, hand.stiffness * jtj

@@ -12,7 +12,8 @@ which avoids an algebraic loop; zero at t = 0 as the seed's initial conditions),
 computes the model's inverse dynamics ``tau_f`` with its inertial, Coriolis and gravity terms
 switchable; the virtual wall computes ``tau_imp = K (q_w - q_eq) + B qd_w`` on a joint, or for a
 Cartesian wall along the unit direction n at the handle ``tau_imp = J_n^T (K (n.p - x_eq) + B J_n qd)``
-(``tau = J^T F``, ``J_n = n^T J_v`` from the compiled frame tree at the sensed pose); the actuators
+(``tau = J^T F``, ``J_n = n^T J_v`` from the compiled frame tree at the sensed pose; for a closed-loop
+device ``n^T J_v T`` in actuated coordinates at the compensator's closed pose); the actuators
 hold ``u = tau_f - tau_imp`` (zero-order hold). The safety switch of Figure 4.7 cuts both torques
 off once the wall coordinate (the wall joint, or the handle along n) leaves its reference by
 ``safety_limit``.
@@ -34,7 +35,7 @@ from numba.core import types
 from numba.core.errors import NumbaIRAssumptionWarning
 from numba.extending import overload
 
-from hapticdesign.analysis.dynamics.closed_loop_plant import closed_loop_terms
+from hapticdesign.analysis.dynamics.closed_loop_plant import closed_loop_terms, handle_along
 from hapticdesign.analysis.dynamics.model import velocity_products_into as velocity_products
 from hapticdesign.model.walk import frame_jacobian, node_poses
 from hapticdesign.simulation import records
@@ -69,11 +70,11 @@ def _solve_in_place(a, b, n):
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
-def _tree_plant_terms(q, qd, plant):
-    """H + M_hand, C, G of a tree's tables at q into the plant's workspace, reusing the last evaluation
+def _tree_plant_terms(q, qd, record):
+    """H + M_hand, C, G of a tree's tables at q into the record's workspace, reusing the last evaluation
     when the non-cyclic q is unchanged; the velocity products of qd."""
-    t, ws = plant.table, plant.ws
-    kinds, cache_q, cache_valid, h, hand_mass = t.kinds, ws.cache_q, ws.cache_valid, ws.h, plant.hand_mass
+    t, ws = record.table, record.ws
+    kinds, cache_q, cache_valid, h, hand_mass = t.kinds, ws.cache_q, ws.cache_valid, ws.h, record.hand_mass
     n = q.shape[0]
     same = cache_valid[0] == 1
     if same:
@@ -94,6 +95,17 @@ def _tree_plant_terms(q, qd, plant):
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
+def _loop_cached(q, qd, ws):
+    """Whether a closed-loop workspace already holds the terms at exactly (q, qd)."""
+    if ws.cache_valid[0] != 1:
+        return False
+    for k in range(q.shape[0]):
+        if q[k] != ws.cache_q[k] or qd[k] != ws.cache_qd[k]:
+            return False
+    return True
+
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def _loop_terms(q, qd, record):
     """H, C(q, qd) qd^2 and G of a closed-loop record (plant or compensator) at (q, qd) into its
     workspace, ``C qd^2`` as the one column of ``ws.c`` (its velocity product ``ws.qd2`` is 1); a failed
@@ -101,37 +113,75 @@ def _loop_terms(q, qd, record):
     ws = record.ws
     status = closed_loop_terms(q, qd, record.structure, record.loop_ws, ws.h, record.cqd, ws.g)
     if status != 0:
+        ws.cache_valid[0] = 0
         if record.status[0] == 0:
             record.status[0] = status
         return status
     for i in range(q.shape[0]):
         ws.c[i, 0] = record.cqd[i]
+        ws.cache_q[i] = q[i]
+        ws.cache_qd[i] = qd[i]
+    ws.cache_valid[0] = 1
     return status
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
-def _loop_plant_terms(q, qd, plant):
-    """:func:`_loop_terms` of the plant, plus the hand's mass."""
-    if _loop_terms(q, qd, plant) == 0:
-        h, hand_mass = plant.ws.h, plant.hand_mass
+def _loop_plant_terms(q, qd, record):
+    """:func:`_loop_terms` of the record, plus the hand's mass; nothing to do at the state last evaluated
+    (a sample instant's sensor call or the handle's position after a step, then stage 1 at that state)."""
+    if _loop_cached(q, qd, record.ws):
+        return
+    if _loop_terms(q, qd, record) == 0:
+        h, hand_mass = record.ws.h, record.hand_mass
         for i in range(q.shape[0]):
             for j in range(q.shape[0]):
                 h[i, j] += hand_mass[i, j]
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
-def _loop_model_terms(q, qd, ctrl):
-    """:func:`_loop_terms` of the compensator's model."""
-    _loop_terms(q, qd, ctrl)
+def _loop_model_terms(q, qd, record):
+    """:func:`_loop_terms` of the compensator's model (nothing to do at the state last evaluated)."""
+    if not _loop_cached(q, qd, record.ws):
+        _loop_terms(q, qd, record)
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
-def _tree_model_terms(q, qd, ctrl):
+def _tree_model_terms(q, qd, record):
     """H, C, G of the compensator's tables at q and the velocity products of qd."""
-    t, ws = ctrl.table, ctrl.ws
+    t, ws = record.table, record.ws
     evaluate_entries(q, t.rows, t.cols, t.vals, t.index, t.kinds, t.degrees, ws.values, ws.phi, ws.entries)
     unpack_entries(ws.entries, q.shape[0], ws.h, ws.c, ws.g)
     velocity_products(qd, ws.qd2)
+
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _handle_normal(q, handle):
+    """The handle's position along the wall direction, ``n . p(q)``, by a walk of a tree (its node poses stay
+    in ``handle``)."""
+    pos, n, node = handle.pos, handle.direction, handle.node
+    node_poses(q, handle.parent, handle.axis, handle.coef, handle.offset, handle.const_rot, handle.const_pos, node,
+               handle.rot, pos)
+    return n[0] * pos[node, 0] + n[1] * pos[node, 1] + n[2] * pos[node, 2]
+
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _tree_handle(q, qd, handle, record, jn, want_jn):
+    """``n . p`` of a tree's handle at q and, when ``want_jn``, ``J_n = n^T J_v`` into ``jn``."""
+    x = _handle_normal(q, handle)
+    if want_jn:
+        jac, n = handle.jac, handle.direction
+        frame_jacobian(handle.node, handle.parent, handle.axis, handle.coef, handle.rot, handle.pos, False, jac)
+        for k in range(q.shape[0]):
+            jn[k] = n[0] * jac[0, k] + n[1] * jac[1, k] + n[2] * jac[2, k]
+    return x
+
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _loop_handle(q, qd, handle, record, jn, want_jn):
+    """``n . p`` and ``J_n = n^T J_v T`` of a closed-loop device's handle at the record's closed pose at
+    (q, qd), evaluated there unless it already is (:func:`_terms`)."""
+    _terms(q, qd, record)
+    return handle_along(record.loop_ws, handle.parent, handle.axis, handle.node, handle.direction, jn, want_jn)
 
 
 # The plant and the compensator are inlined into the loop by their record type (a tree's tables or a
@@ -146,27 +196,31 @@ def _is_loop(record) -> bool:
                                                                               records.LoopController)
 
 
-def _plant_terms(q, qd, plant):
-    """H + M_hand, C with its velocity products (``C qd^2 = ws.c @ ws.qd2``) and G of the plant at (q, qd)
-    into its workspace (numba only: a tree's tables or the closed-loop plant, by the record's type)."""
+def _terms(q, qd, record):
+    """H (+ M_hand for the plant), C with its velocity products (``C qd^2 = ws.c @ ws.qd2``) and G of a
+    plant or compensator record at (q, qd) into its workspace (numba only: a tree's tables or a
+    closed-loop plant, by the record's type)."""
 
 
-def _model_terms(q, qd, ctrl):
-    """H, C with its velocity products and G of the compensator's model at (q, qd) into its workspace (numba only)."""
+def _handle(q, qd, handle, record, jn, want_jn):
+    """The handle's position along the wall direction and, when ``want_jn``, ``J_n`` into ``jn`` (numba
+    only: a tree's walk, or a closed-loop record's closed pose)."""
 
 
 def _status(record):
     """0 while a closed-loop record's loops close on the assembly branch; always 0 for a tree (numba only)."""
 
 
-@overload(_plant_terms, inline="always")
-def _plant_terms_impl(q, qd, plant):
-    return (_loop_plant_terms if _is_loop(plant) else _tree_plant_terms).py_func
+@overload(_terms, inline="always")
+def _terms_impl(q, qd, record):
+    kind = record.instance_class
+    return {records.Plant: _tree_plant_terms, records.Controller: _tree_model_terms,
+            records.LoopPlant: _loop_plant_terms, records.LoopController: _loop_model_terms}[kind].py_func
 
 
-@overload(_model_terms, inline="always")
-def _model_terms_impl(q, qd, ctrl):
-    return (_loop_model_terms if _is_loop(ctrl) else _tree_model_terms).py_func
+@overload(_handle, inline="always")
+def _handle_impl(q, qd, handle, record, jn, want_jn):
+    return (_loop_handle if _is_loop(record) else _tree_handle).py_func
 
 
 @overload(_status, inline="always")
@@ -184,7 +238,7 @@ def accelerations(q, qd, qdd_path, u, prescribed, plant, qdd, tau_c, want_tau_c=
     h, c, g, qd2, a, rhs, free = ws.h, ws.c, ws.g, ws.qd2, ws.a, ws.rhs, ws.free
     damping, coulomb, hand_stiffness, hand_rest = plant.damping, plant.coulomb, plant.hand_stiffness, plant.hand_rest
     n = q.shape[0]
-    _plant_terms(q, qd, plant)
+    _terms(q, qd, plant)
     bias = tau_c
     for i in range(n):
         if prescribed[i] and not want_tau_c:
@@ -247,7 +301,7 @@ def _compensator_torque(q, qd, qdd, ctrl, out):
     ws, switches = ctrl.ws, ctrl.switches
     h, c, g, qd2 = ws.h, ws.c, ws.g, ws.qd2
     n = q.shape[0]
-    _model_terms(q, qd, ctrl)
+    _terms(q, qd, ctrl)
     for i in range(n):
         s_h = 0.0
         for j in range(n):
@@ -258,44 +312,34 @@ def _compensator_torque(q, qd, qdd, ctrl, out):
         out[i] = switches[0] * s_h + switches[1] * s_c + switches[2] * g[i]
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
-def _handle_normal(q, handle):
-    """The handle's position along the wall direction, ``n . p(q)``; leaves the node poses in ``handle``."""
-    pos, n, node = handle.pos, handle.direction, handle.node
-    node_poses(q, handle.parent, handle.axis, handle.coef, handle.offset, handle.const_rot, handle.const_pos, node,
-               handle.rot, pos)
-    return n[0] * pos[node, 0] + n[1] * pos[node, 1] + n[2] * pos[node, 2]
-
-
 @nb.njit(cache=True, error_model="numpy")
-def handle_normal(q, handle):
-    """:func:`_handle_normal` callable from Python (the wall's reference at the start pose)."""
-    return _handle_normal(q, handle)
+def handle_coordinate(q, qd, handle, record):
+    """The handle's position along the wall direction at (q, qd), callable from Python (the wall's
+    reference at the start pose); a closed-loop record is evaluated there, as the loop's first step will be."""
+    return _handle(q, qd, handle, record, handle.jac[0], False)
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
-def _wall_coordinate(q, wall, handle):
+def _wall_coordinate(q, qd, wall, handle, plant):
     """The wall coordinate: the wall joint's position, or the handle's along a Cartesian wall's direction."""
     if wall.cartesian:
-        return _handle_normal(q, handle)
+        return _handle(q, qd, handle, plant, handle.jac[0], False)
     return q[wall.joint]
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
-def _wall_torque(q, qd, wall, handle, out):
+def _wall_torque(q, qd, wall, handle, ctrl, out):
     """``tau_imp`` of the wall at the sensed state: ``K (q_j - q_eq) + B qd_j`` on the wall joint, or
-    ``J_n^T (K (n.p - x_eq) + B J_n qd)`` with ``J_n = n^T J_v`` the handle's Jacobian along n."""
+    ``J_n^T (K (n.p - x_eq) + B J_n qd)`` with ``J_n = n^T J_v`` the handle's Jacobian along n (for a
+    closed-loop device in actuated coordinates, ``n^T J_v T`` at the compensator's closed pose)."""
     if not wall.cartesian:
         for i in range(q.shape[0]):
             out[i] = 0.0
         out[wall.joint] = wall.stiffness * (q[wall.joint] - wall.rest) + wall.damping * qd[wall.joint]
         return
-    x = _handle_normal(q, handle)
-    jac, n = handle.jac, handle.direction
-    frame_jacobian(handle.node, handle.parent, handle.axis, handle.coef, handle.rot, handle.pos, False, jac)
+    x = _handle(q, qd, handle, ctrl, out, True)
     v = 0.0
     for k in range(q.shape[0]):
-        out[k] = n[0] * jac[0, k] + n[1] * jac[1, k] + n[2] * jac[2, k]
         v += out[k] * qd[k]
     force = wall.stiffness * (x - wall.rest) + wall.damping * v
     for k in range(q.shape[0]):
@@ -340,7 +384,7 @@ def run_loop(plant, ctrl, motion, timing, wall, handle, rec, scratch):
     written = 0
     status = STATUS_COMPLETED
     peak = 0.0
-    coord = _wall_coordinate(q, wall, handle)
+    coord = _wall_coordinate(q, qd, wall, handle, plant)
     end_time = 0.0
     for it in range(n_steps + 1):
         t = it * step
@@ -365,7 +409,7 @@ def run_loop(plant, ctrl, motion, timing, wall, handle, rec, scratch):
                 sensed[1, i] = buf[old, 1, i]
                 sensed[2, i] = buf[old, 2, i]
             _compensator_torque(sensed[0], sensed[1], sensed[2], ctrl, tau_f)
-            _wall_torque(sensed[0], sensed[1], wall, handle, tau_imp)
+            _wall_torque(sensed[0], sensed[1], wall, handle, ctrl, tau_imp)
             if tripped:
                 for i in range(n):
                     tau_f[i] = 0.0
@@ -433,7 +477,7 @@ def run_loop(plant, ctrl, motion, timing, wall, handle, rec, scratch):
                 else:
                     q[i] += step / 6.0 * (k1q[i] + 2.0 * k2q[i] + 2.0 * k3q[i] + k4q[i])
                     qd[i] += step / 6.0 * (a1[i] + 2.0 * a2[i] + 2.0 * a3[i] + a4[i])
-        coord = _wall_coordinate(q, wall, handle)
+        coord = _wall_coordinate(q, qd, wall, handle, plant)
         if not tripped and abs(coord - wall.reference) >= wall.safety_limit:
             tripped = True
             trip_time = t + step

@@ -95,8 +95,6 @@ def simulate(
 def handle_of(device: Device, wall: Wall) -> records.Handle:
     """The kernel's handle kinematics for a Cartesian ``wall`` on ``device`` (its end-effector frame)."""
     mech = device.mechanism
-    if mech.loops is not None:
-        raise UserError("a Cartesian wall needs an open-chain device (closed loops are not simulated at the handle)")
     if mech.end_effector is None:
         raise UserError("a Cartesian wall needs a device that names its end-effector (handle) frame")
     return records.handle(mech, unit_direction(wall.direction))
@@ -175,7 +173,8 @@ def simulate_tables(
     motion = records.Motion(prescribed, path_q, path_qd, path_qdd, q_start, np.zeros(n))
     timing = records.Timing(float(config.step), sub, n_steps, stride)
     handle = handle if wall.cartesian else records.no_handle(n)
-    reference = float(kernel.handle_normal(q_start, handle)) if wall.cartesian else float(q_start[wall.joint])
+    reference = (float(kernel.handle_coordinate(q_start, np.zeros(n), handle, plant_record)) if wall.cartesian
+                 else float(q_start[wall.joint]))
     rest = reference + float(wall.equilibrium) if wall.cartesian else float(wall.equilibrium)
     law = records.WallLaw(
         cartesian=wall.cartesian, joint=wall.joint, stiffness=float(wall.stiffness), damping=float(wall.damping),

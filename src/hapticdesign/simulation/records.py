@@ -29,6 +29,7 @@ class Workspace(NamedTuple):
     phi: np.ndarray
     entries: np.ndarray
     cache_q: np.ndarray
+    cache_qd: np.ndarray
     cache_valid: np.ndarray
     h: np.ndarray
     c: np.ndarray
@@ -131,8 +132,10 @@ class WallLaw(NamedTuple):
 
 
 class Handle(NamedTuple):
-    """The folded frame tree (:class:`~hapticdesign.model.walk.KinematicTree`), the handle's node,
-    the wall's unit direction and scratch for node poses and the handle's Jacobian."""
+    """The folded frame tree (:class:`~hapticdesign.model.walk.KinematicTree`; a closed-loop device's
+    loop-opened tree), the handle's node, the wall's unit direction and scratch for node poses and the
+    handle's Jacobian (a closed-loop device takes its poses from the plant's or the compensator's
+    closed pose instead)."""
 
     parent: np.ndarray
     axis: np.ndarray
@@ -201,9 +204,9 @@ def workspace(n: int, n_values: int, n_basis: int, n_entries: int) -> Workspace:
     """Scratch arrays for one set of tables of ``n`` joints."""
     m = n * (n + 1) // 2
     return Workspace(
-        np.zeros((n, n_values)), np.zeros(n_basis), np.zeros(n_entries), np.zeros(n), np.zeros(1, dtype=np.int64),
-        np.zeros((n, n)), np.zeros((n, m)), np.zeros(n), np.zeros(m), np.zeros((n, n)), np.zeros(n),
-        np.zeros(n, dtype=np.int64),
+        np.zeros((n, n_values)), np.zeros(n_basis), np.zeros(n_entries), np.zeros(n), np.zeros(n),
+        np.zeros(1, dtype=np.int64), np.zeros((n, n)), np.zeros((n, m)), np.zeros(n), np.zeros(m), np.zeros((n, n)),
+        np.zeros(n), np.zeros(n, dtype=np.int64),
     )
 
 
@@ -211,8 +214,9 @@ def loop_workspace(n: int) -> Workspace:
     """Scratch for a closed-loop plant of ``n`` actuated joints: no basis tables; ``C qd^2`` is the one
     column of ``c`` and its velocity product ``qd2`` the constant 1, so the loop reads it as ``c @ qd2``."""
     return Workspace(
-        np.zeros((n, 1)), np.zeros(1), np.zeros(1), np.zeros(n), np.zeros(1, dtype=np.int64), np.zeros((n, n)),
-        np.zeros((n, 1)), np.zeros(n), np.ones(1), np.zeros((n, n)), np.zeros(n), np.zeros(n, dtype=np.int64),
+        np.zeros((n, 1)), np.zeros(1), np.zeros(1), np.zeros(n), np.zeros(n), np.zeros(1, dtype=np.int64),
+        np.zeros((n, n)), np.zeros((n, 1)), np.zeros(n), np.ones(1), np.zeros((n, n)), np.zeros(n),
+        np.zeros(n, dtype=np.int64),
     )
 
 
@@ -223,7 +227,7 @@ def handle(mechanism, direction: np.ndarray) -> Handle:
     parent, axis, coef, offset, const_rot, const_pos = tree.arrays
     return Handle(parent, axis, np.ascontiguousarray(coef), offset, const_rot, const_pos,
                   int(tree.frame_node[mechanism.end_effector]), np.ascontiguousarray(direction, dtype=float), rot, pos,
-                  np.zeros((6, mechanism.n_dof)))
+                  np.zeros((6, coef.shape[1])))
 
 
 def no_handle(n: int) -> Handle:

@@ -37,6 +37,7 @@ from hapticdesign.analysis.dynamics.closed_loop import ClosedLoopModel
 from hapticdesign.analysis.loops import closure_kernel as ck
 from hapticdesign.analysis.loops.solver import MAX_ITER, MESSAGES, SINGULAR_RATIO
 from hapticdesign.errors import UserError
+from hapticdesign.model.walk import CONSTANT
 
 OK, NO_CLOSURE, SINGULAR, BRANCH_CHANGE = ck.OK, ck.NO_CLOSURE, ck.SINGULAR, ck.BRANCH_CHANGE
 
@@ -162,3 +163,33 @@ class ClosedLoopPlant:
     def q_full(self) -> np.ndarray:
         """Full coordinates of the last closed pose (the warm start)."""
         return self.workspace[1].copy()
+
+
+@njit(cache=True)
+def handle_along(ws, parent, axis, node, direction, jn, want_jn):
+    """At the last closed pose of a :func:`plant_workspace`: the position of node ``node`` (the handle) along
+    the unit ``direction`` n, ``n . p``, and, when ``want_jn``, into ``jn`` (n_a) its velocity along n per
+    actuated rate, ``J_n = n^T J_v T`` (seed 000 eq. 2.24-2.26 on the loop-opened tree, reduced by ``T``).
+
+    ``J_v T`` is summed over the variable nodes from the handle to the base with each node's joint-value rate
+    per actuated rate (``coef T``, which :func:`closed_loop_terms` leaves in the workspace)."""
+    dyn = ws[0]
+    rot, pos, node_t = dyn[0], dyn[1], dyn[9]
+    x = direction[0] * pos[node, 0] + direction[1] * pos[node, 1] + direction[2] * pos[node, 2]
+    if not want_jn:
+        return x
+    for j in range(jn.shape[0]):
+        jn[j] = 0.0
+    e = node
+    while e >= 0:
+        if axis[e] != CONSTANT:
+            a = axis[e] % 3
+            u0, u1, u2 = rot[e, 0, a], rot[e, 1, a], rot[e, 2, a]
+            if axis[e] < 3:
+                r0, r1, r2 = pos[node, 0] - pos[e, 0], pos[node, 1] - pos[e, 1], pos[node, 2] - pos[e, 2]
+                u0, u1, u2 = u1 * r2 - u2 * r1, u2 * r0 - u0 * r2, u0 * r1 - u1 * r0
+            along = direction[0] * u0 + direction[1] * u1 + direction[2] * u2
+            for j in range(jn.shape[0]):
+                jn[j] += node_t[e, j] * along
+        e = parent[e]
+    return x
