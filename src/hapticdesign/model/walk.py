@@ -14,7 +14,11 @@ transforms keep their :class:`~hapticdesign.model.transforms.Axis` code and affi
   twist at the current pose (rotation axis ``u`` through the node: ``v = u x (p - p_node)``,
   ``w = u``; translation: ``v = u``; seed 000 eq. 2.20-2.26, seed 001 eq. 5.61-5.66 and
   5.87-5.92), weighted by the coupling coefficients of dependent coordinates (eq. 2.38-2.43);
-- :func:`poses_and_jacobians`: both for a batch of coordinate vectors (a single pose is a batch of one).
+- :func:`poses_and_jacobians`: both for a batch of coordinate vectors (a single pose is a batch of one);
+- :class:`WalkPlan` and :func:`planned_poses`: the same poses for the hot loops of closed loops, nodes in
+  an order that puts first those a given set of nodes needs (the loop closures), joint values from the
+  non-zero coupling coefficients only, and the cosine and sine of a joint angle shared by every node that
+  turns by it (or by its negative).
 
 Forward kinematics, the dynamics regressors, the loop-closure kernels and the R-CUBE stiffness model
 all call these.
@@ -97,10 +101,130 @@ class KinematicTree:
         """``(parent, axis, coef, offset, const_rot, const_pos)``, the leading arguments of the kernels."""
         return self.parent, self.axis, self.coef, self.offset, self.const_rot, self.const_pos
 
+    def plan(self, needed: list[int]) -> "WalkPlan":
+        """:class:`WalkPlan` whose first part is the nodes ``needed`` (and their ancestors)."""
+        first = set()
+        for node in needed:
+            while node >= 0 and node not in first:
+                first.add(node)
+                node = int(self.parent[node])
+        order = sorted(first) + [n for n in range(len(self.parent)) if n not in first]
+        nonzero = [np.flatnonzero(row) for row in self.coef]
+        ptr = np.cumsum([0] + [len(k) for k in nonzero])
+        source = np.arange(len(self.parent))
+        sign = np.ones(len(self.parent))
+        seen: dict[tuple, int] = {}
+        for n in order:
+            if self.axis[n] >= 3:
+                continue
+            key = (*self.coef[n], self.offset[n])
+            negated = tuple(-v for v in key)
+            if key in seen:
+                source[n] = seen[key]
+            elif negated in seen:
+                source[n], sign[n] = seen[negated], -1.0
+            else:
+                seen[key] = n
+        return WalkPlan(
+            order=np.array(order, dtype=np.int64), n_first=len(first), ptr=ptr.astype(np.int64),
+            index=np.concatenate([np.zeros(0, dtype=np.int64)] + nonzero).astype(np.int64),
+            value=np.concatenate([np.zeros(0)] + [row[k] for row, k in zip(self.coef, nonzero)]),
+            trig_source=source.astype(np.int64), trig_sign=sign,
+        )
+
     def workspace(self) -> tuple[np.ndarray, np.ndarray]:
         """Zeroed node rotations (M, 3, 3) and origins (M, 3) for :func:`node_poses`."""
         n_node = max(len(self.parent), 1)
         return np.zeros((n_node, 3, 3)), np.zeros((n_node, 3))
+
+
+@dataclass(frozen=True)
+class WalkPlan:
+    """A walk of a :class:`KinematicTree` for the hot loops (:func:`planned_poses`).
+
+    ``order`` lists every node after its parent, the ``n_first`` nodes a chosen set needs first; the
+    coupling coefficients of node ``n`` are the sparse row ``value[ptr[n]:ptr[n + 1]]`` at the coordinates
+    ``index[ptr[n]:ptr[n + 1]]`` (in increasing order, so a joint value is the same sum as the dense one's);
+    a rotation node whose angle (coefficients and offset) equals, or is the negative of, that of an
+    earlier node of ``order``, ``trig_source[n]``, takes its cosine and sine (times ``trig_sign[n]``).
+    """
+
+    order: np.ndarray
+    n_first: int
+    ptr: np.ndarray
+    index: np.ndarray
+    value: np.ndarray
+    trig_source: np.ndarray
+    trig_sign: np.ndarray
+
+    @property
+    def arrays(self) -> tuple:
+        """``(order, n_first, ptr, index, value, trig_source, trig_sign)``, the ``plan`` of the kernels."""
+        return self.order, self.n_first, self.ptr, self.index, self.value, self.trig_source, self.trig_sign
+
+    def workspace(self) -> np.ndarray:
+        """Cosine and sine per node (M, 2), the scratch of :func:`planned_poses`."""
+        return np.zeros((max(len(self.order), 1), 2))
+
+
+@njit(cache=True)
+def planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, start, stop, rot, pos, trig):
+    """:func:`node_poses` of the nodes ``order[start:stop]`` of a :class:`WalkPlan` ``plan`` (its ``arrays``).
+
+    The nodes before ``start`` in the plan's order must hold their poses (and ``trig`` its cosines and
+    sines) at the same ``q``.
+    """
+    order, _, ptr, index, value, source, sign = plan
+    for i in range(start, stop):
+        n = order[i]
+        pn = parent[n]
+        if axis[n] == CONSTANT:
+            for r in range(3):
+                if pn < 0:
+                    for j in range(3):
+                        rot[n, r, j] = const_rot[n, r, j]
+                    pos[n, r] = const_pos[n, r]
+                else:
+                    for j in range(3):
+                        rot[n, r, j] = (rot[pn, r, 0] * const_rot[n, 0, j] + rot[pn, r, 1] * const_rot[n, 1, j]
+                                        + rot[pn, r, 2] * const_rot[n, 2, j])
+                    pos[n, r] = (pos[pn, r] + rot[pn, r, 0] * const_pos[n, 0] + rot[pn, r, 1] * const_pos[n, 1]
+                                 + rot[pn, r, 2] * const_pos[n, 2])
+            continue
+        if pn >= 0:
+            for r in range(3):
+                for j in range(3):
+                    rot[n, r, j] = rot[pn, r, j]
+                pos[n, r] = pos[pn, r]
+        else:
+            for r in range(3):
+                for j in range(3):
+                    rot[n, r, j] = 1.0 if r == j else 0.0
+                pos[n, r] = 0.0
+        a = axis[n] % 3
+        if axis[n] < 3:
+            s = source[n]
+            if s == n:
+                v = offset[n]
+                for k in range(ptr[n], ptr[n + 1]):
+                    v += value[k] * q[index[k]]
+                trig[n, 0] = np.cos(v)
+                trig[n, 1] = np.sin(v)
+            cv = trig[s, 0]
+            sv = sign[n] * trig[s, 1]
+            b = (a + 1) % 3
+            c = (a + 2) % 3
+            for r in range(3):
+                rb = rot[n, r, b]
+                rc = rot[n, r, c]
+                rot[n, r, b] = rb * cv + rc * sv
+                rot[n, r, c] = -rb * sv + rc * cv
+        else:
+            v = offset[n]
+            for k in range(ptr[n], ptr[n + 1]):
+                v += value[k] * q[index[k]]
+            for r in range(3):
+                pos[n, r] += rot[n, r, a] * v
 
 
 @njit(cache=True)

@@ -33,7 +33,7 @@ from numba import njit
 
 from hapticdesign.analysis.dynamics.kernel import body_regressor
 from hapticdesign.analysis.loops.closure_kernel import closure_bias, closure_jacobian, lu_in_place, node_motion
-from hapticdesign.model.walk import CONSTANT, node_poses
+from hapticdesign.model.walk import CONSTANT, planned_poses
 
 
 @njit(cache=True)
@@ -75,43 +75,54 @@ def _wrench_regressor(w, al, acc, out):
 
 
 @njit(cache=True)
-def workspace(n_node, n_dof, na, npas, n_body):
+def workspace(n_node, n_dof, na, passive, n_body):
     """Scratch arrays of :func:`reduce_pose` and :func:`velocity_state` (one set per caller).
 
-    ``(rot, pos, w, al, ac, phi, lu, pinv, t, node_t, rate, jp, ja, bias, gamma)``: node poses
+    ``(rot, pos, w, al, ac, phi, lu, pinv, t, node_t, rate, jp, ja, bias, gamma, trig, slot)``: node poses
     and motions, ``Phi``, an LU scratch, ``Phi_p^-1``, ``T``, every node's joint-value rate per actuated
     rate (``coef T``) and for one rate vector, per body the world Jacobian of its origin over the passive
-    rates (6 x n_p) and over the actuated ones (``J_b T``, 6 x n_a), ``Phidot qd`` and ``gamma``.
+    rates (6 x n_p) and over the actuated ones (``J_b T``, 6 x n_a), ``Phidot qd``, ``gamma``, the walk
+    plan's cosines and sines, and each coordinate's place among the passive ones (-1: actuated).
     """
     n_node = max(n_node, 1)
+    npas = passive.shape[0]
+    slot = np.full(n_dof, -1, dtype=np.int64)
+    for r in range(npas):
+        slot[passive[r]] = r
     return (
         np.zeros((n_node, 3, 3)), np.zeros((n_node, 3)),
         np.zeros((n_node, 3)), np.zeros((n_node, 3)), np.zeros((n_node, 3)),
         np.zeros((npas, n_dof)), np.zeros((npas, npas)), np.zeros((npas, npas)),
         np.zeros((n_dof, na)), np.zeros((n_node, na)), np.zeros(n_node),
         np.zeros((n_body, 6, npas)), np.zeros((n_body, 6, na)),
-        np.zeros(npas), np.zeros(npas),
+        np.zeros(npas), np.zeros(npas), np.zeros((n_node, 2)), slot,
     )
 
 
 @njit(cache=True, inline="always")
-def reduce_pose(q, parent, axis, coef, offset, const_rot, const_pos, body_node, frame_a, frame_b, row_loop, row_comp,
+def reduce_pose(q, parent, axis, offset, const_rot, const_pos, plan, body_node, frame_a, frame_b, row_loop, row_comp,
                 actuated, passive, ws, poses_ready):
     """At a closed full pose ``q``: ``Phi_p^-1``, ``T = [I; S]``, ``coef T`` and every body's Jacobians into ``ws``.
 
-    ``poses_ready``: the node poses and ``Phi`` in ``ws`` are already those of ``q`` (after Newton).
+    ``plan``: the arrays of the loop solver's :class:`~hapticdesign.model.walk.WalkPlan` (closure nodes
+    first). ``poses_ready``: the poses of the plan's first part and ``Phi`` in ``ws`` are already those of
+    ``q`` (after Newton); the other nodes are walked here.
     Returns the pivot ratio of ``Phi_p`` (0: singular, nothing else computed) and the sign of its determinant.
     A body Jacobian column is the unit twist of a variable node on the path from the body to the base
     (folded constant nodes, :data:`~hapticdesign.model.walk.CONSTANT`, carry none) at the body origin: ``(u x (p_b - p_e), u)``
     for a rotation, ``(u, 0)`` for a translation (seed 000 eq. 2.20-2.26).
     """
-    rot, pos, _, _, _, phi, lu, pinv, t, node_t, _, jp, ja, _, _ = ws
+    rot, pos, _, _, _, phi, lu, pinv, t, node_t, _, jp, ja, _, _, trig, slot = ws
+    _, n_first, ptr, index, value, _, _ = plan
     na = actuated.shape[0]
     npas = passive.shape[0]
     n_dof = q.shape[0]
-    if not poses_ready:
-        node_poses(q, parent, axis, coef, offset, const_rot, const_pos, parent.shape[0] - 1, rot, pos)
-        closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, coef, rot, pos, phi)
+    n_node = parent.shape[0]
+    if poses_ready:
+        planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, n_first, n_node, rot, pos, trig)
+    else:
+        planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, 0, n_node, rot, pos, trig)
+        closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, plan, rot, pos, phi)
     for i in range(npas):
         for j in range(npas):
             lu[i, j] = phi[i, passive[j]]
@@ -119,25 +130,22 @@ def reduce_pose(q, parent, axis, coef, offset, const_rot, const_pos, body_node, 
     ratio, sign = lu_in_place(lu, pinv)
     if ratio == 0.0:
         return ratio, sign
-    for i in range(n_dof):
-        for j in range(na):
-            t[i, j] = 0.0
     for j in range(na):
-        t[actuated[j], j] = 1.0
+        for i in range(na):
+            t[actuated[i], j] = 1.0 if i == j else 0.0
     for r in range(npas):
         for j in range(na):
             acc = 0.0
             for i in range(npas):
                 acc -= pinv[r, i] * phi[i, actuated[j]]
             t[passive[r], j] = acc
-    for n in range(parent.shape[0]):
+    for n in range(n_node):
         for j in range(na):
             node_t[n, j] = 0.0
-        for k in range(n_dof):
-            c = coef[n, k]
-            if c != 0.0:
-                for j in range(na):
-                    node_t[n, j] += c * t[k, j]
+        for k in range(ptr[n], ptr[n + 1]):
+            c = value[k]
+            for j in range(na):
+                node_t[n, j] += c * t[index[k], j]
     for b in range(body_node.shape[0]):
         nb = body_node[b]
         for r in range(6):
@@ -167,9 +175,10 @@ def reduce_pose(q, parent, axis, coef, offset, const_rot, const_pos, body_node, 
                 ja[b, 3, j] += c * w0
                 ja[b, 4, j] += c * w1
                 ja[b, 5, j] += c * w2
-            for j in range(npas):
-                c = coef[e, passive[j]]
-                if c != 0.0:
+            for k in range(ptr[e], ptr[e + 1]):
+                j = slot[index[k]]
+                if j >= 0:
+                    c = value[k]
                     jp[b, 0, j] += c * v0
                     jp[b, 1, j] += c * v1
                     jp[b, 2, j] += c * v2
@@ -187,7 +196,7 @@ def velocity_state(qd_a, j, k, parent, axis, frame_a, frame_b, row_loop, row_com
     ``j >= 0`` takes the rate vector ``e_j`` (plus ``e_k`` when ``k != j``) instead of ``qd_a``. The body
     accelerations of ``qdd = [0; gamma]`` add ``J_p gamma`` (``jp`` of :func:`reduce_pose`) to the nodes'.
     """
-    rot, pos, w, al, ac, _, _, pinv, _, node_t, rate, _, _, bias, gamma = ws
+    rot, pos, w, al, ac, _, _, pinv, _, node_t, rate, _, _, bias, gamma, _, _ = ws
     npas = passive.shape[0]
     for n in range(rate.shape[0]):
         if j >= 0:
@@ -323,7 +332,7 @@ def _state(j, na):
 
 
 @njit(cache=True)
-def actuated_entries(qs, parent, axis, coef, offset, const_rot, const_pos, body_node, gravity,
+def actuated_entries(qs, parent, axis, offset, const_rot, const_pos, plan, body_node, gravity,
                      frame_a, frame_b, row_loop, row_comp, actuated, passive, params):
     """Entries (unique H, C, G) in actuated coordinates at closed full poses ``qs`` (P, N) for parameter
     sets ``params`` (K, 10 B): (P, K, E), and the pivot ratio of ``Phi_p`` per pose (0: singular)."""
@@ -335,7 +344,7 @@ def actuated_entries(qs, parent, axis, coef, offset, const_rot, const_pos, body_
     m = na * (na + 1) // 2
     out = np.zeros((n_pose, n_sets, m + na * m + na))
     ratios = np.zeros(n_pose)
-    ws = workspace(parent.shape[0], n_dof, na, npas, n_body)
+    ws = workspace(parent.shape[0], n_dof, na, passive, n_body)
     rot, w, al, ac, jp, ja, gamma = ws[0], ws[2], ws[3], ws[4], ws[11], ws[12], ws[14]
     active = active_bodies(params)
     pw = np.zeros((n_sets, n_body, 10))
@@ -343,7 +352,7 @@ def actuated_entries(qs, parent, axis, coef, offset, const_rot, const_pos, body_
     kp = np.zeros((n_sets, na, npas))
     empty = np.zeros(0)
     for p in range(n_pose):
-        ratio, _ = reduce_pose(qs[p], parent, axis, coef, offset, const_rot, const_pos, body_node, frame_a, frame_b, row_loop,
+        ratio, _ = reduce_pose(qs[p], parent, axis, offset, const_rot, const_pos, plan, body_node, frame_a, frame_b, row_loop,
                                row_comp, actuated, passive, ws, False)
         ratios[p] = ratio
         if ratio == 0.0:
@@ -417,7 +426,7 @@ def _body_motion(w, al, ac, jp, gamma, nb, b, rb, out):
 
 
 @njit(cache=True)
-def actuated_regressor(qs, parent, axis, coef, offset, const_rot, const_pos, body_node, gravity,
+def actuated_regressor(qs, parent, axis, offset, const_rot, const_pos, plan, body_node, gravity,
                        frame_a, frame_b, row_loop, row_comp, actuated, passive):
     """Regressor of the entries (unique H, C, G) in actuated coordinates at closed full poses ``qs`` (P, N):
     (P, E, 10 B), and the pivot ratio of ``Phi_p`` per pose (0: singular). Body axes throughout."""
@@ -428,7 +437,7 @@ def actuated_regressor(qs, parent, axis, coef, offset, const_rot, const_pos, bod
     n_entries = m + na * m + na
     out = np.zeros((n_pose, n_entries, 10 * n_body))
     ratios = np.zeros(n_pose)
-    ws = workspace(parent.shape[0], n_dof, na, passive.shape[0], n_body)
+    ws = workspace(parent.shape[0], n_dof, na, passive, n_body)
     rot, w, al, ac, jp, ja, gamma = ws[0], ws[2], ws[3], ws[4], ws[11], ws[12], ws[14]
     jab = np.zeros((n_body, 6, na))
     rb = np.zeros((n_body, 3, 3))
@@ -439,7 +448,7 @@ def actuated_regressor(qs, parent, axis, coef, offset, const_rot, const_pos, bod
     wrench = np.zeros((6, 10))
     empty = np.zeros(0)
     for p in range(n_pose):
-        ratio, _ = reduce_pose(qs[p], parent, axis, coef, offset, const_rot, const_pos, body_node, frame_a, frame_b, row_loop,
+        ratio, _ = reduce_pose(qs[p], parent, axis, offset, const_rot, const_pos, plan, body_node, frame_a, frame_b, row_loop,
                                row_comp, actuated, passive, ws, False)
         ratios[p] = ratio
         if ratio == 0.0:
