@@ -83,6 +83,44 @@ def _rotation(rot, node, i, k):
 
 
 @njit(cache=True)
+def add_joint_accelerations(acc, parent, axis, rot, pos, al, ac, dal, dac):
+    """Add to the node accelerations ``al``, ``ac`` those of the joint-value accelerations ``acc[n]`` at zero rates.
+
+    The rate-free part of :func:`node_motion` (linear in ``acc``): a rotation node adds ``acc u`` to the
+    angular acceleration, a translation (or constant) node carries its parent's angular acceleration
+    ``dal_p`` over its offset ``d`` and adds ``acc u``: ``dac = dac_p + dal_p x d + acc u``.
+    ``dal``, ``dac``: scratch (M x 3).
+    """
+    for n in range(parent.shape[0]):
+        p = parent[n]
+        s = acc[n]
+        a = axis[n] % 3
+        u0, u1, u2 = rot[n, 0, a], rot[n, 1, a], rot[n, 2, a]
+        if p >= 0:
+            l0, l1, l2 = dal[p, 0], dal[p, 1], dal[p, 2]
+            a0, a1, a2 = dac[p, 0], dac[p, 1], dac[p, 2]
+        else:
+            l0 = l1 = l2 = a0 = a1 = a2 = 0.0
+        if axis[n] < 3:
+            l0, l1, l2 = l0 + s * u0, l1 + s * u1, l2 + s * u2
+        else:
+            if p >= 0:
+                d0, d1, d2 = pos[n, 0] - pos[p, 0], pos[n, 1] - pos[p, 1], pos[n, 2] - pos[p, 2]
+            else:
+                d0, d1, d2 = pos[n, 0], pos[n, 1], pos[n, 2]
+            x0, x1, x2 = _cross(l0, l1, l2, d0, d1, d2)
+            a0, a1, a2 = a0 + x0 + s * u0, a1 + x1 + s * u1, a2 + x2 + s * u2
+        dal[n, 0], dal[n, 1], dal[n, 2] = l0, l1, l2
+        dac[n, 0], dac[n, 1], dac[n, 2] = a0, a1, a2
+        al[n, 0] += l0
+        al[n, 1] += l1
+        al[n, 2] += l2
+        ac[n, 0] += a0
+        ac[n, 1] += a1
+        ac[n, 2] += a2
+
+
+@njit(cache=True)
 def closure_residual(frame_a, frame_b, row_loop, row_comp, rot, pos, out):
     """``phi`` (m,): origin differences and the skew-part vector of ``R_A R_B^T`` in the base frame."""
     for i in range(row_loop.shape[0]):
@@ -109,14 +147,18 @@ def closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, plan, r
 
     ``plan``: the arrays of a :class:`~hapticdesign.model.walk.WalkPlan` (its sparse coupling coefficients).
     Each frame's path to the base is walked once per loop; a column of ``J`` is as in
-    :func:`~hapticdesign.model.walk.frame_jacobian`.
+    :func:`~hapticdesign.model.walk.frame_jacobian`. The rows of a loop are consecutive, loop after loop.
     """
     _, _, ptr, index, value, _, _ = plan
     m = row_loop.shape[0]
     for i in range(m):
         for k in range(phi.shape[1]):
             phi[i, k] = 0.0
+    stop = 0
     for loop in range(frame_a.shape[0]):
+        start = stop
+        while stop < m and row_loop[stop] == loop:
+            stop += 1
         for side in range(2):
             node = frame_a[loop] if side == 0 else frame_b[loop]
             f = 1.0 if side == 0 else -1.0
@@ -130,11 +172,10 @@ def closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, plan, r
                         twist = (u1 * r2 - u2 * r1, u2 * r0 - u0 * r2, u0 * r1 - u1 * r0, u0, u1, u2)
                     else:
                         twist = (u0, u1, u2, 0.0, 0.0, 0.0)
-                    for i in range(m):
-                        if row_loop[i] == loop:
-                            t = f * twist[row_comp[i]]
-                            for k in range(ptr[e], ptr[e + 1]):
-                                phi[i, index[k]] += value[k] * t
+                    for i in range(start, stop):
+                        t = f * twist[row_comp[i]]
+                        for k in range(ptr[e], ptr[e + 1]):
+                            phi[i, index[k]] += value[k] * t
                 e = parent[e]
 
 
@@ -227,16 +268,18 @@ def newton(q, actuated, passive, parent, axis, offset, const_rot, const_pos, pla
     m = passive.shape[0]
     return newton_into(q, actuated, passive, parent, axis, offset, const_rot, const_pos, plan, frame_a, frame_b, row_loop,
                        row_comp, tol, max_iter, singular_ratio, rot, pos, trig, np.empty(m), np.empty((m, q.shape[0])),
-                       np.empty((m, 1)), np.empty((m, m)))
+                       np.empty((m, 1)), np.empty((m, m)), np.empty((m, m)))
 
 
 @njit(cache=True)
 def newton_into(q, actuated, passive, parent, axis, offset, const_rot, const_pos, plan, frame_a, frame_b, row_loop, row_comp,
-                tol, max_iter, singular_ratio, rot, pos, trig, res, phi, rhs, pp):
-    """:func:`newton` on the caller's scratch ``res`` (m), ``phi`` (m x N), ``rhs`` (m x 1), ``pp`` (m x m).
+                tol, max_iter, singular_ratio, rot, pos, trig, res, phi, rhs, pp, pinv):
+    """:func:`newton` on the caller's scratch ``res`` (m), ``phi`` (m x N), ``rhs`` (m x 1), ``pp`` (m x m) and
+    ``pinv`` (m x m).
 
     Each iteration walks only the plan's first part (the nodes of the closures). On success ``rot``, ``pos``
-    and ``trig`` hold those nodes' poses and ``phi`` the constraint Jacobian at the returned ``q``.
+    and ``trig`` hold those nodes' poses, ``phi`` the constraint Jacobian and ``pinv`` ``Phi_p^-1`` at the
+    returned ``q`` (the last iteration factors ``Phi_p`` for the inverse instead of a Newton step).
     """
     m = passive.shape[0]
     n_first = plan[1]
@@ -244,17 +287,22 @@ def newton_into(q, actuated, passive, parent, axis, offset, const_rot, const_pos
         planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, 0, n_first, rot, pos, trig)
         closure_residual(frame_a, frame_b, row_loop, row_comp, rot, pos, res)
         closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, plan, rot, pos, phi)
+        big = 0.0
+        for i in range(m):
+            big = max(big, abs(res[i]))
+        closed = big <= tol
         for i in range(m):
             rhs[i, 0] = -res[i]
             for j in range(m):
                 pp[i, j] = phi[i, passive[j]]
-        ratio, sign = lu_in_place(pp, rhs)
+                pinv[i, j] = 1.0 if i == j else 0.0
+        if closed:
+            ratio, sign = lu_in_place(pp, pinv)
+        else:
+            ratio, sign = lu_in_place(pp, rhs)
         if not np.isfinite(ratio) or ratio <= singular_ratio:
             return SINGULAR, sign, ratio
-        big = 0.0
-        for i in range(m):
-            big = max(big, abs(res[i]))
-        if big <= tol:
+        if closed:
             return OK, sign, ratio
         if it == max_iter:
             break
@@ -287,7 +335,7 @@ def solve_path(qa_path, q_start, sign0, actuated, passive, parent, axis, offset,
     pos = np.zeros((n_node, 3))
     trig = np.zeros((n_node, 2))
     phi = np.empty((m, n_dof))
-    res, rhs, pp = np.empty(m), np.empty((m, 1)), np.empty((m, m))
+    res, rhs, pp, pinv = np.empty(m), np.empty((m, 1)), np.empty((m, m)), np.empty((m, m))
     s = np.empty((m, na))
     start = np.empty(na)
     out = np.empty((n_pose, n_dof))
@@ -295,7 +343,7 @@ def solve_path(qa_path, q_start, sign0, actuated, passive, parent, axis, offset,
     q = q_start.copy()
     trial = q.copy()
     predicted = np.empty(m)
-    # tangent at the current closed pose; after each accepted step, from Newton's last Jacobian there
+    # tangent at the current closed pose; after each accepted step, S = -Phi_p^-1 Phi_a from Newton's last iteration
     planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, 0, plan[1], rot, pos, trig)
     closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, plan, rot, pos, phi)
     velocity_map_into(phi, actuated, passive, pp, s)
@@ -321,7 +369,7 @@ def solve_path(qa_path, q_start, sign0, actuated, passive, parent, axis, offset,
                 predicted[r] = trial[passive[r]]
             code, sign, _ = newton_into(trial, actuated, passive, parent, axis, offset, const_rot, const_pos, plan, frame_a,
                                         frame_b, row_loop, row_comp, tol, max_iter, singular_ratio, rot, pos, trig, res,
-                                        phi, rhs, pp)
+                                        phi, rhs, pp, pinv)
             if code == OK and sign != sign0:
                 code = BRANCH_CHANGE
             if code == OK:
@@ -334,7 +382,12 @@ def solve_path(qa_path, q_start, sign0, actuated, passive, parent, axis, offset,
                 for k in range(n_dof):
                     q[k] = trial[k]
                 done = f
-                velocity_map_into(phi, actuated, passive, pp, s)
+                for r in range(m):
+                    for j in range(na):
+                        acc = 0.0
+                        for i in range(m):
+                            acc -= pinv[r, i] * phi[i, actuated[j]]
+                        s[r, j] = acc
             else:
                 step *= 0.5
                 if step < min_fraction:

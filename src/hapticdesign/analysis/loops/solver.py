@@ -47,7 +47,7 @@ MESSAGES = {
 
 @dataclass(frozen=True)
 class LoopArrays:
-    """Flat arrays of the closures: frame nodes per loop, (loop, component) per constraint row."""
+    """Flat arrays of the closures: frame nodes per loop, (loop, component) per constraint row (loop after loop)."""
 
     frame_a: np.ndarray
     frame_b: np.ndarray
