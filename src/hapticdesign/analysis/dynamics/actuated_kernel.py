@@ -40,7 +40,7 @@ from hapticdesign.analysis.loops.closure_kernel import (
     lu_in_place,
     node_motion,
 )
-from hapticdesign.model.walk import CONSTANT, planned_poses
+from hapticdesign.model.walk import planned_poses, trig_workspace
 
 
 @njit(cache=True)
@@ -101,7 +101,7 @@ def workspace(n_node, n_dof, na, passive, n_body):
         np.zeros((n_node, 3)), np.zeros((n_node, 3)), np.zeros((n_node, 3)),
         np.zeros((npas, n_dof)), np.zeros((npas, npas)), np.zeros((npas, npas)),
         np.zeros((n_dof, na)), np.zeros((n_node, na)), np.zeros(n_node), np.zeros((n_body, 6, na)),
-        np.zeros(npas), np.zeros(npas), np.zeros((n_node, 2)), slot, np.zeros((n_node, 3)), np.zeros((n_node, 3)),
+        np.zeros(npas), np.zeros(npas), trig_workspace(n_node), slot, np.zeros((n_node, 3)), np.zeros((n_node, 3)),
     )
 
 
@@ -131,12 +131,12 @@ def reduce_pose(parent, axis, plan, body_node, actuated, passive, ws):
     ``Phi_p^-1`` at a closed pose (:func:`factor_pose`).
 
     A body Jacobian column is the unit twist of a variable node on the path from the body to the base
-    (folded constant nodes, :data:`~hapticdesign.model.walk.CONSTANT`, carry none) at the body origin: ``(u x (p_b - p_e), u)``
-    for a rotation, ``(u, 0)`` for a translation (seed 000 eq. 2.20-2.26), weighted by the node's
-    joint-value rates ``coef T`` (the plan's sparse coupling coefficients).
+    (constant nodes carry none) at the body origin: ``(u x (p_b - p_e), u)`` for a rotation, ``(u, 0)`` for a
+    translation (seed 000 eq. 2.20-2.26), weighted by the node's joint-value rates ``coef T`` (the plan's
+    sparse coupling coefficients).
     """
     rot, pos, _, _, _, phi, _, pinv, t, node_t, _, ja, _, _, _, _, _, _ = ws
-    _, _, ptr, index, value, _, _ = plan
+    _, _, ptr, index, value, _, _, _ = plan
     na = actuated.shape[0]
     npas = passive.shape[0]
     n_node = parent.shape[0]
@@ -163,7 +163,7 @@ def reduce_pose(parent, axis, plan, body_node, actuated, passive, ws):
                 ja[b, r, j] = 0.0
         e = nb
         while e >= 0:
-            if axis[e] == CONSTANT:
+            if ptr[e] == ptr[e + 1]:  # no coordinate moves this node (constant): no column
                 e = parent[e]
                 continue
             a = axis[e] % 3
@@ -195,7 +195,7 @@ def velocity_state(qd_a, j, k, parent, axis, plan, frame_a, frame_b, row_loop, r
     ``gamma`` then add theirs (:func:`add_joint_accelerations`, joint values' accelerations ``coef [0; gamma]``).
     """
     rot, pos, w, al, ac, _, _, pinv, _, node_t, rate, _, bias, gamma, _, slot, dal, dac = ws
-    _, _, ptr, index, value, _, _ = plan
+    _, _, ptr, index, value, _, _, _ = plan
     npas = passive.shape[0]
     for n in range(rate.shape[0]):
         if j >= 0:

@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from hapticdesign.model.walk import CONSTANT, planned_poses
+from hapticdesign.model.walk import planned_poses, trig_workspace
 
 OK, NO_CLOSURE, SINGULAR, BRANCH_CHANGE = 0, 1, 2, 3
 MAX_NEWTON_STEP = 0.25
@@ -149,7 +149,7 @@ def closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, plan, r
     Each frame's path to the base is walked once per loop; a column of ``J`` is as in
     :func:`~hapticdesign.model.walk.frame_jacobian`. The rows of a loop are consecutive, loop after loop.
     """
-    _, _, ptr, index, value, _, _ = plan
+    _, _, ptr, index, value, _, _, _ = plan
     m = row_loop.shape[0]
     for i in range(m):
         for k in range(phi.shape[1]):
@@ -164,7 +164,7 @@ def closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, plan, r
             f = 1.0 if side == 0 else -1.0
             e = node
             while e >= 0:
-                if axis[e] != CONSTANT:
+                if ptr[e] != ptr[e + 1]:  # a node some coordinate moves
                     a = axis[e] % 3
                     u0, u1, u2 = rot[e, 0, a], rot[e, 1, a], rot[e, 2, a]
                     if axis[e] < 3:
@@ -263,7 +263,8 @@ def newton(q, actuated, passive, parent, axis, offset, const_rot, const_pos, pla
     """Newton on the passive entries of ``q`` (in place). Returns (status, det sign, pivot ratio).
 
     ``plan``: the arrays of a :class:`~hapticdesign.model.walk.WalkPlan` whose first part is the nodes the
-    closures need; ``rot``, ``pos``, ``trig``: the node poses and the plan's scratch.
+    closures need (those that the passive coordinates do not move first); ``rot``, ``pos``, ``trig``: the
+    node poses and the plan's scratch.
     """
     m = passive.shape[0]
     return newton_into(q, actuated, passive, parent, axis, offset, const_rot, const_pos, plan, frame_a, frame_b, row_loop,
@@ -277,14 +278,17 @@ def newton_into(q, actuated, passive, parent, axis, offset, const_rot, const_pos
     """:func:`newton` on the caller's scratch ``res`` (m), ``phi`` (m x N), ``rhs`` (m x 1), ``pp`` (m x m) and
     ``pinv`` (m x m).
 
-    Each iteration walks only the plan's first part (the nodes of the closures). On success ``rot``, ``pos``
+    Each iteration walks only the plan's first part (the nodes of the closures; after the first, only those
+    the passive coordinates move, the plan's ``n_still`` being the others). On success ``rot``, ``pos``
     and ``trig`` hold those nodes' poses, ``phi`` the constraint Jacobian and ``pinv`` ``Phi_p^-1`` at the
     returned ``q`` (the last iteration factors ``Phi_p`` for the inverse instead of a Newton step).
     """
     m = passive.shape[0]
-    n_first = plan[1]
+    n_first, n_still = plan[1], plan[7]
     for it in range(max_iter + 1):
-        planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, 0, n_first, rot, pos, trig)
+        # a Newton step moves only passive coordinates: the nodes they do not move stay where they were
+        planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, 0 if it == 0 else n_still, n_first, rot, pos,
+                      trig)
         closure_residual(frame_a, frame_b, row_loop, row_comp, rot, pos, res)
         closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, plan, rot, pos, phi)
         big = 0.0
@@ -333,7 +337,7 @@ def solve_path(qa_path, q_start, sign0, actuated, passive, parent, axis, offset,
     na = actuated.shape[0]
     rot = np.zeros((n_node, 3, 3))
     pos = np.zeros((n_node, 3))
-    trig = np.zeros((n_node, 2))
+    trig = trig_workspace(n_node)
     phi = np.empty((m, n_dof))
     res, rhs, pp, pinv = np.empty(m), np.empty((m, 1)), np.empty((m, m)), np.empty((m, m))
     s = np.empty((m, na))

@@ -80,8 +80,8 @@ class LoopSolver:
         self.mechanism = mechanism
         self.compiled = mechanism.compiled
         self.arrays = LoopArrays.from_mechanism(mechanism)
-        self.plan = self.compiled.tree.plan([*self.arrays.frame_a, *self.arrays.frame_b])
-        """Walk of the tree with the closures' nodes first (:class:`~hapticdesign.model.walk.WalkPlan`)."""
+        self.plan = self.compiled.tree.plan([*self.arrays.frame_a, *self.arrays.frame_b], list(self.arrays.passive))
+        """Walk of the tree, the closures' nodes first (:class:`~hapticdesign.model.walk.WalkPlan`)."""
         self.n_dof = mechanism.n_dof
         self.n_actuated = mechanism.n_actuated
         lengths = np.abs(self.compiled.node_offset[self.compiled.node_axis >= 3])
