@@ -39,6 +39,7 @@ from hapticdesign.analysis.loops.closure_kernel import (
     closure_jacobian,
     lu_in_place,
     node_motion,
+    rotation_entry,
 )
 from hapticdesign.model.walk import planned_poses, trig_workspace
 
@@ -220,14 +221,6 @@ def velocity_state(qd_a, j, k, parent, axis, plan, frame_a, frame_b, row_loop, r
                 acc += value[c] * gamma[r]
         rate[n] = acc
     add_joint_accelerations(rate, parent, axis, rot, pos, al, ac, dal, dac)
-
-
-@njit(cache=True, inline="always")
-def _rotation(rot, nb, i, k):
-    """Entry ``(i, k)`` of the world rotation of node ``nb`` (the identity for the base, ``nb < 0``)."""
-    if nb >= 0:
-        return rot[nb, i, k]
-    return 1.0 if i == k else 0.0
 
 
 @njit(cache=True)
@@ -445,7 +438,7 @@ def actuated_regressor(qs, parent, axis, offset, const_rot, const_pos, plan, bod
             nb = body_node[b]
             for i in range(3):
                 for k in range(3):
-                    rb[b, i, k] = _rotation(rot, nb, i, k)
+                    rb[b, i, k] = rotation_entry(rot, nb, i, k)
             for i in range(3):
                 for j in range(na):
                     jab[b, i, j] = rb[b, 0, i] * ja[b, 0, j] + rb[b, 1, i] * ja[b, 1, j] + rb[b, 2, i] * ja[b, 2, j]

@@ -75,7 +75,7 @@ def node_motion(rate, parent, axis, rot, pos, w, al, ac):
 
 
 @njit(cache=True, inline="always")
-def _rotation(rot, node, i, k):
+def rotation_entry(rot, node, i, k):
     """Entry ``(i, k)`` of the world rotation of ``node`` (the identity for the base, ``node < 0``)."""
     if node >= 0:
         return rot[node, i, k]
@@ -132,12 +132,13 @@ def closure_residual(frame_a, frame_b, row_loop, row_comp, rot, pos, out):
             pb = pos[nb, c] if nb >= 0 else 0.0
             out[i] = pa - pb
         else:
-            # 0.5 (M[r, s] - M[s, r]) of M = R_A R_B^T, with (r, s) = (2, 1), (0, 2), (1, 0) for rx, ry, rz
+            # 0.5 (M[r, t] - M[t, r]) of M = R_A R_B^T, with (r, t) = (2, 1), (0, 2), (1, 0) for rx, ry, rz
             r = (c - 1) % 3
             t = (c + 1) % 3
             acc = 0.0
             for k in range(3):
-                acc += _rotation(rot, na, r, k) * _rotation(rot, nb, t, k) - _rotation(rot, na, t, k) * _rotation(rot, nb, r, k)
+                acc += (rotation_entry(rot, na, r, k) * rotation_entry(rot, nb, t, k)
+                        - rotation_entry(rot, na, t, k) * rotation_entry(rot, nb, r, k))
             out[i] = 0.5 * acc
 
 
