@@ -14,7 +14,11 @@ transforms keep their :class:`~hapticdesign.model.transforms.Axis` code and affi
   twist at the current pose (rotation axis ``u`` through the node: ``v = u x (p - p_node)``,
   ``w = u``; translation: ``v = u``; seed 000 eq. 2.20-2.26, seed 001 eq. 5.61-5.66 and
   5.87-5.92), weighted by the coupling coefficients of dependent coordinates (eq. 2.38-2.43);
-- :func:`poses_and_jacobians`: both for a batch of coordinate vectors (a single pose is a batch of one).
+- :func:`poses_and_jacobians`: both for a batch of coordinate vectors (a single pose is a batch of one);
+- :class:`WalkPlan` and :func:`planned_poses`: the same poses for the hot loops of closed loops, nodes in
+  an order that puts first those a given set of nodes needs (the loop closures), joint values from the
+  non-zero coupling coefficients only, the cosine and sine of a joint angle shared by every node that
+  turns by it (or by its negative) and, near an angle already evaluated, continued from there.
 
 Forward kinematics, the dynamics regressors, the loop-closure kernels and the R-CUBE stiffness model
 all call these.
@@ -31,6 +35,8 @@ from hapticdesign.model.transforms import Axis, elementary_matrix
 
 CONSTANT = 6
 """Node code of a folded constant transform (after the six :class:`Axis` codes)."""
+ANCHOR_RANGE = 1e-2
+"""rad: :func:`planned_poses` continues a cosine and sine from their anchor angle up to this far."""
 
 
 @dataclass(frozen=True)
@@ -97,10 +103,161 @@ class KinematicTree:
         """``(parent, axis, coef, offset, const_rot, const_pos)``, the leading arguments of the kernels."""
         return self.parent, self.axis, self.coef, self.offset, self.const_rot, self.const_pos
 
+    def plan(self, needed: list[int], moving: list[int]) -> "WalkPlan":
+        """:class:`WalkPlan` whose first part is the nodes ``needed`` (and their ancestors), those that the
+        coordinates ``moving`` do not move first."""
+        first = set()
+        for node in needed:
+            while node >= 0 and node not in first:
+                first.add(node)
+                node = int(self.parent[node])
+        moved: set[int] = set()
+        for n in range(len(self.parent)):  # parents come first
+            if int(self.parent[n]) in moved or np.any(self.coef[n, list(moving)] != 0.0):
+                moved.add(n)
+        still = sorted(first - moved)
+        order = still + sorted(first & moved) + [n for n in range(len(self.parent)) if n not in first]
+        nonzero = [np.flatnonzero(row) for row in self.coef]
+        ptr = np.cumsum([0] + [len(k) for k in nonzero])
+        source = np.arange(len(self.parent))
+        sign = np.ones(len(self.parent))
+        seen: dict[tuple, int] = {}
+        for n in order:
+            if self.axis[n] >= 3:
+                continue
+            key = (*self.coef[n], self.offset[n])
+            negated = tuple(-v for v in key)
+            if key in seen:
+                source[n] = seen[key]
+            elif negated in seen:
+                source[n], sign[n] = seen[negated], -1.0
+            else:
+                seen[key] = n
+        return WalkPlan(
+            order=np.array(order, dtype=np.int64), n_first=len(first), n_still=len(still), ptr=ptr.astype(np.int64),
+            index=np.concatenate([np.zeros(0, dtype=np.int64)] + nonzero).astype(np.int64),
+            value=np.concatenate([np.zeros(0)] + [row[k] for row, k in zip(self.coef, nonzero)]),
+            trig_source=source.astype(np.int64), trig_sign=sign,
+        )
+
     def workspace(self) -> tuple[np.ndarray, np.ndarray]:
         """Zeroed node rotations (M, 3, 3) and origins (M, 3) for :func:`node_poses`."""
         n_node = max(len(self.parent), 1)
         return np.zeros((n_node, 3, 3)), np.zeros((n_node, 3))
+
+
+@dataclass(frozen=True)
+class WalkPlan:
+    """A walk of a :class:`KinematicTree` for the hot loops (:func:`planned_poses`).
+
+    ``order`` lists every node after its parent, the ``n_first`` nodes a chosen set needs first, and of
+    those the ``n_still`` that chosen coordinates do not move first (a walk after a change of only those
+    coordinates starts after them); the coupling coefficients of node ``n`` are the sparse row ``value[ptr[n]:ptr[n + 1]]`` at the coordinates
+    ``index[ptr[n]:ptr[n + 1]]`` (in increasing order, so a joint value is the same sum as the dense one's);
+    a rotation node whose angle (coefficients and offset) equals, or is the negative of, that of an
+    earlier node of ``order``, ``trig_source[n]``, takes its cosine and sine (times ``trig_sign[n]``).
+    """
+
+    order: np.ndarray
+    n_first: int
+    n_still: int
+    ptr: np.ndarray
+    index: np.ndarray
+    value: np.ndarray
+    trig_source: np.ndarray
+    trig_sign: np.ndarray
+
+    @property
+    def arrays(self) -> tuple:
+        """``(order, n_first, ptr, index, value, trig_source, trig_sign, n_still)``, the ``plan`` of the kernels."""
+        return (self.order, self.n_first, self.ptr, self.index, self.value, self.trig_source, self.trig_sign,
+                self.n_still)
+
+    def workspace(self) -> np.ndarray:
+        """The scratch of :func:`planned_poses` (:func:`trig_workspace`)."""
+        return trig_workspace(len(self.order))
+
+
+@njit(cache=True)
+def trig_workspace(n_node):
+    """Per node (M, 5): cosine and sine of its angle, then an anchor angle (none yet: NaN) and its cosine and sine."""
+    out = np.zeros((max(n_node, 1), 5))
+    out[:, 2] = np.nan
+    return out
+
+
+@njit(cache=True)
+def planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, start, stop, rot, pos, trig):
+    """:func:`node_poses` of the nodes ``order[start:stop]`` of a :class:`WalkPlan` ``plan`` (its ``arrays``).
+
+    The nodes before ``start`` in the plan's order must hold their poses (and ``trig`` their cosines and
+    sines) at the same ``q``. ``trig``: :func:`trig_workspace`, kept from call to call. A rotation angle
+    ``v`` within :data:`ANCHOR_RANGE` of its node's anchor angle ``v0`` (where ``cos`` and ``sin`` were last
+    evaluated) follows from the angle-sum formulas with ``d = v - v0``: ``cos d = 1 - d^2/2 + d^4/24 - d^6/720``,
+    ``sin d = d - d^3/6 + d^5/120 - d^7/5040``, whose first omitted terms (``d^8/40320 < 2.5e-21``,
+    ``d^9/362880 < 3e-24``) are far below a unit of round-off; a farther angle is evaluated and becomes the anchor.
+    Along a motion (Newton's iterations, the integrator's stages) most walks need no ``cos`` or ``sin``.
+    """
+    order, _, ptr, index, value, source, sign, _ = plan
+    for i in range(start, stop):
+        n = order[i]
+        pn = parent[n]
+        if axis[n] == CONSTANT:
+            for r in range(3):
+                if pn < 0:
+                    for j in range(3):
+                        rot[n, r, j] = const_rot[n, r, j]
+                    pos[n, r] = const_pos[n, r]
+                else:
+                    for j in range(3):
+                        rot[n, r, j] = (rot[pn, r, 0] * const_rot[n, 0, j] + rot[pn, r, 1] * const_rot[n, 1, j]
+                                        + rot[pn, r, 2] * const_rot[n, 2, j])
+                    pos[n, r] = (pos[pn, r] + rot[pn, r, 0] * const_pos[n, 0] + rot[pn, r, 1] * const_pos[n, 1]
+                                 + rot[pn, r, 2] * const_pos[n, 2])
+            continue
+        if pn >= 0:
+            for r in range(3):
+                for j in range(3):
+                    rot[n, r, j] = rot[pn, r, j]
+                pos[n, r] = pos[pn, r]
+        else:
+            for r in range(3):
+                for j in range(3):
+                    rot[n, r, j] = 1.0 if r == j else 0.0
+                pos[n, r] = 0.0
+        a = axis[n] % 3
+        if axis[n] < 3:
+            s = source[n]
+            if s == n:
+                v = offset[n]
+                for k in range(ptr[n], ptr[n + 1]):
+                    v += value[k] * q[index[k]]
+                d = v - trig[n, 2]
+                if abs(d) <= ANCHOR_RANGE:
+                    d2 = d * d
+                    cd = 1.0 - d2 / 2.0 * (1.0 - d2 / 12.0 * (1.0 - d2 / 30.0))
+                    sd = d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0 * (1.0 - d2 / 42.0)))
+                    trig[n, 0] = trig[n, 3] * cd - trig[n, 4] * sd
+                    trig[n, 1] = trig[n, 4] * cd + trig[n, 3] * sd
+                else:
+                    trig[n, 0] = trig[n, 3] = np.cos(v)
+                    trig[n, 1] = trig[n, 4] = np.sin(v)
+                    trig[n, 2] = v
+            cv = trig[s, 0]
+            sv = sign[n] * trig[s, 1]
+            b = (a + 1) % 3
+            c = (a + 2) % 3
+            for r in range(3):
+                rb = rot[n, r, b]
+                rc = rot[n, r, c]
+                rot[n, r, b] = rb * cv + rc * sv
+                rot[n, r, c] = -rb * sv + rc * cv
+        else:
+            v = offset[n]
+            for k in range(ptr[n], ptr[n + 1]):
+                v += value[k] * q[index[k]]
+            for r in range(3):
+                pos[n, r] += rot[n, r, a] * v
 
 
 @njit(cache=True)

@@ -11,7 +11,8 @@ with ``qdd = T qdd_a + [0; gamma]`` and ``gamma = -Phi_p^-1 (Phidot qd)``:
 - ``G_a = T^T G``: the weight ``-g (m, m c)`` projected likewise (eq. 2.46);
 - the velocity terms ``T^T (H [0; gamma] + c(q, T qd_a))`` (``T^T (H Tdot + C-terms T)``): per body the
   Newton-Euler wrench ``f = m a + al x h + w x (w x h)``, ``n = J al + w x (J w) + h x a`` at the body
-  velocities of ``qd = T qd_a`` and accelerations of ``qdd = [0; gamma]``, projected by ``(J_b T)^T``.
+  velocities of ``qd = T qd_a`` and accelerations of ``qdd = [0; gamma]`` (the node motions at ``qdd = 0``
+  plus those of the passive joints' accelerations ``gamma``), projected by ``(J_b T)^T``.
   It is a quadratic form in ``qd_a``; its coefficients (the columns of eq. 2.50's ``C``: ``Gamma_ijj``
   and ``2 Gamma_ijk``) follow by polarization from ``n_a (n_a + 1) / 2`` rate vectors ``e_j`` and
   ``e_j + e_k``.
@@ -20,8 +21,8 @@ Everything is linear in the standard inertial parameters ``(m, h, J)``: :func:`a
 returns the regressor (ten columns per body, in body axes, via :func:`.kernel.body_regressor`), entry
 by entry in :class:`.model.DynamicsModel`'s order; :func:`actuated_entries` evaluates the entries for
 given parameter sets directly, in world axes (each body's ``h`` and ``J`` rotated once per pose), and
-skips bodies whose parameters are all zero. Both share :func:`reduce_pose` (``Phi_p^-1``, ``T`` and the
-reduced Jacobians at one closed pose) and :func:`velocity_state` (body motions of one rate vector),
+skips bodies whose parameters are all zero. Both share :func:`factor_pose` (poses and ``Phi_p^-1``) and
+:func:`reduce_pose` (``T`` and the reduced Jacobians at one closed pose) and :func:`velocity_state` (body motions of one rate vector),
 which allocate nothing: their scratch arrays come from :func:`workspace`. The closed-loop plant of the
 simulation (:mod:`.closed_loop_plant`) calls them too.
 """
@@ -32,8 +33,15 @@ import numpy as np
 from numba import njit
 
 from hapticdesign.analysis.dynamics.kernel import body_regressor
-from hapticdesign.analysis.loops.closure_kernel import closure_bias, closure_jacobian, lu_in_place, node_motion
-from hapticdesign.model.walk import CONSTANT, node_poses
+from hapticdesign.analysis.loops.closure_kernel import (
+    add_joint_accelerations,
+    closure_bias,
+    closure_jacobian,
+    lu_in_place,
+    node_motion,
+    rotation_entry,
+)
+from hapticdesign.model.walk import planned_poses, trig_workspace
 
 
 @njit(cache=True)
@@ -75,79 +83,88 @@ def _wrench_regressor(w, al, acc, out):
 
 
 @njit(cache=True)
-def workspace(n_node, n_dof, na, npas, n_body):
+def workspace(n_node, n_dof, na, passive, n_body):
     """Scratch arrays of :func:`reduce_pose` and :func:`velocity_state` (one set per caller).
 
-    ``(rot, pos, w, al, ac, phi, lu, pinv, t, node_t, rate, jp, ja, bias, gamma)``: node poses
-    and motions, ``Phi``, an LU scratch, ``Phi_p^-1``, ``T``, every node's joint-value rate per actuated
-    rate (``coef T``) and for one rate vector, per body the world Jacobian of its origin over the passive
-    rates (6 x n_p) and over the actuated ones (``J_b T``, 6 x n_a), ``Phidot qd`` and ``gamma``.
+    ``(rot, pos, w, al, ac, phi, lu, pinv, t, node_t, rate, ja, bias, gamma, trig, slot, dal, dac)``: node
+    poses and motions, ``Phi``, an LU scratch, ``Phi_p^-1``, ``T``, every node's joint-value rate per
+    actuated rate (``coef T``) and for one rate vector, per body the world Jacobian of its origin over the
+    actuated rates (``J_b T``, 6 x n_a), ``Phidot qd``, ``gamma``, the walk plan's cosines and sines, each
+    coordinate's place among the passive ones (-1: actuated) and the node accelerations of ``gamma``.
     """
     n_node = max(n_node, 1)
+    npas = passive.shape[0]
+    slot = np.full(n_dof, -1, dtype=np.int64)
+    for r in range(npas):
+        slot[passive[r]] = r
     return (
         np.zeros((n_node, 3, 3)), np.zeros((n_node, 3)),
         np.zeros((n_node, 3)), np.zeros((n_node, 3)), np.zeros((n_node, 3)),
         np.zeros((npas, n_dof)), np.zeros((npas, npas)), np.zeros((npas, npas)),
-        np.zeros((n_dof, na)), np.zeros((n_node, na)), np.zeros(n_node),
-        np.zeros((n_body, 6, npas)), np.zeros((n_body, 6, na)),
-        np.zeros(npas), np.zeros(npas),
+        np.zeros((n_dof, na)), np.zeros((n_node, na)), np.zeros(n_node), np.zeros((n_body, 6, na)),
+        np.zeros(npas), np.zeros(npas), trig_workspace(n_node), slot, np.zeros((n_node, 3)), np.zeros((n_node, 3)),
     )
 
 
 @njit(cache=True, inline="always")
-def reduce_pose(q, parent, axis, coef, offset, const_rot, const_pos, body_node, frame_a, frame_b, row_loop, row_comp,
-                actuated, passive, ws, poses_ready):
-    """At a closed full pose ``q``: ``Phi_p^-1``, ``T = [I; S]``, ``coef T`` and every body's Jacobians into ``ws``.
+def factor_pose(q, parent, axis, offset, const_rot, const_pos, plan, frame_a, frame_b, row_loop, row_comp, passive, ws):
+    """Every node's pose, ``Phi`` and ``Phi_p^-1`` at a closed full pose ``q`` into ``ws`` (for :func:`reduce_pose`).
 
-    ``poses_ready``: the node poses and ``Phi`` in ``ws`` are already those of ``q`` (after Newton).
-    Returns the pivot ratio of ``Phi_p`` (0: singular, nothing else computed) and the sign of its determinant.
-    A body Jacobian column is the unit twist of a variable node on the path from the body to the base
-    (folded constant nodes, :data:`~hapticdesign.model.walk.CONSTANT`, carry none) at the body origin: ``(u x (p_b - p_e), u)``
-    for a rotation, ``(u, 0)`` for a translation (seed 000 eq. 2.20-2.26).
+    ``plan``: the arrays of the loop solver's :class:`~hapticdesign.model.walk.WalkPlan`. Returns the pivot
+    ratio of ``Phi_p`` (0: singular) and the sign of its determinant. After Newton
+    (:func:`hapticdesign.analysis.loops.closure_kernel.newton_into`), which leaves ``Phi``, ``Phi_p^-1``
+    and the poses of the plan's first part, a walk of the other nodes does the same.
     """
-    rot, pos, _, _, _, phi, lu, pinv, t, node_t, _, jp, ja, _, _ = ws
-    na = actuated.shape[0]
+    rot, pos, _, _, _, phi, lu, pinv, _, _, _, _, _, _, trig, _, _, _ = ws
     npas = passive.shape[0]
-    n_dof = q.shape[0]
-    if not poses_ready:
-        node_poses(q, parent, axis, coef, offset, const_rot, const_pos, parent.shape[0] - 1, rot, pos)
-        closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, coef, rot, pos, phi)
+    planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, 0, parent.shape[0], rot, pos, trig)
+    closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, plan, rot, pos, phi)
     for i in range(npas):
         for j in range(npas):
             lu[i, j] = phi[i, passive[j]]
             pinv[i, j] = 1.0 if i == j else 0.0
-    ratio, sign = lu_in_place(lu, pinv)
-    if ratio == 0.0:
-        return ratio, sign
-    for i in range(n_dof):
-        for j in range(na):
-            t[i, j] = 0.0
+    return lu_in_place(lu, pinv)
+
+
+@njit(cache=True, inline="always")
+def reduce_pose(parent, axis, plan, body_node, actuated, passive, ws):
+    """``T = [I; S]``, ``coef T`` and every body's Jacobian ``J_b T`` into ``ws``, from its node poses, ``Phi`` and
+    ``Phi_p^-1`` at a closed pose (:func:`factor_pose`).
+
+    A body Jacobian column is the unit twist of a variable node on the path from the body to the base
+    (constant nodes carry none) at the body origin: ``(u x (p_b - p_e), u)`` for a rotation, ``(u, 0)`` for a
+    translation (seed 000 eq. 2.20-2.26), weighted by the node's joint-value rates ``coef T`` (the plan's
+    sparse coupling coefficients).
+    """
+    rot, pos, _, _, _, phi, _, pinv, t, node_t, _, ja, _, _, _, _, _, _ = ws
+    _, _, ptr, index, value, _, _, _ = plan
+    na = actuated.shape[0]
+    npas = passive.shape[0]
+    n_node = parent.shape[0]
     for j in range(na):
-        t[actuated[j], j] = 1.0
+        for i in range(na):
+            t[actuated[i], j] = 1.0 if i == j else 0.0
     for r in range(npas):
         for j in range(na):
             acc = 0.0
             for i in range(npas):
                 acc -= pinv[r, i] * phi[i, actuated[j]]
             t[passive[r], j] = acc
-    for n in range(parent.shape[0]):
+    for n in range(n_node):
         for j in range(na):
             node_t[n, j] = 0.0
-        for k in range(n_dof):
-            c = coef[n, k]
-            if c != 0.0:
-                for j in range(na):
-                    node_t[n, j] += c * t[k, j]
+        for k in range(ptr[n], ptr[n + 1]):
+            c = value[k]
+            for j in range(na):
+                node_t[n, j] += c * t[index[k], j]
     for b in range(body_node.shape[0]):
         nb = body_node[b]
         for r in range(6):
             for j in range(na):
                 ja[b, r, j] = 0.0
-            for j in range(npas):
-                jp[b, r, j] = 0.0
         e = nb
         while e >= 0:
-            if axis[e] == CONSTANT:
+            if ptr[e] == ptr[e + 1]:  # no coordinate moves this node (constant): no column
                 e = parent[e]
                 continue
             a = axis[e] % 3
@@ -167,27 +184,19 @@ def reduce_pose(q, parent, axis, coef, offset, const_rot, const_pos, body_node, 
                 ja[b, 3, j] += c * w0
                 ja[b, 4, j] += c * w1
                 ja[b, 5, j] += c * w2
-            for j in range(npas):
-                c = coef[e, passive[j]]
-                if c != 0.0:
-                    jp[b, 0, j] += c * v0
-                    jp[b, 1, j] += c * v1
-                    jp[b, 2, j] += c * v2
-                    jp[b, 3, j] += c * w0
-                    jp[b, 4, j] += c * w1
-                    jp[b, 5, j] += c * w2
             e = parent[e]
-    return ratio, sign
 
 
 @njit(cache=True, inline="always")
-def velocity_state(qd_a, j, k, parent, axis, frame_a, frame_b, row_loop, row_comp, passive, ws):
-    """Node motions at ``qd = T qd_a``, ``qdd = 0`` and ``gamma = -Phi_p^-1 (Phidot qd)`` into ``ws``.
+def velocity_state(qd_a, j, k, parent, axis, plan, frame_a, frame_b, row_loop, row_comp, passive, ws):
+    """Node motions at ``qd = T qd_a`` and ``qdd = [0; gamma]``, ``gamma = -Phi_p^-1 (Phidot qd)``, into ``ws``.
 
-    ``j >= 0`` takes the rate vector ``e_j`` (plus ``e_k`` when ``k != j``) instead of ``qd_a``. The body
-    accelerations of ``qdd = [0; gamma]`` add ``J_p gamma`` (``jp`` of :func:`reduce_pose`) to the nodes'.
+    ``j >= 0`` takes the rate vector ``e_j`` (plus ``e_k`` when ``k != j``) instead of ``qd_a``. The node
+    motions at ``qdd = 0`` give ``Phidot qd`` (:func:`closure_bias`); the passive joints' accelerations
+    ``gamma`` then add theirs (:func:`add_joint_accelerations`, joint values' accelerations ``coef [0; gamma]``).
     """
-    rot, pos, w, al, ac, _, _, pinv, _, node_t, rate, _, _, bias, gamma = ws
+    rot, pos, w, al, ac, _, _, pinv, _, node_t, rate, _, bias, gamma, _, slot, dal, dac = ws
+    _, _, ptr, index, value, _, _, _ = plan
     npas = passive.shape[0]
     for n in range(rate.shape[0]):
         if j >= 0:
@@ -204,14 +213,14 @@ def velocity_state(qd_a, j, k, parent, axis, frame_a, frame_b, row_loop, row_com
         for i in range(npas):
             acc -= pinv[r, i] * bias[i]
         gamma[r] = acc
-
-
-@njit(cache=True, inline="always")
-def _rotation(rot, nb, i, k):
-    """Entry ``(i, k)`` of the world rotation of node ``nb`` (the identity for the base, ``nb < 0``)."""
-    if nb >= 0:
-        return rot[nb, i, k]
-    return 1.0 if i == k else 0.0
+    for n in range(rate.shape[0]):
+        acc = 0.0
+        for c in range(ptr[n], ptr[n + 1]):
+            r = slot[index[c]]
+            if r >= 0:
+                acc += value[c] * gamma[r]
+        rate[n] = acc
+    add_joint_accelerations(rate, parent, axis, rot, pos, al, ac, dal, dac)
 
 
 @njit(cache=True)
@@ -276,10 +285,9 @@ def body_wrench(w, al, ac, nb, pw, s, b):
 
 
 @njit(cache=True, inline="always")
-def mass_and_gravity(ja, jp, b, gravity, pw, s, h, g, kp):
-    """Add body ``b``'s ``(J_b T)^T M (J_b T)`` to ``h`` (n x n), ``-(J_b T)^T`` of its weight's wrench to
-    ``g`` (eq. 2.44, 2.46) and ``(J_b T)^T M J_p`` to ``kp`` (n x n_p; ``kp gamma`` is the velocity term of
-    ``qdd = [0; gamma]``), world parameters ``pw[s, b]``: ``M [v; w] = [m v + w x h; h x v + J w]``."""
+def mass_and_gravity(ja, b, gravity, pw, s, h, g):
+    """Add body ``b``'s ``(J_b T)^T M (J_b T)`` to ``h`` (n x n) and ``-(J_b T)^T`` of its weight's wrench to
+    ``g`` (eq. 2.44, 2.46), world parameters ``pw[s, b]``: ``M [v; w] = [m v + w x h; h x v + J w]``."""
     m, h0, h1, h2 = pw[s, b, 0], pw[s, b, 1], pw[s, b, 2], pw[s, b, 3]
     jxx, jyy, jzz, jxy, jxz, jyz = pw[s, b, 4], pw[s, b, 5], pw[s, b, 6], pw[s, b, 7], pw[s, b, 8], pw[s, b, 9]
     for j in range(ja.shape[2]):
@@ -292,9 +300,6 @@ def mass_and_gravity(ja, jp, b, gravity, pw, s, h, g, kp):
         mw1 = h2 * v0 - h0 * v2 + jxy * w0 + jyy * w1 + jyz * w2
         mw2 = h0 * v1 - h1 * v0 + jxz * w0 + jyz * w1 + jzz * w2
         g[j] -= gravity[0] * mv0 + gravity[1] * mv1 + gravity[2] * mv2
-        for r in range(jp.shape[2]):
-            kp[j, r] += (jp[b, 0, r] * mv0 + jp[b, 1, r] * mv1 + jp[b, 2, r] * mv2
-                         + jp[b, 3, r] * mw0 + jp[b, 4, r] * mw1 + jp[b, 5, r] * mw2)
         for i in range(j + 1):
             e = (ja[b, 0, i] * mv0 + ja[b, 1, i] * mv1 + ja[b, 2, i] * mv2
                  + ja[b, 3, i] * mw0 + ja[b, 4, i] * mw1 + ja[b, 5, i] * mw2)
@@ -323,39 +328,37 @@ def _state(j, na):
 
 
 @njit(cache=True)
-def actuated_entries(qs, parent, axis, coef, offset, const_rot, const_pos, body_node, gravity,
+def actuated_entries(qs, parent, axis, offset, const_rot, const_pos, plan, body_node, gravity,
                      frame_a, frame_b, row_loop, row_comp, actuated, passive, params):
     """Entries (unique H, C, G) in actuated coordinates at closed full poses ``qs`` (P, N) for parameter
     sets ``params`` (K, 10 B): (P, K, E), and the pivot ratio of ``Phi_p`` per pose (0: singular)."""
     n_pose, n_dof = qs.shape
     na = actuated.shape[0]
-    npas = passive.shape[0]
     n_body = body_node.shape[0]
     n_sets = params.shape[0]
     m = na * (na + 1) // 2
     out = np.zeros((n_pose, n_sets, m + na * m + na))
     ratios = np.zeros(n_pose)
-    ws = workspace(parent.shape[0], n_dof, na, npas, n_body)
-    rot, w, al, ac, jp, ja, gamma = ws[0], ws[2], ws[3], ws[4], ws[11], ws[12], ws[14]
+    ws = workspace(parent.shape[0], n_dof, na, passive, n_body)
+    rot, w, al, ac, ja = ws[0], ws[2], ws[3], ws[4], ws[11]
     active = active_bodies(params)
     pw = np.zeros((n_sets, n_body, 10))
     h = np.zeros((n_sets, na, na))
-    kp = np.zeros((n_sets, na, npas))
     empty = np.zeros(0)
     for p in range(n_pose):
-        ratio, _ = reduce_pose(qs[p], parent, axis, coef, offset, const_rot, const_pos, body_node, frame_a, frame_b, row_loop,
-                               row_comp, actuated, passive, ws, False)
+        ratio, _ = factor_pose(qs[p], parent, axis, offset, const_rot, const_pos, plan, frame_a, frame_b, row_loop, row_comp,
+                               passive, ws)
         ratios[p] = ratio
         if ratio == 0.0:
             continue
+        reduce_pose(parent, axis, plan, body_node, actuated, passive, ws)
         h[:] = 0.0
-        kp[:] = 0.0
         for s in range(n_sets):
             world_parameters(rot, body_node, params, s, pw)
             g = out[p, s, m + na * m:]
             for b in range(n_body):
                 if active[b] and body_node[b] >= 0:
-                    mass_and_gravity(ja, jp, b, gravity, pw, s, h[s], g, kp[s])
+                    mass_and_gravity(ja, b, gravity, pw, s, h[s], g)
             e = 0
             for i in range(na):
                 for j in range(i, na):
@@ -364,13 +367,8 @@ def actuated_entries(qs, parent, axis, coef, offset, const_rot, const_pos, body_
         st = 0
         for j in range(na):
             for k in range(j, na):
-                velocity_state(empty, j, k, parent, axis, frame_a, frame_b, row_loop, row_comp, passive, ws)
+                velocity_state(empty, j, k, parent, axis, plan, frame_a, frame_b, row_loop, row_comp, passive, ws)
                 for s in range(n_sets):
-                    for i in range(na):
-                        acc = 0.0
-                        for r in range(npas):
-                            acc += kp[s, i, r] * gamma[r]
-                        out[p, s, m + i * m + st] = acc
                     for b in range(n_body):
                         nb = body_node[b]
                         if not active[b] or nb < 0:
@@ -394,30 +392,21 @@ def actuated_entries(qs, parent, axis, coef, offset, const_rot, const_pos, body_
 
 
 @njit(cache=True, inline="always")
-def _body_motion(w, al, ac, jp, gamma, nb, b, rb, out):
-    """Body-axis ``(w, al, acc)`` of body ``b`` (node ``nb``, rotation ``rb``) at ``qdd = [0; gamma]`` into ``out``."""
+def _body_motion(w, al, ac, nb, rb, out):
+    """Body-axis ``(w, al, acc)`` of a body on node ``nb`` (rotation ``rb``) from the node motions into ``out``."""
     if nb < 0:
         for r in range(3):
             for i in range(3):
                 out[r, i] = 0.0
         return
-    l0, l1, l2 = al[nb, 0], al[nb, 1], al[nb, 2]
-    a0, a1, a2 = ac[nb, 0], ac[nb, 1], ac[nb, 2]
-    for r in range(gamma.shape[0]):
-        a0 += jp[b, 0, r] * gamma[r]
-        a1 += jp[b, 1, r] * gamma[r]
-        a2 += jp[b, 2, r] * gamma[r]
-        l0 += jp[b, 3, r] * gamma[r]
-        l1 += jp[b, 4, r] * gamma[r]
-        l2 += jp[b, 5, r] * gamma[r]
     for i in range(3):
         out[0, i] = rb[0, i] * w[nb, 0] + rb[1, i] * w[nb, 1] + rb[2, i] * w[nb, 2]
-        out[1, i] = rb[0, i] * l0 + rb[1, i] * l1 + rb[2, i] * l2
-        out[2, i] = rb[0, i] * a0 + rb[1, i] * a1 + rb[2, i] * a2
+        out[1, i] = rb[0, i] * al[nb, 0] + rb[1, i] * al[nb, 1] + rb[2, i] * al[nb, 2]
+        out[2, i] = rb[0, i] * ac[nb, 0] + rb[1, i] * ac[nb, 1] + rb[2, i] * ac[nb, 2]
 
 
 @njit(cache=True)
-def actuated_regressor(qs, parent, axis, coef, offset, const_rot, const_pos, body_node, gravity,
+def actuated_regressor(qs, parent, axis, offset, const_rot, const_pos, plan, body_node, gravity,
                        frame_a, frame_b, row_loop, row_comp, actuated, passive):
     """Regressor of the entries (unique H, C, G) in actuated coordinates at closed full poses ``qs`` (P, N):
     (P, E, 10 B), and the pivot ratio of ``Phi_p`` per pose (0: singular). Body axes throughout."""
@@ -428,8 +417,8 @@ def actuated_regressor(qs, parent, axis, coef, offset, const_rot, const_pos, bod
     n_entries = m + na * m + na
     out = np.zeros((n_pose, n_entries, 10 * n_body))
     ratios = np.zeros(n_pose)
-    ws = workspace(parent.shape[0], n_dof, na, passive.shape[0], n_body)
-    rot, w, al, ac, jp, ja, gamma = ws[0], ws[2], ws[3], ws[4], ws[11], ws[12], ws[14]
+    ws = workspace(parent.shape[0], n_dof, na, passive, n_body)
+    rot, w, al, ac, ja = ws[0], ws[2], ws[3], ws[4], ws[11]
     jab = np.zeros((n_body, 6, na))
     rb = np.zeros((n_body, 3, 3))
     mb = np.zeros((3, 3))
@@ -439,16 +428,17 @@ def actuated_regressor(qs, parent, axis, coef, offset, const_rot, const_pos, bod
     wrench = np.zeros((6, 10))
     empty = np.zeros(0)
     for p in range(n_pose):
-        ratio, _ = reduce_pose(qs[p], parent, axis, coef, offset, const_rot, const_pos, body_node, frame_a, frame_b, row_loop,
-                               row_comp, actuated, passive, ws, False)
+        ratio, _ = factor_pose(qs[p], parent, axis, offset, const_rot, const_pos, plan, frame_a, frame_b, row_loop, row_comp,
+                               passive, ws)
         ratios[p] = ratio
         if ratio == 0.0:
             continue
+        reduce_pose(parent, axis, plan, body_node, actuated, passive, ws)
         for b in range(n_body):
             nb = body_node[b]
             for i in range(3):
                 for k in range(3):
-                    rb[b, i, k] = _rotation(rot, nb, i, k)
+                    rb[b, i, k] = rotation_entry(rot, nb, i, k)
             for i in range(3):
                 for j in range(na):
                     jab[b, i, j] = rb[b, 0, i] * ja[b, 0, j] + rb[b, 1, i] * ja[b, 1, j] + rb[b, 2, i] * ja[b, 2, j]
@@ -456,9 +446,9 @@ def actuated_regressor(qs, parent, axis, coef, offset, const_rot, const_pos, bod
         st = 0
         for j in range(na):
             for k in range(j, na):
-                velocity_state(empty, j, k, parent, axis, frame_a, frame_b, row_loop, row_comp, passive, ws)
+                velocity_state(empty, j, k, parent, axis, plan, frame_a, frame_b, row_loop, row_comp, passive, ws)
                 for b in range(n_body):
-                    _body_motion(w, al, ac, jp, gamma, body_node[b], b, rb[b], mb)
+                    _body_motion(w, al, ac, body_node[b], rb[b], mb)
                     _wrench_regressor(mb[0], mb[1], mb[2], wrench)
                     for i in range(na):
                         for c in range(10):

@@ -52,8 +52,9 @@ class ClosedLoopModel(DynamicsModel):
     # -- kernel -------------------------------------------------------------------------------
     def _kernel(self, q_full: np.ndarray, params: np.ndarray | None) -> np.ndarray:
         """Entries for parameter sets (P, S, E), or the regressor (P, E, n_params) when ``params`` is None."""
-        c, a = self.compiled, self.solver.arrays
-        args = (np.ascontiguousarray(q_full, dtype=float), *c.tree.arrays, c.tree.body_node, c.gravity,
+        c, a, t = self.compiled, self.solver.arrays, self.compiled.tree
+        args = (np.ascontiguousarray(q_full, dtype=float), t.parent, t.axis, t.offset, t.const_rot, t.const_pos,
+                self.solver.plan.arrays, t.body_node, c.gravity,
                 a.frame_a, a.frame_b, a.row_loop, a.row_comp, a.actuated, a.passive)
         if params is None:
             out, ratios = actuated_regressor(*args)

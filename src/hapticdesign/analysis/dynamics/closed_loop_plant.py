@@ -37,21 +37,21 @@ from hapticdesign.analysis.dynamics.closed_loop import ClosedLoopModel
 from hapticdesign.analysis.loops import closure_kernel as ck
 from hapticdesign.analysis.loops.solver import MAX_ITER, MESSAGES, SINGULAR_RATIO
 from hapticdesign.errors import UserError
-from hapticdesign.model.walk import CONSTANT
+from hapticdesign.model.walk import CONSTANT, planned_poses
 
 OK, NO_CLOSURE, SINGULAR, BRANCH_CHANGE = ck.OK, ck.NO_CLOSURE, ck.SINGULAR, ck.BRANCH_CHANGE
 
 
 @njit(cache=True)
-def plant_workspace(n_node, n_dof, na, npas, n_body):
-    """Scratch of :func:`closed_loop_terms`: ``(kernel workspace, q, q_last, res, rhs, pp, pw, kp, predicted)``.
+def plant_workspace(n_node, n_dof, na, passive, n_body):
+    """Scratch of :func:`closed_loop_terms`: ``(kernel workspace, q, q_last, res, rhs, pp, pw, predicted)``.
 
     ``q`` is the warm start (full coordinates of the last closed pose), ``q_last`` a copy to fall back to.
     """
+    npas = passive.shape[0]
     return (
-        workspace(n_node, n_dof, na, npas, n_body), np.zeros(n_dof), np.zeros(n_dof), np.zeros(npas),
-        np.zeros((npas, 1)), np.zeros((npas, npas)), np.zeros((1, n_body, 10)), np.zeros((1, na, npas)),
-        np.zeros(npas),
+        workspace(n_node, n_dof, na, passive, n_body), np.zeros(n_dof), np.zeros(n_dof), np.zeros(npas),
+        np.zeros((npas, 1)), np.zeros((npas, npas)), np.zeros((1, n_body, 10)), np.zeros(npas),
     )
 
 
@@ -59,14 +59,16 @@ def plant_workspace(n_node, n_dof, na, npas, n_body):
 def closed_loop_terms(qa, qda, structure, ws, h, cqd, g):
     """``H_a`` (n_a x n_a), ``c_a = C(q, qd) qd^2`` (n_a) and ``G_a`` (n_a) at actuated ``qa``, rates ``qda``.
 
-    ``structure``: ``(parent, axis, coef, offset, const_rot, const_pos, body_node, gravity, frame_a, frame_b, row_loop,
+    ``structure``: ``(parent, axis, offset, const_rot, const_pos, plan, body_node, gravity, frame_a, frame_b, row_loop,
     row_comp, actuated, passive, params (1, 10 B), active (B,), constant (n_a x n_a), tol, max_iter,
-    singular_ratio, branch)``; ``ws``: :func:`plant_workspace`. Returns the status (module docstring).
+    singular_ratio, branch)`` with ``plan`` the arrays of the loop solver's
+    :class:`~hapticdesign.model.walk.WalkPlan`; ``ws``: :func:`plant_workspace`. Returns the status (module
+    docstring).
     """
-    (parent, axis, coef, offset, const_rot, const_pos, body_node, gravity, frame_a, frame_b, row_loop, row_comp,
+    (parent, axis, offset, const_rot, const_pos, plan, body_node, gravity, frame_a, frame_b, row_loop, row_comp,
      actuated, passive, params, active, constant, tol, max_iter, singular_ratio, branch) = structure
-    dyn, q, q_last, res, rhs, pp, pw, kp, predicted = ws
-    rot, pos, w, al, ac, phi, t, jp, ja, gamma = dyn[0], dyn[1], dyn[2], dyn[3], dyn[4], dyn[5], dyn[8], dyn[11], dyn[12], dyn[14]
+    dyn, q, q_last, res, rhs, pp, pw, predicted = ws
+    rot, pos, w, al, ac, phi, pinv, t, ja, trig = dyn[0], dyn[1], dyn[2], dyn[3], dyn[4], dyn[5], dyn[7], dyn[8], dyn[11], dyn[14]
     na = actuated.shape[0]
     npas = passive.shape[0]
     dist = 0.0
@@ -81,9 +83,9 @@ def closed_loop_terms(qa, qda, structure, ws, h, cqd, g):
         q[actuated[j]] = qa[j]
     for r in range(npas):
         predicted[r] = q[passive[r]]
-    status, sign, _ = ck.newton_into(q, actuated, passive, parent, axis, coef, offset, const_rot, const_pos, frame_a,
-                                     frame_b, row_loop, row_comp, tol, max_iter, singular_ratio, rot, pos, res, phi,
-                                     rhs, pp)
+    status, sign, _ = ck.newton_into(q, actuated, passive, parent, axis, offset, const_rot, const_pos, plan, frame_a,
+                                     frame_b, row_loop, row_comp, tol, max_iter, singular_ratio, rot, pos, trig, res,
+                                     phi, rhs, pp, pinv)
     if status == OK and sign != branch:
         status = BRANCH_CHANGE
     if status == OK:
@@ -94,24 +96,19 @@ def closed_loop_terms(qa, qda, structure, ws, h, cqd, g):
         for k in range(q.shape[0]):
             q[k] = q_last[k]
         return status
-    reduce_pose(q, parent, axis, coef, offset, const_rot, const_pos, body_node, frame_a, frame_b, row_loop, row_comp,
-                actuated, passive, dyn, True)
+    # Newton left Phi, Phi_p^-1 and the closures' node poses at q: the other nodes complete factor_pose
+    planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, plan[1], parent.shape[0], rot, pos, trig)
+    reduce_pose(parent, axis, plan, body_node, actuated, passive, dyn)
     world_parameters(rot, body_node, params, 0, pw)
     for i in range(na):
         g[i] = 0.0
+        cqd[i] = 0.0
         for j in range(na):
             h[i, j] = constant[i, j]
-        for r in range(npas):
-            kp[0, i, r] = 0.0
     for b in range(body_node.shape[0]):
         if active[b] and body_node[b] >= 0:
-            mass_and_gravity(ja, jp, b, gravity, pw, 0, h, g, kp[0])
-    velocity_state(qda, -1, -1, parent, axis, frame_a, frame_b, row_loop, row_comp, passive, dyn)
-    for i in range(na):
-        acc = 0.0
-        for r in range(npas):
-            acc += kp[0, i, r] * gamma[r]
-        cqd[i] = acc
+            mass_and_gravity(ja, b, gravity, pw, 0, h, g)
+    velocity_state(qda, -1, -1, parent, axis, plan, frame_a, frame_b, row_loop, row_comp, passive, dyn)
     for b in range(body_node.shape[0]):
         nb = body_node[b]
         if not active[b] or nb < 0:
@@ -130,7 +127,7 @@ class ClosedLoopPlant:
     """
 
     def __init__(self, model: ClosedLoopModel, pi: np.ndarray, q_a0: np.ndarray):
-        solver, c, a = model.solver, model.compiled, model.solver.arrays
+        solver, c, a, tree = model.solver, model.compiled, model.solver.arrays, model.compiled.tree
         params = np.ascontiguousarray(np.atleast_2d(model._params(pi)), dtype=float)
         if params.shape[0] != 1:
             raise UserError("a plant takes one set of standard inertial parameters")
@@ -141,11 +138,12 @@ class ClosedLoopPlant:
             constant[iu, ju] = constant[ju, iu] = model.constant[model.slice_h]
         self.n_dof = n
         self.structure = (
-            *c.tree.arrays, c.tree.body_node, c.gravity,
+            tree.parent, tree.axis, tree.offset, tree.const_rot, tree.const_pos, solver.plan.arrays, tree.body_node,
+            c.gravity,
             a.frame_a, a.frame_b, a.row_loop, a.row_comp, a.actuated, a.passive, params, active_bodies(params),
             constant, float(solver.tol), int(MAX_ITER), float(SINGULAR_RATIO), float(solver.branch),
         )
-        self.workspace = plant_workspace(len(c.tree.parent), solver.n_dof, n, len(a.passive), len(c.tree.body_node))
+        self.workspace = plant_workspace(len(tree.parent), solver.n_dof, n, a.passive, len(tree.body_node))
         self.workspace[1][:] = solver.solve(q_a0)
         self.terms(q_a0, np.zeros(n))  # T at the start pose, for the first tangent predictor
 

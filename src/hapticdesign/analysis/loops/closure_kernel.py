@@ -8,7 +8,7 @@ selected components of all closures:
   (rx, ry, rz: ``sin(angle) axis``, zero at closure);
 - constraint Jacobian ``Phi = select(J_A - J_B)`` (m x N) with ``J`` the world-frame geometric
   Jacobian of a frame origin (seed 000 eq. 2.20-2.26: rotation axis ``u`` through the node,
-  ``v = u x (p - p_node)``; :func:`hapticdesign.model.walk.frame_jacobian`); it is the exact
+  ``v = u x (p - p_node)``, as :func:`hapticdesign.model.walk.frame_jacobian`); it is the exact
   derivative of ``phi`` at closure;
 - bias ``Phidot qd = select(a_A - a_B)`` with ``a`` the accelerations of the frames at ``qdd = 0``
   (:func:`node_motion`, the time derivative of eq. 2.38-2.41).
@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from hapticdesign.model.walk import frame_jacobian, node_poses
+from hapticdesign.model.walk import planned_poses, trig_workspace
 
 OK, NO_CLOSURE, SINGULAR, BRANCH_CHANGE = 0, 1, 2, 3
 MAX_NEWTON_STEP = 0.25
@@ -74,6 +74,52 @@ def node_motion(rate, parent, axis, rot, pos, w, al, ac):
             ac[n, 2] = a2 + ld2 + ww2 + 2.0 * ws2
 
 
+@njit(cache=True, inline="always")
+def rotation_entry(rot, node, i, k):
+    """Entry ``(i, k)`` of the world rotation of ``node`` (the identity for the base, ``node < 0``)."""
+    if node >= 0:
+        return rot[node, i, k]
+    return 1.0 if i == k else 0.0
+
+
+@njit(cache=True)
+def add_joint_accelerations(acc, parent, axis, rot, pos, al, ac, dal, dac):
+    """Add to the node accelerations ``al``, ``ac`` those of the joint-value accelerations ``acc[n]`` at zero rates.
+
+    The rate-free part of :func:`node_motion` (linear in ``acc``): a rotation node adds ``acc u`` to the
+    angular acceleration, a translation (or constant) node carries its parent's angular acceleration
+    ``dal_p`` over its offset ``d`` and adds ``acc u``: ``dac = dac_p + dal_p x d + acc u``.
+    ``dal``, ``dac``: scratch (M x 3).
+    """
+    for n in range(parent.shape[0]):
+        p = parent[n]
+        s = acc[n]
+        a = axis[n] % 3
+        u0, u1, u2 = rot[n, 0, a], rot[n, 1, a], rot[n, 2, a]
+        if p >= 0:
+            l0, l1, l2 = dal[p, 0], dal[p, 1], dal[p, 2]
+            a0, a1, a2 = dac[p, 0], dac[p, 1], dac[p, 2]
+        else:
+            l0 = l1 = l2 = a0 = a1 = a2 = 0.0
+        if axis[n] < 3:
+            l0, l1, l2 = l0 + s * u0, l1 + s * u1, l2 + s * u2
+        else:
+            if p >= 0:
+                d0, d1, d2 = pos[n, 0] - pos[p, 0], pos[n, 1] - pos[p, 1], pos[n, 2] - pos[p, 2]
+            else:
+                d0, d1, d2 = pos[n, 0], pos[n, 1], pos[n, 2]
+            x0, x1, x2 = _cross(l0, l1, l2, d0, d1, d2)
+            a0, a1, a2 = a0 + x0 + s * u0, a1 + x1 + s * u1, a2 + x2 + s * u2
+        dal[n, 0], dal[n, 1], dal[n, 2] = l0, l1, l2
+        dac[n, 0], dac[n, 1], dac[n, 2] = a0, a1, a2
+        al[n, 0] += l0
+        al[n, 1] += l1
+        al[n, 2] += l2
+        ac[n, 0] += a0
+        ac[n, 1] += a1
+        ac[n, 2] += a2
+
+
 @njit(cache=True)
 def closure_residual(frame_a, frame_b, row_loop, row_comp, rot, pos, out):
     """``phi`` (m,): origin differences and the skew-part vector of ``R_A R_B^T`` in the base frame."""
@@ -86,32 +132,52 @@ def closure_residual(frame_a, frame_b, row_loop, row_comp, rot, pos, out):
             pb = pos[nb, c] if nb >= 0 else 0.0
             out[i] = pa - pb
         else:
-            ra = rot[na] if na >= 0 else np.eye(3)
-            rb = rot[nb] if nb >= 0 else np.eye(3)
-            m = ra @ rb.T
-            if c == 3:
-                out[i] = 0.5 * (m[2, 1] - m[1, 2])
-            elif c == 4:
-                out[i] = 0.5 * (m[0, 2] - m[2, 0])
-            else:
-                out[i] = 0.5 * (m[1, 0] - m[0, 1])
+            # 0.5 (M[r, t] - M[t, r]) of M = R_A R_B^T, with (r, t) = (2, 1), (0, 2), (1, 0) for rx, ry, rz
+            r = (c - 1) % 3
+            t = (c + 1) % 3
+            acc = 0.0
+            for k in range(3):
+                acc += (rotation_entry(rot, na, r, k) * rotation_entry(rot, nb, t, k)
+                        - rotation_entry(rot, na, t, k) * rotation_entry(rot, nb, r, k))
+            out[i] = 0.5 * acc
 
 
 @njit(cache=True)
-def closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, coef, rot, pos, phi):
-    """``Phi = select(J_A - J_B)`` (m x N) at the current node poses."""
-    n_dof = coef.shape[1]
-    ja = np.empty((6, n_dof))
-    jb = np.empty((6, n_dof))
-    last = -1
-    for i in range(row_loop.shape[0]):
-        loop = row_loop[i]
-        if loop != last:
-            frame_jacobian(frame_a[loop], parent, axis, coef, rot, pos, False, ja)
-            frame_jacobian(frame_b[loop], parent, axis, coef, rot, pos, False, jb)
-            last = loop
-        for k in range(n_dof):
-            phi[i, k] = ja[row_comp[i], k] - jb[row_comp[i], k]
+def closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, plan, rot, pos, phi):
+    """``Phi = select(J_A - J_B)`` (m x N) at the current node poses.
+
+    ``plan``: the arrays of a :class:`~hapticdesign.model.walk.WalkPlan` (its sparse coupling coefficients).
+    Each frame's path to the base is walked once per loop; a column of ``J`` is as in
+    :func:`~hapticdesign.model.walk.frame_jacobian`. The rows of a loop are consecutive, loop after loop.
+    """
+    _, _, ptr, index, value, _, _, _ = plan
+    m = row_loop.shape[0]
+    for i in range(m):
+        for k in range(phi.shape[1]):
+            phi[i, k] = 0.0
+    stop = 0
+    for loop in range(frame_a.shape[0]):
+        start = stop
+        while stop < m and row_loop[stop] == loop:
+            stop += 1
+        for side in range(2):
+            node = frame_a[loop] if side == 0 else frame_b[loop]
+            f = 1.0 if side == 0 else -1.0
+            e = node
+            while e >= 0:
+                if ptr[e] != ptr[e + 1]:  # a node some coordinate moves
+                    a = axis[e] % 3
+                    u0, u1, u2 = rot[e, 0, a], rot[e, 1, a], rot[e, 2, a]
+                    if axis[e] < 3:
+                        r0, r1, r2 = pos[node, 0] - pos[e, 0], pos[node, 1] - pos[e, 1], pos[node, 2] - pos[e, 2]
+                        twist = (u1 * r2 - u2 * r1, u2 * r0 - u0 * r2, u0 * r1 - u1 * r0, u0, u1, u2)
+                    else:
+                        twist = (u0, u1, u2, 0.0, 0.0, 0.0)
+                    for i in range(start, stop):
+                        t = f * twist[row_comp[i]]
+                        for k in range(ptr[e], ptr[e + 1]):
+                            phi[i, index[k]] += value[k] * t
+                e = parent[e]
 
 
 @njit(cache=True)
@@ -193,35 +259,55 @@ def velocity_map_into(phi, actuated, passive, pp, s):
 
 
 @njit(cache=True)
-def newton(q, actuated, passive, parent, axis, coef, offset, const_rot, const_pos, frame_a, frame_b, row_loop, row_comp,
-           tol, max_iter, singular_ratio, rot, pos):
-    """Newton on the passive entries of ``q`` (in place). Returns (status, det sign, pivot ratio)."""
+def newton(q, actuated, passive, parent, axis, offset, const_rot, const_pos, plan, frame_a, frame_b, row_loop, row_comp,
+           tol, max_iter, singular_ratio, rot, pos, trig):
+    """Newton on the passive entries of ``q`` (in place). Returns (status, det sign, pivot ratio).
+
+    ``plan``: the arrays of a :class:`~hapticdesign.model.walk.WalkPlan` whose first part is the nodes the
+    closures need (those that the passive coordinates do not move first); ``rot``, ``pos``, ``trig``: the
+    node poses and the plan's scratch.
+    """
     m = passive.shape[0]
-    return newton_into(q, actuated, passive, parent, axis, coef, offset, const_rot, const_pos, frame_a, frame_b, row_loop, row_comp,
-                       tol, max_iter, singular_ratio, rot, pos, np.empty(m), np.empty((m, coef.shape[1])),
-                       np.empty((m, 1)), np.empty((m, m)))
+    return newton_into(q, actuated, passive, parent, axis, offset, const_rot, const_pos, plan, frame_a, frame_b, row_loop,
+                       row_comp, tol, max_iter, singular_ratio, rot, pos, trig, np.empty(m), np.empty((m, q.shape[0])),
+                       np.empty((m, 1)), np.empty((m, m)), np.empty((m, m)))
 
 
 @njit(cache=True)
-def newton_into(q, actuated, passive, parent, axis, coef, offset, const_rot, const_pos, frame_a, frame_b, row_loop, row_comp,
-                tol, max_iter, singular_ratio, rot, pos, res, phi, rhs, pp):
-    """:func:`newton` on the caller's scratch ``res`` (m), ``phi`` (m x N), ``rhs`` (m x 1), ``pp`` (m x m).
+def newton_into(q, actuated, passive, parent, axis, offset, const_rot, const_pos, plan, frame_a, frame_b, row_loop, row_comp,
+                tol, max_iter, singular_ratio, rot, pos, trig, res, phi, rhs, pp, pinv):
+    """:func:`newton` on the caller's scratch ``res`` (m), ``phi`` (m x N), ``rhs`` (m x 1), ``pp`` (m x m) and
+    ``pinv`` (m x m).
 
-    On success ``rot``, ``pos`` and ``phi`` hold the node poses and the constraint Jacobian of the returned ``q``.
+    Each iteration walks only the plan's first part (the nodes of the closures; after the first, only those
+    the passive coordinates move, the plan's ``n_still`` being the others). On success ``rot``, ``pos``
+    and ``trig`` hold those nodes' poses, ``phi`` the constraint Jacobian and ``pinv`` ``Phi_p^-1`` at the
+    returned ``q`` (the last iteration factors ``Phi_p`` for the inverse instead of a Newton step).
     """
     m = passive.shape[0]
+    n_first, n_still = plan[1], plan[7]
     for it in range(max_iter + 1):
-        node_poses(q, parent, axis, coef, offset, const_rot, const_pos, parent.shape[0] - 1, rot, pos)
+        # a Newton step moves only passive coordinates: the nodes they do not move stay where they were
+        planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, 0 if it == 0 else n_still, n_first, rot, pos,
+                      trig)
         closure_residual(frame_a, frame_b, row_loop, row_comp, rot, pos, res)
-        closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, coef, rot, pos, phi)
+        closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, plan, rot, pos, phi)
+        big = 0.0
+        for i in range(m):
+            big = max(big, abs(res[i]))
+        closed = big <= tol
         for i in range(m):
             rhs[i, 0] = -res[i]
             for j in range(m):
                 pp[i, j] = phi[i, passive[j]]
-        ratio, sign = lu_in_place(pp, rhs)
+                pinv[i, j] = 1.0 if i == j else 0.0
+        if closed:
+            ratio, sign = lu_in_place(pp, pinv)
+        else:
+            ratio, sign = lu_in_place(pp, rhs)
         if not np.isfinite(ratio) or ratio <= singular_ratio:
             return SINGULAR, sign, ratio
-        if np.max(np.abs(res)) <= tol:
+        if closed:
             return OK, sign, ratio
         if it == max_iter:
             break
@@ -236,7 +322,7 @@ def newton_into(q, actuated, passive, parent, axis, coef, offset, const_rot, con
 
 
 @njit(cache=True)
-def solve_path(qa_path, q_start, sign0, actuated, passive, parent, axis, coef, offset, const_rot, const_pos, frame_a, frame_b,
+def solve_path(qa_path, q_start, sign0, actuated, passive, parent, axis, offset, const_rot, const_pos, plan, frame_a, frame_b,
                row_loop, row_comp, max_step, tol, max_iter, singular_ratio, min_fraction):
     """Continue the closure from ``q_start`` (full, closed) through the actuated poses ``qa_path`` in order.
 
@@ -252,8 +338,9 @@ def solve_path(qa_path, q_start, sign0, actuated, passive, parent, axis, coef, o
     na = actuated.shape[0]
     rot = np.zeros((n_node, 3, 3))
     pos = np.zeros((n_node, 3))
+    trig = trig_workspace(n_node)
     phi = np.empty((m, n_dof))
-    res, rhs, pp = np.empty(m), np.empty((m, 1)), np.empty((m, m))
+    res, rhs, pp, pinv = np.empty(m), np.empty((m, 1)), np.empty((m, m)), np.empty((m, m))
     s = np.empty((m, na))
     start = np.empty(na)
     out = np.empty((n_pose, n_dof))
@@ -261,9 +348,9 @@ def solve_path(qa_path, q_start, sign0, actuated, passive, parent, axis, coef, o
     q = q_start.copy()
     trial = q.copy()
     predicted = np.empty(m)
-    # tangent at the current closed pose; after each accepted step, from Newton's last Jacobian there
-    node_poses(q, parent, axis, coef, offset, const_rot, const_pos, parent.shape[0] - 1, rot, pos)
-    closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, coef, rot, pos, phi)
+    # tangent at the current closed pose; after each accepted step, S = -Phi_p^-1 Phi_a from Newton's last iteration
+    planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, 0, plan[1], rot, pos, trig)
+    closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, plan, rot, pos, phi)
     velocity_map_into(phi, actuated, passive, pp, s)
     for p in range(n_pose):
         for j in range(actuated.shape[0]):
@@ -285,8 +372,9 @@ def solve_path(qa_path, q_start, sign0, actuated, passive, parent, axis, coef, o
                     trial[passive[r]] += s[r, j] * delta
             for r in range(m):
                 predicted[r] = trial[passive[r]]
-            code, sign, _ = newton_into(trial, actuated, passive, parent, axis, coef, offset, const_rot, const_pos, frame_a, frame_b,
-                                        row_loop, row_comp, tol, max_iter, singular_ratio, rot, pos, res, phi, rhs, pp)
+            code, sign, _ = newton_into(trial, actuated, passive, parent, axis, offset, const_rot, const_pos, plan, frame_a,
+                                        frame_b, row_loop, row_comp, tol, max_iter, singular_ratio, rot, pos, trig, res,
+                                        phi, rhs, pp, pinv)
             if code == OK and sign != sign0:
                 code = BRANCH_CHANGE
             if code == OK:
@@ -299,7 +387,12 @@ def solve_path(qa_path, q_start, sign0, actuated, passive, parent, axis, coef, o
                 for k in range(n_dof):
                     q[k] = trial[k]
                 done = f
-                velocity_map_into(phi, actuated, passive, pp, s)
+                for r in range(m):
+                    for j in range(na):
+                        acc = 0.0
+                        for i in range(m):
+                            acc -= pinv[r, i] * phi[i, actuated[j]]
+                        s[r, j] = acc
             else:
                 step *= 0.5
                 if step < min_fraction:

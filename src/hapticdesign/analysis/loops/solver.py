@@ -47,7 +47,7 @@ MESSAGES = {
 
 @dataclass(frozen=True)
 class LoopArrays:
-    """Flat arrays of the closures: frame nodes per loop, (loop, component) per constraint row."""
+    """Flat arrays of the closures: frame nodes per loop, (loop, component) per constraint row (loop after loop)."""
 
     frame_a: np.ndarray
     frame_b: np.ndarray
@@ -80,6 +80,8 @@ class LoopSolver:
         self.mechanism = mechanism
         self.compiled = mechanism.compiled
         self.arrays = LoopArrays.from_mechanism(mechanism)
+        self.plan = self.compiled.tree.plan([*self.arrays.frame_a, *self.arrays.frame_b], list(self.arrays.passive))
+        """Walk of the tree, the closures' nodes first (:class:`~hapticdesign.model.walk.WalkPlan`)."""
         self.n_dof = mechanism.n_dof
         self.n_actuated = mechanism.n_actuated
         lengths = np.abs(self.compiled.node_offset[self.compiled.node_axis >= 3])
@@ -104,13 +106,14 @@ class LoopSolver:
 
     # -- kernels ------------------------------------------------------------------------------
     def _kinematic_args(self) -> tuple:
-        c, a = self.compiled, self.arrays
-        return (*c.tree.arrays, a.frame_a, a.frame_b, a.row_loop, a.row_comp)
+        t, a = self.compiled.tree, self.arrays
+        return (t.parent, t.axis, t.offset, t.const_rot, t.const_pos, self.plan.arrays, a.frame_a, a.frame_b,
+                a.row_loop, a.row_comp)
 
     def _newton(self, q: np.ndarray) -> tuple[int, float, float]:
         a = self.arrays
         return ck.newton(q, a.actuated, a.passive, *self._kinematic_args(), self.tol, MAX_ITER, SINGULAR_RATIO,
-                         *self.compiled.tree.workspace())
+                         *self.compiled.tree.workspace(), self.plan.workspace())
 
     def _actuated(self, q_a: np.ndarray) -> np.ndarray:
         q_a = np.asarray(q_a, dtype=float)
@@ -161,7 +164,7 @@ class LoopSolver:
         rot, pos = self._poses(q)
         c, a = self.compiled, self.arrays
         phi = np.empty((len(a.row_loop), self.n_dof))
-        ck.closure_jacobian(a.frame_a, a.frame_b, a.row_loop, a.row_comp, c.tree.parent, c.tree.axis, c.tree.coef,
+        ck.closure_jacobian(a.frame_a, a.frame_b, a.row_loop, a.row_comp, c.tree.parent, c.tree.axis, self.plan.arrays,
                             rot, pos, phi)
         return phi
 
