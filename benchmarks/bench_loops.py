@@ -9,7 +9,8 @@
    numba loop with the compiled closed-loop plant and compensator,
    :func:`hapticdesign.analysis.dynamics.closed_loop_plant.closed_loop_terms`): type 1 (joints 2 and 3
    held at home), classical RK4 at 1e-4 s, 1 kHz sampling, a stable virtual wall on joint 1, full
-   model compensation; real-time factor = 5 s / run time (goal >= 20).
+   model compensation; real-time factor = 5 s / run time (goal >= 20). The same run at a 1-ms plant
+   step (``--step 1e-3``: one RK4 step per sample) beside it, with its largest difference in q.
 
 Times are CPU time of the benchmark process (``time.process_time``), so that a shared machine does not
 count other processes' time against one core.
@@ -90,6 +91,7 @@ SETUP = textwrap.dedent(
 SIMULATION = textwrap.dedent(
     """
     import time
+    import numpy as np
     from hapticdesign.devices.device_file import load_device_file
     from hapticdesign.simulation.config import LoopConfig, Wall, rest_pose
     from hapticdesign.simulation.criteria import type_paths
@@ -98,12 +100,14 @@ SIMULATION = textwrap.dedent(
     device = load_device_file("{examples}/delta.yaml")
     home = rest_pose(device)
     paths = type_paths(1, device.n_dof, 0, home)
-    config = LoopConfig(duration=5.0, wall=Wall(0, {stiffness}, 0.0, home[0] + 0.01))
-    simulate(device, LoopConfig(duration=0.01, wall=config.wall), paths)  # compile / load the numba cache
-    t0 = time.process_time()
-    trace = simulate(device, config, paths)
-    seconds = time.process_time() - t0
-    print(config.duration, seconds, trace.status)
+    traces = []
+    for step in (1e-4, 1e-3):
+        config = LoopConfig(duration=5.0, step=step, wall=Wall(0, {stiffness}, 0.0, home[0] + 0.01))
+        simulate(device, LoopConfig(duration=0.01, step=step, wall=config.wall), paths)  # compile / load the cache
+        t0 = time.process_time()
+        traces.append(simulate(device, config, paths))
+        print(step, time.process_time() - t0, traces[-1].status)
+    print(np.abs(traces[0].q - traces[1].q).max())
     """
 )
 
@@ -127,10 +131,12 @@ def main() -> None:
         seconds, accuracy, ln = (float(v) for v in _run(SETUP.format(name=name, examples=EXAMPLES, half=half), ONE_CORE))
         region = "torus, exact basis" if name == "phantom-3dof" else f"home +- {half} rad, quadrature to {accuracy:.0e}"
         print(f"{name:13s} LN set-up (process, model and form; {region}): {seconds:.2f} s (goal < 10 s), LN = {ln:.4g}")
-    duration, seconds, status = (float(v) for v in _run(SIMULATION.format(examples=EXAMPLES, stiffness=WALL_K), ONE_CORE))
-    print(f"delta         simulation of {duration:g} s through simulate (type 1, RK4 at 1e-4 s, 1 kHz, wall K = {WALL_K:g} "
-          f"N m/rad on joint 1, full compensation): {seconds:.2f} s, {duration / seconds:.1f} x real time (goal >= 20), "
-          f"status {int(status)}")
+    out = [float(v) for v in _run(SIMULATION.format(examples=EXAMPLES, stiffness=WALL_K), ONE_CORE)]
+    (step, seconds, status), (coarse, coarse_seconds, _), difference = out[0:3], out[3:6], out[6]
+    print(f"delta         simulation of 5 s through simulate (type 1, RK4 at {step:g} s, 1 kHz, wall K = {WALL_K:g} "
+          f"N m/rad on joint 1, full compensation): {seconds:.2f} s, {5 / seconds:.1f} x real time (goal >= 20), "
+          f"status {int(status)}; at a {coarse:g}-s plant step (one RK4 step per sample): {coarse_seconds:.2f} s, "
+          f"{5 / coarse_seconds:.1f} x, max |q difference| {difference:.1e} rad")
 
 
 if __name__ == "__main__":
