@@ -203,17 +203,7 @@ def planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, start, st
         n = order[i]
         pn = parent[n]
         if axis[n] == CONSTANT:
-            for r in range(3):
-                if pn < 0:
-                    for j in range(3):
-                        rot[n, r, j] = const_rot[n, r, j]
-                    pos[n, r] = const_pos[n, r]
-                else:
-                    for j in range(3):
-                        rot[n, r, j] = (rot[pn, r, 0] * const_rot[n, 0, j] + rot[pn, r, 1] * const_rot[n, 1, j]
-                                        + rot[pn, r, 2] * const_rot[n, 2, j])
-                    pos[n, r] = (pos[pn, r] + rot[pn, r, 0] * const_pos[n, 0] + rot[pn, r, 1] * const_pos[n, 1]
-                                 + rot[pn, r, 2] * const_pos[n, 2])
+            _constant_node(n, pn, const_rot, const_pos, rot, pos)
             continue
         if pn >= 0:
             for r in range(3):
@@ -260,23 +250,29 @@ def planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, start, st
                 pos[n, r] += rot[n, r, a] * v
 
 
+@njit(cache=True, inline="always")
+def _constant_node(n, pn, const_rot, const_pos, rot, pos):
+    """World pose of a folded constant node ``n``: its parent's pose (the base for ``pn < 0``) times its transform."""
+    for i in range(3):
+        if pn < 0:
+            for j in range(3):
+                rot[n, i, j] = const_rot[n, i, j]
+            pos[n, i] = const_pos[n, i]
+        else:
+            for j in range(3):
+                rot[n, i, j] = (rot[pn, i, 0] * const_rot[n, 0, j] + rot[pn, i, 1] * const_rot[n, 1, j]
+                                + rot[pn, i, 2] * const_rot[n, 2, j])
+            pos[n, i] = (pos[pn, i] + rot[pn, i, 0] * const_pos[n, 0] + rot[pn, i, 1] * const_pos[n, 1]
+                         + rot[pn, i, 2] * const_pos[n, 2])
+
+
 @njit(cache=True)
 def node_poses(q, parent, axis, coef, offset, const_rot, const_pos, last, rot, pos):
     """World rotation ``rot[n]`` and origin ``pos[n]`` of nodes ``0 .. last`` at coordinates ``q``."""
     for n in range(last + 1):
         pn = parent[n]
         if axis[n] == CONSTANT:
-            for i in range(3):
-                if pn < 0:
-                    for j in range(3):
-                        rot[n, i, j] = const_rot[n, i, j]
-                    pos[n, i] = const_pos[n, i]
-                else:
-                    for j in range(3):
-                        rot[n, i, j] = (rot[pn, i, 0] * const_rot[n, 0, j] + rot[pn, i, 1] * const_rot[n, 1, j]
-                                        + rot[pn, i, 2] * const_rot[n, 2, j])
-                    pos[n, i] = (pos[pn, i] + rot[pn, i, 0] * const_pos[n, 0] + rot[pn, i, 1] * const_pos[n, 1]
-                                 + rot[pn, i, 2] * const_pos[n, 2])
+            _constant_node(n, pn, const_rot, const_pos, rot, pos)
             continue
         v = offset[n]
         for k in range(q.shape[0]):
