@@ -47,17 +47,19 @@ def _paths(device, sim_type: int, amplitude: float = 0.1) -> dict:
             for j in range(device.n_dof) if j != w}
 
 
-@pytest.mark.parametrize("sim_type", [1, 2])
-def test_kernel_matches_the_scipy_reference_loop(device, sim_type):
-    """RK4 at 1e-4 s against RK45 at rtol 1e-8, with a model error, a delay and a damped wall: the two
-    integrators agree to their own accuracy (the closure's Newton tolerance is far below it)."""
+@pytest.mark.parametrize("sim_type, control", [(1, "auto"), (2, "auto"), (1, "fixed")])
+def test_kernel_matches_the_scipy_reference_loop(device, sim_type, control):
+    """RK4 (error-controlled steps, the default for closed loops, or every 1e-4-s plant step) against
+    RK45 at rtol 1e-8, with a model error, a delay and a damped wall: the two integrators agree to their
+    own accuracy (the closure's Newton tolerance is far below it)."""
     home, w = rest_pose(device), WALL_JOINT[device.name]
-    config = LoopConfig(duration=0.2, wall=Wall(w, 0.05, 0.001, home[w] + 0.01),
+    config = LoopConfig(duration=0.2, wall=Wall(w, 0.05, 0.001, home[w] + 0.01), step_control=control,
                         compensator=Compensator(error_percent=20, error_seed=3), sensors=Sensors(delay_samples=1))
     paths = _paths(device, sim_type)
     fast = simulate(device, config, paths)
     slow = simulate_adaptive(device, config, paths, q0=home)
     assert fast.status == slow.status == 0
+    assert fast.steps == 2000 if control == "fixed" else fast.steps < 400  # 200 sample periods of 10 plant steps
     assert fast.q.shape == slow.q.shape
     assert np.abs(fast.q[:, w] - home[w]).max() > 1e-3  # the wall joint moved
     assert np.abs(fast.q - slow.q).max() < 1e-8

@@ -14,13 +14,16 @@ from hapticdesign.simulation.reference import simulate_adaptive
 NONLINEAR = {"r3y": 0.01, "Ixy2": 4e-4, "m3": 0.05, "Ixz3": 1e-3, "r2az": 0.02}
 
 
+@pytest.mark.parametrize("control", ["fixed", "adaptive"])
 @pytest.mark.parametrize("paths", [{1: Held(0.0), 2: Held(0.0)}, {1: Sine(0.52, 3 * np.pi), 2: Sine(0.52, 3 * np.pi)}])
-def test_rk4_loop_matches_scipy_solve_ivp(paths):
+def test_rk4_loop_matches_scipy_solve_ivp(paths, control):
     device = preset("phantom-3dof").with_params(NONLINEAR)
     config = LoopConfig(duration=0.3, wall=Wall(0, 5.0, 0.01, 0.01), compensator=Compensator(error_percent=20),
-                        sensors=Sensors(delay_samples=1, counts_per_revolution=2**16))
+                        sensors=Sensors(delay_samples=1, counts_per_revolution=2**16), step_control=control)
     fast = simulate(device, config, paths)
     slow = simulate_adaptive(device, config, paths)
+    # the fixed step takes every plant step; the adaptive one mostly one step per 10-step sample period
+    assert fast.steps == 3000 if control == "fixed" else fast.steps < 600
     assert fast.q.shape == slow.q.shape
     assert np.abs(fast.q - slow.q).max() < 1e-9
     assert np.abs(fast.u - slow.u).max() < 1e-6 * max(1.0, np.abs(slow.u).max())
@@ -63,6 +66,9 @@ def test_prescribed_joint_constraint_torque_is_inverse_dynamics():
         (LoopConfig(wall=Wall(joint=5)), "unknown joint"),
         (LoopConfig(sensors=Sensors(counts_per_revolution=0)), "counts per revolution"),
         (LoopConfig(compensator=Compensator(error_percent=150)), "error percentage"),
+        (LoopConfig(step_control="variable"), "unknown step control 'variable'"),
+        (LoopConfig(step_control="adaptive", tolerance=float("nan")), "tolerance must be a positive number"),
+        (LoopConfig(step_control="adaptive", tolerance=0.0), "tolerance must be a positive number"),
     ],
 )
 def test_bad_loop_settings_raise_user_error(config, message):
@@ -85,27 +91,30 @@ def test_diverging_run_is_a_result_not_a_crash():
     assert trace.diverged or np.abs(trace.q[:, 0]).max() > 1.0
 
 
-def test_safety_switch_and_excursion_stop_at_the_same_plant_step_as_the_scipy_loop():
-    """Both loops check the excursion at every plant step: equal trip time, stop time and peak."""
+@pytest.mark.parametrize("control", ["fixed", "adaptive"])
+def test_safety_switch_and_excursion_stop_at_the_same_plant_step_as_the_scipy_loop(control):
+    """Both loops check the excursion at every plant step: equal trip time, stop time and peak (an
+    adaptive step that would pass the limit inside is retried to end on that plant step)."""
     device = preset("phantom-3dof").with_params(NONLINEAR)
     paths = {1: Held(0.0), 2: Held(0.0)}
-    tripping = LoopConfig(duration=1.5, wall=Wall(0, 30.0, 0.0, 0.01), safety_limit=0.0217)
+    tripping = LoopConfig(duration=1.5, wall=Wall(0, 30.0, 0.0, 0.01), safety_limit=0.0217, step_control=control)
     fast, slow = simulate(device, tripping, paths), simulate_adaptive(device, tripping, paths)
     assert fast.trip_time is not None and fast.trip_time == pytest.approx(slow.trip_time, abs=1e-12)
     assert abs(fast.trip_time * 1e3 - round(fast.trip_time * 1e3)) > 1e-6  # between two samples
-    stopping = LoopConfig(duration=1.5, wall=Wall(0, 30.0, 0.0, 0.01), stop_excursion=0.012)
+    stopping = LoopConfig(duration=1.5, wall=Wall(0, 30.0, 0.0, 0.01), stop_excursion=0.012, step_control=control)
     fast, slow = simulate(device, stopping, paths), simulate_adaptive(device, stopping, paths)
     assert fast.stopped_at_excursion and slow.stopped_at_excursion
     assert fast.end_time == pytest.approx(slow.end_time, abs=1e-12)
     assert fast.peak == pytest.approx(slow.peak, rel=1e-7) and fast.peak >= 0.012
 
 
-def test_coulomb_friction_and_group_errors_match_the_scipy_loop():
+@pytest.mark.parametrize("control", ["fixed", "adaptive"])
+def test_coulomb_friction_and_group_errors_match_the_scipy_loop(control):
     """Friction in the plant and a seeded per-group modelling error: both loops agree."""
     device = preset("phantom-3dof").with_params(NONLINEAR)
     compensator = Compensator(group_errors=(("mass", 5.0), ("inertia", 10.0)), error_seed=3)
     config = LoopConfig(duration=0.3, wall=Wall(0, 5.0, 0.01, 0.01), compensator=compensator,
-                        coulomb=(0.004, 0.002, 0.001))
+                        coulomb=(0.004, 0.002, 0.001), step_control=control)
     paths = {1: Sine(0.52, 3 * np.pi), 2: Sine(0.52, 3 * np.pi)}
     fast, slow = simulate(device, config, paths), simulate_adaptive(device, config, paths, rtol=1e-10, atol=1e-12)
     assert np.abs(fast.q - slow.q).max() < 1e-8
@@ -127,3 +136,17 @@ def test_coulomb_friction_holds_a_joint_below_its_breakaway_torque():
     slid = simulate(device, LoopConfig(**base, wall=Wall(0, 1.0, 0.0, 0.01), coulomb=(0.002, 0, 0)), paths)
     assert np.abs(held.qd[:, 0]).max() < FRICTION_VELOCITY
     assert np.abs(slid.qd[:, 0]).max() > 3 * FRICTION_VELOCITY
+
+
+def test_adaptive_steps_shrink_where_the_plant_is_stiff():
+    """Coulomb friction ``F_c tanh(qd / v_f)`` is stiff near rest (slope F_c / v_f): the error control
+    takes shorter steps there than on the frictionless plant, and both runs stay on SciPy's."""
+    device = preset("phantom-3dof").with_params(NONLINEAR)
+    paths = {1: Held(0.0), 2: Held(0.0)}
+    smooth = LoopConfig(duration=0.5, wall=Wall(0, 5.0, 0.01, 0.01), step_control="adaptive")
+    stiff = LoopConfig(duration=0.5, wall=Wall(0, 5.0, 0.01, 0.01), step_control="adaptive", coulomb=(0.02, 0.0, 0.0))
+    runs = [(simulate(device, c, paths), simulate_adaptive(device, c, paths, rtol=1e-10, atol=1e-12)) for c in (smooth, stiff)]
+    for fast, slow in runs:
+        assert np.abs(fast.q - slow.q).max() < 1e-8
+    assert runs[0][0].steps == 500  # one step per sample period
+    assert runs[1][0].steps > 600

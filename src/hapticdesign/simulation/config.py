@@ -26,6 +26,11 @@ STATUS_LOOP_LOST = 3
 """A closed-loop device's loops stopped closing on the assembly branch (no closure, a singular or a
 changed branch), in the plant or in the compensator's model: the run ends at the last closed pose."""
 
+STEP_CONTROLS = ("auto", "fixed", "adaptive")
+ADAPTIVE_TOLERANCE = 1e-9
+"""Local error per adaptive step, relative to ``1 + |y|`` for each joint's position (rad or m) and
+velocity (rad/s or m/s) (:func:`hapticdesign.simulation.kernel.run_loop`)."""
+
 FRICTION_VELOCITY = 1e-3
 """Coulomb friction acts as ``F_c tanh(qd / v_f)`` with ``v_f`` = 1e-3 rad/s (or m/s): the sign function
 made smooth enough for a fixed-step integrator; above 3 v_f it is within 0.5 % of ``F_c sign(qd)``."""
@@ -135,6 +140,20 @@ class LoopConfig:
     hand: Hand | None = None
     record_stride: int | None = None
     stop_excursion: float | None = None
+    step_control: str = "auto"
+    """``fixed``: every step is one plant step ``step`` (the seed's fixed-step RK4); ``adaptive``: a step
+    spans several plant steps within a sample period when RK4's local error estimate stays below
+    ``tolerance`` (:func:`~.kernel.run_loop`); ``auto``: fixed for a tree (its results on the seed's
+    grid), adaptive for a closed-loop device (each evaluation of its dynamics solves the loops)."""
+    tolerance: float = ADAPTIVE_TOLERANCE
+
+    def adaptive(self, closed_loop: bool) -> bool:
+        """Whether the run controls its steps by error (``step_control``, for a closed-loop device or not)."""
+        if self.step_control not in STEP_CONTROLS:
+            raise UserError(f"unknown step control {self.step_control!r}; choose one of {', '.join(STEP_CONTROLS)}")
+        if not (self.tolerance > 0 and math.isfinite(self.tolerance)):
+            raise UserError(f"the step tolerance must be a positive number, got {self.tolerance}")
+        return self.step_control == "adaptive" or (self.step_control == "auto" and closed_loop)
 
     def steps_per_sample(self) -> int:
         if not (self.step > 0 and math.isfinite(self.step)):
@@ -156,7 +175,8 @@ class Trace:
 
     ``wall_position`` is the wall coordinate at the recorded rows: the wall joint's position, or the handle's
     position along a Cartesian wall's direction (m). ``peak`` is its largest excursion from the
-    start, checked at every plant step (not only at the recorded rows); ``end_time`` is when the run
+    start, checked at every plant step (not only at the recorded rows; inside an adaptive step from
+    the interpolated wall coordinate); ``end_time`` is when the run
     ended (early when it diverged, reached the excursion stop or, for a closed-loop device, left the
     assembly branch)."""
 
@@ -172,6 +192,9 @@ class Trace:
     peak: float = math.nan
     end_time: float = math.nan
     wall_position: np.ndarray | None = None
+    steps: int | None = None
+    """Integration steps taken (plant steps with a fixed step, fewer with an adaptive one; None from the
+    SciPy loop)."""
 
     @property
     def diverged(self) -> bool:

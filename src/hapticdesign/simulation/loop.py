@@ -171,7 +171,9 @@ def simulate_tables(
     plant_record = _plant_record(plant, damping_matrix, friction, hand_mass, hand_stiffness, q_start.copy())
     controller = _controller_record(model, switches, quant, int(sensors.delay_samples))
     motion = records.Motion(prescribed, path_q, path_qd, path_qdd, q_start, np.zeros(n))
-    timing = records.Timing(float(config.step), sub, n_steps, stride)
+    adaptive = config.adaptive(isinstance(plant, ClosedLoopPlant))
+    timing = records.Timing(float(config.step), sub, n_steps, stride, step_spans(sub, stride) if adaptive
+                            else np.ones(1, dtype=np.int64), float(config.tolerance) if adaptive else 0.0)
     handle = handle if wall.cartesian else records.no_handle(n)
     reference = (float(kernel.handle_coordinate(q_start, np.zeros(n), handle, plant_record)) if wall.cartesian
                  else float(q_start[wall.joint]))
@@ -182,12 +184,19 @@ def simulate_tables(
         safety_limit=math.inf if config.safety_limit is None else float(config.safety_limit),
         stop_excursion=math.inf if config.stop_excursion is None else float(config.stop_excursion),
     )
-    written, status, trip, peak, end_time = kernel.run_loop(plant_record, controller, motion, timing, law, handle, rec,
+    written, status, trip, peak, end_time, taken = kernel.run_loop(plant_record, controller, motion, timing, law, handle, rec,
                                                             records.scratch(n, controller.delay))
     t = np.arange(written) * stride * config.step
     q, qd, u, tau_f, tau_imp, tau_c, position = (r[:written] for r in rec)
     return Trace(t, q, qd, u, tau_f, tau_imp, tau_c, int(status), None if trip < 0 else float(trip),
-                 float(peak), float(end_time), position)
+                 float(peak), float(end_time), position, int(taken))
+
+
+def step_spans(sub: int, stride: int) -> np.ndarray:
+    """The spans (plant steps, largest first) an adaptive step may take: the divisors of both the sample
+    period and the record stride, so that steps end on every sample instant and recorded row."""
+    g = math.gcd(sub, stride)
+    return np.array([d for d in range(g, 0, -1) if g % d == 0], dtype=np.int64)
 
 
 def _plant_record(plant: Dynamics, damping, friction, hand_mass, hand_stiffness, hand_rest):

@@ -106,12 +106,16 @@ class Motion(NamedTuple):
 
 
 class Timing(NamedTuple):
-    """Plant step (s), plant steps per sample, plant steps of the run and between recorded rows."""
+    """Plant step (s), plant steps per sample, plant steps of the run and between recorded rows; the
+    spans (in plant steps, largest first, ending in 1) a step may take and the local error tolerance
+    that chooses among them (0: always one plant step, the seed's fixed step; :func:`.kernel.run_loop`)."""
 
     step: float
     sub: int
     n_steps: int
     stride: int
+    spans: np.ndarray
+    tolerance: float
 
 
 class WallLaw(NamedTuple):
@@ -165,8 +169,8 @@ class Records(NamedTuple):
 
 class Scratch(NamedTuple):
     """The loop's own state and scratch (the kernel allocates nothing): state ``q, qd``, held torque
-    ``u`` and its parts, accelerations and constraint torques, RK4 slopes and stage state, the sensor
-    delay line ``buf`` (delay + 1, 3, n) and the sensed ``(q, qd, qdd)``."""
+    ``u`` and its parts, accelerations and constraint torques, RK4 slopes and stage state, the step's
+    end state and its acceleration (the error estimate's fifth slope), a Cartesian wall's ``J_n``, the sensor delay line ``buf`` (delay + 1, 3, n) and the sensed ``(q, qd, qdd)``."""
 
     q: np.ndarray
     qd: np.ndarray
@@ -186,13 +190,17 @@ class Scratch(NamedTuple):
     c1: np.ndarray
     qs: np.ndarray
     qds: np.ndarray
+    q_new: np.ndarray
+    qd_new: np.ndarray
+    a5: np.ndarray
+    jn: np.ndarray
     buf: np.ndarray
     sensed: np.ndarray
 
 
 def scratch(n: int, delay: int) -> Scratch:
     """The loop's state and scratch for ``n`` joints and a sensor delay of ``delay`` samples."""
-    return Scratch(*(np.zeros(n) for _ in range(18)), np.zeros((delay + 1, 3, n)), np.zeros((3, n)))
+    return Scratch(*(np.zeros(n) for _ in range(22)), np.zeros((delay + 1, 3, n)), np.zeros((3, n)))
 
 
 def table(tables) -> Table:

@@ -32,7 +32,7 @@ def _check_wall_damping(value: float) -> None:
 
 
 def _loop_config(period, step, duration, counts, delay, error_percent, inertial, coriolis, gravity,
-                 wall_damping, hand_mass, hand_damping, hand_stiffness):
+                 wall_damping, hand_mass, hand_damping, hand_stiffness, step_control="auto"):
     from hapticdesign.simulation.config import Compensator, Hand, LoopConfig, Sensors, Wall
 
     _check_error_percent(error_percent)
@@ -50,8 +50,10 @@ def _loop_config(period, step, duration, counts, delay, error_percent, inertial,
         compensator=Compensator(inertial, coriolis, gravity, error_percent),
         wall=Wall(damping=wall_damping),
         hand=hand,
+        step_control=step_control,
     )
     config.steps_per_sample()
+    config.adaptive(False)
     return config
 
 
@@ -64,6 +66,10 @@ def _sim_type(value: int) -> int:
 # Options shared by the device-level commands.
 PERIOD = typer.Option(1e-3, help="Sample period T of the digital side [s].")
 STEP = typer.Option(1e-4, help="Plant integration step [s]; must divide the period.")
+STEP_CONTROL = typer.Option(
+    "auto", help="fixed (RK4 at --step, the seed's), adaptive (RK4 over several plant steps within a sample period "
+                 "while its local error estimate stays below 1e-9) or auto (fixed for open chains, adaptive for "
+                 "closed-loop devices).")
 COUNTS = typer.Option(None, help="Encoder counts per revolution (position quantization); none by default.")
 DELAY = typer.Option(0, help="Sensor delay in samples.")
 ERROR = typer.Option(0.0, help="Compensator modelling error in percent (scales its inertial parameters).")
@@ -115,7 +121,8 @@ def impedance_range_command(
     safety: float = typer.Option(0.06, help="Safety switch excursion [rad] (Figure 4.7)."),
     true_boundary: bool = typer.Option(False, "--true-boundary", help="Also bisect the oscillation-growth boundary."),
     duration: float = typer.Option(5.0, help="Simulated time per stiffness [s]."),
-    period: float = PERIOD, step: float = STEP, counts: Optional[int] = COUNTS, delay: int = DELAY,
+    period: float = PERIOD, step: float = STEP, step_control: str = STEP_CONTROL, counts: Optional[int] = COUNTS,
+    delay: int = DELAY,
     error_percent: float = ERROR, inertial: bool = INERTIAL, coriolis: bool = CORIOLIS, gravity: bool = GRAVITY,
     wall_damping: float = WALL_DAMPING, hand_mass: float = HAND_MASS, hand_damping: float = HAND_DAMPING,
     hand_stiffness: float = HAND_STIFFNESS,
@@ -139,8 +146,8 @@ def impedance_range_command(
                             f"({duration:g} s)")
         dev = resolve_device(preset, device, params, strict=strict)
         config = _with_direction(_loop_config(period, step, duration, counts, delay, error_percent, inertial, coriolis,
-                                              gravity, wall_damping, hand_mass, hand_damping, hand_stiffness),
-                                 wall_direction)
+                                              gravity, wall_damping, hand_mass, hand_damping, hand_stiffness,
+                                              step_control), wall_direction)
         if method not in ("fast", "linear", "analytic"):
             raise UserError(f"--method must be 'fast', 'linear' or 'analytic', got {method!r}")
         if k_limit < 1:
@@ -194,7 +201,8 @@ def transparency_command(
     response: Optional[Path] = typer.Option(None, help="Write the frequency response (CSV) here."),
     method: str = typer.Option("simulation", help="simulation (run the loop) or analytic (the loop linearized at the "
                                                   "start pose: the same estimate, plus the steady-state response)."),
-    period: float = PERIOD, step: float = STEP, counts: Optional[int] = COUNTS, delay: int = DELAY,
+    period: float = PERIOD, step: float = STEP, step_control: str = STEP_CONTROL, counts: Optional[int] = COUNTS,
+    delay: int = DELAY,
     error_percent: float = ERROR, inertial: bool = INERTIAL, coriolis: bool = CORIOLIS, gravity: bool = GRAVITY,
     wall_damping: float = WALL_DAMPING,
     strict: bool = STRICT,
@@ -211,7 +219,7 @@ def transparency_command(
         _check_chirp(amplitude, f0, f1, sweep, period)
         dev = resolve_device(preset, device, params, strict=strict)
         config = _loop_config(period, step, sweep, counts, delay, error_percent, inertial, coriolis, gravity,
-                              wall_damping, 0.0, 0.0, 0.0)
+                              wall_damping, 0.0, 0.0, 0.0, step_control)
         if not (band > 0):
             raise UserError(f"--band must be positive, got {band}")
         if method not in ("simulation", "analytic"):
