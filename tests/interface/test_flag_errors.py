@@ -21,6 +21,8 @@ runner = CliRunner()
     (["eom", "--format", "rtf"], "error: --format: expected latex, python or text, got 'rtf'"),
     (["rcube", "tolerance", "--samples", "0"], "error: --samples must be at least 1, got 0"),
     (["rcube", "tolerance", "--samples", "1", "--grid", "1"], "error: --grid must be at least 2, got 1"),
+    (["impedance-range", "--step-control", "rk45"],
+     "error: unknown step control 'rk45'; choose one of auto, fixed, adaptive (--step-control)"),
     (["eom", "--preset", "phantom-3dof", "--device", "x.yaml"],
      "error: give either a preset or a device file, not both (--preset, --device)"),
 ])

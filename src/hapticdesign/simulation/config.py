@@ -15,7 +15,7 @@ import numpy as np
 
 from hapticdesign.analysis.dynamics.device import dynamics_of
 from hapticdesign.analysis.kinematics import actuated_jacobian
-from hapticdesign.errors import UserError
+from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.device import Device
 from hapticdesign.model.inertia import SEED_FIELDS
 
@@ -150,9 +150,10 @@ class LoopConfig:
     def adaptive(self, closed_loop: bool) -> bool:
         """Whether the run controls its steps by error (``step_control``, for a closed-loop device or not)."""
         if self.step_control not in STEP_CONTROLS:
-            raise UserError(f"unknown step control {self.step_control!r}; choose one of {', '.join(STEP_CONTROLS)}")
+            raise InputError(f"unknown step control {str(self.step_control)[:40]!r}; choose one of "
+                             f"{', '.join(STEP_CONTROLS)}", "step_control")
         if not (self.tolerance > 0 and math.isfinite(self.tolerance)):
-            raise UserError(f"the step tolerance must be a positive number, got {self.tolerance}")
+            raise InputError(f"the step tolerance must be a positive number, got {self.tolerance}", "tolerance")
         return self.step_control == "adaptive" or (self.step_control == "auto" and closed_loop)
 
     def steps_per_sample(self) -> int:
