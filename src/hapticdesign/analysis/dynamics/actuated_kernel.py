@@ -188,17 +188,21 @@ def reduce_pose(parent, axis, plan, body_node, actuated, passive, ws):
 
 
 @njit(cache=True, inline="always")
-def velocity_state(qd_a, j, k, parent, axis, plan, frame_a, frame_b, row_loop, row_comp, passive, ws):
+def velocity_state(qd_a, j, k, axis, plan, motion, frame_a, frame_b, row_loop, row_comp, passive, ws):
     """Node motions at ``qd = T qd_a`` and ``qdd = [0; gamma]``, ``gamma = -Phi_p^-1 (Phidot qd)``, into ``ws``.
 
-    ``j >= 0`` takes the rate vector ``e_j`` (plus ``e_k`` when ``k != j``) instead of ``qd_a``. The node
-    motions at ``qdd = 0`` give ``Phidot qd`` (:func:`closure_bias`); the passive joints' accelerations
-    ``gamma`` then add theirs (:func:`add_joint_accelerations`, joint values' accelerations ``coef [0; gamma]``).
+    ``j >= 0`` takes the rate vector ``e_j`` (plus ``e_k`` when ``k != j``) instead of ``qd_a``; ``motion``:
+    the arrays of a :class:`~hapticdesign.analysis.loops.solver.MotionPlan` that keeps the bodies' and the
+    closures' nodes. The node motions at ``qdd = 0`` give ``Phidot qd`` (:func:`closure_bias`); the passive
+    joints' accelerations ``gamma`` then add theirs (:func:`add_joint_accelerations`, joint values'
+    accelerations ``coef [0; gamma]``).
     """
     rot, pos, w, al, ac, _, _, pinv, _, node_t, rate, _, bias, gamma, _, slot, dal, dac = ws
     _, _, ptr, index, value, _, _, _ = plan
+    order = motion[0]
     npas = passive.shape[0]
-    for n in range(rate.shape[0]):
+    for i in range(order.shape[0]):
+        n = order[i]
         if j >= 0:
             rate[n] = node_t[n, j] + (node_t[n, k] if k != j else 0.0)
         else:
@@ -206,21 +210,22 @@ def velocity_state(qd_a, j, k, parent, axis, plan, frame_a, frame_b, row_loop, r
             for c in range(qd_a.shape[0]):
                 acc += node_t[n, c] * qd_a[c]
             rate[n] = acc
-    node_motion(rate, parent, axis, rot, pos, w, al, ac)
+    node_motion(rate, motion, axis, rot, pos, w, al, ac)
     closure_bias(frame_a, frame_b, row_loop, row_comp, al, ac, bias)
     for r in range(npas):
         acc = 0.0
         for i in range(npas):
             acc -= pinv[r, i] * bias[i]
         gamma[r] = acc
-    for n in range(rate.shape[0]):
+    for i in range(order.shape[0]):
+        n = order[i]
         acc = 0.0
         for c in range(ptr[n], ptr[n + 1]):
             r = slot[index[c]]
             if r >= 0:
                 acc += value[c] * gamma[r]
         rate[n] = acc
-    add_joint_accelerations(rate, parent, axis, rot, pos, al, ac, dal, dac)
+    add_joint_accelerations(rate, motion, axis, rot, pos, al, ac, dal, dac)
 
 
 @njit(cache=True)
@@ -328,7 +333,7 @@ def _state(j, na):
 
 
 @njit(cache=True)
-def actuated_entries(qs, parent, axis, offset, const_rot, const_pos, plan, body_node, gravity,
+def actuated_entries(qs, parent, axis, offset, const_rot, const_pos, plan, motion, body_node, gravity,
                      frame_a, frame_b, row_loop, row_comp, actuated, passive, params):
     """Entries (unique H, C, G) in actuated coordinates at closed full poses ``qs`` (P, N) for parameter
     sets ``params`` (K, 10 B): (P, K, E), and the pivot ratio of ``Phi_p`` per pose (0: singular)."""
@@ -367,7 +372,7 @@ def actuated_entries(qs, parent, axis, offset, const_rot, const_pos, plan, body_
         st = 0
         for j in range(na):
             for k in range(j, na):
-                velocity_state(empty, j, k, parent, axis, plan, frame_a, frame_b, row_loop, row_comp, passive, ws)
+                velocity_state(empty, j, k, axis, plan, motion, frame_a, frame_b, row_loop, row_comp, passive, ws)
                 for s in range(n_sets):
                     for b in range(n_body):
                         nb = body_node[b]
@@ -406,7 +411,7 @@ def _body_motion(w, al, ac, nb, rb, out):
 
 
 @njit(cache=True)
-def actuated_regressor(qs, parent, axis, offset, const_rot, const_pos, plan, body_node, gravity,
+def actuated_regressor(qs, parent, axis, offset, const_rot, const_pos, plan, motion, body_node, gravity,
                        frame_a, frame_b, row_loop, row_comp, actuated, passive):
     """Regressor of the entries (unique H, C, G) in actuated coordinates at closed full poses ``qs`` (P, N):
     (P, E, 10 B), and the pivot ratio of ``Phi_p`` per pose (0: singular). Body axes throughout."""
@@ -446,7 +451,7 @@ def actuated_regressor(qs, parent, axis, offset, const_rot, const_pos, plan, bod
         st = 0
         for j in range(na):
             for k in range(j, na):
-                velocity_state(empty, j, k, parent, axis, plan, frame_a, frame_b, row_loop, row_comp, passive, ws)
+                velocity_state(empty, j, k, axis, plan, motion, frame_a, frame_b, row_loop, row_comp, passive, ws)
                 for b in range(n_body):
                     _body_motion(w, al, ac, body_node[b], rb[b], mb)
                     _wrench_regressor(mb[0], mb[1], mb[2], wrench)

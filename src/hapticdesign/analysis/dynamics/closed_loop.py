@@ -20,7 +20,7 @@ import numpy as np
 
 from hapticdesign.analysis.dynamics.actuated_kernel import actuated_entries, actuated_regressor
 from hapticdesign.analysis.dynamics.model import DynamicsModel, pair_index
-from hapticdesign.analysis.loops.solver import MESSAGES, SINGULAR_RATIO, LoopSolver
+from hapticdesign.analysis.loops.solver import MESSAGES, SINGULAR_RATIO, LoopSolver, MotionPlan
 from hapticdesign.analysis.loops.closure_kernel import SINGULAR
 from hapticdesign.errors import UserError
 from hapticdesign.model.mechanism import Mechanism
@@ -40,6 +40,9 @@ class ClosedLoopModel(DynamicsModel):
         self.mechanism = mechanism
         self.compiled = mechanism.compiled
         self.solver = LoopSolver(mechanism)
+        a = self.solver.arrays
+        self.motion = MotionPlan.of(self.compiled.tree, [*self.compiled.tree.body_node, *a.frame_a, *a.frame_b])
+        """The nodes whose motions the velocity terms read: the bodies' and the closures'."""
         self.n_dof = mechanism.n_actuated
         self.n_params = 10 * len(mechanism.bodies)
         self.pairs = pair_index(self.n_dof)
@@ -54,7 +57,7 @@ class ClosedLoopModel(DynamicsModel):
         """Entries for parameter sets (P, S, E), or the regressor (P, E, n_params) when ``params`` is None."""
         c, a, t = self.compiled, self.solver.arrays, self.compiled.tree
         args = (np.ascontiguousarray(q_full, dtype=float), t.parent, t.axis, t.offset, t.const_rot, t.const_pos,
-                self.solver.plan.arrays, t.body_node, c.gravity,
+                self.solver.plan.arrays, self.motion.arrays, t.body_node, c.gravity,
                 a.frame_a, a.frame_b, a.row_loop, a.row_comp, a.actuated, a.passive)
         if params is None:
             out, ratios = actuated_regressor(*args)

@@ -28,7 +28,7 @@ from hapticdesign.analysis.loops import closure_kernel as ck
 from hapticdesign.errors import UserError
 from hapticdesign.model.loops import ClosedLoops
 from hapticdesign.model.mechanism import Mechanism
-from hapticdesign.model.walk import node_poses
+from hapticdesign.model.walk import CONSTANT, KinematicTree, node_poses
 
 MAX_STEP = 0.1
 """Largest continuation step in the actuated coordinates (rad or m) before Newton."""
@@ -69,6 +69,49 @@ class LoopArrays:
             actuated=np.array(loops.actuated(mech.n_dof), dtype=np.int64),
             passive=np.array(loops.passive, dtype=np.int64),
         )
+
+
+@dataclass(frozen=True)
+class MotionPlan:
+    """The nodes whose motions (:func:`.closure_kernel.node_motion`) a set of nodes needs, in tree order.
+
+    Those nodes and, among their ancestors, the variable ones: the others (constants, fixed
+    translations) only carry a motion along a rigid offset, which the next kept node takes from its
+    kept ancestor ``parent[i]`` (``-1``: the base) over the origin difference. ``moves[i]`` is False when
+    node ``order[i]`` has its kept ancestor's origin (only rotations between them), so that its origin
+    acceleration is the ancestor's.
+    """
+
+    order: np.ndarray
+    parent: np.ndarray
+    moves: np.ndarray
+
+    @classmethod
+    def of(cls, tree: KinematicTree, needed: list[int]) -> "MotionPlan":
+        variable = np.any(tree.coef != 0.0, axis=1)
+        path: set[int] = set()
+        for node in needed:
+            while node >= 0 and node not in path:
+                path.add(node)
+                node = int(tree.parent[node])
+        order = sorted(n for n in path if variable[n] or n in needed)
+        kept = set(order)
+        parents, moves = [], []
+        for n in order:
+            e, moved = n, False
+            while e >= 0 and (e == n or e not in kept):
+                shift = tree.axis[e] >= 3 if tree.axis[e] != CONSTANT else bool(np.any(tree.const_pos[e] != 0.0))
+                moved = moved or bool(shift)
+                e = int(tree.parent[e])
+            parents.append(e)
+            moves.append(moved)
+        return cls(order=np.array(order, dtype=np.int64), parent=np.array(parents, dtype=np.int64),
+                   moves=np.array(moves, dtype=np.bool_))
+
+    @property
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(order, parent, moves)``, the ``motion`` of the kernels."""
+        return self.order, self.parent, self.moves
 
 
 class LoopSolver:
