@@ -188,19 +188,16 @@ def reduce_pose(parent, axis, plan, body_node, actuated, passive, ws):
 
 
 @njit(cache=True, inline="always")
-def velocity_state(qd_a, j, k, axis, plan, motion, frame_a, frame_b, row_loop, row_comp, passive, ws):
-    """Node motions at ``qd = T qd_a`` and ``qdd = [0; gamma]``, ``gamma = -Phi_p^-1 (Phidot qd)``, into ``ws``.
+def motion_state(qd_a, j, k, axis, motion, frame_a, frame_b, row_loop, row_comp, ws):
+    """Node motions at ``qd = T qd_a`` and ``qdd = 0`` and the closures' bias ``Phidot qd`` (:func:`closure_bias`)
+    into ``ws``.
 
     ``j >= 0`` takes the rate vector ``e_j`` (plus ``e_k`` when ``k != j``) instead of ``qd_a``; ``motion``:
     the arrays of a :class:`~hapticdesign.analysis.loops.solver.MotionPlan` that keeps the bodies' and the
-    closures' nodes. The node motions at ``qdd = 0`` give ``Phidot qd`` (:func:`closure_bias`); the passive
-    joints' accelerations ``gamma`` then add theirs (:func:`add_joint_accelerations`, joint values'
-    accelerations ``coef [0; gamma]``).
+    closures' nodes.
     """
-    rot, pos, w, al, ac, _, _, pinv, _, node_t, rate, _, bias, gamma, _, slot, dal, dac = ws
-    _, _, ptr, index, value, _, _, _ = plan
+    rot, pos, w, al, ac, _, _, _, _, node_t, rate, _, bias, _, _, _, _, _ = ws
     order = motion[0]
-    npas = passive.shape[0]
     for i in range(order.shape[0]):
         n = order[i]
         if j >= 0:
@@ -212,6 +209,21 @@ def velocity_state(qd_a, j, k, axis, plan, motion, frame_a, frame_b, row_loop, r
             rate[n] = acc
     node_motion(rate, motion, axis, rot, pos, w, al, ac)
     closure_bias(frame_a, frame_b, row_loop, row_comp, al, ac, bias)
+
+
+@njit(cache=True, inline="always")
+def velocity_state(qd_a, j, k, axis, plan, motion, frame_a, frame_b, row_loop, row_comp, passive, ws):
+    """Node motions at ``qd = T qd_a`` and ``qdd = [0; gamma]``, ``gamma = -Phi_p^-1 (Phidot qd)``, into ``ws``.
+
+    The node motions at ``qdd = 0`` (:func:`motion_state`, same arguments) give ``Phidot qd``; the passive
+    joints' accelerations ``gamma`` then add theirs (:func:`add_joint_accelerations`, joint values'
+    accelerations ``coef [0; gamma]``).
+    """
+    rot, pos, _, al, ac, _, _, pinv, _, _, rate, _, bias, gamma, _, slot, dal, dac = ws
+    _, _, ptr, index, value, _, _, _ = plan
+    order = motion[0]
+    npas = passive.shape[0]
+    motion_state(qd_a, j, k, axis, motion, frame_a, frame_b, row_loop, row_comp, ws)
     for r in range(npas):
         acc = 0.0
         for i in range(npas):
@@ -290,9 +302,10 @@ def body_wrench(w, al, ac, nb, pw, s, b):
 
 
 @njit(cache=True, inline="always")
-def mass_and_gravity(ja, b, gravity, pw, s, h, g):
+def mass_and_gravity(ja, b, gravity, pw, s, h, g, mj):
     """Add body ``b``'s ``(J_b T)^T M (J_b T)`` to ``h`` (n x n) and ``-(J_b T)^T`` of its weight's wrench to
-    ``g`` (eq. 2.44, 2.46), world parameters ``pw[s, b]``: ``M [v; w] = [m v + w x h; h x v + J w]``."""
+    ``g`` (eq. 2.44, 2.46), world parameters ``pw[s, b]``: ``M [v; w] = [m v + w x h; h x v + J w]``.
+    ``mj`` (6 x n) receives ``M (J_b T)``."""
     m, h0, h1, h2 = pw[s, b, 0], pw[s, b, 1], pw[s, b, 2], pw[s, b, 3]
     jxx, jyy, jzz, jxy, jxz, jyz = pw[s, b, 4], pw[s, b, 5], pw[s, b, 6], pw[s, b, 7], pw[s, b, 8], pw[s, b, 9]
     for j in range(ja.shape[2]):
@@ -304,6 +317,7 @@ def mass_and_gravity(ja, b, gravity, pw, s, h, g):
         mw0 = h1 * v2 - h2 * v1 + jxx * w0 + jxy * w1 + jxz * w2
         mw1 = h2 * v0 - h0 * v2 + jxy * w0 + jyy * w1 + jyz * w2
         mw2 = h0 * v1 - h1 * v0 + jxz * w0 + jyz * w1 + jzz * w2
+        mj[0, j], mj[1, j], mj[2, j], mj[3, j], mj[4, j], mj[5, j] = mv0, mv1, mv2, mw0, mw1, mw2
         g[j] -= gravity[0] * mv0 + gravity[1] * mv1 + gravity[2] * mv2
         for i in range(j + 1):
             e = (ja[b, 0, i] * mv0 + ja[b, 1, i] * mv1 + ja[b, 2, i] * mv2
@@ -311,6 +325,40 @@ def mass_and_gravity(ja, b, gravity, pw, s, h, g):
             h[i, j] += e
             if i != j:
                 h[j, i] += e
+
+
+@njit(cache=True, inline="always")
+def passive_inertia(nb, parent, axis, plan, slot, rot, pos, mj, hap):
+    """Add a body's ``(J_b T)^T M J_b,p`` to ``hap`` (n_a x n_p), from ``mj = M (J_b T)`` (:func:`mass_and_gravity`).
+
+    ``J_b,p``: the passive coordinates' columns of the Jacobian of the body origin (node ``nb``) on the
+    loop-opened tree, the unit twists of the nodes they move (as :func:`reduce_pose`), weighted by their
+    coupling coefficients. ``hap`` is the inertia coupling of the actuated motions to the passive joints'
+    accelerations: ``T^T H [0; gamma] = hap gamma``.
+    """
+    _, _, ptr, index, value, _, _, _ = plan
+    e = nb
+    while e >= 0:
+        moved = False
+        for c in range(ptr[e], ptr[e + 1]):
+            moved = moved or slot[index[c]] >= 0
+        if moved:
+            a = axis[e] % 3
+            u0, u1, u2 = rot[e, 0, a], rot[e, 1, a], rot[e, 2, a]
+            if axis[e] < 3:
+                r0, r1, r2 = pos[nb, 0] - pos[e, 0], pos[nb, 1] - pos[e, 1], pos[nb, 2] - pos[e, 2]
+                v0, v1, v2 = u1 * r2 - u2 * r1, u2 * r0 - u0 * r2, u0 * r1 - u1 * r0
+                w0, w1, w2 = u0, u1, u2
+            else:
+                v0, v1, v2 = u0, u1, u2
+                w0 = w1 = w2 = 0.0
+            for i in range(mj.shape[1]):
+                d = mj[0, i] * v0 + mj[1, i] * v1 + mj[2, i] * v2 + mj[3, i] * w0 + mj[4, i] * w1 + mj[5, i] * w2
+                for c in range(ptr[e], ptr[e + 1]):
+                    r = slot[index[c]]
+                    if r >= 0:
+                        hap[i, r] += value[c] * d
+        e = parent[e]
 
 
 @njit(cache=True)
@@ -333,6 +381,89 @@ def _state(j, na):
 
 
 @njit(cache=True)
+def entries_scratch(n_sets, na, npas, n_body):
+    """Scratch of :func:`pose_entries`: ``(pw, h, hap, kmat, mj, biases, empty)``, world parameters per set,
+    ``H_a``, the passive inertia coupling and ``-hap Phi_p^-1`` per set, ``M (J_b T)``, the closures' bias of
+    each rate vector of the polarization and no rate vector (:func:`motion_state` takes the unit ones)."""
+    return (np.zeros((n_sets, n_body, 10)), np.zeros((n_sets, na, na)), np.zeros((n_sets, na, npas)),
+            np.zeros((n_sets, na, npas)), np.zeros((6, na)), np.zeros((na * (na + 1) // 2, npas)), np.zeros(0))
+
+
+@njit(cache=True, inline="always")
+def pose_entries(tree, loops, params, active, ws, scratch, out):
+    """Entries (unique H, C, G) at a closed pose whose node poses, ``Phi`` and ``Phi_p^-1`` are in ``ws``, for
+    the parameter sets ``params`` (K, 10 B), added into ``out`` (K, E) (zero on entry).
+
+    ``tree``: ``(parent, axis, plan, motion, body_node, gravity)``; ``loops``: ``(frame_a, frame_b, row_loop,
+    row_comp, actuated, passive)``; ``scratch``: :func:`entries_scratch`. The velocity terms of a rate vector
+    ``e`` are ``T^T c(q, T e) + hap gamma`` with ``gamma = -Phi_p^-1 (Phidot T e)``: the body wrenches at the
+    node motions of ``qdd = 0`` (:func:`motion_state`) and the closures' bias through
+    ``kmat = -hap Phi_p^-1`` (:func:`passive_inertia`), one tree pass per rate vector. ``scratch``'s
+    ``biases`` keep each rate vector's ``Phidot T e``.
+    """
+    parent, axis, plan, motion, body_node, gravity = tree
+    frame_a, frame_b, row_loop, row_comp, actuated, passive = loops
+    pw, h, hap, kmat, mj, biases, empty = scratch
+    rot, pos, w, al, ac, pinv, ja, bias, slot = ws[0], ws[1], ws[2], ws[3], ws[4], ws[7], ws[11], ws[12], ws[15]
+    na = actuated.shape[0]
+    npas = passive.shape[0]
+    n_body = body_node.shape[0]
+    n_sets = params.shape[0]
+    m = na * (na + 1) // 2
+    reduce_pose(parent, axis, plan, body_node, actuated, passive, ws)
+    h[:] = 0.0
+    hap[:] = 0.0
+    for s in range(n_sets):
+        world_parameters(rot, body_node, params, s, pw)
+        g = out[s, m + na * m:]
+        for b in range(n_body):
+            if active[b] and body_node[b] >= 0:
+                mass_and_gravity(ja, b, gravity, pw, s, h[s], g, mj)
+                passive_inertia(body_node[b], parent, axis, plan, slot, rot, pos, mj, hap[s])
+        e = 0
+        for i in range(na):
+            for j in range(i, na):
+                out[s, e] = h[s, i, j]
+                e += 1
+        for i in range(na):
+            for r in range(npas):
+                acc = 0.0
+                for c in range(npas):
+                    acc -= hap[s, i, c] * pinv[c, r]
+                kmat[s, i, r] = acc
+    st = 0
+    for j in range(na):
+        for k in range(j, na):
+            motion_state(empty, j, k, axis, motion, frame_a, frame_b, row_loop, row_comp, ws)
+            for r in range(npas):
+                biases[st, r] = bias[r]
+            for s in range(n_sets):
+                for i in range(na):
+                    acc = 0.0
+                    for r in range(npas):
+                        acc += kmat[s, i, r] * bias[r]
+                    out[s, m + i * m + st] += acc
+                for b in range(n_body):
+                    nb = body_node[b]
+                    if not active[b] or nb < 0:
+                        continue
+                    f0, f1, f2, n0, n1, n2 = body_wrench(w, al, ac, nb, pw, s, b)
+                    for i in range(na):
+                        out[s, m + i * m + st] += (ja[b, 0, i] * f0 + ja[b, 1, i] * f1 + ja[b, 2, i] * f2
+                                                   + ja[b, 3, i] * n0 + ja[b, 4, i] * n1 + ja[b, 5, i] * n2)
+            st += 1
+    # polarization: the state (j, k), j < k, held C(e_j + e_k); the cross term is what exceeds (j, j) + (k, k)
+    for s in range(n_sets):
+        for i in range(na):
+            st = 0
+            for j in range(na):
+                for k in range(j, na):
+                    if k != j:
+                        out[s, m + i * m + st] -= out[s, m + i * m + _state(j, na)] + out[s, m + i * m + _state(k, na)]
+                    st += 1
+
+
+@njit(cache=True)
 def actuated_entries(qs, parent, axis, offset, const_rot, const_pos, plan, motion, body_node, gravity,
                      frame_a, frame_b, row_loop, row_comp, actuated, passive, params):
     """Entries (unique H, C, G) in actuated coordinates at closed full poses ``qs`` (P, N) for parameter
@@ -345,54 +476,16 @@ def actuated_entries(qs, parent, axis, offset, const_rot, const_pos, plan, motio
     out = np.zeros((n_pose, n_sets, m + na * m + na))
     ratios = np.zeros(n_pose)
     ws = workspace(parent.shape[0], n_dof, na, passive, n_body)
-    rot, w, al, ac, ja = ws[0], ws[2], ws[3], ws[4], ws[11]
+    scratch = entries_scratch(n_sets, na, passive.shape[0], n_body)
+    tree = (parent, axis, plan, motion, body_node, gravity)
+    loops = (frame_a, frame_b, row_loop, row_comp, actuated, passive)
     active = active_bodies(params)
-    pw = np.zeros((n_sets, n_body, 10))
-    h = np.zeros((n_sets, na, na))
-    empty = np.zeros(0)
     for p in range(n_pose):
         ratio, _ = factor_pose(qs[p], parent, axis, offset, const_rot, const_pos, plan, frame_a, frame_b, row_loop, row_comp,
                                passive, ws)
         ratios[p] = ratio
-        if ratio == 0.0:
-            continue
-        reduce_pose(parent, axis, plan, body_node, actuated, passive, ws)
-        h[:] = 0.0
-        for s in range(n_sets):
-            world_parameters(rot, body_node, params, s, pw)
-            g = out[p, s, m + na * m:]
-            for b in range(n_body):
-                if active[b] and body_node[b] >= 0:
-                    mass_and_gravity(ja, b, gravity, pw, s, h[s], g)
-            e = 0
-            for i in range(na):
-                for j in range(i, na):
-                    out[p, s, e] = h[s, i, j]
-                    e += 1
-        st = 0
-        for j in range(na):
-            for k in range(j, na):
-                velocity_state(empty, j, k, axis, plan, motion, frame_a, frame_b, row_loop, row_comp, passive, ws)
-                for s in range(n_sets):
-                    for b in range(n_body):
-                        nb = body_node[b]
-                        if not active[b] or nb < 0:
-                            continue
-                        f0, f1, f2, n0, n1, n2 = body_wrench(w, al, ac, nb, pw, s, b)
-                        for i in range(na):
-                            out[p, s, m + i * m + st] += (ja[b, 0, i] * f0 + ja[b, 1, i] * f1 + ja[b, 2, i] * f2
-                                                          + ja[b, 3, i] * n0 + ja[b, 4, i] * n1 + ja[b, 5, i] * n2)
-                st += 1
-        # polarization: the state (j, k), j < k, held C(e_j + e_k); the cross term is what exceeds (j, j) + (k, k)
-        for s in range(n_sets):
-            for i in range(na):
-                st = 0
-                for j in range(na):
-                    for k in range(j, na):
-                        if k != j:
-                            out[p, s, m + i * m + st] -= (out[p, s, m + i * m + _state(j, na)]
-                                                          + out[p, s, m + i * m + _state(k, na)])
-                        st += 1
+        if ratio != 0.0:
+            pose_entries(tree, loops, params, active, ws, scratch, out[p])
     return out, ratios
 
 
