@@ -34,12 +34,15 @@ from numba import njit
 
 from hapticdesign.analysis.dynamics.kernel import body_regressor
 from hapticdesign.analysis.loops.closure_kernel import (
+    OK,
     add_joint_accelerations,
     closure_bias,
     closure_jacobian,
     lu_in_place,
+    newton_into,
     node_motion,
     rotation_entry,
+    solve_path,
 )
 from hapticdesign.model.walk import planned_poses, trig_workspace
 
@@ -487,6 +490,104 @@ def actuated_entries(qs, parent, axis, offset, const_rot, const_pos, plan, motio
         if ratio != 0.0:
             pose_entries(tree, loops, params, active, ws, scratch, out[p])
     return out, ratios
+
+
+@njit(cache=True)
+def motion_entries(path, q_start, sign0, parent, axis, offset, const_rot, const_pos, plan, motion, body_node, gravity,
+                   frame_a, frame_b, row_loop, row_comp, actuated, passive, params, settings):
+    """Entries (unique H, C, G) in actuated coordinates along a motion: the actuated poses ``path`` (P, n_a) in
+    order, the passive values continued from the closed full pose ``q_start`` on the branch ``sign0`` (as
+    :func:`~hapticdesign.analysis.loops.closure_kernel.solve_path`), for parameter sets ``params`` (K, 10 B).
+
+    ``settings``: ``(max_step, tol, max_iter, singular_ratio, min_fraction)`` of the loop solver. Returns the
+    entries (P, K, E), the per-pose status (OK until the first failure) and the index of the first failed pose
+    (-1 if none). From the second pose on, a step within ``max_step`` is predicted to second order from the
+    last pose, ``dq_p = S dq_a + gamma / 2`` with ``gamma = -Phi_p^-1 (Phidot T dq_a)`` (the passive
+    accelerations of the straight actuated segment, from the closures' biases that :func:`pose_entries` kept
+    per rate vector, by polarization), and corrected by Newton, which leaves ``Phi``, ``Phi_p^-1`` and the
+    closures' node poses for the entries. A second-order term or a correction above half the step (a jump),
+    a failed Newton or another sign of ``det Phi_p`` hands the pose to ``solve_path`` (tangent predictor,
+    step halving), as does the first pose.
+    """
+    max_step, tol, max_iter, singular_ratio, min_fraction = settings
+    n_pose = path.shape[0]
+    n_dof = q_start.shape[0]
+    na = actuated.shape[0]
+    npas = passive.shape[0]
+    n_body = body_node.shape[0]
+    n_sets = params.shape[0]
+    m = na * (na + 1) // 2
+    out = np.zeros((n_pose, n_sets, m + na * m + na))
+    status = np.zeros(n_pose, dtype=np.int64)
+    ws = workspace(parent.shape[0], n_dof, na, passive, n_body)
+    scratch = entries_scratch(n_sets, na, npas, n_body)
+    tree = (parent, axis, plan, motion, body_node, gravity)
+    loops = (frame_a, frame_b, row_loop, row_comp, actuated, passive)
+    active = active_bodies(params)
+    rot, pos, phi, lu, pinv, t, trig, biases = ws[0], ws[1], ws[5], ws[6], ws[7], ws[8], ws[14], scratch[5]
+    q = q_start.copy()
+    q_last = np.empty(n_dof)
+    res, rhs, bias, half_gamma, predicted = np.empty(npas), np.empty((npas, 1)), np.empty(npas), np.empty(npas), np.empty(npas)
+    for p in range(n_pose):
+        dist = 0.0
+        for j in range(na):
+            dist = max(dist, abs(path[p, j] - q[actuated[j]]))
+        fast = p > 0 and dist <= max_step
+        if fast:
+            for r in range(npas):
+                bias[r] = 0.0
+            st = 0
+            for j in range(na):
+                dj = path[p, j] - q[actuated[j]]
+                for k in range(j, na):
+                    dk = path[p, k] - q[actuated[k]]
+                    for r in range(npas):
+                        if k == j:
+                            bias[r] += dj * dj * biases[st, r]
+                        else:
+                            bias[r] += dj * dk * (biases[st, r] - biases[_state(j, na), r] - biases[_state(k, na), r])
+                    st += 1
+            for r in range(npas):
+                acc = 0.0
+                for i in range(npas):
+                    acc -= pinv[r, i] * bias[i]
+                half_gamma[r] = 0.5 * acc
+                fast = fast and abs(half_gamma[r]) <= 0.5 * dist
+        if fast:
+            for k in range(n_dof):
+                q_last[k] = q[k]
+            for j in range(na):
+                delta = path[p, j] - q[actuated[j]]
+                for r in range(npas):
+                    q[passive[r]] += t[passive[r], j] * delta
+                q[actuated[j]] = path[p, j]
+            for r in range(npas):
+                q[passive[r]] += half_gamma[r]
+                predicted[r] = q[passive[r]]
+            code, sign, _ = newton_into(q, actuated, passive, parent, axis, offset, const_rot, const_pos, plan, frame_a,
+                                        frame_b, row_loop, row_comp, tol, max_iter, singular_ratio, rot, pos, trig, res,
+                                        phi, rhs, lu, pinv)
+            fast = code == OK and sign == sign0
+            for r in range(npas):
+                fast = fast and abs(q[passive[r]] - predicted[r]) <= 0.5 * dist + 1e-9
+            if fast:
+                planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, plan[1], parent.shape[0], rot, pos, trig)
+            else:
+                for k in range(n_dof):
+                    q[k] = q_last[k]
+        if not fast:
+            solved, codes, first = solve_path(path[p:p + 1], q, sign0, actuated, passive, parent, axis, offset, const_rot,
+                                              const_pos, plan, frame_a, frame_b, row_loop, row_comp, max_step, tol,
+                                              max_iter, singular_ratio, min_fraction)
+            if first >= 0:
+                status[p] = codes[0]
+                return out, status, p
+            for k in range(n_dof):
+                q[k] = solved[0, k]
+            factor_pose(q, parent, axis, offset, const_rot, const_pos, plan, frame_a, frame_b, row_loop, row_comp,
+                        passive, ws)
+        pose_entries(tree, loops, params, active, ws, scratch, out[p])
+    return out, status, -1
 
 
 @njit(cache=True, inline="always")

@@ -18,7 +18,7 @@ import copy
 
 import numpy as np
 
-from hapticdesign.analysis.dynamics.actuated_kernel import actuated_entries, actuated_regressor
+from hapticdesign.analysis.dynamics.actuated_kernel import actuated_entries, actuated_regressor, motion_entries
 from hapticdesign.analysis.dynamics.model import DynamicsModel, pair_index
 from hapticdesign.analysis.loops.solver import MESSAGES, SINGULAR_RATIO, LoopSolver, MotionPlan
 from hapticdesign.analysis.loops.closure_kernel import SINGULAR
@@ -84,8 +84,23 @@ class ClosedLoopModel(DynamicsModel):
         return out[:, 0, :] if pi.ndim == 1 else np.moveaxis(out, 1, 0)
 
     def entries(self, q: np.ndarray, pi: np.ndarray) -> np.ndarray:
-        """All entries (unique H, C, G) at actuated poses: (P, E) or (S, P, E) for parameter sets (S, n)."""
-        return self.entries_at(self.full_coordinates(q), pi)
+        """All entries (unique H, C, G) at actuated poses, a motion continued from home (as
+        :meth:`full_coordinates`): (P, E) or (S, P, E) for parameter sets (S, n); one compiled pass that solves
+        each pose and evaluates its entries (:func:`.actuated_kernel.motion_entries`)."""
+        pi = self._params(pi)
+        path = np.ascontiguousarray(self._poses(q))
+        c, a, t, s = self.compiled, self.solver.arrays, self.compiled.tree, self.solver
+        out, status, first = motion_entries(
+            path, s.home, s.branch, t.parent, t.axis, t.offset, t.const_rot, t.const_pos, s.plan.arrays,
+            self.motion.arrays, t.body_node, c.gravity, a.frame_a, a.frame_b, a.row_loop, a.row_comp, a.actuated,
+            a.passive, np.ascontiguousarray(np.atleast_2d(pi), dtype=float), s.settings,
+        )
+        if first >= 0:
+            pose = ", ".join(f"{v:.6g}" for v in path[first])
+            raise UserError(f"at q = ({pose}): {MESSAGES[int(status[first])]}")
+        if self.constant is not None:
+            out += self.constant
+        return out[:, 0, :] if pi.ndim == 1 else np.moveaxis(out, 1, 0)
 
     def regressor_at(self, q_full: np.ndarray) -> np.ndarray:
         """Every entry as a row of the standard parameters at closed full poses: (P, E, n_params)."""

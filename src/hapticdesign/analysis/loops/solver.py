@@ -129,6 +129,8 @@ class LoopSolver:
         self.n_actuated = mechanism.n_actuated
         lengths = np.abs(self.compiled.node_offset[self.compiled.node_axis >= 3])
         self.tol = 1e-12 * max(float(lengths.max(initial=0.0)), 1e-3)
+        self.settings = (MAX_STEP, self.tol, MAX_ITER, SINGULAR_RATIO, MIN_FRACTION)
+        """``(max_step, tol, max_iter, singular_ratio, min_fraction)``: the continuation's settings, as the kernels take them."""
         loops = mechanism.loops
         q = np.zeros(self.n_dof)
         q[self.arrays.actuated] = loops.home
@@ -178,7 +180,7 @@ class LoopSolver:
         a = self.arrays
         out, status, first = ck.solve_path(
             path, np.asarray(self.home if start is None else start, dtype=float), self.branch, a.actuated, a.passive,
-            *self._kinematic_args(), MAX_STEP, self.tol, MAX_ITER, SINGULAR_RATIO, MIN_FRACTION,
+            *self._kinematic_args(), *self.settings,
         )
         if not strict:
             return (out[0] if q_a.ndim == 1 else out), (status[0] if q_a.ndim == 1 else status)
