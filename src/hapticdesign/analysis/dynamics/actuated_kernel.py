@@ -330,38 +330,52 @@ def mass_and_gravity(ja, b, gravity, pw, s, h, g, mj):
                 h[j, i] += e
 
 
-@njit(cache=True, inline="always")
-def passive_inertia(nb, parent, axis, plan, slot, rot, pos, mj, hap):
-    """Add a body's ``(J_b T)^T M J_b,p`` to ``hap`` (n_a x n_p), from ``mj = M (J_b T)`` (:func:`mass_and_gravity`).
+def passive_paths(parent: np.ndarray, plan: tuple, body_node: np.ndarray, passive: np.ndarray) -> tuple:
+    """Per body, the nodes from its node to the base that a passive coordinate moves: ``(ptr, nodes)``, body
+    ``b``'s being ``nodes[ptr[b]:ptr[b + 1]]`` (what :func:`passive_inertia` walks). ``plan``: the arrays of
+    the loop solver's :class:`~hapticdesign.model.walk.WalkPlan` (its sparse coupling coefficients)."""
+    _, _, ptr, index, _, _, _, _ = plan
+    moving = set(int(k) for k in passive)
+    counts, nodes = [0], []
+    for nb in body_node:
+        e = int(nb)
+        while e >= 0:
+            if moving.intersection(int(k) for k in index[ptr[e]:ptr[e + 1]]):
+                nodes.append(e)
+            e = int(parent[e])
+        counts.append(len(nodes))
+    return np.array(counts, dtype=np.int64), np.array(nodes, dtype=np.int64)
 
-    ``J_b,p``: the passive coordinates' columns of the Jacobian of the body origin (node ``nb``) on the
-    loop-opened tree, the unit twists of the nodes they move (as :func:`reduce_pose`), weighted by their
-    coupling coefficients. ``hap`` is the inertia coupling of the actuated motions to the passive joints'
-    accelerations: ``T^T H [0; gamma] = hap gamma``.
+
+@njit(cache=True, inline="always")
+def passive_inertia(b, body_node, paths, axis, plan, slot, rot, pos, mj, hap):
+    """Add body ``b``'s ``(J_b T)^T M J_b,p`` to ``hap`` (n_a x n_p), from ``mj = M (J_b T)`` (:func:`mass_and_gravity`).
+
+    ``J_b,p``: the passive coordinates' columns of the Jacobian of the body origin on the loop-opened tree,
+    the unit twists of the nodes they move (``paths``: :func:`passive_paths`; as in :func:`reduce_pose`),
+    weighted by their coupling coefficients. ``hap`` is the inertia coupling of the actuated motions to the
+    passive joints' accelerations: ``T^T H [0; gamma] = hap gamma``.
     """
     _, _, ptr, index, value, _, _, _ = plan
-    e = nb
-    while e >= 0:
-        moved = False
-        for c in range(ptr[e], ptr[e + 1]):
-            moved = moved or slot[index[c]] >= 0
-        if moved:
-            a = axis[e] % 3
-            u0, u1, u2 = rot[e, 0, a], rot[e, 1, a], rot[e, 2, a]
-            if axis[e] < 3:
-                r0, r1, r2 = pos[nb, 0] - pos[e, 0], pos[nb, 1] - pos[e, 1], pos[nb, 2] - pos[e, 2]
-                v0, v1, v2 = u1 * r2 - u2 * r1, u2 * r0 - u0 * r2, u0 * r1 - u1 * r0
-                w0, w1, w2 = u0, u1, u2
-            else:
-                v0, v1, v2 = u0, u1, u2
-                w0 = w1 = w2 = 0.0
-            for i in range(mj.shape[1]):
-                d = mj[0, i] * v0 + mj[1, i] * v1 + mj[2, i] * v2 + mj[3, i] * w0 + mj[4, i] * w1 + mj[5, i] * w2
-                for c in range(ptr[e], ptr[e + 1]):
-                    r = slot[index[c]]
-                    if r >= 0:
-                        hap[i, r] += value[c] * d
-        e = parent[e]
+    first, nodes = paths
+    nb = body_node[b]
+    for c in range(first[b], first[b + 1]):
+        e = nodes[c]
+        a = axis[e] % 3
+        u0, u1, u2 = rot[e, 0, a], rot[e, 1, a], rot[e, 2, a]
+        if axis[e] < 3:
+            r0, r1, r2 = pos[nb, 0] - pos[e, 0], pos[nb, 1] - pos[e, 1], pos[nb, 2] - pos[e, 2]
+            v0, v1, v2 = u1 * r2 - u2 * r1, u2 * r0 - u0 * r2, u0 * r1 - u1 * r0
+            w0, w1, w2 = u0, u1, u2
+        else:
+            v0, v1, v2 = u0, u1, u2
+            w0 = w1 = w2 = 0.0
+        for i in range(mj.shape[1]):
+            d = mj[0, i] * v0 + mj[1, i] * v1 + mj[2, i] * v2 + mj[3, i] * w0 + mj[4, i] * w1 + mj[5, i] * w2
+            for k in range(ptr[e], ptr[e + 1]):
+                r = slot[index[k]]
+                if r >= 0:
+                    hap[i, r] += value[k] * d
 
 
 @njit(cache=True)
@@ -397,14 +411,14 @@ def pose_entries(tree, loops, params, active, ws, scratch, out):
     """Entries (unique H, C, G) at a closed pose whose node poses, ``Phi`` and ``Phi_p^-1`` are in ``ws``, for
     the parameter sets ``params`` (K, 10 B), added into ``out`` (K, E) (zero on entry).
 
-    ``tree``: ``(parent, axis, plan, motion, body_node, gravity)``; ``loops``: ``(frame_a, frame_b, row_loop,
+    ``tree``: ``(parent, axis, plan, motion, body_node, paths, gravity)`` (``paths``: :func:`passive_paths`); ``loops``: ``(frame_a, frame_b, row_loop,
     row_comp, actuated, passive)``; ``scratch``: :func:`entries_scratch`. The velocity terms of a rate vector
     ``e`` are ``T^T c(q, T e) + hap gamma`` with ``gamma = -Phi_p^-1 (Phidot T e)``: the body wrenches at the
     node motions of ``qdd = 0`` (:func:`motion_state`) and the closures' bias through
     ``kmat = -hap Phi_p^-1`` (:func:`passive_inertia`), one tree pass per rate vector. ``scratch``'s
     ``biases`` keep each rate vector's ``Phidot T e``.
     """
-    parent, axis, plan, motion, body_node, gravity = tree
+    parent, axis, plan, motion, body_node, paths, gravity = tree
     frame_a, frame_b, row_loop, row_comp, actuated, passive = loops
     pw, h, hap, kmat, mj, biases, empty = scratch
     rot, pos, w, al, ac, pinv, ja, bias, slot = ws[0], ws[1], ws[2], ws[3], ws[4], ws[7], ws[11], ws[12], ws[15]
@@ -422,7 +436,7 @@ def pose_entries(tree, loops, params, active, ws, scratch, out):
         for b in range(n_body):
             if active[b] and body_node[b] >= 0:
                 mass_and_gravity(ja, b, gravity, pw, s, h[s], g, mj)
-                passive_inertia(body_node[b], parent, axis, plan, slot, rot, pos, mj, hap[s])
+                passive_inertia(b, body_node, paths, axis, plan, slot, rot, pos, mj, hap[s])
         e = 0
         for i in range(na):
             for j in range(i, na):
@@ -468,9 +482,10 @@ def pose_entries(tree, loops, params, active, ws, scratch, out):
 
 @njit(cache=True)
 def actuated_entries(qs, parent, axis, offset, const_rot, const_pos, plan, motion, body_node, gravity,
-                     frame_a, frame_b, row_loop, row_comp, actuated, passive, params):
+                     frame_a, frame_b, row_loop, row_comp, actuated, passive, paths, params):
     """Entries (unique H, C, G) in actuated coordinates at closed full poses ``qs`` (P, N) for parameter
-    sets ``params`` (K, 10 B): (P, K, E), and the pivot ratio of ``Phi_p`` per pose (0: singular)."""
+    sets ``params`` (K, 10 B): (P, K, E), and the pivot ratio of ``Phi_p`` per pose (0: singular). ``paths``:
+    :func:`passive_paths`."""
     n_pose, n_dof = qs.shape
     na = actuated.shape[0]
     n_body = body_node.shape[0]
@@ -480,7 +495,7 @@ def actuated_entries(qs, parent, axis, offset, const_rot, const_pos, plan, motio
     ratios = np.zeros(n_pose)
     ws = workspace(parent.shape[0], n_dof, na, passive, n_body)
     scratch = entries_scratch(n_sets, na, passive.shape[0], n_body)
-    tree = (parent, axis, plan, motion, body_node, gravity)
+    tree = (parent, axis, plan, motion, body_node, paths, gravity)
     loops = (frame_a, frame_b, row_loop, row_comp, actuated, passive)
     active = active_bodies(params)
     for p in range(n_pose):
@@ -494,12 +509,13 @@ def actuated_entries(qs, parent, axis, offset, const_rot, const_pos, plan, motio
 
 @njit(cache=True)
 def motion_entries(path, q_start, sign0, parent, axis, offset, const_rot, const_pos, plan, motion, body_node, gravity,
-                   frame_a, frame_b, row_loop, row_comp, actuated, passive, params, settings):
+                   frame_a, frame_b, row_loop, row_comp, actuated, passive, paths, params, settings):
     """Entries (unique H, C, G) in actuated coordinates along a motion: the actuated poses ``path`` (P, n_a) in
     order, the passive values continued from the closed full pose ``q_start`` on the branch ``sign0`` (as
     :func:`~hapticdesign.analysis.loops.closure_kernel.solve_path`), for parameter sets ``params`` (K, 10 B).
 
-    ``settings``: ``(max_step, tol, max_iter, singular_ratio, min_fraction)`` of the loop solver. Returns the
+    ``paths``: :func:`passive_paths`; ``settings``: ``(max_step, tol, max_iter, singular_ratio, min_fraction)`` of
+    the loop solver. Returns the
     entries (P, K, E), the per-pose status (OK until the first failure) and the index of the first failed pose
     (-1 if none). From the second pose on, a step within ``max_step`` is predicted to second order from the
     last pose, ``dq_p = S dq_a + gamma / 2`` with ``gamma = -Phi_p^-1 (Phidot T dq_a)`` (the passive
@@ -521,7 +537,7 @@ def motion_entries(path, q_start, sign0, parent, axis, offset, const_rot, const_
     status = np.zeros(n_pose, dtype=np.int64)
     ws = workspace(parent.shape[0], n_dof, na, passive, n_body)
     scratch = entries_scratch(n_sets, na, npas, n_body)
-    tree = (parent, axis, plan, motion, body_node, gravity)
+    tree = (parent, axis, plan, motion, body_node, paths, gravity)
     loops = (frame_a, frame_b, row_loop, row_comp, actuated, passive)
     active = active_bodies(params)
     rot, pos, phi, lu, pinv, t, trig, biases = ws[0], ws[1], ws[5], ws[6], ws[7], ws[8], ws[14], scratch[5]

@@ -18,7 +18,12 @@ import copy
 
 import numpy as np
 
-from hapticdesign.analysis.dynamics.actuated_kernel import actuated_entries, actuated_regressor, motion_entries
+from hapticdesign.analysis.dynamics.actuated_kernel import (
+    actuated_entries,
+    actuated_regressor,
+    motion_entries,
+    passive_paths,
+)
 from hapticdesign.analysis.dynamics.model import DynamicsModel, pair_index
 from hapticdesign.analysis.loops.solver import MESSAGES, SINGULAR_RATIO, LoopSolver, MotionPlan
 from hapticdesign.analysis.loops.closure_kernel import SINGULAR
@@ -43,6 +48,9 @@ class ClosedLoopModel(DynamicsModel):
         a = self.solver.arrays
         self.motion = MotionPlan.of(self.compiled.tree, [*self.compiled.tree.body_node, *a.frame_a, *a.frame_b])
         """The nodes whose motions the velocity terms read: the bodies' and the closures'."""
+        self.paths = passive_paths(self.compiled.tree.parent, self.solver.plan.arrays, self.compiled.tree.body_node,
+                                   a.passive)
+        """Per body, the nodes on its path to the base that the passive coordinates move."""
         self.n_dof = mechanism.n_actuated
         self.n_params = 10 * len(mechanism.bodies)
         self.pairs = pair_index(self.n_dof)
@@ -62,7 +70,7 @@ class ClosedLoopModel(DynamicsModel):
         if params is None:
             out, ratios = actuated_regressor(*args)
         else:
-            out, ratios = actuated_entries(*args, np.ascontiguousarray(params, dtype=float))
+            out, ratios = actuated_entries(*args, self.paths, np.ascontiguousarray(params, dtype=float))
         bad = np.flatnonzero(ratios <= SINGULAR_RATIO)
         if bad.size:
             pose = ", ".join(f"{v:.6g}" for v in q_full[bad[0], a.actuated])
@@ -93,7 +101,7 @@ class ClosedLoopModel(DynamicsModel):
         out, status, first = motion_entries(
             path, s.home, s.branch, t.parent, t.axis, t.offset, t.const_rot, t.const_pos, s.plan.arrays,
             self.motion.arrays, t.body_node, c.gravity, a.frame_a, a.frame_b, a.row_loop, a.row_comp, a.actuated,
-            a.passive, np.ascontiguousarray(np.atleast_2d(pi), dtype=float), s.settings,
+            a.passive, self.paths, np.ascontiguousarray(np.atleast_2d(pi), dtype=float), s.settings,
         )
         if first >= 0:
             pose = ", ".join(f"{v:.6g}" for v in path[first])
