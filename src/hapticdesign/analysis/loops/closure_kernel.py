@@ -201,7 +201,7 @@ def closure_bias(frame_a, frame_b, row_loop, row_comp, al, ac, out):
 @njit(cache=True)
 def lu_in_place(u, x):
     """Solve ``u x = b`` (m x m, m x k) by Gaussian elimination with partial pivoting: ``x`` holds ``b`` on entry
-    and the solution on return, ``u`` is overwritten (no allocation).
+    and the solution on return, ``u`` is overwritten (no allocation; one division per pivot).
 
     Returns the pivot ratio ``min |u_ii| / max |u_ii|`` (0 when singular) and the sign of ``det u``.
     """
@@ -215,7 +215,7 @@ def lu_in_place(u, x):
                 best = r
         if best != c:
             sign = -sign
-            for k in range(m):
+            for k in range(c, m):
                 u[c, k], u[best, k] = u[best, k], u[c, k]
             for k in range(x.shape[1]):
                 x[c, k], x[best, k] = x[best, k], x[c, k]
@@ -226,10 +226,12 @@ def lu_in_place(u, x):
             return 0.0, 0.0
         if pivot < 0.0:
             sign = -sign
+        inverse = 1.0 / pivot
+        u[c, c] = inverse
         for r in range(c + 1, m):
-            f = u[r, c] / pivot
+            f = u[r, c] * inverse
             if f != 0.0:
-                for k in range(c, m):
+                for k in range(c + 1, m):
                     u[r, k] -= f * u[c, k]
                 for k in range(x.shape[1]):
                     x[r, k] -= f * x[c, k]
@@ -238,7 +240,7 @@ def lu_in_place(u, x):
             t = x[c, k]
             for j in range(c + 1, m):
                 t -= u[c, j] * x[j, k]
-            x[c, k] = t / u[c, c]
+            x[c, k] = t * u[c, c]
     return small / big, sign
 
 
