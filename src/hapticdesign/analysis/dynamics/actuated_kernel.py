@@ -305,10 +305,10 @@ def body_wrench(w, al, ac, nb, pw, s, b):
 
 
 @njit(cache=True, inline="always")
-def mass_and_gravity(ja, b, gravity, pw, s, h, g, mj):
+def mass_and_gravity(ja, b, gravity, pw, s, h, g, mj, keep):
     """Add body ``b``'s ``(J_b T)^T M (J_b T)`` to ``h`` (n x n) and ``-(J_b T)^T`` of its weight's wrench to
     ``g`` (eq. 2.44, 2.46), world parameters ``pw[s, b]``: ``M [v; w] = [m v + w x h; h x v + J w]``.
-    ``mj`` (6 x n) receives ``M (J_b T)``."""
+    With ``keep`` (a constant of the caller), ``mj`` (6 x n) receives ``M (J_b T)``; without, it is not touched."""
     m, h0, h1, h2 = pw[s, b, 0], pw[s, b, 1], pw[s, b, 2], pw[s, b, 3]
     jxx, jyy, jzz, jxy, jxz, jyz = pw[s, b, 4], pw[s, b, 5], pw[s, b, 6], pw[s, b, 7], pw[s, b, 8], pw[s, b, 9]
     for j in range(ja.shape[2]):
@@ -320,7 +320,8 @@ def mass_and_gravity(ja, b, gravity, pw, s, h, g, mj):
         mw0 = h1 * v2 - h2 * v1 + jxx * w0 + jxy * w1 + jxz * w2
         mw1 = h2 * v0 - h0 * v2 + jxy * w0 + jyy * w1 + jyz * w2
         mw2 = h0 * v1 - h1 * v0 + jxz * w0 + jyz * w1 + jzz * w2
-        mj[0, j], mj[1, j], mj[2, j], mj[3, j], mj[4, j], mj[5, j] = mv0, mv1, mv2, mw0, mw1, mw2
+        if keep:
+            mj[0, j], mj[1, j], mj[2, j], mj[3, j], mj[4, j], mj[5, j] = mv0, mv1, mv2, mw0, mw1, mw2
         g[j] -= gravity[0] * mv0 + gravity[1] * mv1 + gravity[2] * mv2
         for i in range(j + 1):
             e = (ja[b, 0, i] * mv0 + ja[b, 1, i] * mv1 + ja[b, 2, i] * mv2
@@ -435,7 +436,7 @@ def pose_entries(tree, loops, params, active, ws, scratch, out):
         g = out[s, m + na * m:]
         for b in range(n_body):
             if active[b] and body_node[b] >= 0:
-                mass_and_gravity(ja, b, gravity, pw, s, h[s], g, mj)
+                mass_and_gravity(ja, b, gravity, pw, s, h[s], g, mj, True)
                 passive_inertia(b, body_node, paths, axis, plan, slot, rot, pos, mj, hap[s])
         e = 0
         for i in range(na):

@@ -44,14 +44,14 @@ OK, NO_CLOSURE, SINGULAR, BRANCH_CHANGE = ck.OK, ck.NO_CLOSURE, ck.SINGULAR, ck.
 
 @njit(cache=True)
 def plant_workspace(n_node, n_dof, na, passive, n_body):
-    """Scratch of :func:`closed_loop_terms`: ``(kernel workspace, q, q_last, res, rhs, pp, pw, predicted, mj)``.
+    """Scratch of :func:`closed_loop_terms`: ``(kernel workspace, q, q_last, res, rhs, pp, pw, predicted)``.
 
     ``q`` is the warm start (full coordinates of the last closed pose), ``q_last`` a copy to fall back to.
     """
     npas = passive.shape[0]
     return (
         workspace(n_node, n_dof, na, passive, n_body), np.zeros(n_dof), np.zeros(n_dof), np.zeros(npas),
-        np.zeros((npas, 1)), np.zeros((npas, npas)), np.zeros((1, n_body, 10)), np.zeros(npas), np.zeros((6, na)),
+        np.zeros((npas, 1)), np.zeros((npas, npas)), np.zeros((1, n_body, 10)), np.zeros(npas),
     )
 
 
@@ -68,7 +68,7 @@ def closed_loop_terms(qa, qda, structure, ws, h, cqd, g):
     """
     (parent, axis, offset, const_rot, const_pos, plan, motion, body_node, gravity, frame_a, frame_b, row_loop, row_comp,
      actuated, passive, params, active, constant, tol, max_iter, singular_ratio, branch) = structure
-    dyn, q, q_last, res, rhs, pp, pw, predicted, mj = ws
+    dyn, q, q_last, res, rhs, pp, pw, predicted = ws
     rot, pos, w, al, ac, phi, pinv, t, ja, trig = dyn[0], dyn[1], dyn[2], dyn[3], dyn[4], dyn[5], dyn[7], dyn[8], dyn[11], dyn[14]
     na = actuated.shape[0]
     npas = passive.shape[0]
@@ -108,7 +108,7 @@ def closed_loop_terms(qa, qda, structure, ws, h, cqd, g):
             h[i, j] = constant[i, j]
     for b in range(body_node.shape[0]):
         if active[b] and body_node[b] >= 0:
-            mass_and_gravity(ja, b, gravity, pw, 0, h, g, mj)
+            mass_and_gravity(ja, b, gravity, pw, 0, h, g, h, False)
     velocity_state(qda, -1, -1, axis, plan, motion, frame_a, frame_b, row_loop, row_comp, passive, dyn)
     for b in range(body_node.shape[0]):
         nb = body_node[b]
