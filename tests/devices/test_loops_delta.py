@@ -199,8 +199,9 @@ def test_dynamics_along_a_motion_match_the_lagrangian(device):
     for p in (1, 150, 200, 299):
         ref = _lagrangian_mass(device, path[p])
         np.testing.assert_allclose(mass[p], ref, rtol=1e-8, atol=1e-8 * np.abs(ref).max())
-        grad = np.array([(-_potential(device, path[p] + 2 * h * e) + 8 * _potential(device, path[p] + h * e)
-                          - 8 * _potential(device, path[p] - h * e) + _potential(device, path[p] - 2 * h * e)) / (12 * h)
+        qa = path[p]
+        grad = np.array([(-_potential(device, qa + 2 * h * e) + 8 * _potential(device, qa + h * e)
+                          - 8 * _potential(device, qa - h * e) + _potential(device, qa - 2 * h * e)) / (12 * h)
                          for e in np.eye(3)])
         np.testing.assert_allclose(weight[p], grad, rtol=1e-8, atol=1e-8 * np.abs(grad).max())
     h = 1e-3
@@ -209,7 +210,8 @@ def test_dynamics_along_a_motion_match_the_lagrangian(device):
                     - 8 * _lagrangian_mass(device, qa - h * e) + _lagrangian_mass(device, qa - 2 * h * e)) / (12 * h)
                    for e in np.eye(3)])
     gamma = 0.5 * (np.einsum("kij->ijk", dh) + np.einsum("jik->ijk", dh) - np.einsum("ijk->ijk", dh))
-    reference = np.stack([gamma[:, j, j] if j == k else 2 * gamma[:, j, k] for j in range(3) for k in range(j, 3)], axis=1)
+    reference = np.stack([gamma[:, j, j] if j == k else 2 * gamma[:, j, k] for j in range(3) for k in range(j, 3)],
+                         axis=1)
     np.testing.assert_allclose(coriolis[150], reference, rtol=1e-6, atol=1e-6 * np.abs(reference).max())
 
 

@@ -15,16 +15,21 @@ with ``qdd = T qdd_a + [0; gamma]`` and ``gamma = -Phi_p^-1 (Phidot qd)``:
   plus those of the passive joints' accelerations ``gamma``), projected by ``(J_b T)^T``.
   It is a quadratic form in ``qd_a``; its coefficients (the columns of eq. 2.50's ``C``: ``Gamma_ijj``
   and ``2 Gamma_ijk``) follow by polarization from ``n_a (n_a + 1) / 2`` rate vectors ``e_j`` and
-  ``e_j + e_k``.
+  ``e_j + e_k``. The part of ``gamma`` is linear in it: ``T^T H [0; gamma] = hap gamma`` with the inertia
+  coupling ``hap = sum_b (J_b T)^T M_b J_b,p`` (``J_b,p`` the passive coordinates' columns of the body
+  Jacobian), so that the entries take one tree pass per rate vector (the node motions at ``qdd = 0``, whose
+  closure bias gives ``gamma``) and ``hap`` once per pose.
 
 Everything is linear in the standard inertial parameters ``(m, h, J)``: :func:`actuated_regressor`
 returns the regressor (ten columns per body, in body axes, via :func:`.kernel.body_regressor`), entry
-by entry in :class:`.model.DynamicsModel`'s order; :func:`actuated_entries` evaluates the entries for
-given parameter sets directly, in world axes (each body's ``h`` and ``J`` rotated once per pose), and
-skips bodies whose parameters are all zero. Both share :func:`factor_pose` (poses and ``Phi_p^-1``) and
-:func:`reduce_pose` (``T`` and the reduced Jacobians at one closed pose) and :func:`velocity_state` (body motions of one rate vector),
-which allocate nothing: their scratch arrays come from :func:`workspace`. The closed-loop plant of the
-simulation (:mod:`.closed_loop_plant`) calls them too.
+by entry in :class:`.model.DynamicsModel`'s order, from the body motions of both passes
+(:func:`velocity_state`); :func:`actuated_entries` evaluates the entries for given parameter sets
+directly (:func:`pose_entries`), in world axes (each body's ``h`` and ``J`` rotated once per pose), and
+skips bodies whose parameters are all zero; :func:`motion_entries` does the same along a motion, each
+pose continued from the last inside the kernel. They share :func:`factor_pose` (poses and ``Phi_p^-1``)
+and :func:`reduce_pose` (``T`` and the reduced Jacobians at one closed pose), which allocate nothing:
+their scratch arrays come from :func:`workspace`. The closed-loop plant of the simulation
+(:mod:`.closed_loop_plant`) calls them too.
 """
 
 from __future__ import annotations
@@ -336,7 +341,7 @@ def passive_paths(parent: np.ndarray, plan: tuple, body_node: np.ndarray, passiv
     ``b``'s being ``nodes[ptr[b]:ptr[b + 1]]`` (what :func:`passive_inertia` walks). ``plan``: the arrays of
     the loop solver's :class:`~hapticdesign.model.walk.WalkPlan` (its sparse coupling coefficients)."""
     _, _, ptr, index, _, _, _, _ = plan
-    moving = set(int(k) for k in passive)
+    moving = {int(k) for k in passive}
     counts, nodes = [0], []
     for nb in body_node:
         e = int(nb)
@@ -350,7 +355,8 @@ def passive_paths(parent: np.ndarray, plan: tuple, body_node: np.ndarray, passiv
 
 @njit(cache=True, inline="always")
 def passive_inertia(b, body_node, paths, axis, plan, slot, rot, pos, mj, hap):
-    """Add body ``b``'s ``(J_b T)^T M J_b,p`` to ``hap`` (n_a x n_p), from ``mj = M (J_b T)`` (:func:`mass_and_gravity`).
+    """Add body ``b``'s ``(J_b T)^T M J_b,p`` to ``hap`` (n_a x n_p), from ``mj = M (J_b T)`` (:func:`mass_and_gravity`;
+    the passive columns of eq. 2.44's ``J^T M J``).
 
     ``J_b,p``: the passive coordinates' columns of the Jacobian of the body origin on the loop-opened tree,
     the unit twists of the nodes they move (``paths``: :func:`passive_paths`; as in :func:`reduce_pose`),
@@ -409,15 +415,15 @@ def entries_scratch(n_sets, na, npas, n_body):
 
 @njit(cache=True, inline="always")
 def pose_entries(tree, loops, params, active, ws, scratch, out):
-    """Entries (unique H, C, G) at a closed pose whose node poses, ``Phi`` and ``Phi_p^-1`` are in ``ws``, for
-    the parameter sets ``params`` (K, 10 B), added into ``out`` (K, E) (zero on entry).
+    """Entries (unique H, C, G, eq. 2.44-2.50) at a closed pose whose node poses, ``Phi`` and ``Phi_p^-1`` are in
+    ``ws``, for the parameter sets ``params`` (K, 10 B), added into ``out`` (K, E) (zero on entry).
 
-    ``tree``: ``(parent, axis, plan, motion, body_node, paths, gravity)`` (``paths``: :func:`passive_paths`); ``loops``: ``(frame_a, frame_b, row_loop,
-    row_comp, actuated, passive)``; ``scratch``: :func:`entries_scratch`. The velocity terms of a rate vector
-    ``e`` are ``T^T c(q, T e) + hap gamma`` with ``gamma = -Phi_p^-1 (Phidot T e)``: the body wrenches at the
-    node motions of ``qdd = 0`` (:func:`motion_state`) and the closures' bias through
-    ``kmat = -hap Phi_p^-1`` (:func:`passive_inertia`), one tree pass per rate vector. ``scratch``'s
-    ``biases`` keep each rate vector's ``Phidot T e``.
+    ``tree``: ``(parent, axis, plan, motion, body_node, paths, gravity)`` (``paths``: :func:`passive_paths`);
+    ``loops``: ``(frame_a, frame_b, row_loop, row_comp, actuated, passive)``; ``scratch``: :func:`entries_scratch`.
+    The velocity terms of a rate vector ``e`` are ``T^T c(q, T e) + hap gamma`` with
+    ``gamma = -Phi_p^-1 (Phidot T e)``: the body wrenches at the node motions of ``qdd = 0``
+    (:func:`motion_state`) and the closures' bias through ``kmat = -hap Phi_p^-1`` (:func:`passive_inertia`),
+    one tree pass per rate vector. ``scratch``'s ``biases`` keep each rate vector's ``Phidot T e``.
     """
     parent, axis, plan, motion, body_node, paths, gravity = tree
     frame_a, frame_b, row_loop, row_comp, actuated, passive = loops
@@ -511,20 +517,21 @@ def actuated_entries(qs, parent, axis, offset, const_rot, const_pos, plan, motio
 @njit(cache=True)
 def motion_entries(path, q_start, sign0, parent, axis, offset, const_rot, const_pos, plan, motion, body_node, gravity,
                    frame_a, frame_b, row_loop, row_comp, actuated, passive, paths, params, settings):
-    """Entries (unique H, C, G) in actuated coordinates along a motion: the actuated poses ``path`` (P, n_a) in
-    order, the passive values continued from the closed full pose ``q_start`` on the branch ``sign0`` (as
-    :func:`~hapticdesign.analysis.loops.closure_kernel.solve_path`), for parameter sets ``params`` (K, 10 B).
+    """Entries (unique H, C, G, eq. 2.44-2.50) in actuated coordinates along a motion: the actuated poses
+    ``path`` (P, n_a) in order, the passive values continued from the closed full pose ``q_start`` on the
+    branch ``sign0`` (as :func:`~hapticdesign.analysis.loops.closure_kernel.solve_path`), for parameter sets
+    ``params`` (K, 10 B).
 
-    ``paths``: :func:`passive_paths`; ``settings``: ``(max_step, tol, max_iter, singular_ratio, min_fraction)`` of
-    the loop solver. Returns the
-    entries (P, K, E), the per-pose status (OK until the first failure) and the index of the first failed pose
-    (-1 if none). From the second pose on, a step within ``max_step`` is predicted to second order from the
-    last pose, ``dq_p = S dq_a + gamma / 2`` with ``gamma = -Phi_p^-1 (Phidot T dq_a)`` (the passive
-    accelerations of the straight actuated segment, from the closures' biases that :func:`pose_entries` kept
-    per rate vector, by polarization), and corrected by Newton, which leaves ``Phi``, ``Phi_p^-1`` and the
-    closures' node poses for the entries. A second-order term or a correction above half the step (a jump),
-    a failed Newton or another sign of ``det Phi_p`` hands the pose to ``solve_path`` (tangent predictor,
-    step halving), as does the first pose.
+    ``paths``: :func:`passive_paths`; ``settings``: ``(max_step, tol, max_iter, singular_ratio, min_fraction)``
+    of the loop solver. Returns the entries (P, K, E), the per-pose status (OK until the first failure) and
+    the index of the first failed pose (-1 if none). From the second pose on, a step within ``max_step`` is
+    predicted to second order from the last pose, ``dq_p = S dq_a + gamma / 2`` with
+    ``gamma = -Phi_p^-1 (Phidot T dq_a)`` (the passive accelerations of the straight actuated segment, from
+    the closures' biases that :func:`pose_entries` kept per rate vector, by polarization; the passive rates
+    of eq. 2.38-2.43 and their derivative), and corrected by Newton, which leaves ``Phi``, ``Phi_p^-1`` and
+    the closures' node poses for the entries. A second-order term or a correction above half the step (a
+    jump), a failed Newton or another sign of ``det Phi_p`` hands the pose to ``solve_path`` (tangent
+    predictor, step halving), as does the first pose.
     """
     max_step, tol, max_iter, singular_ratio, min_fraction = settings
     n_pose = path.shape[0]
@@ -544,7 +551,8 @@ def motion_entries(path, q_start, sign0, parent, axis, offset, const_rot, const_
     rot, pos, phi, lu, pinv, t, trig, biases = ws[0], ws[1], ws[5], ws[6], ws[7], ws[8], ws[14], scratch[5]
     q = q_start.copy()
     q_last = np.empty(n_dof)
-    res, rhs, bias, half_gamma, predicted = np.empty(npas), np.empty((npas, 1)), np.empty(npas), np.empty(npas), np.empty(npas)
+    res, rhs, bias = np.empty(npas), np.empty((npas, 1)), np.empty(npas)
+    half_gamma, predicted = np.empty(npas), np.empty(npas)
     for p in range(n_pose):
         dist = 0.0
         for j in range(na):
@@ -588,14 +596,15 @@ def motion_entries(path, q_start, sign0, parent, axis, offset, const_rot, const_
             for r in range(npas):
                 fast = fast and abs(q[passive[r]] - predicted[r]) <= 0.5 * dist + 1e-9
             if fast:
-                planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, plan[1], parent.shape[0], rot, pos, trig)
+                planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, plan[1], parent.shape[0], rot, pos,
+                              trig)
             else:
                 for k in range(n_dof):
                     q[k] = q_last[k]
         if not fast:
-            solved, codes, first = solve_path(path[p:p + 1], q, sign0, actuated, passive, parent, axis, offset, const_rot,
-                                              const_pos, plan, frame_a, frame_b, row_loop, row_comp, max_step, tol,
-                                              max_iter, singular_ratio, min_fraction)
+            solved, codes, first = solve_path(path[p:p + 1], q, sign0, actuated, passive, parent, axis, offset,
+                                              const_rot, const_pos, plan, frame_a, frame_b, row_loop, row_comp,
+                                              max_step, tol, max_iter, singular_ratio, min_fraction)
             if first >= 0:
                 status[p] = codes[0]
                 return out, status, p

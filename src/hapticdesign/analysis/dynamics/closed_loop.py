@@ -25,8 +25,13 @@ from hapticdesign.analysis.dynamics.actuated_kernel import (
     passive_paths,
 )
 from hapticdesign.analysis.dynamics.model import DynamicsModel, pair_index
-from hapticdesign.analysis.loops.solver import MESSAGES, SINGULAR_RATIO, LoopSolver, MotionPlan
 from hapticdesign.analysis.loops.closure_kernel import SINGULAR
+from hapticdesign.analysis.loops.solver import (
+    MESSAGES,
+    SINGULAR_RATIO,
+    LoopSolver,
+    MotionPlan,
+)
 from hapticdesign.errors import UserError
 from hapticdesign.model.mechanism import Mechanism
 

@@ -139,8 +139,8 @@ class ClosedLoopPlant:
             constant[iu, ju] = constant[ju, iu] = model.constant[model.slice_h]
         self.n_dof = n
         self.structure = (
-            tree.parent, tree.axis, tree.offset, tree.const_rot, tree.const_pos, solver.plan.arrays, model.motion.arrays,
-            tree.body_node, c.gravity,
+            tree.parent, tree.axis, tree.offset, tree.const_rot, tree.const_pos, solver.plan.arrays,
+            model.motion.arrays, tree.body_node, c.gravity,
             a.frame_a, a.frame_b, a.row_loop, a.row_comp, a.actuated, a.passive, params, active_bodies(params),
             constant, float(solver.tol), int(MAX_ITER), float(SINGULAR_RATIO), float(solver.branch),
         )

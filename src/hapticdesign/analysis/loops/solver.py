@@ -87,7 +87,7 @@ class MotionPlan:
     moves: np.ndarray
 
     @classmethod
-    def of(cls, tree: KinematicTree, needed: list[int]) -> "MotionPlan":
+    def of(cls, tree: KinematicTree, needed: list[int]) -> MotionPlan:
         variable = np.any(tree.coef != 0.0, axis=1)
         path: set[int] = set()
         for node in needed:
@@ -130,7 +130,7 @@ class LoopSolver:
         lengths = np.abs(self.compiled.node_offset[self.compiled.node_axis >= 3])
         self.tol = 1e-12 * max(float(lengths.max(initial=0.0)), 1e-3)
         self.settings = (MAX_STEP, self.tol, MAX_ITER, SINGULAR_RATIO, MIN_FRACTION)
-        """``(max_step, tol, max_iter, singular_ratio, min_fraction)``: the continuation's settings, as the kernels take them."""
+        """``(max_step, tol, max_iter, singular_ratio, min_fraction)``: the continuation's settings (kernel order)."""
         loops = mechanism.loops
         q = np.zeros(self.n_dof)
         q[self.arrays.actuated] = loops.home
