@@ -88,6 +88,7 @@ class MotionPlan:
 
     @classmethod
     def of(cls, tree: KinematicTree, needed: list[int]) -> MotionPlan:
+        """The plan of the nodes ``needed`` (``-1``, the base, needs none) on the folded tree ``tree``."""
         variable = np.any(tree.coef != 0.0, axis=1)
         path: set[int] = set()
         for node in needed:
