@@ -1,8 +1,8 @@
 """Closed-loop benchmarks (issue 13), side by side with the tree case (the 3-DOF Phantom).
 
 1. H, C, G in actuated coordinates on one core, poses per second (goal >= 1e5): at closed poses
-   (the actuated-coordinate kernel alone) and along a smooth motion sampled at 1 kHz, passive joints
-   continued from pose to pose by the loop solver (kernel + solver).
+   (``entries_at``, the actuated-coordinate kernel alone) and along a smooth motion sampled at 1 kHz
+   (``entries``: one kernel that continues the passive joints from pose to pose and evaluates each pose).
 2. LN set-up (model + quadratic form by converged quadrature) for the closed-loop devices (goal < 10 s),
    next to the Phantom's exact-basis set-up.
 3. A 5-s rendering simulation of the delta through :func:`hapticdesign.simulation.loop.simulate` (the

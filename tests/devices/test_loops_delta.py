@@ -187,6 +187,34 @@ def test_coriolis_matches_the_christoffel_symbols_of_the_lagrangian(device):
         np.testing.assert_allclose(coriolis_centrifugal(device, qa), reference, rtol=1e-6, atol=1e-6 * np.abs(reference).max())
 
 
+def test_dynamics_along_a_motion_match_the_lagrangian(device):
+    """A 1 kHz motion, each pose continued from the last (second-order predictor and Newton), with a step the
+    continuation must split: H and G at poses along it, and C at one, against the Lagrangian."""
+    model, pi = dynamics_of(device), device.standard_parameters()
+    t = np.arange(300)[:, None] * 1e-3
+    path = np.array([0.35, 0.35, 0.35]) + 0.15 * np.sin(2 * np.pi * np.array([2.0, 2.5, 3.0]) * t)
+    path[200:] += 0.15
+    mass, weight, coriolis = model.H(path, pi), model.G(path, pi), model.C(path, pi)
+    h = 1e-4
+    for p in (1, 150, 200, 299):
+        ref = _lagrangian_mass(device, path[p])
+        np.testing.assert_allclose(mass[p], ref, rtol=1e-8, atol=1e-8 * np.abs(ref).max())
+        qa = path[p]
+        grad = np.array([(-_potential(device, qa + 2 * h * e) + 8 * _potential(device, qa + h * e)
+                          - 8 * _potential(device, qa - h * e) + _potential(device, qa - 2 * h * e)) / (12 * h)
+                         for e in np.eye(3)])
+        np.testing.assert_allclose(weight[p], grad, rtol=1e-8, atol=1e-8 * np.abs(grad).max())
+    h = 1e-3
+    qa = path[150]
+    dh = np.stack([(-_lagrangian_mass(device, qa + 2 * h * e) + 8 * _lagrangian_mass(device, qa + h * e)
+                    - 8 * _lagrangian_mass(device, qa - h * e) + _lagrangian_mass(device, qa - 2 * h * e)) / (12 * h)
+                   for e in np.eye(3)])
+    gamma = 0.5 * (np.einsum("kij->ijk", dh) + np.einsum("jik->ijk", dh) - np.einsum("ijk->ijk", dh))
+    reference = np.stack([gamma[:, j, j] if j == k else 2 * gamma[:, j, k] for j in range(3) for k in range(j, 3)],
+                         axis=1)
+    np.testing.assert_allclose(coriolis[150], reference, rtol=1e-6, atol=1e-6 * np.abs(reference).max())
+
+
 # -- properties -------------------------------------------------------------------------------------
 def test_mass_matrix_positive_definite(device):
     for qa in _samples(30, 4):

@@ -158,6 +158,24 @@ def test_dynamics_match_pinocchio_reduced_by_the_closed_form(device):
         np.testing.assert_allclose(inverse_dynamics(device, qa, qda, qdda), tau, rtol=1e-6, atol=1e-6 * np.abs(tau).max())
 
 
+def test_dynamics_along_a_motion_match_pinocchio(device):
+    """A 1 kHz motion, each pose continued from the last (second-order predictor and Newton), with a step the
+    continuation must split: H, G and the inverse dynamics at poses along it, against Pinocchio."""
+    model, pi = dynamics_of(device), device.standard_parameters()
+    t = np.arange(300)[:, None] * 1e-3
+    path = np.array([2.0, 1.1]) + 0.3 * np.sin(2 * np.pi * np.array([2.0, 2.5]) * t)
+    path[200:] += 0.15
+    rng = np.random.default_rng(7)
+    qda, qdda = rng.normal(size=path.shape), rng.normal(size=path.shape)
+    mass, weight, tau = model.H(path, pi), model.G(path, pi), model.inverse(path, qda, qdda, pi)
+    tree = _pinocchio_tree(device)
+    for p in (1, 150, 199, 200, 299):
+        ref_mass, ref_weight, ref_tau = _reduced_reference(device, tree, path[p], qda[p], qdda[p])
+        np.testing.assert_allclose(mass[p], ref_mass, rtol=1e-7, atol=1e-7 * np.abs(ref_mass).max())
+        np.testing.assert_allclose(weight[p], ref_weight, rtol=1e-7, atol=1e-7 * np.abs(ref_weight).max())
+        np.testing.assert_allclose(tau[p], ref_tau, rtol=1e-6, atol=1e-6 * np.abs(ref_tau).max())
+
+
 # -- properties -------------------------------------------------------------------------------------
 def test_mass_matrix_positive_definite(device):
     for qa in _samples(30, 6):

@@ -194,8 +194,9 @@ def planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, start, st
     sines) at the same ``q``. ``trig``: :func:`trig_workspace`, kept from call to call. A rotation angle
     ``v`` within :data:`ANCHOR_RANGE` of its node's anchor angle ``v0`` (where ``cos`` and ``sin`` were last
     evaluated) follows from the angle-sum formulas with ``d = v - v0``: ``cos d = 1 - d^2/2 + d^4/24 - d^6/720``,
-    ``sin d = d - d^3/6 + d^5/120 - d^7/5040``, whose first omitted terms (``d^8/40320 < 2.5e-21``,
-    ``d^9/362880 < 3e-24``) are far below a unit of round-off; a farther angle is evaluated and becomes the anchor.
+    ``sin d = d - d^3/6 + d^5/120 - d^7/5040`` (nested, multiplying by the reciprocals rather than dividing),
+    whose first omitted terms (``d^8/40320 < 2.5e-21``, ``d^9/362880 < 3e-24``) are far below a unit of round-off;
+    a farther angle is evaluated and becomes the anchor.
     Along a motion (Newton's iterations, the integrator's stages) most walks need no ``cos`` or ``sin``.
     """
     order, _, ptr, index, value, source, sign, _ = plan
@@ -225,8 +226,8 @@ def planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, start, st
                 d = v - trig[n, 2]
                 if abs(d) <= ANCHOR_RANGE:
                     d2 = d * d
-                    cd = 1.0 - d2 / 2.0 * (1.0 - d2 / 12.0 * (1.0 - d2 / 30.0))
-                    sd = d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0 * (1.0 - d2 / 42.0)))
+                    cd = 1.0 - d2 * 0.5 * (1.0 - d2 * (1.0 / 12.0) * (1.0 - d2 * (1.0 / 30.0)))
+                    sd = d * (1.0 - d2 * (1.0 / 6.0) * (1.0 - d2 * (1.0 / 20.0) * (1.0 - d2 * (1.0 / 42.0))))
                     trig[n, 0] = trig[n, 3] * cd - trig[n, 4] * sd
                     trig[n, 1] = trig[n, 4] * cd + trig[n, 3] * sd
                 else:

@@ -15,16 +15,21 @@ with ``qdd = T qdd_a + [0; gamma]`` and ``gamma = -Phi_p^-1 (Phidot qd)``:
   plus those of the passive joints' accelerations ``gamma``), projected by ``(J_b T)^T``.
   It is a quadratic form in ``qd_a``; its coefficients (the columns of eq. 2.50's ``C``: ``Gamma_ijj``
   and ``2 Gamma_ijk``) follow by polarization from ``n_a (n_a + 1) / 2`` rate vectors ``e_j`` and
-  ``e_j + e_k``.
+  ``e_j + e_k``. The part of ``gamma`` is linear in it: ``T^T H [0; gamma] = hap gamma`` with the inertia
+  coupling ``hap = sum_b (J_b T)^T M_b J_b,p`` (``J_b,p`` the passive coordinates' columns of the body
+  Jacobian), so that the entries take one tree pass per rate vector (the node motions at ``qdd = 0``, whose
+  closure bias gives ``gamma``) and ``hap`` once per pose.
 
 Everything is linear in the standard inertial parameters ``(m, h, J)``: :func:`actuated_regressor`
 returns the regressor (ten columns per body, in body axes, via :func:`.kernel.body_regressor`), entry
-by entry in :class:`.model.DynamicsModel`'s order; :func:`actuated_entries` evaluates the entries for
-given parameter sets directly, in world axes (each body's ``h`` and ``J`` rotated once per pose), and
-skips bodies whose parameters are all zero. Both share :func:`factor_pose` (poses and ``Phi_p^-1``) and
-:func:`reduce_pose` (``T`` and the reduced Jacobians at one closed pose) and :func:`velocity_state` (body motions of one rate vector),
-which allocate nothing: their scratch arrays come from :func:`workspace`. The closed-loop plant of the
-simulation (:mod:`.closed_loop_plant`) calls them too.
+by entry in :class:`.model.DynamicsModel`'s order, from the body motions of both passes
+(:func:`velocity_state`); :func:`actuated_entries` evaluates the entries for given parameter sets
+directly (:func:`pose_entries`), in world axes (each body's ``h`` and ``J`` rotated once per pose), and
+skips bodies whose parameters are all zero; :func:`motion_entries` does the same along a motion, each
+pose continued from the last inside the kernel. They share :func:`factor_pose` (poses and ``Phi_p^-1``)
+and :func:`reduce_pose` (``T`` and the reduced Jacobians at one closed pose), which allocate nothing:
+their scratch arrays come from :func:`workspace`. The closed-loop plant of the simulation
+(:mod:`.closed_loop_plant`) calls them too.
 """
 
 from __future__ import annotations
@@ -34,12 +39,15 @@ from numba import njit
 
 from hapticdesign.analysis.dynamics.kernel import body_regressor
 from hapticdesign.analysis.loops.closure_kernel import (
+    OK,
     add_joint_accelerations,
     closure_bias,
     closure_jacobian,
     lu_in_place,
+    newton_into,
     node_motion,
     rotation_entry,
+    solve_path,
 )
 from hapticdesign.model.walk import planned_poses, trig_workspace
 
@@ -188,17 +196,18 @@ def reduce_pose(parent, axis, plan, body_node, actuated, passive, ws):
 
 
 @njit(cache=True, inline="always")
-def velocity_state(qd_a, j, k, parent, axis, plan, frame_a, frame_b, row_loop, row_comp, passive, ws):
-    """Node motions at ``qd = T qd_a`` and ``qdd = [0; gamma]``, ``gamma = -Phi_p^-1 (Phidot qd)``, into ``ws``.
+def motion_state(qd_a, j, k, axis, motion, frame_a, frame_b, row_loop, row_comp, ws):
+    """Node motions at ``qd = T qd_a`` and ``qdd = 0`` and the closures' bias ``Phidot qd`` (:func:`closure_bias`)
+    into ``ws``.
 
-    ``j >= 0`` takes the rate vector ``e_j`` (plus ``e_k`` when ``k != j``) instead of ``qd_a``. The node
-    motions at ``qdd = 0`` give ``Phidot qd`` (:func:`closure_bias`); the passive joints' accelerations
-    ``gamma`` then add theirs (:func:`add_joint_accelerations`, joint values' accelerations ``coef [0; gamma]``).
+    ``j >= 0`` takes the rate vector ``e_j`` (plus ``e_k`` when ``k != j``) instead of ``qd_a``; ``motion``:
+    the arrays of a :class:`~hapticdesign.analysis.loops.solver.MotionPlan` that keeps the bodies' and the
+    closures' nodes.
     """
-    rot, pos, w, al, ac, _, _, pinv, _, node_t, rate, _, bias, gamma, _, slot, dal, dac = ws
-    _, _, ptr, index, value, _, _, _ = plan
-    npas = passive.shape[0]
-    for n in range(rate.shape[0]):
+    rot, pos, w, al, ac, _, _, _, _, node_t, rate, _, bias, _, _, _, _, _ = ws
+    order = motion[0]
+    for i in range(order.shape[0]):
+        n = order[i]
         if j >= 0:
             rate[n] = node_t[n, j] + (node_t[n, k] if k != j else 0.0)
         else:
@@ -206,21 +215,37 @@ def velocity_state(qd_a, j, k, parent, axis, plan, frame_a, frame_b, row_loop, r
             for c in range(qd_a.shape[0]):
                 acc += node_t[n, c] * qd_a[c]
             rate[n] = acc
-    node_motion(rate, parent, axis, rot, pos, w, al, ac)
+    node_motion(rate, motion, axis, rot, pos, w, al, ac)
     closure_bias(frame_a, frame_b, row_loop, row_comp, al, ac, bias)
+
+
+@njit(cache=True, inline="always")
+def velocity_state(qd_a, j, k, axis, plan, motion, frame_a, frame_b, row_loop, row_comp, passive, ws):
+    """Node motions at ``qd = T qd_a`` and ``qdd = [0; gamma]``, ``gamma = -Phi_p^-1 (Phidot qd)``, into ``ws``.
+
+    The node motions at ``qdd = 0`` (:func:`motion_state`, same arguments) give ``Phidot qd``; the passive
+    joints' accelerations ``gamma`` then add theirs (:func:`add_joint_accelerations`, joint values'
+    accelerations ``coef [0; gamma]``).
+    """
+    rot, pos, _, al, ac, _, _, pinv, _, _, rate, _, bias, gamma, _, slot, dal, dac = ws
+    _, _, ptr, index, value, _, _, _ = plan
+    order = motion[0]
+    npas = passive.shape[0]
+    motion_state(qd_a, j, k, axis, motion, frame_a, frame_b, row_loop, row_comp, ws)
     for r in range(npas):
         acc = 0.0
         for i in range(npas):
             acc -= pinv[r, i] * bias[i]
         gamma[r] = acc
-    for n in range(rate.shape[0]):
+    for i in range(order.shape[0]):
+        n = order[i]
         acc = 0.0
         for c in range(ptr[n], ptr[n + 1]):
             r = slot[index[c]]
             if r >= 0:
                 acc += value[c] * gamma[r]
         rate[n] = acc
-    add_joint_accelerations(rate, parent, axis, rot, pos, al, ac, dal, dac)
+    add_joint_accelerations(rate, motion, axis, rot, pos, al, ac, dal, dac)
 
 
 @njit(cache=True)
@@ -285,9 +310,10 @@ def body_wrench(w, al, ac, nb, pw, s, b):
 
 
 @njit(cache=True, inline="always")
-def mass_and_gravity(ja, b, gravity, pw, s, h, g):
+def mass_and_gravity(ja, b, gravity, pw, s, h, g, mj, keep):
     """Add body ``b``'s ``(J_b T)^T M (J_b T)`` to ``h`` (n x n) and ``-(J_b T)^T`` of its weight's wrench to
-    ``g`` (eq. 2.44, 2.46), world parameters ``pw[s, b]``: ``M [v; w] = [m v + w x h; h x v + J w]``."""
+    ``g`` (eq. 2.44, 2.46), world parameters ``pw[s, b]``: ``M [v; w] = [m v + w x h; h x v + J w]``.
+    With ``keep`` (a constant of the caller), ``mj`` (6 x n) receives ``M (J_b T)``; without, it is not touched."""
     m, h0, h1, h2 = pw[s, b, 0], pw[s, b, 1], pw[s, b, 2], pw[s, b, 3]
     jxx, jyy, jzz, jxy, jxz, jyz = pw[s, b, 4], pw[s, b, 5], pw[s, b, 6], pw[s, b, 7], pw[s, b, 8], pw[s, b, 9]
     for j in range(ja.shape[2]):
@@ -299,6 +325,8 @@ def mass_and_gravity(ja, b, gravity, pw, s, h, g):
         mw0 = h1 * v2 - h2 * v1 + jxx * w0 + jxy * w1 + jxz * w2
         mw1 = h2 * v0 - h0 * v2 + jxy * w0 + jyy * w1 + jyz * w2
         mw2 = h0 * v1 - h1 * v0 + jxz * w0 + jyz * w1 + jzz * w2
+        if keep:
+            mj[0, j], mj[1, j], mj[2, j], mj[3, j], mj[4, j], mj[5, j] = mv0, mv1, mv2, mw0, mw1, mw2
         g[j] -= gravity[0] * mv0 + gravity[1] * mv1 + gravity[2] * mv2
         for i in range(j + 1):
             e = (ja[b, 0, i] * mv0 + ja[b, 1, i] * mv1 + ja[b, 2, i] * mv2
@@ -306,6 +334,55 @@ def mass_and_gravity(ja, b, gravity, pw, s, h, g):
             h[i, j] += e
             if i != j:
                 h[j, i] += e
+
+
+def passive_paths(parent: np.ndarray, plan: tuple, body_node: np.ndarray, passive: np.ndarray) -> tuple:
+    """Per body, the nodes from its node to the base that a passive coordinate moves: ``(ptr, nodes)``, body
+    ``b``'s being ``nodes[ptr[b]:ptr[b + 1]]`` (what :func:`passive_inertia` walks). ``plan``: the arrays of
+    the loop solver's :class:`~hapticdesign.model.walk.WalkPlan` (its sparse coupling coefficients)."""
+    _, _, ptr, index, _, _, _, _ = plan
+    moving = {int(k) for k in passive}
+    counts, nodes = [0], []
+    for nb in body_node:
+        e = int(nb)
+        while e >= 0:
+            if moving.intersection(int(k) for k in index[ptr[e]:ptr[e + 1]]):
+                nodes.append(e)
+            e = int(parent[e])
+        counts.append(len(nodes))
+    return np.array(counts, dtype=np.int64), np.array(nodes, dtype=np.int64)
+
+
+@njit(cache=True, inline="always")
+def passive_inertia(b, body_node, paths, axis, plan, slot, rot, pos, mj, hap):
+    """Add body ``b``'s ``(J_b T)^T M J_b,p`` to ``hap`` (n_a x n_p), from ``mj = M (J_b T)`` (:func:`mass_and_gravity`;
+    the passive columns of eq. 2.44's ``J^T M J``).
+
+    ``J_b,p``: the passive coordinates' columns of the Jacobian of the body origin on the loop-opened tree,
+    the unit twists of the nodes they move (``paths``: :func:`passive_paths`; as in :func:`reduce_pose`),
+    weighted by their coupling coefficients. ``hap`` is the inertia coupling of the actuated motions to the
+    passive joints' accelerations: ``T^T H [0; gamma] = hap gamma``.
+    """
+    _, _, ptr, index, value, _, _, _ = plan
+    first, nodes = paths
+    nb = body_node[b]
+    for c in range(first[b], first[b + 1]):
+        e = nodes[c]
+        a = axis[e] % 3
+        u0, u1, u2 = rot[e, 0, a], rot[e, 1, a], rot[e, 2, a]
+        if axis[e] < 3:
+            r0, r1, r2 = pos[nb, 0] - pos[e, 0], pos[nb, 1] - pos[e, 1], pos[nb, 2] - pos[e, 2]
+            v0, v1, v2 = u1 * r2 - u2 * r1, u2 * r0 - u0 * r2, u0 * r1 - u1 * r0
+            w0, w1, w2 = u0, u1, u2
+        else:
+            v0, v1, v2 = u0, u1, u2
+            w0 = w1 = w2 = 0.0
+        for i in range(mj.shape[1]):
+            d = mj[0, i] * v0 + mj[1, i] * v1 + mj[2, i] * v2 + mj[3, i] * w0 + mj[4, i] * w1 + mj[5, i] * w2
+            for k in range(ptr[e], ptr[e + 1]):
+                r = slot[index[k]]
+                if r >= 0:
+                    hap[i, r] += value[k] * d
 
 
 @njit(cache=True)
@@ -328,10 +405,94 @@ def _state(j, na):
 
 
 @njit(cache=True)
-def actuated_entries(qs, parent, axis, offset, const_rot, const_pos, plan, body_node, gravity,
-                     frame_a, frame_b, row_loop, row_comp, actuated, passive, params):
+def entries_scratch(n_sets, na, npas, n_body):
+    """Scratch of :func:`pose_entries`: ``(pw, h, hap, kmat, mj, biases, empty)``, world parameters per set,
+    ``H_a``, the passive inertia coupling and ``-hap Phi_p^-1`` per set, ``M (J_b T)``, the closures' bias of
+    each rate vector of the polarization and no rate vector (:func:`motion_state` takes the unit ones)."""
+    return (np.zeros((n_sets, n_body, 10)), np.zeros((n_sets, na, na)), np.zeros((n_sets, na, npas)),
+            np.zeros((n_sets, na, npas)), np.zeros((6, na)), np.zeros((na * (na + 1) // 2, npas)), np.zeros(0))
+
+
+@njit(cache=True, inline="always")
+def pose_entries(tree, loops, params, active, ws, scratch, out):
+    """Entries (unique H, C, G, eq. 2.44-2.50) at a closed pose whose node poses, ``Phi`` and ``Phi_p^-1`` are in
+    ``ws``, for the parameter sets ``params`` (K, 10 B), added into ``out`` (K, E) (zero on entry).
+
+    ``tree``: ``(parent, axis, plan, motion, body_node, paths, gravity)`` (``paths``: :func:`passive_paths`);
+    ``loops``: ``(frame_a, frame_b, row_loop, row_comp, actuated, passive)``; ``scratch``: :func:`entries_scratch`.
+    The velocity terms of a rate vector ``e`` are ``T^T c(q, T e) + hap gamma`` with
+    ``gamma = -Phi_p^-1 (Phidot T e)``: the body wrenches at the node motions of ``qdd = 0``
+    (:func:`motion_state`) and the closures' bias through ``kmat = -hap Phi_p^-1`` (:func:`passive_inertia`),
+    one tree pass per rate vector. ``scratch``'s ``biases`` keep each rate vector's ``Phidot T e``.
+    """
+    parent, axis, plan, motion, body_node, paths, gravity = tree
+    frame_a, frame_b, row_loop, row_comp, actuated, passive = loops
+    pw, h, hap, kmat, mj, biases, empty = scratch
+    rot, pos, w, al, ac, pinv, ja, bias, slot = ws[0], ws[1], ws[2], ws[3], ws[4], ws[7], ws[11], ws[12], ws[15]
+    na = actuated.shape[0]
+    npas = passive.shape[0]
+    n_body = body_node.shape[0]
+    n_sets = params.shape[0]
+    m = na * (na + 1) // 2
+    reduce_pose(parent, axis, plan, body_node, actuated, passive, ws)
+    h[:] = 0.0
+    hap[:] = 0.0
+    for s in range(n_sets):
+        world_parameters(rot, body_node, params, s, pw)
+        g = out[s, m + na * m:]
+        for b in range(n_body):
+            if active[b] and body_node[b] >= 0:
+                mass_and_gravity(ja, b, gravity, pw, s, h[s], g, mj, True)
+                passive_inertia(b, body_node, paths, axis, plan, slot, rot, pos, mj, hap[s])
+        e = 0
+        for i in range(na):
+            for j in range(i, na):
+                out[s, e] = h[s, i, j]
+                e += 1
+        for i in range(na):
+            for r in range(npas):
+                acc = 0.0
+                for c in range(npas):
+                    acc -= hap[s, i, c] * pinv[c, r]
+                kmat[s, i, r] = acc
+    st = 0
+    for j in range(na):
+        for k in range(j, na):
+            motion_state(empty, j, k, axis, motion, frame_a, frame_b, row_loop, row_comp, ws)
+            for r in range(npas):
+                biases[st, r] = bias[r]
+            for s in range(n_sets):
+                for i in range(na):
+                    acc = 0.0
+                    for r in range(npas):
+                        acc += kmat[s, i, r] * bias[r]
+                    out[s, m + i * m + st] += acc
+                for b in range(n_body):
+                    nb = body_node[b]
+                    if not active[b] or nb < 0:
+                        continue
+                    f0, f1, f2, n0, n1, n2 = body_wrench(w, al, ac, nb, pw, s, b)
+                    for i in range(na):
+                        out[s, m + i * m + st] += (ja[b, 0, i] * f0 + ja[b, 1, i] * f1 + ja[b, 2, i] * f2
+                                                   + ja[b, 3, i] * n0 + ja[b, 4, i] * n1 + ja[b, 5, i] * n2)
+            st += 1
+    # polarization: the state (j, k), j < k, held C(e_j + e_k); the cross term is what exceeds (j, j) + (k, k)
+    for s in range(n_sets):
+        for i in range(na):
+            st = 0
+            for j in range(na):
+                for k in range(j, na):
+                    if k != j:
+                        out[s, m + i * m + st] -= out[s, m + i * m + _state(j, na)] + out[s, m + i * m + _state(k, na)]
+                    st += 1
+
+
+@njit(cache=True)
+def actuated_entries(qs, parent, axis, offset, const_rot, const_pos, plan, motion, body_node, gravity,
+                     frame_a, frame_b, row_loop, row_comp, actuated, passive, paths, params):
     """Entries (unique H, C, G) in actuated coordinates at closed full poses ``qs`` (P, N) for parameter
-    sets ``params`` (K, 10 B): (P, K, E), and the pivot ratio of ``Phi_p`` per pose (0: singular)."""
+    sets ``params`` (K, 10 B): (P, K, E), and the pivot ratio of ``Phi_p`` per pose (0: singular). ``paths``:
+    :func:`passive_paths`."""
     n_pose, n_dof = qs.shape
     na = actuated.shape[0]
     n_body = body_node.shape[0]
@@ -340,55 +501,119 @@ def actuated_entries(qs, parent, axis, offset, const_rot, const_pos, plan, body_
     out = np.zeros((n_pose, n_sets, m + na * m + na))
     ratios = np.zeros(n_pose)
     ws = workspace(parent.shape[0], n_dof, na, passive, n_body)
-    rot, w, al, ac, ja = ws[0], ws[2], ws[3], ws[4], ws[11]
+    scratch = entries_scratch(n_sets, na, passive.shape[0], n_body)
+    tree = (parent, axis, plan, motion, body_node, paths, gravity)
+    loops = (frame_a, frame_b, row_loop, row_comp, actuated, passive)
     active = active_bodies(params)
-    pw = np.zeros((n_sets, n_body, 10))
-    h = np.zeros((n_sets, na, na))
-    empty = np.zeros(0)
     for p in range(n_pose):
         ratio, _ = factor_pose(qs[p], parent, axis, offset, const_rot, const_pos, plan, frame_a, frame_b, row_loop, row_comp,
                                passive, ws)
         ratios[p] = ratio
-        if ratio == 0.0:
-            continue
-        reduce_pose(parent, axis, plan, body_node, actuated, passive, ws)
-        h[:] = 0.0
-        for s in range(n_sets):
-            world_parameters(rot, body_node, params, s, pw)
-            g = out[p, s, m + na * m:]
-            for b in range(n_body):
-                if active[b] and body_node[b] >= 0:
-                    mass_and_gravity(ja, b, gravity, pw, s, h[s], g)
-            e = 0
-            for i in range(na):
-                for j in range(i, na):
-                    out[p, s, e] = h[s, i, j]
-                    e += 1
-        st = 0
-        for j in range(na):
-            for k in range(j, na):
-                velocity_state(empty, j, k, parent, axis, plan, frame_a, frame_b, row_loop, row_comp, passive, ws)
-                for s in range(n_sets):
-                    for b in range(n_body):
-                        nb = body_node[b]
-                        if not active[b] or nb < 0:
-                            continue
-                        f0, f1, f2, n0, n1, n2 = body_wrench(w, al, ac, nb, pw, s, b)
-                        for i in range(na):
-                            out[p, s, m + i * m + st] += (ja[b, 0, i] * f0 + ja[b, 1, i] * f1 + ja[b, 2, i] * f2
-                                                          + ja[b, 3, i] * n0 + ja[b, 4, i] * n1 + ja[b, 5, i] * n2)
-                st += 1
-        # polarization: the state (j, k), j < k, held C(e_j + e_k); the cross term is what exceeds (j, j) + (k, k)
-        for s in range(n_sets):
-            for i in range(na):
-                st = 0
-                for j in range(na):
-                    for k in range(j, na):
-                        if k != j:
-                            out[p, s, m + i * m + st] -= (out[p, s, m + i * m + _state(j, na)]
-                                                          + out[p, s, m + i * m + _state(k, na)])
-                        st += 1
+        if ratio != 0.0:
+            pose_entries(tree, loops, params, active, ws, scratch, out[p])
     return out, ratios
+
+
+@njit(cache=True)
+def motion_entries(path, q_start, sign0, parent, axis, offset, const_rot, const_pos, plan, motion, body_node, gravity,
+                   frame_a, frame_b, row_loop, row_comp, actuated, passive, paths, params, settings):
+    """Entries (unique H, C, G, eq. 2.44-2.50) in actuated coordinates along a motion: the actuated poses
+    ``path`` (P, n_a) in order, the passive values continued from the closed full pose ``q_start`` on the
+    branch ``sign0`` (as :func:`~hapticdesign.analysis.loops.closure_kernel.solve_path`), for parameter sets
+    ``params`` (K, 10 B).
+
+    ``paths``: :func:`passive_paths`; ``settings``: ``(max_step, tol, max_iter, singular_ratio, min_fraction)``
+    of the loop solver. Returns the entries (P, K, E), the per-pose status (OK until the first failure) and
+    the index of the first failed pose (-1 if none). From the second pose on, a step within ``max_step`` is
+    predicted to second order from the last pose, ``dq_p = S dq_a + gamma / 2`` with
+    ``gamma = -Phi_p^-1 (Phidot T dq_a)`` (the passive accelerations of the straight actuated segment, from
+    the closures' biases that :func:`pose_entries` kept per rate vector, by polarization; the passive rates
+    of eq. 2.38-2.43 and their derivative), and corrected by Newton, which leaves ``Phi``, ``Phi_p^-1`` and
+    the closures' node poses for the entries. A second-order term or a correction above half the step (a
+    jump), a failed Newton or another sign of ``det Phi_p`` hands the pose to ``solve_path`` (tangent
+    predictor, step halving), as does the first pose.
+    """
+    max_step, tol, max_iter, singular_ratio, min_fraction = settings
+    n_pose = path.shape[0]
+    n_dof = q_start.shape[0]
+    na = actuated.shape[0]
+    npas = passive.shape[0]
+    n_body = body_node.shape[0]
+    n_sets = params.shape[0]
+    m = na * (na + 1) // 2
+    out = np.zeros((n_pose, n_sets, m + na * m + na))
+    status = np.zeros(n_pose, dtype=np.int64)
+    ws = workspace(parent.shape[0], n_dof, na, passive, n_body)
+    scratch = entries_scratch(n_sets, na, npas, n_body)
+    tree = (parent, axis, plan, motion, body_node, paths, gravity)
+    loops = (frame_a, frame_b, row_loop, row_comp, actuated, passive)
+    active = active_bodies(params)
+    rot, pos, phi, lu, pinv, t, trig, biases = ws[0], ws[1], ws[5], ws[6], ws[7], ws[8], ws[14], scratch[5]
+    q = q_start.copy()
+    q_last = np.empty(n_dof)
+    res, rhs, bias = np.empty(npas), np.empty((npas, 1)), np.empty(npas)
+    half_gamma, predicted = np.empty(npas), np.empty(npas)
+    for p in range(n_pose):
+        dist = 0.0
+        for j in range(na):
+            dist = max(dist, abs(path[p, j] - q[actuated[j]]))
+        fast = p > 0 and dist <= max_step
+        if fast:
+            for r in range(npas):
+                bias[r] = 0.0
+            st = 0
+            for j in range(na):
+                dj = path[p, j] - q[actuated[j]]
+                for k in range(j, na):
+                    dk = path[p, k] - q[actuated[k]]
+                    for r in range(npas):
+                        if k == j:
+                            bias[r] += dj * dj * biases[st, r]
+                        else:
+                            bias[r] += dj * dk * (biases[st, r] - biases[_state(j, na), r] - biases[_state(k, na), r])
+                    st += 1
+            for r in range(npas):
+                acc = 0.0
+                for i in range(npas):
+                    acc -= pinv[r, i] * bias[i]
+                half_gamma[r] = 0.5 * acc
+                fast = fast and abs(half_gamma[r]) <= 0.5 * dist
+        if fast:
+            for k in range(n_dof):
+                q_last[k] = q[k]
+            for j in range(na):
+                delta = path[p, j] - q[actuated[j]]
+                for r in range(npas):
+                    q[passive[r]] += t[passive[r], j] * delta
+                q[actuated[j]] = path[p, j]
+            for r in range(npas):
+                q[passive[r]] += half_gamma[r]
+                predicted[r] = q[passive[r]]
+            code, sign, _ = newton_into(q, actuated, passive, parent, axis, offset, const_rot, const_pos, plan, frame_a,
+                                        frame_b, row_loop, row_comp, tol, max_iter, singular_ratio, rot, pos, trig, res,
+                                        phi, rhs, lu, pinv)
+            fast = code == OK and sign == sign0
+            for r in range(npas):
+                fast = fast and abs(q[passive[r]] - predicted[r]) <= 0.5 * dist + 1e-9
+            if fast:
+                planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, plan[1], parent.shape[0], rot, pos,
+                              trig)
+            else:
+                for k in range(n_dof):
+                    q[k] = q_last[k]
+        if not fast:
+            solved, codes, first = solve_path(path[p:p + 1], q, sign0, actuated, passive, parent, axis, offset,
+                                              const_rot, const_pos, plan, frame_a, frame_b, row_loop, row_comp,
+                                              max_step, tol, max_iter, singular_ratio, min_fraction)
+            if first >= 0:
+                status[p] = codes[0]
+                return out, status, p
+            for k in range(n_dof):
+                q[k] = solved[0, k]
+            factor_pose(q, parent, axis, offset, const_rot, const_pos, plan, frame_a, frame_b, row_loop, row_comp,
+                        passive, ws)
+        pose_entries(tree, loops, params, active, ws, scratch, out[p])
+    return out, status, -1
 
 
 @njit(cache=True, inline="always")
@@ -406,7 +631,7 @@ def _body_motion(w, al, ac, nb, rb, out):
 
 
 @njit(cache=True)
-def actuated_regressor(qs, parent, axis, offset, const_rot, const_pos, plan, body_node, gravity,
+def actuated_regressor(qs, parent, axis, offset, const_rot, const_pos, plan, motion, body_node, gravity,
                        frame_a, frame_b, row_loop, row_comp, actuated, passive):
     """Regressor of the entries (unique H, C, G) in actuated coordinates at closed full poses ``qs`` (P, N):
     (P, E, 10 B), and the pivot ratio of ``Phi_p`` per pose (0: singular). Body axes throughout."""
@@ -446,7 +671,7 @@ def actuated_regressor(qs, parent, axis, offset, const_rot, const_pos, plan, bod
         st = 0
         for j in range(na):
             for k in range(j, na):
-                velocity_state(empty, j, k, parent, axis, plan, frame_a, frame_b, row_loop, row_comp, passive, ws)
+                velocity_state(empty, j, k, axis, plan, motion, frame_a, frame_b, row_loop, row_comp, passive, ws)
                 for b in range(n_body):
                     _body_motion(w, al, ac, body_node[b], rb[b], mb)
                     _wrench_regressor(mb[0], mb[1], mb[2], wrench)

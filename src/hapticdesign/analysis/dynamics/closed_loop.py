@@ -18,10 +18,20 @@ import copy
 
 import numpy as np
 
-from hapticdesign.analysis.dynamics.actuated_kernel import actuated_entries, actuated_regressor
+from hapticdesign.analysis.dynamics.actuated_kernel import (
+    actuated_entries,
+    actuated_regressor,
+    motion_entries,
+    passive_paths,
+)
 from hapticdesign.analysis.dynamics.model import DynamicsModel, pair_index
-from hapticdesign.analysis.loops.solver import MESSAGES, SINGULAR_RATIO, LoopSolver
 from hapticdesign.analysis.loops.closure_kernel import SINGULAR
+from hapticdesign.analysis.loops.solver import (
+    MESSAGES,
+    SINGULAR_RATIO,
+    LoopSolver,
+    MotionPlan,
+)
 from hapticdesign.errors import UserError
 from hapticdesign.model.mechanism import Mechanism
 
@@ -40,6 +50,12 @@ class ClosedLoopModel(DynamicsModel):
         self.mechanism = mechanism
         self.compiled = mechanism.compiled
         self.solver = LoopSolver(mechanism)
+        a = self.solver.arrays
+        self.motion = MotionPlan.of(self.compiled.tree, [*self.compiled.tree.body_node, *a.frame_a, *a.frame_b])
+        """The nodes whose motions the velocity terms read: the bodies' and the closures'."""
+        self.paths = passive_paths(self.compiled.tree.parent, self.solver.plan.arrays, self.compiled.tree.body_node,
+                                   a.passive)
+        """Per body, the nodes on its path to the base that the passive coordinates move."""
         self.n_dof = mechanism.n_actuated
         self.n_params = 10 * len(mechanism.bodies)
         self.pairs = pair_index(self.n_dof)
@@ -54,12 +70,12 @@ class ClosedLoopModel(DynamicsModel):
         """Entries for parameter sets (P, S, E), or the regressor (P, E, n_params) when ``params`` is None."""
         c, a, t = self.compiled, self.solver.arrays, self.compiled.tree
         args = (np.ascontiguousarray(q_full, dtype=float), t.parent, t.axis, t.offset, t.const_rot, t.const_pos,
-                self.solver.plan.arrays, t.body_node, c.gravity,
+                self.solver.plan.arrays, self.motion.arrays, t.body_node, c.gravity,
                 a.frame_a, a.frame_b, a.row_loop, a.row_comp, a.actuated, a.passive)
         if params is None:
             out, ratios = actuated_regressor(*args)
         else:
-            out, ratios = actuated_entries(*args, np.ascontiguousarray(params, dtype=float))
+            out, ratios = actuated_entries(*args, self.paths, np.ascontiguousarray(params, dtype=float))
         bad = np.flatnonzero(ratios <= SINGULAR_RATIO)
         if bad.size:
             pose = ", ".join(f"{v:.6g}" for v in q_full[bad[0], a.actuated])
@@ -81,8 +97,23 @@ class ClosedLoopModel(DynamicsModel):
         return out[:, 0, :] if pi.ndim == 1 else np.moveaxis(out, 1, 0)
 
     def entries(self, q: np.ndarray, pi: np.ndarray) -> np.ndarray:
-        """All entries (unique H, C, G) at actuated poses: (P, E) or (S, P, E) for parameter sets (S, n)."""
-        return self.entries_at(self.full_coordinates(q), pi)
+        """All entries (unique H, C, G) at actuated poses, a motion continued from home (as
+        :meth:`full_coordinates`): (P, E) or (S, P, E) for parameter sets (S, n); one compiled pass that solves
+        each pose and evaluates its entries (:func:`.actuated_kernel.motion_entries`)."""
+        pi = self._params(pi)
+        path = np.ascontiguousarray(self._poses(q))
+        c, a, t, s = self.compiled, self.solver.arrays, self.compiled.tree, self.solver
+        out, status, first = motion_entries(
+            path, s.home, s.branch, t.parent, t.axis, t.offset, t.const_rot, t.const_pos, s.plan.arrays,
+            self.motion.arrays, t.body_node, c.gravity, a.frame_a, a.frame_b, a.row_loop, a.row_comp, a.actuated,
+            a.passive, self.paths, np.ascontiguousarray(np.atleast_2d(pi), dtype=float), s.settings,
+        )
+        if first >= 0:
+            pose = ", ".join(f"{v:.6g}" for v in path[first])
+            raise UserError(f"at q = ({pose}): {MESSAGES[int(status[first])]}")
+        if self.constant is not None:
+            out += self.constant
+        return out[:, 0, :] if pi.ndim == 1 else np.moveaxis(out, 1, 0)
 
     def regressor_at(self, q_full: np.ndarray) -> np.ndarray:
         """Every entry as a row of the standard parameters at closed full poses: (P, E, n_params)."""

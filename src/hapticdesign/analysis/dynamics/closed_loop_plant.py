@@ -59,13 +59,14 @@ def plant_workspace(n_node, n_dof, na, passive, n_body):
 def closed_loop_terms(qa, qda, structure, ws, h, cqd, g):
     """``H_a`` (n_a x n_a), ``c_a = C(q, qd) qd^2`` (n_a) and ``G_a`` (n_a) at actuated ``qa``, rates ``qda``.
 
-    ``structure``: ``(parent, axis, offset, const_rot, const_pos, plan, body_node, gravity, frame_a, frame_b, row_loop,
-    row_comp, actuated, passive, params (1, 10 B), active (B,), constant (n_a x n_a), tol, max_iter,
+    ``structure``: ``(parent, axis, offset, const_rot, const_pos, plan, motion, body_node, gravity, frame_a, frame_b,
+    row_loop, row_comp, actuated, passive, params (1, 10 B), active (B,), constant (n_a x n_a), tol, max_iter,
     singular_ratio, branch)`` with ``plan`` the arrays of the loop solver's
-    :class:`~hapticdesign.model.walk.WalkPlan`; ``ws``: :func:`plant_workspace`. Returns the status (module
+    :class:`~hapticdesign.model.walk.WalkPlan` and ``motion`` the model's
+    :class:`~hapticdesign.analysis.loops.solver.MotionPlan`; ``ws``: :func:`plant_workspace`. Returns the status (module
     docstring).
     """
-    (parent, axis, offset, const_rot, const_pos, plan, body_node, gravity, frame_a, frame_b, row_loop, row_comp,
+    (parent, axis, offset, const_rot, const_pos, plan, motion, body_node, gravity, frame_a, frame_b, row_loop, row_comp,
      actuated, passive, params, active, constant, tol, max_iter, singular_ratio, branch) = structure
     dyn, q, q_last, res, rhs, pp, pw, predicted = ws
     rot, pos, w, al, ac, phi, pinv, t, ja, trig = dyn[0], dyn[1], dyn[2], dyn[3], dyn[4], dyn[5], dyn[7], dyn[8], dyn[11], dyn[14]
@@ -107,8 +108,8 @@ def closed_loop_terms(qa, qda, structure, ws, h, cqd, g):
             h[i, j] = constant[i, j]
     for b in range(body_node.shape[0]):
         if active[b] and body_node[b] >= 0:
-            mass_and_gravity(ja, b, gravity, pw, 0, h, g)
-    velocity_state(qda, -1, -1, parent, axis, plan, frame_a, frame_b, row_loop, row_comp, passive, dyn)
+            mass_and_gravity(ja, b, gravity, pw, 0, h, g, h, False)
+    velocity_state(qda, -1, -1, axis, plan, motion, frame_a, frame_b, row_loop, row_comp, passive, dyn)
     for b in range(body_node.shape[0]):
         nb = body_node[b]
         if not active[b] or nb < 0:
@@ -138,8 +139,8 @@ class ClosedLoopPlant:
             constant[iu, ju] = constant[ju, iu] = model.constant[model.slice_h]
         self.n_dof = n
         self.structure = (
-            tree.parent, tree.axis, tree.offset, tree.const_rot, tree.const_pos, solver.plan.arrays, tree.body_node,
-            c.gravity,
+            tree.parent, tree.axis, tree.offset, tree.const_rot, tree.const_pos, solver.plan.arrays,
+            model.motion.arrays, tree.body_node, c.gravity,
             a.frame_a, a.frame_b, a.row_loop, a.row_comp, a.actuated, a.passive, params, active_bodies(params),
             constant, float(solver.tol), int(MAX_ITER), float(SINGULAR_RATIO), float(solver.branch),
         )

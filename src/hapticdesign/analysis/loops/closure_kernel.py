@@ -37,15 +37,20 @@ def _cross(a0, a1, a2, b0, b1, b2):
 
 
 @njit(cache=True)
-def node_motion(rate, parent, axis, rot, pos, w, al, ac):
+def node_motion(rate, motion, axis, rot, pos, w, al, ac):
     """World angular velocity ``w`` and, at zero joint accelerations, the angular and origin accelerations
-    ``al``, ``ac`` of every node, for the rate ``rate[n]`` of each node's joint value.
+    ``al``, ``ac`` of the nodes of a motion plan (:class:`~.solver.MotionPlan` arrays ``motion``), for the rate
+    ``rate[n]`` of each node's joint value.
 
-    Rotation node (axis ``u``, rate ``s``): ``w = w_p + s u``, ``al = al_p + w_p x s u``, same origin.
-    Translation node (offset ``d = value u``): ``ac = ac_p + al_p x d + w_p x (w_p x d) + 2 w_p x s u``.
+    From the kept ancestor ``k`` (the base: at rest), over the origin difference ``d = p_n - p_k``:
+    rotation node (axis ``u``, rate ``s``): ``w = w_k + s u``, ``al = al_k + w_k x s u``,
+    ``ac = ac_k + al_k x d + w_k x (w_k x d)``; translation node: ``w = w_k``, ``al = al_k``,
+    ``ac = ac_k + al_k x d + w_k x (w_k x d) + 2 w_k x s u`` (the time derivative of seed 000 eq. 2.38-2.41).
     """
-    for n in range(parent.shape[0]):
-        p = parent[n]
+    order, kept, moves = motion
+    for i in range(order.shape[0]):
+        n = order[i]
+        p = kept[i]
         s = rate[n]
         a = axis[n] % 3
         u0, u1, u2 = rot[n, 0, a], rot[n, 1, a], rot[n, 2, a]
@@ -53,25 +58,23 @@ def node_motion(rate, parent, axis, rot, pos, w, al, ac):
             w0, w1, w2 = w[p, 0], w[p, 1], w[p, 2]
             l0, l1, l2 = al[p, 0], al[p, 1], al[p, 2]
             a0, a1, a2 = ac[p, 0], ac[p, 1], ac[p, 2]
-            d0, d1, d2 = pos[n, 0] - pos[p, 0], pos[n, 1] - pos[p, 1], pos[n, 2] - pos[p, 2]
         else:
             w0 = w1 = w2 = l0 = l1 = l2 = a0 = a1 = a2 = 0.0
-            d0, d1, d2 = pos[n, 0], pos[n, 1], pos[n, 2]
+        if p >= 0 and moves[i]:
+            d0, d1, d2 = pos[n, 0] - pos[p, 0], pos[n, 1] - pos[p, 1], pos[n, 2] - pos[p, 2]
+            wd0, wd1, wd2 = _cross(w0, w1, w2, d0, d1, d2)
+            ww0, ww1, ww2 = _cross(w0, w1, w2, wd0, wd1, wd2)
+            ld0, ld1, ld2 = _cross(l0, l1, l2, d0, d1, d2)
+            a0, a1, a2 = a0 + ld0 + ww0, a1 + ld1 + ww1, a2 + ld2 + ww2
+        x0, x1, x2 = _cross(w0, w1, w2, s * u0, s * u1, s * u2)
         if axis[n] < 3:
-            x0, x1, x2 = _cross(w0, w1, w2, s * u0, s * u1, s * u2)
             w[n, 0], w[n, 1], w[n, 2] = w0 + s * u0, w1 + s * u1, w2 + s * u2
             al[n, 0], al[n, 1], al[n, 2] = l0 + x0, l1 + x1, l2 + x2
             ac[n, 0], ac[n, 1], ac[n, 2] = a0, a1, a2
         else:
-            wd0, wd1, wd2 = _cross(w0, w1, w2, d0, d1, d2)
-            ww0, ww1, ww2 = _cross(w0, w1, w2, wd0, wd1, wd2)
-            ld0, ld1, ld2 = _cross(l0, l1, l2, d0, d1, d2)
-            ws0, ws1, ws2 = _cross(w0, w1, w2, s * u0, s * u1, s * u2)
             w[n, 0], w[n, 1], w[n, 2] = w0, w1, w2
             al[n, 0], al[n, 1], al[n, 2] = l0, l1, l2
-            ac[n, 0] = a0 + ld0 + ww0 + 2.0 * ws0
-            ac[n, 1] = a1 + ld1 + ww1 + 2.0 * ws1
-            ac[n, 2] = a2 + ld2 + ww2 + 2.0 * ws2
+            ac[n, 0], ac[n, 1], ac[n, 2] = a0 + 2.0 * x0, a1 + 2.0 * x1, a2 + 2.0 * x2
 
 
 @njit(cache=True, inline="always")
@@ -83,33 +86,34 @@ def rotation_entry(rot, node, i, k):
 
 
 @njit(cache=True)
-def add_joint_accelerations(acc, parent, axis, rot, pos, al, ac, dal, dac):
-    """Add to the node accelerations ``al``, ``ac`` those of the joint-value accelerations ``acc[n]`` at zero rates.
+def add_joint_accelerations(acc, motion, axis, rot, pos, al, ac, dal, dac):
+    """Add to the node accelerations ``al``, ``ac`` those of the joint-value accelerations ``acc[n]`` at zero rates
+    (the nodes of a motion plan, as :func:`node_motion`).
 
-    The rate-free part of :func:`node_motion` (linear in ``acc``): a rotation node adds ``acc u`` to the
-    angular acceleration, a translation (or constant) node carries its parent's angular acceleration
-    ``dal_p`` over its offset ``d`` and adds ``acc u``: ``dac = dac_p + dal_p x d + acc u``.
-    ``dal``, ``dac``: scratch (M x 3).
+    The rate-free part of :func:`node_motion` (linear in ``acc``): from the kept ancestor ``k``, a node carries
+    its angular acceleration ``dal_k`` over the origin difference ``d`` (``dac = dac_k + dal_k x d``) and adds
+    ``acc u`` to the angular acceleration (rotation) or to the origin's (translation). ``dal``, ``dac``:
+    scratch (M x 3).
     """
-    for n in range(parent.shape[0]):
-        p = parent[n]
+    order, kept, moves = motion
+    for i in range(order.shape[0]):
+        n = order[i]
+        p = kept[i]
         s = acc[n]
         a = axis[n] % 3
-        u0, u1, u2 = rot[n, 0, a], rot[n, 1, a], rot[n, 2, a]
+        u0, u1, u2 = s * rot[n, 0, a], s * rot[n, 1, a], s * rot[n, 2, a]
         if p >= 0:
             l0, l1, l2 = dal[p, 0], dal[p, 1], dal[p, 2]
             a0, a1, a2 = dac[p, 0], dac[p, 1], dac[p, 2]
+            if moves[i]:
+                x0, x1, x2 = _cross(l0, l1, l2, pos[n, 0] - pos[p, 0], pos[n, 1] - pos[p, 1], pos[n, 2] - pos[p, 2])
+                a0, a1, a2 = a0 + x0, a1 + x1, a2 + x2
         else:
             l0 = l1 = l2 = a0 = a1 = a2 = 0.0
         if axis[n] < 3:
-            l0, l1, l2 = l0 + s * u0, l1 + s * u1, l2 + s * u2
+            l0, l1, l2 = l0 + u0, l1 + u1, l2 + u2
         else:
-            if p >= 0:
-                d0, d1, d2 = pos[n, 0] - pos[p, 0], pos[n, 1] - pos[p, 1], pos[n, 2] - pos[p, 2]
-            else:
-                d0, d1, d2 = pos[n, 0], pos[n, 1], pos[n, 2]
-            x0, x1, x2 = _cross(l0, l1, l2, d0, d1, d2)
-            a0, a1, a2 = a0 + x0 + s * u0, a1 + x1 + s * u1, a2 + x2 + s * u2
+            a0, a1, a2 = a0 + u0, a1 + u1, a2 + u2
         dal[n, 0], dal[n, 1], dal[n, 2] = l0, l1, l2
         dac[n, 0], dac[n, 1], dac[n, 2] = a0, a1, a2
         al[n, 0] += l0
@@ -197,7 +201,7 @@ def closure_bias(frame_a, frame_b, row_loop, row_comp, al, ac, out):
 @njit(cache=True)
 def lu_in_place(u, x):
     """Solve ``u x = b`` (m x m, m x k) by Gaussian elimination with partial pivoting: ``x`` holds ``b`` on entry
-    and the solution on return, ``u`` is overwritten (no allocation).
+    and the solution on return, ``u`` is overwritten (no allocation; one division per pivot).
 
     Returns the pivot ratio ``min |u_ii| / max |u_ii|`` (0 when singular) and the sign of ``det u``.
     """
@@ -211,7 +215,7 @@ def lu_in_place(u, x):
                 best = r
         if best != c:
             sign = -sign
-            for k in range(m):
+            for k in range(c, m):
                 u[c, k], u[best, k] = u[best, k], u[c, k]
             for k in range(x.shape[1]):
                 x[c, k], x[best, k] = x[best, k], x[c, k]
@@ -222,10 +226,12 @@ def lu_in_place(u, x):
             return 0.0, 0.0
         if pivot < 0.0:
             sign = -sign
+        inverse = 1.0 / pivot
+        u[c, c] = inverse
         for r in range(c + 1, m):
-            f = u[r, c] / pivot
+            f = u[r, c] * inverse
             if f != 0.0:
-                for k in range(c, m):
+                for k in range(c + 1, m):
                     u[r, k] -= f * u[c, k]
                 for k in range(x.shape[1]):
                     x[r, k] -= f * x[c, k]
@@ -234,7 +240,7 @@ def lu_in_place(u, x):
             t = x[c, k]
             for j in range(c + 1, m):
                 t -= u[c, j] * x[j, k]
-            x[c, k] = t / u[c, c]
+            x[c, k] = t * u[c, c]
     return small / big, sign
 
 

@@ -28,7 +28,7 @@ from hapticdesign.analysis.loops import closure_kernel as ck
 from hapticdesign.errors import UserError
 from hapticdesign.model.loops import ClosedLoops
 from hapticdesign.model.mechanism import Mechanism
-from hapticdesign.model.walk import node_poses
+from hapticdesign.model.walk import CONSTANT, KinematicTree, node_poses
 
 MAX_STEP = 0.1
 """Largest continuation step in the actuated coordinates (rad or m) before Newton."""
@@ -71,6 +71,50 @@ class LoopArrays:
         )
 
 
+@dataclass(frozen=True)
+class MotionPlan:
+    """The nodes whose motions (:func:`.closure_kernel.node_motion`) a set of nodes needs, in tree order.
+
+    Those nodes and, among their ancestors, the variable ones: the others (constants, fixed
+    translations) only carry a motion along a rigid offset, which the next kept node takes from its
+    kept ancestor ``parent[i]`` (``-1``: the base) over the origin difference. ``moves[i]`` is False when
+    node ``order[i]`` has its kept ancestor's origin (only rotations between them), so that its origin
+    acceleration is the ancestor's.
+    """
+
+    order: np.ndarray
+    parent: np.ndarray
+    moves: np.ndarray
+
+    @classmethod
+    def of(cls, tree: KinematicTree, needed: list[int]) -> MotionPlan:
+        """The plan of the nodes ``needed`` (``-1``, the base, needs none) on the folded tree ``tree``."""
+        variable = np.any(tree.coef != 0.0, axis=1)
+        path: set[int] = set()
+        for node in needed:
+            while node >= 0 and node not in path:
+                path.add(node)
+                node = int(tree.parent[node])
+        order = sorted(n for n in path if variable[n] or n in needed)
+        kept = set(order)
+        parents, moves = [], []
+        for n in order:
+            e, moved = n, False
+            while e >= 0 and (e == n or e not in kept):
+                shift = tree.axis[e] >= 3 if tree.axis[e] != CONSTANT else bool(np.any(tree.const_pos[e] != 0.0))
+                moved = moved or bool(shift)
+                e = int(tree.parent[e])
+            parents.append(e)
+            moves.append(moved)
+        return cls(order=np.array(order, dtype=np.int64), parent=np.array(parents, dtype=np.int64),
+                   moves=np.array(moves, dtype=np.bool_))
+
+    @property
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(order, parent, moves)``, the ``motion`` of the kernels."""
+        return self.order, self.parent, self.moves
+
+
 class LoopSolver:
     """Passive coordinates of a closed-loop mechanism (see the module docstring)."""
 
@@ -86,6 +130,8 @@ class LoopSolver:
         self.n_actuated = mechanism.n_actuated
         lengths = np.abs(self.compiled.node_offset[self.compiled.node_axis >= 3])
         self.tol = 1e-12 * max(float(lengths.max(initial=0.0)), 1e-3)
+        self.settings = (MAX_STEP, self.tol, MAX_ITER, SINGULAR_RATIO, MIN_FRACTION)
+        """``(max_step, tol, max_iter, singular_ratio, min_fraction)``: the continuation's settings (kernel order)."""
         loops = mechanism.loops
         q = np.zeros(self.n_dof)
         q[self.arrays.actuated] = loops.home
@@ -135,7 +181,7 @@ class LoopSolver:
         a = self.arrays
         out, status, first = ck.solve_path(
             path, np.asarray(self.home if start is None else start, dtype=float), self.branch, a.actuated, a.passive,
-            *self._kinematic_args(), MAX_STEP, self.tol, MAX_ITER, SINGULAR_RATIO, MIN_FRACTION,
+            *self._kinematic_args(), *self.settings,
         )
         if not strict:
             return (out[0] if q_a.ndim == 1 else out), (status[0] if q_a.ndim == 1 else status)
