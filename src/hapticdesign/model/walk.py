@@ -206,16 +206,7 @@ def planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, start, st
         if axis[n] == CONSTANT:
             _constant_node(n, pn, const_rot, const_pos, rot, pos)
             continue
-        if pn >= 0:
-            for r in range(3):
-                for j in range(3):
-                    rot[n, r, j] = rot[pn, r, j]
-                pos[n, r] = pos[pn, r]
-        else:
-            for r in range(3):
-                for j in range(3):
-                    rot[n, r, j] = 1.0 if r == j else 0.0
-                pos[n, r] = 0.0
+        _parent_pose(n, pn, rot, pos)
         a = axis[n] % 3
         if axis[n] < 3:
             s = source[n]
@@ -252,6 +243,15 @@ def planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, start, st
 
 
 @njit(cache=True, inline="always")
+def _parent_pose(n, pn, rot, pos):
+    """Start node ``n`` at its parent's pose (the base's identity when ``pn < 0``), before its own transform."""
+    for i in range(3):
+        for j in range(3):
+            rot[n, i, j] = rot[pn, i, j] if pn >= 0 else (1.0 if i == j else 0.0)
+        pos[n, i] = pos[pn, i] if pn >= 0 else 0.0
+
+
+@njit(cache=True, inline="always")
 def _constant_node(n, pn, const_rot, const_pos, rot, pos):
     """World pose of a folded constant node ``n``: its parent's pose (the base for ``pn < 0``) times its transform."""
     for i in range(3):
@@ -278,16 +278,7 @@ def node_poses(q, parent, axis, coef, offset, const_rot, const_pos, last, rot, p
         v = offset[n]
         for k in range(q.shape[0]):
             v += coef[n, k] * q[k]
-        if pn >= 0:
-            for i in range(3):
-                for j in range(3):
-                    rot[n, i, j] = rot[pn, i, j]
-                pos[n, i] = pos[pn, i]
-        else:
-            for i in range(3):
-                for j in range(3):
-                    rot[n, i, j] = 1.0 if i == j else 0.0
-                pos[n, i] = 0.0
+        _parent_pose(n, pn, rot, pos)
         a = axis[n] % 3
         if axis[n] < 3:
             b = (a + 1) % 3
@@ -302,6 +293,19 @@ def node_poses(q, parent, axis, coef, offset, const_rot, const_pos, last, rot, p
         else:
             for i in range(3):
                 pos[n, i] += rot[n, i, a] * v
+
+
+@njit(cache=True, inline="always")
+def unit_twist(rot, pos, axis, n, point):
+    """Unit twist ``(v, w)`` of variable node ``n`` at the origin of node ``point``: ``(u x (p - p_n), u)`` for
+    a rotation about the world axis ``u`` through the node, ``(u, 0)`` for a translation along it (seed 000
+    eq. 2.20-2.26); every Jacobian column of the walks."""
+    a = axis[n] % 3
+    u0, u1, u2 = rot[n, 0, a], rot[n, 1, a], rot[n, 2, a]
+    if axis[n] >= 3:
+        return u0, u1, u2, 0.0, 0.0, 0.0
+    r0, r1, r2 = pos[point, 0] - pos[n, 0], pos[point, 1] - pos[n, 1], pos[point, 2] - pos[n, 2]
+    return u1 * r2 - u2 * r1, u2 * r0 - u0 * r2, u0 * r1 - u1 * r0, u0, u1, u2
 
 
 @njit(cache=True)
@@ -319,15 +323,8 @@ def frame_jacobian(node, parent, axis, coef, rot, pos, body, jac):
     n = node
     while n >= 0:
         if axis[n] != CONSTANT:
-            a = axis[n] % 3
             rotation = axis[n] < 3
-            u0, u1, u2 = rot[n, 0, a], rot[n, 1, a], rot[n, 2, a]
-            v0, v1, v2 = u0, u1, u2
-            if rotation:
-                r0 = pos[node, 0] - pos[n, 0]
-                r1 = pos[node, 1] - pos[n, 1]
-                r2 = pos[node, 2] - pos[n, 2]
-                v0, v1, v2 = u1 * r2 - u2 * r1, u2 * r0 - u0 * r2, u0 * r1 - u1 * r0
+            v0, v1, v2, u0, u1, u2 = unit_twist(rot, pos, axis, n, node)
             if body:
                 v0, v1, v2 = _to_node(rot, node, v0, v1, v2)
                 u0, u1, u2 = _to_node(rot, node, u0, u1, u2)

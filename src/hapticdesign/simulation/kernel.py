@@ -544,10 +544,7 @@ def run_loop(plant, ctrl, motion, timing, wall, handle, rec, scratch):
             break
         if it == n_steps:
             break
-        s = _first_span(spans, wanted, it, n_steps)
-        m = spans[s]
-        h = m * step
-        inside_peak = 0.0
+        inside_peak = coord_new = rate_new = 0.0
         if n_free == 0:
             m = 1
             h = step
@@ -558,6 +555,7 @@ def run_loop(plant, ctrl, motion, timing, wall, handle, rec, scratch):
         else:
             for i in range(n):
                 k1q[i] = qd[i]
+            s = _first_span(spans, wanted, it, n_steps)
             while True:
                 # RK4 over m plant steps; prescribed joints follow the path at each stage time
                 m = spans[s]
@@ -607,7 +605,9 @@ def run_loop(plant, ctrl, motion, timing, wall, handle, rec, scratch):
         it += m
         taken += 1
         peak = max(peak, inside_peak)
-        if tolerance > 0.0:
+        if tolerance > 0.0 and n_free > 0:
+            coord, rate = coord_new, rate_new  # the accepted step's end, evaluated for its checks
+        elif tolerance > 0.0:
             coord, rate = _wall_state(q, qd, wall, handle, plant, jn)
         else:
             coord = _wall_coordinate(q, qd, wall, handle, plant)

@@ -49,7 +49,7 @@ from hapticdesign.analysis.loops.closure_kernel import (
     rotation_entry,
     solve_path,
 )
-from hapticdesign.model.walk import planned_poses, trig_workspace
+from hapticdesign.model.walk import planned_poses, trig_workspace, unit_twist
 
 
 @njit(cache=True)
@@ -175,15 +175,7 @@ def reduce_pose(parent, axis, plan, body_node, actuated, passive, ws):
             if ptr[e] == ptr[e + 1]:  # no coordinate moves this node (constant): no column
                 e = parent[e]
                 continue
-            a = axis[e] % 3
-            u0, u1, u2 = rot[e, 0, a], rot[e, 1, a], rot[e, 2, a]
-            if axis[e] < 3:
-                r0, r1, r2 = pos[nb, 0] - pos[e, 0], pos[nb, 1] - pos[e, 1], pos[nb, 2] - pos[e, 2]
-                v0, v1, v2 = u1 * r2 - u2 * r1, u2 * r0 - u0 * r2, u0 * r1 - u1 * r0
-                w0, w1, w2 = u0, u1, u2
-            else:
-                v0, v1, v2 = u0, u1, u2
-                w0 = w1 = w2 = 0.0
+            v0, v1, v2, w0, w1, w2 = unit_twist(rot, pos, axis, e, nb)
             for j in range(na):
                 c = node_t[e, j]
                 ja[b, 0, j] += c * v0
@@ -368,15 +360,7 @@ def passive_inertia(b, body_node, paths, axis, plan, slot, rot, pos, mj, hap):
     nb = body_node[b]
     for c in range(first[b], first[b + 1]):
         e = nodes[c]
-        a = axis[e] % 3
-        u0, u1, u2 = rot[e, 0, a], rot[e, 1, a], rot[e, 2, a]
-        if axis[e] < 3:
-            r0, r1, r2 = pos[nb, 0] - pos[e, 0], pos[nb, 1] - pos[e, 1], pos[nb, 2] - pos[e, 2]
-            v0, v1, v2 = u1 * r2 - u2 * r1, u2 * r0 - u0 * r2, u0 * r1 - u1 * r0
-            w0, w1, w2 = u0, u1, u2
-        else:
-            v0, v1, v2 = u0, u1, u2
-            w0 = w1 = w2 = 0.0
+        v0, v1, v2, w0, w1, w2 = unit_twist(rot, pos, axis, e, nb)
         for i in range(mj.shape[1]):
             d = mj[0, i] * v0 + mj[1, i] * v1 + mj[2, i] * v2 + mj[3, i] * w0 + mj[4, i] * w1 + mj[5, i] * w2
             for k in range(ptr[e], ptr[e + 1]):

@@ -37,7 +37,7 @@ from hapticdesign.analysis.dynamics.closed_loop import ClosedLoopModel
 from hapticdesign.analysis.loops import closure_kernel as ck
 from hapticdesign.analysis.loops.solver import MAX_ITER, MESSAGES, SINGULAR_RATIO
 from hapticdesign.errors import UserError
-from hapticdesign.model.walk import CONSTANT, planned_poses
+from hapticdesign.model.walk import CONSTANT, planned_poses, unit_twist
 
 OK, NO_CLOSURE, SINGULAR, BRANCH_CHANGE = ck.OK, ck.NO_CLOSURE, ck.SINGULAR, ck.BRANCH_CHANGE
 
@@ -182,11 +182,7 @@ def handle_along(ws, parent, axis, node, direction, jn, want_jn):
     e = node
     while e >= 0:
         if axis[e] != CONSTANT:
-            a = axis[e] % 3
-            u0, u1, u2 = rot[e, 0, a], rot[e, 1, a], rot[e, 2, a]
-            if axis[e] < 3:
-                r0, r1, r2 = pos[node, 0] - pos[e, 0], pos[node, 1] - pos[e, 1], pos[node, 2] - pos[e, 2]
-                u0, u1, u2 = u1 * r2 - u2 * r1, u2 * r0 - u0 * r2, u0 * r1 - u1 * r0
+            u0, u1, u2, _, _, _ = unit_twist(rot, pos, axis, e, node)
             along = direction[0] * u0 + direction[1] * u1 + direction[2] * u2
             for j in range(jn.shape[0]):
                 jn[j] += node_t[e, j] * along

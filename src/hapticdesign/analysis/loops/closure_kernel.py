@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from hapticdesign.model.walk import planned_poses, trig_workspace
+from hapticdesign.model.walk import planned_poses, trig_workspace, unit_twist
 
 OK, NO_CLOSURE, SINGULAR, BRANCH_CHANGE = 0, 1, 2, 3
 MAX_NEWTON_STEP = 0.25
@@ -170,13 +170,7 @@ def closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, plan, r
             e = node
             while e >= 0:
                 if ptr[e] != ptr[e + 1]:  # a node some coordinate moves
-                    a = axis[e] % 3
-                    u0, u1, u2 = rot[e, 0, a], rot[e, 1, a], rot[e, 2, a]
-                    if axis[e] < 3:
-                        r0, r1, r2 = pos[node, 0] - pos[e, 0], pos[node, 1] - pos[e, 1], pos[node, 2] - pos[e, 2]
-                        twist = (u1 * r2 - u2 * r1, u2 * r0 - u0 * r2, u0 * r1 - u1 * r0, u0, u1, u2)
-                    else:
-                        twist = (u0, u1, u2, 0.0, 0.0, 0.0)
+                    twist = unit_twist(rot, pos, axis, e, node)
                     for i in range(start, stop):
                         t = f * twist[row_comp[i]]
                         for k in range(ptr[e], ptr[e + 1]):
