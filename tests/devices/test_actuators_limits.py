@@ -105,11 +105,12 @@ def test_simulation_tables_carry_the_reflected_inertia(pendulum_file):
 def test_damping_adds_and_coulomb_is_carried(pendulum_file):
     device = load_device_file(pendulum_file)
     assert device.damping == pytest.approx((0.011,))
-    assert device.coulomb == pytest.approx((0.005,))
-    assert device.reflected_inertia == pytest.approx((RATIO**2 * J_ROTOR,))
+    friction_map, coulomb = device.friction
+    assert friction_map.tolist() == [[1.0]] and coulomb == pytest.approx([0.005])
+    assert device.reflected_inertia == pytest.approx(np.array([[RATIO**2 * J_ROTOR]]))
     assert device.joint_limits() == ((-1.0, 1.0),)
     overridden = device.with_params({"mhandle": 0.03})  # parameter overrides keep actuators and limits
-    assert overridden.reflected_inertia == device.reflected_inertia and overridden.limits == device.limits
+    assert overridden.actuators == device.actuators and overridden.limits == device.limits
     assert mass_matrix(overridden, np.zeros(1))[0, 0] == pytest.approx(pendulum_h() + 0.01 * R_TIP**2, rel=1e-12)
 
 
@@ -292,17 +293,45 @@ def test_torus_region_ignores_the_limits(tmp_path):
 
 # -- the Phantom with its motors --------------------------------------------------------------------------
 def test_phantom_motors_adds_the_reflected_inertia_to_the_preset():
-    """Values from the file's stated source (mahilab/Phantom, PhantomModel.hpp): Jm 1.08e-6, ratios 13.3, 11.2, 11.2."""
+    """Values from the file's stated source (mahilab/Phantom, PhantomModel.hpp): Jm 1.08e-6, ratios 13.3, 11.2, 11.2.
+    Its third motor turns the distal link's absolute angle q3 = -(theta2 + theta3) (the literature map of
+    tests/dynamics/test_literature_phantom.py), so by hand its n^2 J_r reaches H22, H23 and H33, its damping
+    the same entries of the damping matrix, and its friction acts on theta2' + theta3'."""
     motors, plain = load_device_file(EXAMPLES / "phantom-3dof-motors.yaml"), preset("phantom-3dof")
-    reflected = np.diag([13.3**2 * 1.08e-6, 11.2**2 * 1.08e-6, 11.2**2 * 1.08e-6])
+    r1, r2 = 13.3**2 * 1.08e-6, 11.2**2 * 1.08e-6
+    reflected = np.array([[r1, 0, 0], [0, 2 * r2, r2], [0, r2, r2]])
     q = np.random.default_rng(5).uniform(-np.pi, np.pi, (20, 3))
     np.testing.assert_allclose(mass_matrix(motors, q) - mass_matrix(plain, q), np.broadcast_to(reflected, (20, 3, 3)), rtol=0, atol=1e-15)
     np.testing.assert_allclose(coriolis_centrifugal(motors, q), coriolis_centrifugal(plain, q), rtol=1e-13, atol=1e-16)
     np.testing.assert_allclose(gravity(motors, q), gravity(plain, q), rtol=1e-13, atol=1e-16)
-    assert motors.damping == pytest.approx((0.5005, 0.5005, 0.3505))
-    assert motors.coulomb == pytest.approx((0.01, 0.01, 0.01))
-    degrees = [(-90, 90), (-119, 124), (-214, 29)]
-    np.testing.assert_allclose(motors.joint_limits(), np.radians(degrees), rtol=1e-15)
+    assert motors.damping == pytest.approx((0.5005, 0.5010, 0.3505))
+    np.testing.assert_allclose(motors.damping_matrix, [[0.5005, 0, 0], [0, 0.5010, 0.0005], [0, 0.0005, 0.3505]],
+                               rtol=1e-15, atol=1e-18)
+    friction_map, coulomb = motors.friction
+    np.testing.assert_array_equal(np.abs(friction_map), [[1, 0, 0], [0, 1, 0], [0, 1, 1]])
+    assert coulomb == pytest.approx([0.01, 0.01, 0.01])
+    np.testing.assert_allclose(motors.joint_limits(), np.radians([(-90, 90), (-119, 124), (-65, 55)]), rtol=1e-15)
+    assert motors.limit_warnings(np.radians([0, -100, 50])) == []  # q3 = 50 deg, inside the motor's travel
+    travel = motors.limit_warnings(np.radians([0, 20, 20]))  # q3 = -40 deg, below the travel's -29 deg
+    assert len(travel) == 1 and "-theta2 - theta3" in travel[0] and "travel" in travel[0]
+
+
+def test_coupled_motor_in_the_simulation_equals_the_scipy_loop():
+    """The kernel's friction and damping on ``a^T qd`` against the SciPy loop (simulation/reference.py, which sums
+    ``A^T (f tanh(A qd / v))`` with NumPy): the Phantom with its motors, type 2, 0.3 s. The friction's slope
+    ``f / v`` makes the plant stiff near rest (time constant about 1e-4 s), so RK4 takes 1e-5-s steps here."""
+    from hapticdesign.simulation.config import LoopConfig, Wall
+    from hapticdesign.simulation.criteria import type_paths
+    from hapticdesign.simulation.loop import simulate
+    from hapticdesign.simulation.reference import simulate_adaptive
+
+    motors = load_device_file(EXAMPLES / "phantom-3dof-motors.yaml")
+    config = LoopConfig(duration=0.3, step=1e-5, wall=Wall(1, 20.0, 0.0, 0.01))
+    paths = {0: type_paths(2, 3, 1)[0]}
+    fast, slow = simulate(motors, config, paths), simulate_adaptive(motors, config, paths, rtol=1e-10, atol=1e-12)
+    assert fast.status == slow.status == 0
+    assert np.abs(fast.q[:, 2]).max() > 1e-3  # the third joint moved, so its motor's rate theta2' + theta3' varied
+    assert np.abs(fast.q - slow.q).max() < 1e-9
 
 
 def test_phantom_motors_ln_on_the_torus_equals_the_preset():

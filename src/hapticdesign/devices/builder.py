@@ -15,8 +15,10 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+import numpy as np
+
 from hapticdesign.errors import UserError
-from hapticdesign.model.actuators import Actuator, Limits, per_joint
+from hapticdesign.model.actuators import Actuator, Limits, damping_matrix
 from hapticdesign.model.device import Device
 from hapticdesign.model.dh import DHRow, dh_frames
 from hapticdesign.model.elastic import Elasticity
@@ -144,7 +146,8 @@ def assemble_device(
 ) -> Device:
     """A Device whose ``params`` hold every kinematic and inertial name (``m2``, ``r2x``, ``Ixy2``...).
 
-    ``damping`` is the joints' own; the actuators' viscous damping is added to it per coordinate.
+    ``damping`` is the joints' own; the diagonal of the actuators' viscous damping ``b a a^T`` is added to
+    it per coordinate (the off-diagonal part is :attr:`Device.damping_matrix`'s).
     ``elasticity`` (elastic links, joint springs) is checked against the geometry here.
     """
     params = dict(kinematic)
@@ -155,7 +158,7 @@ def assemble_device(
                 raise UserError(f"parameter name {key!r} is ambiguous (rename a body or a parameter)")
             params[key] = float(getattr(inertia, f))
     if actuators:
-        damping = tuple(a + b for a, b in zip(damping, per_joint(actuators, len(damping), "damping")))
+        damping = tuple(a + float(b) for a, b in zip(damping, np.diag(damping_matrix(actuators, len(damping)))))
     device = Device(name, description, tuple(kinematic), builder, params, damping, tuple(actuators),
                     tuple(limits) if any(span is not None for span in limits) else (), elasticity)
     mechanism = device.mechanism  # build once: geometry errors surface at load time, not at first use

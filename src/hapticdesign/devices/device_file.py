@@ -13,7 +13,7 @@ from pydantic import ValidationError
 
 from hapticdesign.analysis.stiffness.link import rigidities
 from hapticdesign.devices.builder import ChainBuilder, DHRowTemplate, FrameTemplate, assemble_device
-from hapticdesign.devices.schema import DeviceFileSpec
+from hapticdesign.devices.schema import DeviceFileSpec, motor_terms
 from hapticdesign.errors import UserError
 from hapticdesign.model.actuators import Actuator
 from hapticdesign.model.device import Device
@@ -77,9 +77,14 @@ def _closed_loops(spec: DeviceFileSpec) -> ClosedLoops | None:
 def _actuators(spec: DeviceFileSpec) -> tuple[Actuator, ...]:
     """The file's actuators with 0-based indices among the actuated joints (in the order of ``joints``)."""
     index = {j.name: k for k, j in enumerate(j for j in spec.joints if j.actuated)}
-    return tuple(
-        Actuator(index[a.joint], a.rotor_inertia, a.gear_ratio, a.coulomb, a.damping) for a in spec.actuators
-    )
+    out = []
+    for a in spec.actuators:
+        terms = tuple((index[name], float(c)) for name, c in motor_terms(a).items())
+        coupling = () if a.drives is None else terms
+        offset = 0.0 if a.drives is None else float(a.drives.constant)
+        limits = None if a.limits is None else (float(a.limits[0]), float(a.limits[1]))
+        out.append(Actuator(terms[0][0], a.rotor_inertia, a.gear_ratio, a.coulomb, a.damping, coupling, offset, limits))
+    return tuple(out)
 
 
 def _location(loc: tuple) -> str:

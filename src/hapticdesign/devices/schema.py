@@ -20,6 +20,7 @@ import math
 import re
 from typing import Annotated, Literal
 
+import numpy as np
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, InstanceOf, model_validator
 
 from hapticdesign.analysis.stiffness.materials import MATERIALS, LinkModuli, isotropic, laminate
@@ -153,10 +154,14 @@ class JointSpec(_FileModel):
 
 
 class ActuatorSpec(_FileModel):
-    """A motor on ``joint`` (:mod:`hapticdesign.model.actuators`): rotor inertia [kg m^2], transmission
-    ratio (rotor rad per joint rad or m), joint-side Coulomb friction (N m or N) and viscous damping."""
+    """A motor on ``joint``, or on the affine combination ``drives`` of actuated coordinates (such as
+    ``theta2 + theta3``; :mod:`hapticdesign.model.actuators`): rotor inertia [kg m^2], transmission
+    ratio (rotor rad per joint rad or m), Coulomb friction (N m or N) and viscous damping on the side of
+    what it turns, and optional ``limits`` of its travel (of ``drives``, in joint units)."""
 
-    joint: Identifier
+    joint: Identifier | None = None
+    drives: Expression | None = None
+    limits: tuple[Number, Number] | None = None
     rotor_inertia: Annotated[Number, Field(ge=0.0)] = 0.0
     gear_ratio: Annotated[Number, Field(gt=0.0)] = 1.0
     coulomb: Annotated[Number, Field(ge=0.0)] = 0.0
@@ -389,8 +394,10 @@ def _check_loops(spec: DeviceFileSpec, frames: list[str]) -> None:
         if not joint.actuated and (joint.damping or joint.limits is not None):
             raise ValueError(f"joints[{i}] ({joint.name}): a passive joint takes no damping or limits (not supported)")
     for i, actuator in enumerate(spec.actuators):
-        if actuator.joint in passive:
-            raise ValueError(f"actuators[{i}].joint: {actuator.joint} is passive (actuated: false)")
+        on_passive = [name for name in motor_terms(actuator) if name in passive]
+        if on_passive:
+            raise ValueError(f"actuators[{i}].{'joint' if actuator.drives is None else 'drives'}: {on_passive[0]} is "
+                             "passive (actuated: false)")
     if passive and not spec.loops:
         raise ValueError(f"joints: passive joint {passive[0]} needs loops: [{{frames: [a, b], close: ...}}] to close")
     if spec.loops and not passive:
@@ -416,10 +423,33 @@ def _check_limits_and_actuators(spec: DeviceFileSpec, coordinates: list[str]) ->
         if joint.limits is not None and not joint.limits[0] < joint.limits[1]:
             raise ValueError(f"joints[{i}] ({joint.name}).limits: need low < high, got [{joint.limits[0]:g}, "
                              f"{joint.limits[1]:g}]")
-    driven: set[str] = set()
+    driven: list[dict[str, float]] = []
     for i, actuator in enumerate(spec.actuators):
-        if actuator.joint not in coordinates:
+        if (actuator.joint is None) == (actuator.drives is None):
+            raise ValueError(f"actuators[{i}]: give either joint (the coordinate it turns) or drives (an affine "
+                             "combination of coordinates such as theta2 + theta3)")
+        if actuator.joint is not None and actuator.joint not in coordinates:
             raise ValueError(f"actuators[{i}].joint: unknown joint {actuator.joint!r} (joints: {', '.join(coordinates)})")
-        if actuator.joint in driven:
+        terms = motor_terms(actuator)
+        if not terms:
+            raise ValueError(f"actuators[{i}].drives: the combination names no coordinate")
+        unknown = [name for name in terms if name not in coordinates]
+        if unknown:
+            raise ValueError(f"actuators[{i}].drives: unknown joint {unknown[0]!r} (joints: {', '.join(coordinates)})")
+        if actuator.limits is not None and not actuator.limits[0] < actuator.limits[1]:
+            raise ValueError(f"actuators[{i}].limits: need low < high, got [{actuator.limits[0]:g}, "
+                             f"{actuator.limits[1]:g}]")
+        if actuator.joint is not None and terms in driven:
             raise ValueError(f"actuators[{i}].joint: joint {actuator.joint} has two actuators (give one per joint)")
-        driven.add(actuator.joint)
+        driven.append(terms)
+    rows = np.array([[terms.get(name, 0.0) for name in coordinates] for terms in driven])
+    if driven and np.linalg.matrix_rank(rows) < len(driven):
+        raise ValueError("actuators: two motors turn the same joint or dependent combinations of joints (give one "
+                         "motor per independent combination)")
+
+
+def motor_terms(actuator: ActuatorSpec) -> dict[str, float]:
+    """The coordinates an actuator turns with their coefficients (``{joint: 1}`` for a motor on one joint)."""
+    if actuator.drives is None:
+        return {actuator.joint: 1.0}
+    return dict(actuator.drives.terms)

@@ -1,12 +1,16 @@
-"""Actuators and joint limits: what a motor adds to a joint, and the range a joint may move in.
+"""Actuators and joint limits: what a motor adds to the joints, and the range a joint may move in.
 
-A motor of rotor inertia ``J_r`` drives joint ``i`` through a transmission of ratio ``n`` (rotor
-angle per joint unit: rad/rad for a revolute joint, rad/m for a prismatic one). Its kinetic energy
-``J_r (n qd_i)^2 / 2`` adds the *reflected inertia* ``n^2 J_r`` to the diagonal entry ``H_ii`` of
-the mass matrix of seed 000 eq. 2.50. The gyroscopic coupling between a rotor and a moving carrier
+A motor of rotor inertia ``J_r`` turns, through a transmission of ratio ``n`` (rotor angle per
+joint unit: rad/rad for a revolute joint, rad/m for a prismatic one), one coordinate or an affine
+combination ``a^T q + a_0`` of them: a capstan that drives the Phantom's distal link from the base
+turns its absolute angle, the sum ``theta2 + theta3`` of seed 000's relative DH angles (Table 2.2).
+Its kinetic energy ``J_r (n a^T qd)^2 / 2`` adds the *reflected inertia* ``n^2 J_r a a^T`` to the
+mass matrix of seed 000 eq. 2.50 (``n^2 J_r`` on the diagonal entry ``H_ii`` when ``a`` is the unit
+vector of coordinate ``i``); its viscous damping ``b`` adds ``b a a^T`` and its Coulomb friction
+``f`` the torque ``f sign(a^T qd) a``, both acting on the combination's rate ``a^T qd``. The gyroscopic coupling between a rotor and a moving carrier
 link is neglected, as usual for geared or capstan drives (Spong, Hutchinson & Vidyasagar,
 *Robot Modeling and Control*, 2006, §7.4); the reflected inertia is therefore a constant matrix,
-``H(q) = H_pi(q) + diag(n^2 J_r)``, and the dynamics stay linear in the standard inertial
+``H(q) = H_pi(q) + sum n^2 J_r a a^T``, and the dynamics stay linear in the standard inertial
 parameters ``pi`` (a constant has no variance over a region, so the Linearity Number of eq. 3.1-3.4
 is unchanged by it). Coulomb friction and viscous damping are given on the joint side (N m and
 N m s/rad, or N and N s/m), i.e. as the joint feels them through the transmission.
@@ -17,32 +21,93 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 Limits = tuple[float, float] | None
 """A joint's range ``(low, high)`` in rad or m, or ``None`` when it moves freely."""
 
 
 @dataclass(frozen=True)
 class Actuator:
-    """A motor on coordinate ``joint`` (0-based): rotor inertia [kg m^2], ratio, joint-side friction."""
+    """A motor on coordinate ``joint`` (0-based), or on the combination ``coupling`` of coordinates:
+    rotor inertia [kg m^2], ratio, friction and damping on the side of the coordinates it turns.
+
+    ``coupling`` holds ``(coordinate, coefficient)`` pairs of ``a`` (empty: ``a`` is the unit vector
+    of ``joint``); ``offset`` is ``a_0`` and ``limits`` the range of ``a^T q + a_0`` (the motor's
+    travel, in joint units), or ``None``.
+    """
 
     joint: int
     rotor_inertia: float = 0.0
     gear_ratio: float = 1.0
     coulomb: float = 0.0
     damping: float = 0.0
+    coupling: tuple[tuple[int, float], ...] = ()
+    offset: float = 0.0
+    limits: Limits = None
 
     @property
     def reflected_inertia(self) -> float:
-        """``n^2 J_r``: kg m^2 on a revolute joint, kg on a prismatic one."""
+        """``n^2 J_r``: kg m^2 on a revolute joint, kg on a prismatic one (times ``a a^T`` in H)."""
         return self.gear_ratio**2 * self.rotor_inertia
 
+    @property
+    def coupled(self) -> bool:
+        """Whether the motor turns anything but one coordinate with coefficient 1."""
+        return bool(self.coupling) and self.coupling != ((self.joint, 1.0),)
 
-def per_joint(actuators: tuple[Actuator, ...], n_dof: int, field: str) -> tuple[float, ...]:
-    """One value per coordinate: the actuators' ``field`` (``reflected_inertia``, ``coulomb``, ``damping``)."""
-    out = [0.0] * n_dof
+    def row(self, n_dof: int) -> np.ndarray:
+        """``a`` (n_dof,): the rate the motor turns is ``a^T qd``."""
+        a = np.zeros(n_dof)
+        for k, coefficient in self.coupling or ((self.joint, 1.0),):
+            a[k] += coefficient
+        return a
+
+
+def transmission(actuators: tuple[Actuator, ...], n_dof: int) -> np.ndarray:
+    """``A`` (actuators x n_dof): row k is actuator k's ``a`` (a unit row for a motor on one joint)."""
+    return np.array([a.row(n_dof) for a in actuators]).reshape(len(actuators), n_dof)
+
+
+def reflected_inertia_matrix(actuators: tuple[Actuator, ...], n_dof: int) -> np.ndarray:
+    """``sum_k n_k^2 J_r,k a_k a_k^T`` (n_dof x n_dof), the constant the motors add to H (eq. 2.50);
+    ``diag(n^2 J_r)`` when every motor turns one joint."""
+    a = transmission(actuators, n_dof)
+    return a.T @ (np.array([x.reflected_inertia for x in actuators]).reshape(-1, 1) * a)
+
+
+def damping_matrix(actuators: tuple[Actuator, ...], n_dof: int) -> np.ndarray:
+    """``sum_k b_k a_k a_k^T`` (n_dof x n_dof): the motors' viscous damping on the coordinates."""
+    a = transmission(actuators, n_dof)
+    return a.T @ (np.array([x.damping for x in actuators]).reshape(-1, 1) * a)
+
+
+def motor_limit_warnings(q, actuators: tuple[Actuator, ...], names: tuple[str, ...]) -> list[str]:
+    """One message per motor whose combination ``a^T q + a_0`` is outside its travel."""
+    q = np.ravel(np.asarray(q, dtype=float))
+    out = []
     for actuator in actuators:
-        out[actuator.joint] += float(getattr(actuator, field))
-    return tuple(out)
+        if actuator.limits is None:
+            continue
+        value = float(actuator.row(len(q)) @ q) + actuator.offset
+        low, high = actuator.limits
+        if not low <= value <= high:
+            out.append(f"the motor on {combination_text(actuator, names)} is at {value:g}, outside its travel "
+                       f"[{low:g}, {high:g}]")
+    return out
+
+
+def combination_text(actuator: Actuator, names: tuple[str, ...]) -> str:
+    """``theta2 + theta3`` for a coupled motor, the coordinate's name otherwise."""
+    terms = actuator.coupling or ((actuator.joint, 1.0),)
+    parts = []
+    for k, coefficient in terms:
+        sign = "-" if coefficient < 0 else "+"
+        size = "" if abs(coefficient) == 1.0 else f"{abs(coefficient):g} "
+        parts.append(f"{sign} {size}{names[k]}")
+    text = " ".join(parts)
+    text = text[2:] if text.startswith("+ ") else "-" + text[2:]
+    return text + (f" {'+' if actuator.offset >= 0 else '-'} {abs(actuator.offset):g}" if actuator.offset else "")
 
 
 def limit_warnings(q, limits: tuple[Limits, ...], names: tuple[str, ...]) -> list[str]:

@@ -5,9 +5,11 @@ inertial parameters of its bodies (seed 000 Table 2.3 names: ``m2``, ``r2ax``, `
 Overrides by name return a new device; unknown names and non-finite values are refused.
 
 Actuators and joint limits (:mod:`hapticdesign.model.actuators`) ride along: ``damping`` is the
-total viscous damping per coordinate (joints plus actuators), ``coulomb`` the Coulomb friction per
-coordinate, ``reflected_inertia`` the constant ``n^2 J_r`` added to the diagonal of H
-(seed 000 eq. 2.50), ``limits`` each coordinate's range or ``None``. ``elasticity``
+total viscous damping per coordinate (joints plus the diagonal of the actuators' ``b a a^T``),
+``damping_matrix`` the whole matrix (off-diagonal terms from motors that turn a combination of
+coordinates), ``friction`` the Coulomb friction of the motors with the combinations they turn,
+``reflected_inertia`` the constant ``sum n^2 J_r a a^T`` added to H (seed 000 eq. 2.50), ``limits``
+each coordinate's range or ``None``. ``elasticity``
 (:mod:`hapticdesign.model.elastic`) names the elastic links and joint springs, when given.
 
 A device knows no file format and owns no analysis: :func:`hapticdesign.devices.loading.load_device`
@@ -25,7 +27,10 @@ from functools import cached_property, lru_cache
 import numpy as np
 
 from hapticdesign.errors import PhysicalConsistencyWarning, UserError
-from hapticdesign.model.actuators import Actuator, Limits, full_turn, limit_warnings, per_joint
+from hapticdesign.model.actuators import (
+    Actuator, Limits, damping_matrix, full_turn, limit_warnings, motor_limit_warnings, reflected_inertia_matrix,
+    transmission,
+)
 from hapticdesign.model.elastic import Elasticity
 from hapticdesign.model.inertia import (
     SEED_FIELDS,
@@ -139,14 +144,22 @@ class Device:
 
     # -- actuators and limits -----------------------------------------------------------------
     @property
-    def reflected_inertia(self) -> tuple[float, ...]:
-        """``n^2 J_r`` per coordinate (kg m^2 or kg), added to the diagonal of H; zeros without actuators."""
-        return per_joint(self.actuators, self.n_dof, "reflected_inertia")
+    def reflected_inertia(self) -> np.ndarray:
+        """``sum n^2 J_r a a^T`` (n_dof x n_dof; kg m^2 or kg), added to H; zeros without actuators."""
+        return reflected_inertia_matrix(self.actuators, self.n_dof)
 
     @property
-    def coulomb(self) -> tuple[float, ...]:
-        """Coulomb friction per coordinate on the joint side (N m or N); zeros without actuators."""
-        return per_joint(self.actuators, self.n_dof, "coulomb")
+    def damping_matrix(self) -> np.ndarray:
+        """The viscous damping matrix: ``diag(damping)`` plus the off-diagonal part of the motors' ``b a a^T``."""
+        coupled = damping_matrix(self.actuators, self.n_dof)
+        return np.diag(np.asarray(self.damping, dtype=float)) + coupled - np.diag(np.diag(coupled))
+
+    @property
+    def friction(self) -> tuple[np.ndarray, np.ndarray]:
+        """The motors' Coulomb friction: ``(A, f)`` with ``A`` (k x n_dof) the combinations the k motors with
+        friction turn and ``f`` (k,) their friction (N m or N): torque ``sum_k f_k sign(a_k^T qd) a_k``."""
+        rubbing = tuple(a for a in self.actuators if a.coulomb > 0)
+        return transmission(rubbing, self.n_dof), np.array([a.coulomb for a in rubbing], dtype=float)
 
     def joint_limits(self) -> tuple[Limits, ...]:
         """Each coordinate's range ``(low, high)`` in rad or m, or ``None`` where none is given."""
@@ -157,8 +170,11 @@ class Device:
         return tuple(full_turn(span) for span in self.joint_limits())
 
     def limit_warnings(self, q: np.ndarray) -> list[str]:
-        """One message per coordinate of ``q`` outside its limits (values outside are allowed)."""
-        return limit_warnings(np.ravel(q), self.joint_limits(), self.mechanism.actuated_coordinates)
+        """One message per coordinate of ``q`` outside its limits, and per motor outside its travel (values
+        outside are allowed)."""
+        names = self.mechanism.actuated_coordinates
+        return (limit_warnings(np.ravel(q), self.joint_limits(), names)
+                + motor_limit_warnings(q, self.actuators, names))
 
 
 @lru_cache(maxsize=64)

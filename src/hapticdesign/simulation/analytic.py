@@ -43,6 +43,10 @@ from hapticdesign.simulation.criteria import Verdict, WallProblem, type_paths
 from hapticdesign.simulation.zwidth import DisplayLoop, controller, plant
 
 
+GROWS = "oscillation grows"
+"""The verdict of a stiffness whose linearized loop is unstable although the run met the criteria."""
+
+
 @lru_cache(maxsize=1)
 def _threads() -> ThreadpoolController:
     """The process's thread pools, found once (finding them reads the loaded libraries)."""
@@ -67,11 +71,16 @@ class WallJoint:
     scale: float = 1.0
 
 
+def linear_loop(device: Device, config: LoopConfig) -> bool:
+    """Whether the sampled loop is linear about a pose: no encoder quantization, no Coulomb friction."""
+    return config.sensors.counts_per_revolution is None and not np.any(plant_friction(device, config)[1] > 0)
+
+
 def linearize(device: Device, sim_type: int, wall_joint: int, config: LoopConfig) -> WallJoint:
     """The 1-DOF sampled loop of the wall joint at the start pose (see the module docstring)."""
     if config.sensors.counts_per_revolution is not None:
         raise UserError("the analytic method has no encoder quantization (not linear): use the simulation")
-    if np.any(plant_friction(device, config) > 0):
+    if np.any(plant_friction(device, config)[1] > 0):
         raise UserError("the analytic method has no Coulomb friction (not linear): use the simulation")
     rest = rest_pose(device)
     paths = type_paths(sim_type, device.n_dof, wall_joint, rest)
@@ -183,6 +192,13 @@ class AnalyticProblem(WallProblem):
     def exact(self) -> bool:
         return self.wall.exact
 
+    @property
+    def growth_is_exact(self) -> bool:
+        """Whether :meth:`grows` decides the wall's stability: type 1 (the held joints leave the wall joint one
+        time-invariant loop about the start pose, exact to first order there), or a driven motion that does not
+        reach the wall joint's row of H, C, G (:attr:`exact`)."""
+        return self.sim_type == 1 or self.exact
+
     def estimate(self) -> float:
         loop = self.wall.loop
         joint = loop.damping ** 2 / loop.inertia if loop.fraction > 0 else 2.0 * loop.damping / loop.period
@@ -238,8 +254,19 @@ class AnalyticProblem(WallProblem):
                 for phi, gamma in self._steps]
         return (np.stack(cols, axis=1) + self.rest) * self.wall.scale
 
+    def grows(self, stiffness: float) -> bool:
+        """Whether the linearized sampled loop is unstable at ``stiffness``: the spectral radius of its
+        one-sample map (the constant state of the affine part left out) exceeds 1. For type 1 this is the
+        exact local growth boundary of the wall (Lyapunov's indirect method for the sampled system)."""
+        m, _, _ = self._augmented(stiffness)
+        with one_blas_thread():
+            radius = float(np.max(np.abs(np.linalg.eigvals(m[:-1, :-1]))))
+        return not radius < 1.0
+
     def verdict(self, stiffness: float) -> Verdict:
-        """The seed's criteria on the exact linear response (overshoot checked at every plant step)."""
+        """The seed's criteria on the exact linear response (overshoot checked at every plant step); where
+        the growth of the linearized loop is the wall's (:attr:`growth_is_exact`), a stiffness at which it
+        grows is not stable whatever the criteria saw in the run's duration (:meth:`grows`)."""
         with one_blas_thread():
             q = self.response(stiffness)
         flat = q.reshape(-1)[: self.samples * self.sub + 1]
@@ -260,4 +287,6 @@ class AnalyticProblem(WallProblem):
         final = float(np.max(np.abs(tail - self.equilibrium)))
         if final > self.criteria.settle_tolerance:
             return Verdict(stiffness, False, "not settled", peak, final)
+        if self.growth_is_exact and self.grows(stiffness):
+            return Verdict(stiffness, False, GROWS, peak, final)
         return Verdict(stiffness, True, "stable", peak, final)

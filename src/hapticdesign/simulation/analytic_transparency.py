@@ -51,7 +51,9 @@ import numpy as np
 from hapticdesign.analysis.dynamics.device import dynamics_of
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
-from hapticdesign.simulation.config import LoopConfig, compensator_device, hand_matrices, plant_friction, rest_pose
+from hapticdesign.simulation.config import (
+    LoopConfig, compensator_device, hand_matrices, plant_damping, plant_friction, rest_pose,
+)
 from hapticdesign.simulation.paths import Chirp
 from hapticdesign.simulation.transparency import (TransparencyResult, band_of, check_request, first_exit, impedance,
                                                   segment_length)
@@ -143,7 +145,7 @@ def transparency_loop(device: Device, sim_type: int, wall_joint: int, config: Lo
     """The wall joint's loop along the chirp at the start pose (module docstring)."""
     if config.sensors.counts_per_revolution is not None:
         raise UserError("the analytic method has no encoder quantization (not linear): use the simulation")
-    if np.any(plant_friction(device, config) > 0):
+    if np.any(plant_friction(device, config)[1] > 0):
         raise UserError("the analytic method has no Coulomb friction (not linear): use the simulation")
     w, n = wall_joint, device.n_dof
     m = moving_joints(n, sim_type, w)
@@ -152,7 +154,7 @@ def transparency_loop(device: Device, sim_type: int, wall_joint: int, config: Lo
     rest = rest_pose(device)
     plant, model = _Row(device, w, m, rest), _Row(compensator_device(device, comp), w, m, rest)
     hand_mass, hand_damping, hand_stiffness = hand_matrices(device, config.hand, rest)
-    damping = np.diag(np.asarray(config.damping if config.damping is not None else device.damping, dtype=float))
+    damping = plant_damping(device, config)
     zero = np.zeros(1)
     j, c = float(plant.inertia(zero)[0]), switches[0] * float(model.inertia(zero)[0])
     k, g = plant.spring(), switches[2] * model.spring()

@@ -276,14 +276,26 @@ def rest_pose(device: Device) -> np.ndarray:
     return np.zeros(device.n_dof) if loops is None else np.array(loops.home, dtype=float)
 
 
-def plant_friction(device: Device, config: LoopConfig) -> np.ndarray:
-    """Coulomb friction per joint: the configuration's, else the device's actuators' (``device.coulomb``), else 0."""
-    values = config.coulomb if config.coulomb is not None else getattr(device, "coulomb", None)
-    friction = np.zeros(device.n_dof) if values is None else np.asarray(values, dtype=float)
+def plant_friction(device: Device, config: LoopConfig) -> tuple[np.ndarray, np.ndarray]:
+    """The plant's Coulomb friction ``(A, f)``: torque ``sum_k f_k sign(a_k^T qd) a_k`` (rows ``a_k`` of ``A``).
+
+    The configuration's values act one per joint (``A = I``); else the device's motors with friction act on
+    the combinations they turn (:attr:`~hapticdesign.model.device.Device.friction`); else there is none."""
+    if config.coulomb is None:
+        return device.friction
+    friction = np.asarray(config.coulomb, dtype=float)
     if friction.shape != (device.n_dof,) or not np.all(np.isfinite(friction)) or np.any(friction < 0):
         raise UserError(f"expected {device.n_dof} finite, non-negative Coulomb friction values, got "
                         f"{np.atleast_1d(friction).tolist()[:8]}")
-    return friction
+    return np.eye(device.n_dof), friction
+
+
+def plant_damping(device: Device, config: LoopConfig) -> np.ndarray:
+    """The plant's viscous damping matrix: ``diag`` of the configuration's values, else the device's
+    (:attr:`~hapticdesign.model.device.Device.damping_matrix`, motors on combinations of joints included)."""
+    if config.damping is not None:
+        return np.diag(np.asarray(config.damping, dtype=float))
+    return device.damping_matrix
 
 
 def handle_jacobian(device: Device, q: np.ndarray) -> np.ndarray:

@@ -16,9 +16,20 @@ from hapticdesign.simulation.config import LoopConfig
 from hapticdesign.simulation.paths import Held, Path, Sine
 
 
+SEED_STEP = 0.01
+"""The seed's step: the wall's spring rests 0.01 rad from the joint's start (seed 000 §4.1.2)."""
+
+
 @dataclass(frozen=True)
 class Criteria:
-    """Stability criteria of the seed's method (all configurable)."""
+    """Stability criteria of the seed's method (all configurable), stated for the seed's 0.01-rad step.
+
+    The seed's limits are 120 % (overshoot), 20 % (settling band) and 600 % (safety switch) of that
+    step. A wall whose step is another size (a Cartesian wall's rest ``0.01 J_n,w`` m from the handle's
+    start is well below a millimetre on a small device) is judged by the same ratios: :meth:`for_step`
+    scales every length by ``|step| / 0.01``. With fixed limits a growing oscillation that starts at a
+    fraction of a millimetre never crosses a 12-mm overshoot or a 2-mm settling band in 5 s.
+    """
 
     overshoot_limit: float = 0.012
     settle_tolerance: float = 0.002
@@ -30,6 +41,17 @@ class Criteria:
             value = getattr(self, name)
             if not (value > 0 and math.isfinite(value)):
                 raise UserError(f"{name.replace('_', ' ')} must be positive, got {value}")
+
+    def for_step(self, step: float) -> "Criteria":
+        """The same criteria for a wall whose spring rests ``step`` from the start (rad, m): the limits
+        (not the settling window, a time) scaled by ``|step| / 0.01``; the seed's step leaves them as they are."""
+        factor = abs(float(step)) / SEED_STEP
+        if factor == 1.0:
+            return self
+        if not (factor > 0 and math.isfinite(factor)):
+            raise UserError(f"the wall's equilibrium must be a non-zero distance from the start, got {step}")
+        return Criteria(self.overshoot_limit * factor, self.settle_tolerance * factor, self.settle_window,
+                        self.safety_limit * factor)
 
 
 @dataclass(frozen=True)
@@ -77,6 +99,9 @@ def require_closed(trace, what: str) -> None:
 class WallProblem:
     """One device, one simulation type, the wall on one joint: what a stable-range search is asked.
 
+    ``criteria`` are stated for the seed's 0.01 step and judged relative to ``equilibrium``
+    (:meth:`Criteria.for_step`).
+
     :class:`~hapticdesign.simulation.impedance.ImpedanceProblem` answers each stiffness by
     simulation, :class:`~hapticdesign.simulation.analytic.AnalyticProblem` from the exact linear
     response; the searches take either."""
@@ -90,6 +115,7 @@ class WallProblem:
 
     def __post_init__(self) -> None:
         check_settle_window(self.criteria, self.config.duration)
+        self.criteria = self.criteria.for_step(self.equilibrium)
 
 
 def check_settle_window(criteria: Criteria, duration: float) -> None:

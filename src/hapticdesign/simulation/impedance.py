@@ -6,7 +6,14 @@ A virtual spring ``K`` on the wall joint (equilibrium 0.01 rad, start 0) is stab
   reference point, so 0.012 rad is a 20 % overshoot of the 0.01 rad step; our reading),
 - the response has settled at the end: in the last ``settle_window`` seconds the joint stays
   within ``settle_tolerance`` of the equilibrium,
-- the safety switch (0.06 rad) has not tripped and the simulation has not diverged.
+- the safety switch (0.06 rad) has not tripped and the simulation has not diverged,
+- where the loop linearized at the start pose gives the exact local growth boundary (type 1, and type
+  2 when the driven motion does not reach the wall joint's equations, e.g. LN = 0 designs), the
+  linearized sampled loop does not grow (spectral radius below 1): a stiffness above the growth
+  boundary is not stable even when a slow growth stays inside the criteria for the run's duration.
+
+The limits are stated for the seed's 0.01-rad step and scale with the wall's step
+(:meth:`~.criteria.Criteria.for_step`).
 
 The seed scans K = 1, 2, 3, ... and reports the last stable K. :func:`fast_search` returns the
 same answer with an exponential bracket and a bisection over integers whenever the stable set
@@ -23,7 +30,7 @@ import numpy as np
 from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
-from hapticdesign.simulation.analytic import AnalyticProblem
+from hapticdesign.simulation.analytic import GROWS, AnalyticProblem, linear_loop
 from hapticdesign.simulation.boundary import envelope_grows
 from hapticdesign.simulation.config import (
     LoopConfig, Wall, compensator_device, normal_jacobian, require_device, require_options, rest_pose, unit_direction,
@@ -51,6 +58,10 @@ class ImpedanceProblem(WallProblem):
         self.model = tables_of(compensator_device(self.device, self.config.compensator))
         self.config = replace(self.config, safety_limit=self.criteria.safety_limit,
                               stop_excursion=self.criteria.overshoot_limit)
+        linear = (AnalyticProblem(self.device, self.sim_type, self.wall_joint, self.equilibrium, self.criteria,
+                                  self.config) if linear_loop(self.device, self.config) else None)
+        self.linear = linear if linear is not None and linear.growth_is_exact else None
+        """The loop linearized at the start pose where its growth decides the wall's stability, else None."""
 
     def estimate(self) -> float:
         """Starting guess: the 1-DOF limit ``b^2 / H_ww`` of full inertial compensation at the start
@@ -89,6 +100,8 @@ class ImpedanceProblem(WallProblem):
             return Verdict(stiffness, False, "safety switch", peak, final)
         if final > self.criteria.settle_tolerance:
             return Verdict(stiffness, False, "not settled", peak, final)
+        if self.linear is not None and self.linear.grows(stiffness):
+            return Verdict(stiffness, False, GROWS, peak, final)
         return Verdict(stiffness, True, "stable", peak, final)
 
 

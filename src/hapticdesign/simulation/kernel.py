@@ -236,7 +236,8 @@ def accelerations(q, qd, qdd_path, u, prescribed, plant, qdd, tau_c, want_tau_c=
     ``want_tau_c``, the constraint torques (``tau_c`` is scratch otherwise)."""
     ws = plant.ws
     h, c, g, qd2, a, rhs, free = ws.h, ws.c, ws.g, ws.qd2, ws.a, ws.rhs, ws.free
-    damping, coulomb, hand_stiffness, hand_rest = plant.damping, plant.coulomb, plant.hand_stiffness, plant.hand_rest
+    damping, hand_stiffness, hand_rest = plant.damping, plant.hand_stiffness, plant.hand_rest
+    coulomb, friction_map = plant.coulomb, plant.friction_map
     n = q.shape[0]
     _terms(q, qd, plant)
     bias = tau_c
@@ -246,8 +247,12 @@ def accelerations(q, qd, qdd_path, u, prescribed, plant, qdd, tau_c, want_tau_c=
         s = g[i] - u[i]
         for col in range(qd2.shape[0]):
             s += c[i, col] * qd2[col]
-        if coulomb[i] != 0.0:
-            s += coulomb[i] * np.tanh(qd[i] / FRICTION_VELOCITY)
+        for k in range(coulomb.shape[0]):
+            if coulomb[k] != 0.0 and friction_map[k, i] != 0.0:
+                rate = 0.0
+                for j in range(n):
+                    rate += friction_map[k, j] * qd[j]
+                s += friction_map[k, i] * coulomb[k] * np.tanh(rate / FRICTION_VELOCITY)
         for j in range(n):
             s += damping[i, j] * qd[j]
             if hand_stiffness[i, j] != 0.0:

@@ -18,7 +18,8 @@ from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation import kernel, records
 from hapticdesign.simulation.config import (
-    LoopConfig, Trace, Wall, compensator_device, hand_matrices, plant_friction, rest_pose, unit_direction,
+    LoopConfig, Trace, Wall, compensator_device, hand_matrices, plant_damping, plant_friction, rest_pose,
+    unit_direction,
 )
 from hapticdesign.simulation.paths import Path
 from hapticdesign.simulation.tables import DynamicsTables, workspace_size
@@ -87,8 +88,8 @@ def simulate(
     hand = hand_matrices(device, config.hand, q_start)
     plant = _dynamics(device, plant, q_start)
     model = _dynamics(compensator_device(device, config.compensator), model, q_start)
-    damping = config.damping if config.damping is not None else device.damping
-    return simulate_tables(plant, model, config, damping, paths, q_start, hand, plant_friction(device, config),
+    return simulate_tables(plant, model, config, plant_damping(device, config), paths, q_start, hand,
+                           plant_friction(device, config),
                            handle_of(device, config.wall) if config.wall.cartesian else None)
 
 
@@ -108,12 +109,13 @@ def simulate_tables(
     paths: dict[int, Path] | None = None,
     q0: np.ndarray | None = None,
     hand: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
-    coulomb: np.ndarray | None = None,
+    coulomb: tuple[np.ndarray, np.ndarray] | None = None,
     handle: records.Handle | None = None,
 ) -> Trace:
     """Simulate the loop for plant and compensator dynamics directly (any number of joints): exact
     basis tables, or closed-loop plants started at ``q0`` (each used by one run only); a Cartesian
-    wall needs the device's ``handle`` (:func:`handle_of`)."""
+    wall needs the device's ``handle`` (:func:`handle_of`). ``damping`` is one value per joint or a
+    matrix; ``coulomb`` the friction ``(A, f)`` of :func:`~.config.plant_friction`."""
     n = plant.n_dof
     sub = config.steps_per_sample()
     if not (config.duration > 0 and math.isfinite(config.duration)):
@@ -140,7 +142,9 @@ def simulate_tables(
             raise UserError("encoder counts per revolution must be positive")
         quant = 2 * np.pi / sensors.counts_per_revolution
     damping = np.asarray(damping, dtype=float)
-    if damping.shape != (n,) or not np.all(np.isfinite(damping)):
+    if damping.shape == (n,):
+        damping = np.diag(damping)
+    if damping.shape != (n, n) or not np.all(np.isfinite(damping)):
         raise UserError(f"expected {n} finite joint dampings, got {damping.tolist()}")
     ratio = config.duration / config.step
     if not math.isfinite(ratio):
@@ -166,9 +170,10 @@ def simulate_tables(
     n_rec = n_steps // stride + 1
     rec = records.Records(*(np.zeros((n_rec, n)) for _ in range(6)), np.zeros(n_rec))
     switches = np.array([comp.inertial, comp.coriolis, comp.gravity], dtype=float)
-    damping_matrix = np.diag(damping) + hand_damping
-    friction = np.zeros(n) if coulomb is None else np.asarray(coulomb, dtype=float)
-    plant_record = _plant_record(plant, damping_matrix, friction, hand_mass, hand_stiffness, q_start.copy())
+    friction_map, friction = (np.zeros((0, n)), np.zeros(0)) if coulomb is None else coulomb
+    plant_record = _plant_record(plant, damping + hand_damping, np.asarray(friction, dtype=float),
+                                 np.ascontiguousarray(friction_map, dtype=float), hand_mass, hand_stiffness,
+                                 q_start.copy())
     controller = _controller_record(model, switches, quant, int(sensors.delay_samples))
     motion = records.Motion(prescribed, path_q, path_qd, path_qdd, q_start, np.zeros(n))
     adaptive = config.adaptive(isinstance(plant, ClosedLoopPlant))
@@ -199,13 +204,14 @@ def step_spans(sub: int, stride: int) -> np.ndarray:
     return np.array([d for d in range(g, 0, -1) if g % d == 0], dtype=np.int64)
 
 
-def _plant_record(plant: Dynamics, damping, friction, hand_mass, hand_stiffness, hand_rest):
+def _plant_record(plant: Dynamics, damping, friction, friction_map, hand_mass, hand_stiffness, hand_rest):
     """The kernel's plant: :class:`~.records.Plant` of tables or :class:`~.records.LoopPlant`."""
     if isinstance(plant, ClosedLoopPlant):
         return records.LoopPlant(plant.structure, plant.workspace, _workspace(plant), np.zeros(plant.n_dof),
-                                 np.zeros(1, dtype=np.int64), damping, friction, hand_mass, hand_stiffness, hand_rest)
-    return records.Plant(records.table(plant), _workspace(plant), damping, friction, hand_mass, hand_stiffness,
-                         hand_rest)
+                                 np.zeros(1, dtype=np.int64), damping, friction, friction_map, hand_mass,
+                                 hand_stiffness, hand_rest)
+    return records.Plant(records.table(plant), _workspace(plant), damping, friction, friction_map, hand_mass,
+                         hand_stiffness, hand_rest)
 
 
 def _controller_record(model: Dynamics, switches: np.ndarray, quant: float, delay: int):

@@ -41,12 +41,16 @@ class Workspace(NamedTuple):
 
 
 class Plant(NamedTuple):
-    """The continuous side: dynamics tables, joint damping (with the hand's), Coulomb friction and the hand."""
+    """The continuous side: dynamics tables, joint damping (with the hand's), Coulomb friction and the hand.
+
+    ``coulomb`` (k,) and ``friction_map`` (k x n): friction ``f_k`` acting on the rate ``a_k^T qd`` of row
+    ``a_k`` (a unit row for friction on one joint; :func:`~.config.plant_friction`)."""
 
     table: Table
     ws: Workspace
     damping: np.ndarray
     coulomb: np.ndarray
+    friction_map: np.ndarray
     hand_mass: np.ndarray
     hand_stiffness: np.ndarray
     hand_rest: np.ndarray
@@ -65,6 +69,7 @@ class LoopPlant(NamedTuple):
     status: np.ndarray
     damping: np.ndarray
     coulomb: np.ndarray
+    friction_map: np.ndarray
     hand_mass: np.ndarray
     hand_stiffness: np.ndarray
     hand_rest: np.ndarray

@@ -25,7 +25,7 @@ from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation.config import (
     FRICTION_VELOCITY, STATUS_COMPLETED, STATUS_DIVERGED, STATUS_EXCURSION, LoopConfig, Trace, compensator_device,
-    hand_matrices, plant_friction, unit_direction,
+    hand_matrices, plant_damping, plant_friction, unit_direction,
 )
 from hapticdesign.simulation.paths import Path
 
@@ -54,7 +54,7 @@ def simulate_adaptive(
     comp = config.compensator
     pi_plant = device.standard_parameters()
     pi_model = compensator_device(device, comp).standard_parameters()
-    damping = np.diag(np.asarray(config.damping if config.damping is not None else device.damping, dtype=float))
+    damping = plant_damping(device, config)
     quant = 0.0 if config.sensors.counts_per_revolution is None else 2 * np.pi / config.sensors.counts_per_revolution
     delay = config.sensors.delay_samples
     safety = math.inf if config.safety_limit is None else config.safety_limit
@@ -73,7 +73,7 @@ def simulate_adaptive(
     q_start[fixed] = path_at(0.0)[0][fixed]
     hand_mass, hand_damping, hand_stiffness = hand_matrices(device, config.hand, q_start)
     damping = damping + hand_damping
-    friction = plant_friction(device, config)
+    friction_map, friction = plant_friction(device, config)
 
     def accel(t: float, q: np.ndarray, qd: np.ndarray, u: np.ndarray):
         qp, qdp, qddp = path_at(t)
@@ -82,7 +82,8 @@ def simulate_adaptive(
         h, c, g = _terms(device, pi_plant, q)
         h = h + hand_mass
         j, k = np.triu_indices(n)
-        bias = (c @ (qd[j] * qd[k]) + g + damping @ qd + friction * np.tanh(qd / FRICTION_VELOCITY)
+        bias = (c @ (qd[j] * qd[k]) + g + damping @ qd
+                + friction_map.T @ (friction * np.tanh(friction_map @ qd / FRICTION_VELOCITY))
                 + hand_stiffness @ (q - q_start) - u)
         qdd = qddp.copy()
         if free:

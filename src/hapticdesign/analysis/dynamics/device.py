@@ -2,7 +2,7 @@
 
 :func:`dynamics_of` gives the regressor model of a device's geometry (cached per builder and
 kinematic parameters, so every device that differs only in inertial parameters shares it). With
-actuators, H carries the constant reflected rotor inertia (seed 000 eq. 2.50 plus ``diag(n^2 J_r)``);
+actuators, H carries the constant reflected rotor inertia (seed 000 eq. 2.50 plus ``sum n^2 J_r a a^T``);
 the regressor in the inertial parameters is the same object's. The other functions evaluate that
 model at the device's standard parameters (seed 000 eq. 2.50-2.52); :func:`tree_mass_matrix` gives
 H of a tree straight from the compiled kernel, without fitting that model.
@@ -26,8 +26,10 @@ def dynamics_of(device: Device) -> DynamicsModel:
     """The compiled regressor model of the device's equations of motion (cached per geometry)."""
     kind = ClosedLoopModel if device.mechanism.loops is not None else DynamicsModel
     base = _model(kind, device.builder, device.kinematic_values())
-    extra = device.reflected_inertia if device.actuators else ()
-    return _with_rotors(base, extra) if any(extra) else base
+    if not device.actuators:
+        return base
+    extra = device.reflected_inertia
+    return _with_rotors(base, tuple(map(tuple, extra.tolist()))) if np.any(extra) else base
 
 
 def mass_matrix(device: Device, q: np.ndarray) -> np.ndarray:
@@ -84,5 +86,5 @@ def _model(cls, builder: MechanismBuilder, kinematic: tuple[tuple[str, float], .
 
 
 @lru_cache(maxsize=16)
-def _with_rotors(base, reflected: tuple[float, ...]):
-    return base.with_constant_inertia(np.diag(reflected))
+def _with_rotors(base, reflected: tuple[tuple[float, ...], ...]):
+    return base.with_constant_inertia(np.array(reflected))

@@ -332,7 +332,8 @@ def _add_body(R: _Ring, body: tuple, rb: list, jac: list, gravity: list, H: list
 
 def _mass_and_gravity(R: _Ring, device: Device, aff: _AffineKinematics) -> tuple[list, list]:
     """``H`` and ``G`` of eq. 2.50 (seed 000 eq. 2.44-2.49), summed over the bodies, with the
-    actuators' reflected rotor inertia ``n^2 J_r`` on the diagonal of ``H``."""
+    actuators' reflected rotor inertia ``sum n^2 J_r a a^T`` added to ``H`` (``n^2 J_r`` on the diagonal for
+    a motor on one joint)."""
     comp = aff.compiled
     n = comp.n_dof
     rot, pos = _node_poses(R, aff)
@@ -344,9 +345,9 @@ def _mass_and_gravity(R: _Ring, device: Device, aff: _AffineKinematics) -> tuple
         _add_body(R, _body_parameters(R, device, body), rb, jac, gravity, H, G)
     H = [[R.reduce(H[min(i, j)][max(i, j)]) for j in range(n)] for i in range(n)]
     G = [R.reduce(x) for x in G]
-    for k, reflected in enumerate(device.reflected_inertia):
+    for (i, j), reflected in np.ndenumerate(device.reflected_inertia):
         if reflected:
-            H[k][k] = H[k][k] + R.num(reflected)
+            H[i][j] = H[i][j] + R.num(float(reflected))
     return H, G
 
 
