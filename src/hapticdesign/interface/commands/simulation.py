@@ -115,10 +115,12 @@ def impedance_range_command(
         None, help="Stiffness grid R, 2R, 3R ... [N m/rad, or N/m for a prismatic joint]; reports k_min and k_max "
                    "on it. Default: the seed's integer scan."),
     k_limit: int = typer.Option(200, help="Largest stiffness tried [N m/rad]."),
-    overshoot: float = typer.Option(0.012, help="Overshoot limit, peak excursion from the start [rad]."),
-    settle_tolerance: float = typer.Option(0.002, help="Settled: within this of the equilibrium at the end [rad]."),
+    overshoot: float = typer.Option(0.012, help="Overshoot limit, peak excursion from the start, for the seed's "
+                                                "0.01 step [rad]; the limits scale with --equilibrium."),
+    settle_tolerance: float = typer.Option(0.002, help="Settled: within this of the equilibrium at the end, for "
+                                                       "the seed's 0.01 step [rad]."),
     settle_window: float = typer.Option(0.5, help="Final window checked for settling [s]."),
-    safety: float = typer.Option(0.06, help="Safety switch excursion [rad] (Figure 4.7)."),
+    safety: float = typer.Option(0.06, help="Safety switch excursion for the seed's 0.01 step [rad] (Figure 4.7)."),
     true_boundary: bool = typer.Option(False, "--true-boundary", help="Also bisect the oscillation-growth boundary."),
     duration: float = typer.Option(5.0, help="Simulated time per stiffness [s]."),
     period: float = PERIOD, step: float = STEP, step_control: str = STEP_CONTROL, counts: Optional[int] = COUNTS,
