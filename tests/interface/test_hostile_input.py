@@ -268,3 +268,39 @@ def test_campaign_recomputes_empty_corrupt_and_stray_case_files_and_is_quiet(tmp
     counts = json.loads(second.stdout)
     assert (counts["run"], counts["skipped"]) == (3, 1)
     assert json.loads((cases / "x0__transparency__type1.json").read_text())["design"] == "x0"
+
+
+# -- round two (issue 24) -------------------------------------------------------------------------
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "devices"
+
+
+def _five_bar_with(tmp_path: Path, old: str, new: str) -> Path:
+    text = (EXAMPLES / "five-bar.yaml").read_text()
+    assert old in text
+    path = tmp_path / "five-bar.yaml"
+    path.write_text(text.replace(old, new))
+    return path
+
+
+def test_a_far_off_home_of_a_closed_loop_is_refused(tmp_path):
+    """The solver follows the loops from home in steps of 0.1 rad: a home of 1e308 rad never ends."""
+    device = _five_bar_with(tmp_path, "home: {q1: 2.0, q2: 1.1}", "home: {q1: 1e308, q2: 1.1}")
+    one_line_error(["dynamics", "--device", str(device), "--q", "2,1.1"], "home: joint values must lie within +-1000")
+
+
+@pytest.mark.parametrize("args, fragment", [
+    (["--inertia", "1e308", "--damping", "0.5"], "outside the range this computation can resolve"),
+    (["--inertia", "1e-300", "--damping", "1e300"], "outside the range this computation can resolve"),
+    (["--inertia", "0.04", "--damping", "0.5", "--period", "1e308"], "outside the range this computation can resolve"),
+    (["--inertia", "0.04", "--damping", "0.5", "--b-values", "0.1,-1"], "must be finite and >= 0, got -1 (--b-values)"),
+])
+def test_zwidth_refuses_loops_it_cannot_resolve_and_negative_dampers(args, fragment):
+    one_line_error(["zwidth", *args], fragment)
+
+
+def test_zwidth_api_caps_the_dampers_before_any_work():
+    from hapticdesign.errors import InputError
+    from hapticdesign.simulation.zwidth import DisplayLoop, zwidth
+
+    with pytest.raises(InputError, match="give 1 to 1000 virtual dampers, got 10,000,000"):
+        zwidth(DisplayLoop(0.04, 0.5, 1e-3), [0.1] * 10**7)
