@@ -178,13 +178,18 @@ def _first_non_finite(value, path: str = "") -> str | None:
     return None
 
 
-def dumps_json(value, **kwargs) -> str:
-    """Strict JSON: a NaN or infinity is refused with the key that holds it (it is not JSON)."""
+def require_finite(value) -> object:
+    """``value`` as plain data (lists, floats), or a :class:`UserError` naming the first NaN or infinity in it."""
     plain = to_jsonable(value)
     bad = _first_non_finite(plain)
     if bad is not None:
         raise UserError(f"the result is not finite ({bad}); check that the inputs are within physical ranges")
-    return json.dumps(plain, **kwargs)
+    return plain
+
+
+def dumps_json(value, **kwargs) -> str:
+    """Strict JSON: a NaN or infinity is refused with the key that holds it (it is not JSON)."""
+    return json.dumps(require_finite(value), **kwargs)
 
 
 def write_atomically(path: Path | str, content: str | bytes) -> None:

@@ -56,7 +56,7 @@ PLANT_STEPS_LIMIT = 5e8
 DESIGN_LIMITS = {"fast": 100_000, "de": 1_000, "linear": 50_000}
 QUADRATURE_POINTS_LIMIT = 1e6
 EIGEN_ORDER_LIMIT = 600
-DEVICE_LIMITS = {"joints": 100, "frames": 1000, "loops": 50}
+DEVICE_LIMITS = {"joints": 32, "frames": 1000, "loops": 16}
 
 _ALLOWED: ContextVar[bool] = ContextVar("hapticdesign_allow_large", default=False)
 
