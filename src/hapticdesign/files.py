@@ -4,8 +4,9 @@ Every data file (parameters, devices, URDF, weights, R-CUBE designs, design sets
 is read through :func:`read_text` and, when structured, :func:`load_structured`; every output
 goes through :func:`write_atomically`. The limits are stated here once:
 
-- a data file may hold at most ``MAX_FILE_BYTES`` (20 MB) of UTF-8 text; larger, binary (a NUL
-  byte) or non-UTF-8 files are refused with one line;
+- a data file may hold at most ``MAX_FILE_BYTES`` (20 MB) of UTF-8 text; larger (counted on what
+  is read, never on the size a file reports), binary (a NUL byte) or non-UTF-8 files are refused
+  with one line, and so are named pipes and devices (``/dev/zero``), even through a symlink;
 - YAML aliases and anchors are refused (data files are data: an alias "bomb" of a few lines
   expands to gigabytes), as are Python-specific tags (``yaml.SafeLoader`` already refuses them);
 - structures nested deeper than ``MAX_DEPTH`` (64) levels are refused;
@@ -18,6 +19,7 @@ import json
 import math
 import os
 import re
+import stat
 import tomllib
 from pathlib import Path
 
@@ -40,24 +42,51 @@ def quote(value: object, limit: int = QUOTE_LIMIT) -> str:
 
 
 def read_text(path: Path | str, what: str = "file") -> str:
-    """The UTF-8 text of a user's file, or a one-line :class:`UserError` (missing, too large, binary)."""
+    """The UTF-8 text of a user's file, or a one-line :class:`UserError` (missing, too large, binary,
+    not a regular file).
+
+    The file type is checked before opening (through symlinks): a named pipe is never opened (it
+    would block until a writer comes), a device such as ``/dev/zero`` is never read (it has no
+    end). At most ``MAX_FILE_BYTES + 1`` bytes are read, whatever size the file reports.
+    """
     path = Path(path)
     try:
-        size = path.stat().st_size
-        if path.is_dir():
+        mode = os.stat(path).st_mode
+        if stat.S_ISDIR(mode):
             raise UserError(f"cannot read {what} {path}: it is a directory")
-        if size > MAX_FILE_BYTES:
-            raise UserError(f"{what} {path} is {size / 2**20:.0f} MB; data files are limited to "
-                            f"{MAX_FILE_BYTES // 2**20} MB")
-        data = path.read_bytes()
+        if not stat.S_ISREG(mode):
+            raise UserError(f"cannot read {what} {path}: it is {_special_kind(mode)}, not a regular file")
+        with open(path, "rb", opener=_nonblocking) as handle:
+            if not stat.S_ISREG(os.fstat(handle.fileno()).st_mode):  # swapped after the check above
+                raise UserError(f"cannot read {what} {path}: it is not a regular file")
+            data = handle.read(MAX_FILE_BYTES + 1)
     except OSError as exc:
         raise UserError(f"cannot read {what} {path}: {exc.strerror or exc}") from None
+    if len(data) > MAX_FILE_BYTES:
+        raise UserError(f"{what} {path} is larger than {MAX_FILE_BYTES // 2**20} MB; data files are limited to "
+                        f"{MAX_FILE_BYTES // 2**20} MB")
     if b"\x00" in data:
         raise UserError(f"{what} {path} is a binary file, not text")
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         raise UserError(f"{what} {path} is not UTF-8 text (byte {exc.start})") from None
+
+
+def _nonblocking(path: str, flags: int) -> int:
+    """Open without waiting (a pipe swapped in after the type check must not block the read)."""
+    return os.open(path, flags | os.O_NONBLOCK)
+
+
+def _special_kind(mode: int) -> str:
+    """Words for a file type that is not a regular file or a directory."""
+    if stat.S_ISFIFO(mode):
+        return "a named pipe"
+    if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
+        return "a device"
+    if stat.S_ISSOCK(mode):
+        return "a socket"
+    return "a special file"
 
 
 class _DataLoader(yaml.SafeLoader):
@@ -149,13 +178,18 @@ def _first_non_finite(value, path: str = "") -> str | None:
     return None
 
 
-def dumps_json(value, **kwargs) -> str:
-    """Strict JSON: a NaN or infinity is refused with the key that holds it (it is not JSON)."""
+def require_finite(value) -> object:
+    """``value`` as plain data (lists, floats), or a :class:`UserError` naming the first NaN or infinity in it."""
     plain = to_jsonable(value)
     bad = _first_non_finite(plain)
     if bad is not None:
         raise UserError(f"the result is not finite ({bad}); check that the inputs are within physical ranges")
-    return json.dumps(plain, **kwargs)
+    return plain
+
+
+def dumps_json(value, **kwargs) -> str:
+    """Strict JSON: a NaN or infinity is refused with the key that holds it (it is not JSON)."""
+    return json.dumps(require_finite(value), **kwargs)
 
 
 def write_atomically(path: Path | str, content: str | bytes) -> None:

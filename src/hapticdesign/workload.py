@@ -28,6 +28,10 @@ what this toolkit measured on a shared 2-core machine, rounded up:
   (24 points per pi radians: a range of about 130 000 rad).
 - :data:`EIGEN_ORDER_LIMIT` = 600: the order ``3 + 3 d`` of the closed-loop matrix of the exact
   stability boundary with a delay of ``d`` samples (about 100 eigenvalue problems each).
+- :data:`DEVICE_LIMITS`: 100 joints, 1 000 frames and 50 closed loops per device, checked when a
+  device file, a URDF or a mechanism is read, before anything is built (every command meets a
+  device there; a device at these limits loads and shows in well under a minute, while the work
+  on it grows with their squares and cubes).
 - Worker processes: the machine's cores (``os.cpu_count()``).
 
 Hard limits (never lifted): 80 % of the machine's physical memory for one array build, and
@@ -52,6 +56,7 @@ PLANT_STEPS_LIMIT = 5e8
 DESIGN_LIMITS = {"fast": 100_000, "de": 1_000, "linear": 50_000}
 QUADRATURE_POINTS_LIMIT = 1e6
 EIGEN_ORDER_LIMIT = 600
+DEVICE_LIMITS = {"joints": 32, "frames": 1000, "loops": 16}
 
 _ALLOWED: ContextVar[bool] = ContextVar("hapticdesign_allow_large", default=False)
 
@@ -90,6 +95,14 @@ def require_within(what: str, amount: float, limit: float, unit: str) -> None:
     if amount > limit and not large_allowed():
         raise WorkloadTooLarge(f"{what} would take {_amount(amount)} {unit}, above the limit of "
                                f"{_amount(limit)} {unit}")
+
+
+def require_device_size(what: str, joints: int, frames: int, loops: int) -> None:
+    """Refuse a device with more joints, frames or closed loops than :data:`DEVICE_LIMITS`, before it is built."""
+    for name, count in (("joints", joints), ("frames", frames), ("loops", loops)):
+        limit = DEVICE_LIMITS[name]
+        if count > limit and not large_allowed():
+            raise WorkloadTooLarge(f"{what} has {count:,} {name}, above the limit of {limit:,} {name}")
 
 
 def physical_memory() -> int:
@@ -158,6 +171,6 @@ def _bytes(value: float) -> str:
     return f"{value:.0f} bytes"
 
 
-__all__ = ["DESIGN_LIMITS", "EIGEN_ORDER_LIMIT", "MEMORY_LIMIT", "PLANT_STEPS_LIMIT", "QUADRATURE_POINTS_LIMIT",
+__all__ = ["DESIGN_LIMITS", "DEVICE_LIMITS", "EIGEN_ORDER_LIMIT", "MEMORY_LIMIT", "PLANT_STEPS_LIMIT", "QUADRATURE_POINTS_LIMIT",
            "WorkloadTooLarge", "allow_large", "basis_bytes", "large_allowed", "loop_bytes", "physical_memory",
-           "require_designs", "require_memory", "require_plant_steps", "require_within", "worker_count"]
+           "require_designs", "require_device_size", "require_memory", "require_plant_steps", "require_within", "worker_count"]

@@ -290,3 +290,35 @@ def test_commands_whose_work_can_grow_take_force(command):
     """Every command whose work a user's numbers or files can make large lifts the limits with --force."""
     result = runner.invoke(app, [*command, "--help"], env={"COLUMNS": "200"})
     assert result.exit_code == 0 and "--force" in result.output
+
+
+@pytest.mark.parametrize("name", ["pipe.yaml", "zero.yaml", "random.urdf", "link.yaml"])
+def test_pipes_and_devices_are_refused_without_reading(tmp_path, name):
+    """A named pipe would block the read until a writer comes, /dev/zero and /dev/urandom never end:
+    the file type is checked first (through a symlink too), and nothing of them is read."""
+    path = tmp_path / name
+    if name == "pipe.yaml":
+        os.mkfifo(path)
+        fragment = "named pipe"
+    elif name == "link.yaml":
+        os.mkfifo(tmp_path / "fifo")
+        path.symlink_to(tmp_path / "fifo")
+        fragment = "named pipe"
+    else:
+        path.symlink_to("/dev/zero" if name == "zero.yaml" else "/dev/urandom")
+        fragment = "a device, not a regular file"
+    _one_error(runner.invoke(app, ["ln", "--device", str(path)]), fragment)
+    if path.suffix == ".yaml":
+        _one_error(runner.invoke(app, ["ln", "--params", str(path)]), fragment)
+
+
+def test_the_size_cap_counts_what_is_read(tmp_path, monkeypatch):
+    """The cap holds on the bytes read, not on the size the file system reports (which is 0 for
+    many special files): a file that reports a small size but holds more is still refused."""
+    import hapticdesign.files as files
+
+    path = tmp_path / "p.yaml"
+    path.write_text("m2: 0.1\n" + "#" * 100 + "\n")
+    monkeypatch.setattr(files, "MAX_FILE_BYTES", 50)
+    with pytest.raises(files.UserError, match="larger than"):
+        files.read_text(path)

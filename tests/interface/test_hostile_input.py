@@ -268,3 +268,63 @@ def test_campaign_recomputes_empty_corrupt_and_stray_case_files_and_is_quiet(tmp
     counts = json.loads(second.stdout)
     assert (counts["run"], counts["skipped"]) == (3, 1)
     assert json.loads((cases / "x0__transparency__type1.json").read_text())["design"] == "x0"
+
+
+# -- round two (issue 24) -------------------------------------------------------------------------
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "devices"
+
+
+def _five_bar_with(tmp_path: Path, old: str, new: str) -> Path:
+    text = (EXAMPLES / "five-bar.yaml").read_text()
+    assert old in text
+    path = tmp_path / "five-bar.yaml"
+    path.write_text(text.replace(old, new))
+    return path
+
+
+def test_a_far_off_home_of_a_closed_loop_is_refused(tmp_path):
+    """The solver follows the loops from home in steps of 0.1 rad: a home of 1e308 rad never ends."""
+    device = _five_bar_with(tmp_path, "home: {q1: 2.0, q2: 1.1}", "home: {q1: 1e308, q2: 1.1}")
+    one_line_error(["dynamics", "--device", str(device), "--q", "2,1.1"], "home: joint values must lie within +-1000")
+
+
+@pytest.mark.parametrize("args, fragment", [
+    (["--inertia", "1e308", "--damping", "0.5"], "outside the range this computation can resolve"),
+    (["--inertia", "1e-300", "--damping", "1e300"], "outside the range this computation can resolve"),
+    (["--inertia", "0.04", "--damping", "0.5", "--period", "1e308"], "outside the range this computation can resolve"),
+    (["--inertia", "0.04", "--damping", "0.5", "--b-values", "0.1,-1"], "must be finite and >= 0, got -1 (--b-values)"),
+])
+def test_zwidth_refuses_loops_it_cannot_resolve_and_negative_dampers(args, fragment):
+    one_line_error(["zwidth", *args], fragment)
+
+
+def test_zwidth_api_caps_the_dampers_before_any_work():
+    from hapticdesign.errors import InputError
+    from hapticdesign.simulation.zwidth import DisplayLoop, zwidth
+
+    with pytest.raises(InputError, match="give 1 to 1000 virtual dampers, got 10,000,000"):
+        zwidth(DisplayLoop(0.04, 0.5, 1e-3), [0.1] * 10**7)
+
+
+def test_eom_of_a_closed_loop_device_is_refused_not_the_opened_tree():
+    """The loop-opened tree's equations drive the passive joints and leave out the closure forces."""
+    one_line_error(["eom", "--device", str(EXAMPLES / "five-bar.yaml")], "five-bar has closed loops (passive joints p1, p2)")
+
+
+def test_dynamics_text_refuses_a_non_finite_result_as_json_does():
+    one_line_error(["dynamics", "--q", "0,0,0", "--qd", "1e200,0,0"], "not finite (tau[0])")
+
+
+def test_symbolic_ln_without_design_variables_is_valid_python(tmp_path):
+    """A 1-DOF prismatic joint has constant H and G: LN is 0 and the function takes no variable."""
+    device = tmp_path / "slide.yaml"
+    device.write_text("name: slide\njoints:\n  - {name: q1, type: prismatic}\nframes:\n"
+                      "  - {name: link, parent: base, transforms: [tz: q1]}\nend_effector: link\n"
+                      "bodies:\n  - {name: ab, frame: link, m: 0.5, Ixx: 1.0e-4, Iyy: 0.0019, Izz: 0.002}\n")
+    args = ["ln", "--device", str(device), "--region", "q1=0:0.1"]
+    result = runner.invoke(app, [*args, "--symbolic", "--format", "python"])
+    assert result.exit_code == 0, result.output
+    namespace: dict = {}
+    exec(compile(result.stdout, "generated.py", "exec"), namespace)  # noqa: S102 - the test's own generated file
+    numeric = json.loads(runner.invoke(app, [*args, "--json"]).stdout)["ln"]
+    assert namespace["linearity_number"]() == pytest.approx(numeric, abs=1e-12)

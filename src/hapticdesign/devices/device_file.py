@@ -21,6 +21,7 @@ from hapticdesign.model.elastic import Elasticity, ElasticLink
 from hapticdesign.model.loops import ClosedLoops, LoopClosure
 from hapticdesign.model.mechanism import JointType
 from hapticdesign.model.params_io import read_mapping
+from hapticdesign.workload import require_device_size
 
 
 def device_from_spec(spec: DeviceFileSpec) -> Device:
@@ -115,6 +116,8 @@ def device_from_mapping(data: object, source: str = "device file") -> Device:
     """Validate a parsed device file and build its Device; problems raise a one-line UserError."""
     if not isinstance(data, dict):
         raise UserError(f"{source}: expected a mapping with keys such as name, joints, dh, frames, bodies")
+    require_device_size(source, *(len(data[key]) if isinstance(data.get(key), list) else 0
+                                  for key in ("joints", "frames", "loops")))
     try:
         spec = DeviceFileSpec.model_validate(data)
     except ValidationError as exc:

@@ -48,6 +48,7 @@ from hapticdesign.model.device import Device
 from hapticdesign.model.inertia import BodyInertia, check_body
 from hapticdesign.model.mechanism import JointType
 from hapticdesign.model.transforms import Axis
+from hapticdesign.workload import require_device_size
 
 SUPPORTED = {"revolute": JointType.REVOLUTE, "continuous": JointType.REVOLUTE, "prismatic": JointType.PRISMATIC}
 _ALIGN_TOL = 1e-12
@@ -202,6 +203,7 @@ def _axis(joint: ET.Element, where: str) -> list[float]:
 def device_from_urdf(text: str, source: str = "URDF", g: float = 9.81) -> Device:
     """Import a URDF document; coordinates follow the joints depth-first from the root link."""
     robot = _parse(text, source)
+    require_device_size(source, len(robot.findall("joint")), len(robot.findall("link")), 0)
     links, root, order = _joint_tree(robot, source)
     coordinates: list[str] = []
     types: list[JointType] = []

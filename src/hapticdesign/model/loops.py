@@ -16,6 +16,7 @@ only *what the device is*; the solver lives in :mod:`hapticdesign.analysis.loops
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from hapticdesign.errors import UserError
@@ -23,6 +24,9 @@ from hapticdesign.errors import UserError
 COMPONENTS = ("x", "y", "z", "rx", "ry", "rz")
 """Closure components in the base frame: origin difference, then rotation-vector difference."""
 COMPONENT_SETS = {"position": ("x", "y", "z"), "pose": COMPONENTS}
+POSE_LIMIT = 1000.0
+"""Largest magnitude of a home or assembly value (rad or m): the solver follows the loops from the
+assembly at home to every pose asked for in steps of 0.1 rad, so a far-off home is work without end."""
 
 
 def component_indices(close: str | list[str] | tuple[str, ...]) -> tuple[int, ...]:
@@ -101,3 +105,7 @@ class ClosedLoops:
             raise UserError(f"assembly: expected {k} passive values, got {len(self.assembly)}")
         if len(self.home) != n - k:
             raise UserError(f"home: expected {n - k} actuated values, got {len(self.home)}")
+        for label, values in (("home", self.home), ("assembly", self.assembly)):
+            if not all(math.isfinite(v) and abs(v) <= POSE_LIMIT for v in values):
+                raise UserError(f"{label}: joint values must lie within +-{POSE_LIMIT:g} (rad or m), got "
+                                f"{', '.join(f'{v:g}' for v in values)}")

@@ -36,9 +36,11 @@ import numpy as np
 from scipy.optimize import brentq
 
 from hapticdesign.analysis.dynamics.device import mass_matrix
-from hapticdesign.errors import UserError
+from hapticdesign.errors import InputError, UserError
 
 VELOCITIES = ("sampled", "difference")
+MAX_DAMPERS = 1000
+"""Most virtual dampers of one Z-width (each one bisects K_max over about 100 eigenvalue problems)."""
 
 
 @dataclass(frozen=True)
@@ -70,6 +72,11 @@ class DisplayLoop:
             raise UserError(f"the compensator fraction must lie in [0, 2), got {self.fraction}")
         if not (self.plant_stiffness >= 0 and math.isfinite(self.plant_stiffness)):
             raise UserError(f"the plant stiffness must be non-negative and finite, got {self.plant_stiffness}")
+        scales = (self.inertia / self.period, self.damping / self.inertia * self.period,
+                  self.period / self.inertia * self.period, self.plant_stiffness / self.inertia * self.period * self.period)
+        if not all(math.isfinite(v) for v in scales) or not np.all(np.isfinite(plant(self).A)):
+            raise UserError(f"the inertia {self.inertia:g}, damping {self.damping:g} and period {self.period:g} are "
+                            "outside the range this computation can resolve (their ratios overflow)")
 
 
 @lru_cache(maxsize=256)
@@ -202,9 +209,12 @@ def damping_grid(loop: DisplayLoop, points: int = 25) -> list[float]:
 
 def zwidth(loop: DisplayLoop, dampers: list[float] | None = None, points: int = 25) -> ZWidth:
     """The Z-width: ``K_max`` for each virtual damper (default: a grid up to the largest usable one)."""
+    if dampers is not None and not 1 <= len(dampers) <= MAX_DAMPERS:
+        raise InputError(f"give 1 to {MAX_DAMPERS} virtual dampers, got {len(dampers):,}", "b_values")
     values = damping_grid(loop, points) if dampers is None else [float(b) for b in dampers]
-    if any(not math.isfinite(b) for b in values):
-        raise UserError("the virtual dampers must be finite numbers")
+    if any(not (math.isfinite(b) and b >= 0.0) for b in values):
+        raise InputError(f"the virtual dampers must be finite and >= 0, got "
+                         f"{min(values, key=lambda b: b if math.isfinite(b) else -math.inf):g}", "b_values")
     bounds = loop.fraction == 0.0 and loop.plant_stiffness == 0.0
     return ZWidth(values, [max_stiffness(loop, b) for b in values],
                   [passivity_stiffness(loop, b) for b in values] if bounds else None,

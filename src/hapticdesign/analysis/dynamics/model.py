@@ -136,6 +136,11 @@ class DynamicsModel:
         return regressor_kernel(np.ascontiguousarray(qs, dtype=float), *tree.arrays, tree.body_node, self.compiled.gravity)
 
     def _coordinate_kinds(self, rng: np.random.Generator) -> list[CoordinateKind]:
+        from hapticdesign.workload import require_memory
+
+        n = self.n_dof
+        require_memory(f"probing the equations of motion of a {n}-joint device with {len(self.mechanism.bodies)} "
+                       "bodies", 4 * 3 * 8.0 * (n * n + n) * self.n_params)
         q0 = rng.uniform(-np.pi, np.pi, (3, self.n_dof))
         yh0, yg0 = self._regressors(q0)
         scale = max(np.abs(yh0).max(), np.abs(yg0).max(), 1e-300)

@@ -366,7 +366,18 @@ def _christoffel(R: _Ring, H: list) -> list:
 
 
 def derive(device: Device, symbolic: str = "all") -> SymbolicEquations:
-    """Exact H, C, G of ``device`` with the parameters named in ``symbolic`` kept as symbols."""
+    """Exact H, C, G of ``device`` with the parameters named in ``symbolic`` kept as symbols.
+
+    Open chains only: the equations of a device with closed loops hold on the closure manifold,
+    with its passive joints fixed by the closures (no closed form here, see
+    :mod:`hapticdesign.analysis.dynamics.closed_loop`); the loop-opened tree's equations would
+    treat passive joints as driven and leave out the closure forces, so they are refused.
+    """
+    loops = device.mechanism.loops
+    if loops is not None:
+        passive = ", ".join(device.mechanism.coordinates[k] for k in loops.passive)
+        raise UserError(f"{device.name} has closed loops (passive joints {passive}): its equations of motion are "
+                        "reduced to the actuated joints numerically at each pose and have no symbolic form here")
     keep = _symbolic_names(device, symbolic)
     aff = _affine_offsets(device, [k for k in device.kinematic if k in keep])
     inertial = [name for name in device.inertial_names() if name in keep]

@@ -116,7 +116,8 @@ class ClosedForm:
             factors = "".join(f" * {g.name}" + (f"**{k}" if k > 1 else "") for g, k in zip(self.gens, monom) if k)
             terms.append(f"{coeff!r}{factors}")
         body = "\n        + ".join(terms) if terms else "0.0"
-        signature = ", ".join(["*", *(python_identifier(s.name) for s in self.variables(part)), "**_unused"])
+        names = [python_identifier(s.name) for s in self.variables(part)]
+        signature = ", ".join(["*", *names, "**_unused"] if names else ["**_unused"])  # "*, **x" is not Python
         return (
             f'"""{_title(part)} of {docstring_text(self.device)} in the seed\'s design variables '
             '(seed 000 eq. 3.1-3.4, Appendix B)."""\n\n\n'

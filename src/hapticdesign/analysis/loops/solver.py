@@ -26,7 +26,7 @@ import numpy as np
 
 from hapticdesign.analysis.loops import closure_kernel as ck
 from hapticdesign.errors import UserError
-from hapticdesign.model.loops import ClosedLoops
+from hapticdesign.model.loops import POSE_LIMIT, ClosedLoops
 from hapticdesign.model.mechanism import Mechanism
 from hapticdesign.model.walk import CONSTANT, KinematicTree, node_poses
 
@@ -167,6 +167,9 @@ class LoopSolver:
             raise UserError(f"expected {self.n_actuated} actuated joint coordinates, got {q_a.shape[-1]}")
         if not np.all(np.isfinite(q_a)):
             raise UserError("joint coordinates must be finite numbers (got NaN or infinity)")
+        if np.any(np.abs(q_a) > POSE_LIMIT):
+            raise UserError(f"joint coordinates of a closed loop must lie within +-{POSE_LIMIT:g} (rad or m); the "
+                            f"loops are followed from home in steps of {MAX_STEP} rad")
         return q_a
 
     # -- positions ----------------------------------------------------------------------------

@@ -19,6 +19,7 @@ from hapticdesign.analysis.dynamics.device import (
 from hapticdesign.interface.options import DEVICE, FORCE, FORCE_HINT, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
 from hapticdesign.workload import allow_large
 from hapticdesign.devices.loading import resolve_device
+from hapticdesign.files import require_finite
 from hapticdesign.interface.common import joint_units, note as stderr_note, parse_vector, print_json, user_errors
 
 
@@ -58,6 +59,7 @@ def dynamics(
             "units": {"joints": joint_units(dev),
                       "note": "SI: q in rad or m, tau in N m or N; H, C, G in the units that make tau so"},
         }
+        require_finite(result)  # text as JSON: no NaN or infinity printed as a result
         if json_out:
             print_json(result)
             return
