@@ -2,15 +2,20 @@
 
 from pathlib import Path
 
+import math
+
+import mpmath
 import numpy as np
 import pytest
+from scipy.linalg import expm
+from scipy.optimize import brentq
 from scipy.signal import cont2discrete
 
 from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
 from hapticdesign.simulation.boundary import (
-    MassDamper, closed_loop_matrix, compensated_boundary, exact_boundary, simulated_boundary,
+    MassDamper, closed_loop_matrix, compensated_boundary, compensated_limit, exact_boundary, simulated_boundary,
 )
 from hapticdesign.simulation.config import Compensator, Hand, LoopConfig
 from hapticdesign.simulation.impedance import ImpedanceProblem, true_boundary
@@ -69,6 +74,84 @@ def test_closed_form_with_compensator_error_is_the_spectral_radius_boundary(iner
     """K* = b^2 (1-a)(1-ac) / [J (1-a)(1-ac) - T a b (1-c)], a = exp(-bT/J), against eigenvalues."""
     system = MassDamper(inertia, damping, period, compensate_inertia=True, model_inertia=fraction * inertia)
     assert compensated_boundary(inertia, damping, period, fraction) == pytest.approx(exact_boundary(system), rel=1e-8)
+
+
+def _own_spectral_limit(j: float, b: float, t: float, c: float) -> float:
+    """Independent oracle: the loop ``u_k = c (u_(k-1) - b v_k) - K q_k`` on the plant discretized with
+    ``scipy.linalg.expm``; the largest K with every eigenvalue inside the unit circle (0 if none)."""
+    e = expm(np.array([[0.0, 1.0, 0.0], [0.0, -b / j, 1.0 / j], [0.0, 0.0, 0.0]]) * t)
+    phi, gamma = e[:2, :2], e[:2, 2]
+
+    def radius(k: float) -> float:
+        law = np.array([-k, -c * b, c])
+        m = np.zeros((3, 3))
+        m[:2, :2] = phi
+        m[:2] += np.outer(gamma, law)
+        m[2] = law
+        return float(np.max(np.abs(np.linalg.eigvals(m))))
+
+    lo = 1e-9 * b * b / j
+    if radius(lo) >= 1.0:
+        return 0.0
+    hi = 2.0 * lo
+    while radius(hi) < 1.0:
+        lo, hi = hi, 2.0 * hi
+    return brentq(lambda k: radius(k) - 1.0, lo, hi, xtol=1e-14, rtol=1e-12)
+
+
+@pytest.mark.parametrize("x", [1e-3, 0.01, 0.1, 0.5, 1.0, 2.0, 3.9, 3.99, 4.01, 4.1, 5.0, 7.0, 10.0])
+def test_closed_form_is_the_spectral_radius_limit_for_x_up_to_10_and_errors_of_10_percent(x):
+    """min(K*, K_-1), or 0 when a c >= 1, equals the eigenvalue limit for x = bT/J up to 10 and
+    E = -10 ... 10 % (never negative, never the complex-pair K* where a real pole leaves first)."""
+    j, t = 0.01, 1e-3
+    b = x * j / t
+    for error in (-10.0, -5.0, -1.0, -0.1, 0.0, 0.1, 1.0, 5.0, 10.0):
+        c = 1.0 - error / 100.0
+        expected = _own_spectral_limit(j, b, t, c)
+        found = compensated_boundary(j, b, t, c)
+        assert found >= 0.0
+        if expected == 0.0:
+            assert found == 0.0 and c > 1.0 and math.log(c) >= x * (1 - 1e-9)
+        else:
+            assert found == pytest.approx(expected, rel=1e-8)
+
+
+def test_complex_pair_form_holds_up_to_x_4_and_a_real_pole_binds_beyond():
+    """At c = 1 K* = b^2/J exactly up to x = 4 (f(4) = 2 (1 + 3 e^-4)); at J = 0.01, b = 5, T = 0.01
+    (x = 5) the real pole at z = -1 sets the limit, well below b^2/J = 2500."""
+    j, t = 0.01, 0.01
+    below = compensated_limit(j, 3.99 * j / t, t, 1.0)
+    assert below.bound == "complex pair" and below.stiffness == pytest.approx((3.99 * j / t) ** 2 / j, rel=1e-12)
+    assert compensated_limit(j, 4.01 * j / t, t, 1.0).bound == "real pole at z = -1"
+    beyond = compensated_limit(j, 5.0, t, 1.0)
+    assert beyond.bound == "real pole at z = -1"
+    assert beyond.stiffness == pytest.approx(_own_spectral_limit(j, 5.0, t, 1.0), rel=1e-9)
+    assert beyond.stiffness == pytest.approx(1674.04, abs=0.01)
+
+
+def test_overestimated_inertia_has_no_stable_spring_when_a_c_reaches_1():
+    """c = 1.05 at x = 0.0128 (J = 0.039, b = 0.5, T = 1 ms): a c > 1, every spring is unstable: 0, not
+    the negative value of K* (whose denominator argument no longer applies)."""
+    j, b, t, c = 0.039, 0.5, 1e-3, 1.05
+    limit = compensated_limit(j, b, t, c)
+    assert limit.stiffness == 0.0 and limit.bound == "no stable spring"
+    assert _own_spectral_limit(j, b, t, c) == 0.0
+    a = math.exp(-b * t / j)
+    plain = b * b * (1 - a) * (1 - a * c) / (j * (1 - a) * (1 - a * c) - t * a * b * (1 - c))
+    assert plain < 0
+
+
+@pytest.mark.parametrize("x", [1e-9, 1e-7, 1e-6, 1e-5, 1e-4, 1e-3])
+@pytest.mark.parametrize("c", [1.0, 0.999, 0.99, 0.9, 0.0])
+def test_closed_form_keeps_full_precision_for_small_x(x, c):
+    """K* at small x against the same expression in 60-digit arithmetic (mpmath): no rounding loss."""
+    j, t = 0.01, 1e-3
+    b = x * j / t
+    with mpmath.workdps(60):
+        jm, bm, tm, cm = (mpmath.mpf(v) for v in (j, b, t, c))
+        a = mpmath.exp(-bm * tm / jm)
+        reference = bm ** 2 * (1 - a) * (1 - a * cm) / (jm * (1 - a) * (1 - a * cm) - tm * a * bm * (1 - cm))
+    assert compensated_boundary(j, b, t, c) == pytest.approx(float(reference), rel=1e-13)
 
 
 def test_closed_form_limits():

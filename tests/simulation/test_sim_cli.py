@@ -43,6 +43,18 @@ def test_error_percent_reports_the_closed_form():
     assert out["k_max_exact"] - 0.5 ** 2 / 0.04 == pytest.approx(0.01 * 0.5 / 1e-3, rel=0.02)
 
 
+def test_over_estimated_inertia_reports_zero_not_a_negative_closed_form():
+    """E = -5 % at J = 0.039, b = 0.5, T = 1 ms: a c = 1.05 exp(-0.0128) > 1, no spring is stable (the
+    written-out K* is negative there); the exact limit and the closed form are both 0."""
+    assert _closed_form(0.039, 0.5, 1e-3, 1.05) < 0
+    result = runner.invoke(app, ["stability-boundary", "--inertia", "0.039", "--damping", "0.5", "--period", "0.001",
+                                 "--compensate-inertia", "--error-percent", "-5", "--samples", "400", "--json"])
+    assert result.exit_code == 0, result.output
+    out = json.loads(result.stdout)
+    assert out["k_max_exact"] == 0.0 and out["k_max_closed_form"] == 0.0
+    assert out["closed_form_bound"] == "no stable spring"
+
+
 @pytest.mark.parametrize("args, message", [
     (["stability-boundary", "--inertia", "0.04", "--damping", "0.5", "--period", "0.001", "--error-percent", "1"],
      "needs --compensate-inertia"),

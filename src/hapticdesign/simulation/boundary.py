@@ -16,19 +16,35 @@ inertial compensator (model inertia ``J_m``, ``J_m = c J`` for a modelling error
 
 The closed form. Over one period the held torque moves the plant (``k_p = 0``) by
 ``v+ = a v + (1 - a) u / b`` and ``q+ = q + J (1 - a) v / b + (T/b - J (1 - a)/b^2) u`` with
-``a = exp(-b T / J)``. The acceleration sampled just before instant k is
+``a = exp(-x)``, ``x = b T / J``. The acceleration sampled just before instant k is
 ``(u_(k-1) - b v_k) / J``, so the law is ``u_k = c (u_(k-1) - b v_k) - K q_k``: a three-state
-linear map of ``(q, v, u_prev)``. Its cubic characteristic polynomial keeps a real root inside
-the unit circle and loses stability when its complex pair reaches ``|z| = 1``; the Schur-Cohn
-(Jury) condition for that crossing is linear in K and gives
+linear map of ``(q, v, u_prev)`` whose characteristic polynomial ``z^3 + a2 z^2 + a1 z + a0`` has
+coefficients affine in K, ``a0 = -a c``. The Schur-Cohn (Jury) conditions are then each linear in K:
 
-    K* = b^2 (1 - a)(1 - a c) / [J (1 - a)(1 - a c) - T a b (1 - c)],
+- ``p(1) > 0``: ``K T (1 - a) / b > 0``, i.e. ``K > 0`` (the pole at z = 1 of the running sum);
+- ``|a0| < 1``: ``a c < 1``. A compensator that over-estimates the inertia (``c > 1``) by more than
+  ``exp(x) - 1`` (about x) makes the loop unstable for every spring: the limit is 0;
+- ``1 - a0^2 > a1 - a0 a2`` (a complex pair reaches ``|z| = 1``)::
 
-which is ``b^2 / J`` at ``c = 1`` (the compensated loop's torque is a running sum
+      K < K* = b^2 (1 - a)(1 - a c) / [J (1 - a)(1 - a c) - T a b (1 - c)]
+             = b^2 (1 - a)(1 - a c) / (J [(1 - c) g(x) + c (1 - a)^2]),   g(x) = 1 - (1 + x) e^-x
+
+  (the denominator is positive for every c >= 0 since ``g(x) <= (1 - a)^2``);
+- ``p(-1) < 0`` (a real pole leaves through z = -1)::
+
+      K < K_-1 = 2 b^2 (1 + a + 2 a c) / (J f(x)),   f(x) = x (1 + e^-x) - 2 (1 - e^-x);
+
+- the remaining Schur-Cohn inequality holds whenever ``a c < 1``.
+
+So the exact limit is ``0`` when ``a c >= 1`` and ``min(K*, K_-1)`` otherwise. ``K*`` binds for
+``x`` up to 4 at ``c = 1`` exactly (``f(4) = 2 (1 + 3 e^-4)``), up to 3.977 at ``c = 0.9`` and 4.023 at
+``c = 1.1``; beyond, the real pole binds (J = 0.01, b = 5, T = 0.01, c = 1: 1674.04, not b^2/J = 2500).
+Within that domain ``K* = b^2 / J`` at ``c = 1`` (the compensated loop's torque is a running sum
 ``u_k = u_(k-1) - b v_k - K q_k``), about ``b^2 / J + (1 - c) b / T`` for ``c`` near 1 (a 1 %
 modelling error adds ``b / (100 T)``: 5 N m/rad at b = 0.5, T = 1 ms) and about ``2 b / T`` at
-``c = 0``. The tests check it against the spectral radius of :func:`closed_loop_matrix` and the
-simulated loop.
+``c = 0``. ``1 - a``, ``g`` and ``f`` are evaluated without cancellation (``expm1`` and their
+series below x = 1), so the limit keeps full precision down to x = 1e-9. The tests check it
+against the spectral radius of the exactly discretized loop and the simulated loop.
 """
 
 from __future__ import annotations
@@ -90,16 +106,55 @@ def _discretize(j: float, b: float, t: float, k_p: float = 0.0) -> tuple[np.ndar
     return e[:2, :2], e[:2, 2]
 
 
-def compensated_boundary(inertia: float, damping: float, period: float, fraction: float = 1.0) -> float:
-    """Closed-form ``K*`` of a 1-DOF inertia with a compensator feeding ``fraction * J * a`` forward.
+def _series(x: float, first: int, term) -> float:
+    """``sum_(n >= first) term(n) x^n / n!`` to double precision (for ``0 <= x < 1``)."""
+    total, power = 0.0, x ** first / math.factorial(first)
+    for n in range(first, first + 40):
+        total += term(n) * power
+        power *= x / (n + 1)
+    return total
 
-    ``fraction = c = 1 - E/100`` for a modelling error of E percent; see the module docstring.
-    ``inf`` when the denominator is not positive (no spring destabilizes the loop).
-    """
-    a = math.exp(-damping * period / inertia)
-    num = damping ** 2 * (1 - a) * (1 - a * fraction)
-    den = inertia * (1 - a) * (1 - a * fraction) - period * a * damping * (1 - fraction)
-    return num / den if den > 0 else math.inf
+
+def _g(x: float) -> float:
+    """``1 - (1 + x) e^-x`` (series ``sum (-1)^n (n - 1) x^n / n!`` from n = 2 below x = 1)."""
+    return _series(x, 2, lambda n: (-1) ** n * (n - 1)) if x < 1.0 else 1.0 - (1.0 + x) * math.exp(-x)
+
+
+def _f(x: float) -> float:
+    """``x (1 + e^-x) - 2 (1 - e^-x)`` (series ``sum (-1)^(n-1) (n - 2) x^n / n!`` from n = 3 below x = 1)."""
+    return _series(x, 3, lambda n: (-1) ** (n - 1) * (n - 2)) if x < 1.0 else x * (1.0 + math.exp(-x)) + 2.0 * math.expm1(-x)
+
+
+@dataclass(frozen=True)
+class CompensatedLimit:
+    """The exact limit with the inertial compensator and the Schur-Cohn condition that sets it:
+    ``"complex pair"`` (``K*``), ``"real pole at z = -1"`` (``K_-1``) or ``"no stable spring"``
+    (``a c >= 1``, limit 0)."""
+
+    stiffness: float
+    bound: str
+
+
+def compensated_limit(inertia: float, damping: float, period: float, fraction: float = 1.0) -> CompensatedLimit:
+    """The closed-form limit of a 1-DOF inertia with a compensator feeding ``fraction * J * a`` forward,
+    exact for every ``x = b T / J`` and ``fraction = c = 1 - E/100 >= 0`` (see the module docstring)."""
+    if not fraction >= 0:
+        raise UserError(f"the compensator fraction must be non-negative, got {fraction}")
+    x = damping * period / inertia
+    one_minus_a = -math.expm1(-x)
+    one_minus_ac = (1.0 - fraction) + fraction * one_minus_a
+    if x == 0 or one_minus_ac <= 0:
+        return CompensatedLimit(0.0, "no stable spring")
+    a = math.exp(-x)
+    k_star = damping ** 2 * one_minus_a * one_minus_ac / (
+        inertia * ((1.0 - fraction) * _g(x) + fraction * one_minus_a ** 2))
+    k_real = 2.0 * damping ** 2 * (1.0 + a + 2.0 * a * fraction) / (inertia * _f(x))
+    return CompensatedLimit(k_star, "complex pair") if k_star <= k_real else CompensatedLimit(k_real, "real pole at z = -1")
+
+
+def compensated_boundary(inertia: float, damping: float, period: float, fraction: float = 1.0) -> float:
+    """The limit of :func:`compensated_limit` (N m/rad): ``min(K*, K_-1)``, or 0 when ``a c >= 1``."""
+    return compensated_limit(inertia, damping, period, fraction).stiffness
 
 
 def closed_loop_matrix(system: MassDamper, stiffness: float) -> np.ndarray:

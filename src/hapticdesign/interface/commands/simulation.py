@@ -288,7 +288,7 @@ def stability_boundary_command(
     force: bool = FORCE,
 ) -> None:
     """Exact vs simulated stiffness limit of a 1-DOF mass-damper under a sampled spring (check of seed 000 ch. 4)."""
-    from hapticdesign.simulation.boundary import MassDamper, compensated_boundary, exact_boundary, simulated_boundary
+    from hapticdesign.simulation.boundary import MassDamper, compensated_limit, exact_boundary, simulated_boundary
 
     with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
         if substeps < 1 or samples < 40:
@@ -315,12 +315,14 @@ def stability_boundary_command(
         system = MassDamper(inertia, damping, period, delay, wall_damping, compensate_inertia,
                             model_inertia=fraction * inertia)
         exact = exact_boundary(system)
-        closed = (compensated_boundary(inertia, damping, period, fraction)
-                  if compensate_inertia and delay == 0 and wall_damping == 0 else None)
+        limit = (compensated_limit(inertia, damping, period, fraction)
+                 if compensate_inertia and delay == 0 and wall_damping == 0 else None)
+        closed = None if limit is None else limit.stiffness
         simulated = simulated_boundary(system, samples=samples, substeps=substeps)
         unbounded = [name for name, v in (("exact", exact), ("closed_form", closed), ("simulated", simulated))
                      if v is not None and not np.isfinite(v)]
         out = {"k_max_exact": _finite_or_none(exact), "k_max_closed_form": _finite_or_none(closed),
+               "closed_form_bound": None if limit is None else limit.bound,
                "k_max_simulated": _finite_or_none(simulated),
                "relative_difference": (simulated - exact) / exact
                if np.isfinite(exact) and np.isfinite(simulated) and exact != 0 else None,
@@ -331,7 +333,7 @@ def stability_boundary_command(
         if json_out:
             print_json(out)
             return
-        form = "" if closed is None else f", closed form {_stiffness_text(closed)}"
+        form = "" if limit is None else f", closed form {_stiffness_text(closed)} ({limit.bound})"
         typer.echo(f"exact {_stiffness_text(exact)}{form}, simulated {_stiffness_text(simulated)} "
                    f"(2b/T = {2 * damping / period:.6g})")
 
