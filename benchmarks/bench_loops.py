@@ -54,7 +54,7 @@ POSES = textwrap.dedent(
     for name, amplitude in (("five-bar", 0.3), ("delta", 0.2)):
         device = load_device_file("{examples}/" + name + ".yaml")
         model, pi = dynamics_of(device), device.standard_parameters()
-        home = model.solver.home[model.solver.arrays.actuated]
+        home = model.solver.home[model.solver.closures.actuated]
         t = np.arange(n)[:, None] * 1e-3  # a 1 kHz sampled motion, 2-3 Hz per joint
         path = home + amplitude * np.sin(2 * np.pi * (2.0 + np.arange(len(home))[None, :] * 0.5) * t)
         model.entries(path[:10], pi)
@@ -82,7 +82,7 @@ SETUP = textwrap.dedent(
     else:
         device = load_device_file("{examples}/" + name + ".yaml")
         solver = dynamics_of(device).solver
-        home = solver.home[solver.arrays.actuated]
+        home = solver.home[solver.closures.actuated]
         region = Region({{k: (h - {half}, h + {half}) for k, h in enumerate(home)}})
     form = linearity_form(dynamics_of(device), region)
     print(time.process_time() - t0, form.accuracy, float(form.ln(device.standard_parameters())))
