@@ -25,11 +25,11 @@ from hapticdesign.analysis.dynamics.actuated_kernel import (
     motion_entries,
     passive_paths,
 )
+from hapticdesign.analysis.configuration import LoopConfiguration
 from hapticdesign.analysis.dynamics.model import DynamicsModel, pair_index
 from hapticdesign.analysis.loops.closure_kernel import SINGULAR
-from hapticdesign.analysis.loops.solver import MESSAGES, SINGULAR_RATIO, LoopSolver
+from hapticdesign.analysis.loops.solver import MESSAGES, SINGULAR_RATIO
 from hapticdesign.errors import UserError
-from hapticdesign.model.mechanism import Mechanism
 from hapticdesign.model.walk import MotionPlan
 
 CHUNK = 4096
@@ -41,12 +41,13 @@ class ClosedLoopModel(DynamicsModel):
 
     exact_basis = False
 
-    def __init__(self, mechanism: Mechanism):
-        if mechanism.loops is None:
-            raise UserError("ClosedLoopModel needs a mechanism with loops; use DynamicsModel for a tree")
+    def __init__(self, configuration: LoopConfiguration):
+        mechanism = configuration.mechanism
+        self.configuration = configuration
+        """The device's configuration space (:func:`~hapticdesign.analysis.configuration.configuration_of`)."""
         self.mechanism = mechanism
         self.compiled = mechanism.compiled
-        self.solver = LoopSolver(mechanism)
+        self.solver = configuration.solver
         a, tree = self.solver.closures, self.compiled.tree
         ptr, nodes = passive_paths(tree.parent, self.solver.plan, tree.body_node, a.passive)
         self.bodies = Bodies(
@@ -81,7 +82,7 @@ class ClosedLoopModel(DynamicsModel):
 
     def full_coordinates(self, q: np.ndarray) -> np.ndarray:
         """Actuated poses (n_a,) or a motion (P, n_a) -> closed full coordinates (continued from home)."""
-        out = self.solver.solve(self._poses(q))
+        out = self.configuration.full(self._poses(q))
         return out[0] if np.asarray(q).ndim == 1 else out
 
     def entries_at(self, q_full: np.ndarray, pi: np.ndarray) -> np.ndarray:
