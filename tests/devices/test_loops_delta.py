@@ -28,7 +28,7 @@ from hapticdesign.analysis.dynamics.device import (
     gravity,
     mass_matrix,
 )
-from hapticdesign.analysis.kinematics import actuated_pose
+from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.devices.device_file import load_device_file
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "devices" / "delta.yaml"
@@ -109,7 +109,7 @@ def _samples(n: int, seed: int) -> np.ndarray:
 def test_forward_kinematics_is_the_trilateration(device):
     p = device.params
     for qa in _samples(20, 1):
-        pose = actuated_pose(device.mechanism, qa, solver=dynamics_of(device).solver)
+        pose = configuration_of(device).pose(qa)
         handle = MOUNT @ (_platform(p, qa) + np.array([0.0, 0.0, -p["h"]]))
         np.testing.assert_allclose(pose[:3, 3], handle, atol=1e-13)
         np.testing.assert_allclose(pose[:3, :3], MOUNT, atol=1e-13)  # the handle only translates
@@ -119,7 +119,7 @@ def test_inverse_kinematics_closed_form(device):
     p = device.params
     for centre in ([0.0, 0.0, -0.10], [0.02, -0.01, -0.09], [-0.015, 0.02, -0.11], [0.01, 0.015, -0.08]):
         qa = _inverse(p, np.array(centre))
-        pose = actuated_pose(device.mechanism, qa, frame="platform", solver=dynamics_of(device).solver)
+        pose = configuration_of(device).pose(qa, frame="platform")
         np.testing.assert_allclose(pose[:3, 3], MOUNT @ np.array(centre), atol=1e-13)
 
 

@@ -28,7 +28,7 @@ from hapticdesign.analysis.dynamics.device import (
     inverse_dynamics,
     mass_matrix,
 )
-from hapticdesign.analysis.kinematics import actuated_jacobian, actuated_pose
+from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.devices.device_file import load_device_file
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "devices" / "five-bar.yaml"
@@ -75,7 +75,7 @@ def _samples(n: int, seed: int) -> np.ndarray:
 
 def test_forward_kinematics_is_the_circle_intersection(device):
     for qa in _samples(20, 1):
-        pose = actuated_pose(device.mechanism, qa, solver=dynamics_of(device).solver)
+        pose = configuration_of(device).pose(qa)
         x, z = _handle(device, qa)
         np.testing.assert_allclose(pose[:3, 3], [x, 0.0, z], atol=1e-13)
 
@@ -88,7 +88,7 @@ def test_inverse_kinematics_law_of_cosines(device):
             rx, rz = x - base, z
             reach = np.hypot(rx, rz)
             qa.append(np.arctan2(rz, rx) + sign * np.arccos((l1**2 + reach**2 - l2**2) / (2 * l1 * reach)))
-        pose = actuated_pose(device.mechanism, np.array(qa), solver=dynamics_of(device).solver)
+        pose = configuration_of(device).pose(np.array(qa))
         np.testing.assert_allclose(pose[:3, 3], [x, 0.0, z], atol=1e-13)
 
 
@@ -101,7 +101,7 @@ def test_passive_angles_follow_the_closed_form(device):
 def test_handle_jacobian_is_the_derivative_of_the_closed_form(device):
     h = 1e-6
     for qa in _samples(5, 3):
-        jac = actuated_jacobian(device.mechanism, qa, solver=dynamics_of(device).solver)
+        jac = configuration_of(device).jacobian(qa)
         fd = np.stack([(_handle(device, qa + h * e) - _handle(device, qa - h * e)) / (2 * h) for e in np.eye(2)], axis=1)
         np.testing.assert_allclose(jac[[0, 2]], fd, atol=1e-8)  # central differences: h^2 ~ 1e-12, eps/h ~ 1e-10
 

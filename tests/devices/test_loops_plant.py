@@ -31,7 +31,7 @@ def device(request):
 
 def _home(device) -> np.ndarray:
     solver = dynamics_of(device).solver
-    return solver.home[solver.arrays.actuated]
+    return solver.home[solver.closures.actuated]
 
 
 def test_terms_match_the_closed_loop_model_at_random_poses(device):

@@ -19,7 +19,7 @@ import pytest
 from typer.testing import CliRunner
 
 from hapticdesign.analysis.dynamics.device import mass_matrix
-from hapticdesign.analysis.kinematics import actuated_jacobian, actuated_pose
+from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.analysis.loops.solver import LoopSolver
 from hapticdesign.analysis.rcube import dynamics as rcube_dynamics
 from hapticdesign.analysis.rcube import kinematics as rcube_kinematics
@@ -54,7 +54,7 @@ def _pose(offset_mm) -> tuple[np.ndarray, np.ndarray]:
 def test_platform_follows_the_closed_form_kinematics(device, offset_mm):
     geometry = final_design().geometry
     r, q = _pose(offset_mm)
-    pose = actuated_pose(device.mechanism, q[:, 0])
+    pose = configuration_of(device).pose(q[:, 0])
     assert np.allclose(pose[:3, 3], rcube_kinematics.forward_kinematics(geometry, q[:, 0]), rtol=0, atol=1e-12)
     assert np.allclose(pose[:3, 3], r, rtol=0, atol=1e-12)
     assert np.allclose(pose[:3, :3], np.eye(3), rtol=0, atol=1e-12)  # the platform translates (eq. 5.20)
@@ -62,7 +62,7 @@ def test_platform_follows_the_closed_form_kinematics(device, offset_mm):
     full = LoopSolver(device.mechanism).solve(q[:, 0])
     expected = np.stack([-q[:, 0], q[:, 1], q[:, 2], -(q[:, 1] + q[:, 2])], axis=-1).ravel()
     assert np.allclose(full[3:], expected, rtol=0, atol=1e-10)
-    J = actuated_jacobian(device.mechanism, q[:, 0])
+    J = configuration_of(device).jacobian(q[:, 0])
     assert np.allclose(J[:3], rcube_kinematics.active_jacobian(geometry, q[:, 0]), rtol=0, atol=1e-12)
     assert np.allclose(J[3:], 0.0, atol=1e-12)
 
@@ -71,7 +71,7 @@ def test_platform_follows_the_closed_form_kinematics(device, offset_mm):
 def test_cartesian_inertia_equals_the_built_in(device, offset_mm):
     r, q = _pose(offset_mm)
     H = mass_matrix(device, q[:, 0])
-    J_inv = np.linalg.inv(actuated_jacobian(device.mechanism, q[:, 0])[:3])
+    J_inv = np.linalg.inv(configuration_of(device).jacobian(q[:, 0])[:3])
     M_C = J_inv.T @ H @ J_inv
     expected = rcube_dynamics.cartesian_mass_matrix(final_design(), r)
     assert np.allclose(M_C, expected, rtol=0, atol=PRINTED * np.abs(expected).max())

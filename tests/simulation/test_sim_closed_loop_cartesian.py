@@ -2,7 +2,7 @@
 
 The wall acts along n at the handle, ``tau = J_n^T F`` with ``J_n = n^T J_v T`` in actuated coordinates. References,
 none of which imports the numba loop: the plain SciPy loop (:mod:`hapticdesign.simulation.reference`, the handle's
-position and Jacobian from :func:`hapticdesign.analysis.kinematics.actuated_pose` / ``actuated_jacobian`` at the pose
+position and Jacobian from :meth:`~hapticdesign.analysis.configuration.Configuration.pose` / ``jacobian`` at the pose
 the loop solver closes); central differences of the handle's closed position; the 1-DOF limit ``b^2 / H_ww`` of full
 inertial compensation (seed 000 §4.1.2), which a Cartesian stiffness K meets at ``K J_n,w^2 = b^2 / H_ww``.
 """
@@ -17,7 +17,7 @@ import pytest
 from typer.testing import CliRunner
 
 import hapticdesign as hd
-from hapticdesign.analysis.kinematics import actuated_jacobian, actuated_pose
+from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.devices.device_file import load_device_file
 from hapticdesign.interface.cli import app
 from hapticdesign.simulation.boundary import envelope_grows
@@ -37,7 +37,7 @@ def device(request):
 
 def _direction(device) -> np.ndarray:
     """The direction the handle moves in when the wall joint turns: the wall acts on that joint's motion."""
-    v = actuated_jacobian(device.mechanism, rest_pose(device))[:3, WALL_JOINT[device.name]]
+    v = configuration_of(device).jacobian(rest_pose(device))[:3, WALL_JOINT[device.name]]
     return v / np.linalg.norm(v)
 
 
@@ -52,8 +52,8 @@ def test_normal_jacobian_is_the_derivative_of_the_closed_handle_position(device)
     home, n = rest_pose(device), _direction(device)
     wall = Wall(0, 1.0, 0.0, 0.0, direction=tuple(n))
     eps = 1e-6
-    numeric = [(n @ actuated_pose(device.mechanism, home + eps * e)[:3, 3]
-                - n @ actuated_pose(device.mechanism, home - eps * e)[:3, 3]) / (2 * eps) for e in np.eye(device.n_dof)]
+    numeric = [(n @ configuration_of(device).pose(home + eps * e)[:3, 3]
+                - n @ configuration_of(device).pose(home - eps * e)[:3, 3]) / (2 * eps) for e in np.eye(device.n_dof)]
     assert np.allclose(normal_jacobian(device, wall, home), numeric, rtol=1e-7, atol=1e-10)
 
 

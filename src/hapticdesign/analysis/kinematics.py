@@ -6,8 +6,9 @@ origin, or translation axis) at the current pose, weighted by the coupling coeff
 dependent coordinates. The walk itself is the compiled one of :mod:`hapticdesign.model.walk`
 (seed 001 eq. 5.61-5.66 and 5.87-5.92 for the R-CUBE chains, whose stiffness model needs a 6 x 23
 Jacobian per chain and pose, eq. 5.93). Closed loops (passive joints) are solved by
-:mod:`hapticdesign.analysis.loops.solver`; :func:`actuated_pose` and :func:`actuated_jacobian` take
-the actuated coordinates of any device and, for loops, map velocities by ``qd = T qd_a``.
+:mod:`hapticdesign.analysis.loops.solver`; the pose and Jacobian of a frame at the actuated
+coordinates of any device (for loops ``J T``, ``qd = T qd_a``) are those of its configuration space,
+:func:`hapticdesign.analysis.configuration.configuration_of`.
 """
 
 from __future__ import annotations
@@ -64,25 +65,3 @@ def poses_and_jacobians(mech: Mechanism, Q: np.ndarray, frame: str | None = None
     walk.poses_and_jacobians(flat, *compiled.tree.arrays, node, False, poses, jac)
     lead = Q.shape[:-1]
     return poses.reshape(lead + (4, 4)), jac.reshape(lead + (6, mech.n_dof))
-
-
-def actuated_pose(mech: Mechanism, q_a: np.ndarray, frame: str | None = None, solver=None) -> np.ndarray:
-    """World pose (4x4) of ``frame`` at actuated coordinates (passive joints solved on the assembly branch)."""
-    return forward_kinematics(mech, _closed(mech, q_a, solver)[0], frame)
-
-
-def actuated_jacobian(mech: Mechanism, q_a: np.ndarray, frame: str | None = None, solver=None) -> np.ndarray:
-    """Geometric Jacobian (6 x N_a) of ``frame`` over the actuated coordinates: ``J(q) T`` with loops."""
-    q, solver = _closed(mech, q_a, solver)
-    full = jacobian(mech, q, frame)
-    return full if solver is None else full @ solver.velocity_transform(q)
-
-
-def _closed(mech: Mechanism, q_a: np.ndarray, solver):
-    """Full coordinates of actuated ones (the identity for a tree) and the loop solver (None for a tree)."""
-    if mech.loops is None:
-        return np.asarray(q_a, dtype=float), None
-    from hapticdesign.analysis.loops.solver import LoopSolver
-
-    solver = solver or LoopSolver(mech)
-    return solver.solve(np.asarray(q_a, dtype=float)), solver

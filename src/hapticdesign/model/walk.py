@@ -18,7 +18,15 @@ transforms keep their :class:`~hapticdesign.model.transforms.Axis` code and affi
 - :class:`WalkPlan` and :func:`planned_poses`: the same poses for the hot loops of closed loops, nodes in
   an order that puts first those a given set of nodes needs (the loop closures), joint values from the
   non-zero coupling coefficients only, the cosine and sine of a joint angle shared by every node that
-  turns by it (or by its negative) and, near an angle already evaluated, continued from there.
+  turns by it (or by its negative) and, near an angle already evaluated, continued from there;
+- :class:`MotionPlan`, :func:`node_motion` and :func:`add_joint_accelerations`: the velocity walk beside
+  the pose walk, the nodes' angular velocities and accelerations (the time derivative of seed 000
+  eq. 2.38-2.41) over only the nodes a set of nodes needs.
+
+:class:`Tree`, :class:`WalkPlan` and :class:`MotionPlan` are NamedTuples, the records the compiled
+kernels take. The kernels of the hot loops are compiled without numba's reference counting
+(``_nrt=False``): they allocate nothing, and each array a record passes would otherwise cost an atomic
+increment and decrement per call.
 
 Forward kinematics, the dynamics regressors, the loop-closure kernels and the R-CUBE stiffness model
 all call these.
@@ -27,6 +35,7 @@ all call these.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -99,9 +108,9 @@ class KinematicTree:
         )
 
     @property
-    def arrays(self) -> tuple[np.ndarray, ...]:
-        """``(parent, axis, coef, offset, const_rot, const_pos)``, the leading arguments of the kernels."""
-        return self.parent, self.axis, self.coef, self.offset, self.const_rot, self.const_pos
+    def arrays(self) -> "Tree":
+        """The kernels' record of the tree (:class:`Tree`)."""
+        return Tree(self.parent, self.axis, self.coef, self.offset, self.const_rot, self.const_pos)
 
     def plan(self, needed: list[int], moving: list[int]) -> "WalkPlan":
         """:class:`WalkPlan` whose first part is the nodes ``needed`` (and their ancestors), those that the
@@ -134,10 +143,10 @@ class KinematicTree:
             else:
                 seen[key] = n
         return WalkPlan(
-            order=np.array(order, dtype=np.int64), n_first=len(first), n_still=len(still), ptr=ptr.astype(np.int64),
+            order=np.array(order, dtype=np.int64), n_first=len(first), ptr=ptr.astype(np.int64),
             index=np.concatenate([np.zeros(0, dtype=np.int64)] + nonzero).astype(np.int64),
             value=np.concatenate([np.zeros(0)] + [row[k] for row, k in zip(self.coef, nonzero)]),
-            trig_source=source.astype(np.int64), trig_sign=sign,
+            trig_source=source.astype(np.int64), trig_sign=sign, n_still=len(still),
         )
 
     def workspace(self) -> tuple[np.ndarray, np.ndarray]:
@@ -146,9 +155,19 @@ class KinematicTree:
         return np.zeros((n_node, 3, 3)), np.zeros((n_node, 3))
 
 
-@dataclass(frozen=True)
-class WalkPlan:
-    """A walk of a :class:`KinematicTree` for the hot loops (:func:`planned_poses`).
+class Tree(NamedTuple):
+    """The arrays of a :class:`KinematicTree` every compiled walk reads (numba record)."""
+
+    parent: np.ndarray
+    axis: np.ndarray
+    coef: np.ndarray
+    offset: np.ndarray
+    const_rot: np.ndarray
+    const_pos: np.ndarray
+
+
+class WalkPlan(NamedTuple):
+    """A walk of a :class:`KinematicTree` for the hot loops (:func:`planned_poses`; a numba record).
 
     ``order`` lists every node after its parent, the ``n_first`` nodes a chosen set needs first, and of
     those the ``n_still`` that chosen coordinates do not move first (a walk after a change of only those
@@ -160,18 +179,12 @@ class WalkPlan:
 
     order: np.ndarray
     n_first: int
-    n_still: int
     ptr: np.ndarray
     index: np.ndarray
     value: np.ndarray
     trig_source: np.ndarray
     trig_sign: np.ndarray
-
-    @property
-    def arrays(self) -> tuple:
-        """``(order, n_first, ptr, index, value, trig_source, trig_sign, n_still)``, the ``plan`` of the kernels."""
-        return (self.order, self.n_first, self.ptr, self.index, self.value, self.trig_source, self.trig_sign,
-                self.n_still)
+    n_still: int
 
     def workspace(self) -> np.ndarray:
         """The scratch of :func:`planned_poses` (:func:`trig_workspace`)."""
@@ -186,9 +199,9 @@ def trig_workspace(n_node):
     return out
 
 
-@njit(cache=True)
-def planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, start, stop, rot, pos, trig):
-    """:func:`node_poses` of the nodes ``order[start:stop]`` of a :class:`WalkPlan` ``plan`` (its ``arrays``).
+@njit(cache=True, _nrt=False)
+def planned_poses(q, tree, plan, start, stop, rot, pos, trig):
+    """:func:`node_poses` of the nodes ``order[start:stop]`` of a :class:`WalkPlan` ``plan`` on the :class:`Tree` ``tree``.
 
     The nodes before ``start`` in the plan's order must hold their poses (and ``trig`` their cosines and
     sines) at the same ``q``. ``trig``: :func:`trig_workspace`, kept from call to call. A rotation angle
@@ -199,7 +212,8 @@ def planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, start, st
     a farther angle is evaluated and becomes the anchor.
     Along a motion (Newton's iterations, the integrator's stages) most walks need no ``cos`` or ``sin``.
     """
-    order, _, ptr, index, value, source, sign, _ = plan
+    parent, axis, offset, const_rot, const_pos = tree.parent, tree.axis, tree.offset, tree.const_rot, tree.const_pos
+    order, ptr, index, value, source, sign = plan.order, plan.ptr, plan.index, plan.value, plan.trig_source, plan.trig_sign
     for i in range(start, stop):
         n = order[i]
         pn = parent[n]
@@ -364,3 +378,126 @@ def poses_and_jacobians(qs, parent, axis, coef, offset, const_rot, const_pos, no
             poses[p, 3, i] = 0.0
         poses[p, 3, 3] = 1.0
         frame_jacobian(node, parent, axis, coef, rot, pos, body, jac[p])
+
+
+class MotionPlan(NamedTuple):
+    """The nodes whose motions (:func:`node_motion`) a set of nodes needs, in tree order (a numba record).
+
+    Those nodes and, among their ancestors, the variable ones: the others (constants, fixed
+    translations) only carry a motion along a rigid offset, which the next kept node takes from its
+    kept ancestor ``parent[i]`` (``-1``: the base) over the origin difference. ``moves[i]`` is False when
+    node ``order[i]`` has its kept ancestor's origin (only rotations between them), so that its origin
+    acceleration is the ancestor's.
+    """
+
+    order: np.ndarray
+    parent: np.ndarray
+    moves: np.ndarray
+
+    @classmethod
+    def of(cls, tree: KinematicTree, needed: list[int]) -> "MotionPlan":
+        """The plan of the nodes ``needed`` (``-1``, the base, needs none) on the folded tree ``tree``."""
+        variable = np.any(tree.coef != 0.0, axis=1)
+        path: set[int] = set()
+        for node in needed:
+            while node >= 0 and node not in path:
+                path.add(node)
+                node = int(tree.parent[node])
+        order = sorted(n for n in path if variable[n] or n in needed)
+        kept = set(order)
+        parents, moves = [], []
+        for n in order:
+            e, moved = n, False
+            while e >= 0 and (e == n or e not in kept):
+                shift = tree.axis[e] >= 3 if tree.axis[e] != CONSTANT else bool(np.any(tree.const_pos[e] != 0.0))
+                moved = moved or bool(shift)
+                e = int(tree.parent[e])
+            parents.append(e)
+            moves.append(moved)
+        return cls(order=np.array(order, dtype=np.int64), parent=np.array(parents, dtype=np.int64),
+                   moves=np.array(moves, dtype=np.bool_))
+
+
+@njit(cache=True)
+def _cross(a0, a1, a2, b0, b1, b2):
+    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+
+
+@njit(cache=True, _nrt=False)
+def node_motion(rate, motion, axis, rot, pos, w, al, ac):
+    """World angular velocity ``w`` and, at zero joint accelerations, the angular and origin accelerations
+    ``al``, ``ac`` of the nodes of a :class:`MotionPlan` ``motion``, for the rate
+    ``rate[n]`` of each node's joint value.
+
+    From the kept ancestor ``k`` (the base: at rest), over the origin difference ``d = p_n - p_k``:
+    rotation node (axis ``u``, rate ``s``): ``w = w_k + s u``, ``al = al_k + w_k x s u``,
+    ``ac = ac_k + al_k x d + w_k x (w_k x d)``; translation node: ``w = w_k``, ``al = al_k``,
+    ``ac = ac_k + al_k x d + w_k x (w_k x d) + 2 w_k x s u`` (the time derivative of seed 000 eq. 2.38-2.41).
+    """
+    order, kept, moves = motion.order, motion.parent, motion.moves
+    for i in range(order.shape[0]):
+        n = order[i]
+        p = kept[i]
+        s = rate[n]
+        a = axis[n] % 3
+        u0, u1, u2 = rot[n, 0, a], rot[n, 1, a], rot[n, 2, a]
+        if p >= 0:
+            w0, w1, w2 = w[p, 0], w[p, 1], w[p, 2]
+            l0, l1, l2 = al[p, 0], al[p, 1], al[p, 2]
+            a0, a1, a2 = ac[p, 0], ac[p, 1], ac[p, 2]
+        else:
+            w0 = w1 = w2 = l0 = l1 = l2 = a0 = a1 = a2 = 0.0
+        if p >= 0 and moves[i]:
+            d0, d1, d2 = pos[n, 0] - pos[p, 0], pos[n, 1] - pos[p, 1], pos[n, 2] - pos[p, 2]
+            wd0, wd1, wd2 = _cross(w0, w1, w2, d0, d1, d2)
+            ww0, ww1, ww2 = _cross(w0, w1, w2, wd0, wd1, wd2)
+            ld0, ld1, ld2 = _cross(l0, l1, l2, d0, d1, d2)
+            a0, a1, a2 = a0 + ld0 + ww0, a1 + ld1 + ww1, a2 + ld2 + ww2
+        x0, x1, x2 = _cross(w0, w1, w2, s * u0, s * u1, s * u2)
+        if axis[n] < 3:
+            w[n, 0], w[n, 1], w[n, 2] = w0 + s * u0, w1 + s * u1, w2 + s * u2
+            al[n, 0], al[n, 1], al[n, 2] = l0 + x0, l1 + x1, l2 + x2
+            ac[n, 0], ac[n, 1], ac[n, 2] = a0, a1, a2
+        else:
+            w[n, 0], w[n, 1], w[n, 2] = w0, w1, w2
+            al[n, 0], al[n, 1], al[n, 2] = l0, l1, l2
+            ac[n, 0], ac[n, 1], ac[n, 2] = a0 + 2.0 * x0, a1 + 2.0 * x1, a2 + 2.0 * x2
+
+
+@njit(cache=True, _nrt=False)
+def add_joint_accelerations(acc, motion, axis, rot, pos, al, ac, dal, dac):
+    """Add to the node accelerations ``al``, ``ac`` those of the joint-value accelerations ``acc[n]`` at zero rates
+    (the nodes of a motion plan, as :func:`node_motion`).
+
+    The rate-free part of :func:`node_motion` (linear in ``acc``): from the kept ancestor ``k``, a node carries
+    its angular acceleration ``dal_k`` over the origin difference ``d`` (``dac = dac_k + dal_k x d``) and adds
+    ``acc u`` to the angular acceleration (rotation) or to the origin's (translation). ``dal``, ``dac``:
+    scratch (M x 3).
+    """
+    order, kept, moves = motion.order, motion.parent, motion.moves
+    for i in range(order.shape[0]):
+        n = order[i]
+        p = kept[i]
+        s = acc[n]
+        a = axis[n] % 3
+        u0, u1, u2 = s * rot[n, 0, a], s * rot[n, 1, a], s * rot[n, 2, a]
+        if p >= 0:
+            l0, l1, l2 = dal[p, 0], dal[p, 1], dal[p, 2]
+            a0, a1, a2 = dac[p, 0], dac[p, 1], dac[p, 2]
+            if moves[i]:
+                x0, x1, x2 = _cross(l0, l1, l2, pos[n, 0] - pos[p, 0], pos[n, 1] - pos[p, 1], pos[n, 2] - pos[p, 2])
+                a0, a1, a2 = a0 + x0, a1 + x1, a2 + x2
+        else:
+            l0 = l1 = l2 = a0 = a1 = a2 = 0.0
+        if axis[n] < 3:
+            l0, l1, l2 = l0 + u0, l1 + u1, l2 + u2
+        else:
+            a0, a1, a2 = a0 + u0, a1 + u1, a2 + u2
+        dal[n, 0], dal[n, 1], dal[n, 2] = l0, l1, l2
+        dac[n, 0], dac[n, 1], dac[n, 2] = a0, a1, a2
+        al[n, 0] += l0
+        al[n, 1] += l1
+        al[n, 2] += l2
+        ac[n, 0] += a0
+        ac[n, 1] += a1
+        ac[n, 2] += a2

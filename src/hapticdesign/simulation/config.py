@@ -13,8 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from hapticdesign.analysis.dynamics.device import dynamics_of
-from hapticdesign.analysis.kinematics import actuated_jacobian
+from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.device import Device
 from hapticdesign.model.inertia import SEED_FIELDS
@@ -272,8 +271,7 @@ def compensator_device(device: Device, compensator: Compensator) -> Device:
 def rest_pose(device: Device) -> np.ndarray:
     """Where the experiments start and the joint paths are centred: q = 0 for an open chain (the seed's),
     the file's ``home`` actuated pose for a closed-loop device (whose loops need not close at 0)."""
-    loops = device.mechanism.loops
-    return np.zeros(device.n_dof) if loops is None else np.array(loops.home, dtype=float)
+    return configuration_of(device).home.copy()
 
 
 def plant_friction(device: Device, config: LoopConfig) -> tuple[np.ndarray, np.ndarray]:
@@ -301,8 +299,7 @@ def plant_damping(device: Device, config: LoopConfig) -> np.ndarray:
 def handle_jacobian(device: Device, q: np.ndarray) -> np.ndarray:
     """The handle's geometric Jacobian (6 x n) over the actuated coordinates at ``q``: ``J`` of a tree,
     ``J T`` of a closed-loop device at its closed pose on the assembly branch."""
-    solver = getattr(dynamics_of(device), "solver", None)
-    return actuated_jacobian(device.mechanism, np.asarray(q, dtype=float), solver=solver)
+    return configuration_of(device).jacobian(np.asarray(q, dtype=float))
 
 
 def normal_jacobian(device: Device, wall: Wall, q: np.ndarray) -> np.ndarray:

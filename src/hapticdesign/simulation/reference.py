@@ -20,7 +20,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from hapticdesign.analysis.dynamics.device import dynamics_of
-from hapticdesign.analysis.kinematics import actuated_jacobian, actuated_pose
+from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation.config import (
@@ -107,20 +107,20 @@ def simulate_adaptive(
     tripped_at = None
     status = STATUS_COMPLETED
     direction = unit_direction(wall.direction) if wall.cartesian else None
-    solver = getattr(dynamics_of(device), "solver", None)
+    space = configuration_of(device)
 
     def coordinate(q_t: np.ndarray) -> float:
         """The wall coordinate: the wall joint, or the handle along the Cartesian wall's direction."""
         if direction is None:
             return float(q_t[wall.joint])
-        return float(direction @ actuated_pose(device.mechanism, q_t, solver=solver)[:3, 3])
+        return float(direction @ space.pose(q_t)[:3, 3])
 
     def wall_torque(qs: np.ndarray, qds: np.ndarray) -> np.ndarray:
         tau = np.zeros(n)
         if direction is None:
             tau[wall.joint] = wall.stiffness * (qs[wall.joint] - wall.equilibrium) + wall.damping * qds[wall.joint]
             return tau
-        j_n = direction @ actuated_jacobian(device.mechanism, qs, solver=solver)[:3]
+        j_n = direction @ space.jacobian(qs)[:3]
         return j_n * (wall.stiffness * (coordinate(qs) - rest) + wall.damping * (j_n @ qds))
 
     reference = coordinate(q_start)

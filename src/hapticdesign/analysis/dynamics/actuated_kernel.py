@@ -28,11 +28,18 @@ directly (:func:`pose_entries`), in world axes (each body's ``h`` and ``J`` rota
 skips bodies whose parameters are all zero; :func:`motion_entries` does the same along a motion, each
 pose continued from the last inside the kernel. They share :func:`factor_pose` (poses and ``Phi_p^-1``)
 and :func:`reduce_pose` (``T`` and the reduced Jacobians at one closed pose), which allocate nothing:
-their scratch arrays come from :func:`workspace`. The closed-loop plant of the simulation
-(:mod:`.closed_loop_plant`) calls them too.
+their scratch arrays come from a :class:`~hapticdesign.analysis.loops.records.Workspace`. The closed-loop
+plant of the simulation (:mod:`.closed_loop_plant`) calls them too.
+
+Besides the loop records (``tree``, ``plan``, ``loops``, ``settings``, ``ws``:
+:mod:`hapticdesign.analysis.loops.closure_kernel`), the kernels take the :class:`Bodies` record: the
+bodies' nodes, gravity, the :class:`~hapticdesign.model.walk.MotionPlan` of the velocity sweeps and
+per body the nodes the passive coordinates move (:func:`passive_paths`).
 """
 
 from __future__ import annotations
+
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -40,16 +47,43 @@ from numba import njit
 from hapticdesign.analysis.dynamics.kernel import body_regressor
 from hapticdesign.analysis.loops.closure_kernel import (
     OK,
-    add_joint_accelerations,
     closure_bias,
     closure_jacobian,
-    lu_in_place,
-    newton_into,
-    node_motion,
+    correct,
     rotation_entry,
     solve_path,
 )
-from hapticdesign.model.walk import planned_poses, trig_workspace, unit_twist
+from hapticdesign.analysis.loops.records import workspace
+from hapticdesign.model.dense import lu_in_place
+from hapticdesign.model.walk import MotionPlan, add_joint_accelerations, node_motion, planned_poses, unit_twist
+
+
+class Bodies(NamedTuple):
+    """The bodies of a closed-loop mechanism for the compiled entries: the node each is attached to, gravity,
+    the :class:`~hapticdesign.model.walk.MotionPlan` of the nodes the bodies and closures need, and per body
+    the nodes from its node to the base that a passive coordinate moves, body ``b``'s being
+    ``path_nodes[path_ptr[b]:path_ptr[b + 1]]`` (:func:`passive_paths`)."""
+
+    body_node: np.ndarray
+    gravity: np.ndarray
+    motion: MotionPlan
+    path_ptr: np.ndarray
+    path_nodes: np.ndarray
+
+
+class EntriesScratch(NamedTuple):
+    """Scratch of :func:`pose_entries`: world parameters per set ``pw``, ``H_a`` per set ``h``, the passive
+    inertia coupling ``hap`` and ``kmat = -hap Phi_p^-1`` per set, ``mj = M (J_b T)``, the closures' bias of
+    each rate vector of the polarization ``biases`` and no rate vector ``empty`` (:func:`motion_state` takes
+    the unit ones)."""
+
+    pw: np.ndarray
+    h: np.ndarray
+    hap: np.ndarray
+    kmat: np.ndarray
+    mj: np.ndarray
+    biases: np.ndarray
+    empty: np.ndarray
 
 
 @njit(cache=True)
@@ -90,43 +124,19 @@ def _wrench_regressor(w, al, acc, out):
     out[3, 9], out[4, 9], out[5, 9] = w1 * w1 - w2 * w2, l2 - w0 * w1, l1 + w0 * w2
 
 
-@njit(cache=True)
-def workspace(n_node, n_dof, na, passive, n_body):
-    """Scratch arrays of :func:`reduce_pose` and :func:`velocity_state` (one set per caller).
-
-    ``(rot, pos, w, al, ac, phi, lu, pinv, t, node_t, rate, ja, bias, gamma, trig, slot, dal, dac)``: node
-    poses and motions, ``Phi``, an LU scratch, ``Phi_p^-1``, ``T``, every node's joint-value rate per
-    actuated rate (``coef T``) and for one rate vector, per body the world Jacobian of its origin over the
-    actuated rates (``J_b T``, 6 x n_a), ``Phidot qd``, ``gamma``, the walk plan's cosines and sines, each
-    coordinate's place among the passive ones (-1: actuated) and the node accelerations of ``gamma``.
-    """
-    n_node = max(n_node, 1)
-    npas = passive.shape[0]
-    slot = np.full(n_dof, -1, dtype=np.int64)
-    for r in range(npas):
-        slot[passive[r]] = r
-    return (
-        np.zeros((n_node, 3, 3)), np.zeros((n_node, 3)),
-        np.zeros((n_node, 3)), np.zeros((n_node, 3)), np.zeros((n_node, 3)),
-        np.zeros((npas, n_dof)), np.zeros((npas, npas)), np.zeros((npas, npas)),
-        np.zeros((n_dof, na)), np.zeros((n_node, na)), np.zeros(n_node), np.zeros((n_body, 6, na)),
-        np.zeros(npas), np.zeros(npas), trig_workspace(n_node), slot, np.zeros((n_node, 3)), np.zeros((n_node, 3)),
-    )
-
-
 @njit(cache=True, inline="always")
-def factor_pose(q, parent, axis, offset, const_rot, const_pos, plan, frame_a, frame_b, row_loop, row_comp, passive, ws):
+def factor_pose(q, tree, plan, loops, ws):
     """Every node's pose, ``Phi`` and ``Phi_p^-1`` at a closed full pose ``q`` into ``ws`` (for :func:`reduce_pose`).
 
-    ``plan``: the arrays of the loop solver's :class:`~hapticdesign.model.walk.WalkPlan`. Returns the pivot
-    ratio of ``Phi_p`` (0: singular) and the sign of its determinant. After Newton
+    Returns the pivot ratio of ``Phi_p`` (0: singular) and the sign of its determinant. After Newton
     (:func:`hapticdesign.analysis.loops.closure_kernel.newton_into`), which leaves ``Phi``, ``Phi_p^-1``
     and the poses of the plan's first part, a walk of the other nodes does the same.
     """
-    rot, pos, _, _, _, phi, lu, pinv, _, _, _, _, _, _, trig, _, _, _ = ws
+    rot, pos, phi, lu, pinv = ws.rot, ws.pos, ws.phi, ws.lu, ws.pinv
+    passive = loops.passive
     npas = passive.shape[0]
-    planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, 0, parent.shape[0], rot, pos, trig)
-    closure_jacobian(frame_a, frame_b, row_loop, row_comp, parent, axis, plan, rot, pos, phi)
+    planned_poses(q, tree, plan, 0, tree.parent.shape[0], rot, pos, ws.trig)
+    closure_jacobian(loops, tree, plan, rot, pos, phi)
     for i in range(npas):
         for j in range(npas):
             lu[i, j] = phi[i, passive[j]]
@@ -135,7 +145,7 @@ def factor_pose(q, parent, axis, offset, const_rot, const_pos, plan, frame_a, fr
 
 
 @njit(cache=True, inline="always")
-def reduce_pose(parent, axis, plan, body_node, actuated, passive, ws):
+def reduce_pose(tree, plan, body_node, loops, ws):
     """``T = [I; S]``, ``coef T`` and every body's Jacobian ``J_b T`` into ``ws``, from its node poses, ``Phi`` and
     ``Phi_p^-1`` at a closed pose (:func:`factor_pose`).
 
@@ -144,8 +154,10 @@ def reduce_pose(parent, axis, plan, body_node, actuated, passive, ws):
     translation (seed 000 eq. 2.20-2.26), weighted by the node's joint-value rates ``coef T`` (the plan's
     sparse coupling coefficients).
     """
-    rot, pos, _, _, _, phi, _, pinv, t, node_t, _, ja, _, _, _, _, _, _ = ws
-    _, _, ptr, index, value, _, _, _ = plan
+    rot, pos, phi, pinv, t, node_t, ja = ws.rot, ws.pos, ws.phi, ws.pinv, ws.t, ws.node_t, ws.ja
+    parent, axis = tree.parent, tree.axis
+    ptr, index, value = plan.ptr, plan.index, plan.value
+    actuated, passive = loops.actuated, loops.passive
     na = actuated.shape[0]
     npas = passive.shape[0]
     n_node = parent.shape[0]
@@ -188,16 +200,15 @@ def reduce_pose(parent, axis, plan, body_node, actuated, passive, ws):
 
 
 @njit(cache=True, inline="always")
-def motion_state(qd_a, j, k, axis, motion, frame_a, frame_b, row_loop, row_comp, ws):
+def motion_state(qd_a, j, k, axis, motion, loops, ws):
     """Node motions at ``qd = T qd_a`` and ``qdd = 0`` and the closures' bias ``Phidot qd`` (:func:`closure_bias`)
     into ``ws``.
 
     ``j >= 0`` takes the rate vector ``e_j`` (plus ``e_k`` when ``k != j``) instead of ``qd_a``; ``motion``:
-    the arrays of a :class:`~hapticdesign.analysis.loops.solver.MotionPlan` that keeps the bodies' and the
-    closures' nodes.
+    a :class:`~hapticdesign.model.walk.MotionPlan` that keeps the bodies' and the closures' nodes.
     """
-    rot, pos, w, al, ac, _, _, _, _, node_t, rate, _, bias, _, _, _, _, _ = ws
-    order = motion[0]
+    node_t, rate = ws.node_t, ws.rate
+    order = motion.order
     for i in range(order.shape[0]):
         n = order[i]
         if j >= 0:
@@ -207,23 +218,23 @@ def motion_state(qd_a, j, k, axis, motion, frame_a, frame_b, row_loop, row_comp,
             for c in range(qd_a.shape[0]):
                 acc += node_t[n, c] * qd_a[c]
             rate[n] = acc
-    node_motion(rate, motion, axis, rot, pos, w, al, ac)
-    closure_bias(frame_a, frame_b, row_loop, row_comp, al, ac, bias)
+    node_motion(rate, motion, axis, ws.rot, ws.pos, ws.w, ws.al, ws.ac)
+    closure_bias(loops, ws.al, ws.ac, ws.bias)
 
 
 @njit(cache=True, inline="always")
-def velocity_state(qd_a, j, k, axis, plan, motion, frame_a, frame_b, row_loop, row_comp, passive, ws):
+def velocity_state(qd_a, j, k, axis, plan, motion, loops, ws):
     """Node motions at ``qd = T qd_a`` and ``qdd = [0; gamma]``, ``gamma = -Phi_p^-1 (Phidot qd)``, into ``ws``.
 
     The node motions at ``qdd = 0`` (:func:`motion_state`, same arguments) give ``Phidot qd``; the passive
     joints' accelerations ``gamma`` then add theirs (:func:`add_joint_accelerations`, joint values'
     accelerations ``coef [0; gamma]``).
     """
-    rot, pos, _, al, ac, _, _, pinv, _, _, rate, _, bias, gamma, _, slot, dal, dac = ws
-    _, _, ptr, index, value, _, _, _ = plan
-    order = motion[0]
-    npas = passive.shape[0]
-    motion_state(qd_a, j, k, axis, motion, frame_a, frame_b, row_loop, row_comp, ws)
+    pinv, rate, bias, gamma, slot = ws.pinv, ws.rate, ws.bias, ws.gamma, ws.slot
+    ptr, index, value = plan.ptr, plan.index, plan.value
+    order = motion.order
+    npas = loops.passive.shape[0]
+    motion_state(qd_a, j, k, axis, motion, loops, ws)
     for r in range(npas):
         acc = 0.0
         for i in range(npas):
@@ -237,7 +248,7 @@ def velocity_state(qd_a, j, k, axis, plan, motion, frame_a, frame_b, row_loop, r
             if r >= 0:
                 acc += value[c] * gamma[r]
         rate[n] = acc
-    add_joint_accelerations(rate, motion, axis, rot, pos, al, ac, dal, dac)
+    add_joint_accelerations(rate, motion, axis, ws.rot, ws.pos, ws.al, ws.ac, ws.dal, ws.dac)
 
 
 @njit(cache=True)
@@ -328,11 +339,11 @@ def mass_and_gravity(ja, b, gravity, pw, s, h, g, mj, keep):
                 h[j, i] += e
 
 
-def passive_paths(parent: np.ndarray, plan: tuple, body_node: np.ndarray, passive: np.ndarray) -> tuple:
+def passive_paths(parent: np.ndarray, plan, body_node: np.ndarray, passive: np.ndarray) -> tuple:
     """Per body, the nodes from its node to the base that a passive coordinate moves: ``(ptr, nodes)``, body
-    ``b``'s being ``nodes[ptr[b]:ptr[b + 1]]`` (what :func:`passive_inertia` walks). ``plan``: the arrays of
-    the loop solver's :class:`~hapticdesign.model.walk.WalkPlan` (its sparse coupling coefficients)."""
-    _, _, ptr, index, _, _, _, _ = plan
+    ``b``'s being ``nodes[ptr[b]:ptr[b + 1]]`` (what :func:`passive_inertia` walks). ``plan``: the loop
+    solver's :class:`~hapticdesign.model.walk.WalkPlan` (its sparse coupling coefficients)."""
+    ptr, index = plan.ptr, plan.index
     moving = {int(k) for k in passive}
     counts, nodes = [0], []
     for nb in body_node:
@@ -346,18 +357,18 @@ def passive_paths(parent: np.ndarray, plan: tuple, body_node: np.ndarray, passiv
 
 
 @njit(cache=True, inline="always")
-def passive_inertia(b, body_node, paths, axis, plan, slot, rot, pos, mj, hap):
+def passive_inertia(b, bodies, axis, plan, slot, rot, pos, mj, hap):
     """Add body ``b``'s ``(J_b T)^T M J_b,p`` to ``hap`` (n_a x n_p), from ``mj = M (J_b T)`` (:func:`mass_and_gravity`;
     the passive columns of eq. 2.44's ``J^T M J``).
 
     ``J_b,p``: the passive coordinates' columns of the Jacobian of the body origin on the loop-opened tree,
-    the unit twists of the nodes they move (``paths``: :func:`passive_paths`; as in :func:`reduce_pose`),
+    the unit twists of the nodes they move (``bodies``' paths: :func:`passive_paths`; as in :func:`reduce_pose`),
     weighted by their coupling coefficients. ``hap`` is the inertia coupling of the actuated motions to the
     passive joints' accelerations: ``T^T H [0; gamma] = hap gamma``.
     """
-    _, _, ptr, index, value, _, _, _ = plan
-    first, nodes = paths
-    nb = body_node[b]
+    ptr, index, value = plan.ptr, plan.index, plan.value
+    first, nodes = bodies.path_ptr, bodies.path_nodes
+    nb = bodies.body_node[b]
     for c in range(first[b], first[b + 1]):
         e = nodes[c]
         v0, v1, v2, w0, w1, w2 = unit_twist(rot, pos, axis, e, nb)
@@ -390,35 +401,35 @@ def _state(j, na):
 
 @njit(cache=True)
 def entries_scratch(n_sets, na, npas, n_body):
-    """Scratch of :func:`pose_entries`: ``(pw, h, hap, kmat, mj, biases, empty)``, world parameters per set,
-    ``H_a``, the passive inertia coupling and ``-hap Phi_p^-1`` per set, ``M (J_b T)``, the closures' bias of
-    each rate vector of the polarization and no rate vector (:func:`motion_state` takes the unit ones)."""
-    return (np.zeros((n_sets, n_body, 10)), np.zeros((n_sets, na, na)), np.zeros((n_sets, na, npas)),
-            np.zeros((n_sets, na, npas)), np.zeros((6, na)), np.zeros((na * (na + 1) // 2, npas)), np.zeros(0))
+    """A zeroed :class:`EntriesScratch`."""
+    return EntriesScratch(np.zeros((n_sets, n_body, 10)), np.zeros((n_sets, na, na)), np.zeros((n_sets, na, npas)),
+                          np.zeros((n_sets, na, npas)), np.zeros((6, na)), np.zeros((na * (na + 1) // 2, npas)),
+                          np.zeros(0))
 
 
 @njit(cache=True, inline="always")
-def pose_entries(tree, loops, params, active, ws, scratch, out):
+def pose_entries(tree, plan, bodies, loops, params, active, ws, scratch, out):
     """Entries (unique H, C, G, eq. 2.44-2.50) at a closed pose whose node poses, ``Phi`` and ``Phi_p^-1`` are in
     ``ws``, for the parameter sets ``params`` (K, 10 B), added into ``out`` (K, E) (zero on entry).
 
-    ``tree``: ``(parent, axis, plan, motion, body_node, paths, gravity)`` (``paths``: :func:`passive_paths`);
-    ``loops``: ``(frame_a, frame_b, row_loop, row_comp, actuated, passive)``; ``scratch``: :func:`entries_scratch`.
+    ``scratch``: :func:`entries_scratch`.
     The velocity terms of a rate vector ``e`` are ``T^T c(q, T e) + hap gamma`` with
     ``gamma = -Phi_p^-1 (Phidot T e)``: the body wrenches at the node motions of ``qdd = 0``
     (:func:`motion_state`) and the closures' bias through ``kmat = -hap Phi_p^-1`` (:func:`passive_inertia`),
     one tree pass per rate vector. ``scratch``'s ``biases`` keep each rate vector's ``Phidot T e``.
     """
-    parent, axis, plan, motion, body_node, paths, gravity = tree
-    frame_a, frame_b, row_loop, row_comp, actuated, passive = loops
-    pw, h, hap, kmat, mj, biases, empty = scratch
-    rot, pos, w, al, ac, pinv, ja, bias, slot = ws[0], ws[1], ws[2], ws[3], ws[4], ws[7], ws[11], ws[12], ws[15]
+    axis = tree.axis
+    body_node, gravity, motion = bodies.body_node, bodies.gravity, bodies.motion
+    actuated, passive = loops.actuated, loops.passive
+    pw, h, hap, kmat, mj, biases, empty = (scratch.pw, scratch.h, scratch.hap, scratch.kmat, scratch.mj, scratch.biases,
+                                           scratch.empty)
+    rot, pos, w, al, ac, pinv, ja, bias, slot = ws.rot, ws.pos, ws.w, ws.al, ws.ac, ws.pinv, ws.ja, ws.bias, ws.slot
     na = actuated.shape[0]
     npas = passive.shape[0]
     n_body = body_node.shape[0]
     n_sets = params.shape[0]
     m = na * (na + 1) // 2
-    reduce_pose(parent, axis, plan, body_node, actuated, passive, ws)
+    reduce_pose(tree, plan, body_node, loops, ws)
     h[:] = 0.0
     hap[:] = 0.0
     for s in range(n_sets):
@@ -427,7 +438,7 @@ def pose_entries(tree, loops, params, active, ws, scratch, out):
         for b in range(n_body):
             if active[b] and body_node[b] >= 0:
                 mass_and_gravity(ja, b, gravity, pw, s, h[s], g, mj, True)
-                passive_inertia(b, body_node, paths, axis, plan, slot, rot, pos, mj, hap[s])
+                passive_inertia(b, bodies, axis, plan, slot, rot, pos, mj, hap[s])
         e = 0
         for i in range(na):
             for j in range(i, na):
@@ -442,7 +453,7 @@ def pose_entries(tree, loops, params, active, ws, scratch, out):
     st = 0
     for j in range(na):
         for k in range(j, na):
-            motion_state(empty, j, k, axis, motion, frame_a, frame_b, row_loop, row_comp, ws)
+            motion_state(empty, j, k, axis, motion, loops, ws)
             for r in range(npas):
                 biases[st, r] = bias[r]
             for s in range(n_sets):
@@ -472,76 +483,68 @@ def pose_entries(tree, loops, params, active, ws, scratch, out):
 
 
 @njit(cache=True)
-def actuated_entries(qs, parent, axis, offset, const_rot, const_pos, plan, motion, body_node, gravity,
-                     frame_a, frame_b, row_loop, row_comp, actuated, passive, paths, params):
+def actuated_entries(qs, tree, plan, bodies, loops, params):
     """Entries (unique H, C, G) in actuated coordinates at closed full poses ``qs`` (P, N) for parameter
-    sets ``params`` (K, 10 B): (P, K, E), and the pivot ratio of ``Phi_p`` per pose (0: singular). ``paths``:
-    :func:`passive_paths`."""
+    sets ``params`` (K, 10 B): (P, K, E), and the pivot ratio of ``Phi_p`` per pose (0: singular)."""
     n_pose, n_dof = qs.shape
-    na = actuated.shape[0]
-    n_body = body_node.shape[0]
+    passive = loops.passive
+    na = loops.actuated.shape[0]
+    n_body = bodies.body_node.shape[0]
     n_sets = params.shape[0]
     m = na * (na + 1) // 2
     out = np.zeros((n_pose, n_sets, m + na * m + na))
     ratios = np.zeros(n_pose)
-    ws = workspace(parent.shape[0], n_dof, na, passive, n_body)
+    ws = workspace(tree.parent.shape[0], n_dof, na, passive, n_body)
     scratch = entries_scratch(n_sets, na, passive.shape[0], n_body)
-    tree = (parent, axis, plan, motion, body_node, paths, gravity)
-    loops = (frame_a, frame_b, row_loop, row_comp, actuated, passive)
     active = active_bodies(params)
     for p in range(n_pose):
-        ratio, _ = factor_pose(qs[p], parent, axis, offset, const_rot, const_pos, plan, frame_a, frame_b, row_loop, row_comp,
-                               passive, ws)
+        ratio, _ = factor_pose(qs[p], tree, plan, loops, ws)
         ratios[p] = ratio
         if ratio != 0.0:
-            pose_entries(tree, loops, params, active, ws, scratch, out[p])
+            pose_entries(tree, plan, bodies, loops, params, active, ws, scratch, out[p])
     return out, ratios
 
 
 @njit(cache=True)
-def motion_entries(path, q_start, sign0, parent, axis, offset, const_rot, const_pos, plan, motion, body_node, gravity,
-                   frame_a, frame_b, row_loop, row_comp, actuated, passive, paths, params, settings):
+def motion_entries(path, q_start, branch, tree, plan, bodies, loops, settings, params):
     """Entries (unique H, C, G, eq. 2.44-2.50) in actuated coordinates along a motion: the actuated poses
     ``path`` (P, n_a) in order, the passive values continued from the closed full pose ``q_start`` on the
-    branch ``sign0`` (as :func:`~hapticdesign.analysis.loops.closure_kernel.solve_path`), for parameter sets
+    branch ``branch`` (as :func:`~hapticdesign.analysis.loops.closure_kernel.solve_path`), for parameter sets
     ``params`` (K, 10 B).
 
-    ``paths``: :func:`passive_paths`; ``settings``: ``(max_step, tol, max_iter, singular_ratio, min_fraction)``
-    of the loop solver. Returns the entries (P, K, E), the per-pose status (OK until the first failure) and
+    Returns the entries (P, K, E), the per-pose status (OK until the first failure) and
     the index of the first failed pose (-1 if none). From the second pose on, a step within ``max_step`` is
     predicted to second order from the last pose, ``dq_p = S dq_a + gamma / 2`` with
     ``gamma = -Phi_p^-1 (Phidot T dq_a)`` (the passive accelerations of the straight actuated segment, from
     the closures' biases that :func:`pose_entries` kept per rate vector, by polarization; the passive rates
-    of eq. 2.38-2.43 and their derivative), and corrected by Newton, which leaves ``Phi``, ``Phi_p^-1`` and
-    the closures' node poses for the entries. A second-order term or a correction above half the step (a
-    jump), a failed Newton or another sign of ``det Phi_p`` hands the pose to ``solve_path`` (tangent
-    predictor, step halving), as does the first pose.
+    of eq. 2.38-2.43 and their derivative), and corrected by the continuation step
+    (:func:`~hapticdesign.analysis.loops.closure_kernel.correct`, bound half the step), which leaves ``Phi``,
+    ``Phi_p^-1`` and the closures' node poses for the entries. A second-order term above half the step or a
+    step ``correct`` refuses hands the pose to ``solve_path`` (tangent predictor, step halving), as does the
+    first pose.
     """
-    max_step, tol, max_iter, singular_ratio, min_fraction = settings
+    actuated, passive = loops.actuated, loops.passive
     n_pose = path.shape[0]
     n_dof = q_start.shape[0]
     na = actuated.shape[0]
     npas = passive.shape[0]
-    n_body = body_node.shape[0]
+    n_body = bodies.body_node.shape[0]
     n_sets = params.shape[0]
     m = na * (na + 1) // 2
     out = np.zeros((n_pose, n_sets, m + na * m + na))
     status = np.zeros(n_pose, dtype=np.int64)
-    ws = workspace(parent.shape[0], n_dof, na, passive, n_body)
+    ws = workspace(tree.parent.shape[0], n_dof, na, passive, n_body)
     scratch = entries_scratch(n_sets, na, npas, n_body)
-    tree = (parent, axis, plan, motion, body_node, paths, gravity)
-    loops = (frame_a, frame_b, row_loop, row_comp, actuated, passive)
     active = active_bodies(params)
-    rot, pos, phi, lu, pinv, t, trig, biases = ws[0], ws[1], ws[5], ws[6], ws[7], ws[8], ws[14], scratch[5]
+    pinv, t, biases = ws.pinv, ws.t, scratch.biases
     q = q_start.copy()
     q_last = np.empty(n_dof)
-    res, rhs, bias = np.empty(npas), np.empty((npas, 1)), np.empty(npas)
-    half_gamma, predicted = np.empty(npas), np.empty(npas)
+    bias, half_gamma = np.empty(npas), np.empty(npas)
     for p in range(n_pose):
         dist = 0.0
         for j in range(na):
             dist = max(dist, abs(path[p, j] - q[actuated[j]]))
-        fast = p > 0 and dist <= max_step
+        fast = p > 0 and dist <= settings.max_step
         if fast:
             for r in range(npas):
                 bias[r] = 0.0
@@ -572,31 +575,21 @@ def motion_entries(path, q_start, sign0, parent, axis, offset, const_rot, const_
                 q[actuated[j]] = path[p, j]
             for r in range(npas):
                 q[passive[r]] += half_gamma[r]
-                predicted[r] = q[passive[r]]
-            code, sign, _ = newton_into(q, actuated, passive, parent, axis, offset, const_rot, const_pos, plan, frame_a,
-                                        frame_b, row_loop, row_comp, tol, max_iter, singular_ratio, rot, pos, trig, res,
-                                        phi, rhs, lu, pinv)
-            fast = code == OK and sign == sign0
-            for r in range(npas):
-                fast = fast and abs(q[passive[r]] - predicted[r]) <= 0.5 * dist + 1e-9
+            fast = correct(q, tree, plan, loops, settings, ws, branch, 0.5 * dist) == OK
             if fast:
-                planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, plan[1], parent.shape[0], rot, pos,
-                              trig)
+                planned_poses(q, tree, plan, plan.n_first, tree.parent.shape[0], ws.rot, ws.pos, ws.trig)
             else:
                 for k in range(n_dof):
                     q[k] = q_last[k]
         if not fast:
-            solved, codes, first = solve_path(path[p:p + 1], q, sign0, actuated, passive, parent, axis, offset,
-                                              const_rot, const_pos, plan, frame_a, frame_b, row_loop, row_comp,
-                                              max_step, tol, max_iter, singular_ratio, min_fraction)
+            solved, codes, first = solve_path(path[p:p + 1], q, branch, tree, plan, loops, settings)
             if first >= 0:
                 status[p] = codes[0]
                 return out, status, p
             for k in range(n_dof):
                 q[k] = solved[0, k]
-            factor_pose(q, parent, axis, offset, const_rot, const_pos, plan, frame_a, frame_b, row_loop, row_comp,
-                        passive, ws)
-        pose_entries(tree, loops, params, active, ws, scratch, out[p])
+            factor_pose(q, tree, plan, loops, ws)
+        pose_entries(tree, plan, bodies, loops, params, active, ws, scratch, out[p])
     return out, status, -1
 
 
@@ -615,19 +608,19 @@ def _body_motion(w, al, ac, nb, rb, out):
 
 
 @njit(cache=True)
-def actuated_regressor(qs, parent, axis, offset, const_rot, const_pos, plan, motion, body_node, gravity,
-                       frame_a, frame_b, row_loop, row_comp, actuated, passive):
+def actuated_regressor(qs, tree, plan, bodies, loops):
     """Regressor of the entries (unique H, C, G) in actuated coordinates at closed full poses ``qs`` (P, N):
     (P, E, 10 B), and the pivot ratio of ``Phi_p`` per pose (0: singular). Body axes throughout."""
     n_pose, n_dof = qs.shape
-    na = actuated.shape[0]
+    body_node, gravity = bodies.body_node, bodies.gravity
+    na = loops.actuated.shape[0]
     n_body = body_node.shape[0]
     m = na * (na + 1) // 2
     n_entries = m + na * m + na
     out = np.zeros((n_pose, n_entries, 10 * n_body))
     ratios = np.zeros(n_pose)
-    ws = workspace(parent.shape[0], n_dof, na, passive, n_body)
-    rot, w, al, ac, ja = ws[0], ws[2], ws[3], ws[4], ws[11]
+    ws = workspace(tree.parent.shape[0], n_dof, na, loops.passive, n_body)
+    rot, w, al, ac, ja = ws.rot, ws.w, ws.al, ws.ac, ws.ja
     jab = np.zeros((n_body, 6, na))
     rb = np.zeros((n_body, 3, 3))
     mb = np.zeros((3, 3))
@@ -637,12 +630,11 @@ def actuated_regressor(qs, parent, axis, offset, const_rot, const_pos, plan, mot
     wrench = np.zeros((6, 10))
     empty = np.zeros(0)
     for p in range(n_pose):
-        ratio, _ = factor_pose(qs[p], parent, axis, offset, const_rot, const_pos, plan, frame_a, frame_b, row_loop, row_comp,
-                               passive, ws)
+        ratio, _ = factor_pose(qs[p], tree, plan, loops, ws)
         ratios[p] = ratio
         if ratio == 0.0:
             continue
-        reduce_pose(parent, axis, plan, body_node, actuated, passive, ws)
+        reduce_pose(tree, plan, body_node, loops, ws)
         for b in range(n_body):
             nb = body_node[b]
             for i in range(3):
@@ -655,7 +647,7 @@ def actuated_regressor(qs, parent, axis, offset, const_rot, const_pos, plan, mot
         st = 0
         for j in range(na):
             for k in range(j, na):
-                velocity_state(empty, j, k, axis, plan, motion, frame_a, frame_b, row_loop, row_comp, passive, ws)
+                velocity_state(empty, j, k, tree.axis, plan, bodies.motion, loops, ws)
                 for b in range(n_body):
                     _body_motion(w, al, ac, body_node[b], rb[b], mb)
                     _wrench_regressor(mb[0], mb[1], mb[2], wrench)

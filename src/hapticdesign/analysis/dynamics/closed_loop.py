@@ -19,21 +19,18 @@ import copy
 import numpy as np
 
 from hapticdesign.analysis.dynamics.actuated_kernel import (
+    Bodies,
     actuated_entries,
     actuated_regressor,
     motion_entries,
     passive_paths,
 )
+from hapticdesign.analysis.configuration import LoopConfiguration
 from hapticdesign.analysis.dynamics.model import DynamicsModel, pair_index
 from hapticdesign.analysis.loops.closure_kernel import SINGULAR
-from hapticdesign.analysis.loops.solver import (
-    MESSAGES,
-    SINGULAR_RATIO,
-    LoopSolver,
-    MotionPlan,
-)
+from hapticdesign.analysis.loops.solver import MESSAGES, SINGULAR_RATIO
 from hapticdesign.errors import UserError
-from hapticdesign.model.mechanism import Mechanism
+from hapticdesign.model.walk import MotionPlan
 
 CHUNK = 4096
 """Poses per kernel call when a regressor (E x n_params per pose) is returned."""
@@ -44,18 +41,21 @@ class ClosedLoopModel(DynamicsModel):
 
     exact_basis = False
 
-    def __init__(self, mechanism: Mechanism):
-        if mechanism.loops is None:
-            raise UserError("ClosedLoopModel needs a mechanism with loops; use DynamicsModel for a tree")
+    def __init__(self, configuration: LoopConfiguration):
+        mechanism = configuration.mechanism
+        self.configuration = configuration
+        """The device's configuration space (:func:`~hapticdesign.analysis.configuration.configuration_of`)."""
         self.mechanism = mechanism
         self.compiled = mechanism.compiled
-        self.solver = LoopSolver(mechanism)
-        a = self.solver.arrays
-        self.motion = MotionPlan.of(self.compiled.tree, [*self.compiled.tree.body_node, *a.frame_a, *a.frame_b])
-        """The nodes whose motions the velocity terms read: the bodies' and the closures'."""
-        self.paths = passive_paths(self.compiled.tree.parent, self.solver.plan.arrays, self.compiled.tree.body_node,
-                                   a.passive)
-        """Per body, the nodes on its path to the base that the passive coordinates move."""
+        self.solver = configuration.solver
+        a, tree = self.solver.closures, self.compiled.tree
+        ptr, nodes = passive_paths(tree.parent, self.solver.plan, tree.body_node, a.passive)
+        self.bodies = Bodies(
+            body_node=tree.body_node, gravity=self.compiled.gravity,
+            motion=MotionPlan.of(tree, [*tree.body_node, *a.frame_a, *a.frame_b]), path_ptr=ptr, path_nodes=nodes,
+        )
+        """The kernels' bodies: their nodes, gravity, the nodes whose motions the velocity terms read (the
+        bodies' and the closures') and per body the nodes on its path to the base the passive coordinates move."""
         self.n_dof = mechanism.n_actuated
         self.n_params = 10 * len(mechanism.bodies)
         self.pairs = pair_index(self.n_dof)
@@ -68,14 +68,12 @@ class ClosedLoopModel(DynamicsModel):
     # -- kernel -------------------------------------------------------------------------------
     def _kernel(self, q_full: np.ndarray, params: np.ndarray | None) -> np.ndarray:
         """Entries for parameter sets (P, S, E), or the regressor (P, E, n_params) when ``params`` is None."""
-        c, a, t = self.compiled, self.solver.arrays, self.compiled.tree
-        args = (np.ascontiguousarray(q_full, dtype=float), t.parent, t.axis, t.offset, t.const_rot, t.const_pos,
-                self.solver.plan.arrays, self.motion.arrays, t.body_node, c.gravity,
-                a.frame_a, a.frame_b, a.row_loop, a.row_comp, a.actuated, a.passive)
+        s, a = self.solver, self.solver.closures
+        args = (np.ascontiguousarray(q_full, dtype=float), s.tree, s.plan, self.bodies, a)
         if params is None:
             out, ratios = actuated_regressor(*args)
         else:
-            out, ratios = actuated_entries(*args, self.paths, np.ascontiguousarray(params, dtype=float))
+            out, ratios = actuated_entries(*args, np.ascontiguousarray(params, dtype=float))
         bad = np.flatnonzero(ratios <= SINGULAR_RATIO)
         if bad.size:
             pose = ", ".join(f"{v:.6g}" for v in q_full[bad[0], a.actuated])
@@ -84,7 +82,7 @@ class ClosedLoopModel(DynamicsModel):
 
     def full_coordinates(self, q: np.ndarray) -> np.ndarray:
         """Actuated poses (n_a,) or a motion (P, n_a) -> closed full coordinates (continued from home)."""
-        out = self.solver.solve(self._poses(q))
+        out = self.configuration.full(self._poses(q))
         return out[0] if np.asarray(q).ndim == 1 else out
 
     def entries_at(self, q_full: np.ndarray, pi: np.ndarray) -> np.ndarray:
@@ -102,12 +100,9 @@ class ClosedLoopModel(DynamicsModel):
         each pose and evaluates its entries (:func:`.actuated_kernel.motion_entries`)."""
         pi = self._params(pi)
         path = np.ascontiguousarray(self._poses(q))
-        c, a, t, s = self.compiled, self.solver.arrays, self.compiled.tree, self.solver
-        out, status, first = motion_entries(
-            path, s.home, s.branch, t.parent, t.axis, t.offset, t.const_rot, t.const_pos, s.plan.arrays,
-            self.motion.arrays, t.body_node, c.gravity, a.frame_a, a.frame_b, a.row_loop, a.row_comp, a.actuated,
-            a.passive, self.paths, np.ascontiguousarray(np.atleast_2d(pi), dtype=float), s.settings,
-        )
+        s = self.solver
+        out, status, first = motion_entries(path, s.home, s.branch, s.tree, s.plan, self.bodies, s.closures, s.settings,
+                                            np.ascontiguousarray(np.atleast_2d(pi), dtype=float))
         if first >= 0:
             pose = ", ".join(f"{v:.6g}" for v in path[first])
             raise UserError(f"at q = ({pose}): {MESSAGES[int(status[first])]}")

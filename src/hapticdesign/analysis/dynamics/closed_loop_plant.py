@@ -5,9 +5,9 @@ motion in the actuated coordinates ``tau_a = H_a qdd_a + c_a(q_a, qd_a) + G_a`` 
 tree reduced by ``T = [I; S]`` (:mod:`.actuated_kernel`), at the passive values that close the loops.
 :func:`closed_loop_terms` gives them inside numba for one parameter set, at one actuated pose and rate:
 
-- the passive values follow by Newton (:func:`hapticdesign.analysis.loops.closure_kernel.newton_into`)
+- the passive values follow by the continuation step (:func:`hapticdesign.analysis.loops.closure_kernel.correct`)
   from a tangent predictor ``q_p + S dq_a`` at the last pose solved, which the workspace carries (a
-  fixed-step integrator moves little between calls, so one or two iterations close the loops);
+  fixed-step integrator moves little between calls, so one or two Newton iterations close the loops);
 - ``H_a`` (n_a x n_a, with the constant reflected rotor inertia), ``c_a = C(q, qd) qd^2`` (the velocity
   terms for the given rates, one tree pass instead of the ``n_a (n_a + 1) / 2`` of eq. 2.50's columns)
   and ``G_a``;
@@ -15,61 +15,82 @@ tree reduced by ``T = [I; S]`` (:mod:`.actuated_kernel`), at the passive values 
   jumped), ``SINGULAR`` (``Phi_p`` singular) or ``BRANCH_CHANGE`` (``det Phi_p`` changed sign). On any
   failure the outputs are left as they were and the workspace keeps the last closed pose.
 
-:class:`ClosedLoopPlant` builds the arrays (``structure``) and the workspace from a
+:class:`ClosedLoopPlant` builds the records (:class:`PlantStructure`, :class:`PlantWorkspace`) from a
 :class:`~.closed_loop.ClosedLoopModel` and starts on the assembly branch at a given actuated pose.
 """
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
 from hapticdesign.analysis.dynamics.actuated_kernel import (
+    Bodies,
     active_bodies,
     body_wrench,
     mass_and_gravity,
     reduce_pose,
     velocity_state,
-    workspace,
     world_parameters,
 )
 from hapticdesign.analysis.dynamics.closed_loop import ClosedLoopModel
 from hapticdesign.analysis.loops import closure_kernel as ck
-from hapticdesign.analysis.loops.solver import MAX_ITER, MESSAGES, SINGULAR_RATIO
+from hapticdesign.analysis.loops.records import Closures, Settings, Workspace, workspace
+from hapticdesign.analysis.loops.solver import MESSAGES
 from hapticdesign.errors import UserError
-from hapticdesign.model.walk import CONSTANT, planned_poses, unit_twist
+from hapticdesign.model.walk import CONSTANT, Tree, WalkPlan, planned_poses, unit_twist
 
 OK, NO_CLOSURE, SINGULAR, BRANCH_CHANGE = ck.OK, ck.NO_CLOSURE, ck.SINGULAR, ck.BRANCH_CHANGE
 
 
-@njit(cache=True)
-def plant_workspace(n_node, n_dof, na, passive, n_body):
-    """Scratch of :func:`closed_loop_terms`: ``(kernel workspace, q, q_last, res, rhs, pp, pw, predicted)``.
+class PlantStructure(NamedTuple):
+    """What :func:`closed_loop_terms` reads: the loop records of the model's solver, its bodies, the branch
+    (sign of ``det Phi_p``), one parameter set ``params`` (1, 10 B), the bodies it moves ``active`` (B,) and
+    the constant inertia added to ``H_a`` (n_a x n_a, the reflected rotor inertia)."""
 
-    ``q`` is the warm start (full coordinates of the last closed pose), ``q_last`` a copy to fall back to.
-    """
-    npas = passive.shape[0]
-    return (
-        workspace(n_node, n_dof, na, passive, n_body), np.zeros(n_dof), np.zeros(n_dof), np.zeros(npas),
-        np.zeros((npas, 1)), np.zeros((npas, npas)), np.zeros((1, n_body, 10)), np.zeros(npas),
-    )
+    tree: Tree
+    plan: WalkPlan
+    bodies: Bodies
+    loops: Closures
+    settings: Settings
+    branch: float
+    params: np.ndarray
+    active: np.ndarray
+    constant: np.ndarray
 
 
-@njit(cache=True)
+class PlantWorkspace(NamedTuple):
+    """Scratch of :func:`closed_loop_terms`: the kernels' :class:`~hapticdesign.analysis.loops.records.Workspace`,
+    the warm start ``q`` (full coordinates of the last closed pose), ``q_last`` a copy to fall back to and the
+    world parameters ``pw`` (1, B, 10)."""
+
+    kernel: Workspace
+    q: np.ndarray
+    q_last: np.ndarray
+    pw: np.ndarray
+
+
+def plant_workspace(n_node: int, n_dof: int, na: int, passive: np.ndarray, n_body: int) -> PlantWorkspace:
+    """A zeroed :class:`PlantWorkspace`."""
+    return PlantWorkspace(workspace(n_node, n_dof, na, passive, n_body), np.zeros(n_dof), np.zeros(n_dof),
+                          np.zeros((1, n_body, 10)))
+
+
+@njit(cache=True, _nrt=False)
 def closed_loop_terms(qa, qda, structure, ws, h, cqd, g):
     """``H_a`` (n_a x n_a), ``c_a = C(q, qd) qd^2`` (n_a) and ``G_a`` (n_a) at actuated ``qa``, rates ``qda``.
 
-    ``structure``: ``(parent, axis, offset, const_rot, const_pos, plan, motion, body_node, gravity, frame_a, frame_b,
-    row_loop, row_comp, actuated, passive, params (1, 10 B), active (B,), constant (n_a x n_a), tol, max_iter,
-    singular_ratio, branch)`` with ``plan`` the arrays of the loop solver's
-    :class:`~hapticdesign.model.walk.WalkPlan` and ``motion`` the model's
-    :class:`~hapticdesign.analysis.loops.solver.MotionPlan`; ``ws``: :func:`plant_workspace`. Returns the status (module
+    ``structure``: :class:`PlantStructure`; ``ws``: :class:`PlantWorkspace`. Returns the status (module
     docstring).
     """
-    (parent, axis, offset, const_rot, const_pos, plan, motion, body_node, gravity, frame_a, frame_b, row_loop, row_comp,
-     actuated, passive, params, active, constant, tol, max_iter, singular_ratio, branch) = structure
-    dyn, q, q_last, res, rhs, pp, pw, predicted = ws
-    rot, pos, w, al, ac, phi, pinv, t, ja, trig = dyn[0], dyn[1], dyn[2], dyn[3], dyn[4], dyn[5], dyn[7], dyn[8], dyn[11], dyn[14]
+    tree, plan, bodies, loops = structure.tree, structure.plan, structure.bodies, structure.loops
+    params, active, constant = structure.params, structure.active, structure.constant
+    dyn, q, q_last, pw = ws.kernel, ws.q, ws.q_last, ws.pw
+    w, al, ac, t, ja = dyn.w, dyn.al, dyn.ac, dyn.t, dyn.ja
+    actuated, passive = loops.actuated, loops.passive
+    body_node = bodies.body_node
     na = actuated.shape[0]
     npas = passive.shape[0]
     dist = 0.0
@@ -82,25 +103,15 @@ def closed_loop_terms(qa, qda, structure, ws, h, cqd, g):
         for r in range(npas):
             q[passive[r]] += t[passive[r], j] * delta
         q[actuated[j]] = qa[j]
-    for r in range(npas):
-        predicted[r] = q[passive[r]]
-    status, sign, _ = ck.newton_into(q, actuated, passive, parent, axis, offset, const_rot, const_pos, plan, frame_a,
-                                     frame_b, row_loop, row_comp, tol, max_iter, singular_ratio, rot, pos, trig, res,
-                                     phi, rhs, pp, pinv)
-    if status == OK and sign != branch:
-        status = BRANCH_CHANGE
-    if status == OK:
-        for r in range(npas):
-            if abs(q[passive[r]] - predicted[r]) > 0.5 * dist + 1e-9:
-                status = NO_CLOSURE
+    status = ck.correct(q, tree, plan, loops, structure.settings, dyn, structure.branch, 0.5 * dist)
     if status != OK:
         for k in range(q.shape[0]):
             q[k] = q_last[k]
         return status
     # Newton left Phi, Phi_p^-1 and the closures' node poses at q: the other nodes complete factor_pose
-    planned_poses(q, parent, axis, offset, const_rot, const_pos, plan, plan[1], parent.shape[0], rot, pos, trig)
-    reduce_pose(parent, axis, plan, body_node, actuated, passive, dyn)
-    world_parameters(rot, body_node, params, 0, pw)
+    planned_poses(q, tree, plan, plan.n_first, tree.parent.shape[0], dyn.rot, dyn.pos, dyn.trig)
+    reduce_pose(tree, plan, body_node, loops, dyn)
+    world_parameters(dyn.rot, body_node, params, 0, pw)
     for i in range(na):
         g[i] = 0.0
         cqd[i] = 0.0
@@ -108,8 +119,8 @@ def closed_loop_terms(qa, qda, structure, ws, h, cqd, g):
             h[i, j] = constant[i, j]
     for b in range(body_node.shape[0]):
         if active[b] and body_node[b] >= 0:
-            mass_and_gravity(ja, b, gravity, pw, 0, h, g, h, False)
-    velocity_state(qda, -1, -1, axis, plan, motion, frame_a, frame_b, row_loop, row_comp, passive, dyn)
+            mass_and_gravity(ja, b, bodies.gravity, pw, 0, h, g, h, False)
+    velocity_state(qda, -1, -1, tree.axis, plan, bodies.motion, loops, dyn)
     for b in range(body_node.shape[0]):
         nb = body_node[b]
         if not active[b] or nb < 0:
@@ -128,7 +139,7 @@ class ClosedLoopPlant:
     """
 
     def __init__(self, model: ClosedLoopModel, pi: np.ndarray, q_a0: np.ndarray):
-        solver, c, a, tree = model.solver, model.compiled, model.solver.arrays, model.compiled.tree
+        solver, tree = model.solver, model.compiled.tree
         params = np.ascontiguousarray(np.atleast_2d(model._params(pi)), dtype=float)
         if params.shape[0] != 1:
             raise UserError("a plant takes one set of standard inertial parameters")
@@ -138,14 +149,13 @@ class ClosedLoopPlant:
             iu, ju = np.triu_indices(n)
             constant[iu, ju] = constant[ju, iu] = model.constant[model.slice_h]
         self.n_dof = n
-        self.structure = (
-            tree.parent, tree.axis, tree.offset, tree.const_rot, tree.const_pos, solver.plan.arrays,
-            model.motion.arrays, tree.body_node, c.gravity,
-            a.frame_a, a.frame_b, a.row_loop, a.row_comp, a.actuated, a.passive, params, active_bodies(params),
-            constant, float(solver.tol), int(MAX_ITER), float(SINGULAR_RATIO), float(solver.branch),
+        self.structure = PlantStructure(
+            tree=solver.tree, plan=solver.plan, bodies=model.bodies, loops=solver.closures, settings=solver.settings,
+            branch=float(solver.branch), params=params, active=active_bodies(params), constant=constant,
         )
-        self.workspace = plant_workspace(len(tree.parent), solver.n_dof, n, a.passive, len(tree.body_node))
-        self.workspace[1][:] = solver.solve(q_a0)
+        self.workspace = plant_workspace(len(tree.parent), solver.n_dof, n, solver.closures.passive,
+                                         len(tree.body_node))
+        self.workspace.q[:] = solver.solve(q_a0)
         self.terms(q_a0, np.zeros(n))  # T at the start pose, for the first tangent predictor
 
     def terms(self, q_a: np.ndarray, qd_a: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -161,7 +171,7 @@ class ClosedLoopPlant:
     @property
     def q_full(self) -> np.ndarray:
         """Full coordinates of the last closed pose (the warm start)."""
-        return self.workspace[1].copy()
+        return self.workspace.q.copy()
 
 
 @njit(cache=True)
@@ -172,8 +182,7 @@ def handle_along(ws, parent, axis, node, direction, jn, want_jn):
 
     ``J_v T`` is summed over the variable nodes from the handle to the base with each node's joint-value rate
     per actuated rate (``coef T``, which :func:`closed_loop_terms` leaves in the workspace)."""
-    dyn = ws[0]
-    rot, pos, node_t = dyn[0], dyn[1], dyn[9]
+    rot, pos, node_t = ws.kernel.rot, ws.kernel.pos, ws.kernel.node_t
     x = direction[0] * pos[node, 0] + direction[1] * pos[node, 1] + direction[2] * pos[node, 2]
     if not want_jn:
         return x

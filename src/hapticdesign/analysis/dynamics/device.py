@@ -14,18 +14,19 @@ from functools import lru_cache
 
 import numpy as np
 
+from hapticdesign.analysis.configuration import configuration_for
 from hapticdesign.analysis.dynamics.closed_loop import ClosedLoopModel
 from hapticdesign.analysis.dynamics.kernel import regressor_kernel
 from hapticdesign.analysis.dynamics.model import DynamicsModel
 from hapticdesign.errors import UserError
-from hapticdesign.model.device import Device, MechanismBuilder, build_mechanism
+from hapticdesign.model.device import Device, MechanismBuilder
 from hapticdesign.model.mechanism import Mechanism
 
 
 def dynamics_of(device: Device) -> DynamicsModel:
-    """The compiled regressor model of the device's equations of motion (cached per geometry)."""
-    kind = ClosedLoopModel if device.mechanism.loops is not None else DynamicsModel
-    base = _model(kind, device.builder, device.kinematic_values())
+    """The compiled regressor model of the device's equations of motion (cached per geometry; a closed-loop
+    device's takes its configuration space, :func:`~hapticdesign.analysis.configuration.configuration_of`)."""
+    base = _model(device.builder, device.kinematic_values())
     if not device.actuators:
         return base
     extra = device.reflected_inertia
@@ -81,8 +82,9 @@ def forward_dynamics(device: Device, q: np.ndarray, qd: np.ndarray, tau: np.ndar
 
 
 @lru_cache(maxsize=16)
-def _model(cls, builder: MechanismBuilder, kinematic: tuple[tuple[str, float], ...]):
-    return cls(build_mechanism(builder, kinematic))
+def _model(builder: MechanismBuilder, kinematic: tuple[tuple[str, float], ...]):
+    space = configuration_for(builder, kinematic)
+    return DynamicsModel(space.mechanism) if space.is_tree else ClosedLoopModel(space)
 
 
 @lru_cache(maxsize=16)

@@ -95,7 +95,7 @@ def quadrature_form(model, region: Region | None = None, weights: Weights | None
     for per_panel in LEVELS:
         poses, w = quadrature_poses(box, per_panel)
         try:
-            q_full = model.full_coordinates(poses)
+            q_full = model.configuration.full(poses)
         except UserError as exc:
             raise InputError(f"LN region {region.describe(model.mechanism.actuated_coordinates)}: {exc} "
                              "(give joint limits or a region inside the workspace)", "region") from None

@@ -32,6 +32,7 @@ from dataclasses import replace
 import numpy as np
 from scipy.linalg import block_diag
 
+from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.analysis.kinematics import jacobian
 from hapticdesign.analysis.loops.solver import LoopSolver
 from hapticdesign.analysis.stiffness import vjm
@@ -110,14 +111,6 @@ def _link_compliance(mech: Mechanism, link: ElasticLink, q: np.ndarray) -> np.nd
     return T @ np.linalg.inv(beam_stiffness(link.axial, link.bending, link.torsion, length)) @ T.T
 
 
-def full_coordinates(mech: Mechanism, q_a) -> np.ndarray:
-    """Every joint's value at actuated coordinates ``q_a`` (passive joints solved on the assembly branch)."""
-    q_a = np.asarray(q_a, dtype=float)
-    if q_a.shape != (mech.n_actuated,) or not np.all(np.isfinite(q_a)):
-        raise UserError(f"expected {mech.n_actuated} finite actuated joint coordinates, got {q_a.tolist()}")
-    return q_a if mech.loops is None else LoopSolver(mech).solve(q_a)
-
-
 def cartesian_stiffness(device: Device, q_a, frame: str | None = None) -> np.ndarray:
     """``K_C`` (6 x 6) of ``frame`` (default: the end effector) at actuated coordinates ``q_a``
     (see the module docstring)."""
@@ -130,7 +123,10 @@ def cartesian_stiffness(device: Device, q_a, frame: str | None = None) -> np.nda
     if frame is None:
         raise UserError(f"device {device.name} names no end-effector frame")
     check_elasticity(mech, elasticity)
-    q = full_coordinates(mech, q_a)
+    q_a = np.asarray(q_a, dtype=float)
+    if q_a.shape != (mech.n_actuated,) or not np.all(np.isfinite(q_a)):
+        raise UserError(f"expected {mech.n_actuated} finite actuated joint coordinates, got {q_a.tolist()}")
+    q = configuration_of(device).full(q_a)
     virtual = virtual_mechanism(mech, elasticity)
     q_virtual = np.concatenate([q, np.zeros(virtual.n_dof - mech.n_dof)])
     rows = jacobian(virtual, q_virtual, frame)

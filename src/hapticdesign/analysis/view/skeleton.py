@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hapticdesign.analysis.dynamics.device import dynamics_of
+from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.device import Device
 from hapticdesign.model.mechanism import JointType
@@ -45,8 +45,7 @@ class Slider:
 def home_pose(device: Device) -> np.ndarray:
     """Actuated coordinates of the home pose: a loop device's ``home``, else zeros; moved to the middle of a
     joint's limits where the value lies outside them."""
-    loops = device.mechanism.loops
-    q = np.array(loops.home, dtype=float) if loops is not None else np.zeros(device.n_dof)
+    q = configuration_of(device).home.copy()
     for k, span in enumerate(device.joint_limits()):
         if span is not None and not span[0] <= q[k] <= span[1]:
             q[k] = 0.5 * (span[0] + span[1])
@@ -68,22 +67,14 @@ def sliders(device: Device, q: np.ndarray) -> list[Slider]:
 
 def actuated_names(device: Device) -> tuple[str, ...]:
     """Names of the actuated coordinates (all coordinates of a tree)."""
-    mech = device.mechanism
-    return mech.coordinates if mech.loops is None else mech.actuated_coordinates
-
-
-def full_coordinates(device: Device, q: np.ndarray) -> np.ndarray:
-    """Every tree coordinate for actuated values ``q``: passive joints solved on the assembly branch."""
-    if device.mechanism.loops is None:
-        return np.asarray(q, dtype=float)
-    return dynamics_of(device).full_coordinates(np.asarray(q, dtype=float))
+    return configuration_of(device).names
 
 
 def frame_poses(device: Device, q: np.ndarray) -> dict[str, np.ndarray]:
     """World pose (4x4) of every frame, ``base`` included, at actuated coordinates ``q``."""
     tree = device.mechanism.compiled.tree
     rot, pos = tree.workspace()
-    q = np.ascontiguousarray(full_coordinates(device, q), dtype=float)
+    q = np.ascontiguousarray(configuration_of(device).full(q), dtype=float)
     node_poses(q, *tree.arrays, len(tree.parent) - 1, rot, pos)
     poses = {}
     for name, node in tree.frame_node.items():
@@ -135,7 +126,7 @@ def export(device: Device, q: np.ndarray) -> dict:
     return {
         "name": device.name,
         "sliders": [{**s.__dict__, "coordinate": actuated[s.index]} for s in sliders(device, q)],
-        "full": [float(v) for v in full_coordinates(device, q)],
+        "full": [float(v) for v in configuration_of(device).full(q)],
         "passive": [] if loops is None else [int(k) for k in loops.passive],
         "closures": [] if loops is None else [[c.frames[0], c.frames[1], [int(v) for v in c.components]]
                                                for c in loops.closures],

@@ -14,8 +14,8 @@ import numpy as np
 import typer
 
 from hapticdesign.analysis.dynamics.cartesian import cartesian_inertia
-from hapticdesign.analysis.dynamics.device import dynamics_of, mass_matrix
-from hapticdesign.analysis.kinematics import actuated_jacobian
+from hapticdesign.analysis.dynamics.device import mass_matrix
+from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.analysis.metrics import dynamic, kinematic, names
 from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
@@ -34,7 +34,7 @@ def task_jacobian(device: Device, q: np.ndarray) -> np.ndarray:
     (planar devices): the translational rows projected on the plane (or line) of motion, i.e. on
     the leading left singular vectors, which leaves every metric unchanged by the choice of axes.
     """
-    full = actuated_jacobian(device.mechanism, q, solver=getattr(dynamics_of(device), "solver", None))
+    full = configuration_of(device).jacobian(q)
     n = device.n_dof
     if n == 3:
         return full[:3]

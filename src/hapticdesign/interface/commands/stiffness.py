@@ -52,12 +52,12 @@ def stiffness(
 ) -> None:
     """Cartesian stiffness K_C of a device's end effector by the virtual joint method (seed 001 eq. 5.98-5.123):
     elastic links and joint springs from the device file, passive joints free, loops closed."""
+    from hapticdesign.analysis.configuration import configuration_of
     from hapticdesign.analysis.stiffness.device import cartesian_stiffness, deflection
 
     with user_errors(quiet=quiet):
         dev = resolve_device(preset, device, params, strict=strict)
-        loops = dev.mechanism.loops
-        qv = parse_vector(q, dev.n_dof, "q") if q is not None else np.array(loops.home if loops else [0.0] * dev.n_dof)
+        qv = parse_vector(q, dev.n_dof, "q") if q is not None else configuration_of(dev).home
         for message in dev.limit_warnings(qv):
             note(f"warning: {message}", quiet)
         if frame is not None and frame not in dev.mechanism.compiled.frame_node:
