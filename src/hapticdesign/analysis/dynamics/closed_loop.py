@@ -97,15 +97,16 @@ class ClosedLoopModel(DynamicsModel):
     def entries(self, q: np.ndarray, pi: np.ndarray) -> np.ndarray:
         """All entries (unique H, C, G) at actuated poses, a motion continued from home (as
         :meth:`full_coordinates`): (P, E) or (S, P, E) for parameter sets (S, n); one compiled pass that solves
-        each pose and evaluates its entries (:func:`.actuated_kernel.motion_entries`)."""
+        each pose and evaluates its entries (:func:`.actuated_kernel.motion_entries`). Where the continuation
+        fails, the poses are closed by the solver, which tries other paths and says what failed
+        (:meth:`~hapticdesign.analysis.loops.solver.LoopSolver.solve`), and the entries evaluated there."""
         pi = self._params(pi)
         path = np.ascontiguousarray(self._poses(q))
         s = self.solver
         out, status, first = motion_entries(path, s.home, s.branch, s.tree, s.plan, self.bodies, s.closures, s.settings,
                                             np.ascontiguousarray(np.atleast_2d(pi), dtype=float))
         if first >= 0:
-            pose = ", ".join(f"{v:.6g}" for v in path[first])
-            raise UserError(f"at q = ({pose}): {MESSAGES[int(status[first])]}")
+            return self.entries_at(s.solve(path), pi)
         if self.constant is not None:
             out += self.constant
         return out[:, 0, :] if pi.ndim == 1 else np.moveaxis(out, 1, 0)

@@ -35,7 +35,9 @@ from hapticdesign.analysis.loops.records import workspace
 from hapticdesign.model.dense import lu_in_place
 from hapticdesign.model.walk import planned_poses, unit_twist
 
-OK, NO_CLOSURE, SINGULAR, BRANCH_CHANGE = 0, 1, 2, 3
+OK, NO_CLOSURE, SINGULAR, BRANCH_CHANGE, ILL_CONDITIONED = 0, 1, 2, 3, 4
+POLISH = 3
+"""Newton iterations past the closure tolerance, at most, to bring the error bound within the accuracy."""
 MAX_NEWTON_STEP = 0.25
 """Largest Newton update of a passive coordinate per iteration (rad or m)."""
 JUMP_SLACK = 1e-9
@@ -159,12 +161,20 @@ def newton_into(q, tree, plan, loops, settings, ws):
     constraint Jacobian and ``ws.pinv`` ``Phi_p^-1`` at the returned ``q`` (the last iteration factors
     ``Phi_p`` for the inverse instead of a Newton step). The pivot ratio estimates the reciprocal condition
     number of ``Phi_p`` (:func:`hapticdesign.model.dense.lu_in_place`).
+
+    **Trust.** A residual ``r`` leaves the passive coordinates off by up to ``|r| / sigma_min`` and ``T`` (so
+    H, C, G) off by about ``sigma_max |r| / sigma_min^2`` relative, with the singular values of ``Phi_p``
+    estimated by its pivots. Near a singular configuration that bound exceeds ``settings.accuracy`` although
+    the residual meets the tolerance: Newton then polishes (at most :data:`POLISH` more iterations, the
+    residual falling to its rounding floor ``settings.floor``), and a pose whose bound stays above the
+    accuracy is ``ILL_CONDITIONED``: refused rather than returned wrong.
     """
     passive = loops.passive
     rot, pos, trig, res, phi, rhs, pp, pinv = ws.rot, ws.pos, ws.trig, ws.res, ws.phi, ws.rhs, ws.lu, ws.pinv
     m = passive.shape[0]
     n_first, n_still = plan.n_first, plan.n_still
-    for it in range(settings.max_iter + 1):
+    polished = 0
+    for it in range(settings.max_iter + POLISH + 1):
         # a Newton step moves only passive coordinates: the nodes they do not move stay where they were
         planned_poses(q, tree, plan, 0 if it == 0 else n_still, n_first, rot, pos, trig)
         closure_residual(loops, rot, pos, res)
@@ -185,8 +195,21 @@ def newton_into(q, tree, plan, loops, settings, ws):
         if not np.isfinite(ratio) or ratio <= settings.singular_ratio:
             return SINGULAR, sign, ratio
         if closed:
-            return OK, sign, ratio
-        if it == settings.max_iter:
+            small = 0.0  # the LU keeps the pivots' reciprocals on its diagonal
+            for i in range(m):
+                small = max(small, abs(pp[i, i]))
+            if max(big, settings.floor) * small / ratio <= settings.accuracy:
+                return OK, sign, ratio
+            if polished == POLISH or big <= settings.floor:
+                return ILL_CONDITIONED, sign, ratio
+            polished += 1
+            for j in range(m):  # a Newton step with the inverse just formed
+                step = 0.0
+                for i in range(m):
+                    step -= pinv[j, i] * res[i]
+                q[passive[j]] += step
+            continue
+        if it >= settings.max_iter:
             break
         # damped: at most MAX_NEWTON_STEP per iteration, so that a rough start reaches its nearest branch
         big = 0.0

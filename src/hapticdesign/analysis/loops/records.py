@@ -48,14 +48,17 @@ class Closures(NamedTuple):
 
 class Settings(NamedTuple):
     """The loop solver's settings: largest continuation step (actuated infinity norm, rad or m), closure
-    tolerance, Newton iterations, the pivot ratio of ``Phi_p`` below which it is singular, and the
-    smallest continuation step as a fraction of a segment."""
+    tolerance, Newton iterations, the pivot ratio of ``Phi_p`` below which it is singular, the smallest
+    continuation step as a fraction of a segment, the relative error bound above which a closed pose is
+    not trusted, and the rounding floor of the closure residual (m)."""
 
     max_step: float
     tol: float
     max_iter: int
     singular_ratio: float
     min_fraction: float
+    accuracy: float
+    floor: float
 
 
 class Workspace(NamedTuple):

@@ -36,11 +36,18 @@ SINGULAR_RATIO = 1e-9
 """Pivot ratio ``min |u_ii| / max |u_ii|`` of ``Phi_p`` below which the constraint Jacobian is singular."""
 MIN_FRACTION = 1e-7
 """Smallest step, as a fraction of a segment, before continuation gives up."""
+ACCURACY = 1e-7
+"""Largest estimated relative error of ``T`` (so of H and G; C's is a few times larger) at a closed pose:
+beyond it the pose is refused as too close to a singular configuration (results stay within about 1e-6)."""
+ROUNDING = 2.2e-16
+"""Machine epsilon: the closure residual cannot fall below about this times the device's size."""
 
 MESSAGES = {
     ck.NO_CLOSURE: "the loops cannot close (outside the workspace the assembly branch reaches)",
     ck.SINGULAR: "the constraint Jacobian of the loops is singular there (a singular configuration)",
     ck.BRANCH_CHANGE: "the motion leaves the assembly branch (det of the constraint Jacobian changes sign)",
+    ck.ILL_CONDITIONED: "too close to a singular configuration for results within 1e-6 (the constraint Jacobian "
+                        "is nearly singular)",
 }
 
 
@@ -66,7 +73,8 @@ class LoopSolver:
         self.n_actuated = mechanism.n_actuated
         lengths = np.abs(self.compiled.node_offset[self.compiled.node_axis >= 3])
         self.tol = 1e-12 * max(float(lengths.max(initial=0.0)), 1e-3)
-        self.settings = Settings(MAX_STEP, self.tol, MAX_ITER, SINGULAR_RATIO, MIN_FRACTION)
+        self.settings = Settings(MAX_STEP, self.tol, MAX_ITER, SINGULAR_RATIO, MIN_FRACTION, ACCURACY,
+                                 ROUNDING * self.tol / 1e-12)
         loops = mechanism.loops
         q = np.zeros(self.n_dof)
         q[self.closures.actuated] = loops.home
@@ -105,16 +113,84 @@ class LoopSolver:
         """
         q_a = self._actuated(q_a)
         path = np.ascontiguousarray(np.atleast_2d(q_a))
-        out, status, first = ck.solve_path(
-            path, np.asarray(self.home if start is None else start, dtype=float), self.branch, self.tree, self.plan,
-            self.closures, self.settings,
-        )
+        begin = np.asarray(self.home if start is None else start, dtype=float)
+        out, status, first = ck.solve_path(path, begin, self.branch, self.tree, self.plan, self.closures, self.settings)
         if not strict:
             return (out[0] if q_a.ndim == 1 else out), (status[0] if q_a.ndim == 1 else status)
-        if first >= 0:
-            pose = ", ".join(f"{v:.6g}" for v in path[first])
-            raise UserError(f"at q = ({pose}): {MESSAGES[int(status[first])]}")
+        while first >= 0:
+            reached = self.detour(path[first], out[first - 1] if first > 0 else begin)
+            if reached is None:
+                raise UserError(self.explain(path[first], int(status[first])))
+            out[first] = reached
+            if first + 1 == len(path):
+                break
+            rest, status_rest, again = ck.solve_path(path[first + 1:], reached, self.branch, self.tree, self.plan,
+                                                     self.closures, self.settings)
+            out[first + 1:] = rest
+            status[first + 1:] = status_rest
+            first = -1 if again < 0 else first + 1 + again
         return out[0] if q_a.ndim == 1 else out
+
+    def detour(self, target: np.ndarray, start: np.ndarray) -> np.ndarray | None:
+        """The closed pose at actuated ``target`` reached from the closed ``start`` another way than the straight
+        segment, or None: joint by joint (each actuated coordinate in turn, in both orders), continued as any
+        motion (on the assembly branch, within the accuracy). Newton straight from ``start`` is not a way: it
+        may land on another assembly mode with the same sign of ``det Phi_p``."""
+        start = np.asarray(start, dtype=float)
+        begin = start[self.closures.actuated]
+        for order in (range(self.n_actuated), reversed(range(self.n_actuated))):
+            waypoints, point = [], begin.copy()
+            for j in order:
+                point = point.copy()
+                point[j] = target[j]
+                waypoints.append(point)
+            out, _, first = ck.solve_path(np.array(waypoints), start, self.branch, self.tree, self.plan, self.closures,
+                                          self.settings)
+            if first < 0:
+                return out[-1]
+        return None
+
+    def explain(self, target: np.ndarray, status: int) -> str:
+        """One line on why ``target`` (actuated) cannot be returned: the pose itself (no closure on the branch, a
+        singular or nearly singular constraint Jacobian, with its distance from the singularity), or only the
+        paths to it."""
+        pose = ", ".join(f"{v:.6g}" for v in target)
+        q = self.home.copy()
+        q[self.closures.actuated] = target
+        loose = self.settings._replace(accuracy=np.inf, tol=10 * self.settings.floor, max_iter=60)
+        code, sign, _ = ck.newton(q, self.tree, self.plan, self.closures, loose)
+        if code != ck.OK:
+            return f"at q = ({pose}): {MESSAGES[status if status != ck.ILL_CONDITIONED else code]}"
+        if sign != self.branch:
+            return (f"at q = ({pose}): the loops close there only on another assembly branch (det of the constraint "
+                    "Jacobian of the other sign than at home)")
+        sigma = self._singular_values(q)
+        bound = self.settings.floor * sigma[0] / sigma[-1] ** 2
+        if bound > self.settings.accuracy:
+            return (f"at q = ({pose}): too close to a singular configuration for results within 1e-6: the constraint "
+                    f"Jacobian's singular values are {sigma[-1]:.3g} and {sigma[0]:.3g} (estimated relative error "
+                    f"{bound:.1g}), about {self._distance(q, loose, sigma[-1]):.2g} (rad or m, actuated coordinates) from a singular pose")
+        return (f"at q = ({pose}): the pose closes on the assembly branch, but the paths tried from home (straight, "
+                "joint by joint) cross a singular configuration or leave the workspace; move there in steps that "
+                "avoid them")
+
+    def _singular_values(self, q: np.ndarray) -> np.ndarray:
+        """Singular values of ``Phi_p`` at the full pose ``q``, largest first."""
+        return np.linalg.svd(self.constraint_jacobian(q)[:, self.closures.passive], compute_uv=False)
+
+    def _distance(self, q: np.ndarray, settings, sigma: float) -> float:
+        """Distance (actuated infinity norm, rad or m) to where ``Phi_p`` is singular, from its smallest singular
+        value over that value's gradient (finite differences of 1e-7 between poses closed to rounding): the singular
+        value falls linearly there."""
+        grad = np.zeros(self.n_actuated)
+        for j in range(self.n_actuated):
+            shifted = q.copy()
+            shifted[self.closures.actuated[j]] += 1e-7
+            code, _, _ = ck.newton(shifted, self.tree, self.plan, self.closures, settings)
+            if code != ck.OK:
+                return 0.0
+            grad[j] = (self._singular_values(shifted)[-1] - sigma) / 1e-7
+        return sigma / max(float(np.abs(grad).sum()), 1e-300)
 
     def residual(self, q: np.ndarray) -> np.ndarray:
         """Closure residual ``phi`` (m,) at full coordinates ``q`` (N,)."""
