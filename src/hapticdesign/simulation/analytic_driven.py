@@ -71,12 +71,21 @@ def row_terms(device: Device, w: int, q: np.ndarray, qd: np.ndarray, qdd: np.nda
     model, pi = dynamics_of(device), device.standard_parameters()
     s_h, s_c, s_g = switches
 
+    n = model.n_dof
+    packed = {pair: col for col, pair in enumerate(zip(*np.triu_indices(n)))}
+    h_cols = [packed[min(w, j), max(w, j)] for j in range(n)]
+
     def terms(poses: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``H_w.``, ``Gamma_w..`` and the row's torque at the poses."""
-        h, g = model.H(poses, pi)[:, w], model.G(poses, pi)[:, w]
-        christoffel = model.christoffel(poses, pi)[:, w]
+        """``H_w.``, ``Gamma_w..`` and the row's torque at the poses, from one evaluation of the entries."""
+        entries = model.entries(poses, pi)
+        h = entries[:, model.slice_h][:, h_cols]
+        c = entries[:, model.slice_c].reshape(len(poses), n, len(model.pairs))[:, w]
+        christoffel = np.zeros((len(poses), n, n))
+        for col, (j, k) in enumerate(model.pairs):
+            christoffel[:, j, k] += 0.5 * c[:, col]
+            christoffel[:, k, j] += 0.5 * c[:, col]
         coriolis = np.einsum("pjk,pj,pk->p", christoffel, qd, qd)
-        return h, christoffel, s_h * np.einsum("pj,pj->p", h, qdd) + s_c * coriolis + s_g * g
+        return h, christoffel, s_h * np.einsum("pj,pj->p", h, qdd) + s_c * coriolis + s_g * entries[:, model.slice_g][:, w]
 
     h, christoffel, rho = terms(q)
     gamma = s_c * 2.0 * np.einsum("pk,pk->p", christoffel[:, w], qd)

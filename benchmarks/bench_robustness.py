@@ -1,0 +1,96 @@
+"""The modelling-error study of docs/simulation.md (issue 25): type 2, several seeded draws per design.
+
+Designs by the Linearity Number engine (Table 3.3 levels, ``--count`` per level, seed 1, rigid-body
+realizable, as the campaign's); masses and inertias of the compensator's model wrong by E percent with
+random signs, ``--draws`` draws per design (:func:`hapticdesign.simulation.robustness.error_cases`,
+analytic type 2), summarized per LN level with 95 % confidence intervals.
+
+    python benchmarks/bench_robustness.py [--count 10] [--draws 5]
+    python benchmarks/bench_robustness.py --write docs/simulation.md     # replace the block there
+    python benchmarks/bench_robustness.py --check docs/simulation.md     # exit 1 when it drifted
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import tempfile
+from pathlib import Path
+
+from hapticdesign.devices.registry import preset
+from hapticdesign.interface.commands.linearity_adapter import write_design_set
+from hapticdesign.simulation.campaign import read_designs
+from hapticdesign.simulation.robustness import error_cases, summarize_errors
+
+LEVELS = "0,0.001,0.01,0.1,1,2"
+ERRORS = [0.0, 1.0, 5.0]
+NAME = "robustness-study"
+
+
+def _ci(row: dict, key: str, low: str, high: str, digits: int = 2) -> str:
+    if row[key] is None:
+        return "-"
+    if row[low] is None:
+        return f"{row[key]:+.{digits}f}"
+    return f"{row[key]:+.{digits}f} ({row[low]:+.{digits}f} to {row[high]:+.{digits}f})"
+
+
+def study(count: int, draws: int, seed: int) -> str:
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "designs.csv"
+        write_design_set("phantom-3dof", None, None, False, LEVELS, count, 1, path, "fast", "rigid-body")
+        designs = read_designs(path)
+    base = preset("phantom-3dof")
+    devices = [(d.name, d.level, base.with_params(d.params)) for d in designs]
+    cases = error_cases(devices, ERRORS, seed, sim_type=2, draws=draws)
+    rows = summarize_errors(cases)
+    lines = [f"Type 2, analytic, {count} designs per level, {draws} sign draws per design and error (seed {seed}; "
+             f"`python benchmarks/bench_robustness.py --count {count} --draws {draws} --seed {seed}`); changes of "
+             "K_max from the same design without error in N m/rad, means with their 95 % confidence intervals; "
+             "c = H_model,11 / H_11 at the start:", "",
+             "| LN | E [%] | cases | K_max | abs. change | c < 1: cases, change | c > 1: cases, change | c > 1: K_max = 0 "
+             "| rank corr. of abs. change with abs(1 - c) |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        if r["error_percent"] == 0:
+            lines.append(f"| {r['level']:g} | 0 | {r['n']} | {_ci(r, 'mean', 'mean_ci_low', 'mean_ci_high')} "
+                         "| - | - | - | - | - |")
+            continue
+        zero = "-" if r["over_to_zero_share"] is None else f"{100 * r['over_to_zero_share']:.0f} %"
+        rho = "-" if r["spearman_abs_change_vs_abs_1_minus_c"] is None else \
+            f"{r['spearman_abs_change_vs_abs_1_minus_c']:.2f}"
+        lines.append(f"| {r['level']:g} | {r['error_percent']:g} | {r['n']} "
+                     f"| {_ci(r, 'mean', 'mean_ci_low', 'mean_ci_high')} "
+                     f"| {_ci(r, 'mean_absolute_change', 'absolute_change_ci_low', 'absolute_change_ci_high')} "
+                     f"| {r['under_n']}: {_ci(r, 'under_change', 'under_ci_low', 'under_ci_high')} "
+                     f"| {r['over_n']}: {_ci(r, 'over_change', 'over_ci_low', 'over_ci_high')} | {zero} | {rho} |")
+    return "\n".join(lines)
+
+
+def replace_block(text: str, block: str) -> str:
+    start, end = f"<!-- {NAME}:start -->", f"<!-- {NAME}:end -->"
+    head, rest = text.split(start, 1)
+    _, tail = rest.split(end, 1)
+    return f"{head}{start}\n{block}\n{end}{tail}"
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--count", type=int, default=10, help="designs per LN level")
+    parser.add_argument("--draws", type=int, default=5, help="error-sign draws per design and error level")
+    parser.add_argument("--seed", type=int, default=1, help="seed of the error signs")
+    parser.add_argument("--write", type=Path, default=None)
+    parser.add_argument("--check", type=Path, default=None)
+    args = parser.parse_args(argv)
+    block = study(args.count, args.draws, args.seed)
+    print(block)
+    if args.write is not None:
+        args.write.write_text(replace_block(args.write.read_text(), block))
+    if args.check is not None and replace_block(args.check.read_text(), block) != args.check.read_text():
+        print(f"the modelling-error table in {args.check} drifted", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
