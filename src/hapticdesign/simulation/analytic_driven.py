@@ -38,7 +38,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from hapticdesign.analysis.dynamics.device import dynamics_of
-from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation.paths import Path, Sine
 
@@ -248,9 +247,3 @@ class DrivenLoop:
                     return math.inf
         return float(np.max(np.abs(np.linalg.eigvals(monodromy))))
 
-
-def require_joint_wall(config, device: Device) -> None:
-    """The time-varying analysis covers a joint wall of an open chain without a hand."""
-    if config.wall.cartesian or config.hand is not None or device.mechanism.loops is not None:
-        raise UserError("the analytic type 2 covers a joint wall of an open chain without a hand: "
-                        "use the simulation for a Cartesian wall, a hand or a closed-loop device")
