@@ -84,7 +84,8 @@ def row_terms(device: Device, w: int, q: np.ndarray, qd: np.ndarray, qdd: np.nda
             christoffel[:, j, k] += 0.5 * c[:, col]
             christoffel[:, k, j] += 0.5 * c[:, col]
         coriolis = np.einsum("pjk,pj,pk->p", christoffel, qd, qd)
-        return h, christoffel, s_h * np.einsum("pj,pj->p", h, qdd) + s_c * coriolis + s_g * entries[:, model.slice_g][:, w]
+        g = entries[:, model.slice_g][:, w]
+        return h, christoffel, s_h * np.einsum("pj,pj->p", h, qdd) + s_c * coriolis + s_g * g
 
     h, christoffel, rho = terms(q)
     gamma = s_c * 2.0 * np.einsum("pk,pk->p", christoffel[:, w], qd)
