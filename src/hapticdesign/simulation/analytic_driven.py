@@ -40,6 +40,7 @@ import numpy as np
 from hapticdesign.analysis.dynamics.device import dynamics_of
 from hapticdesign.model.device import Device
 from hapticdesign.simulation.paths import Path, Sine
+from hapticdesign.workload import require_memory
 
 FD_STEP = 1e-6  # rad, central difference of the torques in q_w for a non-cyclic wall joint
 
@@ -147,6 +148,11 @@ class DrivenLoop:
               switches: tuple[float, float, float], period: float, sub: int, samples: int, delay: int,
               virtual_damping: float, equilibrium: float) -> "DrivenLoop":
         step = period / sub
+        n_dof, n = device.n_dof, 4 + 3 * delay
+        entries = dynamics_of(device).coefficients.shape[1]
+        require_memory(f"the time-varying type-2 loop of {samples * sub:,} plant steps",
+                       8.0 * ((2 * samples * sub + 1) * (entries + 2 * n_dof * n_dof + 4 * n_dof + 16)
+                              + samples * sub * 16 * 6 + samples * (2 * n * n + 2 * n)))
         half = np.arange(2 * samples * sub + 1) * (0.5 * step)
         plant = row_terms(device, w, *reference(paths, start, half))
         maps = rk4_maps(plant, damping, step).reshape(samples, sub, 4, 4)
@@ -156,7 +162,6 @@ class DrivenLoop:
             partial[:, i + 1] = maps[:, i] @ partial[:, i]
         at_samples = np.arange(samples) * sub * 2
         comp = row_terms(model, w, *reference(paths, start, half[at_samples]), switches=switches)
-        n = 4 + 3 * delay
         one, u_col = n - 1, 2
         # the acceleration sensed at sample k, a row over S_k (0 at k = 0)
         acc = np.zeros((samples, n))
