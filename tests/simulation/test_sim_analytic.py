@@ -7,7 +7,10 @@ import pytest
 
 from hapticdesign.devices.registry import preset
 from hapticdesign.errors import UserError
+from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.simulation.analytic import AnalyticProblem
+from hapticdesign.simulation.analytic_driven import DrivenLoop
+from hapticdesign.simulation.criteria import type_paths
 from hapticdesign.simulation.config import Compensator, LoopConfig, Sensors
 from hapticdesign.simulation.impedance import ImpedanceProblem, fast_search, impedance_range
 
@@ -37,9 +40,48 @@ def test_type_one_verdicts_equal_the_simulation(overrides, config):
 def test_linear_design_is_exact_in_type_two_and_others_are_flagged():
     device = preset("phantom-3dof")
     analytic = AnalyticProblem(device, 2)
-    assert analytic.exact
+    assert analytic.exact and analytic.driven is None
     assert fast_search(analytic).k_max == fast_search(ImpedanceProblem(device, 2)).k_max
-    assert not AnalyticProblem(device.with_params(NONLINEAR), 2).exact
+    coupled = AnalyticProblem(device.with_params(NONLINEAR), 2)
+    assert coupled.driven is not None and coupled.exact  # joint 1 is cyclic: linear time-varying, not approximate
+    assert not AnalyticProblem(device.with_params(NONLINEAR), 2, wall_joint=1).exact
+
+
+@pytest.mark.parametrize("config", CONFIGS, ids=["seed", "error5", "delay2", "no-inertial"])
+def test_type_two_time_varying_response_equals_the_simulation(config):
+    """Type 2 on a coupled design: joint 1 (cyclic) is an exactly linear time-varying loop along the
+    driven motion, so the product of its transition matrices gives the nonlinear RK4 simulation's
+    response to round-off: the same k_max, verdicts, peaks and stop times."""
+    device = preset("phantom-3dof").with_params(NONLINEAR)
+    analytic, simulated = AnalyticProblem(device, 2, config=config), ImpedanceProblem(device, 2, config=config)
+    found = fast_search(analytic)
+    assert found.k_max == fast_search(simulated).k_max
+    for k in (max(found.k_max - 1, 1), found.k_max, found.k_max + 1):
+        a, s = analytic.verdict(k), simulated.verdict(k)
+        assert (a.stable, a.criterion) == (s.stable, s.criterion)
+        assert a.peak == pytest.approx(s.peak, rel=1e-9)
+        assert (a.stopped_at is None) == (s.stopped_at is None)
+
+
+def test_type_two_on_a_gravity_loaded_joint_is_linearized_to_second_order():
+    """Joint 2 (not cyclic: gravity and the driven joints' pose enter its row) in type 2: the
+    linearization in q_2 leaves an O(delta^2) difference; the peaks agree to 1e-5 of the simulation's."""
+    device = preset("phantom-3dof").with_params(NONLINEAR)
+    analytic, simulated = AnalyticProblem(device, 2, wall_joint=1), ImpedanceProblem(device, 2, wall_joint=1)
+    for k in (1.0, 5.0):
+        assert analytic.verdict(k).peak == pytest.approx(simulated.verdict(k).peak, rel=1e-5)
+
+
+def test_floquet_multipliers_of_a_decoupled_design_cross_the_unit_circle_at_b_squared_over_j():
+    """On an LN = 0 design the homogeneous sample maps do not change along the motion, so the monodromy
+    over the 2000-sample period (three motion periods of 2/3 s) is the constant map's power; it leaves
+    the unit circle at the closed-form limit b^2 / H11 (x = b T / H11 < 4)."""
+    device = preset("phantom-3dof")
+    loop = DrivenLoop.build(device, device, 0, type_paths(2, 3, 0), np.zeros(3), float(device.damping[0]),
+                            (1.0, 1.0, 1.0), 1e-3, 10, 2100, 0, 0.0, 0.01)
+    assert loop.period_samples == 2000
+    limit = float(device.damping[0]) ** 2 / float(mass_matrix(device, np.zeros(3))[0, 0])
+    assert loop.floquet_radius(0.98 * limit) < 1.0 < loop.floquet_radius(1.02 * limit)
 
 
 def test_api_and_resolution():

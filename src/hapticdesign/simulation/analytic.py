@@ -5,9 +5,12 @@ pose ``q0``: inertia ``J = H_ww(q0)`` (plus a hand's mass ``m_h J_v^T J_v``), da
 the hand's), a physical spring from a hand's stiffness, and a constant torque, the gravity the
 compensator leaves (``G_w - s_G G_model,w``). Coriolis terms vanish at rest. The compensator feeds
 ``c J a`` forward with ``c = H_model,ww / J`` (its model has no hand; a modelling error lowers it).
-For joint 1 of the Phantom (vertical axis, cyclic) this is exact for every design; for a driven
-(type 2) wall joint it is exact when the wall joint's row of H, C, G does not depend on the
-driven joints (LN = 0 designs) and a frozen-pose approximation otherwise.
+For joint 1 of the Phantom (vertical axis, cyclic) this is exact for every design. In type 2 the
+other joints move: when the wall joint's row of H, C, G does not depend on them (LN = 0 designs)
+the same 1-DOF loop is exact; otherwise the loop is linear time-varying along the motion and
+:mod:`.analytic_driven` answers with the product of its one-sample transition matrices (exact for a
+cyclic wall joint such as the Phantom's joint 1, linearized in the wall joint otherwise). A Cartesian
+wall, a hand or a closed-loop device in type 2 keeps the start-pose loop (``exact`` false).
 
 The seed's criteria are then evaluated on the exact linear response: the closed loop of
 :mod:`.zwidth` (plant discretized exactly, digital side as a discrete state-space system) gives
@@ -33,9 +36,10 @@ import numpy as np
 from scipy.linalg import expm
 from threadpoolctl import ThreadpoolController
 
-from hapticdesign.analysis.dynamics.device import coriolis_centrifugal, gravity, mass_matrix
+from hapticdesign.analysis.dynamics.device import coriolis_centrifugal, dynamics_of, gravity, mass_matrix
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
+from hapticdesign.simulation.analytic_driven import DrivenLoop
 from hapticdesign.simulation.config import (
     LoopConfig, compensator_device, handle_jacobian, normal_jacobian, plant_friction, rest_pose,
 )
@@ -184,12 +188,34 @@ class AnalyticProblem(WallProblem):
         self.sub = self.config.steps_per_sample()
         self.samples = int(round(self.config.duration / self.config.sensors.period))
         loop = self.wall.loop
+        self.driven = None
         with one_blas_thread():
             self._plant = plant(loop)
             self._steps = _sub_steps(loop, self.config.step, self.sub)
+            if self._time_varying():
+                self.driven = self._driven_loop()
+
+    def _time_varying(self) -> bool:
+        """Type 2 with the wall joint coupled to the motion, on a joint wall of an open chain without a hand."""
+        cfg = self.config
+        return (self.sim_type == 2 and not self.wall.exact and not cfg.wall.cartesian and cfg.hand is None
+                and self.device.mechanism.loops is None)
+
+    def _driven_loop(self) -> DrivenLoop:
+        device, cfg, w = self.device, self.config, self.wall_joint
+        rest = rest_pose(device)
+        damping = np.asarray(cfg.damping if cfg.damping is not None else device.damping, dtype=float)
+        comp = cfg.compensator
+        switches = (float(comp.inertial), float(comp.coriolis), float(comp.gravity))
+        return DrivenLoop.build(device, compensator_device(device, comp), w, type_paths(2, device.n_dof, w, rest), rest,
+                                float(damping[w]), switches, cfg.sensors.period, self.sub, self.samples,
+                                cfg.sensors.delay_samples, cfg.wall.damping, self.rest)
 
     @property
     def exact(self) -> bool:
+        if self.driven is not None:
+            return bool(dynamics_of(self.device).cyclic[self.wall_joint] and
+                        dynamics_of(compensator_device(self.device, self.config.compensator)).cyclic[self.wall_joint])
         return self.wall.exact
 
     @property
@@ -268,7 +294,7 @@ class AnalyticProblem(WallProblem):
         the growth of the linearized loop is the wall's (:attr:`growth_is_exact`), a stiffness at which it
         grows is not stable whatever the criteria saw in the run's duration (:meth:`grows`)."""
         with one_blas_thread():
-            q = self.response(stiffness)
+            q = self.response(stiffness) if self.driven is None else self.driven.response(stiffness)
         flat = q.reshape(-1)[: self.samples * self.sub + 1]
         finite = np.isfinite(flat)
         excursion = np.abs(flat)

@@ -122,7 +122,9 @@ def _g(x: float) -> float:
 
 def _f(x: float) -> float:
     """``x (1 + e^-x) - 2 (1 - e^-x)`` (series ``sum (-1)^(n-1) (n - 2) x^n / n!`` from n = 3 below x = 1)."""
-    return _series(x, 3, lambda n: (-1) ** (n - 1) * (n - 2)) if x < 1.0 else x * (1.0 + math.exp(-x)) + 2.0 * math.expm1(-x)
+    if x < 1.0:
+        return _series(x, 3, lambda n: (-1) ** (n - 1) * (n - 2))
+    return x * (1.0 + math.exp(-x)) + 2.0 * math.expm1(-x)
 
 
 @dataclass(frozen=True)
@@ -149,7 +151,9 @@ def compensated_limit(inertia: float, damping: float, period: float, fraction: f
     k_star = damping ** 2 * one_minus_a * one_minus_ac / (
         inertia * ((1.0 - fraction) * _g(x) + fraction * one_minus_a ** 2))
     k_real = 2.0 * damping ** 2 * (1.0 + a + 2.0 * a * fraction) / (inertia * _f(x))
-    return CompensatedLimit(k_star, "complex pair") if k_star <= k_real else CompensatedLimit(k_real, "real pole at z = -1")
+    if k_star <= k_real:
+        return CompensatedLimit(k_star, "complex pair")
+    return CompensatedLimit(k_real, "real pole at z = -1")
 
 
 def compensated_boundary(inertia: float, damping: float, period: float, fraction: float = 1.0) -> float:

@@ -72,9 +72,9 @@ class CampaignOptions:
     bandwidth_agreement_hz: float = 0.1
     method: str = "simulation"
     """How the cases are answered: ``simulation`` (the numba loop) or ``analytic`` (the loop linearized at the
-    start pose, no loop run: the impedance range from the exact linear response of :mod:`.analytic`, the
-    bandwidth from the linear transmitted torque of :mod:`.analytic_transparency`; exact for type 1, and
-    for type 2 when LN = 0)."""
+    start pose, no loop run: the impedance range from the exact linear response of :mod:`.analytic` (type 2
+    along the driven motion, :mod:`.analytic_driven`; exact for joint 1), the bandwidth from the linear
+    transmitted torque of :mod:`.analytic_transparency`; exact for type 1, and for type 2 when LN = 0)."""
 
     conditions: LoopConfig = field(default_factory=LoopConfig)
     """Realistic conditions for every case (seed 000 ch. 5's first future-work item): sensors (period,

@@ -165,16 +165,22 @@ def zwidth_chart(zw, title: str, path: Path, units: tuple[str, str] = ("N m s/ra
     return _save_atomically(fig, path)
 
 
-def robustness_chart(rows: list[dict], path: Path) -> list[Path]:
-    """Mean relative change of the stable range against the modelling error, one line per LN level."""
+def robustness_chart(rows: list[dict], path: Path, sim_type: int = 2) -> list[Path]:
+    """Mean relative change of the stable range against the modelling error, one line per LN level, with
+    the 95 % confidence interval of the mean as error bars."""
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
     for level in sorted({r["level"] for r in rows}):
         chosen = sorted((r for r in rows if r["level"] == level), key=lambda r: r["error_percent"])
-        ax.plot([r["error_percent"] for r in chosen], [100 * (r["mean_relative_change"] or 0.0) for r in chosen],
-                "o-", label=f"LN = {level:g}")
+        mean = np.array([100 * (r["mean_relative_change"] or 0.0) for r in chosen])
+        low = np.array([m if r["relative_change_ci_low"] is None else 100 * r["relative_change_ci_low"]
+                        for r, m in zip(chosen, mean)])
+        high = np.array([m if r["relative_change_ci_high"] is None else 100 * r["relative_change_ci_high"]
+                         for r, m in zip(chosen, mean)])
+        ax.errorbar([r["error_percent"] for r in chosen], mean, yerr=[mean - low, high - mean], fmt="o-", capsize=3,
+                    label=f"LN = {level:g}")
     ax.set_xlabel("modelling error of masses and inertias [%] (seeded random signs)")
     ax.set_ylabel("mean |K_max - K_max(0)| / K_max(0) [%]")
-    ax.set_title("Stable impedance range under modelling error, type 1", fontsize=10)
+    ax.set_title(f"Stable impedance range under modelling error, type {sim_type} (95 % CI)", fontsize=10)
     ax.legend(fontsize=8)
     return _save_atomically(fig, path)
 

@@ -323,7 +323,8 @@ def impedance_range(device: Device, sim_type: int = 1, method: str = "fast", k_l
     Without ``resolution`` the seed's integer scan K = 1, 2, 3 ... (``method`` "linear", or "fast"
     for the same answer in fewer runs); with it, :func:`grid_search` on ``R, 2R, 3R ...``.
     ``method="analytic"`` answers the same searches from the exact linear response of the sampled
-    loop at the start pose (:mod:`.analytic`; no ODE integration; exact for type 1 and for LN = 0).
+    loop (:mod:`.analytic`; no ODE integration; exact for type 1 and, along the driven motion
+    (:mod:`.analytic_driven`), for type 2 on a cyclic wall joint such as the Phantom's joint 1).
     For a closed-loop device the joints start at, and move about, its home pose and a joint wall's
     ``equilibrium`` is measured from there (:func:`~.config.rest_pose`); a run whose loops stop closing on
     the assembly branch is a :class:`~hapticdesign.errors.UserError`.
