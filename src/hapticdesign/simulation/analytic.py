@@ -282,8 +282,13 @@ class AnalyticProblem(WallProblem):
 
     def grows(self, stiffness: float) -> bool:
         """Whether the linearized sampled loop is unstable at ``stiffness``: the spectral radius of its
-        one-sample map (the constant state of the affine part left out) exceeds 1. For type 1 this is the
-        exact local growth boundary of the wall (Lyapunov's indirect method for the sampled system)."""
+        one-sample map (the constant state of the affine part left out) exceeds 1, or along a driven motion
+        (:mod:`.analytic_driven`) its largest Floquet multiplier over the motion's period (not decided, so
+        False, when the run is shorter than a period). For type 1 this is the exact local growth boundary
+        of the wall (Lyapunov's indirect method for the sampled system)."""
+        if self.driven is not None:
+            with one_blas_thread():
+                return bool(self.driven.floquet_radius(stiffness) > 1.0)
         m, _, _ = self._augmented(stiffness)
         with one_blas_thread():
             radius = float(np.max(np.abs(np.linalg.eigvals(m[:-1, :-1]))))

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from functools import cached_property
 
 import numpy as np
 
@@ -58,10 +59,17 @@ class ImpedanceProblem(WallProblem):
         self.model = tables_of(compensator_device(self.device, self.config.compensator))
         self.config = replace(self.config, safety_limit=self.criteria.safety_limit,
                               stop_excursion=self.criteria.overshoot_limit)
-        linear = (AnalyticProblem(self.device, self.sim_type, self.wall_joint, self.equilibrium, self.criteria,
-                                  self.config) if linear_loop(self.device, self.config) else None)
-        self.linear = linear if linear is not None and linear.growth_is_exact else None
-        """The loop linearized at the start pose where its growth decides the wall's stability, else None."""
+
+    @cached_property
+    def linear(self) -> AnalyticProblem | None:
+        """The linearized loop where its growth decides the wall's stability
+        (:attr:`.AnalyticProblem.growth_is_exact`), else None; built at the first verdict that needs it (along
+        a driven motion that costs a few tenths of a second)."""
+        if not linear_loop(self.device, self.config):
+            return None
+        linear = AnalyticProblem(self.device, self.sim_type, self.wall_joint, self.equilibrium, self.criteria,
+                                 self.config)
+        return linear if linear.growth_is_exact else None
 
     def estimate(self) -> float:
         """Starting guess: the 1-DOF limit ``b^2 / H_ww`` of full inertial compensation at the start
