@@ -8,17 +8,8 @@ from typing import Optional
 import numpy as np
 import typer
 
-from hapticdesign.analysis.dynamics.device import (
-    coriolis_centrifugal,
-    coriolis_matrix,
-    dynamics_of,
-    gravity,
-    inverse_dynamics,
-    mass_matrix,
-)
 from hapticdesign.interface.options import DEVICE, FORCE, FORCE_HINT, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
 from hapticdesign.workload import allow_large
-from hapticdesign.devices.loading import resolve_device
 from hapticdesign.interface.common import joint_units, note as stderr_note, parse_vector, print_json, user_errors
 
 
@@ -37,7 +28,18 @@ def dynamics(
 ) -> None:
     """H, C, C_cvt, G and tau at one pose, in SI units (seed 000 eq. 2.50-2.52); H includes actuators' reflected
     rotor inertia. A pose outside the joint limits is computed, with a warning line on stderr."""
+    from hapticdesign.analysis.dynamics.device import (
+        coriolis_centrifugal,
+        coriolis_matrix,
+        dynamics_of,
+        gravity,
+        inverse_dynamics,
+        mass_matrix,
+    )
+
     with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
+        from hapticdesign.devices.loading import resolve_device
+
         dev = resolve_device(preset, device, params, strict=strict)
         n = dev.n_dof
         qv = parse_vector(q, n, "q")
@@ -97,6 +99,8 @@ def eom(
     from hapticdesign.analysis.dynamics.symbolic import derive, export
 
     with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
+        from hapticdesign.devices.loading import resolve_device
+
         dev = resolve_device(preset, device, params, strict=strict)
         text = export(derive(dev, symbolic), fmt, part)
         if not json_out:

@@ -8,21 +8,18 @@ and the joint-space mass matrix H of the equations of motion.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Optional
+from typing import TYPE_CHECKING, Optional
 
 import numpy as np
 import typer
 
-from hapticdesign.analysis.dynamics.cartesian import cartesian_inertia
-from hapticdesign.analysis.dynamics.device import dynamics_of, mass_matrix
-from hapticdesign.analysis.kinematics import actuated_jacobian
-from hapticdesign.analysis.metrics import dynamic, kinematic, names
-from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import note, parse_vector, print_json, user_errors
 from hapticdesign.interface.options import DEVICE, FORCE, FORCE_HINT, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
 from hapticdesign.workload import allow_large
-from hapticdesign.model.device import Device
+
+if TYPE_CHECKING:
+    from hapticdesign.model.device import Device
 
 SINGULAR_CONDITION = 1e10
 
@@ -34,6 +31,9 @@ def task_jacobian(device: Device, q: np.ndarray) -> np.ndarray:
     (planar devices): the translational rows projected on the plane (or line) of motion, i.e. on
     the leading left singular vectors, which leaves every metric unchanged by the choice of axes.
     """
+    from hapticdesign.analysis.dynamics.device import dynamics_of
+    from hapticdesign.analysis.kinematics import actuated_jacobian
+
     full = actuated_jacobian(device.mechanism, q, solver=getattr(dynamics_of(device), "solver", None))
     n = device.n_dof
     if n == 3:
@@ -49,6 +49,10 @@ def task_jacobian(device: Device, q: np.ndarray) -> np.ndarray:
 def device_metrics(device: Device, q: np.ndarray) -> dict:
     """Kinematic (eq. 4.24-4.38) and dynamic (eq. 4.90-4.99) metrics at pose ``q``, keyed as in
     :mod:`hapticdesign.analysis.metrics.names`."""
+    from hapticdesign.analysis.dynamics.cartesian import cartesian_inertia
+    from hapticdesign.analysis.dynamics.device import mass_matrix
+    from hapticdesign.analysis.metrics import dynamic, kinematic, names
+
     J = task_jacobian(device, q)
     cond = float(kinematic.condition_number(J))
     if not np.isfinite(cond) or cond > SINGULAR_CONDITION:
@@ -83,6 +87,8 @@ def metrics(
     force: bool = FORCE,
 ) -> None:
     """Kinematic and dynamic metrics of any device at one pose (seed 001 eq. 4.24-4.38, 4.90-4.99)."""
+    from hapticdesign.devices.loading import resolve_device
+
     with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
         dev = resolve_device(preset, device, params, strict=strict)
         qv = parse_vector(q, dev.n_dof, "q")

@@ -7,7 +7,6 @@ from typing import Optional
 
 import typer
 
-from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import note, print_json, user_errors
 from hapticdesign.interface.options import DEVICE, FORCE, FORCE_HINT, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
@@ -35,6 +34,8 @@ def show(
     from hapticdesign.files import write_atomically
 
     with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
+        from hapticdesign.devices.loading import resolve_device
+
         dev = resolve_device(preset, device, params, strict=strict)
         pose = parse_pose(q, dev)
         for message in dev.limit_warnings(pose):

@@ -9,7 +9,6 @@ import numpy as np
 import typer
 
 from hapticdesign.interface.options import DEVICE, FORCE, FORCE_HINT, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
-from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import (joint_units, parse_vector, print_json, progress_bar, progress_lines,
                                            user_errors, write_atomically)
@@ -146,6 +145,8 @@ def impedance_range_command(
         if not (np.isfinite(settle_window) and 0 < settle_window <= duration):
             raise UserError(f"--settle-window ({settle_window:g} s) must be positive and not longer than --duration "
                             f"({duration:g} s)")
+        from hapticdesign.devices.loading import resolve_device
+
         dev = resolve_device(preset, device, params, strict=strict)
         config = _with_direction(_loop_config(period, step, duration, counts, delay, error_percent, inertial, coriolis,
                                               gravity, wall_damping, hand_mass, hand_damping, hand_stiffness,
@@ -219,6 +220,8 @@ def transparency_command(
 
     with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
         _check_chirp(amplitude, f0, f1, sweep, period)
+        from hapticdesign.devices.loading import resolve_device
+
         dev = resolve_device(preset, device, params, strict=strict)
         config = _loop_config(period, step, sweep, counts, delay, error_percent, inertial, coriolis, gravity,
                               wall_damping, 0.0, 0.0, 0.0, step_control)

@@ -13,7 +13,6 @@ from typing import Optional
 import numpy as np
 import typer
 
-from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import note, parse_vector, print_json, user_errors
 from hapticdesign.interface.options import (
@@ -55,6 +54,8 @@ def stiffness(
     from hapticdesign.analysis.stiffness.device import cartesian_stiffness, deflection
 
     with user_errors(quiet=quiet):
+        from hapticdesign.devices.loading import resolve_device
+
         dev = resolve_device(preset, device, params, strict=strict)
         loops = dev.mechanism.loops
         qv = parse_vector(q, dev.n_dof, "q") if q is not None else np.array(loops.home if loops else [0.0] * dev.n_dof)
