@@ -10,7 +10,7 @@ import typer
 
 from hapticdesign.interface.options import DEVICE, FORCE, FORCE_HINT, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
 from hapticdesign.errors import UserError
-from hapticdesign.interface.common import (joint_units, parse_vector, print_json, progress_bar, progress_lines,
+from hapticdesign.interface.common import (joint_units, note, parse_vector, print_json, progress_bar, progress_lines,
                                            user_errors, write_atomically)
 from hapticdesign.workload import allow_large
 
@@ -229,14 +229,24 @@ def transparency_command(
             raise UserError(f"--band must be positive, got {band}")
         if method not in ("simulation", "analytic"):
             raise UserError(f"--method must be 'simulation' or 'analytic', got {method!r}")
+        from hapticdesign.interface.commands.transparency_adapter import bandwidth_note, finite_or_none, stable_limit
+
+        unit = joint_units(dev)[joint_index(dev, joint)]
+        limit = stable_limit(dev, _sim_type(sim_type), joint_index(dev, joint), config)
+        if limit is not None and stiffness > limit:
+            note(f"warning: K = {stiffness:g} {unit['stiffness']} is above joint {joint_index(dev, joint) + 1}'s stable "
+                 f"limit {limit:.4g} {unit['stiffness']} (its sampled loop, linearized at the start pose, grows): the "
+                 "transparency is that of an unstable wall", quiet)
         result = transparency(dev, _sim_type(sim_type), stiffness, Chirp(amplitude, f0, f1, sweep), config,
                               joint_index(dev, joint), band_db=band, method=method)
         if response is not None:
             write_atomically(response, result.response_table())
-        unit = joint_units(dev)[joint_index(dev, joint)]
+        why = bandwidth_note(result.bandwidth_hz, band, f1, stiffness, limit, unit["stiffness"])
         out = {"device": dev.name, "type": sim_type, "joint": joint_index(dev, joint) + 1,
-               "stiffness": stiffness, **result.as_dict(),
-               "units": {"stiffness": unit["stiffness"], "bandwidth_hz": "Hz", "band_db": "dB"}}
+               "stiffness": stiffness, **result.as_dict(), **({"bandwidth_note": why} if why else {}),
+               "stable_limit": finite_or_none(limit),
+               "units": {"stiffness": unit["stiffness"], "stable_limit": unit["stiffness"], "bandwidth_hz": "Hz",
+                         "band_db": "dB"}}
         if json_out:
             print_json(out)
             return
