@@ -52,3 +52,9 @@ def test_stiffness_below_the_limit_gives_no_warning(closed_form_limit):
     out = json.loads(done.stdout)
     assert out["stable_limit"] == pytest.approx(closed_form_limit, rel=1e-6)
     assert (out["bandwidth_hz"] is None) == ("bandwidth_note" in out)
+
+
+def test_the_docs_quote_the_five_bar_limit(closed_form_limit):
+    """docs/simulation.md quotes joint 1's limit of the five-bar; it is the closed form's, to 4 digits."""
+    docs = (Path(__file__).resolve().parents[2] / "docs" / "simulation.md").read_text()
+    assert f"five-bar's {closed_form_limit:.4g} N m/rad on joint 1" in docs
