@@ -36,6 +36,7 @@ def dynamics(
         inverse_dynamics,
         mass_matrix,
     )
+    from hapticdesign.interface.commands.pose_adapter import assembly_branch, branch_line, handle, handle_line
 
     with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
         from hapticdesign.devices.loading import resolve_device
@@ -57,9 +58,14 @@ def dynamics(
             "C_cvt": coriolis_matrix(dev, qv, qdv),
             "G": gravity(dev, qv),
             "tau": inverse_dynamics(dev, qv, qdv, qddv),
-            "units": {"joints": joint_units(dev),
+            "units": {"joints": joint_units(dev), "handle": "m",
                       "note": "SI: q in rad or m, tau in N m or N; H, C, G in the units that make tau so"},
         }
+        found, branch = handle(dev, qv), assembly_branch(dev)
+        if found is not None:
+            result["handle"] = found
+        if branch is not None:
+            result["assembly_branch"] = branch
         if json_out:
             print_json(result)
             return
@@ -75,6 +81,10 @@ def dynamics(
             typer.echo(f"\n{key}: {note}")
             for row in np.atleast_2d(result[key]) if key not in ("G", "tau") else [result[key]]:
                 typer.echo("  " + _row(row))
+        if found is not None:
+            typer.echo("\n" + handle_line(found))
+        if branch is not None:
+            typer.echo(branch_line(branch))
 
 
 def _row(values: np.ndarray) -> str:

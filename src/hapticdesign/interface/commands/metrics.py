@@ -76,6 +76,21 @@ def device_metrics(device: Device, q: np.ndarray) -> dict:
     }
 
 
+def metric_units(device: Device) -> dict:
+    """Units of the ``metrics`` output: the R-CUBE's of seed 001 (revolute joints, translational task rows:
+    :data:`hapticdesign.analysis.metrics.names.METRICS`) with the power of the determinants set to the number of
+    joints; a prismatic joint has m in place of rad."""
+    from hapticdesign.analysis.metrics.names import METRICS
+    from hapticdesign.interface.common import joint_units
+
+    keys = ("manipulability", "condition_number", "I_m", "I_d", "I_f", "I_e", "acceleration_radius")
+    return {"q": [u["position"] for u in joint_units(device)], "handle": "m",
+            "jacobian": "m/rad (task rows per joint; for 6 joints rows 4-6 in rad/rad)",
+            "velocity_ellipsoid_radii": "m/s per rad/s", "cartesian_inertia": "kg",
+            **{key: METRICS[key].unit.replace("^3", f"^{device.n_dof}") for key in keys},
+            "note": "units for revolute joints; a prismatic joint has m in place of rad"}
+
+
 def metrics(
     preset: Optional[str] = PRESET,
     device: Optional[Path] = DEVICE,
@@ -88,6 +103,7 @@ def metrics(
 ) -> None:
     """Kinematic and dynamic metrics of any device at one pose (seed 001 eq. 4.24-4.38, 4.90-4.99)."""
     from hapticdesign.devices.loading import resolve_device
+    from hapticdesign.interface.commands.pose_adapter import handle, handle_line
 
     with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
         dev = resolve_device(preset, device, params, strict=strict)
@@ -95,9 +111,12 @@ def metrics(
         for message in dev.limit_warnings(qv):
             note(f"warning: {message}", quiet)
         result = device_metrics(dev, qv)
+        found = handle(dev, qv)
+        result["units"] = metric_units(dev)
         if json_out:
-            print_json(result)
+            print_json({**result, **({"handle": found} if found is not None else {})})
             return
+        del result["units"]
         for key, value in result.items():
             if key in ("jacobian", "cartesian_inertia"):
                 typer.echo(f"{key}:")
@@ -107,6 +126,8 @@ def metrics(
                 typer.echo(f"{key}: " + " ".join(f"{v:.6g}" for v in value))
             else:
                 typer.echo(f"{key}: {value if isinstance(value, str) else f'{float(value):.6g}'}")
+        if found is not None:
+            typer.echo(handle_line(found))
 
 
 def register(app: typer.Typer) -> None:
