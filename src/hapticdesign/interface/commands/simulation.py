@@ -337,7 +337,9 @@ def stability_boundary_command(
                "k_max_simulated": _finite_or_none(simulated),
                "relative_difference": (simulated - exact) / exact
                if np.isfinite(exact) and np.isfinite(simulated) and exact != 0 else None,
-               "two_b_over_t": 2 * damping / period, "error_percent": error_percent}
+               "two_b_over_t": 2 * damping / period, "error_percent": error_percent,
+               "units": {"k_max_exact": "N m/rad", "k_max_closed_form": "N m/rad", "k_max_simulated": "N m/rad",
+                         "relative_difference": "dimensionless", "two_b_over_t": "N m/rad", "error_percent": "%"}}
         if unbounded:
             out["note"] = (f"k_max {', '.join(unbounded)}: no stiffness up to the search cap destabilizes the loop "
                            "(unbounded; null in JSON)")
