@@ -35,9 +35,10 @@ def assembly_branch(device) -> dict | None:
     if solver is None:
         return None
     mech = device.mechanism
-    names = [mech.coordinates[k] for k in solver.arrays.passive]
+    passive = mech.loops.passive
+    names = [mech.coordinates[k] for k in passive]
     return {"det_phi_p_sign": int(np.sign(solver.branch)),
-            "passive_at_home": {n: float(solver.home[k]) for n, k in zip(names, solver.arrays.passive)},
+            "passive_at_home": {n: float(solver.home[k]) for n, k in zip(names, passive)},
             "assembly_guess": dict(zip(names, map(float, mech.loops.assembly)))}
 
 
