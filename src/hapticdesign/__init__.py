@@ -13,24 +13,44 @@ R-CUBE):
 - :mod:`hapticdesign.analysis.rcube` and :mod:`hapticdesign.optimization`: the R-CUBE.
 """
 
-from hapticdesign.analysis.dynamics.device import (
-    coriolis_centrifugal,
-    coriolis_matrix,
-    dynamics_of,
-    forward_dynamics,
-    gravity,
-    inverse_dynamics,
-    mass_matrix,
-)
-from hapticdesign.analysis.linearity.conditions import linear_conditions
-from hapticdesign.analysis.linearity.form import device_form as linearity_form
-from hapticdesign.devices.loading import load_device
-from hapticdesign.devices.registry import preset
-from hapticdesign.errors import UserError
-from hapticdesign.model.device import Device
-from hapticdesign.simulation.impedance import impedance_range
-from hapticdesign.simulation.transparency import transparency
-from hapticdesign.version import __version__
+from importlib import import_module
+
+_HOMES = {
+    "__version__": "hapticdesign.version",
+    "coriolis_centrifugal": "hapticdesign.analysis.dynamics.device",
+    "coriolis_matrix": "hapticdesign.analysis.dynamics.device",
+    "dynamics_of": "hapticdesign.analysis.dynamics.device",
+    "forward_dynamics": "hapticdesign.analysis.dynamics.device",
+    "gravity": "hapticdesign.analysis.dynamics.device",
+    "inverse_dynamics": "hapticdesign.analysis.dynamics.device",
+    "mass_matrix": "hapticdesign.analysis.dynamics.device",
+    "linear_conditions": "hapticdesign.analysis.linearity.conditions",
+    "load_device": "hapticdesign.devices.loading",
+    "preset": "hapticdesign.devices.registry",
+    "UserError": "hapticdesign.errors",
+    "Device": "hapticdesign.model.device",
+    "impedance_range": "hapticdesign.simulation.impedance",
+    "transparency": "hapticdesign.simulation.transparency",
+}
+_RENAMED = {"linearity_form": ("hapticdesign.analysis.linearity.form", "device_form")}
+
+
+def __getattr__(name: str):
+    """The names below are imported on first use (PEP 562), so ``hapticdesign --help`` loads no solver."""
+    if name in _HOMES:
+        home, attribute = _HOMES[name], name
+    elif name in _RENAMED:
+        home, attribute = _RENAMED[name]
+    else:
+        raise AttributeError(f"module 'hapticdesign' has no attribute {name!r}")
+    value = getattr(import_module(home), attribute)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)
+
 
 __all__ = [
     "__version__",

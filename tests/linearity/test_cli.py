@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -143,3 +144,18 @@ def test_linearize_bad_input_exit_2(args):
     result = runner.invoke(app, ["linearize", *args])
     assert result.exit_code == 2
     assert "error:" in result.stderr
+
+
+FIVE_BAR = Path(__file__).resolve().parents[2] / "examples" / "devices" / "five-bar.yaml"
+
+
+@pytest.mark.parametrize("command", [["linearize"], ["designs", "--count", "1"]])
+def test_closed_loop_device_is_refused_in_one_line(command, tmp_path):
+    """The shipped five-bar declares a loop (``loops:`` in its file): the LN = 0 conditions of eq. 3.12-3.27
+    need a tree's exact basis, so the command says why in one line and exits 2 (no traceback, no file)."""
+    out = tmp_path / "d.csv"
+    result = runner.invoke(app, [*command, "--device", str(FIVE_BAR), "--out", str(out)])
+    assert result.exit_code == 2, result.output
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"error: {command[0]} needs a tree device")
+    assert "closed loops" in lines[0] and not out.exists()

@@ -92,7 +92,10 @@ def _contents_order(name: str) -> tuple[int, str]:
 
 
 def _register_all() -> None:
-    modules = sorted((m.name for m in pkgutil.iter_modules(commands.__path__)), key=_contents_order)
+    """Register every command module's commands; ``*_adapter`` modules hold a command's work, imported when it
+    runs (so ``--help`` loads no engine)."""
+    found = (m.name for m in pkgutil.iter_modules(commands.__path__) if not m.name.endswith("_adapter"))
+    modules = sorted(found, key=_contents_order)
     for name in modules:
         module = importlib.import_module(f"{commands.__name__}.{name}")
         register = getattr(module, "register", None)

@@ -185,12 +185,34 @@ def robustness_chart(rows: list[dict], path: Path, sim_type: int = 2) -> list[Pa
     return _save_atomically(fig, path)
 
 
+ROUND_OFF = 1e-12
+
+
+def colour_scale(values: np.ndarray) -> tuple[float, float, list[float] | None]:
+    """Colour limits of a map and its ticks (None: the colour bar's own). A map whose values differ by less
+    than ``ROUND_OFF`` of the largest is constant (its spread is round-off, not data): one tick at its value
+    and limits 0.1 % either side, so the colour bar does not spread 1e-15 differences over its length."""
+    finite = np.asarray(values, dtype=float)[np.isfinite(values)]
+    if finite.size == 0:
+        return 0.0, 1.0, None
+    lo, hi = float(finite.min()), float(finite.max())
+    if hi - lo > ROUND_OFF * max(abs(lo), abs(hi)):
+        return lo, hi, None
+    value = float(np.mean(finite))
+    half = 1e-3 * abs(value) or 1.0
+    return value - half, value + half, [value]
+
+
 def stiffness_map_chart(result, joint_names: list[str], wall_name: str, path: Path) -> list[Path]:
     """Heat map of the largest stable stiffness over two joints' angles."""
     fig, ax = plt.subplots(figsize=(5.8, 4.6))
-    image = ax.pcolormesh(result.second, result.first, np.array(result.K), shading="nearest", cmap="viridis")
+    values = np.array(result.K, dtype=float)
+    lo, hi, ticks = colour_scale(values)
+    image = ax.pcolormesh(result.second, result.first, values, shading="nearest", cmap="viridis", vmin=lo, vmax=hi)
     bar = fig.colorbar(image, ax=ax, label=f"K_max of {wall_name} [N m/rad]")
     bar.formatter.set_useOffset(False)
+    if ticks is not None:
+        bar.set_ticks(ticks, labels=[f"{t:.6g} (constant)" for t in ticks])
     bar.update_ticks()
     ax.set_xlabel(f"{joint_names[1]} [rad]")
     ax.set_ylabel(f"{joint_names[0]} [rad]")

@@ -25,7 +25,7 @@ from hapticdesign.analysis.view.page import render_page
 from hapticdesign.analysis.view.skeleton import export as view_data
 from hapticdesign.analysis.view.skeleton import home_pose
 from hapticdesign.errors import UserError
-from hapticdesign.studies.steps import Context, Outcome, Page, Table, figure_from_matplotlib
+from hapticdesign.studies.steps import Context, Outcome, Page, Skipped, Table, figure_from_matplotlib
 
 
 def matrix_text(name: str, m: np.ndarray) -> str:
@@ -50,10 +50,44 @@ def device_view(ctx: Context) -> Outcome:
     )
 
 
+NO_SYMBOLIC_LOOPS = ("a closed-loop device has no symbolic tree equations: its passive joints are solved numerically "
+                     "from the loop closures, so H, C and G are not closed-form expressions of the actuated joints")
+
+
+def closed_loop_evaluations(device) -> Outcome:
+    """Seed 000 eq. 2.50-2.52 on a closed-loop device: the compiled H, G and tau in the actuated coordinates at
+    home and at two poses 0.1 rad either side (the symbolic form does not exist, see :data:`NO_SYMBOLIC_LOOPS`)."""
+    n = device.n_dof
+    home = home_pose(device)
+    poses = [home, home + 0.1, home - 0.1]
+    qd, qdd = np.full(n, 0.5), np.full(n, 1.0)
+    rows = []
+    for q in poses:
+        h, g = mass_matrix(device, q), gravity(device, q)
+        rows.append([", ".join(f"{v:.4f}" for v in q), *np.diag(h), *g, *inverse_dynamics(device, q, qd, qdd)])
+    columns = ["q", *[f"H{i}{i}" for i in range(1, n + 1)], *[f"G{i}" for i in range(1, n + 1)],
+               *[f"tau{i}" for i in range(1, n + 1)]]
+    h_home = mass_matrix(device, home)
+    return Outcome(
+        summary=f"{device.name}: tau = H(q) qdd + C(q, qd) qd + G(q) (eq. 2.50) in its {n} actuated coordinates, "
+                "evaluated by the compiled closed-loop model; no symbolic form (" + NO_SYMBOLIC_LOOPS + ").",
+        paragraphs=["H, C and G of the loop-opened tree are projected onto the actuated joints (H_a = T^T H T, "
+                    "G_a = T^T G with T = [I; -Phi_p^-1 Phi_a]) at each pose, the passive joints solved from home on "
+                    "the assembly branch.",
+                    f"Evaluations in SI units (rad or m, N m or N): joint rates {qd[0]} and accelerations {qdd[0]} on "
+                    "every joint."],
+        listings=[("H at home (compiled model):", matrix_text("H", h_home))],
+        tables=[Table("evaluations", "H diagonal, G and tau at home and home +- 0.1 rad", columns, rows)],
+        numbers={"H_at_home": h_home},
+    )
+
+
 def equations_of_motion(ctx: Context) -> Outcome:
     """Seed 000 eq. 2.50-2.52: exact H and G of the design, evaluations, and the size of the symbolic form."""
     import sympy as sp
     device = ctx.settings.device()
+    if device.mechanism.loops is not None:
+        return closed_loop_evaluations(device)
     numeric = derive(device, "none")
     full = derive(device, "all")
     full_text = export(full, "text", "all")
@@ -141,6 +175,10 @@ def linearization(ctx: Context) -> Outcome:
     """Seed 000 §3.2.1: the conditions for LN = 0 (eq. 3.12-3.26) in the seed's variables, the free
     parameters (Table 3.2), the constant H (eq. 3.27), the design's realizability and linear designs."""
     device = ctx.settings.device()
+    if device.mechanism.loops is not None:
+        raise Skipped("the conditions for LN = 0 (eq. 3.12-3.27) are linear equations in the coefficients of a tree's "
+                      "exact trigonometric basis; a closed loop's H, C and G entries are not trigonometric polynomials "
+                      "of the actuated joints (its LN, by quadrature, is in the Linearity Number step)")
     form = device_form(device)
     conditions = linear_conditions(device, form)
     try:

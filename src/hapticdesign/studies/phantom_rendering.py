@@ -26,7 +26,7 @@ from hapticdesign.simulation.campaign import (
     run_campaign,
     summarize,
 )
-from hapticdesign.simulation.config import LoopConfig, Wall
+from hapticdesign.simulation.config import LoopConfig, Wall, rest_pose
 from hapticdesign.simulation.impedance import Criteria, impedance_range, type_paths
 from hapticdesign.simulation.loop import simulate
 from hapticdesign.simulation.paths import Chirp
@@ -48,6 +48,15 @@ from hapticdesign.studies.steps import (
 )
 
 
+def wall_response(device, stiffness: float, duration: float = 5.0, step: float = 0.01):
+    """The type 1 wall experiment of the stable-range searches (Table 4.2-4.3) on joint 1: every joint starts at
+    the device's rest pose (0 for an open chain, ``home`` for a closed loop), the others held there, and the
+    wall's spring rests ``step`` from joint 1's start."""
+    rest = rest_pose(device)
+    wall = Wall(0, stiffness, 0.0, float(rest[0]) + step)
+    return simulate(device, LoopConfig(duration=duration, wall=wall), type_paths(1, device.n_dof, 0, rest))
+
+
 def default_design(ctx: Context) -> Outcome:
     """Maximum stable impedance (§4.1.2-4.1.3) and transparency bandwidth (§4.2.2-4.2.3), types 1 and 2."""
     device = ctx.settings.device()
@@ -63,11 +72,13 @@ def default_design(ctx: Context) -> Outcome:
     bands = {t: transparency(device, t, stiffness) for t in (1, 2)}
     ctx.update(2, 3)
     overshoot = Criteria().overshoot_limit
+    start = float(rest_pose(device)[0])
     fig, ax = plt.subplots(figsize=(7, 3.8))
     for gain, style in ((k, "-"), (k + resolution, "--")):
-        trace = simulate(device, LoopConfig(duration=5.0, wall=Wall(0, float(gain), 0.0, 0.01)), type_paths(1, device.n_dof))
+        trace = wall_response(device, float(gain))
         ax.plot(trace.t, trace.q[:, 0], style, label=f"K = {gain:g} N m/rad")
-    ax.axhline(overshoot, color="grey", lw=0.8, ls=":", label=f"overshoot limit ({overshoot:g} rad from the start)")
+    ax.axhline(start + overshoot, color="grey", lw=0.8, ls=":",
+               label=f"overshoot limit ({overshoot:g} rad from the start)")
     ax.set_xlabel("t [s]")
     ax.set_ylabel("theta1 [rad]")
     ax.legend()

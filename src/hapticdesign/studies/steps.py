@@ -1,9 +1,10 @@
 """Study steps: what one step produces (text, tables, figures, key numbers) and a timed runner.
 
-A step is a function ``step(context) -> Outcome``. The runner times it and records one of three
+A step is a function ``step(context) -> Outcome``. The runner times it and records one of four
 states: ``done``; ``not available`` when an earlier step it builds on did not finish (the step
-raised :class:`NotAvailable`; the report says so and shows no numbers); ``failed`` with the
-one-line reason when the engine raised. Steps import the engines plainly, so a renamed engine
+raised :class:`NotAvailable`; the report says so and shows no numbers); ``skipped`` when the
+device cannot have what the step computes (the step raised :class:`Skipped` with the reason, e.g.
+no symbolic tree equations for a closed loop); ``failed`` with the one-line reason when the engine raised. Steps import the engines plainly, so a renamed engine
 function fails the tests instead of showing "not available" in a report. A study therefore always ends in a report.
 """
 
@@ -20,10 +21,15 @@ from typing import Any, Protocol
 STATUS_DONE = "done"
 STATUS_MISSING = "not available"
 STATUS_FAILED = "failed"
+STATUS_SKIPPED = "skipped"
 
 
 class NotAvailable(Exception):
     """A step cannot run because an earlier step it builds on did not finish."""
+
+
+class Skipped(Exception):
+    """A step does not apply to this device; the message says why."""
 
 
 @dataclass
@@ -150,6 +156,8 @@ def run_steps(steps: Sequence[Step], context: Context) -> list[StepResult]:
             outcome, status, reason = step.run(context), STATUS_DONE, ""
         except NotAvailable as exc:
             outcome, status, reason = Outcome(), STATUS_MISSING, str(exc)
+        except Skipped as exc:
+            outcome, status, reason = Outcome(), STATUS_SKIPPED, str(exc)
         except Exception as exc:  # an engine error ends this step only; the report shows it
             last = traceback.extract_tb(exc.__traceback__)[-1]
             outcome, status = Outcome(), STATUS_FAILED

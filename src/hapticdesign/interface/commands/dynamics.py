@@ -8,18 +8,9 @@ from typing import Optional
 import numpy as np
 import typer
 
-from hapticdesign.analysis.dynamics.device import (
-    coriolis_centrifugal,
-    coriolis_matrix,
-    dynamics_of,
-    gravity,
-    inverse_dynamics,
-    mass_matrix,
-)
+from hapticdesign.files import require_finite
 from hapticdesign.interface.options import DEVICE, FORCE, FORCE_HINT, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
 from hapticdesign.workload import allow_large
-from hapticdesign.devices.loading import resolve_device
-from hapticdesign.files import require_finite
 from hapticdesign.interface.common import joint_units, note as stderr_note, parse_vector, print_json, user_errors
 
 
@@ -38,7 +29,19 @@ def dynamics(
 ) -> None:
     """H, C, C_cvt, G and tau at one pose, in SI units (seed 000 eq. 2.50-2.52); H includes actuators' reflected
     rotor inertia. A pose outside the joint limits is computed, with a warning line on stderr."""
+    from hapticdesign.analysis.dynamics.device import (
+        coriolis_centrifugal,
+        coriolis_matrix,
+        dynamics_of,
+        gravity,
+        inverse_dynamics,
+        mass_matrix,
+    )
+    from hapticdesign.interface.commands.pose_adapter import assembly_branch, branch_line, handle, handle_line
+
     with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
+        from hapticdesign.devices.loading import resolve_device
+
         dev = resolve_device(preset, device, params, strict=strict)
         n = dev.n_dof
         qv = parse_vector(q, n, "q")
@@ -56,10 +59,15 @@ def dynamics(
             "C_cvt": coriolis_matrix(dev, qv, qdv),
             "G": gravity(dev, qv),
             "tau": inverse_dynamics(dev, qv, qdv, qddv),
-            "units": {"joints": joint_units(dev),
+            "units": {"joints": joint_units(dev), "handle": "m",
                       "note": "SI: q in rad or m, tau in N m or N; H, C, G in the units that make tau so"},
         }
         require_finite(result)  # text as JSON: no NaN or infinity printed as a result
+        found, branch = handle(dev, qv), assembly_branch(dev)
+        if found is not None:
+            result["handle"] = found
+        if branch is not None:
+            result["assembly_branch"] = branch
         if json_out:
             print_json(result)
             return
@@ -75,6 +83,10 @@ def dynamics(
             typer.echo(f"\n{key}: {note}")
             for row in np.atleast_2d(result[key]) if key not in ("G", "tau") else [result[key]]:
                 typer.echo("  " + _row(row))
+        if found is not None:
+            typer.echo("\n" + handle_line(found))
+        if branch is not None:
+            typer.echo(branch_line(branch))
 
 
 def _row(values: np.ndarray) -> str:
@@ -99,6 +111,8 @@ def eom(
     from hapticdesign.analysis.dynamics.symbolic import derive, export
 
     with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
+        from hapticdesign.devices.loading import resolve_device
+
         dev = resolve_device(preset, device, params, strict=strict)
         text = export(derive(dev, symbolic), fmt, part)
         if not json_out:

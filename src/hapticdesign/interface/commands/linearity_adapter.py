@@ -105,6 +105,21 @@ def parse_levels(text: str) -> tuple[float, ...]:
     return levels
 
 
+def require_tree(device, command: str) -> None:
+    """Refuse ``linearize``/``designs`` on a device with closed loops, before any work.
+
+    The conditions for LN = 0 (seed 000 eq. 3.12-3.27) are linear equations in the coefficients of
+    the exact trigonometric basis of a tree's H, C and G; a closed loop's entries are not
+    trigonometric polynomials of the actuated joints, so those equations do not exist (its LN,
+    from converged quadrature, is what ``ln`` gives).
+    """
+    if device.mechanism.loops is not None:
+        raise UserError(
+            f"{command} needs a tree device: {device.name} has closed loops, whose equations of motion have no exact "
+            "trigonometric basis for the LN = 0 conditions (eq. 3.12-3.27); 'hapticdesign ln' gives its LN"
+        )
+
+
 def _designs_csv(names: list[str], designs: np.ndarray, form: LinearityForm, level: float = 0.0) -> str:
     parts = form.parts_seed(designs)
     return DesignSet(np.full(len(designs), level), parts, designs).to_csv(names)
@@ -129,6 +144,7 @@ def linearize(
     require_seed(seed)
     require_designs(f"finding {find:,} fully linear designs", find, "linear")
     device = resolve_device(preset, device_file, params_file, strict)
+    require_tree(device, "linearize")
     form = device_form(device)
     conditions = linear_conditions(device, form)
     result: dict = {"device": device.name, "conditions": conditions.equations()}
@@ -232,6 +248,7 @@ def write_design_set(
     require_designs(f"a design set of {count:,} designs at each of {len(levels)} levels ({chosen.value} method)",
                     count * len(levels), chosen.value)
     device = resolve_device(preset, device_file, params_file, strict)
+    require_tree(device, "designs")
     form = device_form(device)
     conditions = linear_conditions(device, form)
     result = design_set(device, form, conditions, practical_bounds(device), levels, count, seed, chosen, kind)

@@ -128,7 +128,7 @@ def ik(l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[float] =
         q = inverse_kinematics(dsg.geometry, parse_vector(position, 3, "position"))
         require_regular(dsg.geometry, q)
         if json_out:
-            print_json({"q": q})
+            print_json({"q": q, "units": {"q": "rad"}})
             return
         typer.echo(_matrix_text("q (rows: chains 1-3; columns q_i1, q_i2, q_i3)", q, "rad"))
 
@@ -156,9 +156,18 @@ def fk(q1: float = typer.Option(..., "--q1", help="Active angle q11 (rad)."),
                             f"{', '.join(f'{v:.4g}' for v in r)} m, which the passive links "
                             f"(l2 = {dsg.geometry.l2:g}, l3 = {dsg.geometry.l3:g} m) cannot reach") from None
         if json_out:
-            print_json({"position": r})
+            print_json({"position": r, "units": {"position": "m"}})
             return
         typer.echo("position [m]: " + ", ".join(f"{v:.9g}" for v in r))
+
+
+STIFFNESS_UNITS = {
+    "position": "m",
+    "K_C": "rows and columns x, y, z, rx, ry, rz: N/m (translational block), N/rad (coupling blocks), N m/rad "
+           "(rotational block); entries below 1e-12 of the largest are round-off, printed as 0",
+    "joint_compliance_share": "fraction of the x, y, z compliance (0 to 1)",
+    "deflection": "m (x, y, z), rad (rx, ry, rz)",
+}
 
 
 @rcube_app.command()
@@ -177,13 +186,14 @@ def stiffness(l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[f
     """Cartesian stiffness K_C (eq. 5.121-5.123), unloaded mode, direct solution; with joint stiffness,
     also the share of the translational compliance that sits in the joints."""
     from hapticdesign.analysis.rcube.stiffness import cartesian_stiffness, platform_deflection
+    from hapticdesign.interface.round_off import without_round_off
 
     with user_errors(quiet=quiet):
         dsg = _design(design, l1, l2, l3, offset, sigma, outer, inner, plies, density)
         dsg = _with_joints(dsg, joint_stiffness, joint_translational)
         r = _position(dsg, position)
         K = cartesian_stiffness(dsg, r, passive=not locked)
-        result = {"position": r, "K_C": K}
+        result = {"position": r, "K_C": without_round_off(K)}
         if not dsg.rigid_joints:
             result["joint_compliance_share"] = _joint_share(dsg, r, K, not locked)
         if wrench:
@@ -191,9 +201,9 @@ def stiffness(l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[f
             w = np.concatenate([w, np.zeros(6 - len(w))])
             result["deflection"] = np.linalg.solve(K, w) if locked else platform_deflection(dsg, r, w)
         if json_out:
-            print_json(result)
+            print_json({**result, "units": STIFFNESS_UNITS})
             return
-        typer.echo(_matrix_text("K_C", K, "N/m, N/rad, N m/rad"))
+        typer.echo(_matrix_text("K_C", result["K_C"], "N/m, N/rad, N m/rad"))
         if "joint_compliance_share" in result:
             typer.echo("share of the x, y, z compliance in the joints: "
                        + ", ".join(f"{100 * v:.1f} %" for v in result["joint_compliance_share"]))
@@ -214,7 +224,8 @@ def mass(l1: Optional[float] = L1, l2: Optional[float] = L2, l3: Optional[float]
         r = _position(dsg, position)
         M = cartesian_mass_matrix(dsg, r)
         if json_out:
-            print_json({"position": r, "M_C": M, "link_mass": dsg.total_link_mass()})
+            print_json({"position": r, "M_C": M, "link_mass": dsg.total_link_mass(),
+                        "units": {"position": "m", "M_C": "kg", "link_mass": "kg"}})
             return
         typer.echo(_matrix_text("M_C", M, "kg"))
         typer.echo(f"total link mass: {dsg.total_link_mass() * 1e3:.1f} g")

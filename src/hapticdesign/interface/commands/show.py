@@ -7,7 +7,6 @@ from typing import Optional
 
 import typer
 
-from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import note, print_json, user_errors
 from hapticdesign.interface.options import DEVICE, FORCE, FORCE_HINT, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
@@ -33,8 +32,11 @@ def show(
     from hapticdesign.analysis.view.page import render_page
     from hapticdesign.analysis.view.skeleton import export, parse_pose
     from hapticdesign.files import write_atomically
+    from hapticdesign.interface.commands.pose_adapter import assembly_branch, branch_line
 
     with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
+        from hapticdesign.devices.loading import resolve_device
+
         dev = resolve_device(preset, device, params, strict=strict)
         pose = parse_pose(q, dev)
         for message in dev.limit_warnings(pose):
@@ -44,10 +46,14 @@ def show(
         html_path, png_path = out / "device.html", out / "device.png"
         write_atomically(html_path, render_page(export(dev, pose)))
         write_atomically(png_path, render_png(dev, pose))
+        branch = assembly_branch(dev)
         if json_out:
-            print_json({"device": dev.name, "q": pose, "html": str(html_path), "png": str(png_path)})
+            print_json({"device": dev.name, "q": pose, "html": str(html_path), "png": str(png_path),
+                        **({"assembly_branch": branch} if branch is not None else {})})
             return
         note(f"wrote {html_path} and {png_path}", quiet)
+        if branch is not None:
+            note(branch_line(branch), quiet)
 
 
 def register(app: typer.Typer) -> None:

@@ -9,9 +9,8 @@ import numpy as np
 import typer
 
 from hapticdesign.interface.options import DEVICE, FORCE, FORCE_HINT, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
-from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
-from hapticdesign.interface.common import (joint_units, parse_vector, print_json, progress_bar, progress_lines,
+from hapticdesign.interface.common import (joint_units, note, parse_vector, print_json, progress_bar, progress_lines,
                                            user_errors, write_atomically)
 from hapticdesign.workload import allow_large
 
@@ -146,6 +145,8 @@ def impedance_range_command(
         if not (np.isfinite(settle_window) and 0 < settle_window <= duration):
             raise UserError(f"--settle-window ({settle_window:g} s) must be positive and not longer than --duration "
                             f"({duration:g} s)")
+        from hapticdesign.devices.loading import resolve_device
+
         dev = resolve_device(preset, device, params, strict=strict)
         config = _with_direction(_loop_config(period, step, duration, counts, delay, error_percent, inertial, coriolis,
                                               gravity, wall_damping, hand_mass, hand_damping, hand_stiffness,
@@ -219,6 +220,8 @@ def transparency_command(
 
     with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
         _check_chirp(amplitude, f0, f1, sweep, period)
+        from hapticdesign.devices.loading import resolve_device
+
         dev = resolve_device(preset, device, params, strict=strict)
         config = _loop_config(period, step, sweep, counts, delay, error_percent, inertial, coriolis, gravity,
                               wall_damping, 0.0, 0.0, 0.0, step_control)
@@ -226,14 +229,24 @@ def transparency_command(
             raise UserError(f"--band must be positive, got {band}")
         if method not in ("simulation", "analytic"):
             raise UserError(f"--method must be 'simulation' or 'analytic', got {method!r}")
+        from hapticdesign.interface.commands.transparency_adapter import bandwidth_note, finite_or_none, stable_limit
+
+        unit = joint_units(dev)[joint_index(dev, joint)]
+        limit = stable_limit(dev, _sim_type(sim_type), joint_index(dev, joint), config)
+        if limit is not None and stiffness > limit:
+            note(f"warning: K = {stiffness:g} {unit['stiffness']} is above joint {joint_index(dev, joint) + 1}'s stable "
+                 f"limit {limit:.4g} {unit['stiffness']} (its sampled loop, linearized at the start pose, grows): the "
+                 "transparency is that of an unstable wall", quiet)
         result = transparency(dev, _sim_type(sim_type), stiffness, Chirp(amplitude, f0, f1, sweep), config,
                               joint_index(dev, joint), band_db=band, method=method)
         if response is not None:
             write_atomically(response, result.response_table())
-        unit = joint_units(dev)[joint_index(dev, joint)]
+        why = bandwidth_note(result.bandwidth_hz, band, f1, stiffness, limit, unit["stiffness"])
         out = {"device": dev.name, "type": sim_type, "joint": joint_index(dev, joint) + 1,
-               "stiffness": stiffness, **result.as_dict(),
-               "units": {"stiffness": unit["stiffness"], "bandwidth_hz": "Hz", "band_db": "dB"}}
+               "stiffness": stiffness, **result.as_dict(), **({"bandwidth_note": why} if why else {}),
+               "stable_limit": finite_or_none(limit),
+               "units": {"stiffness": unit["stiffness"], "stable_limit": unit["stiffness"], "bandwidth_hz": "Hz",
+                         "band_db": "dB"}}
         if json_out:
             print_json(out)
             return
@@ -326,7 +339,9 @@ def stability_boundary_command(
                "k_max_simulated": _finite_or_none(simulated),
                "relative_difference": (simulated - exact) / exact
                if np.isfinite(exact) and np.isfinite(simulated) and exact != 0 else None,
-               "two_b_over_t": 2 * damping / period, "error_percent": error_percent}
+               "two_b_over_t": 2 * damping / period, "error_percent": error_percent,
+               "units": {"k_max_exact": "N m/rad", "k_max_closed_form": "N m/rad", "k_max_simulated": "N m/rad",
+                         "relative_difference": "dimensionless", "two_b_over_t": "N m/rad", "error_percent": "%"}}
         if unbounded:
             out["note"] = (f"k_max {', '.join(unbounded)}: no stiffness up to the search cap destabilizes the loop "
                            "(unbounded; null in JSON)")

@@ -8,7 +8,6 @@ from typing import Optional
 
 import typer
 
-from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import note, parse_vector, print_json, user_errors
 from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, SEED, STRICT
@@ -22,6 +21,7 @@ def _device_joint(preset, device, params, strict, q, joint, error_percent, compe
                   direction=None) -> tuple[float, float, float, float | None]:
     """J = H_jj(q), b_j, the compensator fraction H_model,jj / H_jj of a device at a pose, and
     ``J_n = n^T J_v`` of the joint along a Cartesian wall's ``direction`` (None without one)."""
+    from hapticdesign.analysis.dynamics.device import mass_matrix
     from hapticdesign.devices.loading import resolve_device
     from hapticdesign.simulation.config import Wall, model_device, normal_jacobian
     from hapticdesign.simulation.loop import joint_index

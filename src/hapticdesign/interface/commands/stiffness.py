@@ -13,7 +13,6 @@ from typing import Optional
 import numpy as np
 import typer
 
-from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import note, parse_vector, print_json, user_errors
 from hapticdesign.interface.options import (
@@ -56,6 +55,8 @@ def stiffness(
     from hapticdesign.analysis.stiffness.device import cartesian_stiffness, deflection
 
     with user_errors(quiet=quiet):
+        from hapticdesign.devices.loading import resolve_device
+
         dev = resolve_device(preset, device, params, strict=strict)
         qv = parse_vector(q, dev.n_dof, "q") if q is not None else configuration_of(dev).home
         for message in dev.limit_warnings(qv):

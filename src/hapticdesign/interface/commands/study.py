@@ -6,15 +6,12 @@ from pathlib import Path
 from typing import Optional
 
 import typer
-from rich.console import Console
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
 
-from hapticdesign.analysis.dynamics.device import inverse_dynamics
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import print_json, user_errors
 from hapticdesign.interface.options import DEVICE, FORCE, FORCE_HINT, JSON_OUT, PRESET, QUIET, SEED
 from hapticdesign.workload import allow_large
-from hapticdesign.studies.steps import STATUS_DONE, StepResult
+from hapticdesign.studies.steps import STATUS_DONE, STATUS_FAILED, STATUS_SKIPPED, StepResult
 
 study_app = typer.Typer(
     help="The seeds' pipelines end to end (seed 000 ch. 2-4, seed 001 ch. 4-7), each ending in one HTML report.",
@@ -29,7 +26,9 @@ SCALE = typer.Option(None, "--scale", hidden=True, help="full, quick or smoke (t
 class RichProgress:
     """Study progress on stderr: one line per step, a bar where the step reports its progress."""
 
-    def __init__(self, console: Console) -> None:
+    def __init__(self, console) -> None:
+        from rich.progress import BarColumn, MofNCompleteColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
+
         self.bars = Progress(SpinnerColumn(), TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
                              TimeElapsedColumn(), console=console)
         self.task = None
@@ -64,6 +63,8 @@ def _check_out(out: Path) -> Path:
 
 def _run(module, settings, out: Path, quiet: bool, as_json: bool) -> dict:
     """Run one study with progress (unless quiet or JSON) and write its report; returns the summary."""
+    from rich.console import Console
+
     from hapticdesign.interface.report import write_report
     from hapticdesign.interface.report.writer import summary
 
@@ -86,10 +87,28 @@ def _run(module, settings, out: Path, quiet: bool, as_json: bool) -> dict:
 
 
 def _finish(found: dict, quiet: bool, as_json: bool) -> None:
+    """Print the summary (JSON) or the report's path, then one stderr line per step that failed (always) or was
+    skipped (unless quiet); a failed step makes the exit status 2, after the report is written."""
     if as_json:
         print_json(found)
     elif not quiet:
         typer.echo(f"report: {found['report']}")
+    _end_on_failed_steps([found], quiet)
+
+
+def _end_on_failed_steps(studies: list[dict], quiet: bool) -> None:
+    failed = [line for found in studies for line in _step_lines(found, STATUS_FAILED)]
+    skipped = [line for found in studies for line in _step_lines(found, STATUS_SKIPPED)]
+    for line in failed + ([] if quiet else skipped):
+        typer.echo(line, err=True)
+    if failed:
+        raise typer.Exit(2)
+
+
+def _step_lines(found: dict, status: str) -> list[str]:
+    label = "error" if status == STATUS_FAILED else "note"
+    return [f"{label}: step {key} {status}: {step.get('reason', '')}" for key, step in found["steps"].items()
+            if step["status"] == status]
 
 
 def phantom(quick: bool = QUICK, out: Path = OUT, seed: int = SEED,
@@ -129,6 +148,7 @@ def _print_equations(echo) -> None:
     import numpy as np
     import sympy as sp
 
+    from hapticdesign.analysis.dynamics.device import inverse_dynamics
     from hapticdesign.analysis.dynamics.symbolic import derive, export
     from hapticdesign.devices.registry import preset
 
@@ -169,6 +189,7 @@ def demo(out: Path = typer.Option(Path("out/demo"), "--out", help="Folder for th
         elif not quiet:
             for name, item in found.items():
                 typer.echo(f"{name} report: {item['report']}")
+        _end_on_failed_steps(list(found.values()), quiet)
 
 
 def register(app: typer.Typer) -> None:

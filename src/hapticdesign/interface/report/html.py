@@ -6,7 +6,7 @@ import base64
 from html import escape
 
 from hapticdesign.interface.report.tables import cell_text
-from hapticdesign.studies.steps import STATUS_DONE, STATUS_MISSING, Figure, Page, StepResult, Table
+from hapticdesign.studies.steps import STATUS_DONE, STATUS_MISSING, STATUS_SKIPPED, Figure, Page, StepResult, Table
 from hapticdesign.studies.study import StudyResult
 
 STYLE = """
@@ -29,6 +29,7 @@ figcaption { font-size: .9em; color: #444; }
 .status-done { color: #1a6b1a; font-weight: bold; }
 .status-not-available { color: #8a6d00; font-weight: bold; }
 .status-failed { color: #a01818; font-weight: bold; }
+.status-skipped { color: #555555; font-weight: bold; }
 .note { font-size: .85em; color: #555; }
 .files { font-size: .8em; }
 """
@@ -80,8 +81,9 @@ def _step(step: StepResult, table_href, figure_stem, page_href) -> str:
     parts = [f'<h2 id="{escape(step.key)}">{escape(step.title)}</h2>',
              f"<p>{_status(step.status)} &middot; {step.seconds:.2f} s</p>"]
     if step.status != STATUS_DONE:
-        why = ("This step builds on one that did not finish, so no numbers are shown."
-               if step.status == STATUS_MISSING else "The engine raised an error; no numbers are shown.")
+        why = {STATUS_MISSING: "This step builds on one that did not finish, so no numbers are shown.",
+               STATUS_SKIPPED: "This step does not apply to this device:"}.get(
+            step.status, "The engine raised an error; no numbers are shown.")
         parts.append(f"<p>{escape(why)}</p><pre>{escape(step.reason)}</pre>")
         return "\n".join(parts)
     out = step.outcome
