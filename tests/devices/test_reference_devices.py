@@ -19,9 +19,10 @@ import numpy as np
 import pytest
 
 from hapticdesign.analysis.dynamics.device import gravity, mass_matrix
+from hapticdesign.analysis.inverse_kinematics import handle_pose
 from hapticdesign.devices.device_file import load_device_file
 from hapticdesign.devices.loading import resolve_device
-from hapticdesign.errors import PhysicalConsistencyWarning
+from hapticdesign.errors import PhysicalConsistencyWarning, UserError
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "devices"
 L1, L2, L3, L5, L6 = 0.215, 0.170, 0.0325, -0.0368, 0.0527
@@ -83,3 +84,74 @@ def test_phantom_loads_with_a_warning_for_the_published_inertias():
         resolve_device(device_file=EXAMPLES / "phantom-premium.yaml")
     text = " ".join(str(w.message) for w in caught)
     assert "body be" in text and "body df" in text and "triangle inequality" in text
+
+
+FALCON = {"a": 0.060, "b": 0.1025, "c": 0.014, "d": 0.01125, "e": 0.01125, "f": -0.025, "r": 0.037233758,
+          "s": -0.027330909}
+PHY = (math.pi / 2 + math.pi / 12, -math.pi / 6 + math.pi / 12, -5 * math.pi / 6 + math.pi / 12)
+
+
+def stamper_arm_angles(position) -> np.ndarray:
+    """libnifalcon's inverse kinematics (Stamper's delta), re-derived: in leg i's frame (the base turned by
+    phy_i, moved by (r, s)), v = b cos theta3 - f fixes theta3; the knee circle
+    (u + c - a cos theta1)^2 + (w - a sin theta1)^2 = (d + e + b sin theta3)^2 fixes theta1: with
+    t = tan(theta1 / 2) it is the quadratic l2 t^2 + l1 t + l0 = 0, of which libnifalcon takes the root
+    (-l1 - sqrt(l1^2 - 4 l0 l2)) / (2 l2)."""
+    g = FALCON
+    out = []
+    for phy in PHY:
+        c, s = math.cos(phy), math.sin(phy)
+        x, y, z = position
+        u, v, w = c * x + s * y - g["r"], -s * x + c * y - g["s"], z
+        theta3 = math.acos((v + g["f"]) / g["b"])
+        reach = g["d"] + g["e"] + g["b"] * math.sin(theta3)
+        k = (u + g["c"]) ** 2 + w**2 + g["a"] ** 2 - reach**2
+        l2, l1, l0 = k + 2 * g["a"] * (u + g["c"]), -4 * g["a"] * w, k - 2 * g["a"] * (u + g["c"])
+        out.append(2 * math.atan((-l1 - math.sqrt(l1**2 - 4 * l0 * l2)) / (2 * l2)))
+    return np.array(out)
+
+
+@pytest.fixture(scope="module")
+def falcon():
+    return load_device_file(EXAMPLES / "falcon.yaml")
+
+
+def test_falcon_ik_at_the_centre_puts_every_arm_at_14_567_degrees(falcon):
+    pose = handle_pose(falcon, [0.0, 0.0, 0.11])
+    assert np.degrees(pose.q) == pytest.approx([14.567] * 3, abs=5e-4)
+    assert np.allclose(pose.q, stamper_arm_angles([0.0, 0.0, 0.11]), atol=1e-9)
+
+
+@pytest.mark.parametrize("position", [(0.03, -0.02, 0.13), (-0.04, 0.03, 0.09), (0.0, 0.045, 0.14), (0.02, 0.0, 0.16)])
+def test_falcon_ik_equals_libnifalcons_closed_form(falcon, position):
+    pose = handle_pose(falcon, position)
+    assert np.allclose(pose.q, stamper_arm_angles(position), atol=1e-9)
+    assert np.allclose(pose.position, position, atol=1e-9)
+
+
+def test_phantom_ik_equals_the_closed_form(phantom):
+    """Elbow-down branch of the arm l1, l2: the triangle of the shoulder, elbow and handle (law of cosines)."""
+    for x, y, z in [(0.2, 0.0, -0.1), (0.1, 0.05, -0.05), (0.15, -0.1, 0.05)]:
+        pose = handle_pose(phantom, [x, y, z])
+        rho, h = math.hypot(x, y), math.hypot(math.hypot(x, y), z)
+        q2 = math.atan2(z, rho) + math.acos((L1**2 + h**2 - L2**2) / (2 * L1 * h))
+        q3 = q2 - math.pi / 2 + math.acos((L1**2 + L2**2 - h**2) / (2 * L1 * L2))
+        assert np.allclose(pose.q, [math.atan2(y, x), q2, q3], atol=1e-9)
+
+
+def test_haply_ik_equals_two_circles_intersection():
+    device = load_device_file(EXAMPLES / "haply-2diy.yaml")
+    d, l1, l2 = 0.038, 0.07, 0.09
+    for x, y in [(0.0, 0.12), (0.03, 0.1), (-0.05, 0.08)]:
+        pose = handle_pose(device, [x, y, 0.0])
+        expected = []
+        for base, side in ((-d / 2, 1.0), (d / 2, -1.0)):
+            reach = math.hypot(x - base, y)
+            expected.append(math.atan2(y, x - base) + side * math.acos((l1**2 + reach**2 - l2**2) / (2 * l1 * reach)))
+        assert np.allclose(pose.q, expected, atol=1e-9)
+
+
+@pytest.mark.parametrize("position, message", [((0.5, 0.0, 0.0), "out of reach"), ((0.0, 0.12, 0.01), "out of reach")])
+def test_haply_ik_refuses_points_out_of_reach_and_off_its_plane(position, message):
+    with pytest.raises(UserError, match=message):
+        handle_pose(load_device_file(EXAMPLES / "haply-2diy.yaml"), position)
