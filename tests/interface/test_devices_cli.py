@@ -7,6 +7,7 @@ FalconKinematicStamper::IK gives for (0, 0, 0.11) m); the rest are the one-line 
 from __future__ import annotations
 
 import json
+import xml.etree.ElementTree as ET
 import math
 from pathlib import Path
 
@@ -36,3 +37,47 @@ def test_ik_bad_positions_are_one_line_errors(position, message):
     result = runner.invoke(app, ["ik", "--device", str(EXAMPLES / "falcon.yaml"), "--position", position])
     assert result.exit_code == 2
     assert result.stderr.count("\n") == 1 and message in result.stderr, result.stderr
+
+
+def test_export_writes_mjcf_that_mujoco_loads_and_escapes_the_device_name(tmp_path):
+    mujoco = pytest.importorskip("mujoco")
+    source = (EXAMPLES / "five-bar.yaml").read_text().replace("name: five-bar", "name: 'five\"bar <&> </mujoco>'")
+    device = tmp_path / "odd.yaml"
+    device.write_text(source)
+    out = tmp_path / "five-bar.xml"
+    result = runner.invoke(app, ["export", "--device", str(device), "--format", "mjcf", "--out", str(out)])
+    assert result.exit_code == 0, result.stderr
+    assert ET.parse(out).getroot().get("model") == 'five"bar <&> </mujoco>'
+    model = mujoco.MjModel.from_xml_path(str(out))
+    assert (model.nv, model.neq) == (4, 1)
+
+
+def test_export_urdf_of_a_tree_loads_in_pinocchio(tmp_path):
+    pin = pytest.importorskip("pinocchio")
+    out = tmp_path / "arm.urdf"
+    result = runner.invoke(app, ["export", "--device", str(EXAMPLES / "arm-3r.toml"), "--format", "urdf", "--out",
+                                 str(out)])
+    assert result.exit_code == 0, result.stderr
+    assert pin.buildModelFromUrdf(str(out)).nv == 3
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--device", str(EXAMPLES / "five-bar.yaml"), "--format", "urdf"], "closed loops"),
+    (["--device", str(EXAMPLES / "phantom-premium.yaml"), "--format", "urdf"], "combination of coordinates"),
+    (["--device", str(EXAMPLES / "five-bar.yaml"), "--format", "sdf"], "--format: unknown format 'sdf'"),
+])
+def test_export_refusals_are_one_line_errors_and_write_nothing(tmp_path, args, message):
+    out = tmp_path / "x.out"
+    result = runner.invoke(app, ["export", *args, "--out", str(out), "--quiet"])
+    assert result.exit_code == 2
+    assert result.stderr.count("\n") == 1 and message in result.stderr, result.stderr
+    assert not out.exists()
+
+
+def test_export_to_an_unwritable_place_is_one_line(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    result = runner.invoke(app, ["export", "--device", str(EXAMPLES / "five-bar.yaml"), "--out",
+                                 str(blocker / "sub" / "m.xml")])
+    assert result.exit_code == 2
+    assert result.stderr.count("\n") == 1 and "cannot write" in result.stderr, result.stderr

@@ -1,5 +1,7 @@
 """A device for other simulators: MJCF (MuJoCo) with loops as equality constraints, URDF for trees.
 
+``hapticdesign export --format mjcf|urdf`` writes them (:func:`export_text`).
+
 Every frame of the device is a chain of elementary transforms (:mod:`hapticdesign.model.transforms`).
 Constant transforms fold into a body's fixed position and orientation; each transform driven by the
 coordinates becomes a joint (hinge for ``Rx``/``Ry``/``Rz``, slide for ``tx``/``ty``/``tz``) with its
@@ -234,3 +236,79 @@ def _actuators(device: Device, root: ET.Element) -> None:
             motor.set("ctrlrange", _fmt([-actuator.torque_peak, actuator.torque_peak]))
         part.append(motor)
     root.append(part)
+
+
+def to_urdf(device: Device) -> Export:
+    """The device as a URDF robot: a tree only (URDF has no loop closures), each coupled transform a joint that
+    ``<mimic>``s the one coordinate it follows (URDF cannot state a combination of two coordinates)."""
+    mech = device.mechanism
+    if mech.loops is not None:
+        raise UserError(f"cannot export {device.name!r} as URDF: it has closed loops, which URDF cannot describe "
+                        "(export it as MJCF)")
+    tree = _Tree(mech)
+    robot = ET.Element("robot", name=device.name)
+    ET.SubElement(robot, "link", name="base")
+    link_of = {"base": "base"}
+    joints: list[JointRow] = []
+    limits = dict(zip(mech.actuated_coordinates, device.joint_limits()))
+    for frame in mech.frames:
+        parent = link_of[frame.parent or "base"]
+        for pose, joint in tree.segments(frame):
+            name = frame.name if joint is None else f"{frame.name}__{len(joints)}"
+            ET.SubElement(robot, "link", name=name)
+            element = ET.SubElement(robot, "joint", name=f"{name}__fixed" if joint is None else joint[1],
+                                    type="fixed")
+            ET.SubElement(element, "parent", link=parent)
+            ET.SubElement(element, "child", link=name)
+            ET.SubElement(element, "origin", xyz=_fmt(pose[:3, 3]),
+                          rpy=_fmt(Rotation.from_matrix(pose[:3, :3]).as_euler("xyz")))
+            if joint is not None:
+                _urdf_joint(mech, element, joint, limits, joints)
+            parent = name
+        link_of[frame.name] = parent
+    for attachment in mech.bodies:
+        b = device.body(attachment.name)
+        name = f"body_{attachment.name}"
+        link = ET.SubElement(robot, "link", name=name)
+        inertial = ET.SubElement(link, "inertial")
+        ET.SubElement(inertial, "origin", xyz=_fmt([b.rx, b.ry, b.rz]), rpy="0 0 0")
+        ET.SubElement(inertial, "mass", value=f"{b.m:.17g}")
+        ET.SubElement(inertial, "inertia", ixx=f"{b.Ixx:.17g}", iyy=f"{b.Iyy:.17g}", izz=f"{b.Izz:.17g}",
+                      ixy=f"{-b.Ixy:.17g}", ixz=f"{-b.Ixz:.17g}", iyz=f"{-b.Iyz:.17g}")
+        fixed = ET.SubElement(robot, "joint", name=f"{name}__fixed", type="fixed")
+        ET.SubElement(fixed, "parent", link=link_of[attachment.frame])
+        ET.SubElement(fixed, "child", link=name)
+    ET.indent(robot)
+    return Export(ET.tostring(robot, encoding="unicode") + "\n", tuple(joints))
+
+
+def _urdf_joint(mech: Mechanism, element: ET.Element, joint, limits: dict, joints: list[JointRow]) -> None:
+    """Type, axis, limits and (for a coupling) the ``<mimic>`` of one driven transform."""
+    kind, name, axis, k, row = joint
+    span = limits.get(name) if k is not None else None
+    element.set("type", ("revolute" if span is not None else "continuous") if kind == "hinge" else "prismatic")
+    ET.SubElement(element, "axis", xyz=_fmt(axis))
+    if kind == "slide" and span is None:
+        raise UserError(f"cannot export {name} as URDF: a prismatic joint needs limits")
+    if span is not None:
+        ET.SubElement(element, "limit", lower=f"{span[0]:.17g}", upper=f"{span[1]:.17g}", effort="0", velocity="0")
+    if k is None:
+        terms = [(i, c) for i, c in enumerate(row) if c]
+        if len(terms) != 1:
+            combination = " ".join(f"{c:+g} {mech.coordinates[i]}" for i, c in terms)
+            raise UserError(f"cannot export as URDF: joint {name} turns with {combination}, a combination of "
+                            "coordinates that URDF's mimic cannot state (export it as MJCF)")
+        ET.SubElement(element, "mimic", joint=mech.coordinates[terms[0][0]], multiplier=f"{terms[0][1]:.17g}")
+        if kind == "hinge" and span is None:
+            element.set("type", "continuous")
+    joints.append(JointRow(name, tuple(float(c) for c in (row if k is None else np.eye(mech.n_dof)[k]))))
+
+
+FORMATS = {"mjcf": to_mjcf, "urdf": to_urdf}
+
+
+def export_text(device: Device, fmt: str) -> str:
+    """The device in format ``mjcf`` or ``urdf``."""
+    if fmt not in FORMATS:
+        raise UserError(f"format: unknown format {fmt!r} (use {' or '.join(FORMATS)})")
+    return FORMATS[fmt](device).text

@@ -10,7 +10,8 @@ from typing import Optional
 import typer
 
 from hapticdesign.devices.loading import resolve_device
-from hapticdesign.interface.common import parse_vector, print_json, user_errors
+from hapticdesign.errors import UserError
+from hapticdesign.interface.common import note, parse_vector, print_json, user_errors
 from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
 
 
@@ -46,5 +47,33 @@ def ik(
             typer.echo(f"  {name} = {value:.9g} (passive)")
 
 
+def export(
+    out: Path = typer.Option(..., "--out", help="File to write (MJCF: .xml; URDF: .urdf)."),
+    fmt: str = typer.Option("mjcf", "--format", help="mjcf (MuJoCo; loops as equality constraints) or urdf (trees "
+                            "only)."),
+    preset: Optional[str] = PRESET,
+    device: Optional[Path] = DEVICE,
+    params: Optional[Path] = PARAMS,
+    strict: bool = STRICT,
+    json_out: bool = JSON_OUT,
+    quiet: bool = QUIET,
+) -> None:
+    """Write the device for other simulators: MJCF with couplings as tendons, loops as connect constraints, motors
+    with gear and armature; or URDF for a device without loops."""
+    from hapticdesign.devices.export import export_text
+    from hapticdesign.files import write_atomically
+
+    with user_errors(strict=strict, quiet=quiet):
+        if fmt not in ("mjcf", "urdf"):
+            raise UserError(f"--format: unknown format {fmt!r} (use mjcf or urdf)")
+        dev = resolve_device(preset, device, params, strict=strict)
+        write_atomically(out, export_text(dev, fmt))
+        if json_out:
+            print_json({"device": dev.name, "format": fmt, "out": str(out)})
+        else:
+            note(f"wrote {out} ({fmt})", quiet)
+
+
 def register(app: typer.Typer) -> None:
     app.command("ik")(ik)
+    app.command("export")(export)

@@ -1,4 +1,5 @@
-"""MJCF export checked in MuJoCo: on trees its mass matrix and bias forces equal ours; on closed loops its
+"""Exports checked in established libraries. URDF of a tree in Pinocchio: its ``crba`` and ``rnea`` equal our
+H and ``C qd + G``. MJCF in MuJoCo: on trees its mass matrix and bias forces equal ours; on closed loops its
 constrained accelerations under a torque equal ours.
 
 Oracles: MuJoCo's ``mj_fullM``, ``qfrc_bias``, its constraint Jacobian ``efc_J`` and its own constrained
@@ -26,9 +27,30 @@ import pytest
 
 from hapticdesign.analysis.dynamics.device import coriolis_matrix, forward_dynamics, gravity, mass_matrix
 from hapticdesign.devices.device_file import load_device_file
-from hapticdesign.devices.export import to_mjcf
+from hapticdesign.devices.export import to_mjcf, to_urdf
 
 mujoco = pytest.importorskip("mujoco")
+
+
+def test_urdf_of_a_tree_equals_pinocchios_dynamics():
+    pin = pytest.importorskip("pinocchio")
+    device = _load("arm-3r.toml")
+    model = pin.buildModelFromXML(to_urdf(device).text)
+    model.gravity.linear[:] = device.mechanism.gravity
+    data = model.createData()
+    rng = np.random.default_rng(3)
+    for _ in range(3):
+        q, qd = rng.uniform(-1, 1, 3), rng.uniform(-2, 2, 3)
+        qp, vp = np.zeros(model.nq), np.zeros(model.nv)
+        for k, name in enumerate(device.mechanism.coordinates):
+            joint = model.joints[model.getJointId(name)]
+            qp[joint.idx_q: joint.idx_q + joint.nq] = [np.cos(q[k]), np.sin(q[k])] if joint.nq == 2 else [q[k]]
+            vp[joint.idx_v] = qd[k]
+        M = pin.crba(model, data, qp)
+        M = np.triu(M) + np.triu(M, 1).T
+        assert np.allclose(M, mass_matrix(device, q), rtol=1e-12, atol=1e-14)
+        bias = pin.rnea(model, data, qp, vp, np.zeros(model.nv))
+        assert np.allclose(bias, coriolis_matrix(device, q, qd) @ qd + gravity(device, q), rtol=1e-12, atol=1e-13)
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "devices"
 
 
