@@ -81,3 +81,37 @@ def test_export_to_an_unwritable_place_is_one_line(tmp_path):
                                  str(blocker / "sub" / "m.xml")])
     assert result.exit_code == 2
     assert result.stderr.count("\n") == 1 and "cannot write" in result.stderr, result.stderr
+
+
+def test_spec_json_and_html_of_the_phantom(tmp_path):
+    """Continuous force at home: motor 2's 11.2 x 28.6 mN m over the 0.215 m upper arm (tests/studies/test_spec.py
+    derives every number by hand); the page puts the vendor's 1.4 N beside it."""
+    result = runner.invoke(app, ["spec", "--device", str(EXAMPLES / "phantom-premium.yaml"), "--no-workspace",
+                                 "--out", str(tmp_path), "--json", "--quiet"])
+    assert result.exit_code == 0, result.stderr
+    sheet = json.loads(result.stdout)
+    assert sheet["force_continuous"] == pytest.approx(11.2 * 0.0286 / 0.215, rel=1e-9)
+    page = (tmp_path / "spec.html").read_text()
+    assert "1.4 N" in page and "800 N/m" in page and "8.5 N" in page
+    assert json.loads((tmp_path / "spec.json").read_text())["force_peak"] == pytest.approx(11.2 * 0.129 / 0.215)
+
+
+def test_spec_page_escapes_the_device_name(tmp_path):
+    source = (EXAMPLES / "haply-2diy.yaml").read_text().replace("name: haply-2diy", "name: '<script>x</script>'")
+    device = tmp_path / "odd.yaml"
+    device.write_text(source)
+    result = runner.invoke(app, ["spec", "--device", str(device), "--no-workspace", "--out", str(tmp_path / "o"),
+                                 "--quiet"])
+    assert result.exit_code == 0, result.stderr
+    page = (tmp_path / "o" / "spec.html").read_text()
+    assert "<script>" not in page and "&lt;script&gt;" in page
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--device", str(EXAMPLES / "pantograph-2dof.yaml")], "singular"),
+    (["--device", str(EXAMPLES / "haply-2diy.yaml"), "--q", "1,2,3"], "--q: expected 2 values"),
+])
+def test_spec_bad_poses_are_one_line_errors(args, message):
+    result = runner.invoke(app, ["spec", *args, "--no-workspace"])
+    assert result.exit_code == 2
+    assert result.stderr.count("\n") == 1 and message in result.stderr, result.stderr

@@ -74,6 +74,58 @@ def export(
             note(f"wrote {out} ({fmt})", quiet)
 
 
+def spec(
+    preset: Optional[str] = PRESET,
+    device: Optional[Path] = DEVICE,
+    params: Optional[Path] = PARAMS,
+    q: Optional[str] = typer.Option(None, "--q", help="Actuated joint coordinates, comma-separated (rad or m); "
+                                    "default the home pose."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Folder for spec.html (beside the vendor's numbers where "
+                                       "known) and spec.json."),
+    rate: float = typer.Option(1000.0, "--rate", min=1.0, max=1e6, help="Servo rate of the renderable stiffness [Hz]."),
+    workspace: bool = typer.Option(True, "--workspace/--no-workspace", help="Search the workspace cube (inverse "
+                                   "kinematics to 26 points per bisection step; the slow part)."),
+    strict: bool = STRICT,
+    json_out: bool = JSON_OUT,
+    quiet: bool = QUIET,
+) -> None:
+    """Spec sheet at a pose: resolution, continuous and peak force, apparent mass, backdrive friction, stiffness,
+    workspace cube and renderable stiffness beside the passivity bounds."""
+    from hapticdesign.files import dumps_json, write_atomically
+    from hapticdesign.studies.spec import spec_sheet
+    from hapticdesign.studies.spec_page import spec_page
+
+    with user_errors(strict=strict, quiet=quiet):
+        dev = resolve_device(preset, device, params, strict=strict)
+        pose = None if q is None else parse_vector(q, dev.n_dof, "q")
+        sheet = spec_sheet(dev, pose, rate=rate, workspace=workspace)
+        if out is not None:
+            write_atomically(out / "spec.json", dumps_json(sheet) + "\n")
+            write_atomically(out / "spec.html", spec_page(sheet))
+            note(f"wrote {out / 'spec.html'} and {out / 'spec.json'}", quiet)
+        if json_out:
+            print_json(sheet)
+            return
+        units = sheet["units"]
+        for key, value in sheet.items():
+            if key != "units":
+                typer.echo(f"{key}: {_text(value)}" + (f" [{units[key]}]" if key in units else ""))
+
+
+def _text(value) -> str:
+    """Numbers with 4 significant digits, dicts as ``key value`` pairs, None as ``not stated``."""
+    if value is None:
+        return "not stated"
+    if isinstance(value, dict):
+        return ", ".join(f"{k} {_text(v)}" for k, v in value.items())
+    if isinstance(value, (float, int)):
+        return f"{value:.4g}"
+    if isinstance(value, str):
+        return value
+    return "(" + ", ".join(f"{v:.4g}" for v in value) + ")"
+
+
 def register(app: typer.Typer) -> None:
     app.command("ik")(ik)
     app.command("export")(export)
+    app.command("spec")(spec)
