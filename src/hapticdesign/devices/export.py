@@ -10,7 +10,8 @@ driven by ``+-q_k`` alone is coordinate ``k``'s joint (named as the coordinate);
 transform (a coupling such as the Phantom's ``q2 - q3``) is a joint of its own, tied to the coordinates
 by a fixed tendon held at zero length (MJCF) or by ``<mimic>`` (URDF, one coordinate only). Loops close
 with ``connect`` constraints between sites at the two frames (``weld`` for a whole pose; a planar closure
-in two components becomes a ``connect`` whose third component holds already, a redundant constraint). Motors become ``motor`` actuators with the
+in two components becomes a ``connect`` whose third component holds already, a redundant constraint).
+Motors become ``motor`` actuators with the
 transmission ratio as ``gear`` and the reflected rotor inertia as ``armature``, on the coordinate's joint or,
 for a motor on a combination of coordinates, on a fixed tendon. Names are escaped by the XML writer.
 

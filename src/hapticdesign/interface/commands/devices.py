@@ -1,5 +1,5 @@
 """Commands ``ik``, ``spec`` and ``export``: a device's inverse kinematics, its spec sheet, and its model for
-other simulators (:mod:`hapticdesign.analysis.inverse_kinematics`, :mod:`hapticdesign.devices.spec`,
+other simulators (:mod:`hapticdesign.analysis.inverse_kinematics`, :mod:`hapticdesign.studies.spec`,
 :mod:`hapticdesign.devices.export`)."""
 
 from __future__ import annotations
@@ -24,8 +24,9 @@ def ik(
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
 ) -> None:
-    """Inverse kinematics: the actuated (and passive) joint coordinates that put the handle at a position, on
-    the branch of the home pose (continued from home along the straight segment)."""
+    """Inverse kinematics by Newton on the geometric Jacobian (seed 000 eq. 2.20-2.26): the actuated (and
+    passive) joint coordinates that put the handle at a position, on the branch of the home pose (continued from
+    home along the straight segment)."""
     from hapticdesign.analysis.inverse_kinematics import handle_pose
 
     with user_errors(strict=strict, quiet=quiet):
@@ -58,8 +59,8 @@ def export(
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
 ) -> None:
-    """Write the device for other simulators: MJCF with couplings as tendons, loops as connect constraints, motors
-    with gear and armature; or URDF for a device without loops."""
+    """Write the device's seed 000 eq. 2.50 dynamics for other simulators: MJCF with couplings as tendons,
+    loops as connect constraints, motors with gear and armature; or URDF for a device without loops."""
     from hapticdesign.devices.export import export_text
     from hapticdesign.files import write_atomically
 
@@ -89,8 +90,9 @@ def spec(
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
 ) -> None:
-    """Spec sheet at a pose: resolution, continuous and peak force, apparent mass, backdrive friction, stiffness,
-    workspace cube and renderable stiffness beside the passivity bounds."""
+    """Spec sheet at a pose (seed 001 ch. 4 metrics, seed 000 §4 rendering): resolution, continuous and peak
+    force, apparent mass, backdrive friction, VJM stiffness (seed 001 §5.2), workspace cube and renderable
+    stiffness beside the passivity bounds."""
     from hapticdesign.files import dumps_json, write_atomically
     from hapticdesign.studies.spec import spec_sheet
     from hapticdesign.studies.spec_page import spec_page
