@@ -31,7 +31,7 @@ from scipy.spatial.transform import Rotation
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.model.mechanism import Mechanism
-from hapticdesign.model.transforms import Axis, elementary_matrix
+from hapticdesign.model.transforms import elementary_matrix
 
 BOUND_MASS = 1e-9
 BOUND_INERTIA = 1e-12
@@ -84,7 +84,6 @@ class _Tree:
     def __init__(self, mech: Mechanism):
         self.mech = mech
         self.primary = _primaries(mech)
-        self.joints: list[JointRow] = []
 
     def segments(self, frame) -> list[tuple[np.ndarray, tuple | None]]:
         """``(fixed pose, (name, kind, axis, coordinate or None, row))`` per driven transform, then the rest."""
