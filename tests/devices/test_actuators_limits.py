@@ -160,6 +160,13 @@ def test_pose_outside_the_limits_is_computed_with_one_warning(pendulum_file):
     ({"actuators": [{"joint": "q1", "gear_ratio": 0}]}, "actuators[0].gear_ratio"),
     ({"actuators": [{"joint": "q1", "rotor_inertia": -1e-6}]}, "actuators[0].rotor_inertia"),
     ({"actuators": [{"joint": "q1", "inertia": 1e-6}]}, "actuators[0].inertia: unknown key"),
+    ({"actuators": [{"joint": "q1", "torque_continuous": -0.03}]}, "actuators[0].torque_continuous"),
+    ({"actuators": [{"joint": "q1", "torque_peak": 0}]}, "actuators[0].torque_peak"),
+    ({"actuators": [{"joint": "q1", "torque_continuous": 0.03, "torque_peak": 0.01}]},
+     "actuators[0].torque_peak: 0.01 N m is below torque_continuous"),
+    ({"actuators": [{"joint": "q1", "encoder_cpr": 0}]}, "actuators[0].encoder_cpr"),
+    ({"actuators": [{"joint": "q1", "encoder_cpr": 512.5}]}, "actuators[0].encoder_cpr"),
+    ({"actuators": [{"joint": "q1", "encoder_cpr": 512, "quadrature": 3}]}, "actuators[0].quadrature"),
 ])
 def test_bad_limits_and_actuators_are_one_line_errors(tmp_path, change, message):
     path = tmp_path / "bad.json"
@@ -167,6 +174,17 @@ def test_bad_limits_and_actuators_are_one_line_errors(tmp_path, change, message)
     result = runner.invoke(app, ["dynamics", "--device", str(path), "--q", "0"])
     assert result.exit_code == 2
     assert result.stderr.count("\n") == 1 and message in result.stderr, result.stderr
+
+
+def test_motor_ratings_and_encoder_reach_the_model(tmp_path):
+    """1024 lines x4 behind an 11.6 ratio: 4096 * 11.6 / (2 pi) counts per joint radian."""
+    path = tmp_path / "rated.json"
+    motor = {"joint": "q1", "gear_ratio": RATIO, "torque_continuous": 0.0286, "torque_peak": 0.129, "encoder_cpr": 1024}
+    path.write_text(json.dumps(pendulum(actuators=[motor])))
+    (actuator,) = load_device_file(path).actuators
+    assert (actuator.torque_continuous, actuator.torque_peak, actuator.encoder_cpr, actuator.quadrature) == (
+        0.0286, 0.129, 1024, 4)
+    assert actuator.counts_per_radian == pytest.approx(1024 * 4 * RATIO / (2 * math.pi), rel=1e-15)
 
 
 URDF = """<robot name="two">

@@ -104,6 +104,9 @@ def _json_cases(tmp: Path) -> dict[tuple[str, ...], list]:
         ("stability-boundary",): ["--inertia", "0.01", "--damping", "0.1", "--period", "0.001", "--samples", "400"],
         ("metrics",): ["--q", "0.1,0.5,0.3"],
         ("stiffness",): ["--device", RCUBE_FILE, "--wrench", "0,0,-5"],
+        ("ik",): ["--device", RCUBE_FILE.parent / "falcon.yaml", "--position", "0,0,0.11"],
+        ("spec",): ["--device", RCUBE_FILE.parent / "haply-2diy.yaml", "--no-workspace"],
+        ("export",): ["--device", RCUBE_FILE.parent / "five-bar.yaml", "--out", tmp / "five-bar.xml"],
         ("rcube", "ik"): ["--position", "0.11,0.1,0.12"],
         ("rcube", "fk"): ["--q1", "0.1", "--q2", "0", "--q3", "-0.1"],
         ("rcube", "stiffness"): [],
@@ -247,6 +250,9 @@ def _bad_inputs(tmp: Path) -> dict[tuple[str, ...], list]:
     a_file.write_text("not a folder")
     return {
         ("dynamics",): ["--q", "1,2"],
+        ("ik",): ["--device", RCUBE_FILE.parent / "falcon.yaml", "--position", "0.5,0,0"],
+        ("spec",): ["--device", RCUBE_FILE.parent / "haply-2diy.yaml", "--q", "1", "--no-workspace"],
+        ("export",): ["--device", RCUBE_FILE.parent / "five-bar.yaml", "--out", a_file / "m.xml"],
         ("eom",): ["--format", "pdf"],
         ("ln",): ["--region", "q3=2:1"],
         ("linearize",): ["--find", "-1"],

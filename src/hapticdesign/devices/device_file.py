@@ -84,7 +84,8 @@ def _actuators(spec: DeviceFileSpec) -> tuple[Actuator, ...]:
         coupling = () if a.drives is None else terms
         offset = 0.0 if a.drives is None else float(a.drives.constant)
         limits = None if a.limits is None else (float(a.limits[0]), float(a.limits[1]))
-        out.append(Actuator(terms[0][0], a.rotor_inertia, a.gear_ratio, a.coulomb, a.damping, coupling, offset, limits))
+        out.append(Actuator(terms[0][0], a.rotor_inertia, a.gear_ratio, a.coulomb, a.damping, coupling, offset, limits,
+                            a.torque_continuous, a.torque_peak, a.encoder_cpr, a.quadrature))
     return tuple(out)
 
 

@@ -157,7 +157,9 @@ class ActuatorSpec(_FileModel):
     """A motor on ``joint``, or on the affine combination ``drives`` of actuated coordinates (such as
     ``theta2 + theta3``; :mod:`hapticdesign.model.actuators`): rotor inertia [kg m^2], transmission
     ratio (rotor rad per joint rad or m), Coulomb friction (N m or N) and viscous damping on the side of
-    what it turns, and optional ``limits`` of its travel (of ``drives``, in joint units)."""
+    what it turns, and optional ``limits`` of its travel (of ``drives``, in joint units); the motor's
+    continuous and peak torque (N m at the motor) and its encoder's counts per revolution and
+    quadrature factor, where known."""
 
     joint: Identifier | None = None
     drives: Expression | None = None
@@ -166,6 +168,10 @@ class ActuatorSpec(_FileModel):
     gear_ratio: Annotated[Number, Field(gt=0.0)] = 1.0
     coulomb: Annotated[Number, Field(ge=0.0)] = 0.0
     damping: Annotated[Number, Field(ge=0.0)] = 0.0
+    torque_continuous: Annotated[Number, Field(gt=0.0)] | None = None
+    torque_peak: Annotated[Number, Field(gt=0.0)] | None = None
+    encoder_cpr: Annotated[int, Field(strict=True, gt=0, le=10**9)] | None = None
+    quadrature: Literal[1, 2, 4] = 4
 
 
 def _components(value: object) -> tuple[int, ...]:
@@ -439,6 +445,10 @@ def _check_limits_and_actuators(spec: DeviceFileSpec, coordinates: list[str]) ->
         if actuator.limits is not None and not actuator.limits[0] < actuator.limits[1]:
             raise ValueError(f"actuators[{i}].limits: need low < high, got [{actuator.limits[0]:g}, "
                              f"{actuator.limits[1]:g}]")
+        if (actuator.torque_continuous is not None and actuator.torque_peak is not None
+                and actuator.torque_peak < actuator.torque_continuous):
+            raise ValueError(f"actuators[{i}].torque_peak: {actuator.torque_peak:g} N m is below torque_continuous "
+                             f"{actuator.torque_continuous:g} N m")
         if actuator.joint is not None and terms in driven:
             raise ValueError(f"actuators[{i}].joint: joint {actuator.joint} has two actuators (give one per joint)")
         driven.append(terms)

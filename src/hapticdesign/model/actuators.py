@@ -34,7 +34,10 @@ class Actuator:
 
     ``coupling`` holds ``(coordinate, coefficient)`` pairs of ``a`` (empty: ``a`` is the unit vector
     of ``joint``); ``offset`` is ``a_0`` and ``limits`` the range of ``a^T q + a_0`` (the motor's
-    travel, in joint units), or ``None``.
+    travel, in joint units), or ``None``. ``torque_continuous`` and ``torque_peak`` are the motor's
+    rated torques (N m at the motor shaft, before the transmission), ``encoder_cpr`` its encoder's
+    counts per motor revolution as the data sheet gives them (lines; ``quadrature`` edges per line,
+    4 for x4 decoding); ``None`` when not known.
     """
 
     joint: int
@@ -45,6 +48,17 @@ class Actuator:
     coupling: tuple[tuple[int, float], ...] = ()
     offset: float = 0.0
     limits: Limits = None
+    torque_continuous: float | None = None
+    torque_peak: float | None = None
+    encoder_cpr: int | None = None
+    quadrature: int = 4
+
+    @property
+    def counts_per_radian(self) -> float | None:
+        """Encoder counts per radian (or metre) of ``a^T q``: ``cpr * quadrature * n / (2 pi)``."""
+        if self.encoder_cpr is None:
+            return None
+        return self.encoder_cpr * self.quadrature * self.gear_ratio / (2.0 * math.pi)
 
     @property
     def reflected_inertia(self) -> float:

@@ -1,0 +1,133 @@
+"""Commands ``ik``, ``spec`` and ``export``: a device's inverse kinematics, its spec sheet, and its model for
+other simulators (:mod:`hapticdesign.analysis.inverse_kinematics`, :mod:`hapticdesign.studies.spec`,
+:mod:`hapticdesign.devices.export`)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+from hapticdesign.devices.loading import resolve_device
+from hapticdesign.errors import UserError
+from hapticdesign.interface.common import note, parse_vector, print_json, user_errors
+from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
+
+
+def ik(
+    position: str = typer.Option(..., "--position", help="Handle position x,y,z in the device's base frame (m)."),
+    preset: Optional[str] = PRESET,
+    device: Optional[Path] = DEVICE,
+    params: Optional[Path] = PARAMS,
+    strict: bool = STRICT,
+    json_out: bool = JSON_OUT,
+    quiet: bool = QUIET,
+) -> None:
+    """Inverse kinematics by Newton on the geometric Jacobian (seed 000 eq. 2.20-2.26): the actuated (and
+    passive) joint coordinates that put the handle at a position, on the branch of the home pose (continued from
+    home along the straight segment)."""
+    from hapticdesign.analysis.inverse_kinematics import handle_pose
+
+    with user_errors(strict=strict, quiet=quiet):
+        dev = resolve_device(preset, device, params, strict=strict)
+        target = parse_vector(position, 3, "position")
+        pose = handle_pose(dev, target)
+        result = {"device": dev.name, "position": target, "q": pose.q, "passive": pose.passive,
+                  "coordinates": list(dev.mechanism.actuated_coordinates),
+                  "passive_coordinates": [dev.mechanism.coordinates[k] for k in
+                                          (dev.mechanism.loops.passive if dev.mechanism.loops else ())],
+                  "units": {"position": "m", "q": "rad or m", "passive": "rad or m"}}
+        if json_out:
+            print_json(result)
+            return
+        typer.echo(f"{dev.name}: handle at ({', '.join(f'{v:.6g}' for v in target)}) m")
+        for name, value in zip(result["coordinates"], pose.q):
+            typer.echo(f"  {name} = {value:.9g}")
+        for name, value in zip(result["passive_coordinates"], pose.passive):
+            typer.echo(f"  {name} = {value:.9g} (passive)")
+
+
+def export(
+    out: Path = typer.Option(..., "--out", help="File to write (MJCF: .xml; URDF: .urdf)."),
+    fmt: str = typer.Option("mjcf", "--format", help="mjcf (MuJoCo; loops as equality constraints) or urdf (trees "
+                            "only)."),
+    preset: Optional[str] = PRESET,
+    device: Optional[Path] = DEVICE,
+    params: Optional[Path] = PARAMS,
+    strict: bool = STRICT,
+    json_out: bool = JSON_OUT,
+    quiet: bool = QUIET,
+) -> None:
+    """Write the device's seed 000 eq. 2.50 dynamics for other simulators: MJCF with couplings as tendons,
+    loops as connect constraints, motors with gear and armature; or URDF for a device without loops."""
+    from hapticdesign.devices.export import export_text
+    from hapticdesign.files import write_atomically
+
+    with user_errors(strict=strict, quiet=quiet):
+        if fmt not in ("mjcf", "urdf"):
+            raise UserError(f"--format: unknown format {fmt!r} (use mjcf or urdf)")
+        dev = resolve_device(preset, device, params, strict=strict)
+        write_atomically(out, export_text(dev, fmt))
+        if json_out:
+            print_json({"device": dev.name, "format": fmt, "out": str(out)})
+        else:
+            note(f"wrote {out} ({fmt})", quiet)
+
+
+def spec(
+    preset: Optional[str] = PRESET,
+    device: Optional[Path] = DEVICE,
+    params: Optional[Path] = PARAMS,
+    q: Optional[str] = typer.Option(None, "--q", help="Actuated joint coordinates, comma-separated (rad or m); "
+                                    "default the home pose."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Folder for spec.html (beside the vendor's numbers where "
+                                       "known) and spec.json."),
+    rate: float = typer.Option(1000.0, "--rate", min=1.0, max=1e6, help="Servo rate of the renderable stiffness [Hz]."),
+    workspace: bool = typer.Option(True, "--workspace/--no-workspace", help="Search the workspace cube (inverse "
+                                   "kinematics to 26 points per bisection step; the slow part)."),
+    strict: bool = STRICT,
+    json_out: bool = JSON_OUT,
+    quiet: bool = QUIET,
+) -> None:
+    """Spec sheet at a pose (seed 001 ch. 4 metrics, seed 000 §4 rendering): resolution, continuous and peak
+    force, apparent mass, backdrive friction, VJM stiffness (seed 001 §5.2), workspace cube and renderable
+    stiffness beside the passivity bounds."""
+    from hapticdesign.files import dumps_json, write_atomically
+    from hapticdesign.studies.spec import spec_sheet
+    from hapticdesign.studies.spec_page import spec_page
+
+    with user_errors(strict=strict, quiet=quiet):
+        dev = resolve_device(preset, device, params, strict=strict)
+        pose = None if q is None else parse_vector(q, dev.n_dof, "q")
+        sheet = spec_sheet(dev, pose, rate=rate, workspace=workspace)
+        if out is not None:
+            write_atomically(out / "spec.json", dumps_json(sheet) + "\n")
+            write_atomically(out / "spec.html", spec_page(sheet))
+            note(f"wrote {out / 'spec.html'} and {out / 'spec.json'}", quiet)
+        if json_out:
+            print_json(sheet)
+            return
+        units = sheet["units"]
+        for key, value in sheet.items():
+            if key != "units":
+                typer.echo(f"{key}: {_text(value)}" + (f" [{units[key]}]" if key in units else ""))
+
+
+def _text(value) -> str:
+    """Numbers with 4 significant digits, dicts as ``key value`` pairs, None as ``not stated``."""
+    if value is None:
+        return "not stated"
+    if isinstance(value, dict):
+        return ", ".join(f"{k} {_text(v)}" for k, v in value.items())
+    if isinstance(value, (float, int)):
+        return f"{value:.4g}"
+    if isinstance(value, str):
+        return value
+    return "(" + ", ".join(f"{v:.4g}" for v in value) + ")"
+
+
+def register(app: typer.Typer) -> None:
+    app.command("ik")(ik)
+    app.command("export")(export)
+    app.command("spec")(spec)

@@ -1,0 +1,225 @@
+"""A device's spec sheet: the quantities vendors print, computed from the device file at a pose.
+
+With ``J_v`` the handle's translational Jacobian over the actuated coordinates (``J T`` with loops), ``H``
+the mass matrix with the reflected rotor inertia, and the motors' transmission ``A`` (row k: the
+combination ``a_k^T q`` motor k turns through ratio ``n_k``), one motor count, a motor torque and a motor's
+friction reach the handle as follows:
+
+- ``resolution`` (m): one count of motor k turns ``a_k^T q`` by ``Delta_k = 2 pi / (cpr_k quadrature_k n_k)``
+  and moves the handle by ``J_v A^-1 e_k Delta_k``; the sheet gives the largest of these over k.
+- ``force_continuous`` / ``force_peak`` (N): the radius of the largest ball inside the force polytope
+  ``{F : |(A^-T J_v^T F)_k| <= n_k tau_k}`` (motor torques at their rating; gravity not included). The
+  polytope is symmetric about 0, so the ball is centred there and its radius is the smallest distance
+  ``n_k tau_k / |g_k|`` to a facet (``g_k`` row k of ``A^-T J_v^T``). A device of fewer than three actuated
+  coordinates is measured in the plane (or line) its handle moves in.
+- ``apparent_mass`` (kg): the eigenvalues of ``(J_v H^-1 J_v^T)^+`` on that range.
+- ``backdrive_friction`` (N): the motors' Coulomb friction ``f_k`` (on ``a_k^T q``) as a force at the handle:
+  moving along a unit direction ``u`` at speed v dissipates ``sum_k f_k |a_k^T qd|`` with ``J_v qd = u v``,
+  so the handle feels ``sum_k f_k |(A J_v^+ u)_k|``; its smallest and largest value over directions
+  (exact, :func:`backdrive_friction`).
+- ``stiffness`` (N/m): the smallest eigenvalue of the translational block of the VJM ``K_C`` where the file's
+  links carry sections (:mod:`hapticdesign.analysis.stiffness.device`).
+- ``workspace`` (mm): the edge of the largest cube (square for a planar device) centred on the home handle
+  position whose corners, edge midpoints and face centres the handle reaches from home by inverse
+  kinematics (:mod:`hapticdesign.analysis.inverse_kinematics`) within the joint limits and without a
+  singularity, found by bisection.
+- ``renderable_stiffness`` (N/m): the exact stability limit of a virtual spring sampled every T with a
+  delay of one sample (:func:`hapticdesign.simulation.boundary.exact_boundary`) on the 1-DOF model of the
+  handle along a direction u: mass ``1 / (u^T J_v H^-1 J_v^T u)`` and damping ``u^T J_v^+T B J_v^+ u`` (B the
+  joint and motor viscous damping); the smallest over the axes, the principal directions and 60 evenly
+  spread directions. A pure spring uses the position only, so
+  the velocity estimate does not enter. Beside it the passivity bounds of Abbott & Okamura (2005):
+  ``2 b / T`` (viscous) and ``2 f_c / Delta`` (Coulomb friction against encoder quantization), with the
+  smallest damping (eigenvalue) and friction over directions and the resolution ``Delta``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from hapticdesign.analysis.dynamics.device import mass_matrix
+from hapticdesign.analysis.inverse_kinematics import handle_pose, home_actuated
+from hapticdesign.analysis.kinematics import actuated_jacobian, actuated_pose
+from hapticdesign.errors import UserError
+from hapticdesign.model.actuators import transmission
+from hapticdesign.model.device import Device
+from hapticdesign.simulation.boundary import MassDamper, exact_boundary
+
+SERVO_RATE = 1000.0
+"""Hz, the default sampling rate of the renderable-stiffness limit."""
+DIRECTIONS = 60
+"""Directions spread over the sphere (circle for a planar device) for the worst wall direction."""
+CUBE_SEARCH = (0.0, 0.4, 12)
+"""Bisection of the workspace cube's half edge: lower and upper bound (m) and number of halvings."""
+
+
+@dataclass(frozen=True)
+class Handle:
+    """The handle's kinematics and dynamics at one pose, in the range of ``J_v`` (basis ``U``)."""
+
+    q: np.ndarray
+    position: np.ndarray
+    jacobian: np.ndarray
+    basis: np.ndarray
+    mass: np.ndarray
+
+
+def handle_at(device: Device, q) -> Handle:
+    q = np.asarray(q, dtype=float)
+    mech = device.mechanism
+    jv = actuated_jacobian(mech, q)[:3]
+    u, s, _ = np.linalg.svd(jv)
+    rank = int(np.sum(s > 1e-9 * s[0]))
+    if rank < device.n_dof:
+        raise UserError(f"the pose ({', '.join(f'{v:.6g}' for v in q)}) is singular: the handle's Jacobian has rank "
+                        f"{rank} < {device.n_dof}")
+    return Handle(q, actuated_pose(mech, q)[:3, 3], jv, u[:, :rank], mass_matrix(device, q))
+
+
+def _motor_map(device: Device) -> np.ndarray | None:
+    """``A^-1`` (coordinates x motors), or None when the motors are not one per coordinate."""
+    if len(device.actuators) != device.n_dof:
+        return None
+    a = transmission(device.actuators, device.n_dof)
+    return np.linalg.inv(a)
+
+
+def directions(dim: int, count: int = DIRECTIONS) -> np.ndarray:
+    """Evenly spread unit vectors (Fibonacci sphere; a half circle in 2-D, a line in 1-D), symmetric use."""
+    if dim == 1:
+        return np.ones((1, 1))
+    if dim == 2:
+        t = np.pi * np.arange(count) / count
+        return np.stack([np.cos(t), np.sin(t)], axis=1)
+    k = np.arange(count) + 0.5
+    z = 1.0 - k / count
+    r = np.sqrt(1.0 - z**2)
+    phi = np.pi * (3.0 - math.sqrt(5.0)) * k
+    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
+
+
+def resolution(device: Device, h: Handle) -> float | None:
+    inv = _motor_map(device)
+    if inv is None or any(a.encoder_cpr is None for a in device.actuators):
+        return None
+    steps = [h.jacobian @ inv[:, k] / a.counts_per_radian for k, a in enumerate(device.actuators)]
+    return float(max(np.linalg.norm(s) for s in steps))
+
+
+def inscribed_force(device: Device, h: Handle, which: str) -> float | None:
+    """Radius of the largest ball in the force polytope (in the handle's range)."""
+    inv = _motor_map(device)
+    torques = [getattr(a, f"torque_{which}") for a in device.actuators]
+    if inv is None or any(t is None for t in torques):
+        return None
+    g = inv.T @ h.jacobian.T @ h.basis
+    limits = np.array([a.gear_ratio * t for a, t in zip(device.actuators, torques)])
+    return float(np.min(limits / np.linalg.norm(g, axis=1)))
+
+
+def apparent_mass(device: Device, h: Handle) -> tuple[float, float]:
+    mobility, _ = _cartesian(device, h)
+    eig = 1.0 / np.linalg.eigvalsh(mobility)
+    return float(eig.min()), float(eig.max())
+
+
+def backdrive_friction(device: Device, h: Handle) -> tuple[float, float] | None:
+    """Smallest and largest ``||C u||_1`` over unit u, ``C = diag(f) A J_v^+ U`` (square when the motors are one
+    per coordinate): the smallest is ``min_k 1 / |C^-1 e_k|`` (the vertices of ``{u : ||C u||_1 <= 1}``), the
+    largest ``max_s |C^T s|`` over sign vectors s."""
+    if not device.actuators or not any(a.coulomb for a in device.actuators):
+        return None
+    a = transmission(device.actuators, device.n_dof)
+    c = np.array([x.coulomb for x in device.actuators])[:, None] * (a @ np.linalg.pinv(h.jacobian) @ h.basis)
+    if c.shape[0] != c.shape[1]:
+        return None
+    inv = np.linalg.inv(c)
+    signs = np.array(list(np.ndindex(*(2,) * c.shape[0]))) * 2.0 - 1.0
+    return float(1.0 / np.linalg.norm(inv, axis=0).max()), float(np.linalg.norm(signs @ c, axis=1).max())
+
+
+def _cartesian(device: Device, h: Handle) -> tuple[np.ndarray, np.ndarray]:
+    """The handle's mobility ``U^T J_v H^-1 J_v^T U`` and damping ``U^T J_v^+T B J_v^+ U`` in its range."""
+    mobility = h.basis.T @ h.jacobian @ np.linalg.solve(h.mass, h.jacobian.T) @ h.basis
+    pinv = np.linalg.pinv(h.jacobian) @ h.basis
+    return mobility, pinv.T @ device.damping_matrix @ pinv
+
+
+def wall_directions(device: Device, h: Handle) -> np.ndarray:
+    """The axes, the principal directions of the mobility and of the damping, and evenly spread ones."""
+    mobility, damping = _cartesian(device, h)
+    dim = h.basis.shape[1]
+    return np.vstack([np.eye(dim), np.linalg.eigh(mobility)[1].T, np.linalg.eigh(damping)[1].T,
+                      directions(dim)])
+
+
+def renderable_stiffness(device: Device, h: Handle, rate: float = SERVO_RATE, delay: int = 1) -> float:
+    mobility, damping = _cartesian(device, h)
+    limits = [exact_boundary(MassDamper(1.0 / float(u @ mobility @ u), float(u @ damping @ u), 1.0 / rate, delay))
+              for u in wall_directions(device, h)]
+    return float(min(limits))
+
+
+def workspace_cube(device: Device, h: Handle) -> float:
+    """Edge (m) of the largest cube (square) around the home handle position reached from home."""
+    basis = h.basis
+    signs = [s for s in np.ndindex(*(3,) * basis.shape[1]) if any(v != 1 for v in s)]
+    offsets = np.array([[v - 1.0 for v in s] for s in signs]) @ basis.T
+
+    def reaches(half: float) -> bool:
+        for offset in offsets:
+            try:
+                handle_pose(device, h.position + half * offset, start=h.q)
+            except UserError:
+                return False
+        return True
+
+    lo, hi, halvings = CUBE_SEARCH
+    if reaches(hi):
+        return 2 * hi
+    for _ in range(halvings):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if reaches(mid) else (lo, mid)
+    return 2 * lo
+
+
+def spec_sheet(device: Device, q=None, rate: float = SERVO_RATE, workspace: bool = True) -> dict:
+    """Every quantity of the module docstring at pose ``q`` (default: home), as a JSON-ready dict."""
+    q = home_actuated(device) if q is None else np.asarray(q, dtype=float)
+    h = handle_at(device, q)
+    res = resolution(device, h)
+    friction = backdrive_friction(device, h)
+    _, damping = _cartesian(device, h)
+    smallest_damping = float(np.linalg.eigvalsh(damping).min())
+    mass = apparent_mass(device, h)
+    sheet = {
+        "device": device.name, "q": q, "handle": h.position, "dimensions": h.basis.shape[1],
+        "resolution": res,
+        "force_continuous": inscribed_force(device, h, "continuous"),
+        "force_peak": inscribed_force(device, h, "peak"),
+        "apparent_mass": {"min": mass[0], "max": mass[1]},
+        "backdrive_friction": None if friction is None else {"min": friction[0], "max": friction[1]},
+        "stiffness": _stiffness(device, q),
+        "workspace": {"cube": 1000.0 * workspace_cube(device, h)} if workspace else None,
+        "renderable_stiffness": {
+            "exact": renderable_stiffness(device, h, rate), "rate": rate, "delay_samples": 1,
+            "passivity_viscous": 2.0 * smallest_damping * rate,
+            "passivity_coulomb": None if friction is None or res is None else 2.0 * friction[0] / res,
+        },
+        "units": {"resolution": "m", "force_continuous": "N", "force_peak": "N", "apparent_mass": "kg",
+                  "backdrive_friction": "N", "stiffness": "N/m", "workspace": "mm", "renderable_stiffness": "N/m",
+                  "rate": "Hz", "handle": "m", "q": "rad or m"},
+    }
+    return sheet
+
+
+def _stiffness(device: Device, q: np.ndarray) -> float | None:
+    elasticity = device.elasticity
+    if elasticity is None or not (elasticity.links or elasticity.joints):
+        return None
+    from hapticdesign.analysis.stiffness.device import cartesian_stiffness
+
+    return float(np.linalg.eigvalsh(cartesian_stiffness(device, q)[:3, :3]).min())

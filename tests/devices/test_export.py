@@ -1,0 +1,118 @@
+"""Exports checked in established libraries. URDF of a tree in Pinocchio: its ``crba`` and ``rnea`` equal our
+H and ``C qd + G``. MJCF in MuJoCo: on trees its mass matrix and bias forces equal ours; on closed loops its
+constrained accelerations under a torque equal ours.
+
+Oracles: MuJoCo's ``mj_fullM``, ``qfrc_bias``, its constraint Jacobian ``efc_J`` and its own constrained
+``qacc``. The export has more joints than the device has coordinates (couplings such as the Phantom's
+``q2 - q3`` are joints of their own, tied by tendons), with ``qpos = T q``: ours must be ``T^T M T`` and
+``T^T qfrc_bias`` (T constant, so no T-dot term). The exported frames between two joints carry
+MuJoCo's ``boundmass`` 1e-9 kg and ``boundinertia`` 1e-12 kg m^2 (it refuses moving bodies without mass):
+that bounds the agreement, to 1e-8 kg m^2 on H (25 such bodies at most, 0.5 m from the axes at most) and
+1e-7 N m on the bias (their weight on those arms).
+
+MuJoCo's equality constraints are soft: with impedance d its constraint force is short of the ideal one by
+a factor of order (1 - d). Its accelerations approach ours as d -> 1 (checked on the five-bar and the delta,
+each tenfold step of 1 - d making the error at least 5 times smaller, and within 10 (1 - d) = 1e-3 at
+MuJoCo's stiffest d = 0.9999: measured 5.7e-5 on the five-bar, 7.1e-4 on the delta); the ideal (hard) limit, solved from
+MuJoCo's M, qfrc_bias and efc_J, equals ours within 1e-6 (relative).
+"""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from hapticdesign.analysis.dynamics.device import coriolis_matrix, forward_dynamics, gravity, mass_matrix
+from hapticdesign.devices.device_file import load_device_file
+from hapticdesign.devices.export import to_mjcf, to_urdf
+
+mujoco = pytest.importorskip("mujoco")
+
+
+def test_urdf_of_a_tree_equals_pinocchios_dynamics():
+    pin = pytest.importorskip("pinocchio")
+    device = _load("arm-3r.toml")
+    model = pin.buildModelFromXML(to_urdf(device).text)
+    model.gravity.linear[:] = device.mechanism.gravity
+    data = model.createData()
+    rng = np.random.default_rng(3)
+    for _ in range(3):
+        q, qd = rng.uniform(-1, 1, 3), rng.uniform(-2, 2, 3)
+        qp, vp = np.zeros(model.nq), np.zeros(model.nv)
+        for k, name in enumerate(device.mechanism.coordinates):
+            joint = model.joints[model.getJointId(name)]
+            qp[joint.idx_q: joint.idx_q + joint.nq] = [np.cos(q[k]), np.sin(q[k])] if joint.nq == 2 else [q[k]]
+            vp[joint.idx_v] = qd[k]
+        M = pin.crba(model, data, qp)
+        M = np.triu(M) + np.triu(M, 1).T
+        assert np.allclose(M, mass_matrix(device, q), rtol=1e-12, atol=1e-14)
+        bias = pin.rnea(model, data, qp, vp, np.zeros(model.nv))
+        assert np.allclose(bias, coriolis_matrix(device, q, qd) @ qd + gravity(device, q), rtol=1e-12, atol=1e-13)
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "devices"
+
+
+def _load(name):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return load_device_file(EXAMPLES / name)
+
+
+@pytest.mark.parametrize("name", ["arm-3r.toml", "phantom-3dof-motors.yaml"])
+def test_tree_mass_matrix_and_bias_equal_mujocos(name):
+    device = _load(name)
+    export = to_mjcf(device)
+    model = mujoco.MjModel.from_xml_string(export.text)
+    data = mujoco.MjData(model)
+    T = export.transform()
+    rng = np.random.default_rng(7)
+    for _ in range(3):
+        q, qd = rng.uniform(-1, 1, device.n_dof), rng.uniform(-2, 2, device.n_dof)
+        data.qpos[:], data.qvel[:] = T @ q, T @ qd
+        mujoco.mj_forward(model, data)
+        M = np.zeros((model.nv, model.nv))
+        mujoco.mj_fullM(model, data, M)
+        assert np.allclose(T.T @ M @ T, mass_matrix(device, q), rtol=0, atol=1e-8)
+        assert np.allclose(T.T @ data.qfrc_bias, coriolis_matrix(device, q, qd) @ qd + gravity(device, q), rtol=0,
+                           atol=1e-7)
+
+
+def _accelerations(device, impedance: str | None = None):
+    """Ours, MuJoCo's own and the hard-constraint limit from MuJoCo's matrices, at home under a torque."""
+    text = to_mjcf(device).text
+    if impedance is not None:
+        text = text.replace('solimp="0.9999 0.9999 0.001 0.5 2"', f'solimp="{impedance}"')
+    model = mujoco.MjModel.from_xml_string(text)
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, 0)
+    tau = np.linspace(0.005, -0.003, device.n_dof)
+    dofs = [model.joint(name).dofadr[0] for name in device.mechanism.actuated_coordinates]
+    data.qfrc_applied[dofs] = tau
+    mujoco.mj_forward(model, data)
+    M = np.zeros((model.nv, model.nv))
+    mujoco.mj_fullM(model, data, M)
+    J = data.efc_J.reshape(-1, model.nv)[: data.ne]
+    kkt = np.block([[M, J.T], [J, np.zeros((len(J), len(J)))]])
+    rhs = np.concatenate([data.qfrc_applied - data.qfrc_bias, np.zeros(len(J))])
+    hard = np.linalg.lstsq(kkt, rhs, rcond=None)[0][: model.nv]
+    ours = forward_dynamics(device, np.array(device.mechanism.loops.home), np.zeros(device.n_dof), tau)
+    return ours, data.qacc[dofs].copy(), hard[dofs]
+
+
+@pytest.mark.parametrize("name", ["five-bar.yaml", "delta.yaml", "falcon.yaml"])
+def test_closed_loop_accelerations_equal_the_hard_constraint_limit_of_mujocos_model(name):
+    ours, _, hard = _accelerations(_load(name))
+    assert np.abs(hard - ours).max() <= 1e-6 * np.abs(ours).max()
+
+
+@pytest.mark.parametrize("name", ["five-bar.yaml", "delta.yaml"])
+def test_mujocos_soft_constrained_accelerations_approach_ours(name):
+    device = _load(name)
+    errors = []
+    for d in ("0.99", "0.999", "0.9999"):
+        ours, soft, _ = _accelerations(device, f"{d} {d} 0.001 0.5 2")
+        errors.append(np.abs(soft - ours).max() / np.abs(ours).max())
+    assert errors[1] < errors[0] / 5 and errors[2] < errors[1] / 5
+    assert errors[2] < 1e-3
