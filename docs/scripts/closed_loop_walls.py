@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 import hapticdesign as hd
-from hapticdesign.analysis.kinematics import actuated_jacobian
+from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.devices.device_file import load_device_file
 from hapticdesign.simulation.analytic import AnalyticProblem
 from hapticdesign.simulation.config import LoopConfig, Wall, normal_jacobian, rest_pose
@@ -53,7 +53,7 @@ def main() -> None:
         print(f"| {name} | joint {joint + 1} [N m/rad] | {found[0].k_max:.4g} | {found[1].k_max:.4g} | "
               f"{boundary:.4g} | {closed:.4g} |")
         w = CARTESIAN_JOINT[name]
-        v = actuated_jacobian(device.mechanism, home)[:3, w]
+        v = configuration_of(device).jacobian(home)[:3, w]
         n = v / np.linalg.norm(v)
         j_nw = float(normal_jacobian(device, Wall(w, 1.0, 0.0, 0.0, direction=tuple(n)), home)[w])
         h_ww = float(hd.mass_matrix(device, home)[w, w])

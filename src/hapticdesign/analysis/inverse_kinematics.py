@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.analysis.kinematics import forward_kinematics, jacobian
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
@@ -51,15 +52,9 @@ class _Chain:
     def __init__(self, device: Device, frame: str | None):
         self.mech = device.mechanism
         self.frame = frame
-        loops = self.mech.loops
-        if loops is None:
-            self.solver = None
-            self.full = np.zeros(self.mech.n_dof)
-        else:
-            from hapticdesign.analysis.loops.solver import LoopSolver
-
-            self.solver = LoopSolver(self.mech)
-            self.full = self.solver.home.copy()
+        configuration = configuration_of(device)
+        self.solver = None if configuration.is_tree else configuration.solver
+        self.full = np.zeros(self.mech.n_dof) if self.solver is None else self.solver.home.copy()
 
     def close(self, q_a: np.ndarray) -> np.ndarray:
         if self.solver is None:
@@ -74,8 +69,7 @@ class _Chain:
 
 def home_actuated(device: Device) -> np.ndarray:
     """The file's home pose (zeros for a device without loops)."""
-    loops = device.mechanism.loops
-    return np.array(loops.home if loops is not None else [0.0] * device.n_dof, dtype=float)
+    return configuration_of(device).home.copy()
 
 
 def handle_pose(device: Device, position, frame: str | None = None, start=None, step: float = STEP) -> HandlePose:

@@ -42,7 +42,7 @@ import numpy as np
 
 from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.analysis.inverse_kinematics import handle_pose, home_actuated
-from hapticdesign.analysis.kinematics import actuated_jacobian, actuated_pose
+from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.errors import UserError
 from hapticdesign.model.actuators import transmission
 from hapticdesign.model.device import Device
@@ -69,14 +69,14 @@ class Handle:
 
 def handle_at(device: Device, q) -> Handle:
     q = np.asarray(q, dtype=float)
-    mech = device.mechanism
-    jv = actuated_jacobian(mech, q)[:3]
+    configuration = configuration_of(device)
+    jv = configuration.jacobian(q)[:3]
     u, s, _ = np.linalg.svd(jv)
     rank = int(np.sum(s > 1e-9 * s[0]))
     if rank < device.n_dof:
         raise UserError(f"the pose ({', '.join(f'{v:.6g}' for v in q)}) is singular: the handle's Jacobian has rank "
                         f"{rank} < {device.n_dof}")
-    return Handle(q, actuated_pose(mech, q)[:3, 3], jv, u[:, :rank], mass_matrix(device, q))
+    return Handle(q, configuration.pose(q)[:3, 3], jv, u[:, :rank], mass_matrix(device, q))
 
 
 def _motor_map(device: Device) -> np.ndarray | None:
