@@ -25,6 +25,8 @@ browser:
 demo: $(STAMP)
 	$(BIN)/hapticdesign demo
 
+# pytest -n 2 compiles the rendering loop once in the controller before its two workers start
+# (tests/conftest.py), so that they load it from numba's cache instead of each compiling it.
 test: $(STAMP) browser
 	$(BIN)/python -m pytest -n 2
 

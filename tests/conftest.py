@@ -12,6 +12,22 @@ import pytest
 from hapticdesign.devices.registry import preset
 
 
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "devices"
+
+
+def pytest_configure(config):
+    """With pytest-xdist workers (``-n``), compile the rendering loop here first, for a tree and for a closed-loop
+    device, each with a joint and a Cartesian wall, so that the workers load it from numba's cache instead of
+    each compiling it (an empty cache costs one compile, not one per worker; a warm one milliseconds)."""
+    if hasattr(config, "workerinput") or not config.getoption("numprocesses", None):
+        return
+    from hapticdesign.devices.device_file import load_device_file
+    from hapticdesign.simulation.loop import warm_up
+
+    for device in (preset("phantom-3dof"), load_device_file(EXAMPLES / "five-bar.yaml")):
+        warm_up(device)
+
+
 @pytest.fixture(scope="session")
 def phantom3():
     return preset("phantom-3dof")

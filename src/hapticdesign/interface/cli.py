@@ -12,11 +12,13 @@ import importlib
 import os
 import pkgutil
 import sys
+from contextlib import nullcontext
 
 import typer
 from typer.core import TyperGroup
 
 from hapticdesign.interface import commands
+from hapticdesign.simulation.warmup import compile_notice
 
 CONTENTS = {
     "dynamics": "Equations of motion (seed 000 ch. 2)",
@@ -110,10 +112,19 @@ def _register_all() -> None:
 _register_all()
 
 
+def _notice(line: str) -> None:
+    sys.stderr.write(f"{line}\n")
+    sys.stderr.flush()
+
+
 def main() -> None:
-    """Run the command; an output stream that cannot be written (``> /dev/full``) is one line, exit 2."""
+    """Run the command; an output stream that cannot be written (``> /dev/full``) is one line, exit 2.
+
+    A run that compiles a numba kernel (the first on a machine: later runs load it from numba's cache)
+    says so in one line on stderr first, unless ``--quiet``."""
     try:
-        app()
+        with nullcontext() if "--quiet" in sys.argv[1:] else compile_notice(_notice):
+            app()
         sys.stdout.flush()
     except OSError as exc:
         if isinstance(exc, BrokenPipeError):

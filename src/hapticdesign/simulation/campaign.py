@@ -2,9 +2,11 @@
 
 Design files are CSV with the columns ``level, ln, ln_H, ln_C, ln_G`` and every inertial
 parameter of the device in the seed's names (``m1 ... Iyz3a``); an optional ``design`` column
-names the rows. The LN columns are carried along (``nan`` allowed where unknown); ``level`` groups. Every case (design x criterion x type) runs on Dask workers (local processes by
-default, or a cluster at ``--scheduler``; one task per design) and is written to ``cases/<key>.json``
-the moment its design's task finishes; a rerun skips the cases already written. The aggregation writes the per-design table
+names the rows. The LN columns are carried along (``nan`` allowed where unknown); ``level`` groups. The first design's cases run in
+the calling process before any worker starts, so that the numba kernels are compiled (or loaded) once and left
+in numba's cache for the workers (:mod:`.warmup`); every other case (design x criterion x type) runs on Dask
+workers (local processes by default, or a cluster at ``--scheduler``; one task per design). Each case is
+written to ``cases/<key>.json`` the moment its design's task finishes; a rerun skips the cases already written. The aggregation writes the per-design table
 (``results.csv``), per-level range, mean and standard deviation with the share of designs whose
 type 1 and type 2 results agree (``summary.csv``, ``summary.md``) and the figures.
 """
@@ -309,27 +311,36 @@ def _run_locked(designs: list[Design], out: Path, options: CampaignOptions, sche
     todo = [(d, c, t) for d in designs for c in CRITERIA for t in TYPES
             if not case_done(cases_dir / f"{case_key(d.name, c, t)}.json", d.name, c, t)]
     total = len(designs) * len(CRITERIA) * len(TYPES)
-    if todo:
-        from dask.distributed import as_completed
+    by_design: dict[str, tuple[Design, list[tuple[str, int]]]] = {}
+    for d, c, t in todo:
+        by_design.setdefault(d.name, (d, []))[1].append((c, t))
+    done = total - len(todo)
 
-        client = _client(scheduler, workers, quiet)
-        try:
-            by_design: dict[str, tuple[Design, list[tuple[str, int]]]] = {}
-            for d, c, t in todo:
-                by_design.setdefault(d.name, (d, []))[1].append((c, t))
-            futures = {client.submit(run_design_cases, options.preset, d.params, cases, options, key=f"cases-{d.name}",
-                                     pure=False): (d, cases) for d, cases in by_design.values()}
-            done = total - len(todo)
-            for fut in as_completed(futures):
-                d, cases = futures[fut]
-                for (c, t), result in zip(cases, fut.result()):
-                    record = {"design": d.name, "level": d.level, "criterion": c, "type": t, **result}
-                    write_atomically(cases_dir / f"{case_key(d.name, c, t)}.json", json.dumps(record))
-                    done += 1
-                    if progress is not None:
-                        progress(done, total)
-        finally:
-            _close(client, own_cluster=not scheduler)
+    def record(d: Design, cases: list[tuple[str, int]], results: list[dict]) -> None:
+        nonlocal done
+        for (c, t), result in zip(cases, results):
+            write_atomically(cases_dir / f"{case_key(d.name, c, t)}.json",
+                             json.dumps({"design": d.name, "level": d.level, "criterion": c, "type": t, **result}))
+            done += 1
+            if progress is not None:
+                progress(done, total)
+
+    if by_design:
+        # The first design here, before any worker starts: this process compiles the kernels (or loads them)
+        # once and leaves them in numba's cache, where the workers load them instead of each compiling them.
+        first, *rest = by_design.values()
+        record(*first, run_design_cases(options.preset, first[0].params, first[1], options))
+        if rest:
+            from dask.distributed import as_completed
+
+            client = _client(scheduler, workers, quiet)
+            try:
+                futures = {client.submit(run_design_cases, options.preset, d.params, cases, options,
+                                         key=f"cases-{d.name}", pure=False): (d, cases) for d, cases in rest}
+                for fut in as_completed(futures):
+                    record(*futures[fut], fut.result())
+            finally:
+                _close(client, own_cluster=not scheduler)
     aggregate(designs, out, options)
     return {"cases": total, "run": len(todo), "skipped": total - len(todo)}
 

@@ -448,7 +448,13 @@ def run_loop(plant, ctrl, motion, timing, wall, handle, rec, scratch):
     Compiled without numba's reference counting (``_nrt=False``): the loop allocates nothing (its
     arrays come in ``scratch``), and each array a helper reads from a record would otherwise cost an
     atomic increment and decrement of its reference count in the innermost loop, which took about a
-    third of a tree run's time (Phantom, type 1: 56 -> 17 ms for 5 s)."""
+    third of a tree run's time (Phantom, type 1: 56 -> 17 ms for 5 s).
+
+    The evaluation of the plant (:func:`accelerations` with the record's terms) is inlined at two places
+    only, one for a sample instant and stage 1, one for stages 2-4 and the error estimate's slope (loops
+    over the stages pick their arrays): numba's compile time grows faster than the code it inlines, and
+    the six inlined copies this loop had took most of the 127 CPU-s a fresh install spent on its first
+    ``impedance-range`` (``benchmarks/bench_cold.py``); the arithmetic, and so every trace, is the same."""
     prescribed, path_q, path_qd, path_qdd = motion.prescribed, motion.path_q, motion.path_qd, motion.path_qdd
     step, sub, n_steps, stride, spans, tolerance = (timing.step, timing.sub, timing.n_steps, timing.stride, timing.spans,
                                                     timing.tolerance)
@@ -487,8 +493,15 @@ def run_loop(plant, ctrl, motion, timing, wall, handle, rec, scratch):
     taken = 0
     while True:
         t = it * step
-        if it % sub == 0:
-            accelerations(q, qd, path_qdd[2 * it], u, prescribed, plant, qdd, c1)
+        # one evaluation of the plant, inlined once for both uses: at a sample instant the sensors'
+        # acceleration under the torque held so far (phase 0), then stage 1 under the new torque (phase 1,
+        # which also gives the recorded constraint torque)
+        phase = 0 if it % sub == 0 else 1
+        while True:
+            accelerations(q, qd, path_qdd[2 * it], u, prescribed, plant, qdd if phase == 0 else a1, c1, True)
+            if phase == 1:
+                break
+            phase = 1
             if it == 0:
                 for i in range(n):
                     if not prescribed[i]:
@@ -515,8 +528,6 @@ def run_loop(plant, ctrl, motion, timing, wall, handle, rec, scratch):
                     tau_imp[i] = 0.0
             for i in range(n):
                 u[i] = tau_f[i] - tau_imp[i]
-        # stage 1 (also gives the recorded constraint torque)
-        accelerations(q, qd, path_qdd[2 * it], u, prescribed, plant, a1, c1)
         if _status(plant) != 0 or _status(ctrl) != 0:
             # a closed-loop plant or model left its assembly branch here or in the last step's stages
             status = STATUS_LOOP_LOST
@@ -566,28 +577,31 @@ def run_loop(plant, ctrl, motion, timing, wall, handle, rec, scratch):
                 m = spans[s]
                 h = m * step
                 mid, end = 2 * it + m, 2 * (it + m)
-                _stage_state(q, qd, k1q, a1, 0.5 * h, prescribed, path_q[mid], path_qd[mid], qs, qds)
-                for i in range(n):
-                    k2q[i] = qds[i]
-                accelerations(qs, qds, path_qdd[mid], u, prescribed, plant, a2, tau_c, False)
-                _stage_state(q, qd, k2q, a2, 0.5 * h, prescribed, path_q[mid], path_qd[mid], qs, qds)
-                for i in range(n):
-                    k3q[i] = qds[i]
-                accelerations(qs, qds, path_qdd[mid], u, prescribed, plant, a3, tau_c, False)
-                _stage_state(q, qd, k3q, a3, h, prescribed, path_q[end], path_qd[end], qs, qds)
-                for i in range(n):
-                    k4q[i] = qds[i]
-                accelerations(qs, qds, path_qdd[end], u, prescribed, plant, a4, tau_c, False)
-                for i in range(n):
-                    if prescribed[i]:
-                        q_new[i] = path_q[end, i]
-                        qd_new[i] = path_qd[end, i]
+                # stages 2-4, then (error control only) the slope at the step's end: one inlined evaluation
+                for stage in range(4):
+                    if stage == 3:
+                        for i in range(n):
+                            if prescribed[i]:
+                                q_new[i] = path_q[end, i]
+                                qd_new[i] = path_qd[end, i]
+                            else:
+                                q_new[i] = q[i] + h / 6.0 * (k1q[i] + 2.0 * k2q[i] + 2.0 * k3q[i] + k4q[i])
+                                qd_new[i] = qd[i] + h / 6.0 * (a1[i] + 2.0 * a2[i] + 2.0 * a3[i] + a4[i])
+                        if tolerance == 0.0:
+                            break
+                        at_q, at_qd, row, slope = q_new, qd_new, end, a5
                     else:
-                        q_new[i] = q[i] + h / 6.0 * (k1q[i] + 2.0 * k2q[i] + 2.0 * k3q[i] + k4q[i])
-                        qd_new[i] = qd[i] + h / 6.0 * (a1[i] + 2.0 * a2[i] + 2.0 * a3[i] + a4[i])
+                        k_in, a_in, k_out, slope = ((k1q, a1, k2q, a2) if stage == 0 else
+                                                    (k2q, a2, k3q, a3) if stage == 1 else (k3q, a3, k4q, a4))
+                        row = mid if stage < 2 else end
+                        _stage_state(q, qd, k_in, a_in, 0.5 * h if stage < 2 else h, prescribed, path_q[row],
+                                     path_qd[row], qs, qds)
+                        for i in range(n):
+                            k_out[i] = qds[i]
+                        at_q, at_qd = qs, qds
+                    accelerations(at_q, at_qd, path_qdd[row], u, prescribed, plant, slope, tau_c, False)
                 if tolerance == 0.0:
                     break
-                accelerations(q_new, qd_new, path_qdd[end], u, prescribed, plant, a5, tau_c, False)
                 err = _step_error(q_new, qd_new, k4q, a4, a5, h, prescribed, tolerance)
                 if not (err <= 1.0) and s < n_span - 1:
                     s = _first_span(spans, s + 1, it, n_steps)

@@ -23,6 +23,7 @@ from hapticdesign.simulation.config import (
 )
 from hapticdesign.simulation.paths import Path
 from hapticdesign.simulation.tables import DynamicsTables, workspace_size
+from hapticdesign.simulation.warmup import ensure_compiled
 from hapticdesign.workload import loop_bytes, require_memory
 
 
@@ -180,6 +181,8 @@ def simulate_tables(
     timing = records.Timing(float(config.step), sub, n_steps, stride, step_spans(sub, stride) if adaptive
                             else np.ones(1, dtype=np.int64), float(config.tolerance) if adaptive else 0.0)
     handle = handle if wall.cartesian else records.no_handle(n)
+    if wall.cartesian:
+        ensure_compiled(kernel.handle_coordinate, q_start, np.zeros(n), handle, plant_record)
     reference = (float(kernel.handle_coordinate(q_start, np.zeros(n), handle, plant_record)) if wall.cartesian
                  else float(q_start[wall.joint]))
     rest = reference + float(wall.equilibrium) if wall.cartesian else float(wall.equilibrium)
@@ -189,12 +192,26 @@ def simulate_tables(
         safety_limit=math.inf if config.safety_limit is None else float(config.safety_limit),
         stop_excursion=math.inf if config.stop_excursion is None else float(config.stop_excursion),
     )
+    scratch = records.scratch(n, controller.delay)
+    ensure_compiled(kernel.run_loop, plant_record, controller, motion, timing, law, handle, rec, scratch)
     written, status, trip, peak, end_time, taken = kernel.run_loop(plant_record, controller, motion, timing, law, handle, rec,
-                                                            records.scratch(n, controller.delay))
+                                                                   scratch)
     t = np.arange(written) * stride * config.step
     q, qd, u, tau_f, tau_imp, tau_c, position = (r[:written] for r in rec)
     return Trace(t, q, qd, u, tau_f, tau_imp, tau_c, int(status), None if trip < 0 else float(trip),
                  float(peak), float(end_time), position, int(taken))
+
+
+def warm_up(device: Device) -> None:
+    """Compile the loop for ``device``'s kind of dynamics (a tree's tables or a closed-loop plant), with a joint
+    wall and, when the device names its handle, a Cartesian one, or load it from numba's cache: two
+    sample periods of each, results discarded. Run once before starting workers, so that they load the
+    kernels instead of each compiling them (:mod:`.warmup`)."""
+    walls = [Wall(joint=0, stiffness=0.0)]
+    if device.mechanism.end_effector is not None:
+        walls.append(Wall(joint=0, stiffness=0.0, direction=(1.0, 0.0, 0.0)))
+    for wall in walls:
+        simulate(device, LoopConfig(duration=2 * LoopConfig().sensors.period, wall=wall))
 
 
 def step_spans(sub: int, stride: int) -> np.ndarray:
