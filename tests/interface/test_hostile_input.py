@@ -328,3 +328,23 @@ def test_symbolic_ln_without_design_variables_is_valid_python(tmp_path):
     exec(compile(result.stdout, "generated.py", "exec"), namespace)  # noqa: S102 - the test's own generated file
     numeric = json.loads(runner.invoke(app, [*args, "--json"]).stdout)["ln"]
     assert namespace["linearity_number"]() == pytest.approx(numeric, abs=1e-12)
+
+
+@pytest.mark.parametrize("call, fragment", [
+    (lambda d: d.with_params({"m2": True}), "True is not a number"),
+    (lambda d: d.with_params({"m2": np.bool_(False)}), "is not a number"),
+    (lambda d: d.with_params({"m2": 1e308, "r2x": 1e308}).check(), "body 2: m r^2 overflows"),
+    (lambda d: hd.dynamics_of(d).H(np.zeros(3), np.full(d.standard_parameters().shape, np.nan)), "must be finite"),
+    (lambda d: hd.dynamics_of(d).G(np.zeros(3), np.full(d.standard_parameters().shape, np.inf)), "must be finite"),
+    (lambda d: _form(d).ln(np.full(d.standard_parameters().shape, np.nan)), "must be finite"),
+    (lambda d: _form(d).ln(np.full(d.standard_parameters().shape, 1e200)), "overflows"),
+])
+def test_api_refuses_booleans_non_finite_and_overflowing_parameters(phantom3, call, fragment):
+    with pytest.raises(UserError, match=fragment.replace("^", r"\^")):
+        call(phantom3)
+
+
+def _form(device):
+    from hapticdesign.analysis.linearity.form import device_form
+
+    return device_form(device)
