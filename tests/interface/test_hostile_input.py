@@ -117,7 +117,9 @@ def test_campaign_workers_are_capped_at_the_cores(tmp_path, monkeypatch):
 
 # -- nonsense settings ----------------------------------------------------------------------------
 NONSENSE = [
-    (["impedance-range", "--settle-window", "10"], "--settle-window (10 s) must be positive and not longer than --duration"),
+    (["impedance-range", "--settle-window", "10"], "--settle-window (10 s) must be positive and shorter than --duration"),
+    (["impedance-range", "--duration", "0.5"], "--settle-window (0.5 s) must be positive and shorter than --duration"),
+    (["impedance-range", "--duration", "1", "--settle-window", "1"], "shorter than --duration (1 s)"),
     (["impedance-range", "--wall-damping", "-1"], "--wall-damping must be a finite number >= 0"),
     (["impedance-range", "--error-percent", "100"], "--error-percent must be a finite number between -100 and 100"),
     (["impedance-range", "--error-percent", "-100"], "between -100 and 100"),
@@ -348,3 +350,15 @@ def _form(device):
     from hapticdesign.analysis.linearity.form import device_form
 
     return device_form(device)
+
+
+def test_campaign_and_library_refuse_a_settle_window_as_long_as_the_run(tmp_path, phantom3):
+    from hapticdesign.simulation.config import LoopConfig
+    from hapticdesign.simulation.criteria import Criteria, WallProblem
+
+    designs = write_designs(tmp_path / "d.csv", rows=[(0.0, {})])
+    one_line_error(["campaign", "--designs", str(designs), "--out", str(tmp_path / "o"), "--duration", "0.5"],
+                   "--duration (0.5 s) must be longer than the 0.5 s settle window")
+    assert not (tmp_path / "o").exists()
+    with pytest.raises(UserError, match="must be shorter than the simulated time"):
+        WallProblem(phantom3, criteria=Criteria(settle_window=1.0), config=LoopConfig(duration=1.0))

@@ -94,6 +94,6 @@ class WallProblem:
 
 def check_settle_window(criteria: Criteria, duration: float) -> None:
     """The settling test needs a window within the run, or every stiffness is "not settled"."""
-    if criteria.settle_window > duration:
-        raise UserError(f"the settle window ({criteria.settle_window:g} s) must not be longer than the simulated "
-                        f"time ({duration:g} s): every stiffness would count as not settled")
+    if criteria.settle_window >= duration:
+        raise UserError(f"the settle window ({criteria.settle_window:g} s) must be shorter than the simulated "
+                        f"time ({duration:g} s): a window that holds the start counts every stiffness as not settled")
