@@ -362,3 +362,19 @@ def test_campaign_and_library_refuse_a_settle_window_as_long_as_the_run(tmp_path
     assert not (tmp_path / "o").exists()
     with pytest.raises(UserError, match="must be shorter than the simulated time"):
         WallProblem(phantom3, criteria=Criteria(settle_window=1.0), config=LoopConfig(duration=1.0))
+
+
+def test_impedance_range_refuses_a_wall_its_joint_cannot_push():
+    """Joint 1 of the Phantom turns about the vertical: it cannot move the handle along z at q = 0."""
+    one_line_error(["impedance-range", "--wall-direction", "0,0,1"], "joint 1 does not move the handle along the wall")
+
+
+def test_a_huge_direction_is_a_direction_not_the_zero_vector():
+    from hapticdesign.simulation.config import unit_direction
+
+    assert unit_direction((0.0, 1e308, 0.0)).tolist() == [0.0, 1.0, 0.0]
+    assert unit_direction((3e307, 4e307, 0.0)) == pytest.approx([0.6, 0.8, 0.0], abs=1e-15)
+    huge, unit = (runner.invoke(app, ["zwidth", "--preset", "phantom-3dof", "--wall-direction", d, "--b-values", "0",
+                                      "--json"]) for d in ("0,1e308,0", "0,1,0"))
+    assert huge.exit_code == 0, huge.output
+    assert json.loads(huge.stdout) == json.loads(unit.stdout)

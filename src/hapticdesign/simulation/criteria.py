@@ -12,8 +12,11 @@ import numpy as np
 
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
-from hapticdesign.simulation.config import LoopConfig
+from hapticdesign.simulation.config import LoopConfig, normal_jacobian, rest_pose
 from hapticdesign.simulation.paths import Held, Path, Sine
+
+REACH_FLOOR = 1e-12
+"""Smallest ``|J_n,w|`` (m/rad or m/m) of a Cartesian wall's joint that counts as moving the handle along it."""
 
 
 @dataclass(frozen=True)
@@ -90,6 +93,17 @@ class WallProblem:
 
     def __post_init__(self) -> None:
         check_settle_window(self.criteria, self.config.duration)
+        if self.config.wall.cartesian:
+            require_reach(self.device, self.config, self.wall_joint)
+
+
+def require_reach(device: Device, config: LoopConfig, wall_joint: int) -> None:
+    """A Cartesian wall needs the wall joint to move the handle along its direction at the start pose
+    (``J_n,w = n^T J_v,w`` not 0): otherwise the wall acts on nothing and every stiffness is "stable"."""
+    reach = float(normal_jacobian(device, config.wall, rest_pose(device))[wall_joint])
+    if not (math.isfinite(reach) and abs(reach) > REACH_FLOOR):
+        raise UserError(f"joint {wall_joint + 1} does not move the handle along the wall direction "
+                        f"{', '.join(f'{v:g}' for v in config.wall.direction)} at the start pose")
 
 
 def check_settle_window(criteria: Criteria, duration: float) -> None:
