@@ -322,3 +322,12 @@ def test_the_size_cap_counts_what_is_read(tmp_path, monkeypatch):
     monkeypatch.setattr(files, "MAX_FILE_BYTES", 50)
     with pytest.raises(files.UserError, match="larger than"):
         files.read_text(path)
+
+
+@pytest.mark.parametrize("nu", ["-1", "0.5", "-3"])
+def test_a_poisson_ratio_outside_the_isotropic_bounds_is_one_line(tmp_path, nu):
+    """G = E / (2 (1 + nu)) divides by zero at nu = -1; a stable isotropic solid has -1 < nu < 0.5."""
+    path = tmp_path / "elastic.yaml"
+    path.write_text(ONE_LINK.format(name="ok", body="ab") + "links:\n  - {name: l, from: link, to: handle, "
+                    f"section: {{shape: tube, D: 0.01, d: 0.008}}, material: {{E: 2.0e11, nu: {nu}}}}}\n")
+    _one_error(runner.invoke(app, ["ln", "--device", str(path)]), "Poisson's ratio nu must lie in (-1, 0.5)")
