@@ -378,3 +378,14 @@ def test_a_huge_direction_is_a_direction_not_the_zero_vector():
                                       "--json"]) for d in ("0,1e308,0", "0,1,0"))
     assert huge.exit_code == 0, huge.output
     assert json.loads(huge.stdout) == json.loads(unit.stdout)
+
+
+@pytest.mark.parametrize("method", ["analytic", "fast"])
+def test_impedance_range_refuses_a_wall_joint_without_inertia(tmp_path, method):
+    """Links 2, 3, 2a and 3a massless: H22 = 0 at the start, no dynamics to bound (a division by zero)."""
+    params = tmp_path / "massless.yaml"
+    bodies = ("2", "3", "2a", "3a")
+    names = [f"{n}{b}" for b in bodies for n in ("m", "Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz")]
+    params.write_text("".join(f"{name}: 0\n" for name in names + [f"r{b}{a}" for b in bodies for a in "xyz"]))
+    one_line_error(["impedance-range", "--method", method, "--params", str(params), "--joint", "2"],
+                   "joint 2 has no inertia at the start pose (H22 = 0)")

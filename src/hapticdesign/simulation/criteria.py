@@ -93,8 +93,25 @@ class WallProblem:
 
     def __post_init__(self) -> None:
         check_settle_window(self.criteria, self.config.duration)
+        require_inertia(self.device, rest_pose(self.device))
         if self.config.wall.cartesian:
             require_reach(self.device, self.config, self.wall_joint)
+
+
+def require_inertia(device: Device, q: np.ndarray) -> None:
+    """The plant ``H qdd = tau - C qd - G`` needs ``H`` positive definite at the start pose; a joint
+    whose bodies are all massless has no inertia there and no motion to simulate or to bound."""
+    from hapticdesign.analysis.dynamics.device import mass_matrix
+
+    h = np.atleast_2d(mass_matrix(device, q))
+    empty = [k + 1 for k in range(h.shape[0]) if not h[k, k] > 0.0]
+    if empty:
+        raise UserError(f"joint {empty[0]} has no inertia at the start pose (H{empty[0]}{empty[0]} = "
+                        f"{h[empty[0] - 1, empty[0] - 1]:g}): its bodies are massless, so it has no dynamics to simulate")
+    eig = np.linalg.eigvalsh(h)
+    if not eig[0] > 1e-12 * eig[-1]:
+        raise UserError(f"the mass matrix at the start pose is singular (smallest eigenvalue {eig[0]:.3g}): some "
+                        "motion of the joints has no inertia")
 
 
 def require_reach(device: Device, config: LoopConfig, wall_joint: int) -> None:
