@@ -389,3 +389,8 @@ def test_impedance_range_refuses_a_wall_joint_without_inertia(tmp_path, method):
     params.write_text("".join(f"{name}: 0\n" for name in names + [f"r{b}{a}" for b in bodies for a in "xyz"]))
     one_line_error(["impedance-range", "--method", method, "--params", str(params), "--joint", "2"],
                    "joint 2 has no inertia at the start pose (H22 = 0)")
+
+
+def test_rcube_lengths_that_overflow_the_kinematics_are_refused():
+    one_line_error(["rcube", "ik", "--l1", "1e308", "--l2", "1e308", "--l3", "1e308", "--position", "0,0,0"],
+                   "must be a positive length of at most 1000 m, got 1e+308")
