@@ -331,3 +331,17 @@ def test_a_poisson_ratio_outside_the_isotropic_bounds_is_one_line(tmp_path, nu):
     path.write_text(ONE_LINK.format(name="ok", body="ab") + "links:\n  - {name: l, from: link, to: handle, "
                     f"section: {{shape: tube, D: 0.01, d: 0.008}}, material: {{E: 2.0e11, nu: {nu}}}}}\n")
     _one_error(runner.invoke(app, ["ln", "--device", str(path)]), "Poisson's ratio nu must lie in (-1, 0.5)")
+
+
+def test_identical_runs_write_identical_svg_bytes(tmp_path):
+    """matplotlib salts SVG ids at random and dates the file unless told otherwise: the same inputs
+    must give the same bytes (PNG and SVG)."""
+    for name in ("a", "b"):
+        result = runner.invoke(app, ["zwidth", "--inertia", "0.04", "--damping", "0.5", "--points", "3",
+                                     "--out", str(tmp_path / name), "--quiet"])
+        assert result.exit_code == 0, result.output
+    for suffix in (".svg", ".png"):
+        first, second = ((tmp_path / n / "zwidth").with_suffix(suffix).read_bytes() for n in ("a", "b"))
+        assert first == second
+    svg = (tmp_path / "a" / "zwidth.svg").read_text()
+    assert "<dc:date>" not in svg and "<svg" in svg

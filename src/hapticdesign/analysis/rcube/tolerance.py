@@ -34,6 +34,7 @@ from hapticdesign.analysis.rcube.design import RCubeDesign
 from hapticdesign.analysis.rcube.kinematics import chain_angles, chain_jacobian, cube_grid, passive_reach
 from hapticdesign.analysis.rcube.stiffness import chain_stiffness_matrices
 from hapticdesign.errors import UserError
+from hapticdesign.files import save_figure
 from hapticdesign.model.rcube import RCubeGeometry, axis_permutation, chain_mechanism
 
 SECONDS_PER_SAMPLE = 0.012
@@ -361,5 +362,5 @@ def save_figure(nominal: SampleResult, results: list[SampleResult], path) -> Non
         ax.legend(fontsize=7)
     fig.suptitle(f"R-CUBE manufacturing tolerances: {len(results)} samples", fontsize=10)
     fig.tight_layout()
-    fig.savefig(path, dpi=150)
+    save_figure(fig, path, dpi=150)
     plt.close(fig)
