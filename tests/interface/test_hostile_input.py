@@ -394,3 +394,14 @@ def test_impedance_range_refuses_a_wall_joint_without_inertia(tmp_path, method):
 def test_rcube_lengths_that_overflow_the_kinematics_are_refused():
     one_line_error(["rcube", "ik", "--l1", "1e308", "--l2", "1e308", "--l3", "1e308", "--position", "0,0,0"],
                    "must be a positive length of at most 1000 m, got 1e+308")
+
+
+@pytest.mark.parametrize("place", ["cases", "figures"])
+def test_campaign_refuses_a_planted_symlink_and_writes_nothing_through_it(tmp_path, place):
+    designs = write_designs(tmp_path / "d.csv", rows=[(0.0, {})])
+    out, outside = tmp_path / "o", tmp_path / "outside"
+    out.mkdir()
+    outside.mkdir()
+    (out / place).symlink_to(outside)
+    one_line_error(["campaign", "--designs", str(designs), "--out", str(out)], f"{out / place} is a symbolic link")
+    assert list(outside.iterdir()) == []

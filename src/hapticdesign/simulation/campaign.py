@@ -300,6 +300,10 @@ def run_campaign(designs_path: Path, out: Path, options: CampaignOptions | None 
 def _run_locked(designs: list[Design], out: Path, options: CampaignOptions, scheduler: str | None,
                 workers: int | None, progress: Callable[[int, int], None] | None, quiet: bool) -> dict:
     cases_dir = out / "cases"
+    for place in (cases_dir, out / "figures"):
+        if place.is_symlink() or (place.exists() and not place.is_dir()):
+            raise UserError(f"{place} is a symbolic link or a file; a campaign writes only into real folders inside "
+                            "its output folder (remove it or choose another output folder)")
     cases_dir.mkdir(parents=True, exist_ok=True)
     settings = json.dumps({**asdict(options), "designs": [asdict(d) for d in designs]}, sort_keys=True)
     stamp = out / "campaign.json"
