@@ -345,3 +345,27 @@ def test_identical_runs_write_identical_svg_bytes(tmp_path):
         assert first == second
     svg = (tmp_path / "a" / "zwidth.svg").read_text()
     assert "<dc:date>" not in svg and "<svg" in svg
+
+
+def test_rcube_design_file_tolerances_are_read_as_promised(tmp_path):
+    """docs/rcube.md and --design's help promise ``tolerances: {l1, l2, l3, joint_offset}``."""
+    path = _write(tmp_path / "design.yaml", "l1: 0.12\ntolerances: {l1: 0.0005, l2: 0.0002, l3: 0.001, "
+                                             "joint_offset: 0.0001}\n")
+    result = runner.invoke(app, ["rcube", "tolerance", "--design", str(path), "--samples", "2", "--grid", "2", "--json"])
+    assert result.exit_code == 0, result.output
+    assert json.loads(result.stdout)["tolerances"] == {"lengths": [0.0005, 0.0002, 0.001], "joint_offset": 0.0001}
+    assert runner.invoke(app, ["rcube", "stiffness", "--design", str(path)]).exit_code == 0  # the design reads it too
+
+
+@pytest.mark.parametrize("body, fragment", [("tolerances: {l1: -1}", "tolerances.l1 must be a non-negative length"),
+                                            ("tolerances: {l4: 1}", "tolerances: unknown key(s) 'l4'"),
+                                            ("tolerances: {l2: yes}", "tolerances.l2 must be a non-negative length")])
+def test_rcube_tolerances_are_validated_before_any_note(tmp_path, body, fragment):
+    path = _write(tmp_path / "design.yaml", body + "\n")
+    _one_error(runner.invoke(app, ["rcube", "tolerance", "--design", str(path), "--samples", "2", "--grid", "2"]),
+               fragment)
+
+
+def test_a_study_report_folder_that_cannot_be_written_is_named_before_the_banner():
+    _one_error(runner.invoke(app, ["study", "rcube", "--out", "/proc/hapticdesign-report"]),
+               "--out /proc/hapticdesign-report: cannot write the report there")

@@ -405,3 +405,47 @@ def test_campaign_refuses_a_planted_symlink_and_writes_nothing_through_it(tmp_pa
     (out / place).symlink_to(outside)
     one_line_error(["campaign", "--designs", str(designs), "--out", str(out)], f"{out / place} is a symbolic link")
     assert list(outside.iterdir()) == []
+
+
+def _frames_file(path: Path, frames: int) -> Path:
+    lines = ["name: frames", "joints: [{name: q1}]", "frames:", "  - {name: f0, parent: base, transforms: [Rz: q1]}"]
+    lines += [f"  - {{name: f{i}, parent: f{i - 1}, transforms: [tx: 0.001]}}" for i in range(1, frames)]
+    lines += [f"end_effector: f{frames - 1}", "bodies: [{name: b, frame: f0, m: 0.5, rx: 0.1, Ixx: 1.0e-4, "
+              "Iyy: 0.0019, Izz: 0.002}]"]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+@pytest.mark.parametrize("command", [["show", "--out", "OUT"], ["dynamics", "--q", "0"], ["ln"], ["eom"]])
+def test_devices_above_the_size_limits_are_refused_on_every_path(tmp_path, monkeypatch, command):
+    monkeypatch.delenv("HAPTICDESIGN_FORCE", raising=False)
+    command = [a.replace("OUT", str(tmp_path / "out")) for a in command]
+    frames = _frames_file(tmp_path / "frames.yaml", 50_000)
+    one_line_error([*command, "--device", str(frames)], "has 50,000 frames, above the limit of 1,000 frames")
+    chain = _chain_urdf(tmp_path / "chain.urdf", 200)
+    one_line_error([*command, "--device", str(chain)], "has 200 joints, above the limit of 32 joints")
+    assert not (tmp_path / "out").exists()
+
+
+def test_loops_are_limited_and_force_lifts_the_device_limits(monkeypatch):
+    from hapticdesign.workload import WorkloadTooLarge, allow_large, require_device_size
+
+    monkeypatch.delenv("HAPTICDESIGN_FORCE", raising=False)
+    with pytest.raises(WorkloadTooLarge, match="has 300 loops, above the limit of 16 loops"):
+        require_device_size("the file", 30, 100, 300)
+    with allow_large():
+        require_device_size("the file", 600, 50_000, 300)
+
+
+def test_the_probe_of_a_large_tree_is_estimated_before_it_allocates(monkeypatch):
+    """200 joints and bodies: the regressor probes alone would take 7.7 GB (they once ran out of memory)."""
+    from hapticdesign.analysis.dynamics.model import DynamicsModel
+    from hapticdesign.workload import allow_large
+
+    monkeypatch.delenv("HAPTICDESIGN_FORCE", raising=False)
+    with allow_large():
+        from hapticdesign.devices.urdf import load_urdf
+
+        device = load_urdf(_chain_urdf(Path(__import__("tempfile").mkdtemp()) / "c.urdf", 200))
+    with pytest.raises(UserError, match="probing the equations of motion of a 200-joint device"):
+        DynamicsModel(device.mechanism)

@@ -112,6 +112,9 @@ def main() -> None:
     try:
         app()
         sys.stdout.flush()
+    except KeyboardInterrupt:  # Ctrl-C: one line, no traceback; files are written atomically, none is half-written
+        sys.stderr.write("error: interrupted\n")
+        sys.exit(130)
     except OSError as exc:
         if isinstance(exc, BrokenPipeError):
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())

@@ -19,6 +19,8 @@ import logging
 import math
 import os
 import re
+import signal
+import threading
 import warnings
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -237,6 +239,21 @@ def _client(scheduler: str | None, workers: int | None, quiet: bool = False):
                                dashboard_address=None, silence_logs=logging.CRITICAL + 1 if quiet else logging.ERROR))
 
 
+def _hold_interrupts():
+    """Ignore Ctrl-C (SIGINT) while the worker processes start, so that they inherit "ignore" and never
+    answer it (it reaches the terminal's whole process group): only this process does, closing the
+    workers, with one line. Returns the handler to restore (None off the main thread, where Python
+    cannot set one). A Ctrl-C during the start itself is not seen."""
+    if threading.current_thread() is not threading.main_thread():
+        return None
+    return signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _release_interrupts(previous) -> None:
+    if previous is not None:
+        signal.signal(signal.SIGINT, previous)
+
+
 def _close(client, own_cluster: bool) -> None:
     """Stop the client, then the local cluster it started (workers first, so none heartbeats a closed
     scheduler)."""
@@ -316,8 +333,14 @@ def _run_locked(designs: list[Design], out: Path, options: CampaignOptions, sche
     if todo:
         from dask.distributed import as_completed
 
-        client = _client(scheduler, workers, quiet)
+        held = _hold_interrupts()
         try:
+            client = _client(scheduler, workers, quiet)
+        except BaseException:
+            _release_interrupts(held)
+            raise
+        try:
+            _release_interrupts(held)
             by_design: dict[str, tuple[Design, list[tuple[str, int]]]] = {}
             for d, c, t in todo:
                 by_design.setdefault(d.name, (d, []))[1].append((c, t))
