@@ -449,3 +449,35 @@ def test_the_probe_of_a_large_tree_is_estimated_before_it_allocates(monkeypatch)
         device = load_urdf(_chain_urdf(Path(__import__("tempfile").mkdtemp()) / "c.urdf", 200))
     with pytest.raises(UserError, match="probing the equations of motion of a 200-joint device"):
         DynamicsModel(device.mechanism)
+
+
+def test_ctrl_c_is_one_line(monkeypatch):
+    from hapticdesign.interface.commands import dynamics
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(dynamics, "resolve_device", interrupted)
+    result = runner.invoke(app, ["dynamics", "--q", "0,0,0"])
+    assert result.exit_code == 130
+    assert result.stderr == "error: interrupted\n" and result.stdout == ""
+
+
+def test_campaign_workers_start_with_ctrl_c_ignored():
+    """Ctrl-C reaches the terminal's whole process group: processes started while the campaign holds
+    interrupts (as its Dask workers are) inherit "ignore" and print no traceback; the handler returns."""
+    import signal
+    import subprocess
+    import sys
+
+    from hapticdesign.simulation.campaign import _hold_interrupts, _release_interrupts
+
+    before = signal.getsignal(signal.SIGINT)
+    previous = _hold_interrupts()
+    try:
+        child = subprocess.run([sys.executable, "-c", "import signal; print(signal.getsignal(signal.SIGINT) == signal.SIG_IGN)"],
+                               capture_output=True, text=True, check=True)
+    finally:
+        _release_interrupts(previous)
+    assert child.stdout.strip() == "True"
+    assert signal.getsignal(signal.SIGINT) is before
