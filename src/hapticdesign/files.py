@@ -10,11 +10,14 @@ goes through :func:`write_atomically`. The limits are stated here once:
 - YAML aliases and anchors are refused (data files are data: an alias "bomb" of a few lines
   expands to gigabytes), as are Python-specific tags (``yaml.SafeLoader`` already refuses them);
 - structures nested deeper than ``MAX_DEPTH`` (64) levels are refused;
-- a message quotes at most ``QUOTE_LIMIT`` (60) characters of a user's value (:func:`quote`).
+- a message quotes at most ``QUOTE_LIMIT`` (60) characters of a user's value (:func:`quote`);
+- a figure is rendered by :func:`figure_bytes`: the same figure gives the same bytes (SVG ids
+  hashed with a fixed salt, no creation date in SVG or PDF).
 """
 
 from __future__ import annotations
 
+import io
 import json
 import math
 import os
@@ -215,3 +218,27 @@ def write_atomically(path: Path | str, content: str | bytes) -> None:
         except OSError:  # the place itself is broken (a file where a folder should be): nothing was written
             pass
         raise UserError(f"cannot write {path}: {exc.strerror or exc}") from None
+
+
+FIGURE_SALT = "hapticdesign"
+"""``svg.hashsalt`` of every figure: matplotlib hashes SVG ids with a random salt unless one is set."""
+_UNDATED = {"svg": {"Date": None}, "pdf": {"CreationDate": None, "ModDate": None}}
+
+
+def figure_bytes(fig, fmt: str, **options) -> bytes:
+    """A matplotlib figure as ``fmt`` (png, svg, pdf) bytes, identical for identical figures (no date,
+    a fixed SVG hash salt); ``options`` go to ``savefig`` (dpi, bbox_inches)."""
+    import matplotlib
+
+    buffer = io.BytesIO()
+    with matplotlib.rc_context({"svg.hashsalt": FIGURE_SALT}):
+        fig.savefig(buffer, format=fmt, metadata=_UNDATED.get(fmt), **options)
+    return buffer.getvalue()
+
+
+def save_figure(fig, path: Path | str, **options) -> Path:
+    """Write ``fig`` to ``path`` in the format its suffix names (PNG without one), through
+    :func:`figure_bytes` and :func:`write_atomically`."""
+    path = Path(path)
+    write_atomically(path, figure_bytes(fig, path.suffix[1:].lower() or "png", **options))
+    return path

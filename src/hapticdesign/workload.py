@@ -28,7 +28,7 @@ what this toolkit measured on a shared 2-core machine, rounded up:
   (24 points per pi radians: a range of about 130 000 rad).
 - :data:`EIGEN_ORDER_LIMIT` = 600: the order ``3 + 3 d`` of the closed-loop matrix of the exact
   stability boundary with a delay of ``d`` samples (about 100 eigenvalue problems each).
-- :data:`DEVICE_LIMITS`: 100 joints, 1 000 frames and 50 closed loops per device, checked when a
+- :data:`DEVICE_LIMITS`: 32 joints, 1 000 frames and 16 closed loops per device, checked when a
   device file, a URDF or a mechanism is read, before anything is built (every command meets a
   device there; a device at these limits loads and shows in well under a minute, while the work
   on it grows with their squares and cubes).

@@ -322,3 +322,50 @@ def test_the_size_cap_counts_what_is_read(tmp_path, monkeypatch):
     monkeypatch.setattr(files, "MAX_FILE_BYTES", 50)
     with pytest.raises(files.UserError, match="larger than"):
         files.read_text(path)
+
+
+@pytest.mark.parametrize("nu", ["-1", "0.5", "-3"])
+def test_a_poisson_ratio_outside_the_isotropic_bounds_is_one_line(tmp_path, nu):
+    """G = E / (2 (1 + nu)) divides by zero at nu = -1; a stable isotropic solid has -1 < nu < 0.5."""
+    path = tmp_path / "elastic.yaml"
+    path.write_text(ONE_LINK.format(name="ok", body="ab") + "links:\n  - {name: l, from: link, to: handle, "
+                    f"section: {{shape: tube, D: 0.01, d: 0.008}}, material: {{E: 2.0e11, nu: {nu}}}}}\n")
+    _one_error(runner.invoke(app, ["ln", "--device", str(path)]), "Poisson's ratio nu must lie in (-1, 0.5)")
+
+
+def test_identical_runs_write_identical_svg_bytes(tmp_path):
+    """matplotlib salts SVG ids at random and dates the file unless told otherwise: the same inputs
+    must give the same bytes (PNG and SVG)."""
+    for name in ("a", "b"):
+        result = runner.invoke(app, ["zwidth", "--inertia", "0.04", "--damping", "0.5", "--points", "3",
+                                     "--out", str(tmp_path / name), "--quiet"])
+        assert result.exit_code == 0, result.output
+    for suffix in (".svg", ".png"):
+        first, second = ((tmp_path / n / "zwidth").with_suffix(suffix).read_bytes() for n in ("a", "b"))
+        assert first == second
+    svg = (tmp_path / "a" / "zwidth.svg").read_text()
+    assert "<dc:date>" not in svg and "<svg" in svg
+
+
+def test_rcube_design_file_tolerances_are_read_as_promised(tmp_path):
+    """docs/rcube.md and --design's help promise ``tolerances: {l1, l2, l3, joint_offset}``."""
+    path = _write(tmp_path / "design.yaml", "l1: 0.12\ntolerances: {l1: 0.0005, l2: 0.0002, l3: 0.001, "
+                                             "joint_offset: 0.0001}\n")
+    result = runner.invoke(app, ["rcube", "tolerance", "--design", str(path), "--samples", "2", "--grid", "2", "--json"])
+    assert result.exit_code == 0, result.output
+    assert json.loads(result.stdout)["tolerances"] == {"lengths": [0.0005, 0.0002, 0.001], "joint_offset": 0.0001}
+    assert runner.invoke(app, ["rcube", "stiffness", "--design", str(path)]).exit_code == 0  # the design reads it too
+
+
+@pytest.mark.parametrize("body, fragment", [("tolerances: {l1: -1}", "tolerances.l1 must be a non-negative length"),
+                                            ("tolerances: {l4: 1}", "tolerances: unknown key(s) 'l4'"),
+                                            ("tolerances: {l2: yes}", "tolerances.l2 must be a non-negative length")])
+def test_rcube_tolerances_are_validated_before_any_note(tmp_path, body, fragment):
+    path = _write(tmp_path / "design.yaml", body + "\n")
+    _one_error(runner.invoke(app, ["rcube", "tolerance", "--design", str(path), "--samples", "2", "--grid", "2"]),
+               fragment)
+
+
+def test_a_study_report_folder_that_cannot_be_written_is_named_before_the_banner():
+    _one_error(runner.invoke(app, ["study", "rcube", "--out", "/proc/hapticdesign-report"]),
+               "--out /proc/hapticdesign-report: cannot write the report there")

@@ -117,7 +117,9 @@ def test_campaign_workers_are_capped_at_the_cores(tmp_path, monkeypatch):
 
 # -- nonsense settings ----------------------------------------------------------------------------
 NONSENSE = [
-    (["impedance-range", "--settle-window", "10"], "--settle-window (10 s) must be positive and not longer than --duration"),
+    (["impedance-range", "--settle-window", "10"], "--settle-window (10 s) must be positive and shorter than --duration"),
+    (["impedance-range", "--duration", "0.5"], "--settle-window (0.5 s) must be positive and shorter than --duration"),
+    (["impedance-range", "--duration", "1", "--settle-window", "1"], "shorter than --duration (1 s)"),
     (["impedance-range", "--wall-damping", "-1"], "--wall-damping must be a finite number >= 0"),
     (["impedance-range", "--error-percent", "100"], "--error-percent must be a finite number between -100 and 100"),
     (["impedance-range", "--error-percent", "-100"], "between -100 and 100"),
@@ -328,3 +330,154 @@ def test_symbolic_ln_without_design_variables_is_valid_python(tmp_path):
     exec(compile(result.stdout, "generated.py", "exec"), namespace)  # noqa: S102 - the test's own generated file
     numeric = json.loads(runner.invoke(app, [*args, "--json"]).stdout)["ln"]
     assert namespace["linearity_number"]() == pytest.approx(numeric, abs=1e-12)
+
+
+@pytest.mark.parametrize("call, fragment", [
+    (lambda d: d.with_params({"m2": True}), "True is not a number"),
+    (lambda d: d.with_params({"m2": np.bool_(False)}), "is not a number"),
+    (lambda d: d.with_params({"m2": 1e308, "r2x": 1e308}).check(), "body 2: m r^2 overflows"),
+    (lambda d: hd.dynamics_of(d).H(np.zeros(3), np.full(d.standard_parameters().shape, np.nan)), "must be finite"),
+    (lambda d: hd.dynamics_of(d).G(np.zeros(3), np.full(d.standard_parameters().shape, np.inf)), "must be finite"),
+    (lambda d: _form(d).ln(np.full(d.standard_parameters().shape, np.nan)), "must be finite"),
+    (lambda d: _form(d).ln(np.full(d.standard_parameters().shape, 1e200)), "overflows"),
+])
+def test_api_refuses_booleans_non_finite_and_overflowing_parameters(phantom3, call, fragment):
+    with pytest.raises(UserError, match=fragment.replace("^", r"\^")):
+        call(phantom3)
+
+
+def _form(device):
+    from hapticdesign.analysis.linearity.form import device_form
+
+    return device_form(device)
+
+
+def test_campaign_and_library_refuse_a_settle_window_as_long_as_the_run(tmp_path, phantom3):
+    from hapticdesign.simulation.config import LoopConfig
+    from hapticdesign.simulation.criteria import Criteria, WallProblem
+
+    designs = write_designs(tmp_path / "d.csv", rows=[(0.0, {})])
+    one_line_error(["campaign", "--designs", str(designs), "--out", str(tmp_path / "o"), "--duration", "0.5"],
+                   "--duration (0.5 s) must be longer than the 0.5 s settle window")
+    assert not (tmp_path / "o").exists()
+    with pytest.raises(UserError, match="must be shorter than the simulated time"):
+        WallProblem(phantom3, criteria=Criteria(settle_window=1.0), config=LoopConfig(duration=1.0))
+
+
+def test_impedance_range_refuses_a_wall_its_joint_cannot_push():
+    """Joint 1 of the Phantom turns about the vertical: it cannot move the handle along z at q = 0."""
+    one_line_error(["impedance-range", "--wall-direction", "0,0,1"], "joint 1 does not move the handle along the wall")
+
+
+def test_a_huge_direction_is_a_direction_not_the_zero_vector():
+    from hapticdesign.simulation.config import unit_direction
+
+    assert unit_direction((0.0, 1e308, 0.0)).tolist() == [0.0, 1.0, 0.0]
+    assert unit_direction((3e307, 4e307, 0.0)) == pytest.approx([0.6, 0.8, 0.0], abs=1e-15)
+    huge, unit = (runner.invoke(app, ["zwidth", "--preset", "phantom-3dof", "--wall-direction", d, "--b-values", "0",
+                                      "--json"]) for d in ("0,1e308,0", "0,1,0"))
+    assert huge.exit_code == 0, huge.output
+    assert json.loads(huge.stdout) == json.loads(unit.stdout)
+
+
+@pytest.mark.parametrize("method", ["analytic", "fast"])
+def test_impedance_range_refuses_a_wall_joint_without_inertia(tmp_path, method):
+    """Links 2, 3, 2a and 3a massless: H22 = 0 at the start, no dynamics to bound (a division by zero)."""
+    params = tmp_path / "massless.yaml"
+    bodies = ("2", "3", "2a", "3a")
+    names = [f"{n}{b}" for b in bodies for n in ("m", "Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz")]
+    params.write_text("".join(f"{name}: 0\n" for name in names + [f"r{b}{a}" for b in bodies for a in "xyz"]))
+    one_line_error(["impedance-range", "--method", method, "--params", str(params), "--joint", "2"],
+                   "joint 2 has no inertia at the start pose (H22 = 0)")
+
+
+def test_rcube_lengths_that_overflow_the_kinematics_are_refused():
+    one_line_error(["rcube", "ik", "--l1", "1e308", "--l2", "1e308", "--l3", "1e308", "--position", "0,0,0"],
+                   "must be a positive length of at most 1000 m, got 1e+308")
+
+
+@pytest.mark.parametrize("place", ["cases", "figures"])
+def test_campaign_refuses_a_planted_symlink_and_writes_nothing_through_it(tmp_path, place):
+    designs = write_designs(tmp_path / "d.csv", rows=[(0.0, {})])
+    out, outside = tmp_path / "o", tmp_path / "outside"
+    out.mkdir()
+    outside.mkdir()
+    (out / place).symlink_to(outside)
+    one_line_error(["campaign", "--designs", str(designs), "--out", str(out)], f"{out / place} is a symbolic link")
+    assert list(outside.iterdir()) == []
+
+
+def _frames_file(path: Path, frames: int) -> Path:
+    lines = ["name: frames", "joints: [{name: q1}]", "frames:", "  - {name: f0, parent: base, transforms: [Rz: q1]}"]
+    lines += [f"  - {{name: f{i}, parent: f{i - 1}, transforms: [tx: 0.001]}}" for i in range(1, frames)]
+    lines += [f"end_effector: f{frames - 1}", "bodies: [{name: b, frame: f0, m: 0.5, rx: 0.1, Ixx: 1.0e-4, "
+              "Iyy: 0.0019, Izz: 0.002}]"]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+@pytest.mark.parametrize("command", [["show", "--out", "OUT"], ["dynamics", "--q", "0"], ["ln"], ["eom"]])
+def test_devices_above_the_size_limits_are_refused_on_every_path(tmp_path, monkeypatch, command):
+    monkeypatch.delenv("HAPTICDESIGN_FORCE", raising=False)
+    command = [a.replace("OUT", str(tmp_path / "out")) for a in command]
+    frames = _frames_file(tmp_path / "frames.yaml", 50_000)
+    one_line_error([*command, "--device", str(frames)], "has 50,000 frames, above the limit of 1,000 frames")
+    chain = _chain_urdf(tmp_path / "chain.urdf", 200)
+    one_line_error([*command, "--device", str(chain)], "has 200 joints, above the limit of 32 joints")
+    assert not (tmp_path / "out").exists()
+
+
+def test_loops_are_limited_and_force_lifts_the_device_limits(monkeypatch):
+    from hapticdesign.workload import WorkloadTooLarge, allow_large, require_device_size
+
+    monkeypatch.delenv("HAPTICDESIGN_FORCE", raising=False)
+    with pytest.raises(WorkloadTooLarge, match="has 300 loops, above the limit of 16 loops"):
+        require_device_size("the file", 30, 100, 300)
+    with allow_large():
+        require_device_size("the file", 600, 50_000, 300)
+
+
+def test_the_probe_of_a_large_tree_is_estimated_before_it_allocates(monkeypatch):
+    """200 joints and bodies: the regressor probes alone would take 7.7 GB (they once ran out of memory)."""
+    from hapticdesign.analysis.dynamics.model import DynamicsModel
+    from hapticdesign.workload import allow_large
+
+    monkeypatch.delenv("HAPTICDESIGN_FORCE", raising=False)
+    with allow_large():
+        from hapticdesign.devices.urdf import load_urdf
+
+        device = load_urdf(_chain_urdf(Path(__import__("tempfile").mkdtemp()) / "c.urdf", 200))
+    with pytest.raises(UserError, match="probing the equations of motion of a 200-joint device"):
+        DynamicsModel(device.mechanism)
+
+
+def test_ctrl_c_is_one_line(monkeypatch):
+    from hapticdesign.interface.commands import dynamics
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(dynamics, "resolve_device", interrupted)
+    result = runner.invoke(app, ["dynamics", "--q", "0,0,0"])
+    assert result.exit_code == 130
+    assert result.stderr == "error: interrupted\n" and result.stdout == ""
+
+
+def test_campaign_workers_start_with_ctrl_c_ignored():
+    """Ctrl-C reaches the terminal's whole process group: processes started while the campaign holds
+    interrupts (as its Dask workers are) inherit "ignore" and print no traceback; the handler returns."""
+    import signal
+    import subprocess
+    import sys
+
+    from hapticdesign.simulation.campaign import _hold_interrupts, _release_interrupts
+
+    before = signal.getsignal(signal.SIGINT)
+    previous = _hold_interrupts()
+    try:
+        child = subprocess.run([sys.executable, "-c", "import signal; print(signal.getsignal(signal.SIGINT) == signal.SIG_IGN)"],
+                               capture_output=True, text=True, check=True)
+    finally:
+        _release_interrupts(previous)
+    assert child.stdout.strip() == "True"
+    assert signal.getsignal(signal.SIGINT) is before

@@ -53,6 +53,15 @@ class OneLineErrors(TyperGroup):
             sys.exit(exc.exit_code)
         sys.exit(code if isinstance(code, int) else 0)
 
+    def invoke(self, ctx):
+        """Ctrl-C: one line (typer then exits with status 130); every file is written atomically, so
+        none is left half-written, and an interrupted campaign resumes from the cases it wrote."""
+        try:
+            return super().invoke(ctx)
+        except KeyboardInterrupt:
+            typer.echo("error: interrupted", err=True)
+            raise
+
     def list_commands(self, ctx) -> list[str]:
         """Commands section by section, in the order of :data:`CONTENTS`."""
         sections = [*dict.fromkeys(CONTENTS.values()), OTHER]

@@ -95,6 +95,8 @@ class Device:
                 close = [k for k in known if k.lower() == str(key).lower()]
                 hint = f" (did you mean {close[0]}?)" if close else ""
                 raise UserError(f"unknown parameter name {key!r} for device {self.name}{hint}")
+            if isinstance(value, (bool, np.bool_)):
+                raise UserError(f"parameter {key}: {value!r} is not a number")
             try:
                 val = float(value)
             except (TypeError, ValueError):

@@ -16,6 +16,7 @@ parameters belong to a rigid body (mass >= 0, triangle inequality on the princip
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from enum import Enum
 
@@ -165,6 +166,11 @@ def check_body(name: str, body: BodyInertia, rel_tol: float = 1e-12) -> Consiste
         return ConsistencyReport(name, error=f"body {name}: inertial parameters must be finite numbers")
     if body.m < 0:
         return ConsistencyReport(name, error=f"body {name}: negative mass m{name} = {body.m:g}")
+    with np.errstate(over="ignore"):
+        moment = body.m * float(np.dot(values[1:4], values[1:4]))
+    if not math.isfinite(moment):
+        return ConsistencyReport(name, error=f"body {name}: m r^2 overflows (mass and centre of mass too large "
+                                            "to be a finite number)")
     inertia = body.inertia_at_com
     scale = max(np.abs(inertia).max(), 1e-300)
     if body.m == 0:

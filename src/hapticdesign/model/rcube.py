@@ -56,6 +56,10 @@ def axis_permutation(chain: int) -> tuple[int, int, int]:
     return _AXIS_PERMUTATIONS[chain]
 
 
+MAX_LENGTH = 1000.0
+"""Longest link or offset (m): the kinematics square lengths (eq. 5.39), which overflows near 1e154 m."""
+
+
 @dataclass(frozen=True)
 class RCubeGeometry:
     """Link lengths ``l1, l2, l3`` (m), chain offset ``S`` (eq. 5.2; ``None`` means ``S = l1``,
@@ -70,10 +74,10 @@ class RCubeGeometry:
     def __post_init__(self) -> None:
         for name in ("l1", "l2", "l3"):
             value = getattr(self, name)
-            if not isfinite(value) or value <= 0.0:
-                raise UserError(f"{name} must be a positive length in metres, got {value!r}")
-        if self.offset is not None and not isfinite(self.offset):
-            raise UserError(f"offset must be finite, got {self.offset!r}")
+            if not isfinite(value) or not 0.0 < value <= MAX_LENGTH:
+                raise UserError(f"{name} must be a positive length of at most {MAX_LENGTH:g} m, got {value!r}")
+        if self.offset is not None and not (isfinite(self.offset) and abs(self.offset) <= MAX_LENGTH):
+            raise UserError(f"offset must be a finite length of at most {MAX_LENGTH:g} m, got {self.offset!r}")
         if self.sigma not in (-1, 1):
             raise UserError(f"sigma must be -1 or +1, got {self.sigma!r}")
 

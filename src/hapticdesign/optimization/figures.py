@@ -6,6 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
+from hapticdesign.files import save_figure
+
 
 def _pyplot():
     import matplotlib
@@ -17,13 +19,10 @@ def _pyplot():
 
 
 def _save(fig, out_dir: Path, name: str) -> list[Path]:
-    out_dir.mkdir(parents=True, exist_ok=True)
     paths = []
     fig.tight_layout()
     for ext in ("png", "svg"):
-        path = out_dir / f"{name}.{ext}"
-        fig.savefig(path)
-        paths.append(path)
+        paths.append(save_figure(fig, out_dir / f"{name}.{ext}"))
     _pyplot().close(fig)
     return paths
 

@@ -21,6 +21,8 @@ import logging
 import math
 import os
 import re
+import signal
+import threading
 import warnings
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -239,6 +241,21 @@ def _client(scheduler: str | None, workers: int | None, quiet: bool = False):
                                dashboard_address=None, silence_logs=logging.CRITICAL + 1 if quiet else logging.ERROR))
 
 
+def _hold_interrupts():
+    """Ignore Ctrl-C (SIGINT) while the worker processes start, so that they inherit "ignore" and never
+    answer it (it reaches the terminal's whole process group): only this process does, closing the
+    workers, with one line. Returns the handler to restore (None off the main thread, where Python
+    cannot set one). A Ctrl-C during the start itself is not seen."""
+    if threading.current_thread() is not threading.main_thread():
+        return None
+    return signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _release_interrupts(previous) -> None:
+    if previous is not None:
+        signal.signal(signal.SIGINT, previous)
+
+
 def _close(client, own_cluster: bool) -> None:
     """Stop the client, then the local cluster it started (workers first, so none heartbeats a closed
     scheduler)."""
@@ -302,6 +319,10 @@ def run_campaign(designs_path: Path, out: Path, options: CampaignOptions | None 
 def _run_locked(designs: list[Design], out: Path, options: CampaignOptions, scheduler: str | None,
                 workers: int | None, progress: Callable[[int, int], None] | None, quiet: bool) -> dict:
     cases_dir = out / "cases"
+    for place in (cases_dir, out / "figures"):
+        if place.is_symlink() or (place.exists() and not place.is_dir()):
+            raise UserError(f"{place} is a symbolic link or a file; a campaign writes only into real folders inside "
+                            "its output folder (remove it or choose another output folder)")
     cases_dir.mkdir(parents=True, exist_ok=True)
     settings = json.dumps({**asdict(options), "designs": [asdict(d) for d in designs]}, sort_keys=True)
     stamp = out / "campaign.json"
@@ -333,8 +354,14 @@ def _run_locked(designs: list[Design], out: Path, options: CampaignOptions, sche
         if rest:
             from dask.distributed import as_completed
 
-            client = _client(scheduler, workers, quiet)
+            held = _hold_interrupts()
             try:
+                client = _client(scheduler, workers, quiet)
+            except BaseException:
+                _release_interrupts(held)
+                raise
+            try:
+                _release_interrupts(held)
                 futures = {client.submit(run_design_cases, options.preset, d.params, cases, options,
                                          key=f"cases-{d.name}", pure=False): (d, cases) for d, cases in rest}
                 for fut in as_completed(futures):

@@ -76,10 +76,11 @@ def unit_direction(direction) -> np.ndarray:
         raise UserError(f"the wall direction must be three numbers, got {direction!r}") from None
     if n.shape != (3,) or not np.all(np.isfinite(n)):
         raise UserError(f"the wall direction must be three finite numbers, got {np.atleast_1d(n).tolist()[:6]}")
-    norm = float(np.linalg.norm(n))
-    if norm == 0.0:
+    largest = float(np.abs(n).max())
+    if largest == 0.0:
         raise UserError("the wall direction must not be the zero vector")
-    return n / norm
+    n = n / largest  # scaled first: the norm of (0, 1e308, 0) overflows
+    return n / float(np.linalg.norm(n))
 
 
 @dataclass(frozen=True)

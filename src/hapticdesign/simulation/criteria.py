@@ -12,8 +12,11 @@ import numpy as np
 
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
-from hapticdesign.simulation.config import LoopConfig
+from hapticdesign.simulation.config import LoopConfig, normal_jacobian, rest_pose
 from hapticdesign.simulation.paths import Held, Path, Sine
+
+REACH_FLOOR = 1e-12
+"""Smallest ``|J_n,w|`` (m/rad or m/m) of a Cartesian wall's joint that counts as moving the handle along it."""
 
 
 SEED_STEP = 0.01
@@ -115,11 +118,39 @@ class WallProblem:
 
     def __post_init__(self) -> None:
         check_settle_window(self.criteria, self.config.duration)
+        require_inertia(self.device, rest_pose(self.device))
+        if self.config.wall.cartesian:
+            require_reach(self.device, self.config, self.wall_joint)
         self.criteria = self.criteria.for_step(self.equilibrium)
+
+
+def require_inertia(device: Device, q: np.ndarray) -> None:
+    """The plant ``H qdd = tau - C qd - G`` needs ``H`` positive definite at the start pose; a joint
+    whose bodies are all massless has no inertia there and no motion to simulate or to bound."""
+    from hapticdesign.analysis.dynamics.device import mass_matrix
+
+    h = np.atleast_2d(mass_matrix(device, q))
+    empty = [k + 1 for k in range(h.shape[0]) if not h[k, k] > 0.0]
+    if empty:
+        raise UserError(f"joint {empty[0]} has no inertia at the start pose (H{empty[0]}{empty[0]} = "
+                        f"{h[empty[0] - 1, empty[0] - 1]:g}): its bodies are massless, so it has no dynamics to simulate")
+    eig = np.linalg.eigvalsh(h)
+    if not eig[0] > 1e-12 * eig[-1]:
+        raise UserError(f"the mass matrix at the start pose is singular (smallest eigenvalue {eig[0]:.3g}): some "
+                        "motion of the joints has no inertia")
+
+
+def require_reach(device: Device, config: LoopConfig, wall_joint: int) -> None:
+    """A Cartesian wall needs the wall joint to move the handle along its direction at the start pose
+    (``J_n,w = n^T J_v,w`` not 0): otherwise the wall acts on nothing and every stiffness is "stable"."""
+    reach = float(normal_jacobian(device, config.wall, rest_pose(device))[wall_joint])
+    if not (math.isfinite(reach) and abs(reach) > REACH_FLOOR):
+        raise UserError(f"joint {wall_joint + 1} does not move the handle along the wall direction "
+                        f"{', '.join(f'{v:g}' for v in config.wall.direction)} at the start pose")
 
 
 def check_settle_window(criteria: Criteria, duration: float) -> None:
     """The settling test needs a window within the run, or every stiffness is "not settled"."""
-    if criteria.settle_window > duration:
-        raise UserError(f"the settle window ({criteria.settle_window:g} s) must not be longer than the simulated "
-                        f"time ({duration:g} s): every stiffness would count as not settled")
+    if criteria.settle_window >= duration:
+        raise UserError(f"the settle window ({criteria.settle_window:g} s) must be shorter than the simulated "
+                        f"time ({duration:g} s): a window that holds the start counts every stiffness as not settled")

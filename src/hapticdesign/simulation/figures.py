@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import io
 from pathlib import Path
 
 import matplotlib
@@ -11,16 +10,15 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from hapticdesign.files import write_atomically  # noqa: E402
+from hapticdesign.files import save_figure  # noqa: E402
 
 LABELS = {"impedance": ("Maximum stable impedance [N m/rad]", "k_max"),
           "transparency": ("Transparency bandwidth [Hz]", "bandwidth")}
 
 
 def _save(fig, path: Path) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
     for suffix in (".png", ".svg"):
-        fig.savefig(path.with_suffix(suffix), dpi=120, bbox_inches="tight")
+        save_figure(fig, path.with_suffix(suffix), dpi=120, bbox_inches="tight")
     plt.close(fig)
 
 
@@ -28,11 +26,7 @@ def _save_atomically(fig, path: Path) -> list[Path]:
     """PNG and SVG of ``fig`` through :func:`hapticdesign.files.write_atomically` (one-line errors)."""
     written = []
     for suffix in (".png", ".svg"):
-        buffer = io.BytesIO()
-        fig.savefig(buffer, format=suffix[1:], dpi=120, bbox_inches="tight")
-        target = path.with_suffix(suffix)
-        write_atomically(target, buffer.getvalue())
-        written.append(target)
+        written.append(save_figure(fig, path.with_suffix(suffix), dpi=120, bbox_inches="tight"))
     plt.close(fig)
     return written
 

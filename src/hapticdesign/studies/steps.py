@@ -10,13 +10,14 @@ function fails the tests instead of showing "not available" in a report. A study
 
 from __future__ import annotations
 
-import io
 import time
 import traceback
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Protocol
+
+from hapticdesign.files import figure_bytes
 
 STATUS_DONE = "done"
 STATUS_MISSING = "not available"
@@ -58,11 +59,10 @@ def figure_from_matplotlib(fig, name: str, title: str, caption: str = "") -> Fig
     """Render a matplotlib figure to PNG and SVG, then close it."""
     import matplotlib.pyplot as plt
 
-    png, svg = io.BytesIO(), io.StringIO()
-    fig.savefig(png, format="png", dpi=110, bbox_inches="tight")
-    fig.savefig(svg, format="svg", bbox_inches="tight")
+    png = figure_bytes(fig, "png", dpi=110, bbox_inches="tight")
+    svg = figure_bytes(fig, "svg", bbox_inches="tight").decode("utf-8")
     plt.close(fig)
-    return Figure(name, title, png.getvalue(), svg.getvalue(), caption)
+    return Figure(name, title, png, svg, caption)
 
 
 def figure_from_files(stem, name: str, title: str, caption: str = "") -> Figure:

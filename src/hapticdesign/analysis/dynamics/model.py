@@ -244,6 +244,8 @@ class DynamicsModel:
         pi = _float_array(pi, "standard inertial parameters", self.n_params)
         if pi.shape[-1] != self.n_params:
             raise UserError(f"expected {self.n_params} standard inertial parameters, got {pi.shape[-1]}")
+        if not np.all(np.isfinite(pi)):
+            raise UserError("standard inertial parameters must be finite numbers (got NaN or infinity)")
         return pi
 
     def with_constant_inertia(self, h: np.ndarray) -> "DynamicsModel":

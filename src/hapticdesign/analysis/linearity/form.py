@@ -54,10 +54,15 @@ class LinearityForm:
         pi = np.asarray(pi, dtype=float)
         if pi.shape[-1] != self.n_params:
             raise UserError(f"expected {self.n_params} standard inertial parameters, got {pi.shape[-1]}")
+        if not np.all(np.isfinite(pi)):
+            raise UserError("standard inertial parameters must be finite numbers (got NaN or infinity; m r or "
+                            "m r^2 may overflow)")
         flat = np.atleast_2d(pi)
         n = self.n_params
         products = flat @ self.Q.transpose(1, 0, 2).reshape(n, 3 * n)  # one BLAS call for the batch
         out = np.einsum("skq,sq->sk", products.reshape(-1, 3, n), flat)
+        if not np.all(np.isfinite(out)):
+            raise UserError("the Linearity Number overflows for these inertial parameters (not a finite number)")
         out = np.maximum(out, 0.0)
         return out[0] if pi.ndim == 1 else out
 

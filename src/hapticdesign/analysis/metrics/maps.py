@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from hapticdesign.errors import UserError
+from hapticdesign.files import save_figure
 
 
 def plane_grid(centre, half_width: float, n: int, normal_axis: int = 2) -> tuple[np.ndarray, np.ndarray]:
@@ -52,8 +53,6 @@ def save_map(path: Path, values: np.ndarray, offsets: np.ndarray, title: str, la
     ax.set_xlabel(f"{labels[0]} (mm from centre)")
     ax.set_ylabel(f"{labels[1]} (mm from centre)")
     fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path)
+    path = save_figure(fig, path)
     plt.close(fig)
     return path

@@ -4,7 +4,8 @@ File keys (SI units): ``l1, l2, l3`` (m), optional ``offset`` (m), ``sigma``, ``
 (kg/m^3), ``links``: three entries ``{D, d, plies: [a, b, c, d]}`` (plies at 0, 90, -45 and
 45 degrees of M55J) or ``{D, d, E, G}`` (isotropic, Pa), and ``joints``: one entry for every joint
 or a list of five (joints ``phi_i1 .. phi_i5``, eq. 5.5-5.14), each ``{rotational, translational,
-torsional}`` in N m/rad, N/m, N m/rad (any omitted: rigid; ``torsional`` defaults to ``rotational``).
+torsional}`` in N m/rad, N/m, N m/rad (any omitted: rigid; ``torsional`` defaults to ``rotational``),
+and ``tolerances: {l1, l2, l3, joint_offset}`` (m, the Monte Carlo of manufacturing tolerances).
 """
 
 from __future__ import annotations
@@ -23,7 +24,8 @@ from hapticdesign.analysis.stiffness.materials import isotropic, laminate
 from hapticdesign.analysis.stiffness.sections import Tube
 
 
-DESIGN_KEYS = ("l1", "l2", "l3", "offset", "sigma", "density", "links", "joints")
+DESIGN_KEYS = ("l1", "l2", "l3", "offset", "sigma", "density", "links", "joints", "tolerances")
+"""Keys of a design file; ``tolerances`` is read by :func:`~.tolerance.tolerances_from_file` (``rcube tolerance``)."""
 LINK_KEYS = ("D", "d", "plies", "E", "G", "density")
 
 

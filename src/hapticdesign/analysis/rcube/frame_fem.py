@@ -27,6 +27,7 @@ from math import atan2, degrees
 import numpy as np
 
 from hapticdesign.errors import UserError
+from hapticdesign.files import save_figure
 from hapticdesign.analysis.rcube.design import RCubeDesign
 from hapticdesign.analysis.rcube.kinematics import inverse_kinematics, require_regular
 from hapticdesign.model.mechanism import Mechanism
@@ -351,5 +352,5 @@ def save_correlation_figure(agreements: list[Agreement], path) -> None:
     ax.set_title("R-CUBE: FE vs VJM under the ±5 N loads of Table 5.1", fontsize=9)
     ax.legend(fontsize=6, ncol=2)
     fig.tight_layout()
-    fig.savefig(path, dpi=150)
+    save_figure(fig, path, dpi=150)
     plt.close(fig)

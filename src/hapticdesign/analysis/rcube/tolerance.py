@@ -34,6 +34,7 @@ from hapticdesign.analysis.rcube.design import RCubeDesign
 from hapticdesign.analysis.rcube.kinematics import chain_angles, chain_jacobian, cube_grid, passive_reach
 from hapticdesign.analysis.rcube.stiffness import chain_stiffness_matrices
 from hapticdesign.errors import UserError
+from hapticdesign.files import parse_structured, quote, read_text, save_figure as write_figure
 from hapticdesign.model.rcube import RCubeGeometry, axis_permutation, chain_mechanism
 
 SECONDS_PER_SAMPLE = 0.012
@@ -58,6 +59,10 @@ class Tolerances:
         values = (*self.lengths, self.joint_offset)
         if len(self.lengths) != 3 or not all(isfinite(v) and v >= 0.0 for v in values):
             raise UserError(f"tolerances must be non-negative lengths in metres, got {values!r}")
+
+
+TOLERANCE_KEYS = ("l1", "l2", "l3", "joint_offset")
+"""Keys of a design file's ``tolerances`` mapping (m)."""
 
 
 @dataclass(frozen=True)
@@ -317,25 +322,33 @@ def default_tolerances(design: RCubeDesign) -> Tolerances:
 
 
 def tolerances_from_file(path, design: RCubeDesign) -> Tolerances:
-    """The design file's ``tolerances: {l1, l2, l3, joint_offset}`` (m); missing keys take ISO 2768-m."""
-    from pathlib import Path
-
-    import yaml
-
-    try:
-        data = yaml.safe_load(Path(path).read_text()) or {}
-    except (OSError, yaml.YAMLError) as exc:
-        raise UserError(f"cannot read tolerances from {path}: {exc}") from None
+    """The design file's ``tolerances: {l1, l2, l3, joint_offset}`` (m, each ``+-t >= 0``); missing keys
+    take ISO 2768-m. The file is read as the design is (:func:`~.design_io.load_design`)."""
+    data = parse_structured(read_text(path, "design file"), "yaml", str(path))  # JSON is YAML too
     base = default_tolerances(design)
     entry = data.get("tolerances", {}) if isinstance(data, dict) else {}
     if not isinstance(entry, dict):
-        raise UserError(f"{path}: 'tolerances' must map l1, l2, l3, joint_offset to lengths in metres")
+        raise UserError(f"{path}: 'tolerances' must map {', '.join(TOLERANCE_KEYS)} to lengths in metres")
+    unknown = sorted(map(str, set(entry) - set(TOLERANCE_KEYS)))
+    if unknown:
+        raise UserError(f"{path}: tolerances: unknown key(s) {', '.join(quote(k) for k in unknown[:5])}; use "
+                        f"{', '.join(TOLERANCE_KEYS)}")
+    defaults = dict(zip(TOLERANCE_KEYS, (*base.lengths, base.joint_offset)))
+    values = {}
+    for key in TOLERANCE_KEYS:
+        value = entry.get(key, defaults[key])
+        number = None if isinstance(value, bool) else _float_or_none(value)
+        if number is None or not (isfinite(number) and number >= 0.0):
+            raise UserError(f"{path}: tolerances.{key} must be a non-negative length in metres, got {quote(value)}")
+        values[key] = number
+    return Tolerances(tuple(values[k] for k in TOLERANCE_KEYS[:3]), values["joint_offset"])
+
+
+def _float_or_none(value) -> float | None:
     try:
-        lengths = tuple(float(entry.get(k, t)) for k, t in zip(("l1", "l2", "l3"), base.lengths))
-        joint = float(entry.get("joint_offset", base.joint_offset))
+        return float(value)
     except (TypeError, ValueError):
-        raise UserError(f"{path}: tolerances must be numbers (m), got {entry!r}") from None
-    return Tolerances(lengths, joint)
+        return None
 
 
 def save_figure(nominal: SampleResult, results: list[SampleResult], path) -> None:
@@ -361,5 +374,5 @@ def save_figure(nominal: SampleResult, results: list[SampleResult], path) -> Non
         ax.legend(fontsize=7)
     fig.suptitle(f"R-CUBE manufacturing tolerances: {len(results)} samples", fontsize=10)
     fig.tight_layout()
-    fig.savefig(path, dpi=150)
+    write_figure(fig, path, dpi=150)
     plt.close(fig)

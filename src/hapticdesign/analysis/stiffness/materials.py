@@ -29,8 +29,11 @@ class LinkModuli:
 
 
 def isotropic(E: float, G: float | None = None, nu: float = 0.3) -> LinkModuli:
-    """An isotropic material (eq. 4.58): ``G = E / (2 (1 + nu))`` unless given."""
+    """An isotropic material (eq. 4.58): ``G = E / (2 (1 + nu))`` unless given; Poisson's ratio of a
+    stable isotropic solid lies in (-1, 0.5) (positive bulk and shear moduli)."""
     E = _positive("E", E)
+    if G is None and not -1.0 < nu < 0.5:
+        raise UserError(f"Poisson's ratio nu must lie in (-1, 0.5) for an isotropic material, got {nu:g}")
     G = E / (2.0 * (1.0 + nu)) if G is None else _positive("G", G)
     return LinkModuli(E, E, G)
 

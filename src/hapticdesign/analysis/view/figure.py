@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-import io
-
 import numpy as np
 
+from hapticdesign.files import figure_bytes
 from hapticdesign.analysis.view.skeleton import frame_poses, links, mass_centres
 from hapticdesign.model.device import Device
 
@@ -15,10 +14,9 @@ def render_png(device: Device, q: np.ndarray, dpi: int = 150) -> bytes:
     import matplotlib.pyplot as plt
 
     fig = device_figure(device, q, dpi)
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png")
+    png = figure_bytes(fig, "png")
     plt.close(fig)
-    return buffer.getvalue()
+    return png
 
 
 def device_figure(device: Device, q: np.ndarray, dpi: int = 150):

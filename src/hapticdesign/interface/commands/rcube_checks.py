@@ -151,8 +151,8 @@ def tolerance(samples: int = typer.Option(200, "--samples", help="Number of Mont
         seconds = tol.check_budget(samples, grid, allow=allow_long)
         dsg = _design(design)
         tolerances = _tolerances(design, dsg, tol_l1, tol_l2, tol_l3, tol_joint)
-        note(f"{samples} samples, estimated {seconds:.0f} s", quiet or json_out)
         nominal = tol.evaluate_sample(dsg, *tol.nominal_errors(), side, grid)
+        note(f"rcube tolerance: {samples} Monte Carlo samples, estimated {seconds:.0f} s", quiet or json_out)
         with progress_bar(not (quiet or json_out)) as report:
             results = tol.monte_carlo(dsg, tolerances, samples, seed, side, grid, report)
         s = tol.summary(nominal, results, load)

@@ -142,8 +142,8 @@ def impedance_range_command(
     with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
         if not (np.isfinite(duration) and duration > 0):
             raise UserError(f"--duration must be a positive number of seconds, got {duration}")
-        if not (np.isfinite(settle_window) and 0 < settle_window <= duration):
-            raise UserError(f"--settle-window ({settle_window:g} s) must be positive and not longer than --duration "
+        if not (np.isfinite(settle_window) and 0 < settle_window < duration):
+            raise UserError(f"--settle-window ({settle_window:g} s) must be positive and shorter than --duration "
                             f"({duration:g} s)")
         from hapticdesign.devices.loading import resolve_device
 
@@ -421,8 +421,8 @@ def campaign_command(
         if not (np.isfinite(duration) and duration > 0 and np.isfinite(stiffness) and stiffness > 0):
             raise UserError("--duration and --stiffness must be positive")
         _check_chirp(0.3, 0.1, f1, sweep, 1e-3)
-        if duration < 0.5:
-            raise UserError(f"--duration ({duration:g} s) must not be shorter than the 0.5 s settle window")
+        if duration <= 0.5:
+            raise UserError(f"--duration ({duration:g} s) must be longer than the 0.5 s settle window")
         if method not in ("simulation", "analytic"):
             raise UserError(f"--method must be 'simulation' or 'analytic', got {method!r}")
         if counts is not None and counts < 1:

@@ -55,9 +55,18 @@ def _scale(quick: bool, scale: Optional[str]) -> str:
 
 
 def _check_out(out: Path) -> Path:
+    """The report folder, created and tried with a scratch file before the study starts (and before its banner)."""
+    import tempfile
+
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise UserError(f"--out {out} is a file; give a folder")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=out):
+            pass
+    except OSError as exc:
+        raise UserError(f"--out {out}: cannot write the report there ({exc.strerror or exc})") from None
     return out
 
 
