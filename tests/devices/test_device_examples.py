@@ -202,19 +202,6 @@ def test_pantograph_kinetic_and_potential_energy_from_kinematics(pantograph):
         assert _relative(gravity(pantograph, q), np.array(grad)) < 1e-7
 
 
-def test_pantograph_mass_matrix_and_skew_symmetry(pantograph):
-    rng = np.random.default_rng(8)
-    for _ in range(10):
-        q, qd = rng.uniform(-np.pi, np.pi, 2), rng.normal(size=2)
-        mass = mass_matrix(pantograph, q)
-        np.testing.assert_allclose(mass, mass.T, atol=1e-15)
-        assert np.linalg.eigvalsh(mass)[0] > 0
-        h = 1e-6
-        mass_rate = (mass_matrix(pantograph, q + h * qd) - mass_matrix(pantograph, q - h * qd)) / (2 * h)
-        n = mass_rate - 2 * coriolis_matrix(pantograph, q, qd)
-        assert np.abs(n + n.T).max() < 1e-7 * np.abs(mass_rate).max()
-
-
 def test_pantograph_energy_balance_with_damping(pantograph):
     """E(t) - E(0) = -int qd' D qd dt along a free motion with the file's joint damping."""
     damping = np.diag(pantograph.damping)

@@ -8,7 +8,8 @@ from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.devices.registry import preset
 from hapticdesign.simulation.config import LoopConfig
 from hapticdesign.simulation.paths import Chirp
-from hapticdesign.simulation.transparency import first_exit, transparency
+from hapticdesign.simulation.transparency import transparency
+from hapticdesign.simulation.transparency_estimate import first_exit
 
 
 @pytest.mark.parametrize("sim_type", [1, 2])

@@ -135,13 +135,13 @@ __all__ = ["activity", "fail", "note", "parse_vector", "print_json", "progress_b
 def joint_units(device) -> list[dict[str, str]]:
     """Per coordinate: its unit and those of its torque (force), stiffness and damping (revolute
     joints in rad, N m, N m/rad, N m s/rad; prismatic joints in m, N, N/m, N s/m)."""
+    from hapticdesign.analysis.configuration import configuration_of
     from hapticdesign.model.mechanism import JointType
 
     types = device.mechanism.joint_types
     coordinates = device.mechanism.coordinates
-    actuated = getattr(device.mechanism, "actuated_coordinates", coordinates)
     out = []
-    for name in actuated:
+    for name in configuration_of(device).names:
         prismatic = types[coordinates.index(name)] == JointType.PRISMATIC
         out.append({"joint": name, "position": "m" if prismatic else "rad", "effort": "N" if prismatic else "N m",
                     "stiffness": "N/m" if prismatic else "N m/rad", "damping": "N s/m" if prismatic else "N m s/rad"})

@@ -23,6 +23,7 @@ from math import isfinite
 
 import numpy as np
 
+from hapticdesign.analysis.rcube.kinematics import arm_angles, elbow_cosine
 from hapticdesign.errors import UserError
 
 Q_MAX_RANGE = (0.07, 1.5)
@@ -87,11 +88,6 @@ def critical_points(q_max, workspace: Workspace = Workspace()) -> dict[str, tupl
     }
 
 
-def elbow_cosine(r_x, r_y, l2, l3) -> np.ndarray:
-    """``cos q_i3`` of the passive 2R arm reaching ``(r_x, r_y)`` (eq. 5.39, 6.32)."""
-    return (np.square(r_x) + np.square(r_y) - np.square(l2) - np.square(l3)) / (2.0 * l2 * l3)
-
-
 def distal_sine(r_x, r_y, l2, l3, sigma: int = -1) -> np.ndarray:
     """``sin(q_i2 + q_i3)`` of the passive arm at ``(r_x, r_y)`` (eq. 5.40-5.45, 6.50-6.52).
 
@@ -99,14 +95,8 @@ def distal_sine(r_x, r_y, l2, l3, sigma: int = -1) -> np.ndarray:
     ``r_b``; the elbow takes the configuration ``sigma`` (eq. 5.42). Unreachable points are
     evaluated at the nearest reachable elbow angle (their Constraints 3-7 fail anyway).
     """
-    c3 = np.clip(elbow_cosine(r_x, r_y, l2, l3), -1.0, 1.0)
-    s3 = sigma * np.sqrt(1.0 - c3**2)
-    q3 = np.arctan2(s3, c3)
-    x, rb = r_y, r_x
-    den = l2**2 + l3**2 + 2.0 * l2 * l3 * c3
-    c2 = (l2 * x + l3 * x * c3 - l3 * rb * s3) / den
-    s2 = (-l2 * rb - l3 * rb * c3 - l3 * x * s3) / den
-    return np.sin(np.arctan2(s2, c2) + q3)
+    q2, q3 = arm_angles(r_x, r_y, l2, l3, sigma)
+    return np.sin(q2 + q3)
 
 
 def constraint_values(X, workspace: Workspace = Workspace()) -> np.ndarray:

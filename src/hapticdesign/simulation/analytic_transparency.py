@@ -55,8 +55,8 @@ from hapticdesign.simulation.config import (
     LoopConfig, compensator_device, hand_matrices, plant_damping, plant_friction, rest_pose,
 )
 from hapticdesign.simulation.paths import Chirp
-from hapticdesign.simulation.transparency import (TransparencyResult, band_of, check_request, first_exit, impedance,
-                                                  segment_length)
+from hapticdesign.simulation.transparency_estimate import (TransparencyResult, band_of, check_request, first_exit,
+                                                           impedance, segment_length)
 
 SIGNALS = ("acc", "vel", "pos", "held_acc", "held_vel", "held_pos")
 """The chirp's ``s'', s', s`` at every plant step and their sampled, delayed, held copies."""

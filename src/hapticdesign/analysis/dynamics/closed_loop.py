@@ -4,9 +4,10 @@
 ``C_a`` from ``T^T (H Tdot + C-terms T)`` (:mod:`.actuated_kernel`), where ``H, C, G`` are the
 loop-opened tree's (the same kernel as every tree device) and ``T`` comes from the loop solver
 (:mod:`hapticdesign.analysis.loops.solver`). Every entry stays linear in the standard inertial
-parameters, so this model is a :class:`~.model.DynamicsModel` whose entries come from a regressor
-evaluated pose by pose instead of an exact trigonometric basis: H, C (eq. 2.50's columns), C_cvt
-(eq. 2.52, from the Christoffel symbols of ``H_a``), G, inverse and forward dynamics are inherited.
+parameters, so this model is an :class:`~.model.EquationsOfMotion` whose entries come from a regressor
+evaluated pose by pose instead of an exact trigonometric basis (it is no :class:`~.model.ExactBasis`): H,
+C (eq. 2.50's columns), C_cvt (eq. 2.52, from the Christoffel symbols of ``H_a``), G, inverse and forward
+dynamics are inherited.
 
 A batch of actuated poses is a motion (:meth:`LoopSolver.solve`): passive values are continued
 along it from the home assembly.
@@ -26,7 +27,7 @@ from hapticdesign.analysis.dynamics.actuated_kernel import (
     passive_paths,
 )
 from hapticdesign.analysis.configuration import LoopConfiguration
-from hapticdesign.analysis.dynamics.model import DynamicsModel, pair_index
+from hapticdesign.analysis.dynamics.model import EquationsOfMotion, pair_index
 from hapticdesign.analysis.loops.closure_kernel import SINGULAR
 from hapticdesign.analysis.loops.solver import MESSAGES, SINGULAR_RATIO
 from hapticdesign.errors import UserError
@@ -36,10 +37,8 @@ CHUNK = 4096
 """Poses per kernel call when a regressor (E x n_params per pose) is returned."""
 
 
-class ClosedLoopModel(DynamicsModel):
+class ClosedLoopModel(EquationsOfMotion):
     """Regressor model of a closed-loop mechanism in its actuated coordinates (see module docstring)."""
-
-    exact_basis = False
 
     def __init__(self, configuration: LoopConfiguration):
         mechanism = configuration.mechanism
@@ -131,14 +130,3 @@ class ClosedLoopModel(DynamicsModel):
         constant[self.slice_h] = h[iu, ju]
         out.constant = constant + (0.0 if self.constant is None else self.constant)
         return out
-
-    # -- what a closed loop has not -------------------------------------------------------------
-    @property
-    def cyclic(self) -> tuple[bool, ...]:
-        return (False,) * self.n_dof
-
-    def basis(self, q: np.ndarray) -> np.ndarray:
-        raise UserError("a closed-loop device has no exact trigonometric basis (its LN uses quadrature)")
-
-    def coefficients_for(self, pi: np.ndarray) -> np.ndarray:
-        return self.basis(None)

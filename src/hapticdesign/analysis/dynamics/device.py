@@ -17,13 +17,13 @@ import numpy as np
 from hapticdesign.analysis.configuration import configuration_for
 from hapticdesign.analysis.dynamics.closed_loop import ClosedLoopModel
 from hapticdesign.analysis.dynamics.kernel import regressor_kernel
-from hapticdesign.analysis.dynamics.model import DynamicsModel
+from hapticdesign.analysis.dynamics.model import DynamicsModel, EquationsOfMotion
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device, MechanismBuilder
 from hapticdesign.model.mechanism import Mechanism
 
 
-def dynamics_of(device: Device) -> DynamicsModel:
+def dynamics_of(device: Device) -> EquationsOfMotion:
     """The compiled regressor model of the device's equations of motion (cached per geometry; a closed-loop
     device's takes its configuration space, :func:`~hapticdesign.analysis.configuration.configuration_of`)."""
     base = _model(device.builder, device.kinematic_values())

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import copy
 from functools import cached_property
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 from numba import njit
@@ -92,18 +93,157 @@ def _require_basis_memory(bases: list[CoordinateBasis], n_dof: int, n_params: in
                    f"{points:,} grid poses)", basis_bytes(points, n_dof, n_params))
 
 
-class DynamicsModel:
-    """Regressor model of one mechanism geometry; parameters ``pi`` are inputs of every call.
+class EquationsOfMotion:
+    """H, C, C_cvt, G, inverse and forward dynamics from the entries (unique H, C, G; eq. 2.50-2.52) of a subclass.
 
-    Arrays of poses ``q`` have shape (P, N) or (N,); parameters have shape (n_params,) or
-    (S, n_params) for S parameter sets at once (results then lead with S).
-
-    ``constant`` (None, or one value per entry) is added to every evaluation: the reflected rotor
-    inertia of actuators (:meth:`with_constant_inertia`); ``coefficients`` and :meth:`regressor`
-    stay purely linear in the inertial parameters.
+    A subclass sets ``mechanism``, ``n_dof``, ``n_params``, ``pairs`` and the slices ``slice_h``, ``slice_c``,
+    ``slice_g`` of its entries, and gives :meth:`entries` (P, E) or (S, P, E) and :meth:`entry_regressor`:
+    :class:`DynamicsModel` from its exact basis, :class:`~.closed_loop.ClosedLoopModel` pose by pose.
+    Arrays of poses ``q`` have shape (P, N) or (N,); parameters have shape (n_params,) or (S, n_params) for
+    S parameter sets at once (results then lead with S). ``constant`` (None, or one value per entry) is added
+    to every evaluation: the reflected rotor inertia of actuators.
     """
 
     constant: np.ndarray | None = None
+
+    def _poses(self, q: np.ndarray) -> np.ndarray:
+        q = _float_array(q, "joint coordinates", self.n_dof)
+        if q.shape[-1] != self.n_dof:
+            raise UserError(f"expected {self.n_dof} joint coordinates, got {q.shape[-1]}")
+        if not np.all(np.isfinite(q)):
+            raise UserError("joint coordinates must be finite numbers (got NaN or infinity)")
+        return np.atleast_2d(q)
+
+    def _params(self, pi: np.ndarray) -> np.ndarray:
+        pi = _float_array(pi, "standard inertial parameters", self.n_params)
+        if pi.shape[-1] != self.n_params:
+            raise UserError(f"expected {self.n_params} standard inertial parameters, got {pi.shape[-1]}")
+        if not np.all(np.isfinite(pi)):
+            raise UserError("standard inertial parameters must be finite numbers (got NaN or infinity)")
+        return pi
+
+    def _squeeze(self, q: np.ndarray, out: np.ndarray) -> np.ndarray:
+        return out[..., 0, :] if np.asarray(q).ndim == 1 else out
+
+    def _h_from(self, e: np.ndarray) -> np.ndarray:
+        n = self.n_dof
+        iu, ju = np.triu_indices(n)
+        h = np.empty(e.shape[:-1] + (n, n))
+        h[..., iu, ju] = e[..., self.slice_h]
+        h[..., ju, iu] = e[..., self.slice_h]
+        return h
+
+    def H(self, q: np.ndarray, pi: np.ndarray) -> np.ndarray:
+        """Mass matrix (eq. 2.50)."""
+        h = self._h_from(self.entries(q, pi))
+        return h[..., 0, :, :] if np.asarray(q).ndim == 1 else h
+
+    def C(self, q: np.ndarray, pi: np.ndarray) -> np.ndarray:
+        """Coriolis and centrifugal matrix, N x N(N+1)/2 (eq. 2.50)."""
+        e = self.entries(q, pi)[..., self.slice_c]
+        c = e.reshape(e.shape[:-1] + (self.n_dof, len(self.pairs)))
+        return c[..., 0, :, :] if np.asarray(q).ndim == 1 else c
+
+    def G(self, q: np.ndarray, pi: np.ndarray) -> np.ndarray:
+        """Gravity torques (eq. 2.50)."""
+        return self._squeeze(q, self.entries(q, pi)[..., self.slice_g])
+
+    def christoffel(self, q: np.ndarray, pi: np.ndarray) -> np.ndarray:
+        """``Gamma_ijk`` (..., N, N, N) recovered from C."""
+        c = self.C(q, pi)
+        n = self.n_dof
+        gamma = np.empty(c.shape[:-1] + (n, n))
+        for col, (j, k) in enumerate(self.pairs):
+            if j == k:
+                gamma[..., j, j] = c[..., col]
+            else:
+                gamma[..., j, k] = gamma[..., k, j] = 0.5 * c[..., col]
+        return gamma
+
+    def C_cvt(self, q: np.ndarray, qd: np.ndarray, pi: np.ndarray) -> np.ndarray:
+        """N x N Coriolis matrix of eq. 2.51-2.52, ``C_cvt_ij = sum_k Gamma_ijk qd_k``."""
+        qd = self._velocities(qd, q)
+        return np.einsum("...ijk,...k->...ij", self.christoffel(q, pi), qd)
+
+    def _velocities(self, v: np.ndarray, q: np.ndarray) -> np.ndarray:
+        v = _float_array(v, "joint rates", self.n_dof)
+        if v.shape[-1] != self.n_dof:
+            raise UserError(f"expected {self.n_dof} joint rates, got {v.shape[-1]}")
+        if not np.all(np.isfinite(v)):
+            raise UserError("joint rates must be finite numbers (got NaN or infinity)")
+        return v
+
+    def inverse(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, pi: np.ndarray) -> np.ndarray:
+        """Inverse dynamics ``tau = H qdd + C qd^2 + G`` (eq. 2.50)."""
+        e = self.entries(q, pi)
+        qd = self._velocities(qd, q)
+        qdd = self._velocities(qdd, q)
+        h = self._h_from(e)
+        c = e[..., self.slice_c].reshape(e.shape[:-1] + (self.n_dof, len(self.pairs)))
+        qd2 = velocity_products(np.atleast_2d(qd))
+        tau = (
+            np.einsum("...ij,...j->...i", h, np.atleast_2d(qdd))
+            + np.einsum("...ic,...c->...i", c, qd2)
+            + e[..., self.slice_g]
+        )
+        return self._squeeze(q, tau)
+
+    def forward(self, q: np.ndarray, qd: np.ndarray, tau: np.ndarray, pi: np.ndarray) -> np.ndarray:
+        """Forward dynamics ``qdd = H^-1 (tau - C qd^2 - G)``."""
+        e = self.entries(q, pi)
+        qd = self._velocities(qd, q)
+        tau = self._velocities(tau, q)
+        h = self._h_from(e)
+        c = e[..., self.slice_c].reshape(e.shape[:-1] + (self.n_dof, len(self.pairs)))
+        rhs = np.atleast_2d(tau) - np.einsum("...ic,...c->...i", c, velocity_products(np.atleast_2d(qd))) - e[..., self.slice_g]
+        try:
+            qdd = np.linalg.solve(h, rhs[..., None])[..., 0]
+        except np.linalg.LinAlgError:
+            raise UserError("the mass matrix is singular at this pose (check the inertial parameters)") from None
+        return self._squeeze(q, qdd)
+
+    def regressor(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+        """Joint-torque regressor ``Y`` with ``tau = Y pi``: (P, N, n_params) or (N, n_params).
+
+        ``Y pi`` leaves out a :attr:`constant` (reflected rotor inertia ``h``: add ``h qdd``).
+        """
+        e = self.entry_regressor(q)  # (P, E, n_params)
+        n, m = self.n_dof, len(self.pairs)
+        h = self._h_from(np.moveaxis(e, -1, 1)).transpose(0, 2, 3, 1)  # (P, N, N, n_params)
+        c = e[:, self.slice_c].reshape(e.shape[0], n, m, self.n_params)
+        qd2 = velocity_products(np.atleast_2d(self._velocities(qd, q)))
+        y = (
+            np.einsum("pijn,pj->pin", h, np.atleast_2d(self._velocities(qdd, q)))
+            + np.einsum("picn,pc->pin", c, qd2)
+            + e[:, self.slice_g]
+        )
+        return y[0] if np.asarray(q).ndim == 1 else y
+
+
+@runtime_checkable
+class ExactBasis(Protocol):
+    """What a model with an exact basis of H, C, G offers (a tree's :class:`DynamicsModel`): the basis functions,
+    their tables for compiled evaluation, the coefficients for a parameter set and the coordinates that enter
+    nothing. The Linearity Number's exact moments and the simulation's tables need it; a closed-loop model
+    has none (its LN uses quadrature, its simulation the compiled plant)."""
+
+    cyclic: tuple[bool, ...]
+
+    def basis(self, q: np.ndarray) -> np.ndarray: ...
+
+    @property
+    def basis_tables(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]: ...
+
+    def coefficients_for(self, pi: np.ndarray) -> np.ndarray: ...
+
+
+class DynamicsModel(EquationsOfMotion):
+    """Regressor model of one tree geometry on its exact basis (:class:`ExactBasis`); parameters ``pi`` are
+    inputs of every call.
+
+    ``constant`` (:meth:`with_constant_inertia`: the reflected rotor inertia) enters the constant basis
+    function; ``coefficients`` and :meth:`regressor` stay purely linear in the inertial parameters.
+    """
 
     def __init__(self, mechanism: Mechanism, max_degree: int = 4, tol: float = 1e-10, seed: int = 0):
         self.mechanism = mechanism
@@ -232,22 +372,6 @@ class DynamicsModel:
         degrees = np.array([b.degree for b in self.bases], dtype=np.int64)
         return kinds, degrees, np.ascontiguousarray(self.index, dtype=np.int64)
 
-    def _poses(self, q: np.ndarray) -> np.ndarray:
-        q = _float_array(q, "joint coordinates", self.n_dof)
-        if q.shape[-1] != self.n_dof:
-            raise UserError(f"expected {self.n_dof} joint coordinates, got {q.shape[-1]}")
-        if not np.all(np.isfinite(q)):
-            raise UserError("joint coordinates must be finite numbers (got NaN or infinity)")
-        return np.atleast_2d(q)
-
-    def _params(self, pi: np.ndarray) -> np.ndarray:
-        pi = _float_array(pi, "standard inertial parameters", self.n_params)
-        if pi.shape[-1] != self.n_params:
-            raise UserError(f"expected {self.n_params} standard inertial parameters, got {pi.shape[-1]}")
-        if not np.all(np.isfinite(pi)):
-            raise UserError("standard inertial parameters must be finite numbers (got NaN or infinity)")
-        return pi
-
     def with_constant_inertia(self, h: np.ndarray) -> "DynamicsModel":
         """This model with the constant matrix ``h`` (N, N) added to H: ``H(q) = H_pi(q) + h``.
 
@@ -282,106 +406,9 @@ class DynamicsModel:
             return phi @ coef
         return np.einsum("pb,bes->spe", phi, coef)
 
-    def _squeeze(self, q: np.ndarray, out: np.ndarray) -> np.ndarray:
-        return out[..., 0, :] if np.asarray(q).ndim == 1 else out
-
-    def _h_from(self, e: np.ndarray) -> np.ndarray:
-        n = self.n_dof
-        iu, ju = np.triu_indices(n)
-        h = np.empty(e.shape[:-1] + (n, n))
-        h[..., iu, ju] = e[..., self.slice_h]
-        h[..., ju, iu] = e[..., self.slice_h]
-        return h
-
-    def H(self, q: np.ndarray, pi: np.ndarray) -> np.ndarray:
-        """Mass matrix (eq. 2.50)."""
-        h = self._h_from(self.entries(q, pi))
-        return h[..., 0, :, :] if np.asarray(q).ndim == 1 else h
-
-    def C(self, q: np.ndarray, pi: np.ndarray) -> np.ndarray:
-        """Coriolis and centrifugal matrix, N x N(N+1)/2 (eq. 2.50)."""
-        e = self.entries(q, pi)[..., self.slice_c]
-        c = e.reshape(e.shape[:-1] + (self.n_dof, len(self.pairs)))
-        return c[..., 0, :, :] if np.asarray(q).ndim == 1 else c
-
-    def G(self, q: np.ndarray, pi: np.ndarray) -> np.ndarray:
-        """Gravity torques (eq. 2.50)."""
-        return self._squeeze(q, self.entries(q, pi)[..., self.slice_g])
-
-    def christoffel(self, q: np.ndarray, pi: np.ndarray) -> np.ndarray:
-        """``Gamma_ijk`` (..., N, N, N) recovered from C."""
-        c = self.C(q, pi)
-        n = self.n_dof
-        gamma = np.empty(c.shape[:-1] + (n, n))
-        for col, (j, k) in enumerate(self.pairs):
-            if j == k:
-                gamma[..., j, j] = c[..., col]
-            else:
-                gamma[..., j, k] = gamma[..., k, j] = 0.5 * c[..., col]
-        return gamma
-
-    def C_cvt(self, q: np.ndarray, qd: np.ndarray, pi: np.ndarray) -> np.ndarray:
-        """N x N Coriolis matrix of eq. 2.51-2.52, ``C_cvt_ij = sum_k Gamma_ijk qd_k``."""
-        qd = self._velocities(qd, q)
-        return np.einsum("...ijk,...k->...ij", self.christoffel(q, pi), qd)
-
-    def _velocities(self, v: np.ndarray, q: np.ndarray) -> np.ndarray:
-        v = _float_array(v, "joint rates", self.n_dof)
-        if v.shape[-1] != self.n_dof:
-            raise UserError(f"expected {self.n_dof} joint rates, got {v.shape[-1]}")
-        if not np.all(np.isfinite(v)):
-            raise UserError("joint rates must be finite numbers (got NaN or infinity)")
-        return v
-
-    def inverse(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, pi: np.ndarray) -> np.ndarray:
-        """Inverse dynamics ``tau = H qdd + C qd^2 + G`` (eq. 2.50)."""
-        e = self.entries(q, pi)
-        qd = self._velocities(qd, q)
-        qdd = self._velocities(qdd, q)
-        h = self._h_from(e)
-        c = e[..., self.slice_c].reshape(e.shape[:-1] + (self.n_dof, len(self.pairs)))
-        qd2 = velocity_products(np.atleast_2d(qd))
-        tau = (
-            np.einsum("...ij,...j->...i", h, np.atleast_2d(qdd))
-            + np.einsum("...ic,...c->...i", c, qd2)
-            + e[..., self.slice_g]
-        )
-        return self._squeeze(q, tau)
-
-    def forward(self, q: np.ndarray, qd: np.ndarray, tau: np.ndarray, pi: np.ndarray) -> np.ndarray:
-        """Forward dynamics ``qdd = H^-1 (tau - C qd^2 - G)``."""
-        e = self.entries(q, pi)
-        qd = self._velocities(qd, q)
-        tau = self._velocities(tau, q)
-        h = self._h_from(e)
-        c = e[..., self.slice_c].reshape(e.shape[:-1] + (self.n_dof, len(self.pairs)))
-        rhs = np.atleast_2d(tau) - np.einsum("...ic,...c->...i", c, velocity_products(np.atleast_2d(qd))) - e[..., self.slice_g]
-        try:
-            qdd = np.linalg.solve(h, rhs[..., None])[..., 0]
-        except np.linalg.LinAlgError:
-            raise UserError("the mass matrix is singular at this pose (check the inertial parameters)") from None
-        return self._squeeze(q, qdd)
-
     def entry_regressor(self, q: np.ndarray) -> np.ndarray:
         """Every entry (unique H, C, G) as a row of the standard parameters: (P, E, n_params)."""
         return np.tensordot(self.basis(q), self.coefficients, axes=(1, 0))
-
-    def regressor(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
-        """Joint-torque regressor ``Y`` with ``tau = Y pi``: (P, N, n_params) or (N, n_params).
-
-        ``Y pi`` leaves out a :attr:`constant` (reflected rotor inertia ``h``: add ``h qdd``).
-        """
-        e = self.entry_regressor(q)  # (P, E, n_params)
-        n, m = self.n_dof, len(self.pairs)
-        h = self._h_from(np.moveaxis(e, -1, 1)).transpose(0, 2, 3, 1)  # (P, N, N, n_params)
-        c = e[:, self.slice_c].reshape(e.shape[0], n, m, self.n_params)
-        qd2 = velocity_products(np.atleast_2d(self._velocities(qd, q)))
-        y = (
-            np.einsum("pijn,pj->pin", h, np.atleast_2d(self._velocities(qdd, q)))
-            + np.einsum("picn,pc->pin", c, qd2)
-            + e[:, self.slice_g]
-        )
-        return y[0] if np.asarray(q).ndim == 1 else y
 
     @cached_property
     def cyclic(self) -> tuple[bool, ...]:

@@ -27,7 +27,7 @@ import sympy as sp
 from sympy.polys.domains import RR
 from sympy.polys.rings import ring
 
-from hapticdesign.analysis.linearity.form import PARTS, LinearityForm
+from hapticdesign.analysis.linearity.quadratic import PARTS, LinearityForm
 from hapticdesign.analysis.linearity.symbols import seed_symbols, standard_expressions
 from hapticdesign.errors import InputError, UserError
 from hapticdesign.escape import docstring_text, python_identifier

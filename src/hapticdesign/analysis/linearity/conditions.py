@@ -17,7 +17,7 @@ import numpy as np
 import sympy as sp
 
 from hapticdesign.analysis.dynamics.device import dynamics_of
-from hapticdesign.analysis.linearity.form import LinearityForm
+from hapticdesign.analysis.linearity.quadratic import LinearityForm
 from hapticdesign.analysis.linearity.symbols import seed_symbols, standard_expressions, standard_names
 from hapticdesign.model.device import Device
 

@@ -28,7 +28,7 @@ from scipy.optimize import brentq, differential_evolution, minimize
 
 from hapticdesign.analysis.linearity.bounds import BodyBounds, within_bounds
 from hapticdesign.analysis.linearity.conditions import LinearConditions
-from hapticdesign.analysis.linearity.form import LinearityForm
+from hapticdesign.analysis.linearity.quadratic import LinearityForm
 from hapticdesign.analysis.linearity.linear_designs import find_linear_designs, realizable
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device

@@ -17,7 +17,7 @@ import numpy as np
 from hapticdesign.analysis.linearity.bounds import BodyBounds, within_bounds
 from hapticdesign.analysis.linearity.conditions import LinearConditions
 from hapticdesign.analysis.linearity.convex import SCALE, body_constraints, solve
-from hapticdesign.analysis.linearity.form import LinearityForm
+from hapticdesign.analysis.linearity.quadratic import LinearityForm
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.model.inertia import Realizability, pseudo_inertia, seed_from_standard

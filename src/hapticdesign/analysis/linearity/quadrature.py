@@ -22,6 +22,7 @@ import math
 
 import numpy as np
 
+from hapticdesign.analysis.linearity.quadratic import LinearityForm
 from hapticdesign.analysis.linearity.region import PANEL_LENGTH, Region
 from hapticdesign.analysis.linearity.weights import Weights
 from hapticdesign.errors import InputError, UserError
@@ -85,8 +86,6 @@ def _moments(model, q_full: np.ndarray, weights: np.ndarray, entry_weights: tupl
 
 def quadrature_form(model, region: Region | None = None, weights: Weights | None = None):
     """``LinearityForm`` of a closed-loop model by converged quadrature (see the module docstring)."""
-    from hapticdesign.analysis.linearity.form import LinearityForm
-
     region = region or Region()
     weights = weights or Weights.unit(model.n_dof)
     box = region_box(region, model.n_dof)

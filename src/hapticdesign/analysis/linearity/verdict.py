@@ -21,7 +21,7 @@ import numpy as np
 
 from hapticdesign.analysis.linearity.bounds import BodyBounds, clip_to_bounds, within_bounds
 from hapticdesign.analysis.linearity.convex import SCALE, body_constraints, bounds_scale, realizability_lmi, solve
-from hapticdesign.analysis.linearity.form import LinearityForm
+from hapticdesign.analysis.linearity.quadratic import LinearityForm
 from hapticdesign.analysis.linearity.linear_designs import realizable
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device

@@ -81,14 +81,26 @@ def chain_angles(geometry: RCubeGeometry, chain: int, position) -> np.ndarray:
     g = geometry
     a, b, c = axis_permutation(chain)
     q1 = np.arcsin(np.clip((r[..., a] - g.S) / g.l1, -1.0, 1.0))
-    x = r[..., c] - g.l1 * np.cos(q1)
-    rb = r[..., b]
-    c3 = np.clip((x**2 + rb**2 - g.l2**2 - g.l3**2) / (2 * g.l2 * g.l3), -1.0, 1.0)
-    s3 = g.sigma * np.sqrt(1.0 - c3**2)
-    den = g.l2**2 + g.l3**2 + 2 * g.l2 * g.l3 * c3
-    c2 = (g.l2 * x + g.l3 * x * c3 - g.l3 * rb * s3) / den
-    s2 = (-g.l2 * rb - g.l3 * rb * c3 - g.l3 * x * s3) / den
-    return np.stack([q1, np.arctan2(s2, c2), np.arctan2(s3, c3)], axis=-1)
+    q2, q3 = arm_angles(r[..., b], r[..., c] - g.l1 * np.cos(q1), g.l2, g.l3, g.sigma)
+    return np.stack([q1, q2, q3], axis=-1)
+
+
+def elbow_cosine(r_x, r_y, l2, l3) -> np.ndarray:
+    """``cos q_i3`` of the passive 2R arm (links ``l2``, ``l3``) reaching ``(r_x, r_y)`` (eq. 5.39, 6.32)."""
+    return (np.square(r_x) + np.square(r_y) - np.square(l2) - np.square(l3)) / (2.0 * l2 * l3)
+
+
+def arm_angles(r_x, r_y, l2, l3, sigma: int) -> tuple[np.ndarray, np.ndarray]:
+    """Angles ``(q_i2, q_i3)`` of the passive 2R arm reaching ``(r_x, r_y)`` with the elbow configuration
+    ``sigma`` (eq. 5.39-5.45): ``r_y`` is the reach along the link-1 direction (``r_c - l1 cos q_i1``) and
+    ``r_x`` the across coordinate ``r_b``. Unreachable points are evaluated at the nearest reachable elbow
+    angle (:func:`passive_reach` tells them apart)."""
+    c3 = np.clip(elbow_cosine(r_x, r_y, l2, l3), -1.0, 1.0)
+    s3 = sigma * np.sqrt(1.0 - c3**2)
+    den = l2**2 + l3**2 + 2.0 * l2 * l3 * c3
+    c2 = (l2 * r_y + l3 * r_y * c3 - l3 * r_x * s3) / den
+    s2 = (-l2 * r_x - l3 * r_x * c3 - l3 * r_y * s3) / den
+    return np.arctan2(s2, c2), np.arctan2(s3, c3)
 
 
 def forward_kinematics(geometry: RCubeGeometry, q_active) -> np.ndarray:

@@ -8,7 +8,8 @@ References, independent of the loop solver and of the actuated-coordinate kernel
   rods of each parallelogram, lower bars, platform): ``H_a = sum m Jc^T Jc + Jw^T R I R^T Jw`` with
   Jacobians by finite differences, ``G_a`` the gradient of the potential, C from the Christoffel
   symbols of that ``H_a``;
-- properties: energy conservation without damping, ``Hdot - 2 C_cvt`` skew-symmetric, H positive definite.
+- energy conservation without damping; H positive definite and ``Hdot - 2 C_cvt`` skew-symmetric are checked for
+  every example device in tests/dynamics/test_example_properties.py.
 """
 
 from __future__ import annotations
@@ -22,7 +23,6 @@ from scipy.spatial.transform import Rotation
 
 from hapticdesign.analysis.dynamics.device import (
     coriolis_centrifugal,
-    coriolis_matrix,
     dynamics_of,
     forward_dynamics,
     gravity,
@@ -215,23 +215,7 @@ def test_dynamics_along_a_motion_match_the_lagrangian(device):
     np.testing.assert_allclose(coriolis[150], reference, rtol=1e-6, atol=1e-6 * np.abs(reference).max())
 
 
-# -- properties -------------------------------------------------------------------------------------
-def test_mass_matrix_positive_definite(device):
-    for qa in _samples(30, 4):
-        assert np.linalg.eigvalsh(mass_matrix(device, qa)).min() > 0.0
-
-
-def test_hdot_minus_two_c_cvt_is_skew_symmetric(device):
-    rng = np.random.default_rng(5)
-    h = 1e-3
-    for qa in _samples(5, 6):
-        qd = rng.normal(size=3)
-        hdot = (-mass_matrix(device, qa + 2 * h * qd) + 8 * mass_matrix(device, qa + h * qd) - 8 * mass_matrix(device, qa - h * qd)
-                + mass_matrix(device, qa - 2 * h * qd)) / (12 * h)
-        n = hdot - 2 * coriolis_matrix(device, qa, qd)
-        assert np.abs(n + n.T).max() <= 1e-8 * np.abs(hdot).max()
-
-
+# -- energy (H PD and Hdot - 2 C_cvt skew: tests/dynamics/test_example_properties.py) ---------------
 def test_energy_is_conserved_without_damping(device):
     qa0, qd0 = np.array([0.35, 0.30, 0.40]), np.array([2.0, -1.0, 0.5])
 

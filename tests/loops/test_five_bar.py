@@ -6,8 +6,8 @@ References, all independent of the loop solver and of the actuated-coordinate ke
 - dynamics: Pinocchio's CRBA/RNEA of the loop-opened tree (4 revolute joints), reduced to the
   actuated coordinates with passive rates and accelerations obtained by finite differences of the
   closed-form passive angles (``tau_a = T^T rnea(q, T qd_a, qdd)``, d'Alembert);
-- properties: energy conservation without damping (scipy ``solve_ivp``), ``Hdot - 2 C_cvt``
-  skew-symmetric, H positive definite.
+- energy conservation without damping (scipy ``solve_ivp``); H positive definite and ``Hdot - 2 C_cvt``
+  skew-symmetric are checked for every example device in tests/dynamics/test_example_properties.py.
 """
 
 from __future__ import annotations
@@ -21,7 +21,6 @@ from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
 from hapticdesign.analysis.dynamics.device import (
-    coriolis_matrix,
     dynamics_of,
     forward_dynamics,
     gravity,
@@ -176,24 +175,7 @@ def test_dynamics_along_a_motion_match_pinocchio(device):
         np.testing.assert_allclose(tau[p], ref_tau, rtol=1e-6, atol=1e-6 * np.abs(ref_tau).max())
 
 
-# -- properties -------------------------------------------------------------------------------------
-def test_mass_matrix_positive_definite(device):
-    for qa in _samples(30, 6):
-        assert np.linalg.eigvalsh(mass_matrix(device, qa)).min() > 0.0
-
-
-def test_hdot_minus_two_c_cvt_is_skew_symmetric(device):
-    rng = np.random.default_rng(7)
-    h = 1e-3
-    for qa in _samples(6, 8):
-        qd = rng.normal(size=2)
-        # fourth-order central difference of H along qd: truncation ~h^4
-        hdot = (-mass_matrix(device, qa + 2 * h * qd) + 8 * mass_matrix(device, qa + h * qd) - 8 * mass_matrix(device, qa - h * qd)
-                + mass_matrix(device, qa - 2 * h * qd)) / (12 * h)
-        n = hdot - 2 * coriolis_matrix(device, qa, qd)
-        assert np.abs(n + n.T).max() <= 1e-8 * np.abs(hdot).max()
-
-
+# -- energy (H PD and Hdot - 2 C_cvt skew: tests/dynamics/test_example_properties.py) ---------------
 def _potential(device, qa: np.ndarray) -> float:
     """Gravity potential from the closed-form positions of every mass centre."""
     d, l1, l2 = _lengths(device)

@@ -64,9 +64,9 @@ def test_cli_refuses_the_singular_pose_in_one_line():
 def test_a_pose_whose_straight_path_fails_is_reached_joint_by_joint():
     """The delta at (-1.596, -2.224, -2.203): the straight segment from home leaves the workspace, the path that
     moves one arm after the other does not. The pose it returns closes the loops, keeps home's sign of
-    ``det Phi_p``, and puts the handle where the delta's trilateration (tests/devices/test_loops_delta.py, closed
+    ``det Phi_p``, and puts the handle where the delta's trilateration (tests/loops/test_delta.py, closed
     form, lower platform solution) puts it."""
-    from tests.devices.test_loops_delta import MOUNT, _platform
+    from tests.loops.test_delta import MOUNT, _platform
 
     delta = load_device_file(DELTA)
     conf = configuration_of(delta)

@@ -1,7 +1,7 @@
 """The compiled closed-loop plant (H_a, C(q, qd) qd, G_a pose after pose) of the five-bar and the delta.
 
 References: the closed-loop model's entries (the slow path, itself checked against Pinocchio and the
-Lagrangian in test_loops_five_bar.py / test_loops_delta.py) at random poses; energy conservation of a
+Lagrangian in test_five_bar.py / test_delta.py) at random poses; energy conservation of a
 free motion without damping integrated by scipy's ``solve_ivp`` with the plant, the potential taken
 from the frame poses of the mechanism (``Mechanism.frame_pose``) at the closed coordinates.
 """
