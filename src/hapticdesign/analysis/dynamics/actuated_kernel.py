@@ -49,11 +49,12 @@ from hapticdesign.analysis.loops.closure_kernel import (
     OK,
     closure_bias,
     closure_jacobian,
+    continue_to,
     correct,
     rotation_entry,
-    solve_path,
+    tangent_into,
 )
-from hapticdesign.analysis.loops.records import workspace
+from hapticdesign.analysis.loops.records import Workspace, workspace
 from hapticdesign.model.dense import lu_in_place
 from hapticdesign.model.walk import MotionPlan, add_joint_accelerations, node_motion, planned_poses, unit_twist
 
@@ -69,6 +70,25 @@ class Bodies(NamedTuple):
     motion: MotionPlan
     path_ptr: np.ndarray
     path_nodes: np.ndarray
+
+
+class MotionWork(NamedTuple):
+    """Scratch of :func:`motion_entries_into`: the bodies the parameter sets move (:func:`active_bodies`), the
+    entries' workspace and scratch, the last pose ``q_last``, the
+    closures' bias and half the passive accelerations of a step, and for a pose handed to the continuation
+    (:func:`~hapticdesign.analysis.loops.closure_kernel.continue_to`) its own workspace ``fallback``, tangent
+    ``s``, ``start`` and ``trial``."""
+
+    active: np.ndarray
+    ws: Workspace
+    scratch: "EntriesScratch"
+    q_last: np.ndarray
+    bias: np.ndarray
+    half_gamma: np.ndarray
+    fallback: Workspace
+    s: np.ndarray
+    start: np.ndarray
+    trial: np.ndarray
 
 
 class EntriesScratch(NamedTuple):
@@ -496,13 +516,19 @@ def actuated_entries(qs, tree, plan, bodies, loops, params):
     ratios = np.zeros(n_pose)
     ws = workspace(tree.parent.shape[0], n_dof, na, passive, n_body)
     scratch = entries_scratch(n_sets, na, passive.shape[0], n_body)
-    active = active_bodies(params)
-    for p in range(n_pose):
+    entries_into(qs, tree, plan, bodies, loops, params, active_bodies(params), ws, scratch, out, ratios)
+    return out, ratios
+
+
+@njit(cache=True, _nrt=False)
+def entries_into(qs, tree, plan, bodies, loops, params, active, ws, scratch, out, ratios):
+    """The pose loop of :func:`actuated_entries` into ``out`` and ``ratios``; it allocates nothing, so it is compiled
+    without reference counting (the records' arrays cost no atomic counts per pose)."""
+    for p in range(qs.shape[0]):
         ratio, _ = factor_pose(qs[p], tree, plan, loops, ws)
         ratios[p] = ratio
         if ratio != 0.0:
             pose_entries(tree, plan, bodies, loops, params, active, ws, scratch, out[p])
-    return out, ratios
 
 
 @njit(cache=True)
@@ -520,13 +546,13 @@ def motion_entries(path, q_start, branch, tree, plan, bodies, loops, settings, p
     of eq. 2.38-2.43 and their derivative), and corrected by the continuation step
     (:func:`~hapticdesign.analysis.loops.closure_kernel.correct`, bound half the step), which leaves ``Phi``,
     ``Phi_p^-1`` and the closures' node poses for the entries. A second-order term above half the step or a
-    step ``correct`` refuses hands the pose to ``solve_path`` (tangent predictor, step halving), as does the
+    step ``correct`` refuses hands the pose to ``continue_to`` (tangent predictor, step halving), as does the
     first pose.
     """
-    actuated, passive = loops.actuated, loops.passive
+    passive = loops.passive
     n_pose = path.shape[0]
     n_dof = q_start.shape[0]
-    na = actuated.shape[0]
+    na = loops.actuated.shape[0]
     npas = passive.shape[0]
     n_body = bodies.body_node.shape[0]
     n_sets = params.shape[0]
@@ -534,12 +560,27 @@ def motion_entries(path, q_start, branch, tree, plan, bodies, loops, settings, p
     out = np.zeros((n_pose, n_sets, m + na * m + na))
     status = np.zeros(n_pose, dtype=np.int64)
     ws = workspace(tree.parent.shape[0], n_dof, na, passive, n_body)
-    scratch = entries_scratch(n_sets, na, npas, n_body)
-    active = active_bodies(params)
-    pinv, t, biases = ws.pinv, ws.t, scratch.biases
+    work = MotionWork(active_bodies(params), ws, entries_scratch(n_sets, na, npas, n_body), np.empty(n_dof),
+                      np.empty(npas), np.empty(npas), workspace(tree.parent.shape[0], n_dof, na, passive, 0),
+                      np.empty((npas, na)), np.empty(na), np.empty(n_dof))
     q = q_start.copy()
-    q_last = np.empty(n_dof)
-    bias, half_gamma = np.empty(npas), np.empty(npas)
+    first = motion_entries_into(path, q, branch, tree, plan, bodies, loops, settings, params, work, out, status)
+    return out, status, first
+
+
+@njit(cache=True, _nrt=False)
+def motion_entries_into(path, q, branch, tree, plan, bodies, loops, settings, params, work, out, status):
+    """The pose loop of :func:`motion_entries` from the closed full pose ``q`` (in place) into ``out`` and
+    ``status``; returns the index of the first failed pose (-1 if none). It allocates nothing, so it is compiled
+    without reference counting."""
+    actuated, passive = loops.actuated, loops.passive
+    n_pose = path.shape[0]
+    n_dof = q.shape[0]
+    na = actuated.shape[0]
+    npas = passive.shape[0]
+    active, ws, scratch = work.active, work.ws, work.scratch
+    q_last, bias, half_gamma = work.q_last, work.bias, work.half_gamma
+    pinv, t, biases = ws.pinv, ws.t, scratch.biases
     for p in range(n_pose):
         dist = 0.0
         for j in range(na):
@@ -582,15 +623,19 @@ def motion_entries(path, q_start, branch, tree, plan, bodies, loops, settings, p
                 for k in range(n_dof):
                     q[k] = q_last[k]
         if not fast:
-            solved, codes, first = solve_path(path[p:p + 1], q, branch, tree, plan, loops, settings)
-            if first >= 0:
-                status[p] = codes[0]
-                return out, status, p
-            for k in range(n_dof):
-                q[k] = solved[0, k]
+            fresh = work.fallback  # as a new workspace: no angle of its walk anchored yet
+            for n in range(fresh.trig.shape[0]):
+                fresh.trig[n, 2] = np.nan
+            tangent_into(q, tree, plan, loops, fresh, work.s)
+            code = continue_to(path[p], q, branch, tree, plan, loops, settings, fresh, work.s, work.start, work.trial)
+            if code != OK:
+                status[p] = code
+                return p
             factor_pose(q, tree, plan, loops, ws)
         pose_entries(tree, plan, bodies, loops, params, active, ws, scratch, out[p])
-    return out, status, -1
+    return -1
+
+
 
 
 @njit(cache=True, inline="always")

@@ -244,66 +244,84 @@ def correct(q, tree, plan, loops, settings, ws, branch, bound):
     return code
 
 
-@njit(cache=True)
-def solve_path(qa_path, q_start, branch, tree, plan, loops, settings):
-    """Continue the closure from ``q_start`` (full, closed) through the actuated poses ``qa_path`` in order.
+@njit(cache=True, _nrt=False)
+def tangent_into(q, tree, plan, loops, ws, s):
+    """``S = -Phi_p^-1 Phi_a`` (n_p x n_a) into ``s`` at the closed full pose ``q`` (the continuation's tangent)."""
+    planned_poses(q, tree, plan, 0, plan.n_first, ws.rot, ws.pos, ws.trig)
+    closure_jacobian(loops, tree, plan, ws.rot, ws.pos, ws.phi)
+    velocity_map_into(ws.phi, loops.actuated, loops.passive, ws.lu, s)
 
-    Each segment is split into steps of at most ``settings.max_step`` (actuated infinity norm) with a
-    tangent predictor; a step :func:`correct` refuses (Newton fails, another sign of ``det Phi_p``, a
-    corrector above half the step) is halved down to ``settings.min_fraction`` of the segment. Returns
-    full poses (P, N), per-pose status (OK until the first failure) and the index of the first failed
-    pose (-1 if none).
+
+@njit(cache=True, _nrt=False)
+def continue_to(target, q, branch, tree, plan, loops, settings, ws, s, start, trial):
+    """Continue the closed full pose ``q`` (in place) to the actuated pose ``target`` (n_a,) with the tangent ``s``
+    at ``q`` (:func:`tangent_into`; updated along). Returns the status.
+
+    The segment is split into steps of at most ``settings.max_step`` (actuated infinity norm) with a tangent
+    predictor; a step :func:`correct` refuses (Newton fails, another sign of ``det Phi_p``, a corrector above
+    half the step) is halved down to ``settings.min_fraction`` of the segment. ``start`` (n_a) and ``trial``
+    (N): scratch; nothing is allocated.
     """
     actuated, passive = loops.actuated, loops.passive
-    n_pose = qa_path.shape[0]
-    n_dof = q_start.shape[0]
     m = passive.shape[0]
     na = actuated.shape[0]
-    ws = workspace(tree.parent.shape[0], n_dof, na, passive, 0)
+    n_dof = q.shape[0]
     phi, pinv = ws.phi, ws.pinv
+    for j in range(na):
+        start[j] = q[actuated[j]]
+    dist = 0.0
+    for j in range(na):
+        dist = max(dist, abs(target[j] - start[j]))
+    done = 0.0
+    step = 1.0 if dist <= settings.max_step else settings.max_step / dist
+    code = OK
+    while done < 1.0:
+        f = min(1.0, done + step)
+        for k in range(n_dof):
+            trial[k] = q[k]
+        for j in range(na):
+            delta = start[j] + f * (target[j] - start[j]) - q[actuated[j]]
+            trial[actuated[j]] += delta
+            for r in range(m):
+                trial[passive[r]] += s[r, j] * delta
+        code = correct(trial, tree, plan, loops, settings, ws, branch, 0.5 * step * dist)
+        if code == OK:
+            for k in range(n_dof):
+                q[k] = trial[k]
+            done = f
+            for r in range(m):
+                for j in range(na):
+                    acc = 0.0
+                    for i in range(m):
+                        acc -= pinv[r, i] * phi[i, actuated[j]]
+                    s[r, j] = acc
+        else:
+            step *= 0.5
+            if step < settings.min_fraction:
+                break
+    return code
+
+
+@njit(cache=True)
+def solve_path(qa_path, q_start, branch, tree, plan, loops, settings):
+    """Continue the closure from ``q_start`` (full, closed) through the actuated poses ``qa_path`` in order
+    (:func:`continue_to` from pose to pose). Returns full poses (P, N), per-pose status (OK until the first
+    failure) and the index of the first failed pose (-1 if none).
+    """
+    n_pose = qa_path.shape[0]
+    n_dof = q_start.shape[0]
+    m = loops.passive.shape[0]
+    na = loops.actuated.shape[0]
+    ws = workspace(tree.parent.shape[0], n_dof, na, loops.passive, 0)
     s = np.empty((m, na))
     start = np.empty(na)
     out = np.empty((n_pose, n_dof))
     status = np.zeros(n_pose, dtype=np.int64)
     q = q_start.copy()
     trial = q.copy()
-    # tangent at the current closed pose; after each accepted step, S = -Phi_p^-1 Phi_a from Newton's last iteration
-    planned_poses(q, tree, plan, 0, plan.n_first, ws.rot, ws.pos, ws.trig)
-    closure_jacobian(loops, tree, plan, ws.rot, ws.pos, phi)
-    velocity_map_into(phi, actuated, passive, ws.lu, s)
+    tangent_into(q, tree, plan, loops, ws, s)
     for p in range(n_pose):
-        for j in range(na):
-            start[j] = q[actuated[j]]
-        dist = 0.0
-        for j in range(na):
-            dist = max(dist, abs(qa_path[p, j] - start[j]))
-        done = 0.0
-        step = 1.0 if dist <= settings.max_step else settings.max_step / dist
-        code = OK
-        while done < 1.0:
-            f = min(1.0, done + step)
-            for k in range(n_dof):
-                trial[k] = q[k]
-            for j in range(na):
-                delta = start[j] + f * (qa_path[p, j] - start[j]) - q[actuated[j]]
-                trial[actuated[j]] += delta
-                for r in range(m):
-                    trial[passive[r]] += s[r, j] * delta
-            code = correct(trial, tree, plan, loops, settings, ws, branch, 0.5 * step * dist)
-            if code == OK:
-                for k in range(n_dof):
-                    q[k] = trial[k]
-                done = f
-                for r in range(m):
-                    for j in range(na):
-                        acc = 0.0
-                        for i in range(m):
-                            acc -= pinv[r, i] * phi[i, actuated[j]]
-                        s[r, j] = acc
-            else:
-                step *= 0.5
-                if step < settings.min_fraction:
-                    break
+        code = continue_to(qa_path[p], q, branch, tree, plan, loops, settings, ws, s, start, trial)
         if code != OK:
             status[p] = code
             return out, status, p
