@@ -29,7 +29,7 @@ what this toolkit measured on a shared 2-core machine, rounded up:
 - :data:`EIGEN_ORDER_LIMIT` = 600: the order ``3 + 3 d`` of the closed-loop matrix of the exact
   stability boundary with a delay of ``d`` samples (about 100 eigenvalue problems each).
 - :data:`DEVICE_LIMITS`: 32 joints, 1 000 frames and 16 closed loops per device, checked when a
-  device file, a URDF or a mechanism is read, before anything is built (every command meets a
+  device file or a URDF is read, before anything is built (every command meets a
   device there; a device at these limits loads and shows in well under a minute, while the work
   on it grows with their squares and cubes).
 - Worker processes: the machine's cores (``os.cpu_count()``).

@@ -99,7 +99,7 @@ def _json_cases(tmp: Path) -> dict[tuple[str, ...], list]:
         ("ln",): [],
         ("linearize",): [],
         ("designs",): ["--levels", "0,1", "--count", "2", "--out", tmp / "designs.csv"],
-        ("impedance-range",): ["--duration", "0.5", "--k-limit", "4"],
+        ("impedance-range",): ["--duration", "0.6", "--k-limit", "4"],
         ("transparency",): ["--sweep", "1", "--f1", "2"],
         ("stability-boundary",): ["--inertia", "0.01", "--damping", "0.1", "--period", "0.001", "--samples", "400"],
         ("metrics",): ["--q", "0.1,0.5,0.3"],
@@ -202,7 +202,7 @@ def test_campaign_json_lists_its_files_and_summary(tmp_path):
     designs = tmp_path / "d.csv"
     assert _invoke(["designs", "--levels", "0", "--count", "1", "--out", designs, "--quiet"]).exit_code == 0
     result = _invoke(["campaign", "--designs", designs, "--out", tmp_path / "c", "--workers", "1", "--k-limit", "4",
-                      "--duration", "0.5", "--sweep", "1", "--f1", "2", "--json"])
+                      "--duration", "0.6", "--sweep", "1", "--f1", "2", "--json"])
     assert result.exit_code == 0, result.output
     out = json.loads(result.stdout)
     assert (out["cases"], out["run"], out["skipped"]) == (4, 4, 0)

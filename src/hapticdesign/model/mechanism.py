@@ -20,7 +20,6 @@ from hapticdesign.errors import UserError
 from hapticdesign.model.loops import ClosedLoops
 from hapticdesign.model.transforms import ElementaryTransform
 from hapticdesign.model.walk import KinematicTree, poses_and_jacobians
-from hapticdesign.workload import require_device_size
 
 
 class JointType(str, Enum):
@@ -63,8 +62,6 @@ class Mechanism:
     loops: ClosedLoops | None = None
 
     def __post_init__(self) -> None:
-        require_device_size("the mechanism", len(self.coordinates), len(self.frames),
-                            len(self.loops.closures) if self.loops else 0)
         names = [f.name for f in self.frames]
         if len(set(names)) != len(names):
             raise UserError("frame names must be unique")
