@@ -452,12 +452,12 @@ def test_the_probe_of_a_large_tree_is_estimated_before_it_allocates(monkeypatch)
 
 
 def test_ctrl_c_is_one_line(monkeypatch):
-    from hapticdesign.interface.commands import dynamics
+    from hapticdesign.devices import loading
 
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(dynamics, "resolve_device", interrupted)
+    monkeypatch.setattr(loading, "resolve_device", interrupted)
     result = runner.invoke(app, ["dynamics", "--q", "0,0,0"])
     assert result.exit_code == 130
     assert result.stderr == "error: interrupted\n" and result.stdout == ""

@@ -94,7 +94,7 @@ def test_dynamics_command_in_actuated_coordinates():
                                       "--qd", "1,0.5", "--qdd", "0.2,-0.3", "--json"])
     assert result.exit_code == 0, result.output
     out = json.loads(result.output)
-    assert set(out) == {"device", "q", "qd", "qdd", "H", "C", "C_cvt", "G", "tau", "units"}
+    assert set(out) == {"device", "q", "qd", "qdd", "H", "C", "C_cvt", "G", "tau", "units", "handle", "assembly_branch"}
     assert np.shape(out["H"]) == (2, 2) and np.shape(out["C"]) == (2, 3) and np.shape(out["C_cvt"]) == (2, 2)
     # the printed parts assemble the printed torque (seed 000 eq. 2.50)
     tau = np.array(out["tau"])

@@ -125,7 +125,7 @@ def test_a_run_that_leaves_the_branch_ends_with_its_status():
 
 def test_cli_one_line_error_when_the_chirp_leaves_the_branch():
     result = CliRunner().invoke(app, ["transparency", "--device", str(EXAMPLES / "delta.yaml"), "--joint", "1",
-                                      "--amplitude", "2", "--sweep", "2", "--f1", "10"])
+                                      "--stiffness", "0.005", "--amplitude", "2", "--sweep", "2", "--f1", "10"])
     assert result.exit_code == 2
     assert "assembly branch" in result.output and len(result.output.strip().splitlines()) == 1
 

@@ -18,7 +18,6 @@ import typer
 from typer.core import TyperGroup
 
 from hapticdesign.interface import commands
-from hapticdesign.simulation.warmup import compile_notice
 
 CONTENTS = {
     "dynamics": "Equations of motion (seed 000 ch. 2)",
@@ -126,13 +125,23 @@ def _notice(line: str) -> None:
     sys.stderr.flush()
 
 
+def _compile_notice(args: list[str]):
+    """The compile notice of :func:`main` (numba's event listener), or nothing where no kernel can compile:
+    ``--quiet``, ``--help``, ``--version`` or no command, which then import no engine."""
+    if not args or "--quiet" in args or any(a in ("--help", "-h", "--version") for a in args):
+        return nullcontext()
+    from hapticdesign.simulation.warmup import compile_notice
+
+    return compile_notice(_notice)
+
+
 def main() -> None:
     """Run the command; an output stream that cannot be written (``> /dev/full``) is one line, exit 2.
 
     A run that compiles a numba kernel (the first on a machine: later runs load it from numba's cache)
     says so in one line on stderr first, unless ``--quiet``."""
     try:
-        with nullcontext() if "--quiet" in sys.argv[1:] else compile_notice(_notice):
+        with _compile_notice(sys.argv[1:]):
             app()
         sys.stdout.flush()
     except OSError as exc:

@@ -9,7 +9,6 @@ from typing import Optional
 
 import typer
 
-from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import note, parse_vector, print_json, user_errors
 from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
@@ -30,6 +29,8 @@ def ik(
     from hapticdesign.analysis.inverse_kinematics import handle_pose
 
     with user_errors(strict=strict, quiet=quiet):
+        from hapticdesign.devices.loading import resolve_device
+
         dev = resolve_device(preset, device, params, strict=strict)
         target = parse_vector(position, 3, "position")
         pose = handle_pose(dev, target)
@@ -67,6 +68,8 @@ def export(
     with user_errors(strict=strict, quiet=quiet):
         if fmt not in ("mjcf", "urdf"):
             raise UserError(f"--format: unknown format {fmt!r} (use mjcf or urdf)")
+        from hapticdesign.devices.loading import resolve_device
+
         dev = resolve_device(preset, device, params, strict=strict)
         write_atomically(out, export_text(dev, fmt))
         if json_out:
@@ -98,6 +101,8 @@ def spec(
     from hapticdesign.studies.spec_page import spec_page
 
     with user_errors(strict=strict, quiet=quiet):
+        from hapticdesign.devices.loading import resolve_device
+
         dev = resolve_device(preset, device, params, strict=strict)
         pose = None if q is None else parse_vector(q, dev.n_dof, "q")
         sheet = spec_sheet(dev, pose, rate=rate, workspace=workspace)
