@@ -363,3 +363,19 @@ def test_phantom_motors_ln_on_the_torus_equals_the_preset():
     torus = Region()
     assert device_form(motors, torus).ln(motors.standard_parameters()) == pytest.approx(
         device_form(plain, torus).ln(plain.standard_parameters()), rel=1e-12)
+
+
+@pytest.mark.parametrize("drives, message", [
+    ("theta2; import os", "cannot read"),
+    ("theta9 + theta3", "unknown joint 'theta9'"),
+    ("pi", "names no coordinate"),
+    ("1e308*theta2 + theta3", "coefficients must be finite"),
+])
+def test_bad_motor_combinations_are_one_line(tmp_path, drives, message):
+    text = (EXAMPLES / "phantom-3dof-motors.yaml").read_text().replace("{drives: -theta2 - theta3,",
+                                                                        f"{{drives: '{drives}',")
+    path = tmp_path / "motors.yaml"
+    path.write_text(text)
+    result = runner.invoke(app, ["dynamics", "--device", str(path), "--q", "0,0,0"])
+    assert result.exit_code == 2
+    assert result.stderr.count("\n") == 1 and message in result.stderr, result.stderr

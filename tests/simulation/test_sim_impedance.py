@@ -162,3 +162,21 @@ def test_bad_type_and_criteria():
         ImpedanceProblem(preset("phantom-3dof"), 3)
     with pytest.raises(UserError, match="overshoot limit"):
         Criteria(overshoot_limit=0.0)
+
+
+def test_criteria_scale_with_the_step():
+    """The seed's limits are 120 %, 20 % and 600 % of its 0.01-rad step (overshoot 0.012, settling 0.002, switch
+    0.06): a wall with another step is judged by the same ratios, the seed's step keeps them, the window (a time)
+    stays. Without the scaling a 0.64-mm Cartesian step was judged against a 12-mm overshoot and a 2-mm band."""
+    from hapticdesign.simulation.criteria import Criteria
+
+    seed = Criteria()
+    assert seed.for_step(0.01) == seed
+    scaled = Criteria().for_step(-0.00064)
+    assert (scaled.overshoot_limit, scaled.settle_tolerance, scaled.safety_limit) == pytest.approx(
+        (1.2 * 0.00064, 0.2 * 0.00064, 6 * 0.00064), rel=1e-12)
+    assert scaled.settle_window == seed.settle_window
+    problem = ImpedanceProblem(preset("phantom-3dof"), 1, equilibrium=0.02)
+    assert problem.criteria.overshoot_limit == pytest.approx(0.024, rel=1e-12)
+    with pytest.raises(UserError, match="equilibrium"):
+        Criteria().for_step(0.0)

@@ -439,6 +439,8 @@ def _check_limits_and_actuators(spec: DeviceFileSpec, coordinates: list[str]) ->
         terms = motor_terms(actuator)
         if not terms:
             raise ValueError(f"actuators[{i}].drives: the combination names no coordinate")
+        if any(not abs(c) <= MAX_COEFFICIENT for c in terms.values()):
+            raise ValueError(f"actuators[{i}].drives: coefficients must be finite and at most {MAX_COEFFICIENT:g} in size")
         unknown = [name for name in terms if name not in coordinates]
         if unknown:
             raise ValueError(f"actuators[{i}].drives: unknown joint {unknown[0]!r} (joints: {', '.join(coordinates)})")
@@ -456,6 +458,10 @@ def _check_limits_and_actuators(spec: DeviceFileSpec, coordinates: list[str]) ->
     if driven and np.linalg.matrix_rank(rows) < len(driven):
         raise ValueError("actuators: two motors turn the same joint or dependent combinations of joints (give one "
                          "motor per independent combination)")
+
+
+MAX_COEFFICIENT = 1000.0
+"""Largest coefficient of a motor's combination of joints (its square multiplies the reflected inertia)."""
 
 
 def motor_terms(actuator: ActuatorSpec) -> dict[str, float]:
