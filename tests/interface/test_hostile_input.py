@@ -117,11 +117,11 @@ def test_campaign_workers_are_capped_at_the_cores(tmp_path, monkeypatch):
 
 # -- nonsense settings ----------------------------------------------------------------------------
 NONSENSE = [
-    (["impedance-range", "--settle-window", "10"], "--settle-window (10 s) must be positive and shorter than --duration"),
-    (["impedance-range", "--duration", "0.5"], "--settle-window (0.5 s) must be positive and shorter than --duration"),
-    (["impedance-range", "--duration", "1", "--settle-window", "1"], "shorter than --duration (1 s)"),
-    (["impedance-range", "--wall-damping", "-1"], "--wall-damping must be a finite number >= 0"),
-    (["impedance-range", "--error-percent", "100"], "--error-percent must be a finite number between -100 and 100"),
+    (["impedance-range", "--settle-window", "10"], "the settle window (10 s) must be shorter than the simulated time (5 s)"),
+    (["impedance-range", "--duration", "0.5"], "settle window (0.5 s) must be shorter than the simulated time (0.5 s)"),
+    (["impedance-range", "--duration", "1", "--settle-window", "1"], "(--settle-window, --duration)"),
+    (["impedance-range", "--wall-damping", "-1"], "wall damping must be a finite number >= 0, got -1.0 (--wall-damping)"),
+    (["impedance-range", "--error-percent", "100"], "must be a finite number between -100 and 100 (exclusive), got 100.0 (--error-percent)"),
     (["impedance-range", "--error-percent", "-100"], "between -100 and 100"),
     (["impedance-range", "--delay", "1000000000"], "must be shorter than the simulated time"),
     (["transparency", "--f0", "5", "--f1", "2"], "0 <= f0 < f1"),
@@ -129,8 +129,8 @@ NONSENSE = [
     (["transparency", "--f1", "inf"], "must be finite"),
     (["transparency", "--amplitude", "0"], "--amplitude must be a finite, non-zero angle"),
     (["transparency", "--amplitude", "nan"], "--amplitude must be a finite, non-zero angle"),
-    (["transparency", "--wall-damping", "-0.5"], "--wall-damping must be a finite number >= 0"),
-    ([*BOUNDARY, "--wall-damping", "-1"], "--wall-damping must be a finite number >= 0"),
+    (["transparency", "--wall-damping", "-0.5"], "wall damping must be a finite number >= 0, got -0.5 (--wall-damping)"),
+    ([*BOUNDARY, "--wall-damping", "-1"], "wall damping must be a finite number >= 0, got -1.0 (--wall-damping)"),
     ([*BOUNDARY, "--compensate-inertia", "--error-percent", "150"], "between -100 and 100"),
     ([*BOUNDARY, "--delay", "2000", "--samples", "4000"], "shorter than a quarter of --samples"),
     (["designs", "--seed", "-1"], "--seed"),

@@ -18,7 +18,7 @@ from hapticdesign.simulation.boundary import (
     MassDamper, closed_loop_matrix, compensated_boundary, compensated_limit, exact_boundary, simulated_boundary,
 )
 from hapticdesign.simulation.config import Compensator, Hand, LoopConfig
-from hapticdesign.simulation.impedance import ImpedanceProblem, true_boundary
+from hapticdesign.simulation.impedance import ImpedanceProblem, growth_boundary
 
 CASES = [
     (0.01, 0.5, 1e-3, 0, False),
@@ -181,7 +181,7 @@ def test_hand_on_a_one_dof_device_meets_the_exact_discrete_analysis():
     r2 = 0.15 ** 2
     hand = Hand(mass=0.4, damping=2.0, stiffness=40.0)
     config = LoopConfig(hand=hand, compensator=Compensator(coriolis=False, gravity=False))
-    simulated = true_boundary(ImpedanceProblem(device, 1, config=config))
+    simulated = growth_boundary(ImpedanceProblem(device, 1, config=config))
     system = MassDamper(j + hand.mass * r2, 0.3 + hand.damping * r2, 1e-3, compensate_inertia=True,
                         model_inertia=j, plant_stiffness=hand.stiffness * r2)
     exact = exact_boundary(system)

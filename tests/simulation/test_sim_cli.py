@@ -58,8 +58,8 @@ def test_over_estimated_inertia_reports_zero_not_a_negative_closed_form():
 @pytest.mark.parametrize("args, message", [
     (["stability-boundary", "--inertia", "0.04", "--damping", "0.5", "--period", "0.001", "--error-percent", "1"],
      "needs --compensate-inertia"),
-    (["impedance-range", "--resolution", "-1"], "--resolution must be a positive number"),
-    (["impedance-range", "--resolution", "500"], "above --k-limit"),
+    (["impedance-range", "--resolution", "-1"], "resolution must be a positive number, got -1.0 (--resolution)"),
+    (["impedance-range", "--resolution", "500"], "above the stiffness limit 200 (--resolution, --k-limit)"),
 ])
 def test_bad_settings_are_one_line_errors(args, message):
     result = runner.invoke(app, args)

@@ -10,7 +10,7 @@ from hapticdesign.devices.loading import resolve_device
 from hapticdesign.simulation.boundary import compensated_boundary
 from hapticdesign.simulation.config import Compensator, LoopConfig, Wall
 from hapticdesign.simulation.impedance import (
-    Criteria, ImpedanceProblem, fast_search, grid_search, impedance_range, linear_scan, true_boundary,
+    Criteria, ImpedanceProblem, fast_search, grid_search, impedance_range, linear_scan, growth_boundary,
 )
 from hapticdesign.simulation.loop import simulate
 
@@ -54,7 +54,7 @@ def test_type_one_growth_boundary_is_b_squared_over_h11():
     under full inertial compensation is b1^2 / H11 (see test_sim_boundary): within 0.05 %."""
     device = preset("phantom-3dof").with_params({"r3y": 0.01, "Ixy2": 4e-4, "m3": 0.05})
     h11 = mass_matrix(device, np.zeros(3))[0, 0]
-    k = true_boundary(ImpedanceProblem(device, 1))
+    k = growth_boundary(ImpedanceProblem(device, 1))
     assert k == pytest.approx(device.damping[0] ** 2 / h11, rel=5e-4)
 
 
@@ -70,7 +70,7 @@ def test_compensator_error_boundary_is_the_closed_form(error_percent):
     h11, b = mass_matrix(device, np.zeros(3))[0, 0], device.damping[0]
     c = mass_matrix(model, np.zeros(3))[0, 0] / h11
     config = LoopConfig(compensator=Compensator(error_percent=error_percent))
-    k = true_boundary(ImpedanceProblem(device, 1, config=config))
+    k = growth_boundary(ImpedanceProblem(device, 1, config=config))
     expected = compensated_boundary(h11, b, 1e-3, c)
     assert k == pytest.approx(expected, rel=1e-3)
     assert expected > b * b / h11 + 0.9 * (1 - c) * b / 1e-3

@@ -6,7 +6,7 @@ import pytest
 from hapticdesign.analysis.dynamics.device import inverse_dynamics
 from hapticdesign.devices.registry import preset
 from hapticdesign.errors import UserError
-from hapticdesign.simulation.config import Compensator, LoopConfig, Sensors, Wall
+from hapticdesign.simulation.config import Compensator, Hand, LoopConfig, Sensors, Wall
 from hapticdesign.simulation.loop import joint_index, simulate
 from hapticdesign.simulation.paths import Chirp, Held, Sine
 from hapticdesign.simulation.reference import simulate_adaptive
@@ -58,22 +58,31 @@ def test_prescribed_joint_constraint_torque_is_inverse_dynamics():
 
 
 @pytest.mark.parametrize(
-    "config, message",
+    "settings, message",
     [
-        (LoopConfig(sensors=Sensors(period=0.0)), "period must be positive"),
-        (LoopConfig(sensors=Sensors(period=-1e-3)), "period must be positive"),
-        (LoopConfig(step=3e-4), "does not divide"),
-        (LoopConfig(wall=Wall(joint=5)), "unknown joint"),
-        (LoopConfig(sensors=Sensors(counts_per_revolution=0)), "counts per revolution"),
-        (LoopConfig(compensator=Compensator(error_percent=150)), "error percentage"),
-        (LoopConfig(step_control="variable"), "unknown step control 'variable'"),
-        (LoopConfig(step_control="adaptive", tolerance=float("nan")), "tolerance must be a positive number"),
-        (LoopConfig(step_control="adaptive", tolerance=0.0), "tolerance must be a positive number"),
+        (dict(sensors=dict(period=0.0)), "period must be positive"),
+        (dict(sensors=dict(period=-1e-3)), "period must be positive"),
+        (dict(step=3e-4), "does not divide"),
+        (dict(sensors=dict(counts_per_revolution=0)), "counts per revolution"),
+        (dict(compensator=dict(error_percent=150)), "error percentage"),
+        (dict(step_control="variable"), "unknown step control 'variable'"),
+        (dict(step_control="adaptive", tolerance=float("nan")), "tolerance must be a positive number"),
+        (dict(step_control="adaptive", tolerance=0.0), "tolerance must be a positive number"),
+        (dict(duration=float("nan")), "simulated time must be a positive number"),
+        (dict(wall=dict(damping=-1.0)), "wall damping must be a finite number >= 0"),
+        (dict(sensors=dict(delay_samples=-1)), "sensor delay must be a non-negative"),
+        (dict(hand=dict(mass=-1.0)), "hand's mass, damping and stiffness must be finite and non-negative"),
     ],
 )
-def test_bad_loop_settings_raise_user_error(config, message):
+def test_bad_loop_settings_are_refused_when_configured(settings, message):
+    parts = {"sensors": Sensors, "compensator": Compensator, "wall": Wall, "hand": Hand}
     with pytest.raises(UserError, match=message):
-        simulate(preset("phantom-3dof"), config)
+        LoopConfig(**{key: parts[key](**value) if key in parts else value for key, value in settings.items()})
+
+
+def test_an_unknown_wall_joint_is_refused_by_the_run():
+    with pytest.raises(UserError, match="unknown joint"):
+        simulate(preset("phantom-3dof"), LoopConfig(wall=Wall(joint=5)))
 
 
 def test_joint_names():

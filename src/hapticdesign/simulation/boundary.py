@@ -57,7 +57,7 @@ import numpy as np
 from scipy.linalg import expm
 from scipy.optimize import brentq
 
-from hapticdesign.errors import UserError
+from hapticdesign.errors import InputError, UserError
 from hapticdesign.simulation.config import Compensator, LoopConfig, Sensors, Wall
 from hapticdesign.simulation.loop import simulate_tables
 from hapticdesign.simulation.tables import DynamicsTables
@@ -87,7 +87,11 @@ class MassDamper:
         if not (self.damping >= 0 and math.isfinite(self.damping)):
             raise UserError(f"the damping must be non-negative, got {self.damping}")
         if self.delay_samples < 0:
-            raise UserError("the delay must be a non-negative number of samples")
+            raise InputError(f"the sensor delay must be a non-negative number of samples, got {self.delay_samples}",
+                             "delay")
+        if not (self.virtual_damping >= 0 and math.isfinite(self.virtual_damping)):
+            raise InputError(f"the wall damping must be a finite number >= 0, got {self.virtual_damping}",
+                             "wall_damping")
         if not (self.plant_stiffness >= 0 and math.isfinite(self.plant_stiffness)):
             raise UserError(f"the plant stiffness must be non-negative, got {self.plant_stiffness}")
         if self.model_inertia is not None and not (self.model_inertia >= 0 and math.isfinite(self.model_inertia)):

@@ -56,6 +56,10 @@ class Wall:
     equilibrium: float = 0.01
     direction: tuple[float, float, float] | None = None
 
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.damping) and self.damping >= 0):
+            raise InputError(f"the wall damping must be a finite number >= 0, got {self.damping}", "wall_damping")
+
     @property
     def cartesian(self) -> bool:
         return self.direction is not None
@@ -102,6 +106,11 @@ class Compensator:
     group_errors: tuple[tuple[str, float], ...] = ()
     error_seed: int | None = None
 
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.error_percent) and -100 < self.error_percent < 100):
+            raise InputError(f"the error percentage must be a finite number between -100 and 100 (exclusive), got "
+                             f"{self.error_percent}", "error_percent")
+
 
 @dataclass(frozen=True)
 class Sensors:
@@ -110,6 +119,12 @@ class Sensors:
     period: float = 1e-3
     counts_per_revolution: int | None = None
     delay_samples: int = 0
+
+    def __post_init__(self) -> None:
+        if isinstance(self.delay_samples, bool) or self.delay_samples != int(self.delay_samples) or self.delay_samples < 0:
+            raise InputError(f"the sensor delay must be a non-negative number of samples, got {self.delay_samples}", "delay")
+        if self.counts_per_revolution is not None and not self.counts_per_revolution >= 1:
+            raise InputError(f"the encoder counts per revolution must be at least 1, got {self.counts_per_revolution}", "counts")
 
 
 @dataclass(frozen=True)
@@ -122,6 +137,17 @@ class Hand:
     mass: float = 0.0
     damping: float = 0.0
     stiffness: float = 0.0
+
+    def __post_init__(self) -> None:
+        values = (self.mass, self.damping, self.stiffness)
+        if not all(math.isfinite(v) and v >= 0 for v in values):
+            raise InputError(f"the hand's mass, damping and stiffness must be finite and non-negative, got "
+                             f"{', '.join(f'{v:g}' for v in values)}", "hand_mass", "hand_damping", "hand_stiffness")
+
+    @staticmethod
+    def optional(mass: float = 0.0, damping: float = 0.0, stiffness: float = 0.0) -> "Hand | None":
+        """A hand when any of its values is non-zero, else None (no hand)."""
+        return Hand(mass, damping, stiffness) if (mass or damping or stiffness) else None
 
 
 @dataclass(frozen=True)
@@ -147,6 +173,12 @@ class LoopConfig:
     grid), adaptive for a closed-loop device (each evaluation of its dynamics solves the loops)."""
     tolerance: float = ADAPTIVE_TOLERANCE
 
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.duration) and self.duration > 0):
+            raise InputError(f"the simulated time must be a positive number of seconds, got {self.duration}", "duration")
+        self.steps_per_sample()
+        self.adaptive(False)
+
     def adaptive(self, closed_loop: bool) -> bool:
         """Whether the run controls its steps by error (``step_control``, for a closed-loop device or not)."""
         if self.step_control not in STEP_CONTROLS:
@@ -158,15 +190,15 @@ class LoopConfig:
 
     def steps_per_sample(self) -> int:
         if not (self.step > 0 and math.isfinite(self.step)):
-            raise UserError(f"the plant step must be positive, got {self.step}")
+            raise InputError(f"the plant step must be positive, got {self.step}", "step")
         period = self.sensors.period
         if not (period > 0 and math.isfinite(period)):
-            raise UserError(f"the sample period must be positive, got {period}")
+            raise InputError(f"the sample period must be positive, got {period}", "period")
         ratio = period / self.step
         if not math.isfinite(ratio):
-            raise UserError(f"the sample period {period} s over the plant step {self.step} s overflows")
+            raise InputError(f"the sample period {period} s over the plant step {self.step} s overflows", "period", "step")
         if abs(ratio - round(ratio)) > 1e-9 * ratio or round(ratio) < 1:
-            raise UserError(f"the plant step {self.step} s does not divide the sample period {period} s")
+            raise InputError(f"the plant step {self.step} s does not divide the sample period {period} s", "step", "period")
         return int(round(ratio))
 
 
@@ -314,8 +346,6 @@ def hand_matrices(device: Device, hand: Hand | None, q0: np.ndarray) -> tuple[np
     n = len(q0)
     if hand is None:
         return np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n))
-    if min(hand.mass, hand.damping, hand.stiffness) < 0:
-        raise UserError("hand mass, damping and stiffness must be non-negative")
     jv = handle_jacobian(device, q0)[:3]
     jtj = jv.T @ jv
     return hand.mass * jtj, hand.damping * jtj, hand.stiffness * jtj

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from hapticdesign.errors import UserError
+from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation.config import LoopConfig, normal_jacobian, rest_pose
 from hapticdesign.simulation.paths import Held, Path, Sine
@@ -152,5 +152,6 @@ def require_reach(device: Device, config: LoopConfig, wall_joint: int) -> None:
 def check_settle_window(criteria: Criteria, duration: float) -> None:
     """The settling test needs a window within the run, or every stiffness is "not settled"."""
     if criteria.settle_window >= duration:
-        raise UserError(f"the settle window ({criteria.settle_window:g} s) must be shorter than the simulated "
-                        f"time ({duration:g} s): a window that holds the start counts every stiffness as not settled")
+        raise InputError(f"the settle window ({criteria.settle_window:g} s) must be shorter than the simulated "
+                         f"time ({duration:g} s): a window that holds the start counts every stiffness as not settled",
+                         "settle_window", "duration")

@@ -29,7 +29,7 @@ from functools import cached_property
 import numpy as np
 
 from hapticdesign.analysis.dynamics.device import mass_matrix
-from hapticdesign.errors import UserError
+from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation.analytic import GROWS, AnalyticProblem, linear_loop
 from hapticdesign.simulation.boundary import envelope_grows
@@ -130,6 +130,8 @@ class RangeResult:
     resolution: float = 1.0
     exact: bool | None = None
     """For the analytic method: whether the linearized loop is exact for this device and type."""
+    k_true_boundary: float | None = None
+    """The oscillation-growth boundary (:func:`growth_boundary`), when asked for."""
 
     def as_dict(self) -> dict:
         first = self.first_unstable
@@ -145,6 +147,7 @@ class RangeResult:
             "stopped_at_first_unstable": None if first is None else first.stopped_at,
             "simulations": self.simulations,
             "method": self.method,
+            **({} if self.k_true_boundary is None else {"k_true_boundary": self.k_true_boundary}),
         }
 
 
@@ -233,10 +236,11 @@ def grid_search(problem: ImpedanceProblem, resolution: float, k_limit: float = 2
     away from it and bisecting.
     """
     if not (resolution > 0 and math.isfinite(resolution)):
-        raise UserError(f"the stiffness resolution must be positive, got {resolution}")
+        raise InputError(f"the stiffness resolution must be a positive number, got {resolution}", "resolution")
     n_limit = int(math.floor(k_limit / resolution + 1e-9))
     if n_limit < 1:
-        raise UserError(f"the stiffness limit {k_limit} is below the resolution {resolution}")
+        raise InputError(f"the stiffness limit {k_limit} is below the resolution {resolution}", "k_limit",
+                         "resolution")
     seen: dict[int, Verdict] = {}
 
     def check(n: int) -> Verdict:
@@ -281,7 +285,7 @@ def grid_search(problem: ImpedanceProblem, resolution: float, k_limit: float = 2
                        bottom * resolution, resolution)
 
 
-def true_boundary(problem: ImpedanceProblem, rel_tol: float = 1e-4, margin: float | None = None,
+def growth_boundary(problem: ImpedanceProblem, rel_tol: float = 1e-4, margin: float | None = None,
                   k_limit: float = 1e5) -> float:
     """Stiffness at which the oscillation of the wall joint starts to grow (no overshoot criterion).
 
@@ -321,7 +325,7 @@ def true_boundary(problem: ImpedanceProblem, rel_tol: float = 1e-4, margin: floa
 def impedance_range(device: Device, sim_type: int = 1, method: str = "fast", k_limit: int = 200,
                     criteria: Criteria | None = None, config: LoopConfig | None = None,
                     wall_joint: int = 0, equilibrium: float = 0.01,
-                    resolution: float | None = None, wall_direction=None) -> RangeResult:
+                    resolution: float | None = None, wall_direction=None, true_boundary: bool = False) -> RangeResult:
     """Maximum stable impedance of ``wall_joint`` for simulation type 1 or 2 (seed §4.1.2).
 
     With ``wall_direction`` (x, y, z) the wall is Cartesian: K in N/m along that direction at the
@@ -333,6 +337,8 @@ def impedance_range(device: Device, sim_type: int = 1, method: str = "fast", k_l
     ``method="analytic"`` answers the same searches from the exact linear response of the sampled
     loop (:mod:`.analytic`; no ODE integration; exact for type 1 and, along the driven motion
     (:mod:`.analytic_driven`), for type 2 on a cyclic wall joint such as the Phantom's joint 1).
+    ``true_boundary`` also bisects the oscillation-growth boundary (simulated methods,
+    :func:`growth_boundary`) into :attr:`RangeResult.k_true_boundary`.
     For a closed-loop device the joints start at, and move about, its home pose and a joint wall's
     ``equilibrium`` is measured from there (:func:`~.config.rest_pose`); a run whose loops stop closing on
     the assembly branch is a :class:`~hapticdesign.errors.UserError`.
@@ -342,20 +348,29 @@ def impedance_range(device: Device, sim_type: int = 1, method: str = "fast", k_l
     if criteria is not None and not isinstance(criteria, Criteria):
         raise UserError(f"criteria must be a Criteria, got {type(criteria).__name__}")
     if method not in ("fast", "linear", "analytic"):
-        raise UserError(f"search method must be 'fast', 'linear' or 'analytic', got {method!r}")
+        raise InputError(f"method (of the search) must be 'fast', 'linear' or 'analytic', got {method!r}", "method")
     if isinstance(k_limit, bool) or not isinstance(k_limit, (int, float)) or not math.isfinite(k_limit):
         raise UserError(f"the stiffness limit must be a number, got {k_limit!r}")
     if k_limit < 1:
-        raise UserError("the stiffness limit must be at least 1 (N m/rad, or N/m)")
+        raise InputError("the stiffness limit must be at least 1 (N m/rad, or N/m)", "k_limit")
+    if resolution is not None and not (resolution > 0 and math.isfinite(resolution)):
+        raise InputError(f"the stiffness resolution must be a positive number, got {resolution}", "resolution")
+    if resolution is not None and resolution > k_limit:
+        raise InputError(f"the stiffness resolution {resolution:g} is above the stiffness limit {k_limit:g}",
+                         "resolution", "k_limit")
     config = config or LoopConfig(wall=Wall())
     if wall_direction is not None:
         config = replace(config, wall=replace(config.wall, direction=tuple(unit_direction(wall_direction).tolist())))
-    require_search_workload(config, planned_simulations(method, k_limit, resolution))
-    if method == "analytic":
-        analytic = AnalyticProblem(device, sim_type, wall_joint, equilibrium, criteria or Criteria(), config)
-        found = grid_search(analytic, resolution, k_limit) if resolution is not None else fast_search(analytic, k_limit)
-        return replace(found, method="analytic", exact=analytic.exact)
-    problem = ImpedanceProblem(device, sim_type, wall_joint, equilibrium, criteria or Criteria(), config)
+    require_search_workload(config, planned_simulations(method, k_limit, resolution, true_boundary))
+    wall = (device, sim_type, wall_joint, equilibrium, criteria or Criteria(), config)
+    problem = AnalyticProblem(*wall) if method == "analytic" else ImpedanceProblem(*wall)
     if resolution is not None:
-        return grid_search(problem, resolution, k_limit)
-    return (fast_search if method == "fast" else linear_scan)(problem, k_limit)
+        found = grid_search(problem, resolution, k_limit)
+    else:
+        found = (linear_scan if method == "linear" else fast_search)(problem, k_limit)
+    if method == "analytic":
+        found = replace(found, method="analytic", exact=problem.exact)
+    if true_boundary:
+        simulated = problem if isinstance(problem, ImpedanceProblem) else ImpedanceProblem(*wall)
+        found = replace(found, k_true_boundary=growth_boundary(simulated))
+    return found

@@ -37,36 +37,13 @@ from numba.extending import overload
 
 from hapticdesign.analysis.dynamics.closed_loop_plant import closed_loop_terms, handle_along
 from hapticdesign.analysis.dynamics.model import velocity_products_into as velocity_products
+from hapticdesign.model.dense import lu_in_place
 from hapticdesign.model.walk import frame_jacobian, node_poses
 from hapticdesign.simulation import records
 from hapticdesign.simulation.config import (
     FRICTION_VELOCITY, STATUS_COMPLETED, STATUS_DIVERGED, STATUS_EXCURSION, STATUS_LOOP_LOST,
 )
 from hapticdesign.simulation.tables import evaluate_entries, unpack_entries
-
-
-@nb.njit(cache=True, error_model="numpy", inline="always")
-def _solve_in_place(a, b, n):
-    """Gaussian elimination with partial pivoting on the leading n x n block; b becomes x."""
-    for col in range(n):
-        piv = col
-        for r in range(col + 1, n):
-            if abs(a[r, col]) > abs(a[piv, col]):
-                piv = r
-        if piv != col:
-            for k in range(n):
-                a[col, k], a[piv, k] = a[piv, k], a[col, k]
-            b[col], b[piv] = b[piv], b[col]
-        for r in range(col + 1, n):
-            f = a[r, col] / a[col, col]
-            for k in range(col, n):
-                a[r, k] -= f * a[col, k]
-            b[r] -= f * b[col]
-    for col in range(n - 1, -1, -1):
-        s = b[col]
-        for k in range(col + 1, n):
-            s -= a[col, k] * b[k]
-        b[col] = s / a[col, col]
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
@@ -271,13 +248,13 @@ def accelerations(q, qd, qdd_path, u, prescribed, plant, qdd, tau_c, want_tau_c=
         for j in range(n):
             if prescribed[j]:
                 s -= h[i, j] * qdd[j]
-        rhs[r] = s
+        rhs[r, 0] = s
         for cc in range(nf):
             a[r, cc] = h[i, free[cc]]
-    if nf > 0:
-        _solve_in_place(a, rhs, nf)
+    if nf > 0 and lu_in_place(a[:nf, :nf], rhs[:nf])[0] == 0.0:
+        rhs[:nf, 0] = np.nan  # a singular H: the run diverges and says so
     for r in range(nf):
-        qdd[free[r]] = rhs[r]
+        qdd[free[r]] = rhs[r, 0]
     if not want_tau_c:
         return
     for i in range(n):

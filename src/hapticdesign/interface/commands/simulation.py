@@ -20,42 +20,6 @@ SCALE_RANGE = (1e-12, 1e12)
 
 
 
-def _check_error_percent(value: float) -> None:
-    if not (np.isfinite(value) and -100 < value < 100):
-        raise UserError(f"--error-percent must be a finite number between -100 and 100 (exclusive), got {value}")
-
-
-def _check_wall_damping(value: float) -> None:
-    if not (np.isfinite(value) and value >= 0):
-        raise UserError(f"--wall-damping must be a finite number >= 0, got {value}")
-
-
-def _loop_config(period, step, duration, counts, delay, error_percent, inertial, coriolis, gravity,
-                 wall_damping, hand_mass, hand_damping, hand_stiffness, step_control="auto"):
-    from hapticdesign.simulation.config import Compensator, Hand, LoopConfig, Sensors, Wall
-
-    _check_error_percent(error_percent)
-    _check_wall_damping(wall_damping)
-    if delay < 0:
-        raise UserError(f"--delay must be a non-negative number of samples, got {delay}")
-
-    hand = None
-    if hand_mass or hand_damping or hand_stiffness:
-        hand = Hand(hand_mass, hand_damping, hand_stiffness)
-    config = LoopConfig(
-        duration=duration,
-        step=step,
-        sensors=Sensors(period=period, counts_per_revolution=counts, delay_samples=delay),
-        compensator=Compensator(inertial, coriolis, gravity, error_percent),
-        wall=Wall(damping=wall_damping),
-        hand=hand,
-        step_control=step_control,
-    )
-    config.steps_per_sample()
-    config.adaptive(False)
-    return config
-
-
 def _sim_type(value: int) -> int:
     if value not in (1, 2):
         raise UserError(f"--type must be 1 or 2, got {value}")
@@ -81,18 +45,6 @@ WALL_DIRECTION = typer.Option(
                "criteria in m along it; --joint is the joint left free). Default: a wall on --joint.")
 
 
-def _with_direction(config, text: str | None):
-    """The configuration with a Cartesian wall along ``--wall-direction`` (unchanged without it)."""
-    from dataclasses import replace
-
-    from hapticdesign.simulation.config import unit_direction
-
-    if text is None:
-        return config
-    vector = parse_vector(text, 3, "wall-direction")
-    if not vector.any():
-        raise UserError("--wall-direction must not be the zero vector")
-    return replace(config, wall=replace(config.wall, direction=tuple(unit_direction(vector).tolist())))
 HAND_MASS = typer.Option(0.0, help="Hand mass at the handle [kg] (off by default).")
 HAND_DAMPING = typer.Option(0.0, help="Hand damping at the handle [N s/m].")
 HAND_STIFFNESS = typer.Option(0.0, help="Hand stiffness at the handle [N/m].")
@@ -133,51 +85,29 @@ def impedance_range_command(
     force: bool = FORCE,
 ) -> None:
     """Maximum stable impedance of one joint under a virtual spring (seed 000 §4.1.2-4.1.3)."""
-    from hapticdesign.simulation.impedance import (Criteria, ImpedanceProblem, fast_search, grid_search,
-                                                   impedance_range, linear_scan, planned_simulations,
-                                                   require_search_workload)
-    from hapticdesign.simulation.impedance import true_boundary as growth_boundary
+    from hapticdesign.simulation.config import Compensator, Hand, LoopConfig, Sensors, Wall, unit_direction
+    from hapticdesign.simulation.impedance import Criteria, impedance_range
     from hapticdesign.simulation.loop import joint_index
 
     with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
-        if not (np.isfinite(duration) and duration > 0):
-            raise UserError(f"--duration must be a positive number of seconds, got {duration}")
-        if not (np.isfinite(settle_window) and 0 < settle_window < duration):
-            raise UserError(f"--settle-window ({settle_window:g} s) must be positive and shorter than --duration "
-                            f"({duration:g} s)")
         from hapticdesign.devices.loading import resolve_device
 
         dev = resolve_device(preset, device, params, strict=strict)
-        config = _with_direction(_loop_config(period, step, duration, counts, delay, error_percent, inertial, coriolis,
-                                              gravity, wall_damping, hand_mass, hand_damping, hand_stiffness,
-                                              step_control), wall_direction)
-        if method not in ("fast", "linear", "analytic"):
-            raise UserError(f"--method must be 'fast', 'linear' or 'analytic', got {method!r}")
-        if k_limit < 1:
-            raise UserError("--k-limit must be at least 1")
-        if resolution is not None and not (resolution > 0 and np.isfinite(resolution)):
-            raise UserError(f"--resolution must be a positive number, got {resolution}")
-        if resolution is not None and resolution > k_limit:
-            raise UserError(f"--resolution {resolution} is above --k-limit {k_limit}")
-        criteria = Criteria(overshoot, settle_tolerance, settle_window, safety)
-        require_search_workload(config, planned_simulations(method, k_limit, resolution, true_boundary))
-        problem = ImpedanceProblem(dev, _sim_type(sim_type), joint_index(dev, joint), equilibrium, criteria, config)
-        if method == "analytic":
-            result = impedance_range(dev, sim_type, "analytic", k_limit, criteria, config, problem.wall_joint,
-                                     equilibrium, resolution)
-        elif resolution is not None:
-            result = grid_search(problem, resolution, k_limit)
-        else:
-            result = (fast_search if method == "fast" else linear_scan)(problem, k_limit)
-        unit = joint_units(dev)[problem.wall_joint]
-        if config.wall.cartesian:
-            unit = {"stiffness": "N/m", "position": "m"}
-        wall = {"wall_direction": list(config.wall.direction)} if config.wall.cartesian else {}
-        out = {"device": dev.name, "type": sim_type, "joint": problem.wall_joint + 1, **wall, **result.as_dict(),
-               "units": {"k_max": unit["stiffness"], "k_min": unit["stiffness"], "peak_at_first_unstable": unit["position"],
-                         "stopped_at_first_unstable": "s"}}
-        if true_boundary:
-            out["k_true_boundary"] = growth_boundary(problem)
+        config = LoopConfig(duration=duration, step=step, step_control=step_control,
+                            sensors=Sensors(period, counts, delay),
+                            compensator=Compensator(inertial, coriolis, gravity, error_percent),
+                            wall=Wall(damping=wall_damping), hand=Hand.optional(hand_mass, hand_damping, hand_stiffness))
+        direction = None if wall_direction is None else parse_vector(wall_direction, 3, "wall-direction")
+        wall_joint = joint_index(dev, joint)
+        result = impedance_range(dev, _sim_type(sim_type), method, k_limit,
+                                 Criteria(overshoot, settle_tolerance, settle_window, safety), config, wall_joint,
+                                 equilibrium, resolution, direction, true_boundary)
+        out = {"device": dev.name, "type": sim_type, "joint": wall_joint + 1,
+               **({} if direction is None else {"wall_direction": unit_direction(direction).tolist()}),
+               **result.as_dict()}
+        unit = {"stiffness": "N/m", "position": "m"} if direction is not None else joint_units(dev)[wall_joint]
+        out["units"] = {"k_max": unit["stiffness"], "k_min": unit["stiffness"], "peak_at_first_unstable": unit["position"],
+                        "stopped_at_first_unstable": "s"}
         if json_out:
             print_json(out)
             return
@@ -214,6 +144,7 @@ def transparency_command(
     force: bool = FORCE,
 ) -> None:
     """Transparency bandwidth of one joint: G_T = Z_M / Z_D leaves +-3 dB (seed 000 §4.2.2, eq. 4.1-4.2)."""
+    from hapticdesign.simulation.config import Compensator, LoopConfig, Sensors, Wall
     from hapticdesign.simulation.loop import joint_index
     from hapticdesign.simulation.paths import Chirp
     from hapticdesign.simulation.transparency import transparency
@@ -223,8 +154,9 @@ def transparency_command(
         from hapticdesign.devices.loading import resolve_device
 
         dev = resolve_device(preset, device, params, strict=strict)
-        config = _loop_config(period, step, sweep, counts, delay, error_percent, inertial, coriolis, gravity,
-                              wall_damping, 0.0, 0.0, 0.0, step_control)
+        config = LoopConfig(duration=sweep, step=step, step_control=step_control, sensors=Sensors(period, counts, delay),
+                            compensator=Compensator(inertial, coriolis, gravity, error_percent),
+                            wall=Wall(damping=wall_damping))
         if not (band > 0):
             raise UserError(f"--band must be positive, got {band}")
         if method not in ("simulation", "analytic"):
@@ -309,10 +241,9 @@ def stability_boundary_command(
         if not (np.isfinite(inertia) and inertia > 0 and np.isfinite(period) and period > 0):
             raise UserError(f"--inertia and --period must be positive numbers, got {inertia:g} and {period:g}")
         _check_scale(inertia=inertia, damping=damping, period=period, wall_damping=wall_damping)
-        _check_error_percent(error_percent)
-        _check_wall_damping(wall_damping)
-        if delay < 0:
-            raise UserError(f"--delay must be a non-negative number of samples, got {delay}")
+        if not (np.isfinite(error_percent) and -100 < error_percent < 100):
+            raise UserError(f"--error-percent must be a finite number between -100 and 100 (exclusive), got "
+                            f"{error_percent}")
         if damping * period / substeps > inertia:
             raise UserError(f"the plant step --period / --substeps = {period / substeps:.3g} s is longer than the "
                             f"plant's time constant J/b = {inertia / damping:.3g} s; raise --substeps")
@@ -403,11 +334,9 @@ def campaign_command(
     """Both criteria and both types over a design set; resumable (seed 000 §4.1.4, §4.2.4)."""
     import os
 
-    from dataclasses import replace
-
     from hapticdesign.devices.registry import preset as preset_device
     from hapticdesign.simulation.campaign import CampaignOptions, load_cases, read_designs, run_campaign, summarize
-    from hapticdesign.simulation.config import compensator_device
+    from hapticdesign.simulation.config import Compensator, LoopConfig, Sensors, compensator_device
     from hapticdesign.simulation.paths import Chirp
 
     with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
@@ -425,15 +354,13 @@ def campaign_command(
             raise UserError(f"--duration ({duration:g} s) must be longer than the 0.5 s settle window")
         if method not in ("simulation", "analytic"):
             raise UserError(f"--method must be 'simulation' or 'analytic', got {method!r}")
-        if counts is not None and counts < 1:
-            raise UserError(f"--counts must be at least 1, got {counts}")
         friction = None if coulomb is None else tuple(float(v) for v in parse_vector(coulomb, None, "coulomb"))
         if friction is not None and any(v < 0 for v in friction):
             raise UserError("--coulomb: friction torques must be >= 0")
-        conditions = replace(_loop_config(1e-3, 1e-4, duration, counts, delay, error_percent, True, True, True,
-                                          0.0, 0.0, 0.0, 0.0), coulomb=friction)
-        conditions = replace(conditions, compensator=replace(conditions.compensator, group_errors=_group_errors(
-            group_errors), error_seed=error_seed))
+        conditions = LoopConfig(duration=duration, sensors=Sensors(counts_per_revolution=counts, delay_samples=delay),
+                                compensator=Compensator(error_percent=error_percent,
+                                                        group_errors=_group_errors(group_errors), error_seed=error_seed),
+                                coulomb=friction)
         compensator_device(preset_device(preset or "phantom-3dof"), conditions.compensator)  # bad groups fail now
         options = CampaignOptions(preset or "phantom-3dof", k_limit, stiffness, Chirp(0.3, 0.1, f1, sweep), duration,
                                   method=method, conditions=conditions)
