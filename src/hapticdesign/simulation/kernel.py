@@ -135,9 +135,8 @@ def _tree_model_terms(q, qd, record):
 def _handle_normal(q, handle):
     """The handle's position along the wall direction, ``n . p(q)``, by a walk of a tree (its node poses stay
     in ``handle``)."""
-    pos, n, node = handle.pos, handle.direction, handle.node
-    node_poses(q, handle.parent, handle.axis, handle.coef, handle.offset, handle.const_rot, handle.const_pos, node,
-               handle.rot, pos)
+    pos, n, node, tree = handle.pos, handle.direction, handle.node, handle.tree
+    node_poses(q, tree.parent, tree.axis, tree.coef, tree.offset, tree.const_rot, tree.const_pos, node, handle.rot, pos)
     return n[0] * pos[node, 0] + n[1] * pos[node, 1] + n[2] * pos[node, 2]
 
 
@@ -147,7 +146,8 @@ def _tree_handle(q, qd, handle, record, jn, want_jn):
     x = _handle_normal(q, handle)
     if want_jn:
         jac, n = handle.jac, handle.direction
-        frame_jacobian(handle.node, handle.parent, handle.axis, handle.coef, handle.rot, handle.pos, False, jac)
+        tree = handle.tree
+        frame_jacobian(handle.node, tree.parent, tree.axis, tree.coef, handle.rot, handle.pos, False, jac)
         for k in range(q.shape[0]):
             jn[k] = n[0] * jac[0, k] + n[1] * jac[1, k] + n[2] * jac[2, k]
     return x
@@ -158,7 +158,7 @@ def _loop_handle(q, qd, handle, record, jn, want_jn):
     """``n . p`` and ``J_n = n^T J_v T`` of a closed-loop device's handle at the record's closed pose at
     (q, qd), evaluated there unless it already is (:func:`_terms`)."""
     _terms(q, qd, record)
-    return handle_along(record.loop_ws, handle.parent, handle.axis, handle.node, handle.direction, jn, want_jn)
+    return handle_along(record.loop_ws, handle.tree.parent, handle.tree.axis, handle.node, handle.direction, jn, want_jn)
 
 
 # The plant and the compensator are inlined into the loop by their record type (a tree's tables or a

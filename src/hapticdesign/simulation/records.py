@@ -10,6 +10,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from hapticdesign.model.walk import Tree
+
 
 class Table(NamedTuple):
     """Sparse basis coefficients of H, C, G (:class:`~.tables.DynamicsTables`) for :func:`~.tables.evaluate_entries`."""
@@ -147,12 +149,7 @@ class Handle(NamedTuple):
     handle's Jacobian (a closed-loop device takes its poses from the plant's or the compensator's
     closed pose instead)."""
 
-    parent: np.ndarray
-    axis: np.ndarray
-    coef: np.ndarray
-    offset: np.ndarray
-    const_rot: np.ndarray
-    const_pos: np.ndarray
+    tree: Tree
     node: int
     direction: np.ndarray
     rot: np.ndarray
@@ -238,14 +235,13 @@ def handle(mechanism, direction: np.ndarray) -> Handle:
     """The kernel's view of a mechanism's handle (end-effector frame) for a wall along ``direction``."""
     tree = mechanism.compiled.tree
     rot, pos = tree.workspace()
-    parent, axis, coef, offset, const_rot, const_pos = tree.arrays
-    return Handle(parent, axis, np.ascontiguousarray(coef), offset, const_rot, const_pos,
-                  int(tree.frame_node[mechanism.end_effector]), np.ascontiguousarray(direction, dtype=float), rot, pos,
-                  np.zeros((6, coef.shape[1])))
+    arrays = tree.arrays._replace(coef=np.ascontiguousarray(tree.coef))
+    return Handle(arrays, int(tree.frame_node[mechanism.end_effector]), np.ascontiguousarray(direction, dtype=float),
+                  rot, pos, np.zeros((6, arrays.coef.shape[1])))
 
 
 def no_handle(n: int) -> Handle:
     """A placeholder :class:`Handle` for a joint wall (same array types, so one compiled loop)."""
-    return Handle(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros((0, n)), np.zeros(0),
-                  np.zeros((0, 3, 3)), np.zeros((0, 3)), -1, np.zeros(3), np.zeros((1, 3, 3)), np.zeros((1, 3)),
-                  np.zeros((6, n)))
+    empty = Tree(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros((0, n)), np.zeros(0),
+                 np.zeros((0, 3, 3)), np.zeros((0, 3)))
+    return Handle(empty, -1, np.zeros(3), np.zeros((1, 3, 3)), np.zeros((1, 3)), np.zeros((6, n)))
