@@ -17,8 +17,8 @@ at once: the closures ``phi(q) = 0`` and the handle's position on the directions
 fails at that point) when Newton does not converge or the handle is off the goal in 3-D (out of reach, or off a
 planar device's plane), when the system's pivot ratio falls below ``IK_SINGULAR`` or the sign of its determinant
 (``det Phi_p det(U^T J_v T)``, Schur's complement) or of ``det Phi_p`` (the assembly branch) changes from home's
-(behind a singularity). At each point it leaves ``J_v T`` (3 x n_a). :func:`entries_designs` gives ``H`` at those
-poses with the closed-loop dynamics' own kernel (:func:`~hapticdesign.analysis.dynamics.actuated_kernel.entries_into`).
+(behind a singularity). At each point it leaves ``J_v T`` (3 x n_a). :func:`mass_designs` gives ``H`` at those
+poses with the closed-loop dynamics' own pose kernels (:mod:`hapticdesign.analysis.dynamics.actuated_kernel`).
 ``tests/design/test_design_batch.py`` checks both against the one-design path (:mod:`.metrics.indices`).
 """
 
@@ -31,7 +31,7 @@ from numba import njit
 
 from hapticdesign.analysis.configuration import IK_JOINT_STEP, IK_STEP, IK_WAY, configuration_of
 from hapticdesign.analysis.dynamics.actuated_kernel import (
-    Bodies, active_bodies, entries_into, entries_scratch, passive_paths,
+    Bodies, factor_pose, mass_and_gravity, passive_paths, reduce_pose, world_parameters,
 )
 from hapticdesign.analysis.loops import closure_kernel as ck
 from hapticdesign.analysis.loops.records import Closures, Settings, workspace
@@ -222,25 +222,33 @@ def reach_designs(offsets, targets, shape, plan, loops, settings, reach, out):
 
 
 @njit(cache=True)
-def entries_designs(offsets, full, status, shape, plan, bodies, loops, params, out):
-    """Entries (unique H, C, G in actuated coordinates) at the poses ``full`` (D, P, N) of the designs whose status
-    is OK, for their parameters ``params`` (D, 10 B), into ``out`` (D, P, E)."""
+def mass_designs(offsets, full, status, shape, plan, bodies, loops, params, out):
+    """``H`` (actuated coordinates, without the reflected rotor inertia) at the poses ``full`` (D, P, N) of the
+    designs whose status is OK, for their standard parameters ``params`` (D, 10 B), into ``out`` (D, P, n_a, n_a):
+    ``sum_b (J_b T)^T M_b (J_b T)`` (eq. 2.44) with the closed-loop dynamics' own pose kernels."""
     n_design, n_pose, n = full.shape
     na = loops.actuated.shape[0]
-    n_body = bodies.body_node.shape[0]
+    body_node = bodies.body_node
+    n_body = body_node.shape[0]
     ws = workspace(shape.parent.shape[0], n, na, loops.passive, n_body)
-    scratch = entries_scratch(1, na, loops.passive.shape[0], n_body)
-    ratios = np.zeros(n_pose)
-    entries = np.zeros((n_pose, 1, out.shape[2]))
+    pw = np.zeros((1, n_body, 10))
+    h = np.zeros((na, na))
+    g = np.zeros(na)
+    mj = np.zeros((6, na))
     for d in range(n_design):
         if status[d] != OK:
             continue
         tree = Tree(shape.parent, shape.axis, shape.coef, offsets[d], shape.const_rot, shape.const_pos)
         sets = params[d:d + 1]
-        entries_into(full[d], tree, plan, bodies, loops, sets, active_bodies(sets), ws, scratch, entries, ratios)
         for p in range(n_pose):
-            for e in range(out.shape[2]):
-                out[d, p, e] = entries[p, 0, e]
+            factor_pose(full[d, p], tree, plan, loops, ws)
+            reduce_pose(tree, plan, body_node, loops, ws)
+            world_parameters(ws.rot, body_node, sets, 0, pw)
+            h[:] = 0.0
+            for b in range(n_body):
+                if body_node[b] >= 0:
+                    mass_and_gravity(ws.ja, b, bodies.gravity, pw, 0, h, g, mj, False)
+            out[d, p] = h
 
 
 class DesignBatch:
@@ -292,7 +300,6 @@ class DesignBatch:
         u, s, _ = np.linalg.svd(jac)
         self.reach = Reach(IK_STEP, self.settings.tol, IK_WAY * IK_STEP, 60, IK_JOINT_STEP, SINGULAR_PIVOTS, int(handle),
                            np.ascontiguousarray(u[:, :n_a]), guess)
-        self.n_entries = n_a * (n_a + 1) // 2 * (1 + n_a) + n_a
 
     def _sensitivity(self, device: Device) -> np.ndarray:
         """``d offset / d p`` (nodes x parameters), exact for the affine values of a device file."""
@@ -330,15 +337,11 @@ class DesignBatch:
         """``H`` (D, P, n_a, n_a) at the reached poses, standard parameters ``params`` (D, 10 B) or one set for every
         design (10 B,), and reflected rotor inertia ``reflected`` (D, n_a, n_a) or (n_a, n_a)."""
         d, p = reached.status.shape[0], reached.full.shape[1]
-        entries = np.zeros((d, p, self.n_entries))
-        params = np.ascontiguousarray(np.broadcast_to(np.atleast_2d(params), (d, np.shape(params)[-1])), dtype=float)
-        entries_designs(np.ascontiguousarray(offsets, dtype=float), reached.full, reached.status, self.shape,
-                        self.plan, self.bodies, self.closures, params, entries)
         na = len(self.closures.actuated)
-        iu, ju = np.triu_indices(na)
-        h = np.empty((d, p, na, na))
-        h[..., iu, ju] = entries[..., :len(iu)]
-        h[..., ju, iu] = entries[..., :len(iu)]
+        h = np.zeros((d, p, na, na))
+        params = np.ascontiguousarray(np.broadcast_to(np.atleast_2d(params), (d, np.shape(params)[-1])), dtype=float)
+        mass_designs(np.ascontiguousarray(offsets, dtype=float), reached.full, reached.status, self.shape, self.plan,
+                     self.bodies, self.closures, params, h)
         return h + (reflected[:, None] if np.ndim(reflected) == 3 else reflected)
 
     def reason(self, reached: Reached, design: int, points: np.ndarray) -> str | None:
