@@ -89,10 +89,27 @@ class Reached(NamedTuple):
     point: np.ndarray
 
 
+class Scratch(NamedTuple):
+    """The continuation's scratch: node poses, cosines and sines, the handle's Jacobian, the system and its right-hand
+    side, the closure residual, ``Phi``, ``Phi_p`` and ``S = -Phi_p^-1 Phi_a``."""
+
+    rot: np.ndarray
+    pos: np.ndarray
+    trig: np.ndarray
+    jac: np.ndarray
+    a: np.ndarray
+    rhs: np.ndarray
+    res: np.ndarray
+    phi: np.ndarray
+    pp: np.ndarray
+    t: np.ndarray
+
+
 @njit(cache=True)
-def _walk_and_system(q, tree, plan, loops, reach, goal, rot, pos, trig, jac, a, rhs, res):
-    """Node poses, the system ``[Phi; U^T J_v]`` (N x N) into ``a`` and ``[-phi; U^T (goal - p)]`` into ``rhs``;
+def _walk_and_system(q, tree, plan, loops, reach, goal, ws):
+    """Node poses, the system ``[Phi; U^T J_v]`` (N x N) into ``ws.a`` and ``[-phi; U^T (goal - p)]`` into ``ws.rhs``;
     returns the largest closure residual and the 3-D distance of the handle from ``goal``."""
+    rot, pos, trig, jac, a, rhs, res = ws.rot, ws.pos, ws.trig, ws.jac, ws.a, ws.rhs, ws.res
     m = loops.row_loop.shape[0]
     n = q.shape[0]
     planned_poses(q, tree, plan, 0, plan.n_first, rot, pos, trig)
@@ -121,8 +138,7 @@ def _newton(q, tree, plan, loops, settings, reach, goal, mode, tol, ws):
     (status, sign of the system's determinant). ``mode`` 0: no sign to keep (home)."""
     a, rhs = ws.a, ws.rhs
     for _ in range(reach.max_iter):
-        big, dist = _walk_and_system(q, tree, plan, loops, reach, goal, ws.rot, ws.pos, ws.trig, ws.jac, a, rhs,
-                                     ws.res)
+        big, dist = _walk_and_system(q, tree, plan, loops, reach, goal, ws)
         ratio, sign = lu_in_place(a, rhs)
         if not ratio > reach.singular:
             return SINGULAR, sign
@@ -139,22 +155,6 @@ def _newton(q, tree, plan, loops, settings, reach, goal, mode, tol, ws):
         if tol > reach.tol and scale == 1.0 and dist <= 1.5 * reach.step and big <= 1.5 * reach.step:
             return OK, sign  # on the way: one corrector from a pose near the segment, checked by the next step's walk
     return OUT_OF_REACH, 0.0
-
-
-class Scratch(NamedTuple):
-    """The continuation's scratch: node poses, cosines and sines, the handle's Jacobian, the system and its right-hand
-    side, the closure residual, ``Phi``, ``Phi_p`` and ``S = -Phi_p^-1 Phi_a``."""
-
-    rot: np.ndarray
-    pos: np.ndarray
-    trig: np.ndarray
-    jac: np.ndarray
-    a: np.ndarray
-    rhs: np.ndarray
-    res: np.ndarray
-    phi: np.ndarray
-    pp: np.ndarray
-    t: np.ndarray
 
 
 @njit(cache=True)
