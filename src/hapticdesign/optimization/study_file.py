@@ -214,6 +214,9 @@ class StudySpec(_StudyModel):
         twice = sorted({n for n in names if names.count(n) > 1})
         if twice:
             raise ValueError(f"objectives: name {twice[0]!r} is used twice (give each objective its own name)")
+        clash = [n for n in names if n in self.variables]
+        if clash:
+            raise ValueError(f"objectives: name {clash[0]!r} is also a variable (name the objective otherwise)")
         for i, c in enumerate(self.constraints):
             if isinstance(c, ExpressionConstraint):
                 unknown = [n for n in c.parsed.names if n not in self.variables]
