@@ -233,12 +233,13 @@ class StudySpec(_StudyModel):
 
 
 class Study:
-    """A checked study file bound to its device file: ``spec``, the device path (resolved against the
-    study file's folder), both files' text and a ``fingerprint`` of the two (a checkpoint is resumed only
-    by the same study)."""
+    """A checked study file bound to its device file: ``spec``, the study file's ``path``, the device path
+    (resolved against the study file's folder), both files' text and a ``fingerprint`` of the two (a
+    checkpoint is resumed only by the same study)."""
 
-    def __init__(self, spec: StudySpec, device_path: Path, study_text: str, device_text: str):
+    def __init__(self, spec: StudySpec, path: Path, device_path: Path, study_text: str, device_text: str):
         self.spec = spec
+        self.path = path
         self.device_path = device_path
         self.study_text = study_text
         self.device_text = device_text
@@ -267,4 +268,4 @@ def load_study(path: Path | str) -> Study:
     path = Path(path)
     spec = study_from_mapping(load_structured(path, "study file"), str(path))
     device_path = path.parent / spec.device
-    return Study(spec, device_path, read_text(path, "study file"), read_text(device_path, "device file"))
+    return Study(spec, path, device_path, read_text(path, "study file"), read_text(device_path, "device file"))
