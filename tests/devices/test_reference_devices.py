@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from hapticdesign.analysis.dynamics.device import gravity, mass_matrix
-from hapticdesign.analysis.inverse_kinematics import handle_pose
+from hapticdesign.analysis.configuration import handle_pose
 from hapticdesign.devices.device_file import load_device_file
 from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import PhysicalConsistencyWarning, UserError

@@ -13,7 +13,7 @@ from pydantic import ValidationError
 
 from hapticdesign.analysis.stiffness.link import rigidities
 from hapticdesign.devices.builder import ChainBuilder, DHRowTemplate, FrameTemplate, assemble_device
-from hapticdesign.devices.schema import DeviceFileSpec, motor_terms
+from hapticdesign.devices.schema import ActuatorSpec, DeviceFileSpec, motor_terms
 from hapticdesign.errors import UserError
 from hapticdesign.model.actuators import Actuator
 from hapticdesign.model.device import Device
@@ -77,16 +77,23 @@ def _closed_loops(spec: DeviceFileSpec) -> ClosedLoops | None:
 
 def _actuators(spec: DeviceFileSpec) -> tuple[Actuator, ...]:
     """The file's actuators with 0-based indices among the actuated joints (in the order of ``joints``)."""
-    index = {j.name: k for k, j in enumerate(j for j in spec.joints if j.actuated)}
-    out = []
-    for a in spec.actuators:
-        terms = tuple((index[name], float(c)) for name, c in motor_terms(a).items())
-        coupling = () if a.drives is None else terms
-        offset = 0.0 if a.drives is None else float(a.drives.constant)
-        limits = None if a.limits is None else (float(a.limits[0]), float(a.limits[1]))
-        out.append(Actuator(terms[0][0], a.rotor_inertia, a.gear_ratio, a.coulomb, a.damping, coupling, offset, limits,
-                            a.torque_continuous, a.torque_peak, a.encoder_cpr, a.quadrature))
-    return tuple(out)
+    index = actuated_index(spec)
+    return tuple(actuator_from_spec(a, index) for a in spec.actuators)
+
+
+def actuated_index(spec: DeviceFileSpec) -> dict[str, int]:
+    """Each actuated joint's 0-based place among the actuated joints (in the order of ``joints``)."""
+    return {j.name: k for k, j in enumerate(j for j in spec.joints if j.actuated)}
+
+
+def actuator_from_spec(a: ActuatorSpec, index: dict[str, int]) -> Actuator:
+    """One actuator of a file, its coordinates numbered by ``index`` (:func:`actuated_index`)."""
+    terms = tuple((index[name], float(c)) for name, c in motor_terms(a).items())
+    coupling = () if a.drives is None else terms
+    offset = 0.0 if a.drives is None else float(a.drives.constant)
+    limits = None if a.limits is None else (float(a.limits[0]), float(a.limits[1]))
+    return Actuator(terms[0][0], a.rotor_inertia, a.gear_ratio, a.coulomb, a.damping, coupling, offset, limits,
+                    a.torque_continuous, a.torque_peak, a.encoder_cpr, a.quadrature)
 
 
 def _location(loc: tuple) -> str:
@@ -113,16 +120,21 @@ def describe_validation_error(exc: ValidationError) -> str:
     return f"{where}: {message}{more}" if where else f"{message}{more}"
 
 
-def device_from_mapping(data: object, source: str = "device file") -> Device:
-    """Validate a parsed device file and build its Device; problems raise a one-line UserError."""
+def spec_from_mapping(data: object, source: str = "device file") -> DeviceFileSpec:
+    """Validate a parsed device file; problems raise a one-line UserError."""
     if not isinstance(data, dict):
         raise UserError(f"{source}: expected a mapping with keys such as name, joints, dh, frames, bodies")
     require_device_size(source, *(len(data[key]) if isinstance(data.get(key), list) else 0
                                   for key in ("joints", "frames", "loops")))
     try:
-        spec = DeviceFileSpec.model_validate(data)
+        return DeviceFileSpec.model_validate(data)
     except ValidationError as exc:
         raise UserError(f"{source}: {describe_validation_error(exc)}") from None
+
+
+def device_from_mapping(data: object, source: str = "device file") -> Device:
+    """Validate a parsed device file and build its Device; problems raise a one-line UserError."""
+    spec = spec_from_mapping(data, source)
     try:
         return device_from_spec(spec)
     except UserError as exc:

@@ -21,7 +21,7 @@ friction reach the handle as follows:
   links carry sections (:mod:`hapticdesign.analysis.stiffness.device`).
 - ``workspace`` (mm): the edge of the largest cube (square for a planar device) centred on the home handle
   position whose corners, edge midpoints and face centres the handle reaches from home by inverse
-  kinematics (:mod:`hapticdesign.analysis.inverse_kinematics`) within the joint limits and without a
+  kinematics (:func:`hapticdesign.analysis.configuration.handle_pose`) within the joint limits and without a
   singularity, found by bisection.
 - ``renderable_stiffness`` (N/m): the exact stability limit of a virtual spring sampled every T with a
   delay of one sample (:func:`hapticdesign.simulation.boundary.exact_boundary`) on the 1-DOF model of the
@@ -41,8 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from hapticdesign.analysis.dynamics.device import mass_matrix
-from hapticdesign.analysis.inverse_kinematics import handle_pose, home_actuated
-from hapticdesign.analysis.configuration import configuration_of
+from hapticdesign.analysis.configuration import configuration_of, handle_pose
 from hapticdesign.errors import UserError
 from hapticdesign.model.actuators import transmission
 from hapticdesign.model.device import Device
@@ -188,7 +187,7 @@ def workspace_cube(device: Device, h: Handle) -> float:
 
 def spec_sheet(device: Device, q=None, rate: float = SERVO_RATE, workspace: bool = True) -> dict:
     """Every quantity of the module docstring at pose ``q`` (default: home), as a JSON-ready dict."""
-    q = home_actuated(device) if q is None else np.asarray(q, dtype=float)
+    q = configuration_of(device).home.copy() if q is None else np.asarray(q, dtype=float)
     h = handle_at(device, q)
     res = resolution(device, h)
     friction = backdrive_friction(device, h)

@@ -110,6 +110,10 @@ class ClosedLoopModel(EquationsOfMotion):
             out += self.constant
         return out[:, 0, :] if pi.ndim == 1 else np.moveaxis(out, 1, 0)
 
+    def H_at(self, q_full: np.ndarray, pi: np.ndarray) -> np.ndarray:
+        """H_a (eq. 2.50 in the actuated coordinates) at closed full poses (P, N): (P, n_a, n_a)."""
+        return self._h_from(self.entries_at(np.atleast_2d(q_full), pi))
+
     def regressor_at(self, q_full: np.ndarray) -> np.ndarray:
         """Every entry as a row of the standard parameters at closed full poses: (P, E, n_params)."""
         q_full = np.atleast_2d(q_full)

@@ -38,6 +38,21 @@ def mass_matrix(device: Device, q: np.ndarray) -> np.ndarray:
     return dynamics_of(device).H(q, device.standard_parameters())
 
 
+def mass_matrix_at(device: Device, q_full: np.ndarray) -> np.ndarray:
+    """H over the actuated coordinates, the reflected rotor inertia included, at closed full poses ``q_full``
+    (P, N) (from :meth:`~hapticdesign.analysis.configuration.Configuration.reach` or ``full``): (P, n_a, n_a).
+
+    A tree's comes straight from the compiled kernel (:func:`tree_mass_matrix`, no fitted model), a closed-loop
+    device's from the entries of its model at those poses (no continuation from home)."""
+    space = configuration_for(device.builder, device.kinematic_values())
+    q_full = np.atleast_2d(np.asarray(q_full, dtype=float))
+    if space.is_tree:
+        h = tree_mass_matrix(space.mechanism, q_full, device.standard_parameters())
+    else:
+        h = _model(device.builder, device.kinematic_values()).H_at(q_full, device.standard_parameters())
+    return h + device.reflected_inertia
+
+
 def tree_mass_matrix(mechanism: Mechanism, q: np.ndarray, parameters: np.ndarray) -> np.ndarray:
     """H (eq. 2.50) of a tree mechanism at poses ``(..., N)`` for standard inertial parameters
     ``(10 x bodies,)``, straight from the compiled regressor kernel.

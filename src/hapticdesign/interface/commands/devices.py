@@ -1,5 +1,5 @@
 """Commands ``ik``, ``spec`` and ``export``: a device's inverse kinematics, its spec sheet, and its model for
-other simulators (:mod:`hapticdesign.analysis.inverse_kinematics`, :mod:`hapticdesign.studies.spec`,
+other simulators (:func:`hapticdesign.analysis.configuration.handle_pose`, :mod:`hapticdesign.studies.spec`,
 :mod:`hapticdesign.devices.export`)."""
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ def ik(
     """Inverse kinematics by Newton on the geometric Jacobian (seed 000 eq. 2.20-2.26): the actuated (and
     passive) joint coordinates that put the handle at a position, on the branch of the home pose (continued from
     home along the straight segment)."""
-    from hapticdesign.analysis.inverse_kinematics import handle_pose
+    from hapticdesign.analysis.configuration import handle_pose
 
     with user_errors(strict=strict, quiet=quiet):
         from hapticdesign.devices.loading import resolve_device

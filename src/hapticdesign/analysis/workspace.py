@@ -1,0 +1,93 @@
+"""A Cartesian workspace the handle must reach: a box sampled on a grid, reached by inverse kinematics (issue 23).
+
+``Workspace(center, size, grid)`` is the box ``center +- size / 2`` (m, base frame) sampled with ``grid``
+points per axis whose size is not 0, edges included; an axis of size 0 keeps the centre's coordinate (a
+planar device's plane, a line). :meth:`Workspace.points` lists the points in snake (boustrophedon) order, so
+that each point is next to the one before it. :func:`reach_workspace` reaches them: from the device's home
+pose (on the loops' ``assembly`` branch) to the first point, then from each point to the next, by the one
+inverse kinematics of the project (:meth:`~hapticdesign.analysis.configuration.Configuration.reach`, small
+Cartesian steps on the home branch). A point out of reach, behind a singularity or needing a joint outside its
+limits raises a one-line :class:`UserError` naming the point.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from hapticdesign.analysis.configuration import check_limits, configuration_of
+from hapticdesign.errors import InputError
+from hapticdesign.model.device import Device
+
+POINT_LIMIT = 10_000
+"""Most workspace points (``grid`` to the power of the axes whose size is not 0)."""
+
+
+@dataclass(frozen=True)
+class Workspace:
+    """A box ``center +- size / 2`` (m) with ``grid`` points per axis whose size is not 0."""
+
+    center: tuple[float, float, float]
+    size: tuple[float, float, float]
+    grid: int
+
+    def __post_init__(self) -> None:
+        center = tuple(float(v) for v in np.ravel(self.center))
+        size = tuple(float(v) for v in np.ravel(self.size))
+        if len(center) != 3 or not all(math.isfinite(v) for v in center):
+            raise InputError(f"workspace: the centre is 3 finite numbers (m), got {list(np.ravel(self.center))}",
+                             "center")
+        if len(size) != 3 or not all(math.isfinite(v) and v >= 0.0 for v in size):
+            raise InputError(f"workspace: the size is 3 finite numbers >= 0 (m), got {list(np.ravel(self.size))}",
+                             "size")
+        if isinstance(self.grid, bool) or not isinstance(self.grid, (int, np.integer)):
+            raise InputError(f"workspace: grid is a whole number of points per axis, got {self.grid!r}", "grid")
+        axes = sum(v > 0.0 for v in size)
+        if axes and self.grid < 2:
+            raise InputError(f"workspace: grid must be at least 2 (points per axis, edges included), got {self.grid}",
+                             "grid")
+        if axes and float(self.grid) ** axes > POINT_LIMIT:
+            raise InputError(f"workspace: {self.grid}^{axes} points is above the limit of {POINT_LIMIT}", "grid")
+        object.__setattr__(self, "center", center)
+        object.__setattr__(self, "size", size)
+        object.__setattr__(self, "grid", int(self.grid))
+
+    def points(self) -> np.ndarray:
+        """The grid points (P, 3) in snake order (each next to the one before it); the centre alone when every
+        size is 0."""
+        axes = [k for k in range(3) if self.size[k] > 0.0]
+        offsets = np.linspace(-0.5, 0.5, self.grid)
+        out = []
+        for index in _snake([self.grid] * len(axes)):
+            point = list(self.center)
+            for k, i in zip(axes, index):
+                point[k] += self.size[k] * offsets[i]
+            out.append(point)
+        return np.array(out, dtype=float)
+
+
+def _snake(counts: list[int]) -> list[tuple[int, ...]]:
+    """Grid indices in boustrophedon order: every other sweep of the inner axes runs backwards."""
+    if not counts:
+        return [()]
+    inner = _snake(counts[1:])
+    return [(i, *rest) for i in range(counts[0]) for rest in (inner if i % 2 == 0 else inner[::-1])]
+
+
+@dataclass(frozen=True)
+class WorkspacePoses:
+    """The workspace points (P, 3) and the poses that reach them: actuated (P, n_a) and full (P, N) coordinates."""
+
+    points: np.ndarray
+    q: np.ndarray
+    full: np.ndarray
+
+
+def reach_workspace(device: Device, points: np.ndarray, frame: str | None = None) -> WorkspacePoses:
+    """The poses that put the handle (or ``frame``'s origin) at ``points`` (P, 3), reached in order from home."""
+    points = np.asarray(points, dtype=float)
+    q, full = configuration_of(device).reach(points, frame)
+    check_limits(device, q, points)
+    return WorkspacePoses(points, q, full)

@@ -1,0 +1,231 @@
+"""Design variables of a device file: what an optimization may change, and the device at chosen values.
+
+A design variable is named as in a study file (issue 23):
+
+- a ``parameters`` name of the file (geometry: a length, a motor spacing), m or rad;
+- an inertial parameter by its seed name (seed 000 Table 2.3: ``m2``, ``r2x``, ``Ixx2``, ...) of a body the
+  file gives by its parameters;
+- ``links.<link>.D`` or ``links.<link>.d``: the outer or inner diameter (m) of an elastic link's section
+  (``d`` of a tube only; a rod has ``D``);
+- ``actuators.<joint>.<field>`` (or ``actuators.<k>.<field>``, ``k`` the 0-based place of the actuator in the
+  file, for a motor that ``drives`` a combination): a numeric field of a motor, one of :data:`ACTUATOR_FIELDS`.
+
+:class:`DesignSpace` reads and validates the file once and builds its device once; :meth:`DesignSpace.device`
+applies values to that device (no file is read again and no schema is run again): each value is checked as the
+file's own validation checks it (a finite number, ``D > d >= 0``, ``gear_ratio > 0``, a body's physical
+consistency, the loops closing at home, ...), and an invalid design raises a one-line :class:`UserError`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+from pydantic import ValidationError
+
+from hapticdesign.analysis.configuration import configuration_of
+from hapticdesign.analysis.stiffness.device import check_elasticity
+from hapticdesign.analysis.stiffness.link import rigidities
+from hapticdesign.analysis.stiffness.sections import Tube
+from hapticdesign.devices.device_file import (
+    actuated_index,
+    actuator_from_spec,
+    describe_validation_error,
+    device_from_spec,
+    spec_from_mapping,
+)
+from hapticdesign.devices.schema import ActuatorSpec, DeviceFileSpec
+from hapticdesign.errors import UserError
+from hapticdesign.model.actuators import damping_matrix
+from hapticdesign.model.device import Device
+from hapticdesign.model.elastic import Elasticity, ElasticLink
+from hapticdesign.model.inertia import SEED_FIELDS, check_body, seed_parameter_name
+from hapticdesign.model.params_io import read_mapping
+
+ACTUATOR_FIELDS = ("rotor_inertia", "gear_ratio", "coulomb", "damping", "torque_continuous", "torque_peak")
+"""The numeric fields of a motor a design variable may change (units as in the device file)."""
+
+
+@dataclass(frozen=True)
+class Variable:
+    """One design variable: its name, what it changes (``parameter``, ``inertial``, ``section``, ``actuator``),
+    the place it changes (a parameter or body name, a link's or an actuator's index) and the field."""
+
+    name: str
+    kind: str
+    target: str | int
+    field: str = ""
+
+
+class DesignSpace:
+    """The design variables ``names`` of the device file ``source`` (a path or its parsed mapping)."""
+
+    def __init__(self, source: str | Path | Mapping, names: Iterable[str]):
+        where = "device file" if isinstance(source, Mapping) else str(source)
+        if isinstance(source, Mapping):
+            data = dict(source)
+        else:
+            path = Path(source)
+            if path.suffix.lower() == ".urdf":
+                raise UserError(f"{where}: design variables need a device file (YAML, TOML or JSON), not a URDF file")
+            data = read_mapping(path)
+        self.spec: DeviceFileSpec = spec_from_mapping(data, where)
+        try:
+            self.base: Device = device_from_spec(self.spec)
+        except UserError as exc:
+            raise UserError(f"{where}: {exc}") from None
+        self.variables: tuple[Variable, ...] = tuple(self._variable(str(name)) for name in names)
+        taken = [v.name for v in self.variables]
+        twice = sorted({n for n in taken if taken.count(n) > 1})
+        if twice:
+            raise UserError(f"design variable {twice[0]} is given twice")
+        self.names: tuple[str, ...] = tuple(taken)
+        self._index = actuated_index(self.spec)
+        self._joint_damping = np.array([j.damping for j in self.spec.joints if j.actuated], dtype=float)
+
+    # -- names --------------------------------------------------------------------------------
+    def _variable(self, name: str) -> Variable:
+        spec, base = self.spec, self.base
+        if name in spec.parameters:
+            return Variable(name, "parameter", name)
+        bodies = {seed_parameter_name(f, b.name): b.name for b in spec.bodies for f in SEED_FIELDS}
+        if name in bodies:
+            return Variable(name, "inertial", bodies[name])
+        parts = name.split(".")
+        if len(parts) == 3 and parts[0] == "links":
+            return self._section(name, parts[1], parts[2])
+        if len(parts) == 3 and parts[0] == "actuators":
+            return self._actuator(name, parts[1], parts[2])
+        known = ", ".join(spec.parameters) or "none"
+        raise UserError(f"unknown design variable {name!r} for device {base.name}: use a parameter ({known}), an "
+                        "inertial parameter by its seed name (such as m2), links.<link>.D or .d, or "
+                        "actuators.<joint>.<field>")
+
+    def _section(self, name: str, link: str, field: str) -> Variable:
+        links = [entry.name for entry in self.spec.links]
+        if link not in links:
+            raise UserError(f"design variable {name}: device {self.base.name} has no link {link!r} (links: "
+                            f"{', '.join(links) or 'none'})")
+        wanted = ("D", "d") if self.spec.links[links.index(link)].section.d > 0.0 else ("D",)
+        if field not in wanted:
+            raise UserError(f"design variable {name}: link {link}'s section has {' and '.join(wanted)} (m)"
+                            + ("" if "d" in wanted else "; a rod has no inner diameter"))
+        return Variable(name, "section", links.index(link), field)
+
+    def _actuator(self, name: str, which: str, field: str) -> Variable:
+        actuators = self.spec.actuators
+        by_joint = {a.joint: k for k, a in enumerate(actuators) if a.joint is not None}
+        if which in by_joint:
+            k = by_joint[which]
+        elif which.isdigit() and int(which) < len(actuators):
+            k = int(which)
+        else:
+            known = ", ".join([*by_joint, *(str(k) for k, a in enumerate(actuators) if a.joint is None)]) or "none"
+            raise UserError(f"design variable {name}: device {self.base.name} has no actuator {which!r} (actuators "
+                            f"by joint or place: {known})")
+        if field not in ACTUATOR_FIELDS:
+            raise UserError(f"design variable {name}: an actuator's variable is one of {', '.join(ACTUATOR_FIELDS)}")
+        return Variable(name, "actuator", k, field)
+
+    def defaults(self) -> dict[str, float]:
+        """Each variable's value in the file (NaN for an actuator field the file leaves unset)."""
+        out = {}
+        for v in self.variables:
+            if v.kind in ("parameter", "inertial"):
+                out[v.name] = float(self.base.params[v.name])
+            elif v.kind == "section":
+                out[v.name] = float(getattr(self.spec.links[v.target].section, v.field))
+            else:
+                value = getattr(self.spec.actuators[v.target], v.field)
+                out[v.name] = math.nan if value is None else float(value)
+        return out
+
+    # -- designs ------------------------------------------------------------------------------
+    def device(self, values: Mapping[str, float]) -> Device:
+        """The device with ``values`` (variable name to number) applied; the others keep the file's values.
+
+        Raises a one-line UserError for an unknown name, a value that is not a finite number, and a design the
+        device file's validation refuses."""
+        by_name = {v.name: v for v in self.variables}
+        changes: dict[str, dict] = {"parameter": {}, "inertial": {}, "section": {}, "actuator": {}}
+        for name, raw in values.items():
+            if name not in by_name:
+                raise UserError(f"{name!r} is not a design variable of this study (variables: {', '.join(self.names)})")
+            value = _number(name, raw)
+            v = by_name[name]
+            key = v.name if v.kind in ("parameter", "inertial") else v.target
+            if v.kind in ("section", "actuator"):
+                changes[v.kind].setdefault(key, {})[v.field] = value
+            else:
+                changes[v.kind][key] = value
+        device = self.base
+        overrides = {**changes["parameter"], **changes["inertial"]}
+        if overrides:
+            device = device.with_params(overrides)
+        for body in sorted({by_name[n].target for n in changes["inertial"]}):
+            report = check_body(body, device.body(body))
+            if report.error:
+                raise UserError(report.error)
+        if changes["section"]:
+            device = replace(device, elasticity=self._elasticity(changes["section"]))
+        if changes["actuator"]:
+            device = self._with_actuators(device, changes["actuator"])
+        if changes["parameter"]:
+            self._check_geometry(device)
+        return device
+
+    def _elasticity(self, sections: dict[int, dict[str, float]]) -> Elasticity:
+        links = []
+        for k, spec in enumerate(self.spec.links):
+            section = spec.section
+            if k in sections:
+                sizes = {"D": section.D, "d": section.d, **sections[k]}
+                try:
+                    section = Tube(sizes["D"], sizes["d"])
+                except UserError as exc:
+                    raise UserError(f"link {spec.name}: {exc}") from None
+            links.append(ElasticLink(spec.name, spec.start, spec.end, *rigidities(spec.material, section)))
+        joints = self.base.elasticity.joints if self.base.elasticity is not None else ()
+        return Elasticity(tuple(links), joints)
+
+    def _with_actuators(self, device: Device, fields: dict[int, dict[str, float]]) -> Device:
+        actuators = list(device.actuators)
+        for k, change in fields.items():
+            spec = self.spec.actuators[k]
+            try:
+                checked = ActuatorSpec.model_validate({**dict(spec), **change})
+            except ValidationError as exc:
+                raise UserError(f"actuators[{k}].{describe_validation_error(exc)}") from None
+            if (checked.torque_continuous is not None and checked.torque_peak is not None
+                    and checked.torque_peak < checked.torque_continuous):
+                raise UserError(f"actuators[{k}].torque_peak: {checked.torque_peak:g} N m is below torque_continuous "
+                                f"{checked.torque_continuous:g} N m")
+            actuators[k] = actuator_from_spec(checked, self._index)
+        damping = self._joint_damping + np.diag(damping_matrix(tuple(actuators), len(self._joint_damping)))
+        return replace(device, actuators=tuple(actuators), damping=tuple(float(b) for b in damping))
+
+    @staticmethod
+    def _check_geometry(device: Device) -> None:
+        """What the file's loading checks of a geometry: the links' frames apart, the loops closing at home."""
+        mechanism = device.mechanism
+        if device.elasticity is not None:
+            check_elasticity(mechanism, device.elasticity)
+        if mechanism.loops is not None:
+            configuration_of(device)
+
+
+def _number(name: str, value: object) -> float:
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise UserError(f"design variable {name}: {value!r} is not a number")
+    value = float(value)
+    if not math.isfinite(value):
+        raise UserError(f"design variable {name}: value must be finite, got {value!r}")
+    return value
+
+
+def design_space(source: str | Path | Mapping, names: Iterable[str]) -> DesignSpace:
+    """The design variables ``names`` of the device file ``source`` (see the module docstring)."""
+    return DesignSpace(source, names)
