@@ -82,10 +82,10 @@ class BoundStudy:
         try:
             device = self.space.device(values)
         except UserError as exc:
-            return Answer(nothing, f"invalid device: {exc}", 0.0)
+            return Answer(nothing, f"invalid device: {exc}")
         result = evaluate(device, self.points, [index for index, _ in self.keys])
         if result.reason is not None:
-            return Answer(nothing, f"workspace: {result.reason}", 0.0)
+            return Answer(nothing, f"workspace: {result.reason}")
         return Answer(tuple(reduce(result.values[index], how) for index, how in self.keys))
 
     def evaluate(self, batch: list[dict[str, float]]) -> list[Answer]:

@@ -5,10 +5,9 @@ index of its choice (a whole number, :class:`~hapticdesign.optimization.pymoo_ru
 generation's designs go to an evaluator in one batch (a loop here, or a Dask cluster, :mod:`.study_dask`),
 which answers every reduced index the study reads, or why the design has none (a workspace point out of
 reach, an invalid device). Objectives enter pymoo as minimized values (a maximized one negated);
-constraints as ``g <= 0`` scaled by their bound, plus one column that is 0 for a valid design and
-``2 - reached`` for a design without values (``reached`` the share of the workspace points it reached), so
-that NSGA-II's constrained domination (Deb et al. 2002) ranks it behind every valid design and the
-designs that reach more of the workspace ahead of those that reach less.
+constraints as ``g <= 0`` scaled by their bound, plus one column that is 1 for a design without values
+(0 otherwise), so that NSGA-II's constrained domination (Deb et al. 2002) ranks it behind every valid
+design.
 
 Checkpoint: with an output folder, each generation's answers are written to
 ``checkpoint/generation-NNNN.json`` as they arrive. A rerun replays the same seeded algorithm and takes
@@ -40,12 +39,10 @@ RUN_FILE = "run.json"
 @dataclass(frozen=True)
 class Answer:
     """The evaluator's answer for one design: every reduced index of :func:`reduced_keys` in order (NaN
-    when the design has none), ``reason``, empty for a valid design, else why it has no values, and
-    ``reached``, the share of the workspace points the design reached (1 for a valid design)."""
+    when the design has none) and ``reason``, empty for a valid design, else why it has no values."""
 
     reduced: tuple[float, ...]
     reason: str = ""
-    reached: float = 1.0
 
 
 Evaluator = Callable[[list[dict[str, float]]], list[Answer]]
@@ -97,8 +94,8 @@ class Encoding:
 class Record:
     """One evaluated design: its generation (1 = the initial population), design vector, variable values,
     objectives (the study's sense and units), constrained values, why it has no values (``invalid``) or
-    which constraint it breaks first (``violated``), both empty when it is feasible, the share of the
-    workspace it reached and its total scaled constraint violation."""
+    which constraint it breaks first (``violated``), both empty when it is feasible, and its total scaled
+    constraint violation."""
 
     generation: int
     x: tuple[float, ...]
@@ -107,7 +104,6 @@ class Record:
     constraints: tuple[float, ...]
     invalid: str
     violated: str
-    reached: float
     violation: float
 
     @property
@@ -151,7 +147,7 @@ def record_of(spec: StudySpec, generation: int, x, values: dict[str, float], ans
         invalid = f"{bad[0]} is not a finite number" if bad else ""
     g, violated = _violations(spec, constraints) if not invalid else (np.zeros(0), "")
     return Record(generation, tuple(float(v) for v in x), values, objectives, constraints, invalid, violated,
-                  answer.reached, float(np.sum(np.maximum(g, 0.0))))
+                  float(np.sum(np.maximum(g, 0.0))))
 
 
 def minimized(spec: StudySpec, record: Record) -> np.ndarray:
@@ -162,8 +158,8 @@ def minimized(spec: StudySpec, record: Record) -> np.ndarray:
 
 
 def _g(spec: StudySpec, record: Record) -> np.ndarray:
-    if record.invalid:  # 1 to 2: designs that reach more of the workspace rank ahead
-        return np.concatenate([[2.0 - record.reached], np.zeros(len(_violations(spec, [0.0] * len(spec.constraints))[0]))])
+    if record.invalid:
+        return np.concatenate([[1.0], np.zeros(len(_violations(spec, [0.0] * len(spec.constraints))[0]))])
     return np.concatenate([[0.0], _violations(spec, record.constraints)[0]])
 
 
@@ -197,16 +193,15 @@ class Checkpoint:
         try:
             kept = json.loads(read_text(self._path(generation), "checkpoint"))
             same = np.array_equal(np.array(kept["X"], dtype=float).reshape(X.shape), X)
-            answers = zip(kept["reduced"], kept["reasons"], kept["reached"], strict=True)
-            return [Answer(tuple(r), s, f) for r, s, f in answers] if same else None
+            answers = zip(kept["reduced"], kept["reasons"], strict=True)
+            return [Answer(tuple(r), s) for r, s in answers] if same else None
         except (ValueError, KeyError, TypeError, UserError):
             return None
 
     def save(self, generation: int, X: np.ndarray, answers: list[Answer]) -> None:
         if self.folder is None:
             return
-        kept = {"X": X.tolist(), "reduced": [list(a.reduced) for a in answers], "reasons": [a.reason for a in answers],
-                "reached": [a.reached for a in answers]}
+        kept = {"X": X.tolist(), "reduced": [list(a.reduced) for a in answers], "reasons": [a.reason for a in answers]}
         write_atomically(self._path(generation), json.dumps(kept))
 
 

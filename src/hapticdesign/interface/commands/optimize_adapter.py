@@ -11,6 +11,8 @@ import math
 from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
+
 from hapticdesign.errors import UserError
 from hapticdesign.files import write_atomically
 from hapticdesign.interface.report.optimization_page import Picture, render
@@ -89,16 +91,24 @@ def summary_lines(summary: dict) -> list[str]:
     return lines
 
 
-def _no_front(run: StudyRun) -> UserError:
-    """Why the front is empty, with the closest design."""
+CLOSEST_CANDIDATES = 12
+"""Designs of the last generation tried point by point when no design reaches the workspace."""
+
+
+def _no_front(run: StudyRun, bound: BoundStudy) -> UserError:
+    """Why the front is empty, with the closest design: the most workspace points reached (each from home),
+    or the least constraint violation."""
     valid = [r for r in run.records if not r.invalid]
     if not valid:
-        closest = max(run.records, key=lambda r: r.reached)
-        shown = ", ".join(f"{k} = {v:.6g}" for k, v in closest.values.items())
-        return UserError(f"no design reaches the workspace or is valid; the closest ({shown}) failed: {closest.invalid}")
+        last = [r for r in run.records if r.generation == run.records[-1].generation][:CLOSEST_CANDIDATES]
+        counts = [bound.points_reached(r.values) for r in last]
+        best = int(np.argmax(counts))
+        shown = ", ".join(f"{k} = {v:.6g}" for k, v in last[best].values.items())
+        return UserError(f"no design of {run.evaluations} reaches the whole workspace; the closest ({shown}) reaches "
+                         f"{counts[best]} of {len(bound.points)} points ({last[best].invalid})")
     closest = min(valid, key=lambda r: r.violation)
     shown = ", ".join(f"{k} = {v:.6g}" for k, v in closest.values.items())
-    return UserError(f"no design meets the constraints; the closest ({shown}) has {closest.violated}")
+    return UserError(f"no design of {run.evaluations} meets the constraints; the closest ({shown}) has {closest.violated}")
 
 
 def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Selection) -> list[Path]:
@@ -129,7 +139,7 @@ def optimize(study_path: Path, seed: int, out: Path | None, scheduler: str | Non
         evaluate = _evaluator(bound, scheduler, quiet, stack)
         run = run_study(study, seed, evaluate, out, progress)
     if not run.front:
-        raise _no_front(run)
+        raise _no_front(run, bound)
     selection = select_design(run, **rule)
     written = [] if out is None else write_outputs(out, run, bound, selection)
     return summary_of(run, selection), written
