@@ -9,9 +9,11 @@ from __future__ import annotations
 import math
 
 
-def planar_arm(l1: float = 0.2, l2: float = 0.2 / math.sqrt(2.0), elbow: float = 3 * math.pi / 4) -> dict:
-    """The device-file mapping of the arm (lengths in m, ``elbow`` the elbow angle at home in rad)."""
-    return {
+def planar_arm(l1: float = 0.2, l2: float = 0.2 / math.sqrt(2.0), elbow: float = 3 * math.pi / 4,
+               link_bodies: bool = False) -> dict:
+    """The device-file mapping of the arm (lengths in m, ``elbow`` the elbow angle at home in rad); with
+    ``link_bodies`` its two bodies are the links' tube and rod (``bodies: - {name: 1, link: upper}``)."""
+    arm = {
         "name": "planar-arm",
         "parameters": {"l1": l1, "l2": l2, "e": elbow},
         "joints": [{"name": "q1"}, {"name": "q2"}],
@@ -35,3 +37,6 @@ def planar_arm(l1: float = 0.2, l2: float = 0.2 / math.sqrt(2.0), elbow: float =
                   {"name": "lower", "from": "lower", "to": "tip", "section": {"shape": "rod", "D": 0.008},
                    "material": "aluminium_6061"}],
     }
+    if link_bodies:
+        arm["bodies"] = [{"name": "1", "link": "upper"}, {"name": "2", "link": "lower"}]
+    return arm

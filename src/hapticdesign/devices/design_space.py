@@ -13,7 +13,10 @@ A design variable is named as in a study file (issue 23):
 :class:`DesignSpace` reads and validates the file once and builds its device once; :meth:`DesignSpace.device`
 applies values to that device (no file is read again and no schema is run again): each value is checked as the
 file's own validation checks it (a finite number, ``D > d >= 0``, ``gear_ratio > 0``, a body's physical
-consistency, the loops closing at home, ...), and an invalid design raises a one-line :class:`UserError`.
+consistency, the loops closing at home, ...), and an invalid design raises a one-line :class:`UserError`. Bodies
+that are links (``bodies: - {name: b, link: l}``) follow the lengths and sections: their mass and inertia are
+computed again (:func:`~hapticdesign.devices.device_file.link_body_inertias`) whenever a parameter or a section
+changes.
 """
 
 from __future__ import annotations
@@ -35,6 +38,7 @@ from hapticdesign.devices.device_file import (
     actuator_from_spec,
     describe_validation_error,
     device_from_spec,
+    link_body_inertias,
     spec_from_mapping,
 )
 from hapticdesign.devices.schema import ActuatorSpec, DeviceFileSpec
@@ -85,15 +89,20 @@ class DesignSpace:
         self.names: tuple[str, ...] = tuple(taken)
         self._index = actuated_index(self.spec)
         self._joint_damping = np.array([j.damping for j in self.spec.joints if j.actuated], dtype=float)
+        self._link_bodies = any(b.link is not None for b in self.spec.bodies)
 
     # -- names --------------------------------------------------------------------------------
     def _variable(self, name: str) -> Variable:
         spec, base = self.spec, self.base
         if name in spec.parameters:
             return Variable(name, "parameter", name)
-        bodies = {seed_parameter_name(f, b.name): b.name for b in spec.bodies for f in SEED_FIELDS}
+        bodies = {seed_parameter_name(f, b.name): b for b in spec.bodies for f in SEED_FIELDS}
         if name in bodies:
-            return Variable(name, "inertial", bodies[name])
+            body = bodies[name]
+            if body.link is not None:
+                raise UserError(f"design variable {name}: body {body.name} is link {body.link}'s tube, its mass and "
+                                f"inertia follow the link (vary links.{body.link}.D or .d, or the lengths)")
+            return Variable(name, "inertial", body.name)
         parts = name.split(".")
         if len(parts) == 3 and parts[0] == "links":
             return self._section(name, parts[1], parts[2])
@@ -169,16 +178,22 @@ class DesignSpace:
             report = check_body(body, device.body(body))
             if report.error:
                 raise UserError(report.error)
+        tubes = self._sections(changes["section"])
         if changes["section"]:
-            device = replace(device, elasticity=self._elasticity(changes["section"]))
+            device = replace(device, elasticity=self._elasticity(tubes))
         if changes["actuator"]:
             device = self._with_actuators(device, changes["actuator"])
         if changes["parameter"]:
             self._check_geometry(device)
+        if self._link_bodies and (changes["parameter"] or changes["section"]):
+            inertias = link_body_inertias(self.spec, device.mechanism, tubes)
+            device = device.with_params({seed_parameter_name(f, body): float(getattr(inertia, f))
+                                         for body, inertia in inertias.items() for f in SEED_FIELDS})
         return device
 
-    def _elasticity(self, sections: dict[int, dict[str, float]]) -> Elasticity:
-        links = []
+    def _sections(self, sections: dict[int, dict[str, float]]) -> dict[str, Tube]:
+        """The links' sections with ``sections`` (link index to changed sizes) applied, by link name."""
+        out = {}
         for k, spec in enumerate(self.spec.links):
             section = spec.section
             if k in sections:
@@ -187,9 +202,14 @@ class DesignSpace:
                     section = Tube(sizes["D"], sizes["d"])
                 except UserError as exc:
                     raise UserError(f"link {spec.name}: {exc}") from None
-            links.append(ElasticLink(spec.name, spec.start, spec.end, *rigidities(spec.material, section)))
+            out[spec.name] = section
+        return out
+
+    def _elasticity(self, tubes: dict[str, Tube]) -> Elasticity:
+        links = tuple(ElasticLink(spec.name, spec.start, spec.end, *rigidities(spec.material, tubes[spec.name]))
+                      for spec in self.spec.links)
         joints = self.base.elasticity.joints if self.base.elasticity is not None else ()
-        return Elasticity(tuple(links), joints)
+        return Elasticity(links, joints)
 
     def _with_actuators(self, device: Device, fields: dict[int, dict[str, float]]) -> Device:
         actuators = list(device.actuators)

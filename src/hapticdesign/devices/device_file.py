@@ -7,26 +7,71 @@ with the URDF reader). Inertial parameters keep the seed's names (seed 000 Table
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 
+import numpy as np
 from pydantic import ValidationError
 
 from hapticdesign.analysis.stiffness.link import rigidities
+from hapticdesign.analysis.stiffness.sections import Tube
 from hapticdesign.devices.builder import ChainBuilder, DHRowTemplate, FrameTemplate, assemble_device
-from hapticdesign.devices.schema import ActuatorSpec, DeviceFileSpec, motor_terms
+from hapticdesign.devices.schema import ActuatorSpec, DeviceFileSpec, body_frame, motor_terms
 from hapticdesign.errors import UserError
 from hapticdesign.model.actuators import Actuator
-from hapticdesign.model.device import Device
+from hapticdesign.model.device import Device, build_mechanism
+from hapticdesign.model.inertia import BodyInertia, tube_body
 from hapticdesign.model.elastic import Elasticity, ElasticLink
 from hapticdesign.model.loops import ClosedLoops, LoopClosure
-from hapticdesign.model.mechanism import JointType
+from hapticdesign.model.mechanism import JointType, Mechanism
 from hapticdesign.model.params_io import read_mapping
 from hapticdesign.workload import require_device_size
 
 
 def device_from_spec(spec: DeviceFileSpec) -> Device:
     """The Device described by a validated device file."""
-    builder = ChainBuilder(
+    builder = chain_builder(spec)
+    kinematic = {**spec.parameters, "g": spec.g}
+    link_bodies = link_body_inertias(spec, build_mechanism(builder, tuple((k, float(v)) for k, v in kinematic.items())))
+    return assemble_device(
+        spec.name,
+        spec.description,
+        kinematic,
+        builder,
+        {b.name: link_bodies[b.name] if b.link is not None else b.inertia() for b in spec.bodies},
+        tuple(j.damping for j in spec.joints if j.actuated),
+        _actuators(spec),
+        tuple(None if j.limits is None else (float(j.limits[0]), float(j.limits[1])) for j in spec.joints
+              if j.actuated),
+        _elasticity(spec),
+    )
+
+
+def link_body_inertias(spec: DeviceFileSpec, mechanism: Mechanism,
+                       sections: Mapping[str, Tube] | None = None) -> dict[str, BodyInertia]:
+    """The inertias of the file's bodies that are links (``bodies: - {name: b, link: l}``): the link's tube from its
+    start frame to its end frame (:func:`~hapticdesign.model.inertia.tube_body`), with the section of ``sections``
+    (by link name) where given, else the file's, and the geometry of ``mechanism`` (the two frames are one rigid
+    piece, so any pose gives the same vector; q = 0 is taken)."""
+    links = {link.name: link for link in spec.links}
+    q = np.zeros(mechanism.n_dof)
+    out = {}
+    for body in spec.bodies:
+        if body.link is None:
+            continue
+        link = links[body.link]
+        start = mechanism.frame_pose(q, link.start)
+        axis = start[:3, :3].T @ (mechanism.frame_pose(q, link.end)[:3, 3] - start[:3, 3])
+        if not np.linalg.norm(axis) > 0.0:
+            raise UserError(f"link {link.name}: frames {link.start!r} and {link.end!r} coincide (zero length)")
+        section = (sections or {}).get(link.name, link.section)
+        out[body.name] = tube_body(axis, section.D, section.d, link.material.density)
+    return out
+
+
+def chain_builder(spec: DeviceFileSpec) -> ChainBuilder:
+    """The mechanism builder of a validated device file (its geometry, for any parameter values)."""
+    return ChainBuilder(
         coordinates=tuple(j.name for j in spec.joints),
         joint_types=tuple(JointType(j.type) for j in spec.joints),
         dh=tuple(
@@ -35,21 +80,9 @@ def device_from_spec(spec: DeviceFileSpec) -> Device:
         frames=tuple(
             FrameTemplate(f.name, None if f.parent == "base" else f.parent, tuple(f.transforms)) for f in spec.frames
         ),
-        bodies=tuple((b.name, b.frame) for b in spec.bodies),
+        bodies=tuple((b.name, body_frame(spec, b)) for b in spec.bodies),
         end_effector=spec.end_effector,
         loops=_closed_loops(spec),
-    )
-    return assemble_device(
-        spec.name,
-        spec.description,
-        {**spec.parameters, "g": spec.g},
-        builder,
-        {b.name: b.inertia() for b in spec.bodies},
-        tuple(j.damping for j in spec.joints if j.actuated),
-        _actuators(spec),
-        tuple(None if j.limits is None else (float(j.limits[0]), float(j.limits[1])) for j in spec.joints
-              if j.actuated),
-        _elasticity(spec),
     )
 
 

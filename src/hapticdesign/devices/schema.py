@@ -18,12 +18,13 @@ from __future__ import annotations
 
 import math
 import re
+from dataclasses import replace
 from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, InstanceOf, model_validator
 
-from hapticdesign.analysis.stiffness.materials import MATERIALS, LinkModuli, isotropic, laminate
+from hapticdesign.analysis.stiffness.materials import LAMINATE_DENSITY, MATERIALS, LinkModuli, isotropic, laminate
 from hapticdesign.analysis.stiffness.sections import Tube
 from hapticdesign.devices.builder import BODY_NAME_PATTERN, IDENTIFIER_PATTERN, LinearExpr, TransformSpec
 from hapticdesign.errors import UserError
@@ -208,10 +209,13 @@ class FrameSpec(_FileModel):
 
 
 class BodySpec(_FileModel):
-    """A rigid body on ``frame`` with the seed's inertial parameters (Table 2.3)."""
+    """A rigid body on ``frame`` with the seed's inertial parameters (Table 2.3), or the tube or rod of an elastic
+    ``link`` (its mass and inertia follow the link's length, section and material density:
+    :func:`hapticdesign.model.inertia.tube_body`)."""
 
     name: BodyName
-    frame: Name
+    frame: Name | None = None
+    link: BodyName | None = None
     m: Number = 0.0
     rx: Number = 0.0
     ry: Number = 0.0
@@ -230,8 +234,9 @@ class BodySpec(_FileModel):
 SECTIONS = {"tube": ("D", "d"), "rod": ("D",)}
 """Cross-section shapes of a link and their dimensions (m): a tube's outer and inner diameters, a rod's
 diameter (eq. 5.162-5.165; a rod is a tube with ``d = 0``)."""
-_MATERIAL_USAGE = (f"a material is one of {', '.join(MATERIALS)}, {{E: ..., G: ...}} (or {{E: ..., nu: ...}}, Pa) "
-                   "or {laminate: [a, b, c, d]} (M55J plies at 0, 90, -45, 45 degrees)")
+_MATERIAL_USAGE = (f"a material is one of {', '.join(MATERIALS)}, {{E: ..., G: ...}} (or {{E: ..., nu: ...}}, Pa; "
+                   "optional density: kg/m^3) or {laminate: [a, b, c, d]} (M55J plies at 0, 90, -45, 45 degrees; "
+                   f"optional density, default {LAMINATE_DENSITY:g} kg/m^3)")
 
 
 def _section(value: object) -> Tube:
@@ -262,14 +267,24 @@ def _material(value: object) -> LinkModuli:
             raise ValueError(f"unknown material {value!r}; {_MATERIAL_USAGE}")
         return MATERIALS[value]
     try:
-        if isinstance(value, dict) and set(value) == {"laminate"} and isinstance(value["laminate"], list):
-            return laminate(tuple(_constant(n) for n in value["laminate"]))
-        if isinstance(value, dict) and "E" in value and set(value) <= {"E", "G", "nu"}:
+        if (isinstance(value, dict) and set(value) - {"density"} == {"laminate"}
+                and isinstance(value["laminate"], list)):
+            density = _density(value.get("density", LAMINATE_DENSITY))
+            return replace(laminate(tuple(_constant(n) for n in value["laminate"])), density=density)
+        if isinstance(value, dict) and "E" in value and set(value) <= {"E", "G", "nu", "density"}:
             G = _constant(value["G"]) if "G" in value else None
-            return isotropic(_constant(value["E"]), G, _constant(value.get("nu", 0.3)))
+            density = _density(value["density"]) if "density" in value else None
+            return isotropic(_constant(value["E"]), G, _constant(value.get("nu", 0.3)), density)
     except UserError as exc:
         raise ValueError(str(exc)) from None
     raise ValueError(_MATERIAL_USAGE)
+
+
+def _density(value: object) -> float:
+    density = _constant(value)
+    if not density > 0.0:
+        raise ValueError(f"a material's density must be positive (kg/m^3), got {density:g}")
+    return density
 
 
 class LinkSpec(_FileModel):
@@ -365,6 +380,12 @@ def _check(spec: DeviceFileSpec) -> None:
     for i, body in enumerate(spec.bodies):
         if any(other.name == body.name for other in spec.bodies[:i]):
             raise ValueError(f"bodies[{i}]: body name {body.name!r} is used twice")
+        if body.link is not None:
+            _check_link_body(spec, i, body)
+            continue
+        if body.frame is None:
+            raise ValueError(f"bodies[{i}] ({body.name}): give its frame (with m, rx, ..., Iyz) or the link it is "
+                             "(link: name)")
         if body.frame not in frames:
             raise ValueError(f"bodies[{i}] ({body.name}): unknown frame {body.frame!r} (frames: {', '.join(frames)})")
         report = check_body(body.name, body.inertia())
@@ -375,6 +396,29 @@ def _check(spec: DeviceFileSpec) -> None:
     _check_limits_and_actuators(spec, coordinates)
     _check_loops(spec, frames)
     _check_links(spec, frames)
+
+
+def _check_link_body(spec: DeviceFileSpec, i: int, body: BodySpec) -> None:
+    """A body that is a link's tube: the link exists and has a density; no frame or inertial values of its own."""
+    given = [f for f in ("frame", *SEED_FIELDS) if f in body.model_fields_set]
+    if given:
+        raise ValueError(f"bodies[{i}] ({body.name}): a body on a link takes its frame, mass and inertia from the link "
+                         f"(remove {given[0]})")
+    links = {link.name: link for link in spec.links}
+    if body.link not in links:
+        raise ValueError(f"bodies[{i}] ({body.name}): unknown link {body.link!r} (links: {', '.join(links) or 'none'})")
+    if links[body.link].material.density is None:
+        raise ValueError(f"bodies[{i}] ({body.name}): link {body.link}'s material has no density (give "
+                         "material: {E: ..., G: ..., density: ...} in kg/m^3)")
+    if any(other.link == body.link for other in spec.bodies[:i]):
+        raise ValueError(f"bodies[{i}] ({body.name}): link {body.link} already has a body")
+
+
+def body_frame(spec: DeviceFileSpec, body: BodySpec) -> str:
+    """The frame a body is attached to: its own, or its link's start frame."""
+    if body.link is None:
+        return body.frame
+    return next(link.start for link in spec.links if link.name == body.link)
 
 
 def _check_links(spec: DeviceFileSpec, frames: list[str]) -> None:

@@ -21,28 +21,36 @@ def _positive(name: str, value: float) -> float:
 
 @dataclass(frozen=True)
 class LinkModuli:
-    """Moduli (Pa) entering eq. 4.59: axial ``E_x``, hoop ``E_y`` (= ``E_z``), shear ``G_xy``."""
+    """Moduli (Pa) entering eq. 4.59: axial ``E_x``, hoop ``E_y`` (= ``E_z``), shear ``G_xy``; and the density
+    (kg/m^3) where known, which a body that follows a link needs (docs/device-files.md)."""
 
     E_x: float
     E_y: float
     G_xy: float
+    density: float | None = None
 
 
-def isotropic(E: float, G: float | None = None, nu: float = 0.3) -> LinkModuli:
+def isotropic(E: float, G: float | None = None, nu: float = 0.3, density: float | None = None) -> LinkModuli:
     """An isotropic material (eq. 4.58): ``G = E / (2 (1 + nu))`` unless given; Poisson's ratio of a
-    stable isotropic solid lies in (-1, 0.5) (positive bulk and shear moduli)."""
+    stable isotropic solid lies in (-1, 0.5) (positive bulk and shear moduli); ``density`` in kg/m^3."""
     E = _positive("E", E)
     if G is None and not -1.0 < nu < 0.5:
         raise UserError(f"Poisson's ratio nu must lie in (-1, 0.5) for an isotropic material, got {nu:g}")
     G = E / (2.0 * (1.0 + nu)) if G is None else _positive("G", G)
-    return LinkModuli(E, E, G)
+    return LinkModuli(E, E, G, None if density is None else _positive("density", density))
 
 
-STRUCTURAL_STEEL = isotropic(200e9, nu=0.3)
-"""Structural steel as in the seed's verification cases (§5.2.1, §5.2.5): E = 200 GPa, nu = 0.3."""
+STRUCTURAL_STEEL = isotropic(200e9, nu=0.3, density=7850.0)
+"""Structural steel as in the seed's verification cases (§5.2.1, §5.2.5): E = 200 GPa, nu = 0.3; density
+7850 kg/m^3 (EN 1991-1-1 Table A.4: 77.0-78.5 kN/m^3)."""
 
-ALUMINIUM_6061 = isotropic(68.9e9, G=26.0e9)
-"""Aluminium 6061-T6: E = 68.9 GPa, G = 26 GPa (ASM Aerospace Specification Metals data sheet)."""
+ALUMINIUM_6061 = isotropic(68.9e9, G=26.0e9, density=2700.0)
+"""Aluminium 6061-T6: E = 68.9 GPa, G = 26 GPa, density 2700 kg/m^3 (ASM Aerospace Specification Metals data
+sheet: 2.70 g/cc)."""
+
+LAMINATE_DENSITY = 1790.0
+"""kg/m^3 of a laminate link without a stated density: the M55J/epoxy of seed 001, whose final design's 77.7 g of
+links (Table 7.9) with the tubes of Table 7.8 imply 1.79 g/cm^3."""
 
 MATERIALS = {"steel": STRUCTURAL_STEEL, "aluminium_6061": ALUMINIUM_6061}
 """Named materials a device file's links may use (docs/device-files.md)."""
