@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from hapticdesign.analysis.metrics.indices import INDICES
 from hapticdesign.errors import UserError
 from hapticdesign.files import save_figure
 from hapticdesign.optimization.selection import least_rms, normalize
@@ -108,13 +109,18 @@ def _pyplot():
     return plt
 
 
+def _unit(index: str) -> str:
+    unit = INDICES[index].unit
+    return "-" if unit == "1" else unit
+
+
 def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: str = "pareto") -> list[Path]:
     """The front in pairs of objectives (every feasible design in grey, the front in blue, the selected
     design as a red star); one objective: its value per evaluation; more than three: parallel coordinates
     of the normalized front (0 best)."""
     plt = _pyplot()
     spec = run.spec
-    labels = [f"{o.name} ({o.reduce} {o.index}, {o.sense}imize)" for o in spec.objectives]
+    labels = [f"{o.name}: {o.reduce} {o.index} ({_unit(o.index)}), {o.sense}imize" for o in spec.objectives]
     feasible = [r for r in run.records if r.feasible]
     F_all = np.array([r.objectives for r in feasible]).reshape(len(feasible), len(labels))
     F = np.array([run.records[k].objectives for k in run.front]).reshape(len(run.front), len(labels))
