@@ -26,7 +26,7 @@ KEPT = ("report.html", "pareto.png", "front.csv", "selected.yaml")
 def run(study: str, scratch: Path) -> tuple[dict, float]:
     out = scratch / study
     begin = time.perf_counter()
-    done = subprocess.run([sys.executable, "-m", "hapticdesign.interface.cli", "optimize",
+    done = subprocess.run([sys.executable, "-c", "from hapticdesign.interface.cli import main; main()", "optimize",
                            str(ROOT / "examples" / "studies" / f"{study}.yaml"), "--seed", "1", "--out", str(out),
                            "--json", "--quiet"], capture_output=True, text=True, check=True)
     elapsed = time.perf_counter() - begin

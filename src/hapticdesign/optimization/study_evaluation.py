@@ -30,7 +30,7 @@ from hapticdesign.optimization.study_file import Study
 from hapticdesign.optimization.study_run import Answer, reduced_keys
 from hapticdesign.workload import require_within
 
-STUDY_LIMIT = 2e5
+STUDY_LIMIT = 1e5
 """Most design-point evaluations of a study without ``--force``: population x generations x workspace
 points (each one a design's pose reached and its indices computed; docs/limits.md)."""
 
