@@ -10,7 +10,6 @@ Pinocchio in tests/dynamics).
 
 from __future__ import annotations
 
-import itertools
 import math
 from pathlib import Path
 
@@ -18,10 +17,11 @@ import numpy as np
 import pytest
 
 from hapticdesign.analysis.configuration import configuration_of
-from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.analysis.metrics.indices import evaluate, handle_jacobians, reduce
 from hapticdesign.analysis.workspace import Workspace, reach_workspace
 from hapticdesign.devices.device_file import device_from_mapping, load_device_file
+from hapticdesign.errors import UserError
+from tests.helpers.handle_energy import cartesian_mass
 from tests.helpers.planar_arm import planar_arm
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "devices"
@@ -72,29 +72,6 @@ def test_closed_loop_jacobian_is_the_derivative_of_the_handle_position(name):
         np.testing.assert_allclose(jac, numeric, rtol=0, atol=1e-8)
 
 
-def _cartesian_mass_from_energy(device, point: np.ndarray, basis: np.ndarray) -> np.ndarray:
-    """``Lambda`` in ``basis`` (3 x k) from ``2 T(v) = v^T Lambda v`` (polarization over basis vectors and their
-    sums), each ``qd`` from central differences of the inverse kinematics along ``v``."""
-    space = configuration_of(device)
-    q_a, full = space.reach(point[None])
-    H = mass_matrix(device, q_a[0])
-    h = 1e-6
-
-    def energy2(v):
-        ahead, _ = space.reach(np.array([point + h * v]), start=full[0])
-        back, _ = space.reach(np.array([point - h * v]), start=full[0])
-        qd = (ahead[0] - back[0]) / (2 * h)
-        return qd @ H @ qd
-
-    k = basis.shape[1]
-    lam = np.zeros((k, k))
-    for i in range(k):
-        lam[i, i] = energy2(basis[:, i])
-    for i, j in itertools.combinations(range(k), 2):
-        lam[i, j] = lam[j, i] = (energy2(basis[:, i] + basis[:, j]) - lam[i, i] - lam[j, j]) / 2
-    return lam
-
-
 @pytest.mark.parametrize("name", ["five-bar", "delta", "phantom-3dof-motors"])
 def test_apparent_mass_is_the_kinetic_energy_of_handle_velocities(name):
     device = load_device_file(EXAMPLES / f"{name}.yaml")
@@ -104,7 +81,7 @@ def test_apparent_mass_is_the_kinetic_energy_of_handle_velocities(name):
     point = home + basis @ np.full(basis.shape[1], 0.01)
     result = evaluate(device, point[None], ["apparent_mass", "inertia_uniformity"])
     assert result.reason is None
-    eig = np.linalg.eigvalsh(_cartesian_mass_from_energy(device, point, basis))
+    eig = np.linalg.eigvalsh(cartesian_mass(device, point, basis))
     assert result.values["apparent_mass"][0] == pytest.approx(eig[-1], rel=1e-6)
     assert result.values["inertia_uniformity"][0] == pytest.approx(eig[0] / eig[-1], rel=1e-6)
 
@@ -118,5 +95,5 @@ def test_a_point_out_of_reach_is_the_reason():
 
 def test_unknown_index_is_refused():
     device = load_device_file(EXAMPLES / "five-bar.yaml")
-    with pytest.raises(ValueError, match="unknown index 'stiffnes'"):
+    with pytest.raises(UserError, match="unknown index 'stiffnes'"):
         evaluate(device, np.zeros((1, 3)), ["stiffnes"])

@@ -8,10 +8,9 @@ friction reach the handle as follows:
 - ``resolution`` (m): one count of motor k turns ``a_k^T q`` by ``Delta_k = 2 pi / (cpr_k quadrature_k n_k)``
   and moves the handle by ``J_v A^-1 e_k Delta_k``; the sheet gives the largest of these over k.
 - ``force_continuous`` / ``force_peak`` (N): the radius of the largest ball inside the force polytope
-  ``{F : |(A^-T J_v^T F)_k| <= n_k tau_k}`` (motor torques at their rating; gravity not included). The
-  polytope is symmetric about 0, so the ball is centred there and its radius is the smallest distance
-  ``n_k tau_k / |g_k|`` to a facet (``g_k`` row k of ``A^-T J_v^T``). A device of fewer than three actuated
-  coordinates is measured in the plane (or line) its handle moves in.
+  ``{F : |(A^-T J_v^T F)_k| <= n_k tau_k}`` (motor torques at their rating; gravity not included;
+  :mod:`hapticdesign.analysis.metrics.force`, the ``force`` design index's too). A device of fewer than three
+  actuated coordinates is measured in the plane (or line) its handle moves in.
 - ``apparent_mass`` (kg): the eigenvalues of ``(J_v H^-1 J_v^T)^+`` on that range.
 - ``backdrive_friction`` (N): the motors' Coulomb friction ``f_k`` (on ``a_k^T q``) as a force at the handle:
   moving along a unit direction ``u`` at speed v dissipates ``sum_k f_k |a_k^T qd|`` with ``J_v qd = u v``,
@@ -27,30 +26,28 @@ friction reach the handle as follows:
   delay of one sample (:func:`hapticdesign.simulation.boundary.exact_boundary`) on the 1-DOF model of the
   handle along a direction u: mass ``1 / (u^T J_v H^-1 J_v^T u)`` and damping ``u^T J_v^+T B J_v^+ u`` (B the
   joint and motor viscous damping); the smallest over the axes, the principal directions and 60 evenly
-  spread directions. A pure spring uses the position only, so
-  the velocity estimate does not enter. Beside it the passivity bounds of Abbott & Okamura (2005):
+  spread directions (:mod:`hapticdesign.simulation.wall_stiffness`, the ``kmax`` design index's too). A pure
+  spring uses the position only, so the velocity estimate does not enter. Beside it the passivity bounds of Abbott & Okamura (2005):
   ``2 b / T`` (viscous) and ``2 f_c / Delta`` (Coulomb friction against encoder quantization), with the
   smallest damping (eigenvalue) and friction over directions and the resolution ``Delta``.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.analysis.configuration import configuration_of, handle_pose
+from hapticdesign.analysis.metrics import force as polytope
 from hapticdesign.errors import UserError
 from hapticdesign.model.actuators import transmission
 from hapticdesign.model.device import Device
-from hapticdesign.simulation.boundary import MassDamper, exact_boundary
+from hapticdesign.simulation.wall_stiffness import wall_limit
 
 SERVO_RATE = 1000.0
 """Hz, the default sampling rate of the renderable-stiffness limit."""
-DIRECTIONS = 60
-"""Directions spread over the sphere (circle for a planar device) for the worst wall direction."""
 CUBE_SEARCH = (0.0, 0.4, 12)
 """Bisection of the workspace cube's half edge: lower and upper bound (m) and number of halvings."""
 
@@ -78,30 +75,8 @@ def handle_at(device: Device, q) -> Handle:
     return Handle(q, configuration.pose(q)[:3, 3], jv, u[:, :rank], mass_matrix(device, q))
 
 
-def _motor_map(device: Device) -> np.ndarray | None:
-    """``A^-1`` (coordinates x motors), or None when the motors are not one per coordinate."""
-    if len(device.actuators) != device.n_dof:
-        return None
-    a = transmission(device.actuators, device.n_dof)
-    return np.linalg.inv(a)
-
-
-def directions(dim: int, count: int = DIRECTIONS) -> np.ndarray:
-    """Evenly spread unit vectors (Fibonacci sphere; a half circle in 2-D, a line in 1-D), symmetric use."""
-    if dim == 1:
-        return np.ones((1, 1))
-    if dim == 2:
-        t = np.pi * np.arange(count) / count
-        return np.stack([np.cos(t), np.sin(t)], axis=1)
-    k = np.arange(count) + 0.5
-    z = 1.0 - k / count
-    r = np.sqrt(1.0 - z**2)
-    phi = np.pi * (3.0 - math.sqrt(5.0)) * k
-    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
-
-
 def resolution(device: Device, h: Handle) -> float | None:
-    inv = _motor_map(device)
+    inv = polytope.motor_map(device)
     if inv is None or any(a.encoder_cpr is None for a in device.actuators):
         return None
     steps = [h.jacobian @ inv[:, k] / a.counts_per_radian for k, a in enumerate(device.actuators)]
@@ -109,14 +84,12 @@ def resolution(device: Device, h: Handle) -> float | None:
 
 
 def inscribed_force(device: Device, h: Handle, which: str) -> float | None:
-    """Radius of the largest ball in the force polytope (in the handle's range)."""
-    inv = _motor_map(device)
-    torques = [getattr(a, f"torque_{which}") for a in device.actuators]
-    if inv is None or any(t is None for t in torques):
+    """Radius of the largest ball in the force polytope (in the handle's range;
+    :func:`hapticdesign.analysis.metrics.force.inscribed_force`)."""
+    inv, limits = polytope.motor_map(device), polytope.torque_limits(device, which)
+    if inv is None or limits is None:
         return None
-    g = inv.T @ h.jacobian.T @ h.basis
-    limits = np.array([a.gear_ratio * t for a, t in zip(device.actuators, torques)])
-    return float(np.min(limits / np.linalg.norm(g, axis=1)))
+    return float(polytope.inscribed_force(h.jacobian, h.basis, inv, limits))
 
 
 def apparent_mass(device: Device, h: Handle) -> tuple[float, float]:
@@ -147,19 +120,10 @@ def _cartesian(device: Device, h: Handle) -> tuple[np.ndarray, np.ndarray]:
     return mobility, pinv.T @ device.damping_matrix @ pinv
 
 
-def wall_directions(device: Device, h: Handle) -> np.ndarray:
-    """The axes, the principal directions of the mobility and of the damping, and evenly spread ones."""
-    mobility, damping = _cartesian(device, h)
-    dim = h.basis.shape[1]
-    return np.vstack([np.eye(dim), np.linalg.eigh(mobility)[1].T, np.linalg.eigh(damping)[1].T,
-                      directions(dim)])
-
-
 def renderable_stiffness(device: Device, h: Handle, rate: float = SERVO_RATE, delay: int = 1) -> float:
+    """The smallest exact wall limit over directions (:func:`hapticdesign.simulation.wall_stiffness.wall_limit`)."""
     mobility, damping = _cartesian(device, h)
-    limits = [exact_boundary(MassDamper(1.0 / float(u @ mobility @ u), float(u @ damping @ u), 1.0 / rate, delay))
-              for u in wall_directions(device, h)]
-    return float(min(limits))
+    return wall_limit(mobility, damping, 1.0 / rate, delay)
 
 
 def workspace_cube(device: Device, h: Handle) -> float:

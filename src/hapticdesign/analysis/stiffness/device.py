@@ -126,7 +126,17 @@ def cartesian_stiffness(device: Device, q_a, frame: str | None = None) -> np.nda
     q_a = np.asarray(q_a, dtype=float)
     if q_a.shape != (mech.n_actuated,) or not np.all(np.isfinite(q_a)):
         raise UserError(f"expected {mech.n_actuated} finite actuated joint coordinates, got {q_a.tolist()}")
-    q = configuration_of(device).full(q_a)
+    return cartesian_stiffness_at(device, configuration_of(device).full(q_a), frame)
+
+
+def cartesian_stiffness_at(device: Device, q: np.ndarray, frame: str | None = None) -> np.ndarray:
+    """``K_C`` (6 x 6) of ``frame`` (default: the end effector) at the closed full pose ``q`` (N,) of a device with
+    elastic links or joint springs (:func:`cartesian_stiffness` at actuated coordinates)."""
+    elasticity, mech = device.elasticity, device.mechanism
+    if elasticity is None or not (elasticity.links or elasticity.joints):
+        raise UserError(f"device {device.name} has no elastic links or joint springs (give links: with a "
+                        "section and a material)")
+    frame = frame or mech.end_effector
     virtual = virtual_mechanism(mech, elasticity)
     q_virtual = np.concatenate([q, np.zeros(virtual.n_dof - mech.n_dof)])
     rows = jacobian(virtual, q_virtual, frame)

@@ -1,0 +1,72 @@
+"""The whole registry of design indices: the analysis layer's (:mod:`hapticdesign.analysis.metrics.indices`) and
+``kmax``, the stable Cartesian wall stiffness, which needs the sampled loop's exact analysis of this layer.
+
+``kmax`` (N/m) = the exact stable stiffness of a virtual wall at the handle
+(:func:`hapticdesign.simulation.wall_stiffness.wall_limit`: the 1-DOF model of the handle along a direction, mass
+``1 / (u^T J_v H^-1 J_v^T u)`` and damping ``u^T J_v^+T B J_v^+ u``, the loop discretized exactly) with the
+options ``period`` (s, default 0.001), ``delay`` (samples, default 1), ``damping`` (the wall's virtual damper, N s/m,
+default 0) and ``direction`` (a base-frame vector; default: the worst direction). The index lives here, above the
+analysis layer, because its engine (:mod:`hapticdesign.simulation.boundary`) does; an optimization or a study asks
+this module's :func:`evaluate` and :data:`DESIGN_INDICES`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping
+
+import numpy as np
+
+from hapticdesign.analysis.metrics.indices import INDICES, Evaluation, HandleStates, Index, Request
+from hapticdesign.analysis.metrics.indices import evaluate as evaluate_with
+from hapticdesign.errors import UserError
+from hapticdesign.model.device import Device
+from hapticdesign.simulation.wall_stiffness import wall_limit
+
+
+def _options(options: Mapping[str, object]) -> tuple[float, int, float, np.ndarray | None]:
+    period, delay, damping, direction = (options[k] for k in ("period", "delay", "damping", "direction"))
+    if isinstance(period, bool) or not isinstance(period, (int, float)) or not (math.isfinite(period) and period > 0):
+        raise UserError(f"index kmax: the sample period is a positive number of seconds, got {period!r}")
+    if isinstance(delay, bool) or not isinstance(delay, int) or not 0 <= delay <= 100:
+        raise UserError(f"index kmax: the delay is a whole number of samples from 0 to 100, got {delay!r}")
+    if isinstance(damping, bool) or not isinstance(damping, (int, float)) or not (math.isfinite(damping)
+                                                                                   and damping >= 0):
+        raise UserError(f"index kmax: the wall's damping is a number >= 0 (N s/m), got {damping!r}")
+    if direction is not None:
+        direction = np.asarray(direction, dtype=float)
+        if direction.shape != (3,) or not np.all(np.isfinite(direction)) or not np.linalg.norm(direction) > 0:
+            raise UserError(f"index kmax: the direction is 3 finite numbers, not all 0, got {options['direction']!r}")
+        direction = direction / np.linalg.norm(direction)
+    return float(period), delay, float(damping), direction
+
+
+def _kmax(h: HandleStates, options: Mapping[str, object]) -> np.ndarray:
+    period, delay, virtual, direction = _options(options)
+    basis = h.svd[0]
+    damping = h.device.damping_matrix
+    out = []
+    for u, jv, mobility in zip(basis, h.jacobian, h.mobility):
+        pinv = np.linalg.pinv(jv) @ u
+        along = None
+        if direction is not None:
+            along = u.T @ direction
+            if not abs(np.linalg.norm(along) - 1.0) <= 1e-9:
+                raise UserError(f"index kmax: the direction {np.round(direction, 6).tolist()} is not one the handle "
+                                "moves in")
+        out.append(wall_limit(mobility, pinv.T @ damping @ pinv, period, delay, virtual, along))
+    return np.array(out)
+
+
+DESIGN_INDICES: dict[str, Index] = {**INDICES, "kmax": Index(
+    "kmax", "N/m", "exact stable wall stiffness of the sampled loop along a direction (or the worst)",
+    "seed 000 ch. 4-5; hapticdesign.simulation.boundary.exact_boundary", _kmax,
+    {"period": 0.001, "delay": 1, "damping": 0.0, "direction": None})}
+"""Every design index: name -> :class:`~hapticdesign.analysis.metrics.indices.Index`."""
+
+
+def evaluate(device: Device, points: np.ndarray, requests: Iterable[str | Request],
+             frame: str | None = None) -> Evaluation:
+    """The indices ``requests`` (any of :data:`DESIGN_INDICES`) at the workspace ``points`` (P, 3), reached in order
+    from home (:func:`hapticdesign.analysis.metrics.indices.evaluate`)."""
+    return evaluate_with(device, points, requests, frame, DESIGN_INDICES)
