@@ -123,6 +123,9 @@ def _changed(tmp_path: Path, change) -> Path:
     (lambda d: d["variables"].update(l2=[float("nan"), 0.1]), "expected a finite number"),
     (lambda d: d["workspace"].update(grid=1) or d["workspace"]["box"].update(size=[0.02, 0, 0.02]), "grid must be at least 2"),
     (lambda d: d.update(device="missing.yaml"), "cannot read device file"),
+    (lambda d: d["objectives"][0].update(options={"speed": 1}), "index isotropy: unknown option 'speed'"),
+    (lambda d: d["constraints"].append({"index": "kmax", "reduce": "min", ">=": 100.0, "options": {"period": -1.0}}),
+     "index kmax: the sample period is a positive number of seconds"),
 ])
 def test_bad_studies_are_one_line(tmp_path, change, message):
     out = tmp_path / "out"

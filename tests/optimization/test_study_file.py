@@ -43,7 +43,7 @@ def test_the_issue_example_reads_with_its_kinds_of_variables_and_constraints():
     expression = spec.constraints[1]
     assert isinstance(expression, ExpressionConstraint)
     assert expression.value({"l1": 0.1, "l2": 0.2}) == pytest.approx(0.3)
-    assert spec.index_names == ("isotropy", "apparent_mass")
+    assert [use.index for use in spec.index_uses] == ["isotropy", "apparent_mass", "isotropy"]
     assert (spec.algorithm.population, spec.algorithm.generations) == (40, 60)
 
 

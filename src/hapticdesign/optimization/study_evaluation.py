@@ -18,7 +18,8 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from hapticdesign.analysis.metrics.indices import evaluate, reduce, require_indices
+from hapticdesign.analysis.metrics.indices import Request, evaluate_at, reduce, requests_of
+from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.analysis.view.figure import render_png
 from hapticdesign.analysis.view.skeleton import home_pose
 from hapticdesign.analysis.workspace import Workspace, reach_workspace
@@ -28,6 +29,7 @@ from hapticdesign.files import parse_structured
 from hapticdesign.model.inertia import SEED_FIELDS, seed_parameter_name
 from hapticdesign.optimization.study_file import Study
 from hapticdesign.optimization.study_run import Answer, reduced_keys
+from hapticdesign.simulation.design_indices import DESIGN_INDICES, evaluate
 from hapticdesign.workload import require_within
 
 STUDY_LIMIT = 1e5
@@ -67,14 +69,25 @@ class BoundStudy:
             raise UserError(f"{study.path}: device {study.device_path.name!r} must be a device file (.yaml, .yml, "
                             ".toml or .json)")
         self.mapping = parse_structured(study.device_text, kind, str(study.device_path))
+        self.keys = reduced_keys(spec)
+        asked = list(dict.fromkeys(key[:2] for key in self.keys))
+        self.labels = {request: f"request{k}" for k, request in enumerate(asked)}
+        self.requests = [Request(index, {k: list(v) if isinstance(v, tuple) else v for k, v in options}, label)
+                         for (index, options), label in self.labels.items()]
         try:
             self.space = DesignSpace(self.mapping, spec.variables)
-            require_indices(spec.index_names)
+            requests_of(self.requests, DESIGN_INDICES)
+            self._check_options()
         except UserError as exc:
             raise UserError(f"{study.path}: {exc}") from None
         self.points = workspace_of(study).points()
-        self.keys = reduced_keys(spec)
         self.title = f"{self.space.base.name} ({study.path.name})"
+
+    def _check_options(self) -> None:
+        """Every index with its options once at the device file's home pose, so that an option's bad value
+        is refused before the run (not found in every design)."""
+        device = self.space.base
+        evaluate_at(device, configuration_of(device).full(home_pose(device)), self.requests, None, DESIGN_INDICES)
 
     def answer(self, values: dict[str, float]) -> Answer:
         """The reduced indices of one design, or why it has none."""
@@ -83,10 +96,10 @@ class BoundStudy:
             device = self.space.device(values)
         except UserError as exc:
             return Answer(nothing, f"invalid device: {exc}")
-        result = evaluate(device, self.points, [index for index, _ in self.keys])
+        result = evaluate(device, self.points, self.requests)
         if result.reason is not None:
             return Answer(nothing, f"workspace: {result.reason}")
-        return Answer(tuple(reduce(result.values[index], how) for index, how in self.keys))
+        return Answer(tuple(reduce(result.values[self.labels[key[:2]]], key[2]) for key in self.keys))
 
     def evaluate(self, batch: list[dict[str, float]]) -> list[Answer]:
         """Answers for a batch of designs, in order."""

@@ -123,11 +123,30 @@ class _Bounded(_StudyModel):
         return self
 
 
-class IndexConstraint(_Bounded):
-    """An index reduced over the workspace, bounded."""
+OptionValue = int | float | list[Finite] | str | None
+
+
+class _IndexUse(_StudyModel):
+    """An index of the registry, its ``options`` (``kmax``'s sample period, delay, damping, direction; see
+    docs/indices.md) and its reduction over the workspace points."""
 
     index: str = Field(min_length=1, max_length=64)
     reduce: Literal["min", "max", "mean"]
+    options: dict[str, OptionValue] = Field({}, max_length=16)
+
+    @property
+    def request(self) -> tuple[str, tuple]:
+        """The index with its options, hashable: designs are asked each such request once."""
+        return (self.index, tuple(sorted((k, tuple(v) if isinstance(v, list) else v) for k, v in self.options.items())))
+
+    @property
+    def key(self) -> tuple:
+        """The request and its reduction."""
+        return (*self.request, self.reduce)
+
+
+class IndexConstraint(_Bounded, _IndexUse):
+    """An index reduced over the workspace, bounded."""
 
     @property
     def label(self) -> str:
@@ -175,12 +194,10 @@ def _constraint(value: object) -> object:
 Constraint = Annotated[IndexConstraint | ExpressionConstraint, BeforeValidator(_constraint)]
 
 
-class Objective(_StudyModel):
+class Objective(_IndexUse):
     """An index reduced over the workspace, minimized or maximized; ``name`` labels it (default: the index)."""
 
     name: str = Field("", max_length=64)
-    index: str = Field(min_length=1, max_length=64)
-    reduce: Literal["min", "max", "mean"]
     sense: Literal["min", "max"]
 
     @model_validator(mode="after")
@@ -226,10 +243,9 @@ class StudySpec(_StudyModel):
         return self
 
     @property
-    def index_names(self) -> tuple[str, ...]:
-        """Every index the study reads, in order of first use."""
-        used = [o.index for o in self.objectives] + [c.index for c in self.constraints if isinstance(c, IndexConstraint)]
-        return tuple(dict.fromkeys(used))
+    def index_uses(self) -> tuple[_IndexUse, ...]:
+        """The objectives and the index constraints: every index the study reads."""
+        return (*self.objectives, *(c for c in self.constraints if isinstance(c, IndexConstraint)))
 
 
 class Study:

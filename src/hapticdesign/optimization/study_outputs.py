@@ -16,11 +16,11 @@ from pathlib import Path
 
 import numpy as np
 
-from hapticdesign.analysis.metrics.indices import INDICES
 from hapticdesign.errors import UserError
 from hapticdesign.files import save_figure
 from hapticdesign.optimization.selection import least_rms, normalize
 from hapticdesign.optimization.study_run import StudyRun, constraint_labels
+from hapticdesign.simulation.design_indices import DESIGN_INDICES
 
 
 @dataclass(frozen=True)
@@ -110,7 +110,7 @@ def _pyplot():
 
 
 def _unit(index: str) -> str:
-    unit = INDICES[index].unit
+    unit = DESIGN_INDICES[index].unit
     return "-" if unit == "1" else unit
 
 

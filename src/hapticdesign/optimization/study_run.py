@@ -30,7 +30,7 @@ from pymoo.core.problem import Problem
 from hapticdesign.errors import UserError
 from hapticdesign.files import read_text, write_atomically
 from hapticdesign.optimization.pymoo_run import AlgorithmSpec, pareto_filter, run
-from hapticdesign.optimization.study_file import Choice, ExpressionConstraint, IndexConstraint, Study, StudySpec
+from hapticdesign.optimization.study_file import Choice, ExpressionConstraint, Study, StudySpec
 
 CHECKPOINT = "checkpoint"
 RUN_FILE = "run.json"
@@ -49,11 +49,10 @@ Evaluator = Callable[[list[dict[str, float]]], list[Answer]]
 """Answers for a batch of designs (variable name -> value), in order."""
 
 
-def reduced_keys(spec: StudySpec) -> tuple[tuple[str, str], ...]:
-    """The ``(index, reduction)`` pairs the study reads: objectives first, then index constraints."""
-    pairs = [(o.index, o.reduce) for o in spec.objectives]
-    pairs += [(c.index, c.reduce) for c in spec.constraints if isinstance(c, IndexConstraint)]
-    return tuple(dict.fromkeys(pairs))
+def reduced_keys(spec: StudySpec) -> tuple[tuple, ...]:
+    """The reduced indices the study reads (index, options, reduction): objectives first, then index
+    constraints, each once."""
+    return tuple(dict.fromkeys(use.key for use in spec.index_uses))
 
 
 @dataclass(frozen=True)
@@ -137,8 +136,8 @@ def record_of(spec: StudySpec, generation: int, x, values: dict[str, float], ans
     """One design's record from its answer: objectives, constrained values and whether it is feasible."""
     keys = reduced_keys(spec)
     reduced = dict(zip(keys, answer.reduced))
-    objectives = tuple(reduced[(o.index, o.reduce)] for o in spec.objectives)
-    constraints = tuple(c.value(values) if isinstance(c, ExpressionConstraint) else reduced[(c.index, c.reduce)]
+    objectives = tuple(reduced[o.key] for o in spec.objectives)
+    constraints = tuple(c.value(values) if isinstance(c, ExpressionConstraint) else reduced[c.key]
                         for c in spec.constraints)
     invalid = answer.reason
     if not invalid:

@@ -44,16 +44,22 @@ def _table(title: str, columns: list[str], rows: list[list], highlight: int | No
             f"<tbody>{''.join(body)}</tbody></table></div>")
 
 
+def _options(options: dict) -> str:
+    return ", ".join(f"{k} = {v}" for k, v in options.items())
+
+
 def _study_rows(run: StudyRun) -> str:
     spec = run.spec
     variables = [[name, *(("choice of " + ", ".join(f"{v:g}" for v in var.values), "") if isinstance(var, Choice)
                           else (f"{var[0]:g}", f"{var[1]:g}"))] for name, var in spec.variables.items()]
-    objectives = [[o.name, o.index, o.reduce, o.sense] for o in spec.objectives]
-    constraints = [[c.label, "" if c.at_least is None else c.at_least, "" if c.at_most is None else c.at_most]
+    objectives = [[o.name, o.index, _options(o.options), o.reduce, o.sense] for o in spec.objectives]
+    constraints = [[c.label + (f" ({_options(c.options)})" if getattr(c, "options", None) else ""),
+                    "" if c.at_least is None else c.at_least, "" if c.at_most is None else c.at_most]
                    for c in spec.constraints]
     box = spec.workspace.box
     parts = [_table("Variables", ["variable", "low or choices", "high"], variables),
-             _table("Objectives (reduced over the workspace)", ["name", "index", "reduction", "sense"], objectives)]
+             _table("Objectives (reduced over the workspace)", ["name", "index", "options", "reduction", "sense"],
+                    objectives)]
     if constraints:
         parts.append(_table("Constraints", ["constrained value", ">=", "<="], constraints))
     parts.append(f'<p>Workspace: box centred at {escape(str(list(box.center)))} m, edges {escape(str(list(box.size)))} m, '
