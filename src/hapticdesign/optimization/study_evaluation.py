@@ -28,6 +28,7 @@ from hapticdesign.errors import UserError
 from hapticdesign.files import parse_structured
 from hapticdesign.model.inertia import SEED_FIELDS, seed_parameter_name
 from hapticdesign.optimization.study_file import Study
+from hapticdesign.optimization.study_outputs import index_maps
 from hapticdesign.optimization.study_run import Answer, reduced_keys
 from hapticdesign.simulation.design_indices import DESIGN_INDICES, evaluate
 from hapticdesign.workload import require_within
@@ -146,7 +147,8 @@ class BoundStudy:
         return header + yaml.safe_dump(self.device_mapping(values), sort_keys=False, allow_unicode=False)
 
     def pictures(self, values: dict[str, float]) -> list[tuple[bytes, str]]:
-        """The selected design's picture at the workspace centre (at home when the centre is out of reach)."""
+        """The selected design's picture at the workspace centre (at home when the centre is out of reach) and
+        maps of its indices over the workspace points."""
         device = self.space.device(values)
         centre = np.asarray(workspace_of(self.study).center, dtype=float)
         try:
@@ -155,7 +157,14 @@ class BoundStudy:
         except UserError:
             q = home_pose(device)
             where = "at home"
-        return [(render_png(device, q, dpi=100), f"The selected design {where}")]
+        out = [(render_png(device, q, dpi=100), f"The selected design {where}")]
+        result = evaluate(device, self.points, self.requests)
+        if result.reason is None:
+            names = {label: f"{index} ({DESIGN_INDICES[index].unit})" for (index, _), label in self.labels.items()}
+            maps = {names[label]: result.values[label] for label in self.labels.values()}
+            out.append((index_maps(self.points, maps, "The selected design's indices over the workspace"),
+                        "The selected design's indices at the workspace points"))
+        return out
 
 
 def bind_study(study: Study) -> BoundStudy:

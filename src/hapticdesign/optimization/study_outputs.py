@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from hapticdesign.errors import UserError
-from hapticdesign.files import save_figure
+from hapticdesign.files import figure_bytes, save_figure
 from hapticdesign.optimization.selection import least_rms, normalize
 from hapticdesign.optimization.study_run import StudyRun, constraint_labels
 from hapticdesign.simulation.design_indices import DESIGN_INDICES
@@ -161,3 +161,27 @@ def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: s
     paths = [save_figure(fig, out / f"{name}.{ext}") for ext in ("png", "svg")]
     plt.close(fig)
     return paths
+
+
+def index_maps(points: np.ndarray, values: dict[str, np.ndarray], title: str) -> bytes:
+    """PNG of each index over the workspace points (one panel per index, colour = value): the two axes of
+    the box that vary for a planar workspace, a 3D scatter for a solid one."""
+    plt = _pyplot()
+    varying = [k for k in range(3) if np.ptp(points[:, k]) > 0.0]
+    n = len(values)
+    solid = len(varying) == 3
+    fig = plt.figure(figsize=(4.6 * n, 4.0), dpi=100)
+    for i, (label, v) in enumerate(values.items(), start=1):
+        ax = fig.add_subplot(1, n, i, projection="3d" if solid else None)
+        axes = varying if solid or len(varying) == 2 else (varying + [k for k in range(3) if k not in varying])[:2]
+        coordinates = [points[:, k] * 1e3 for k in axes]
+        shown = ax.scatter(*coordinates, c=v, cmap="viridis", s=60 if not solid else 40)
+        for k, name in zip(axes, ("set_xlabel", "set_ylabel", "set_zlabel")):
+            getattr(ax, name)(f"{'xyz'[k]} (mm)")
+        fig.colorbar(shown, ax=ax, shrink=0.8)
+        ax.set_title(label, fontsize=9)
+    fig.suptitle(title)
+    fig.tight_layout()
+    png = figure_bytes(fig, "png")
+    plt.close(fig)
+    return png
