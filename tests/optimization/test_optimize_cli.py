@@ -49,6 +49,8 @@ def test_outputs_json_and_the_same_bytes_for_the_same_seed(tmp_path):
         assert design["variables"]["l2"] <= 0.25
     assert summary["selected"]["rule"].startswith("least RMS")
     assert all((tmp_path / "a" / name).is_file() for name in OUTPUTS)
+    page = (tmp_path / "a" / "report.html").read_text()
+    assert "The selected design at the workspace centre" in page and "indices at the workspace points" in page
     second = optimize(study, "--seed", 7, "--out", tmp_path / "b", "--json")
     assert second.stdout == first.stdout
     assert files(tmp_path / "a") == files(tmp_path / "b")
