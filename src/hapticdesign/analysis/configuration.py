@@ -33,8 +33,11 @@ from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device, MechanismBuilder, build_mechanism
 from hapticdesign.model.mechanism import Mechanism
 
-IK_STEP = 0.002
+IK_STEP = 0.01
 """m: largest Cartesian step of :meth:`Configuration.reach` along a straight segment."""
+IK_WAY = 1e-3
+"""Position tolerance on the way between two points, as a fraction of :data:`IK_STEP` (at the points themselves it
+is 1e-12 of the device's size)."""
 IK_ITER = 30
 """Newton iterations per Cartesian step."""
 IK_JOINT_STEP = 0.2
@@ -103,7 +106,8 @@ class Configuration:
 
         Continuation from ``start`` (a closed full pose; default: home, on the loops' assembly branch) to the
         first point, then from each point to the next, along straight Cartesian segments in steps of at most
-        :data:`IK_STEP`, each closed by Newton on the actuated coordinates (least squares on ``J_v T``, at most
+        :data:`IK_STEP` (met within :data:`IK_WAY` of the step on the way, within 1e-12 of the device's size at the
+        points), each closed by Newton on the actuated coordinates (least squares on ``J_v T``, at most
         :data:`IK_JOINT_STEP` per iteration, the loops closed from the last pose), so every answer stays on the
         branch of the start. The working mode is the sign of ``det(B^T J_v T)`` (``B`` the directions the handle
         moves at the start, when there are as many as actuated coordinates); a change of that sign between two
@@ -163,9 +167,10 @@ class _Walk:
         begin = self.p.copy()
         n_steps = max(1, int(np.ceil(np.linalg.norm(target - begin) / IK_STEP)))
         for k in range(1, n_steps + 1):
-            self._newton(begin + (target - begin) * (k / n_steps), target)
+            self._newton(begin + (target - begin) * (k / n_steps), target,
+                         self.tol if k == n_steps else IK_WAY * IK_STEP)
 
-    def _newton(self, goal: np.ndarray, target: np.ndarray) -> None:
+    def _newton(self, goal: np.ndarray, target: np.ndarray, tol: float) -> None:
         space, q_a, q = self.space, self.q_a, self.q
         for _ in range(IK_ITER):
             p, jac = space.position_and_jacobian(q, self.frame)
@@ -174,7 +179,7 @@ class _Walk:
             if s[-1] <= IK_SINGULAR * s[0] or (self.mode and self._mode(jac) != self.mode):
                 raise UserError(f"the handle cannot reach ({_text(target)}) m: it is out of reach or behind a singularity (the "
                                 f"handle's Jacobian loses rank near ({_text(p)}) m on the way)")
-            if np.linalg.norm(error) <= self.tol:
+            if np.linalg.norm(error) <= tol:
                 self.q_a, self.q, self.p = q_a, q, p
                 return
             dq = np.linalg.lstsq(jac, error, rcond=None)[0]

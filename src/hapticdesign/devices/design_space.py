@@ -90,6 +90,8 @@ class DesignSpace:
         self._index = actuated_index(self.spec)
         self._joint_damping = np.array([j.damping for j in self.spec.joints if j.actuated], dtype=float)
         self._link_bodies = any(b.link is not None for b in self.spec.bodies)
+        self.cache: dict[str, object] = {}
+        """What a caller builds once per space (the batched kernels' structure, ...)."""
 
     # -- names --------------------------------------------------------------------------------
     def _variable(self, name: str) -> Variable:
@@ -153,6 +155,15 @@ class DesignSpace:
         return out
 
     # -- designs ------------------------------------------------------------------------------
+    def checked_values(self, values: Mapping[str, float]) -> dict[str, float]:
+        """``values`` as floats, each of a variable of this space and a finite number (one-line UserError)."""
+        out = {}
+        for name, raw in values.items():
+            if name not in self.names:
+                raise UserError(f"{name!r} is not a design variable of this study (variables: {', '.join(self.names)})")
+            out[name] = _number(name, raw)
+        return out
+
     def device(self, values: Mapping[str, float]) -> Device:
         """The device with ``values`` (variable name to number) applied; the others keep the file's values.
 
@@ -160,10 +171,7 @@ class DesignSpace:
         device file's validation refuses."""
         by_name = {v.name: v for v in self.variables}
         changes: dict[str, dict] = {"parameter": {}, "inertial": {}, "section": {}, "actuator": {}}
-        for name, raw in values.items():
-            if name not in by_name:
-                raise UserError(f"{name!r} is not a design variable of this study (variables: {', '.join(self.names)})")
-            value = _number(name, raw)
+        for name, value in self.checked_values(values).items():
             v = by_name[name]
             key = v.name if v.kind in ("parameter", "inertial") else v.target
             if v.kind in ("section", "actuator"):

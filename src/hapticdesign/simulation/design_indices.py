@@ -8,17 +8,26 @@ options ``period`` (s, default 0.001), ``delay`` (samples, default 1), ``damping
 default 0) and ``direction`` (a base-frame vector; default: the worst direction). The index lives here, above the
 analysis layer, because its engine (:mod:`hapticdesign.simulation.boundary`) does; an optimization or a study asks
 this module's :func:`evaluate` and :data:`DESIGN_INDICES`.
+
+:func:`evaluate_designs` evaluates many designs of a :class:`~hapticdesign.devices.design_space.DesignSpace` at
+once: through the compiled kernels of :mod:`hapticdesign.analysis.design_batch` when the device has closed loops,
+the indices need only ``J_v`` and ``H`` (:data:`~hapticdesign.analysis.metrics.indices.KINEMATIC_DYNAMIC`) and the
+variables are geometry (``parameters``); otherwise design by design (:func:`evaluate`). Both give the same values.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 
 import numpy as np
 
-from hapticdesign.analysis.metrics.indices import INDICES, Evaluation, HandleStates, Index, Request
+from hapticdesign.analysis.design_batch import OK, DesignBatch
+from hapticdesign.analysis.metrics.indices import (
+    INDICES, KINEMATIC_DYNAMIC, Evaluation, HandleStates, Index, Request, requests_of,
+)
 from hapticdesign.analysis.metrics.indices import evaluate as evaluate_with
+from hapticdesign.devices.design_space import DesignSpace
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation.wall_stiffness import wall_limit
@@ -70,3 +79,63 @@ def evaluate(device: Device, points: np.ndarray, requests: Iterable[str | Reques
     """The indices ``requests`` (any of :data:`DESIGN_INDICES`) at the workspace ``points`` (P, 3), reached in order
     from home (:func:`hapticdesign.analysis.metrics.indices.evaluate`)."""
     return evaluate_with(device, points, requests, frame, DESIGN_INDICES)
+
+
+def evaluate_designs(space: DesignSpace, designs: Sequence[Mapping[str, float]], points: np.ndarray,
+                     requests: Iterable[str | Request]) -> list[Evaluation]:
+    """:func:`evaluate` of each design (variable values) of ``space`` at the workspace ``points`` (P, 3); a design the
+    device file refuses fails with its reason (see the module docstring for the batched path)."""
+    checked = requests_of(requests, DESIGN_INDICES)
+    points = np.asarray(points, dtype=float)
+    batch = _batch(space, checked)
+    if batch is None:
+        return [_one(space, values, points, checked) for values in designs]
+    kinematic = np.tile(batch.p0, (len(designs), 1))
+    column = {name: k for k, name in enumerate(batch.names)}
+    refused: dict[int, str] = {}
+    for d, values in enumerate(designs):
+        try:
+            for name, value in space.checked_values(values).items():
+                kinematic[d, column[name]] = value
+        except UserError as exc:
+            refused[d] = str(exc)
+    offsets = batch.offsets(kinematic)
+    reached = batch.reach_points(offsets, points)
+    base = space.base
+    mass = batch.mass_matrices(offsets, reached, base.standard_parameters(), base.reflected_inertia)
+    states = HandleStates.of(reached.jvt.reshape(-1, 3, reached.jvt.shape[-1]), mass.reshape(-1, *mass.shape[2:]))
+    ok = reached.status == OK
+    states.__dict__.update(jacobian=states.jacobian[np.repeat(ok, len(points))], mass=states.mass[np.repeat(ok, len(points))])
+    values = {r.key: DESIGN_INDICES[r.index].values(states, {**DESIGN_INDICES[r.index].options, **r.options})
+              .reshape(-1, len(points)) for r in checked}
+    out, row = [], 0
+    for d in range(len(designs)):
+        if d in refused:
+            out.append(Evaluation({}, refused[d]))
+        elif not ok[d]:
+            out.append(Evaluation({}, batch.reason(reached, d, points)))
+        else:
+            out.append(Evaluation({key: v[row] for key, v in values.items()}))
+        row += int(ok[d])
+    return out
+
+
+def _batch(space: DesignSpace, requests: list[Request]) -> DesignBatch | None:
+    """The space's compiled structure when the batched path applies (see the module docstring), else None."""
+    if (space.base.mechanism.loops is None or any(r.index not in KINEMATIC_DYNAMIC for r in requests)
+            or any(v.kind != "parameter" for v in space.variables)):
+        return None
+    if space.cache.get("batch") is None:
+        try:
+            space.cache["batch"] = DesignBatch(space.base)
+        except UserError:
+            space.cache["batch"] = False
+    return space.cache["batch"] or None
+
+
+def _one(space: DesignSpace, values: Mapping[str, float], points: np.ndarray, requests: list[Request]) -> Evaluation:
+    try:
+        device = space.device(values)
+    except UserError as exc:
+        return Evaluation({}, str(exc))
+    return evaluate(device, points, requests)

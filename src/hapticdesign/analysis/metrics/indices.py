@@ -61,7 +61,7 @@ class HandleStates:
     """The handle's kinematics and dynamics at closed full poses ``full`` (P, N) of ``device``; each quantity is
     computed once, when an index first asks for it."""
 
-    device: Device
+    device: Device | None
     full: np.ndarray
     frame: str | None = None
 
@@ -106,6 +106,15 @@ class HandleStates:
         u, _ = self.svd
         k = np.array([cartesian_stiffness_at(self.device, q, self.frame)[:3, :3] for q in self.full])
         return np.swapaxes(u, 1, 2) @ k @ u
+
+
+    @classmethod
+    def of(cls, jacobian: np.ndarray, mass: np.ndarray) -> "HandleStates":
+        """The states of poses whose ``J_v`` (P, 3, n_a) and ``H`` (P, n_a, n_a) are known already (many designs'
+        poses at once, :mod:`hapticdesign.analysis.design_batch`): enough for the :data:`KINEMATIC_DYNAMIC` indices."""
+        states = cls(None, np.zeros((len(jacobian), 0)))
+        states.__dict__.update(jacobian=jacobian, mass=mass)
+        return states
 
 
 def handle_jacobians(device: Device, full: np.ndarray, frame: str | None = None) -> np.ndarray:
@@ -224,6 +233,9 @@ INDICES: dict[str, Index] = {index.name: index for index in (
 )}
 """The registry of the analysis layer: index name -> :class:`Index` (``kmax`` needs the simulation layer:
 :mod:`hapticdesign.simulation.design_indices` holds the whole registry)."""
+
+KINEMATIC_DYNAMIC = ("isotropy", "condition", "manipulability", "apparent_mass", "inertia_uniformity")
+"""The indices that need only ``J_v`` and ``H`` at the poses (:meth:`HandleStates.of`)."""
 
 REDUCTIONS: dict[str, Callable[[np.ndarray], float]] = {
     "min": lambda v: float(np.min(v)),

@@ -1,0 +1,49 @@
+"""Many designs through the compiled kernels (:mod:`hapticdesign.analysis.design_batch`) against one design at a
+time (:func:`hapticdesign.simulation.design_indices.evaluate`, whose indices are checked against closed forms,
+finite differences and kinetic energy in test_indices.py): same values, same failures."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from hapticdesign.analysis.workspace import Workspace
+from hapticdesign.devices.design_space import design_space
+from hapticdesign.simulation.design_indices import evaluate, evaluate_designs
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "devices"
+INDICES = ["isotropy", "apparent_mass", "condition", "manipulability", "inertia_uniformity"]
+CASES = {
+    "five-bar": (["l1", "l2", "d"], Workspace((0.0, 0.0, 0.18), (0.06, 0.0, 0.06), 3),
+                 {"l1": (0.08, 0.13), "l2": (0.12, 0.17), "d": (0.05, 0.1)}),
+    "delta": (["La", "Lb", "R"], Workspace((-0.10, 0.0, 0.0), (0.03, 0.03, 0.03), 2),
+              {"La": (0.05, 0.07), "Lb": (0.09, 0.11), "R": (0.03, 0.04)}),
+}
+
+
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_batched_designs_equal_one_design_at_a_time(name):
+    names, workspace, bounds = CASES[name]
+    space = design_space(EXAMPLES / f"{name}.yaml", names)
+    rng = np.random.default_rng(7)
+    designs = [{k: float(rng.uniform(*bounds[k])) for k in names} for _ in range(6)]
+    points = workspace.points()
+    batched = evaluate_designs(space, designs, points, INDICES)
+    for values, fast in zip(designs, batched):
+        slow = evaluate(space.device(values), points, INDICES)
+        assert (fast.reason is None) == (slow.reason is None), (fast.reason, slow.reason)
+        for key in INDICES if slow.reason is None else ():
+            np.testing.assert_allclose(fast.values[key], slow.values[key], rtol=1e-9)
+
+
+def test_batched_failures_name_the_point_or_the_design():
+    space = design_space(EXAMPLES / "five-bar.yaml", ["l1", "l2"])
+    points = np.array([[0.0, 0.0, 0.18], [0.0, 0.0, 0.235], [0.0, 0.0, 0.30]])
+    designs = [{"l1": 0.10, "l2": 0.14}, {"l1": 0.02, "l2": 0.03}, {"l1": 0.10, "l2": float("nan")}]
+    fast = evaluate_designs(space, designs, points, ["isotropy"])
+    slow = evaluate(space.device(designs[0]), points, ["isotropy"])
+    assert "(0, 0, 0.3) m" in fast[0].reason and "(0, 0, 0.3) m" in slow.reason
+    assert "cannot close" in fast[1].reason
+    assert "finite" in fast[2].reason
