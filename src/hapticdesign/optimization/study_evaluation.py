@@ -30,7 +30,7 @@ from hapticdesign.model.inertia import SEED_FIELDS, seed_parameter_name
 from hapticdesign.optimization.study_file import Study
 from hapticdesign.optimization.study_outputs import index_maps
 from hapticdesign.optimization.study_run import Answer, reduced_keys
-from hapticdesign.simulation.design_indices import DESIGN_INDICES, evaluate
+from hapticdesign.simulation.design_indices import DESIGN_INDICES, evaluate, evaluate_designs
 from hapticdesign.workload import require_within
 
 STUDY_LIMIT = 1e5
@@ -90,21 +90,18 @@ class BoundStudy:
         device = self.space.base
         evaluate_at(device, configuration_of(device).full(home_pose(device)), self.requests, None, DESIGN_INDICES)
 
-    def answer(self, values: dict[str, float]) -> Answer:
-        """The reduced indices of one design, or why it has none."""
-        nothing = (math.nan,) * len(self.keys)
-        try:
-            device = self.space.device(values)
-        except UserError as exc:
-            return Answer(nothing, f"invalid device: {exc}")
-        result = evaluate(device, self.points, self.requests)
-        if result.reason is not None:
-            return Answer(nothing, f"workspace: {result.reason}")
-        return Answer(tuple(reduce(result.values[self.labels[key[:2]]], key[2]) for key in self.keys))
-
     def evaluate(self, batch: list[dict[str, float]]) -> list[Answer]:
-        """Answers for a batch of designs, in order."""
-        return [self.answer(values) for values in batch]
+        """Answers for a batch of designs, in order: the registry evaluates them together (through the compiled
+        kernels where it can, :func:`~hapticdesign.simulation.design_indices.evaluate_designs`), each reduced
+        here; a design the device file refuses or that misses a workspace point has none, and says why."""
+        nothing = (math.nan,) * len(self.keys)
+        out = []
+        for result in evaluate_designs(self.space, batch, self.points, self.requests):
+            if result.reason is not None:
+                out.append(Answer(nothing, result.reason))
+            else:
+                out.append(Answer(tuple(reduce(result.values[self.labels[key[:2]]], key[2]) for key in self.keys)))
+        return out
 
     def points_reached(self, values: dict[str, float]) -> int:
         """How many workspace points the design reaches, each from home on its own (the closest design of a
