@@ -129,6 +129,7 @@ def _violations(spec: StudySpec, constraints: Sequence[float]) -> tuple[np.ndarr
 
 
 def constraint_labels(spec: StudySpec) -> tuple[str, ...]:
+    """Column names of the constrained values (``min_isotropy``, ``l1 + l2``)."""
     return tuple(c.label for c in spec.constraints)
 
 
@@ -157,6 +158,7 @@ def minimized(spec: StudySpec, record: Record) -> np.ndarray:
 
 
 def _g(spec: StudySpec, record: Record) -> np.ndarray:
+    """pymoo's ``g <= 0`` row: the validity column, then the scaled constraints (0 for a design without values)."""
     if record.invalid:
         return np.concatenate([[1.0], np.zeros(len(_violations(spec, [0.0] * len(spec.constraints))[0]))])
     return np.concatenate([[0.0], _violations(spec, record.constraints)[0]])
