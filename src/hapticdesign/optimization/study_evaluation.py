@@ -12,6 +12,7 @@ checks refuse, or one that does not reach a point, has no values and says why.
 from __future__ import annotations
 
 import copy
+import json
 import math
 from pathlib import Path
 
@@ -139,8 +140,8 @@ class BoundStudy:
     def device_file_text(self, values: dict[str, float]) -> str:
         """:meth:`device_mapping` as YAML, headed by where it comes from."""
         shown = ", ".join(f"{k} = {v!r}" for k, v in values.items())
-        header = (f"# The design selected by `hapticdesign optimize {self.study.path.name}` from device file "
-                  f"{self.study.device_path.name}:\n# {shown}\n")
+        names = (json.dumps(self.study.path.name), json.dumps(self.study.device_path.name))  # no line break in them
+        header = f"# The design selected by study {names[0]} from device file {names[1]}:\n# {shown}\n"
         return header + yaml.safe_dump(self.device_mapping(values), sort_keys=False, allow_unicode=False)
 
     def pictures(self, values: dict[str, float]) -> list[tuple[bytes, str]]:
