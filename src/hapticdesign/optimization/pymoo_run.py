@@ -22,6 +22,7 @@ from pymoo.algorithms.soo.nonconvex.pso import PSO
 from pymoo.core.algorithm import Algorithm
 from pymoo.core.callback import Callback
 from pymoo.core.problem import ElementwiseProblem, LoopedElementwiseEvaluation, Problem
+from pymoo.core.repair import Repair
 from pymoo.operators.crossover.sbx import SBX
 from pymoo.operators.mutation.pm import PM
 from pymoo.operators.repair.rounding import RoundingRepair
@@ -39,7 +40,9 @@ METHODS = ("nsga2", "pso")
 class AlgorithmSpec:
     """The algorithm of one run: ``method`` (NSGA-II or particle swarm), ``population`` and
     ``generations``. ``integer``: integer variables, NSGA-II only (integer sampling, SBX and polynomial
-    mutation with distribution index 3 and rounding repair, duplicates eliminated). ``initial``: the first
+    mutation with distribution index 3 and rounding repair, duplicates eliminated). ``discrete``: columns
+    that hold whole numbers among real ones (the index of a discrete choice), NSGA-II only: sampled and
+    varied as reals and rounded by :class:`RoundColumns`, duplicates eliminated. ``initial``: the first
     population's rows; without it pymoo's own seeded random sampling is used."""
 
     method: str = "nsga2"
@@ -47,11 +50,12 @@ class AlgorithmSpec:
     generations: int = 100
     integer: bool = False
     initial: np.ndarray | None = None
+    discrete: tuple[int, ...] = ()
 
     def __post_init__(self) -> None:
         if self.method not in METHODS:
             raise UserError(f"unknown optimization method {self.method!r}; choose one of {', '.join(METHODS)}")
-        if self.integer and self.method != "nsga2":
+        if (self.integer or self.discrete) and self.method != "nsga2":
             raise UserError("integer variables need the nsga2 method")
         if self.population < 2:
             raise UserError(f"population must be at least 2, got {self.population}")
@@ -69,7 +73,24 @@ def build_algorithm(spec: AlgorithmSpec) -> Algorithm:
                    "crossover": SBX(prob=1.0, eta=3.0, vtype=float, repair=RoundingRepair()),
                    "mutation": PM(prob=1.0, eta=3.0, vtype=float, repair=RoundingRepair()),
                    "eliminate_duplicates": True, **options}
+    elif spec.discrete:
+        options = {"repair": RoundColumns(spec.discrete), "eliminate_duplicates": True, **options}
     return NSGA2(pop_size=spec.population, **options)
+
+
+class RoundColumns(Repair):
+    """Round the ``columns`` of every design to the nearest whole number within the problem's bounds
+    (pymoo's ``RoundingRepair`` rounds every column)."""
+
+    def __init__(self, columns: tuple[int, ...]):
+        super().__init__()
+        self.columns = list(columns)
+
+    def _do(self, problem, X, **kwargs):
+        X = np.array(X, dtype=float)
+        low, high = np.ceil(problem.xl[self.columns]), np.floor(problem.xu[self.columns])
+        X[:, self.columns] = np.clip(np.round(X[:, self.columns]), low, high)
+        return X
 
 
 def pareto_filter(X: np.ndarray, F: np.ndarray) -> np.ndarray:

@@ -81,6 +81,18 @@ def weighted_rms(primary, secondary, weight: float = 1.0) -> np.ndarray:
     return np.sqrt((a**2 + weight * b**2) / 2.0)
 
 
+def least_rms(normalized: np.ndarray, weights=None) -> int:
+    """Row of the least weighted RMS ``sqrt(sum_i w_i a_i^2 / k)`` of ``normalized (n, k)`` (0 best in
+    every column, eq. 7.1-7.4): Figures 7.2-7.3's rule over any number of indices (all weights 1: the
+    plain RMS of Figure 7.2; ``k = 2`` with weights ``(1, w)`` is :func:`weighted_rms`). Ties go to the
+    first row."""
+    a = np.atleast_2d(np.asarray(normalized, dtype=float))
+    w = np.ones(a.shape[1]) if weights is None else np.asarray(weights, dtype=float)
+    if w.shape != (a.shape[1],) or not np.all(w >= 0.0) or not np.any(w > 0.0):
+        raise UserError(f"give one non-negative weight per index, not all 0 (indices: {a.shape[1]})")
+    return int(np.argmin(np.sqrt((a**2 @ w) / a.shape[1])))
+
+
 def select(metrics: dict[str, np.ndarray], weights=(0.0, 0.25, 0.5, 0.75)) -> dict[str, int | dict[float, int]]:
     """Index of the minimum RMS of ``(omega_nn*, mu_vn*)`` (Fig. 7.2) and of the minimum weighted RMS
     for each weight on ``mu_vn*`` (Fig. 7.3, Table 7.5)."""

@@ -227,7 +227,9 @@ def check_scheduler(address: str) -> None:
         raise UserError(f"{address[:80]!r} is not a Dask scheduler address (expected e.g. tcp://host:8786)")
 
 
-def _client(scheduler: str | None, workers: int | None, quiet: bool = False):
+def dask_client(scheduler: str | None, workers: int | None, quiet: bool = False):
+    """A client of the Dask scheduler at ``scheduler`` (a one-line error when it cannot be reached), or of a
+    local cluster of ``workers`` processes (one thread each) when ``scheduler`` is None."""
     from dask.distributed import Client, LocalCluster
 
     if scheduler:
@@ -256,7 +258,7 @@ def _release_interrupts(previous) -> None:
         signal.signal(signal.SIGINT, previous)
 
 
-def _close(client, own_cluster: bool) -> None:
+def close_client(client, own_cluster: bool) -> None:
     """Stop the client, then the local cluster it started (workers first, so none heartbeats a closed
     scheduler)."""
     cluster = getattr(client, "cluster", None) if own_cluster else None
@@ -356,7 +358,7 @@ def _run_locked(designs: list[Design], out: Path, options: CampaignOptions, sche
 
             held = _hold_interrupts()
             try:
-                client = _client(scheduler, workers, quiet)
+                client = dask_client(scheduler, workers, quiet)
             except BaseException:
                 _release_interrupts(held)
                 raise
@@ -367,7 +369,7 @@ def _run_locked(designs: list[Design], out: Path, options: CampaignOptions, sche
                 for fut in as_completed(futures):
                     record(*futures[fut], fut.result())
             finally:
-                _close(client, own_cluster=not scheduler)
+                close_client(client, own_cluster=not scheduler)
     aggregate(designs, out, options)
     return {"cases": total, "run": len(todo), "skipped": total - len(todo)}
 

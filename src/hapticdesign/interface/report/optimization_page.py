@@ -1,0 +1,107 @@
+"""The HTML report of ``optimize``: the study, the front, the selected design with its picture and index
+maps, and the files beside it. One document, inline styles, base64 PNG figures, no scripts; every user
+string (names, expressions, reasons, the device's name) is escaped."""
+
+from __future__ import annotations
+
+import base64
+from dataclasses import dataclass
+from html import escape
+
+from hapticdesign.interface.report.html import STYLE
+from hapticdesign.interface.report.tables import cell_text
+from hapticdesign.optimization.study_file import Choice
+from hapticdesign.optimization.study_outputs import Selection
+from hapticdesign.optimization.study_run import StudyRun, constraint_labels
+
+
+@dataclass(frozen=True)
+class Picture:
+    """A PNG figure of the report with its caption."""
+
+    png: bytes
+    caption: str
+
+
+def _image(picture: Picture) -> str:
+    data = base64.b64encode(picture.png).decode("ascii")
+    return (f'<figure><img alt="{escape(picture.caption)}" src="data:image/png;base64,{data}">'
+            f"<figcaption>{escape(picture.caption)}</figcaption></figure>")
+
+
+TEXT = ' class="text"'
+
+
+def _table(title: str, columns: list[str], rows: list[list], highlight: int | None = None) -> str:
+    head = "".join(f"<th>{escape(c)}</th>" for c in columns)
+    body = []
+    for k, row in enumerate(rows):
+        style = ' style="background:#fde2e2"' if k == highlight else ""
+        cells = "".join(f"<td{TEXT if isinstance(v, str) else ''}>{escape(cell_text(v))}</td>" for v in row)
+        body.append(f"<tr{style}>{cells}</tr>")
+    wide = ' class="wide"' if len(columns) > 8 else ""
+    return (f'<div class="table-wrap"><table{wide}><caption>{escape(title)}</caption><thead><tr>{head}</tr></thead>'
+            f"<tbody>{''.join(body)}</tbody></table></div>")
+
+
+def _options(options: dict) -> str:
+    return ", ".join(f"{k} = {v}" for k, v in options.items())
+
+
+def _study_rows(run: StudyRun) -> str:
+    spec = run.spec
+    variables = [[name, *(("choice of " + ", ".join(f"{v:g}" for v in var.values), "") if isinstance(var, Choice)
+                          else (f"{var[0]:g}", f"{var[1]:g}"))] for name, var in spec.variables.items()]
+    objectives = [[o.name, o.index, _options(o.options), o.reduce, o.sense] for o in spec.objectives]
+    constraints = [[c.label + (f" ({_options(c.options)})" if getattr(c, "options", None) else ""),
+                    "" if c.at_least is None else c.at_least, "" if c.at_most is None else c.at_most]
+                   for c in spec.constraints]
+    box = spec.workspace.box
+    parts = [_table("Variables", ["variable", "low or choices", "high"], variables),
+             _table("Objectives (reduced over the workspace)", ["name", "index", "options", "reduction", "sense"],
+                    objectives)]
+    if constraints:
+        parts.append(_table("Constraints", ["constrained value", ">=", "<="], constraints))
+    parts.append(f'<p>Workspace: box centred at {escape(str(list(box.center)))} m, edges {escape(str(list(box.size)))} m, '
+                 f"{spec.workspace.grid} points per axis of nonzero size. NSGA-II, population "
+                 f"{spec.algorithm.population}, {spec.algorithm.generations} generations, seed {run.seed}: "
+                 f"{run.evaluations} designs evaluated, {sum(r.feasible for r in run.records)} feasible.</p>")
+    return "".join(parts)
+
+
+def _reasons(run: StudyRun) -> str:
+    counts: dict[str, int] = {}
+    for r in run.records:
+        if not r.feasible:
+            key = r.reason.split(":")[0]
+            counts[key] = counts.get(key, 0) + 1
+    if not counts:
+        return "<p>Every evaluated design was feasible.</p>"
+    rows = [[k, v] for k, v in sorted(counts.items(), key=lambda kv: (-kv[1], kv[0]))[:12]]
+    return _table("Why designs were infeasible (evaluations.csv has each design's reason)", ["reason", "designs"], rows)
+
+
+def render(run: StudyRun, selection: Selection, title: str, pareto: Picture, pictures: list[Picture],
+           files: list[str]) -> str:
+    """The report as one HTML document."""
+    spec = run.spec
+    names = [o.name for o in spec.objectives]
+    columns = ["design", *spec.variables, *names, *constraint_labels(spec)]
+    rows = [[n, *(run.records[k].values[v] for v in spec.variables), *run.records[k].objectives,
+             *run.records[k].constraints] for n, k in enumerate(run.front, start=1)]
+    chosen = run.records[selection.record]
+    selected_rows = ([[name, chosen.values[name]] for name in spec.variables]
+                     + [[name, value] for name, value in zip(names, chosen.objectives)])
+    body = [f"<h1>Optimization study: {escape(title)}</h1>", "<h2>Study</h2>", _study_rows(run),
+            "<h2>Pareto front</h2>", _image(pareto),
+            _table(f"The front: {len(run.front)} feasible, non-dominated designs (front.csv)", columns, rows,
+                   selection.position),
+            "<h2>Selected design</h2>",
+            f"<p>Design {selection.position + 1} of the front, by the {escape(selection.rule)}; as a device file: "
+            "selected.yaml.</p>",
+            _table("Selected design", ["quantity", "value"], selected_rows),
+            *(_image(p) for p in pictures),
+            "<h2>Infeasible designs</h2>", _reasons(run),
+            "<h2>Files</h2><ul class=\"files\">", *(f"<li>{escape(f)}</li>" for f in files), "</ul>"]
+    return (f'<!DOCTYPE html><html lang="en"><head><meta charset="utf-8"><title>{escape(title)}</title>'
+            f"<style>{STYLE}</style></head><body>{''.join(body)}</body></html>\n")

@@ -1,0 +1,287 @@
+"""The study file: what to optimize on a device file (YAML or TOML, docs/optimization.md).
+
+A study names a device file (relative to the study file), the ``variables`` the optimizer may change
+(continuous bounds ``[low, high]`` or a discrete choice ``{values: [...]}``), the ``workspace`` the handle
+must reach (a box and a grid), the ``objectives`` (an index reduced over the workspace and a sense), the
+``constraints`` (an index or an affine expression of the variables, bounded by ``<=`` and/or ``>=``) and
+the ``algorithm`` (NSGA-II, population and generations). Everything is checked here with one-line
+messages naming the field; the names of variables and indices are checked against the device and the
+index registry when the study is bound to them (:mod:`.study_run`).
+
+Expressions use the device files' grammar (:func:`hapticdesign.devices.schema.parse_expression`):
+``l1 + l2``, ``2*l1 - d``; their names are variables of the study.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from pathlib import Path
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError, field_validator, model_validator
+
+from hapticdesign.devices.builder import LinearExpr
+from hapticdesign.devices.device_file import describe_validation_error
+from hapticdesign.devices.schema import parse_expression
+from hapticdesign.errors import UserError
+from hapticdesign.files import load_structured, quote, read_text
+
+REDUCTIONS = ("min", "max", "mean")
+"""Reductions of an index over the workspace points (``mean``: the arithmetic mean over the uniform
+Cartesian grid, so ``isotropy`` with ``mean`` is the global conditioning index on that measure)."""
+SENSES = ("min", "max")
+MAX_VARIABLES = 64
+MAX_CHOICES = 1000
+MAX_GRID = 101
+
+
+def _finite(value: object) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ValueError(f"expected a number, got {quote(value)}")
+    if not math.isfinite(value):
+        raise ValueError(f"expected a finite number, got {value!r}")
+    return float(value)
+
+
+Finite = Annotated[float, BeforeValidator(_finite)]
+
+
+class _StudyModel(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True)
+
+
+class Choice(_StudyModel):
+    """A discrete variable: one of ``values`` (distinct, in the given order)."""
+
+    values: tuple[Finite, ...] = Field(min_length=1, max_length=MAX_CHOICES)
+
+    @model_validator(mode="after")
+    def _distinct(self) -> "Choice":
+        if len(set(self.values)) != len(self.values):
+            raise ValueError("values: each choice must be given once")
+        return self
+
+
+def _variable(value: object) -> object:
+    if isinstance(value, (list, tuple)):
+        if len(value) != 2:
+            raise ValueError(f"bounds are [low, high], got {len(value)} numbers")
+        low, high = (_finite(v) for v in value)
+        if not low < high:
+            raise ValueError(f"bounds need low < high, got [{low:g}, {high:g}] (fix a value in the device file "
+                             "instead of giving equal bounds)")
+        return (low, high)
+    if isinstance(value, dict):
+        try:
+            return Choice.model_validate(value)
+        except ValidationError as exc:
+            raise ValueError(describe_validation_error(exc)) from None
+    if isinstance(value, Choice):
+        return value
+    raise ValueError(f"a variable is [low, high] or {{values: [...]}}, got {quote(value)}")
+
+
+Variable = Annotated[tuple[float, float] | Choice, BeforeValidator(_variable)]
+
+
+class Box(_StudyModel):
+    """An axis-aligned box of the base frame: ``center`` and edge lengths ``size`` (m, >= 0)."""
+
+    center: tuple[Finite, Finite, Finite]
+    size: tuple[Finite, Finite, Finite]
+
+    @model_validator(mode="after")
+    def _sizes(self) -> "Box":
+        if any(s < 0.0 for s in self.size):
+            raise ValueError(f"size: edge lengths must be at least 0 m, got {list(self.size)}")
+        return self
+
+
+class WorkspaceSpec(_StudyModel):
+    """The region the handle must reach: ``box`` sampled by ``grid`` points per axis of nonzero size
+    (edges included); an axis of size 0 contributes its centre."""
+
+    box: Box
+    grid: Annotated[int, Field(strict=True, ge=1, le=MAX_GRID)] = 5
+
+
+def _bounds(data: object) -> object:
+    if isinstance(data, dict) and "<=" not in data and ">=" not in data:
+        raise ValueError("a constraint needs a bound: '<=' and/or '>='")
+    return data
+
+
+class _Bounded(_StudyModel):
+    at_most: Finite | None = Field(None, alias="<=")
+    at_least: Finite | None = Field(None, alias=">=")
+
+    @model_validator(mode="after")
+    def _ordered(self) -> "_Bounded":
+        if self.at_most is not None and self.at_least is not None and not self.at_least <= self.at_most:
+            raise ValueError(f"'>=' {self.at_least:g} is above '<=' {self.at_most:g}: nothing can meet both")
+        return self
+
+
+OptionValue = int | float | list[Finite] | str | None
+
+
+class _IndexUse(_StudyModel):
+    """An index of the registry, its ``options`` (``kmax``'s sample period, delay, damping, direction; see
+    docs/indices.md) and its reduction over the workspace points."""
+
+    index: str = Field(min_length=1, max_length=64)
+    reduce: Literal["min", "max", "mean"]
+    options: dict[str, OptionValue] = Field({}, max_length=16)
+
+    @property
+    def request(self) -> tuple[str, tuple]:
+        """The index with its options, hashable: designs are asked each such request once."""
+        return (self.index, tuple(sorted((k, tuple(v) if isinstance(v, list) else v) for k, v in self.options.items())))
+
+    @property
+    def key(self) -> tuple:
+        """The request and its reduction."""
+        return (*self.request, self.reduce)
+
+
+class IndexConstraint(_Bounded, _IndexUse):
+    """An index reduced over the workspace, bounded."""
+
+    @property
+    def label(self) -> str:
+        return f"{self.reduce}_{self.index}"
+
+
+class ExpressionConstraint(_Bounded):
+    """An affine expression of the variables (the device files' grammar), bounded."""
+
+    expression: str = Field(min_length=1, max_length=1000)
+
+    @field_validator("expression")
+    @classmethod
+    def _parses(cls, text: str) -> str:
+        parse_expression(text)
+        return text
+
+    @property
+    def parsed(self) -> LinearExpr:
+        return parse_expression(self.expression)
+
+    @property
+    def label(self) -> str:
+        return self.expression
+
+    def value(self, values: dict[str, float]) -> float:
+        """The expression at the variables' ``values``."""
+        parsed = self.parsed
+        return parsed.constant + sum(c * values[name] for name, c in parsed.terms)
+
+
+def _constraint(value: object) -> object:
+    value = _bounds(value)
+    if isinstance(value, (IndexConstraint, ExpressionConstraint)):
+        return value
+    if isinstance(value, dict):
+        kind = ExpressionConstraint if "expression" in value else IndexConstraint
+        try:
+            return kind.model_validate(value)
+        except ValidationError as exc:
+            raise ValueError(describe_validation_error(exc)) from None
+    raise ValueError(f"a constraint is a mapping such as {{index: isotropy, reduce: min, '>=': 0.1}}, got {quote(value)}")
+
+
+Constraint = Annotated[IndexConstraint | ExpressionConstraint, BeforeValidator(_constraint)]
+
+
+class Objective(_IndexUse):
+    """An index reduced over the workspace, minimized or maximized; ``name`` labels it (default: the index)."""
+
+    name: str = Field("", max_length=64)
+    sense: Literal["min", "max"]
+
+    @model_validator(mode="after")
+    def _default_name(self) -> "Objective":
+        if not self.name:
+            object.__setattr__(self, "name", self.index)
+        return self
+
+
+class AlgorithmSettings(_StudyModel):
+    """NSGA-II (Deb et al. 2002, pymoo) with ``population`` designs over ``generations`` generations."""
+
+    method: Literal["nsga2"] = "nsga2"
+    population: Annotated[int, Field(strict=True, ge=4, le=100_000)] = 40
+    generations: Annotated[int, Field(strict=True, ge=1, le=100_000)] = 60
+
+
+class StudySpec(_StudyModel):
+    """A whole study file."""
+
+    device: str = Field(min_length=1, max_length=1000)
+    variables: dict[str, Variable] = Field(min_length=1, max_length=MAX_VARIABLES)
+    workspace: WorkspaceSpec
+    objectives: list[Objective] = Field(min_length=1, max_length=16)
+    constraints: list[Constraint] = Field([], max_length=64)
+    algorithm: AlgorithmSettings = AlgorithmSettings()
+
+    @model_validator(mode="after")
+    def _names(self) -> "StudySpec":
+        names = [o.name for o in self.objectives]
+        twice = sorted({n for n in names if names.count(n) > 1})
+        if twice:
+            raise ValueError(f"objectives: name {twice[0]!r} is used twice (give each objective its own name)")
+        clash = [n for n in names if n in self.variables]
+        if clash:
+            raise ValueError(f"objectives: name {clash[0]!r} is also a variable (name the objective otherwise)")
+        for i, c in enumerate(self.constraints):
+            if isinstance(c, ExpressionConstraint):
+                unknown = [n for n in c.parsed.names if n not in self.variables]
+                if unknown:
+                    raise ValueError(f"constraints[{i}]: {unknown[0]!r} in {c.expression!r} is not a variable of the study "
+                                     f"(variables: {', '.join(self.variables)})")
+        return self
+
+    @property
+    def index_uses(self) -> tuple[_IndexUse, ...]:
+        """The objectives and the index constraints: every index the study reads."""
+        return (*self.objectives, *(c for c in self.constraints if isinstance(c, IndexConstraint)))
+
+
+class Study:
+    """A checked study file bound to its device file: ``spec``, the study file's ``path``, the device path
+    (resolved against the study file's folder), both files' text and a ``fingerprint`` of the two (a
+    checkpoint is resumed only by the same study)."""
+
+    def __init__(self, spec: StudySpec, path: Path, device_path: Path, study_text: str, device_text: str):
+        self.spec = spec
+        self.path = path
+        self.device_path = device_path
+        self.study_text = study_text
+        self.device_text = device_text
+
+    @property
+    def fingerprint(self) -> str:
+        digest = hashlib.sha256()
+        for text in (self.study_text, self.device_text):
+            digest.update(text.encode())
+            digest.update(b"\0")
+        return digest.hexdigest()
+
+
+def study_from_mapping(data: object, source: str = "study file") -> StudySpec:
+    """Validate a parsed study file; problems raise a one-line UserError naming the field."""
+    if not isinstance(data, dict):
+        raise UserError(f"{source}: expected a mapping with keys device, variables, workspace, objectives")
+    try:
+        return StudySpec.model_validate(data)
+    except ValidationError as exc:
+        raise UserError(f"{source}: {describe_validation_error(exc)}") from None
+
+
+def load_study(path: Path | str) -> Study:
+    """Read a study file (``.yaml``, ``.yml``, ``.toml`` or ``.json``) and its device file."""
+    path = Path(path)
+    spec = study_from_mapping(load_structured(path, "study file"), str(path))
+    device_path = path.parent / spec.device
+    return Study(spec, path, device_path, read_text(path, "study file"), read_text(device_path, "device file"))

@@ -1,0 +1,187 @@
+"""What a study run leaves: the front and every evaluation as CSV, the selected design, the Pareto figure.
+
+The selected design follows seed 001's rule (§7.2, Figures 7.2-7.3): each objective is normalized over
+the front (eq. 7.1) and turned so that 0 is its best value (eq. 7.2-7.4), and the design with the least
+RMS of these, or the least weighted RMS, is chosen (:func:`~hapticdesign.optimization.selection.least_rms`).
+Numbers in the CSV files are written with Python's shortest round-trip representation, so the same run
+gives the same bytes and reading them back gives the same floats.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from hapticdesign.errors import UserError
+from hapticdesign.files import figure_bytes, save_figure
+from hapticdesign.optimization.selection import least_rms, normalize
+from hapticdesign.optimization.study_run import StudyRun, constraint_labels
+from hapticdesign.simulation.design_indices import DESIGN_INDICES
+
+
+@dataclass(frozen=True)
+class Selection:
+    """The chosen design: its ``position`` on the front (0-based), its record index and the rule in words."""
+
+    position: int
+    record: int
+    rule: str
+
+
+def normalized_front(run: StudyRun) -> np.ndarray:
+    """The front's objectives normalized (eq. 7.1) with 0 the best value of each (eq. 7.2-7.4)."""
+    columns = []
+    for k, objective in enumerate(run.spec.objectives):
+        n = normalize([run.records[i].objectives[k] for i in run.front])
+        columns.append(1.0 - n if objective.sense == "max" else n)
+    return np.column_stack(columns)
+
+
+def select_design(run: StudyRun, weights: dict[str, float] | None = None, design: int | None = None) -> Selection:
+    """The least-RMS design of the front, the least weighted RMS with ``weights`` per objective name
+    (objectives not named weigh 1), or the front's ``design``-th row (1-based, as in front.csv)."""
+    if not run.front:
+        raise UserError("no feasible design to select: the front is empty")
+    if design is not None:
+        if not 1 <= design <= len(run.front):
+            raise UserError(f"the front has designs 1 to {len(run.front)}, not {design}")
+        return Selection(design - 1, run.front[design - 1], f"design {design} of the front, chosen by hand")
+    names = [o.name for o in run.spec.objectives]
+    weights = dict(weights or {})
+    unknown = [n for n in weights if n not in names]
+    if unknown:
+        raise UserError(f"no objective named {unknown[0]!r} to weigh (objectives: {', '.join(names)})")
+    w = [float(weights.get(n, 1.0)) for n in names]
+    position = least_rms(normalized_front(run), w)
+    rule = ("least RMS of the normalized objectives (seed 001 Fig. 7.2)" if not weights else
+            "least weighted RMS of the normalized objectives (seed 001 Fig. 7.3; weights "
+            + ", ".join(f"{n} {x:g}" for n, x in zip(names, w)) + ")")
+    return Selection(position, run.front[position], rule)
+
+
+def _number(value: float) -> str:
+    return repr(float(value)) if np.isfinite(value) else ""
+
+
+def _csv(header: list[str], rows: list[list[str]]) -> str:
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(header)
+    writer.writerows(rows)
+    return buffer.getvalue()
+
+
+def front_csv(run: StudyRun) -> str:
+    """One row per front design: its number, variables, objectives and constrained values."""
+    spec = run.spec
+    header = ["design", *spec.variables, *(o.name for o in spec.objectives), *constraint_labels(spec)]
+    rows = []
+    for n, k in enumerate(run.front, start=1):
+        r = run.records[k]
+        rows.append([str(n), *(_number(r.values[v]) for v in spec.variables), *map(_number, r.objectives),
+                     *map(_number, r.constraints)])
+    return _csv(header, rows)
+
+
+def evaluations_csv(run: StudyRun) -> str:
+    """Every evaluated design: generation, variables, objectives, constrained values, feasible or why not."""
+    spec = run.spec
+    header = ["evaluation", "generation", *spec.variables, *(o.name for o in spec.objectives),
+              *constraint_labels(spec), "feasible", "reason"]
+    rows = []
+    for n, r in enumerate(run.records, start=1):
+        rows.append([str(n), str(r.generation), *(_number(r.values[v]) for v in spec.variables),
+                     *map(_number, r.objectives), *map(_number, r.constraints), "yes" if r.feasible else "no",
+                     r.reason])
+    return _csv(header, rows)
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _unit(index: str) -> str:
+    unit = DESIGN_INDICES[index].unit
+    return "-" if unit == "1" else unit
+
+
+def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: str = "pareto") -> list[Path]:
+    """The front in pairs of objectives (every feasible design in grey, the front in blue, the selected
+    design as a red star); one objective: its value per evaluation; more than three: parallel coordinates
+    of the normalized front (0 best)."""
+    plt = _pyplot()
+    spec = run.spec
+    labels = [f"{o.name}: {o.reduce} {o.index} ({_unit(o.index)}), {o.sense}imize" for o in spec.objectives]
+    feasible = [r for r in run.records if r.feasible]
+    F_all = np.array([r.objectives for r in feasible]).reshape(len(feasible), len(labels))
+    F = np.array([run.records[k].objectives for k in run.front]).reshape(len(run.front), len(labels))
+    pick = None if selection is None else F[selection.position]
+    k = len(labels)
+    if k == 1:
+        fig, ax = plt.subplots(figsize=(6, 4), dpi=100)
+        numbers = [n for n, r in enumerate(run.records, start=1) if r.feasible]
+        ax.scatter(numbers, F_all[:, 0], s=6, color="0.6", label="feasible designs")
+        if pick is not None:
+            ax.scatter([selection.record + 1], [pick[0]], marker="*", s=140, color="red", label="selected")
+        ax.set_xlabel("evaluation")
+        ax.set_ylabel(labels[0])
+        ax.legend(fontsize=8)
+    elif k <= 3:
+        pairs = [(0, 1)] if k == 2 else [(0, 1), (0, 2), (1, 2)]
+        fig, axes = plt.subplots(1, len(pairs), figsize=(5.5 * len(pairs), 4.5), dpi=100, squeeze=False)
+        for ax, (i, j) in zip(axes[0], pairs):
+            ax.scatter(F_all[:, i], F_all[:, j], s=6, color="0.75", label="feasible designs")
+            ax.scatter(F[:, i], F[:, j], s=22, color="tab:blue", label="front")
+            if pick is not None:
+                ax.scatter([pick[i]], [pick[j]], marker="*", s=160, color="red", label="selected")
+            ax.set_xlabel(labels[i])
+            ax.set_ylabel(labels[j])
+            ax.legend(fontsize=8)
+    else:
+        fig, ax = plt.subplots(figsize=(1.6 * k + 2, 4.5), dpi=100)
+        normalized = normalized_front(run)
+        for row in normalized:
+            ax.plot(range(k), row, color="tab:blue", alpha=0.4, linewidth=0.8)
+        if selection is not None:
+            ax.plot(range(k), normalized[selection.position], color="red", linewidth=2.2, label="selected")
+            ax.legend(fontsize=8)
+        ax.set_xticks(range(k), [o.name for o in spec.objectives], rotation=20)
+        ax.set_ylabel("normalized objective (0 = best on the front)")
+    fig.suptitle(f"Pareto front: {len(run.front)} designs of {run.evaluations} evaluated")
+    fig.tight_layout()
+    paths = [save_figure(fig, out / f"{name}.{ext}") for ext in ("png", "svg")]
+    plt.close(fig)
+    return paths
+
+
+def index_maps(points: np.ndarray, values: dict[str, np.ndarray], title: str) -> bytes:
+    """PNG of each index over the workspace points (one panel per index, colour = value): the two axes of
+    the box that vary for a planar workspace, a 3D scatter for a solid one."""
+    plt = _pyplot()
+    varying = [k for k in range(3) if np.ptp(points[:, k]) > 0.0]
+    n = len(values)
+    solid = len(varying) == 3
+    fig = plt.figure(figsize=(4.6 * n, 4.0), dpi=100)
+    for i, (label, v) in enumerate(values.items(), start=1):
+        ax = fig.add_subplot(1, n, i, projection="3d" if solid else None)
+        axes = varying if solid or len(varying) == 2 else (varying + [k for k in range(3) if k not in varying])[:2]
+        coordinates = [points[:, k] * 1e3 for k in axes]
+        shown = ax.scatter(*coordinates, c=v, cmap="viridis", s=60 if not solid else 40)
+        for k, name in zip(axes, ("set_xlabel", "set_ylabel", "set_zlabel")):
+            getattr(ax, name)(f"{'xyz'[k]} (mm)")
+        fig.colorbar(shown, ax=ax, shrink=0.8)
+        ax.set_title(label, fontsize=9)
+    fig.suptitle(title)
+    fig.tight_layout()
+    png = figure_bytes(fig, "png")
+    plt.close(fig)
+    return png

@@ -1,0 +1,158 @@
+"""``hapticdesign optimize``: outputs, --json, byte-identical reruns, a Dask cluster, bad input in one line.
+
+Oracles: the files of a second run with the same seed (same bytes), the run in one process (for the cluster),
+the other commands that must read ``selected.yaml`` and the device built from the design space at the same
+values (same mass matrix), and the escaping of a hostile name.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from hapticdesign.analysis.dynamics.device import mass_matrix
+from hapticdesign.analysis.view.skeleton import home_pose
+from hapticdesign.devices.design_space import design_space
+from hapticdesign.devices.device_file import load_device_file
+from hapticdesign.interface.cli import app
+from tests.optimization.test_study_run import ISOTROPY, MASS, point, small_study, write_study
+
+runner = CliRunner()
+OUTPUTS = ("front.csv", "evaluations.csv", "pareto.png", "pareto.svg", "report.html", "selected.yaml")
+
+
+def optimize(*args):
+    return runner.invoke(app, ["optimize", *map(str, args)])
+
+
+def files(folder: Path) -> dict[str, bytes]:
+    return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def test_outputs_json_and_the_same_bytes_for_the_same_seed(tmp_path):
+    study = small_study(tmp_path)
+    first = optimize(study, "--seed", 7, "--out", tmp_path / "a", "--json")
+    assert first.exit_code == 0, first.output
+    summary = json.loads(first.stdout)
+    assert set(summary) == {"front", "evaluations", "selected"}
+    assert summary["evaluations"] == len((tmp_path / "a" / "evaluations.csv").read_text().splitlines()) - 1
+    for design in summary["front"]:
+        assert set(design["variables"]) == {"l2", "actuators.q2.gear_ratio"}
+        assert set(design["objectives"]) == {"iso", "mass"}
+        assert 0.0 < design["objectives"]["iso"] <= 1.0 and design["objectives"]["mass"] > 0.0
+        assert design["variables"]["l2"] <= 0.25
+    assert summary["selected"]["rule"].startswith("least RMS")
+    assert all((tmp_path / "a" / name).is_file() for name in OUTPUTS)
+    page = (tmp_path / "a" / "report.html").read_text()
+    assert "The selected design at the workspace centre" in page and "indices at the workspace points" in page
+    second = optimize(study, "--seed", 7, "--out", tmp_path / "b", "--json")
+    assert second.stdout == first.stdout
+    assert files(tmp_path / "a") == files(tmp_path / "b")
+    again = optimize(study, "--seed", 7, "--out", tmp_path / "a", "--json")  # a finished run replays its checkpoint
+    assert again.stdout == first.stdout and files(tmp_path / "a") == files(tmp_path / "b")
+
+
+def test_selected_yaml_is_a_device_file_that_other_commands_read(tmp_path):
+    study = small_study(tmp_path)
+    res = optimize(study, "--seed", 1, "--out", tmp_path / "out", "--json", "--select", "iso=1,mass=0")
+    assert res.exit_code == 0, res.output
+    selected = json.loads(res.stdout)["selected"]
+    path = tmp_path / "out" / "selected.yaml"
+    device = load_device_file(path)
+    expected = design_space(yaml.safe_load((tmp_path / "arm.yaml").read_text()), selected["variables"]).device(
+        selected["variables"])
+    q = home_pose(device)
+    assert np.array_equal(mass_matrix(device, q), mass_matrix(expected, q))
+    for command in (["dynamics", "--device", str(path), "--q", "0.1,0.2", "--json"],
+                    ["metrics", "--device", str(path), "--q", "0.1,0.2", "--json"]):
+        out = runner.invoke(app, command)
+        assert out.exit_code == 0, (command, out.output)
+    assert selected["objectives"]["iso"] == max(d["objectives"]["iso"] for d in json.loads(res.stdout)["front"])
+
+
+def test_the_report_escapes_user_strings(tmp_path):
+    hostile = "<script>alert(1)</script>"
+    path = write_study(tmp_path, {"l2": [0.12, 0.16]}, [dict(ISOTROPY, name=hostile), MASS], population=4,
+                       generations=1, center=point(0.14))
+    res = optimize(path, "--seed", 1, "--out", tmp_path / "out")
+    assert res.exit_code == 0, res.output
+    page = (tmp_path / "out" / "report.html").read_text()
+    assert hostile not in page and "&lt;script&gt;alert(1)&lt;/script&gt;" in page
+
+
+def test_a_dask_cluster_gives_the_same_front(tmp_path):
+    from dask.distributed import LocalCluster
+
+    study = small_study(tmp_path)
+    local = optimize(study, "--seed", 2, "--out", tmp_path / "local")
+    assert local.exit_code == 0, local.output
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, protocol="tcp", dashboard_address=None) as cluster:
+        remote = optimize(study, "--seed", 2, "--out", tmp_path / "remote", "--scheduler", cluster.scheduler_address)
+    assert remote.exit_code == 0, remote.output
+    for name in ("front.csv", "evaluations.csv", "selected.yaml"):
+        assert (tmp_path / "local" / name).read_bytes() == (tmp_path / "remote" / name).read_bytes()
+
+
+def _error(args, message: str, out: Path | None = None) -> None:
+    res = optimize(*args)
+    assert res.exit_code == 2, res.output
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: ") and message in lines[0], res.stderr
+    assert "Traceback" not in res.output
+    if out is not None:
+        assert not any(out.glob("*.csv")) and not (out / "report.html").exists()
+
+
+def _changed(tmp_path: Path, change) -> Path:
+    path = small_study(tmp_path)
+    data = yaml.safe_load(path.read_text())
+    change(data)
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda d: d["variables"].update(l9=[0.1, 0.2]), "unknown design variable 'l9'"),
+    (lambda d: d["variables"].update({"links.nothing.D": [0.01, 0.02]}), "has no link 'nothing'"),
+    (lambda d: d["objectives"][0].update(index="beauty"), "unknown index 'beauty'"),
+    (lambda d: d["variables"].update(l2=[0.3, 0.1]), "bounds need low < high"),
+    (lambda d: d["variables"].update(l2=[float("nan"), 0.1]), "expected a finite number"),
+    (lambda d: d["workspace"].update(grid=1) or d["workspace"]["box"].update(size=[0.02, 0, 0.02]), "grid must be at least 2"),
+    (lambda d: d.update(device="missing.yaml"), "cannot read device file"),
+    (lambda d: d["objectives"][0].update(options={"speed": 1}), "index isotropy: unknown option 'speed'"),
+    (lambda d: d["constraints"].append({"index": "kmax", "reduce": "min", ">=": 100.0, "options": {"period": -1.0}}),
+     "index kmax: the sample period is a positive number of seconds"),
+])
+def test_bad_studies_are_one_line(tmp_path, change, message):
+    out = tmp_path / "out"
+    _error([_changed(tmp_path, change), "--seed", 1, "--out", out], message, out)
+    assert not out.exists()
+
+
+def test_work_above_the_limit_is_refused(tmp_path):
+    path = _changed(tmp_path, lambda d: d["algorithm"].update(population=1000, generations=1000))
+    _error([path, "--seed", 1, "--out", tmp_path / "out"], "above the limit of")
+
+
+def test_a_workspace_no_design_reaches_names_the_closest_design(tmp_path):
+    far = [3.0 * math.cos(0.7), 0.0, 3.0 * math.sin(0.7)]  # 3 m: beyond any l1 + l2 <= 0.5 m
+    path = write_study(tmp_path, {"l2": [0.12, 0.3]}, [ISOTROPY], population=4, generations=2, center=far)
+    _error([path, "--seed", 1, "--out", tmp_path / "out"], "no design of 8 reaches the whole workspace; the closest (l2 = ")
+
+
+@pytest.mark.parametrize("select, message", [("9", "the front has designs 1 to"), ("speed=1", "no objective named 'speed'"),
+                                             ("iso=-1", "--select: expected rms")])
+def test_bad_selection_is_one_line(tmp_path, select, message):
+    _error([small_study(tmp_path), "--seed", 1, "--select", select], message)
+
+
+def test_another_study_in_the_same_folder_is_refused(tmp_path):
+    study = small_study(tmp_path)
+    assert optimize(study, "--seed", 1, "--out", tmp_path / "out").exit_code == 0
+    _error([study, "--seed", 2, "--out", tmp_path / "out"], "holds a run of another study or seed")

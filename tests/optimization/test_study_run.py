@@ -1,0 +1,139 @@
+"""Study runs on a planar two-link arm: known optima, a front against brute force, determinism, resume.
+
+Oracles: the closed form of the two-link arm (isotropic exactly at ``l2 / l1 = 1 / sqrt(2)`` with the elbow at
+135 degrees, i.e. at the distance ``l1 / sqrt(2)`` from the shoulder; Salisbury & Craig 1982), exhaustive
+enumeration of a discrete design space, a dense grid's non-dominated set compared by pymoo's hypervolume
+indicator, and the uninterrupted run (for resume).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from pymoo.indicators.hv import HV
+from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
+
+from hapticdesign.optimization.study_evaluation import bind_study
+from hapticdesign.optimization.study_file import load_study
+from hapticdesign.optimization.study_outputs import front_csv
+from hapticdesign.optimization.study_run import run_study
+from tests.helpers.planar_arm import planar_arm
+
+L1 = 0.2
+ANGLE = 0.7
+
+
+def point(r: float) -> list[float]:
+    """A point of the arm's plane (x-z) at distance ``r`` from the shoulder."""
+    return [r * math.cos(ANGLE), 0.0, r * math.sin(ANGLE)]
+
+
+def write_study(folder: Path, variables: dict, objectives: list, population: int, generations: int,
+                center=None, size=(0.0, 0.0, 0.0), grid: int = 1, constraints=()) -> Path:
+    (folder / "arm.yaml").write_text(yaml.safe_dump(planar_arm(L1)))
+    study = {"device": "arm.yaml", "variables": variables,
+             "workspace": {"box": {"center": center or point(L1 / math.sqrt(2.0)), "size": list(size)}, "grid": grid},
+             "objectives": objectives, "constraints": list(constraints),
+             "algorithm": {"method": "nsga2", "population": population, "generations": generations}}
+    (folder / "study.yaml").write_text(yaml.safe_dump(study, sort_keys=False))
+    return folder / "study.yaml"
+
+
+ISOTROPY = {"name": "iso", "index": "isotropy", "reduce": "min", "sense": "max"}
+MASS = {"name": "mass", "index": "apparent_mass", "reduce": "mean", "sense": "min"}
+
+
+def best(run, k: int = 0):
+    return run.records[run.front[0]]
+
+
+def test_single_objective_finds_the_isotropic_two_link_arm(tmp_path):
+    path = write_study(tmp_path, {"l2": [0.08, 0.3]}, [ISOTROPY], population=12, generations=40)
+    study = load_study(path)
+    run = run_study(study, 3, bind_study(study).evaluate)
+    top = best(run)
+    assert len(run.front) == 1
+    assert top.values["l2"] == pytest.approx(L1 / math.sqrt(2.0), rel=1e-3)  # 0.14 mm of 141 mm
+    assert top.objectives[0] == pytest.approx(1.0, abs=1e-3)
+
+
+def test_single_objective_over_choices_finds_the_brute_force_optimum(tmp_path):
+    l2_values = [0.09, 0.11, 0.13, 0.15, 0.17, 0.19]
+    ratios = [5.0, 8.0, 11.2, 13.3, 20.0]
+    variables = {"l2": {"values": l2_values}, "actuators.q1.gear_ratio": {"values": ratios}}
+    path = write_study(tmp_path, variables, [MASS], population=8, generations=8,
+                       center=point(0.15), size=(0.02, 0.0, 0.02), grid=2)
+    study = load_study(path)
+    bound = bind_study(study)
+    designs = [{"l2": a, "actuators.q1.gear_ratio": b} for a, b in itertools.product(l2_values, ratios)]
+    masses = [answer.reduced[0] for answer in bound.evaluate(designs)]
+    run = run_study(study, 5, bound.evaluate)
+    assert best(run).values == designs[int(np.argmin(masses))]
+    assert best(run).objectives[0] == min(masses)
+    assert run.evaluations < len(designs) * 2
+
+
+def test_two_objective_front_against_a_brute_force_front(tmp_path):
+    variables = {"l2": [0.09, 0.3], "actuators.q2.gear_ratio": [4.0, 20.0]}
+    path = write_study(tmp_path, variables, [ISOTROPY, MASS], population=16, generations=12,
+                       center=point(0.15), size=(0.02, 0.0, 0.02), grid=2)
+    study = load_study(path)
+    bound = bind_study(study)
+    grid = [{"l2": a, "actuators.q2.gear_ratio": b}
+            for a, b in itertools.product(np.linspace(0.09, 0.3, 15), np.linspace(4.0, 20.0, 8))]
+    answers = [a for a in bound.evaluate(grid) if not a.reason]
+    brute = np.array([[-a.reduced[0], a.reduced[1]] for a in answers])  # minimized: -isotropy, mass
+    brute = brute[NonDominatedSorting().do(brute, only_non_dominated_front=True)]
+    run = run_study(study, 11, bound.evaluate)
+    found = np.array([[-run.records[k].objectives[0], run.records[k].objectives[1]] for k in run.front])
+    reference = np.max(np.vstack([brute, found]), axis=0) + 0.05 * np.ptp(np.vstack([brute, found]), axis=0)
+    hv_brute, hv_found = HV(ref_point=reference)(brute), HV(ref_point=reference)(found)
+    assert hv_found >= 0.97 * hv_brute, (hv_found, hv_brute)
+
+
+def small_study(tmp_path) -> Path:
+    variables = {"l2": [0.09, 0.3], "actuators.q2.gear_ratio": {"values": [4.0, 8.0, 16.0]}}
+    return write_study(tmp_path, variables, [ISOTROPY, MASS], population=8, generations=4,
+                       center=point(0.15), size=(0.02, 0.0, 0.02), grid=2,
+                       constraints=[{"expression": "l2", "<=": 0.25}])
+
+
+def test_same_seed_same_front_other_seed_other_designs(tmp_path):
+    study = load_study(small_study(tmp_path))
+    evaluate = bind_study(study).evaluate
+    a, b, c = (run_study(study, seed, evaluate) for seed in (2, 2, 3))
+    assert front_csv(a) == front_csv(b)
+    assert [r.x for r in a.records] == [r.x for r in b.records]
+    assert [r.x for r in a.records] != [r.x for r in c.records]
+
+
+class Interrupt(Exception):
+    pass
+
+
+def test_an_interrupted_run_continues_from_its_checkpoint_and_ends_with_the_same_front(tmp_path):
+    study = load_study(small_study(tmp_path))
+    bound = bind_study(study)
+    whole = run_study(study, 4, bound.evaluate)
+    asked = []
+
+    def counting(batch):
+        asked.append(len(batch))
+        return bound.evaluate(batch)
+
+    def stop_after_two(generation, total):
+        if generation == 2:
+            raise Interrupt
+
+    with pytest.raises(Interrupt):
+        run_study(study, 4, counting, tmp_path / "out", stop_after_two)
+    first = len(asked)
+    resumed = run_study(study, 4, counting, tmp_path / "out")
+    assert first == 2 and len(asked) == first + 2  # generations 3 and 4 only
+    assert front_csv(resumed) == front_csv(whole)
+    assert [r.objectives for r in resumed.records] == [r.objectives for r in whole.records]
