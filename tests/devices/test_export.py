@@ -60,7 +60,7 @@ def _load(name):
         return load_device_file(EXAMPLES / name)
 
 
-@pytest.mark.parametrize("name", ["arm-3r.toml", "phantom-3dof-motors.yaml"])
+@pytest.mark.parametrize("name", ["arm-3r.toml", "phantom-3dof-motors.yaml", "phantom-premium.yaml"])
 def test_tree_mass_matrix_and_bias_equal_mujocos(name):
     device = _load(name)
     export = to_mjcf(device)
