@@ -1,6 +1,6 @@
 """Exports checked in established libraries. URDF of a tree in Pinocchio: its ``crba`` and ``rnea`` equal our
 H and ``C qd + G``. MJCF in MuJoCo: on trees its mass matrix and bias forces equal ours; on closed loops its
-constrained accelerations under a torque equal ours.
+constrained accelerations under a torque equal ours (the R-CUBE's welds included).
 
 Oracles: MuJoCo's ``mj_fullM``, ``qfrc_bias``, its constraint Jacobian ``efc_J`` and its own constrained
 ``qacc``. The export has more joints than the device has coordinates (couplings such as the Phantom's
@@ -79,11 +79,16 @@ def test_tree_mass_matrix_and_bias_equal_mujocos(name):
                            atol=1e-7)
 
 
-def _accelerations(device, impedance: str | None = None):
-    """Ours, MuJoCo's own and the hard-constraint limit from MuJoCo's matrices, at home under a torque."""
+def _accelerations(device, impedance: str | None = None, bound_mass: float | None = None):
+    """Ours, MuJoCo's own and the hard-constraint limit from MuJoCo's matrices, at home under a torque (with
+    another constraint impedance or another bound on the massless frames' mass if given)."""
     text = to_mjcf(device).text
     if impedance is not None:
         text = text.replace('solimp="0.9999 0.9999 0.001 0.5 2"', f'solimp="{impedance}"')
+    if bound_mass is not None:
+        assert text.count('boundmass="1e-09" boundinertia="1e-12"') == 1
+        text = text.replace('boundmass="1e-09" boundinertia="1e-12"',
+                            f'boundmass="{bound_mass:g}" boundinertia="{bound_mass * 1e-3:g}"')
     model = mujoco.MjModel.from_xml_string(text)
     data = mujoco.MjData(model)
     mujoco.mj_resetDataKeyframe(model, data, 0)
@@ -101,10 +106,25 @@ def _accelerations(device, impedance: str | None = None):
     return ours, data.qacc[dofs].copy(), hard[dofs]
 
 
-@pytest.mark.parametrize("name", ["five-bar.yaml", "delta.yaml", "falcon.yaml"])
+@pytest.mark.parametrize("name", ["five-bar.yaml", "delta.yaml", "falcon.yaml", "rcube.yaml"])
 def test_closed_loop_accelerations_equal_the_hard_constraint_limit_of_mujocos_model(name):
     ours, _, hard = _accelerations(_load(name))
     assert np.abs(hard - ours).max() <= 1e-6 * np.abs(ours).max()
+
+
+def test_rcube_weld_export_differs_from_ours_by_the_bound_mass_only():
+    """The R-CUBE closes its loops with two welds (whole pose) over 12 passive joints and carries only 77.7 g of
+    tubes, so MuJoCo's 1e-9 kg on each massless frame shows (measured 5e-7 relative): a tenfold smaller bound
+    makes the difference about tenfold smaller, down to 1e-8 at 1e-11 kg."""
+    device = _load("rcube.yaml")
+    model = mujoco.MjModel.from_xml_string(to_mjcf(device).text)
+    assert list(model.eq_type) == [mujoco.mjtEq.mjEQ_WELD] * 2
+    errors = []
+    for bound in (1e-9, 1e-10, 1e-11):
+        ours, _, hard = _accelerations(device, bound_mass=bound)
+        errors.append(np.abs(hard - ours).max() / np.abs(ours).max())
+    assert errors[1] < errors[0] / 5 and errors[2] < errors[1] / 5
+    assert errors[2] < 1e-8
 
 
 @pytest.mark.parametrize("name", ["five-bar.yaml", "delta.yaml"])
