@@ -69,3 +69,21 @@ def test_phantom_cube_is_reachable_throughout(edge_mm):
     half = edge_mm / 2000
     axis = np.linspace(-half, half, 11)
     assert all(reachable(HOME + np.array(p)) for p in itertools.product(axis, axis, axis))
+
+
+def test_phantom_workspace_sections_equal_the_closed_form(edge_mm):
+    """The sheet's sections (three planes through home, 7 x 7 points over 3 cube edges): reached exactly where
+    the closed form has a pose within the limits."""
+    from hapticdesign.studies.spec import handle_at
+    from hapticdesign.studies.spec_maps import workspace_sections
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        device = load_device_file(Path(__file__).resolve().parents[2] / "examples" / "devices" / "phantom-premium.yaml")
+    h = handle_at(device, np.zeros(3))
+    sections = workspace_sections(device, h.q, h.position, h.basis, edge_mm / 1000, points=7)
+    assert [s.names for s in sections] == [("x", "y"), ("x", "z"), ("y", "z")]
+    for s in sections:
+        oracle = np.array([[reachable(HOME + a * s.axes[0] + b * s.axes[1]) for b in s.v] for a in s.u])
+        assert 0 < oracle.sum() < oracle.size
+        assert np.array_equal(s.reached, oracle), s.names
