@@ -1,4 +1,7 @@
-"""Run every ``benchmarks/bench_*.py`` (its ``main()``), or those named on the command line."""
+"""Run every ``benchmarks/bench_*.py`` (its ``main()``), or those named on the command line.
+
+``--readme`` runs only the parts that feed README.md's speed table (``speed_table.py``; ``--write`` puts the table
+into README.md; naming parts, e.g. ``--readme dynamics rcube``, runs those only)."""
 
 from __future__ import annotations
 
@@ -21,4 +24,10 @@ def main(names: list[str]) -> None:
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    if "--readme" in sys.argv[1:]:
+        sys.path.insert(0, str(HERE))
+        from speed_table import main as speed_table
+
+        speed_table([a for a in sys.argv[1:] if a != "--readme"])
+    else:
+        main(sys.argv[1:])

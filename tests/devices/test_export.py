@@ -1,6 +1,6 @@
 """Exports checked in established libraries. URDF of a tree in Pinocchio: its ``crba`` and ``rnea`` equal our
 H and ``C qd + G``. MJCF in MuJoCo: on trees its mass matrix and bias forces equal ours; on closed loops its
-constrained accelerations under a torque equal ours.
+constrained accelerations under a torque equal ours (the R-CUBE's welds included).
 
 Oracles: MuJoCo's ``mj_fullM``, ``qfrc_bias``, its constraint Jacobian ``efc_J`` and its own constrained
 ``qacc``. The export has more joints than the device has coordinates (couplings such as the Phantom's
@@ -57,10 +57,10 @@ EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "devices"
 def _load(name):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return load_device_file(EXAMPLES / name)
+        return load_device_file(EXAMPLES / name if isinstance(name, str) else name)
 
 
-@pytest.mark.parametrize("name", ["arm-3r.toml", "phantom-3dof-motors.yaml"])
+@pytest.mark.parametrize("name", ["arm-3r.toml", "phantom-3dof-motors.yaml", "phantom-premium.yaml"])
 def test_tree_mass_matrix_and_bias_equal_mujocos(name):
     device = _load(name)
     export = to_mjcf(device)
@@ -79,11 +79,16 @@ def test_tree_mass_matrix_and_bias_equal_mujocos(name):
                            atol=1e-7)
 
 
-def _accelerations(device, impedance: str | None = None):
-    """Ours, MuJoCo's own and the hard-constraint limit from MuJoCo's matrices, at home under a torque."""
+def _accelerations(device, impedance: str | None = None, bound_mass: float | None = None):
+    """Ours, MuJoCo's own and the hard-constraint limit from MuJoCo's matrices, at home under a torque (with
+    another constraint impedance or another bound on the massless frames' mass if given)."""
     text = to_mjcf(device).text
     if impedance is not None:
         text = text.replace('solimp="0.9999 0.9999 0.001 0.5 2"', f'solimp="{impedance}"')
+    if bound_mass is not None:
+        assert text.count('boundmass="1e-09" boundinertia="1e-12"') == 1
+        text = text.replace('boundmass="1e-09" boundinertia="1e-12"',
+                            f'boundmass="{bound_mass:g}" boundinertia="{bound_mass * 1e-3:g}"')
     model = mujoco.MjModel.from_xml_string(text)
     data = mujoco.MjData(model)
     mujoco.mj_resetDataKeyframe(model, data, 0)
@@ -101,10 +106,25 @@ def _accelerations(device, impedance: str | None = None):
     return ours, data.qacc[dofs].copy(), hard[dofs]
 
 
-@pytest.mark.parametrize("name", ["five-bar.yaml", "delta.yaml", "falcon.yaml"])
+@pytest.mark.parametrize("name", ["five-bar.yaml", "delta.yaml", "falcon.yaml", "rcube.yaml"])
 def test_closed_loop_accelerations_equal_the_hard_constraint_limit_of_mujocos_model(name):
     ours, _, hard = _accelerations(_load(name))
     assert np.abs(hard - ours).max() <= 1e-6 * np.abs(ours).max()
+
+
+def test_rcube_weld_export_differs_from_ours_by_the_bound_mass_only():
+    """The R-CUBE closes its loops with two welds (whole pose) over 12 passive joints and carries only 77.7 g of
+    tubes, so MuJoCo's 1e-9 kg on each massless frame shows (measured 5e-7 relative): a tenfold smaller bound
+    makes the difference about tenfold smaller, down to 1e-8 at 1e-11 kg."""
+    device = _load("rcube.yaml")
+    model = mujoco.MjModel.from_xml_string(to_mjcf(device).text)
+    assert list(model.eq_type) == [mujoco.mjtEq.mjEQ_WELD] * 2
+    errors = []
+    for bound in (1e-9, 1e-10, 1e-11):
+        ours, _, hard = _accelerations(device, bound_mass=bound)
+        errors.append(np.abs(hard - ours).max() / np.abs(ours).max())
+    assert errors[1] < errors[0] / 5 and errors[2] < errors[1] / 5
+    assert errors[2] < 1e-8
 
 
 @pytest.mark.parametrize("name", ["five-bar.yaml", "delta.yaml"])
@@ -116,3 +136,62 @@ def test_mujocos_soft_constrained_accelerations_approach_ours(name):
         errors.append(np.abs(soft - ours).max() / np.abs(ours).max())
     assert errors[1] < errors[0] / 5 and errors[2] < errors[1] / 5
     assert errors[2] < 1e-3
+
+
+PEAK = 0.129  # N m at the motor: the Maxon RE 25's stall torque, as examples/devices/phantom-premium.yaml states it
+PREMIUM_RATIOS = (13.3, 11.2, 11.2)
+PREMIUM_LIMITS_DEG = ((-90, 90), (-124, 119), (-29, 214))
+
+
+def test_mjcf_carries_the_phantoms_joint_limits_and_peak_torques_and_mujoco_clamps_to_them():
+    """Joint ranges from the file's limits, ``ctrlrange``/``forcerange`` +-tau_p at the motor, and the
+    joint's ``actuatorfrcrange`` +-n tau_p: MuJoCo's own ``qfrc_actuator`` saturates at n tau_p."""
+    device = _load("phantom-premium.yaml")
+    model = mujoco.MjModel.from_xml_string(to_mjcf(device).text)
+    data = mujoco.MjData(model)
+    for k, name in enumerate(("q1", "q2", "q3")):
+        joint = model.joint(name)
+        assert np.allclose(joint.range, np.radians(PREMIUM_LIMITS_DEG[k]), rtol=1e-15)
+        assert model.jnt_limited[joint.id]
+        assert np.allclose(model.jnt_actfrcrange[joint.id], [-PREMIUM_RATIOS[k] * PEAK, PREMIUM_RATIOS[k] * PEAK])
+        motor = model.actuator(f"motor{k + 1}")
+        assert np.allclose(motor.ctrlrange, [-PEAK, PEAK]) and np.allclose(motor.forcerange, [-PEAK, PEAK])
+        assert motor.gear[0] == PREMIUM_RATIOS[k]
+    dofs = [model.joint(n).dofadr[0] for n in ("q1", "q2", "q3")]
+    for ctrl, expected in ((np.array([0.05, -0.02, 0.1]), np.array([0.05, -0.02, 0.1])),
+                           (np.array([1.0, -3.0, 0.5]), np.array([PEAK, -PEAK, PEAK]))):
+        data.ctrl[:] = ctrl
+        mujoco.mj_forward(model, data)
+        assert np.allclose(data.qfrc_actuator[dofs], np.array(PREMIUM_RATIOS) * expected, rtol=1e-12)
+
+
+def _with_peak_torques(tmp_path):
+    """phantom-3dof-motors.yaml with the RE 25's peak torque on its three motors (the third on -theta2 - theta3)."""
+    text = (EXAMPLES / "phantom-3dof-motors.yaml").read_text()
+    assert text.count("damping: 0.0005}") == 3
+    path = tmp_path / "peaks.yaml"
+    path.write_text(text.replace("damping: 0.0005}", f"damping: 0.0005, torque_peak: {PEAK}}}"))
+    return _load(path)
+
+
+def test_mjcf_of_a_coupled_motor_limits_its_tendon(tmp_path):
+    """The third motor turns -theta2 - theta3 within [-29, 214] deg: its tendon's range and force range."""
+    model = mujoco.MjModel.from_xml_string(to_mjcf(_with_peak_torques(tmp_path)).text)
+    tendon = model.tendon("drive3")
+    assert np.allclose(model.tendon_range[tendon.id], np.radians([-29, 214]), rtol=1e-15)
+    assert model.tendon_limited[tendon.id]
+    assert np.allclose(model.tendon_actfrcrange[tendon.id], [-11.2 * PEAK, 11.2 * PEAK])
+    assert np.allclose(model.jnt_range[model.joint("theta3").id], np.radians([-65, 55]), rtol=1e-15)
+
+
+def test_urdf_carries_joint_limits_and_efforts_read_by_pinocchio(tmp_path):
+    """Pinocchio's limits: the file's ranges, effort n tau_p on joints with a motor of their own, 0 on theta3
+    (its motor turns a combination, which URDF cannot state)."""
+    pin = pytest.importorskip("pinocchio")
+    model = pin.buildModelFromXML(to_urdf(_with_peak_torques(tmp_path)).text)
+    expected = {"theta1": ((-90, 90), 13.3 * PEAK), "theta2": ((-119, 124), 11.2 * PEAK), "theta3": ((-65, 55), 0.0)}
+    for name, (span, effort) in expected.items():
+        joint = model.joints[model.getJointId(name)]
+        assert model.lowerPositionLimit[joint.idx_q] == pytest.approx(np.radians(span[0]), rel=1e-15)
+        assert model.upperPositionLimit[joint.idx_q] == pytest.approx(np.radians(span[1]), rel=1e-15)
+        assert model.effortLimit[joint.idx_v] == pytest.approx(effort, rel=1e-15)

@@ -80,11 +80,33 @@ def test_phantom_reproduces_the_memos_test_vectors(phantom):
     assert np.allclose(gravity(phantom, np.array([0, 0.5, 0.5])) * scale, [0, -0.014303, -0.035360], atol=5e-7)
 
 
-def test_phantom_loads_with_a_warning_for_the_published_inertias():
-    with pytest.warns(PhysicalConsistencyWarning) as caught:
+def test_phantom_file_holds_rigid_bodies_where_the_published_split_does_not():
+    """The memo's be and df break the triangle inequality about their axes; the file moves a moment about
+    the vertical from the base to them (H unchanged, checked above) and loads without a warning, while the
+    same file with the published split warns for both bodies."""
+    for xx, yy, zz in (IBE, IDF):
+        assert xx > yy + zz
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
         resolve_device(device_file=EXAMPLES / "phantom-premium.yaml")
-    text = " ".join(str(w.message) for w in caught)
-    assert "body be" in text and "body df" in text and "triangle inequality" in text
+
+
+def test_phantom_with_the_published_split_warns_for_be_and_df(tmp_path):
+    text = (EXAMPLES / "phantom-premium.yaml").read_text()
+    published = {"Ixx: 11.47e-4, Iyy: 11.47e-4, Izz: 11.47e-4": "Ixx: 11.87e-4, Iyy: 11.87e-4, Izz: 11.87e-4",
+                 "Iyy: 7.11534784e-4, Izz: 0.841e-4": "Iyy: 6.86534784e-4, Izz: 0.591e-4",
+                 "Iyy: 0.779e-4, Izz: 1.10248526e-4": "Iyy: 0.629e-4, Izz: 0.95248526e-4"}
+    for ours, theirs in published.items():
+        assert text.count(ours) == 1
+        text = text.replace(ours, theirs)
+    path = tmp_path / "published.yaml"
+    path.write_text(text)
+    with pytest.warns(PhysicalConsistencyWarning) as caught:
+        device = resolve_device(device_file=path)
+    message = " ".join(str(w.message) for w in caught)
+    assert "body be" in message and "body df" in message and "triangle inequality" in message
+    for q in (np.zeros(3), np.array([0.3, -0.4, 0.9])):
+        assert np.allclose(mass_matrix(device, q), cavusoglu_mass_matrix(q) + np.diag(ROTOR), rtol=1e-9, atol=1e-12)
 
 
 FALCON = {"a": 0.060, "b": 0.1025, "c": 0.014, "d": 0.01125, "e": 0.01125, "f": -0.025, "r": 0.037233758,

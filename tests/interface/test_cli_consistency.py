@@ -207,6 +207,8 @@ def test_campaign_json_lists_its_files_and_summary(tmp_path):
     out = json.loads(result.stdout)
     assert (out["cases"], out["run"], out["skipped"]) == (4, 4, 0)
     assert all(Path(p).is_file() for p in out["tables"] + out["figures"]) and out["figures"]
+    index = Path(out["index"]).read_text()
+    assert all(f'href="{Path(p).relative_to(tmp_path / "c").as_posix()}"' in index for p in out["tables"] + out["figures"])
     with Path(out["tables"][1]).open() as f:
         rows = list(csv.DictReader(f))
     assert len(out["summary"]) == len(rows) == 4  # one level x two criteria x two types

@@ -96,6 +96,14 @@ def test_spec_json_and_html_of_the_phantom(tmp_path):
     assert json.loads((tmp_path / "spec.json").read_text())["force_peak"] == pytest.approx(11.2 * 0.129 / 0.215)
 
 
+def test_spec_page_of_a_closed_loop_device_shows_its_workspace_section(tmp_path):
+    result = runner.invoke(app, ["spec", "--device", str(EXAMPLES / "five-bar.yaml"), "--out", str(tmp_path),
+                                 "--quiet"])
+    assert result.exit_code == 0, result.stderr
+    page = (tmp_path / "spec.html").read_text()
+    assert "<h2>Workspace sections</h2>" in page and page.count('src="data:image/png;base64,') == 1
+
+
 def test_spec_page_escapes_the_device_name(tmp_path):
     source = (EXAMPLES / "haply-2diy.yaml").read_text().replace("name: haply-2diy", "name: '<script>x</script>'")
     device = tmp_path / "odd.yaml"

@@ -8,6 +8,7 @@ with the URDF reader). Inertial parameters keep the seed's names (seed 000 Table
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -16,7 +17,7 @@ from pydantic import ValidationError
 from hapticdesign.analysis.stiffness.link import rigidities
 from hapticdesign.analysis.stiffness.sections import Tube
 from hapticdesign.devices.builder import ChainBuilder, DHRowTemplate, FrameTemplate, assemble_device
-from hapticdesign.devices.schema import ActuatorSpec, DeviceFileSpec, body_frame, motor_terms
+from hapticdesign.devices.schema import HOME_POSITION, ActuatorSpec, DeviceFileSpec, body_frame, motor_terms
 from hapticdesign.errors import UserError
 from hapticdesign.model.actuators import Actuator
 from hapticdesign.model.device import Device, build_mechanism
@@ -29,8 +30,33 @@ from hapticdesign.workload import require_device_size
 
 
 def device_from_spec(spec: DeviceFileSpec) -> Device:
-    """The Device described by a validated device file."""
-    builder = chain_builder(spec)
+    """The Device described by a validated device file; a ``home`` with a handle ``position`` is the pose the
+    inverse kinematics reaches from the home of the joint values (0 where not given) on its assembly branch."""
+    device = _device(spec, _closed_loops(spec))
+    position = spec.home.get(HOME_POSITION)
+    if isinstance(position, list):
+        device = _device(spec, _home_at(device, position))
+    return device
+
+
+def _home_at(device: Device, position: list[float]) -> ClosedLoops:
+    """The device's loops with their home (and assembly guess) moved to the pose that puts the handle at
+    ``position``: the configuration space's inverse kinematics, continued from the home of the joint values."""
+    from hapticdesign.analysis.configuration import configuration_of  # the loop solver, for such files only
+
+    space = configuration_of(device)
+    try:
+        q_a = space.inverse_kinematics(position)
+    except UserError as exc:
+        raise UserError(f"home.{HOME_POSITION}: {exc}") from None
+    loops = device.mechanism.loops
+    full = space.full(q_a)
+    return replace(loops, home=tuple(float(v) for v in q_a), assembly=tuple(float(full[k]) for k in loops.passive))
+
+
+def _device(spec: DeviceFileSpec, loops: ClosedLoops | None) -> Device:
+    """The Device of the file with the given loops (their home and assembly)."""
+    builder = chain_builder(spec, loops)
     kinematic = {**spec.parameters, "g": spec.g}
     link_bodies = link_body_inertias(spec, build_mechanism(builder, tuple((k, float(v)) for k, v in kinematic.items())))
     return assemble_device(
@@ -69,8 +95,9 @@ def link_body_inertias(spec: DeviceFileSpec, mechanism: Mechanism,
     return out
 
 
-def chain_builder(spec: DeviceFileSpec) -> ChainBuilder:
-    """The mechanism builder of a validated device file (its geometry, for any parameter values)."""
+def chain_builder(spec: DeviceFileSpec, loops: ClosedLoops | None = None) -> ChainBuilder:
+    """The mechanism builder of a validated device file (its geometry, for any parameter values), with ``loops``
+    (default: the file's own, :func:`_closed_loops`)."""
     return ChainBuilder(
         coordinates=tuple(j.name for j in spec.joints),
         joint_types=tuple(JointType(j.type) for j in spec.joints),
@@ -82,7 +109,7 @@ def chain_builder(spec: DeviceFileSpec) -> ChainBuilder:
         ),
         bodies=tuple((b.name, body_frame(spec, b)) for b in spec.bodies),
         end_effector=spec.end_effector,
-        loops=_closed_loops(spec),
+        loops=_closed_loops(spec) if loops is None else loops,
     )
 
 
@@ -104,8 +131,14 @@ def _closed_loops(spec: DeviceFileSpec) -> ClosedLoops | None:
         passive=tuple(k for k, j in enumerate(spec.joints) if not j.actuated),
         closures=tuple(LoopClosure(tuple(loop.frames), tuple(loop.close)) for loop in spec.loops),
         assembly=tuple(float(spec.assembly[j.name]) for j in spec.joints if not j.actuated),
-        home=tuple(float(spec.home.get(name, 0.0)) for name, j in zip(names, spec.joints) if j.actuated),
+        home=tuple(float(_joint_home(spec, name)) for name, j in zip(names, spec.joints) if j.actuated),
     )
+
+
+def _joint_home(spec: DeviceFileSpec, name: str) -> float:
+    """The home value the file gives joint ``name`` (0 where none; a handle position is no joint value)."""
+    value = spec.home.get(name, 0.0)
+    return 0.0 if isinstance(value, list) else value
 
 
 def _actuators(spec: DeviceFileSpec) -> tuple[Actuator, ...]:

@@ -15,6 +15,13 @@ Motors become ``motor`` actuators with the
 transmission ratio as ``gear`` and the reflected rotor inertia as ``armature``, on the coordinate's joint or,
 for a motor on a combination of coordinates, on a fixed tendon. Names are escaped by the XML writer.
 
+Limits. A coordinate's limits become its joint's ``range`` (MJCF) or ``<limit lower upper>`` (URDF), a
+coupled motor's travel the ``range`` of its tendon. A motor with a peak torque ``tau_p`` (N m at the motor)
+gets ``ctrlrange`` and ``forcerange`` ``+-tau_p`` (its scalar force, before ``gear``) and, on the joint or
+tendon it turns, ``actuatorfrcrange`` ``+-n tau_p`` (the transmission's output); in URDF the joint's
+``effort`` is ``n tau_p`` (0 where no motor states a peak torque) and ``velocity`` 0 (a device file states
+no speed limit). URDF cannot state a motor on a combination of coordinates: its limits are left out.
+
 MuJoCo refuses moving bodies without mass, and most frames between two joints carry none: the MJCF sets
 ``<compiler boundmass="1e-9" boundinertia="1e-12">`` (kg, kg m^2), a change far below any device's own.
 It also refuses inertias that break the triangle inequality (a file may still hold them, with a warning).
@@ -127,6 +134,7 @@ def to_mjcf(device: Device) -> Export:
     reflected = {}
     friction = {}
     damping = dict(zip(mech.actuated_coordinates, device.damping))
+    efforts = _joint_efforts(device)
     for actuator in device.actuators:
         if not actuator.coupled:
             name = mech.actuated_coordinates[actuator.joint]
@@ -153,6 +161,8 @@ def to_mjcf(device: Device) -> Export:
                     span = device.joint_limits()[mech.actuated_coordinates.index(jname)]
                     if span is not None:
                         j.set("range", _fmt(span))
+                    if jname in efforts:
+                        j.set("actuatorfrcrange", _fmt([-efforts[jname], efforts[jname]]))
             parent = body
         element[frame.name] = parent
     for attachment in mech.bodies:
@@ -168,6 +178,18 @@ def to_mjcf(device: Device) -> Export:
     ET.SubElement(keyframe, "key", name="home", qpos=_fmt(np.array([j.row for j in ordered]) @ _home(mech)))
     ET.indent(root)
     return Export(ET.tostring(root, encoding="unicode") + "\n", ordered)
+
+
+def _output_torque(actuator) -> float | None:
+    """``n tau_p``: the peak torque (or force) the transmission delivers, or None without a peak torque."""
+    return None if actuator.torque_peak is None else actuator.gear_ratio * actuator.torque_peak
+
+
+def _joint_efforts(device: Device) -> dict[str, float]:
+    """``n tau_p`` per coordinate turned by a motor of its own that states a peak torque."""
+    names = device.mechanism.actuated_coordinates
+    return {names[a.joint]: _output_torque(a) for a in device.actuators
+            if not a.coupled and a.torque_peak is not None}
 
 
 def _home(mech: Mechanism) -> np.ndarray:
@@ -226,6 +248,10 @@ def _actuators(device: Device, root: ET.Element) -> None:
                                ("frictionloss", actuator.coulomb)):
                 if value:
                     fixed.set(key, f"{value:.17g}")
+            if actuator.limits is not None:
+                fixed.set("range", _fmt(np.array(actuator.limits) - actuator.offset))
+            if actuator.torque_peak is not None:
+                fixed.set("actuatorfrcrange", _fmt([-_output_torque(actuator), _output_torque(actuator)]))
             for k, c in enumerate(actuator.row(device.n_dof)):
                 if c:
                     ET.SubElement(fixed, "joint", joint=mech.actuated_coordinates[k], coef=f"{c:.17g}")
@@ -234,6 +260,7 @@ def _actuators(device: Device, root: ET.Element) -> None:
             motor.set("joint", mech.actuated_coordinates[actuator.joint])
         if actuator.torque_peak is not None:
             motor.set("ctrlrange", _fmt([-actuator.torque_peak, actuator.torque_peak]))
+            motor.set("forcerange", _fmt([-actuator.torque_peak, actuator.torque_peak]))
         part.append(motor)
     root.append(part)
 
@@ -251,6 +278,7 @@ def to_urdf(device: Device) -> Export:
     link_of = {"base": "base"}
     joints: list[JointRow] = []
     limits = dict(zip(mech.actuated_coordinates, device.joint_limits()))
+    efforts = _joint_efforts(device)
     for frame in mech.frames:
         parent = link_of[frame.parent or "base"]
         for pose, joint in tree.segments(frame):
@@ -263,7 +291,7 @@ def to_urdf(device: Device) -> Export:
             ET.SubElement(element, "origin", xyz=_fmt(pose[:3, 3]),
                           rpy=_fmt(Rotation.from_matrix(pose[:3, :3]).as_euler("xyz")))
             if joint is not None:
-                _urdf_joint(mech, element, joint, limits, joints)
+                _urdf_joint(mech, element, joint, (limits, efforts), joints)
             parent = name
         link_of[frame.name] = parent
     for attachment in mech.bodies:
@@ -282,16 +310,23 @@ def to_urdf(device: Device) -> Export:
     return Export(ET.tostring(robot, encoding="unicode") + "\n", tuple(joints))
 
 
-def _urdf_joint(mech: Mechanism, element: ET.Element, joint, limits: dict, joints: list[JointRow]) -> None:
-    """Type, axis, limits and (for a coupling) the ``<mimic>`` of one driven transform."""
+def _urdf_joint(mech: Mechanism, element: ET.Element, joint, bounds: tuple[dict, dict],
+                joints: list[JointRow]) -> None:
+    """Type, axis, limits (range and the motor's ``n tau_p`` as effort) and (for a coupling) the ``<mimic>`` of
+    one driven transform."""
     kind, name, axis, k, row = joint
+    limits, efforts = bounds
     span = limits.get(name) if k is not None else None
+    effort = efforts.get(name, 0.0) if k is not None else 0.0
     element.set("type", ("revolute" if span is not None else "continuous") if kind == "hinge" else "prismatic")
     ET.SubElement(element, "axis", xyz=_fmt(axis))
     if kind == "slide" and span is None:
         raise UserError(f"cannot export {name} as URDF: a prismatic joint needs limits")
     if span is not None:
-        ET.SubElement(element, "limit", lower=f"{span[0]:.17g}", upper=f"{span[1]:.17g}", effort="0", velocity="0")
+        ET.SubElement(element, "limit", lower=f"{span[0]:.17g}", upper=f"{span[1]:.17g}", effort=f"{effort:.17g}",
+                      velocity="0")
+    elif effort:
+        ET.SubElement(element, "limit", effort=f"{effort:.17g}", velocity="0")
     if k is None:
         terms = [(i, c) for i, c in enumerate(row) if c]
         if len(terms) != 1:

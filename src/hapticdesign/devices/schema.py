@@ -118,6 +118,8 @@ def _name(value: object) -> object:
 
 
 Expression = Annotated[LinearExpr, BeforeValidator(_expression)]
+HOME_POSITION = "position"
+"""The key of ``home`` that gives the handle's home position instead of joint values."""
 Number = Annotated[float, BeforeValidator(_constant)]
 Identifier = Annotated[str, Field(pattern=IDENTIFIER_PATTERN)]
 Name = Annotated[str, BeforeValidator(_name), Field(min_length=1, max_length=200)]
@@ -313,7 +315,7 @@ class DeviceFileSpec(_FileModel):
     actuators: list[ActuatorSpec] = []
     loops: list[LoopSpec] = []
     assembly: dict[Identifier, Number] = {}
-    home: dict[Identifier, Number] = {}
+    home: dict[Identifier, Number | list[Number]] = {}
     links: list[LinkSpec] = []
     joint_stiffness: dict[Identifier, Annotated[Number, Field(gt=0.0)]] = {}
 
@@ -462,9 +464,17 @@ def _check_loops(spec: DeviceFileSpec, frames: list[str]) -> None:
     missing = [name for name in passive if name not in spec.assembly]
     if missing:
         raise ValueError(f"assembly: give a value near the intended branch at home for passive joint {missing[0]}")
-    for name in spec.home:
-        if name not in actuated:
+    for name, value in spec.home.items():
+        if isinstance(value, list):
+            if name != HOME_POSITION:
+                raise ValueError(f"home.{name}: a joint's home value is one number (a handle position is "
+                                 f"home: {{{HOME_POSITION}: [x, y, z]}})")
+            if len(value) != 3:
+                raise ValueError(f"home.{HOME_POSITION}: a handle position is 3 numbers [x, y, z] (m), got {len(value)}")
+        elif name not in actuated:
             raise ValueError(f"home: {name!r} is not an actuated joint (actuated: {', '.join(actuated)})")
+    if spec.home and not spec.loops:
+        raise ValueError("home: only a device with loops has a home of its own (a tree's home is q = 0)")
 
 
 def _check_limits_and_actuators(spec: DeviceFileSpec, coordinates: list[str]) -> None:

@@ -103,6 +103,70 @@ def kinematics_step(ctx: Context) -> Outcome:
     )
 
 
+CHAIN_COLOURS = ("#c0392b", "#27ae60", "#2e6fd8")
+CHAIN_POINTS = ("chain_base", "tip1", "tip2", "tip3")
+"""Frames of :func:`~hapticdesign.model.rcube.chain_mechanism` joined by the drawn links: base, l1, l2, l3."""
+
+
+def device_figure(design, side: float = 0.12):
+    """The design at home: each chain's links l1, l2, l3 from its base (eq. 5.2-5.18, the chain's own forward
+    kinematics at the angles of eq. 5.30-5.45), the platform, the dexterous cube and a scale bar."""
+    from hapticdesign.analysis.kinematics import forward_kinematics
+    from hapticdesign.model.rcube import chain_mechanism
+
+    g = design.geometry
+    angles = rcube_kinematics.inverse_kinematics(g, g.home)
+    fig = plt.figure(figsize=(6.0, 5.2))
+    ax = fig.add_subplot(projection="3d", proj_type="ortho")
+    points = [np.zeros(3)]
+    for chain, colour in enumerate(CHAIN_COLOURS):
+        mech = chain_mechanism(g, chain)
+        q = np.asarray(angles[chain], dtype=float)
+        path = np.array([forward_kinematics(mech, q, frame)[:3, 3] for frame in CHAIN_POINTS])
+        ax.plot(*path.T, color=colour, linewidth=3.5, solid_capstyle="round", label=f"chain {chain + 1}")
+        ax.scatter(*path[:-1].T, s=14, color="#34495e", depthshade=False)
+        ax.plot(*np.stack([np.zeros(3), path[0]]).T, color="#7f8c8d", linewidth=1.0, linestyle=":")
+        points.append(path)
+    ax.scatter(*g.home, s=50, color="#e67e22", depthshade=False, label="platform (home)")
+    half = side / 2
+    corners = np.array([[x, y, z] for x in (-half, half) for y in (-half, half) for z in (-half, half)]) + g.home
+    for i in range(8):
+        for j in range(i + 1, 8):
+            if np.count_nonzero(corners[i] != corners[j]) == 1:
+                ax.plot(*corners[[i, j]].T, color="#95a5a6", linewidth=0.8)
+    points = np.vstack(points + [corners])
+    low, high = points.min(axis=0), points.max(axis=0)
+    middle, span = 0.5 * (low + high), 0.55 * float((high - low).max())
+    for set_limits, m in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), middle):
+        set_limits(m - span, m + span)
+    ax.set_box_aspect((1, 1, 1))
+    start = middle - span
+    ax.plot([start[0], start[0] + 0.05], [start[1]] * 2, [start[2]] * 2, color="black", linewidth=3.0)
+    ax.text(start[0], start[1], start[2] + 0.04 * span, "50 mm", fontsize=8)
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_zlabel("z [m]")
+    ax.tick_params(labelsize=7)
+    ax.legend(loc="upper left", fontsize=7)
+    return fig
+
+
+def device_step(ctx: Context) -> Outcome:
+    """A picture of the final design at home with its dexterous cube (§5.1, Table 7.8)."""
+    design = _final()
+    g = design.geometry
+    caption = (f"Table 7.8's design (l1, l2, l3 = {g.l1 * 1e3:.1f}, {g.l2 * 1e3:.1f}, {g.l3 * 1e3:.1f} mm, chain "
+               f"offset S = {g.S * 1e3:.1f} mm) at home, the platform at ({', '.join(f'{v * 1e3:.1f}' for v in g.home)}) "
+               "mm: each chain's base on its axis (dotted from the origin), its actuated link l1 and the passive links "
+               "l2 and l3 to the platform, and the 120 mm cube the platform must reach (grey).")
+    return Outcome(
+        summary=f"The final design at home: three chains on the x, y and z axes carrying the platform at "
+                f"{np.round(g.home * 1e3, 1).tolist()} mm.",
+        figures=[figure_from_matplotlib(device_figure(design), "rcube_device", "The modified R-CUBE at home",
+                                        caption)],
+    )
+
+
 SEED_PLIES = ((4, 7, 7), (2, 6, 6), (2, 6, 2))
 """Table 7.8's plies per link at 0, 90 and +-45 deg."""
 SEED_RATIO = 0.75
@@ -407,6 +471,7 @@ def optimization_step(ctx: Context) -> Outcome:
 
 def steps() -> list[Step]:
     return [
+        Step("device", "The device (§5.1, Table 7.8)", device_step),
         Step("kinematics", "Kinematics and workspace (§5.1, Tables 7.2-7.3)", kinematics_step),
         Step("final_design", "Final design: stiffness, inertia, modes (Tables 7.8-7.9, eq. 7.6-7.13)", final_design_step),
         Step("maps", "Workspace maps of the metrics (§7.5, Figures 7.5-7.19)", maps_step),

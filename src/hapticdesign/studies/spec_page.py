@@ -7,6 +7,7 @@ stiffness CHAI3D recommends for rendering on it (800 N/m) and on the Novint Falc
 
 from __future__ import annotations
 
+import base64
 import html
 
 VENDOR = {
@@ -20,8 +21,8 @@ VENDOR = {
                        "peak is higher, presumably in a favourable direction or pose and with a higher peak "
                        "current than the stall data of the model."),
         "apparent_mass": (0.075, "kg", "ours at home with the rotors: 37 g along the forearm's swing, 81 g along "
-                          "the base rotation (the base's 11.87e-4 kg m^2 and motor 1's reflected inertia over "
-                          "0.215 m); the vendor's under 75 g is presumably at its nominal position and along its "
+                          "the base rotation (H11, the moments about the vertical and motor 1's reflected inertia, "
+                          "over 0.215 m); the vendor's under 75 g is presumably at its nominal position and along its "
                           "main directions."),
         "renderable_stiffness": (800.0, "N/m", "CHAI3D's recommended stiffness is far above the exact limit of "
                                  "the model alone (its only damping is 0.0005 N m s/rad per joint, which bounds "
@@ -58,8 +59,20 @@ def _value(sheet: dict, key: str) -> str:
     return f"{value:.4g}"
 
 
-def spec_page(sheet: dict) -> str:
-    """A self-contained HTML page of ``sheet`` (:func:`hapticdesign.studies.spec.spec_sheet`); text escaped."""
+def _figures(figures) -> str:
+    """``(title, caption, png bytes)`` as embedded images (the page stays one self-contained file)."""
+    out = []
+    for title, caption, png in figures:
+        data = base64.b64encode(png).decode("ascii")
+        out.append(f"<h2>{html.escape(title)}</h2>\n<figure><img src=\"data:image/png;base64,{data}\" "
+                   f"alt=\"{html.escape(title)}\" style=\"max-width: 100%\"><figcaption>{html.escape(caption)}"
+                   "</figcaption></figure>\n")
+    return "".join(out)
+
+
+def spec_page(sheet: dict, figures=()) -> str:
+    """A self-contained HTML page of ``sheet`` (:func:`hapticdesign.studies.spec.spec_sheet`) and ``figures``
+    (``(title, caption, png bytes)``, e.g. :func:`hapticdesign.studies.spec_maps.workspace_png`); text escaped."""
     vendor = VENDOR.get(sheet["device"], {})
     rows = []
     for key, label, unit in ROWS:
@@ -82,5 +95,5 @@ def spec_page(sheet: dict) -> str:
         f"<p>At q = ({html.escape(pose)}), handle at ({html.escape(handle)}) mm. Forces exclude gravity; "
         "definitions in hapticdesign.studies.spec.</p>\n"
         "<table border=\"1\"><tr><th>quantity</th><th>ours</th><th>unit</th><th>vendor</th><th>why they differ</th>"
-        "</tr>\n" + "\n".join(rows) + "\n</table>\n</body></html>\n"
+        "</tr>\n" + "\n".join(rows) + "\n</table>\n" + _figures(figures) + "</body></html>\n"
     )

@@ -145,8 +145,27 @@
     var d = [p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]];
     var right = -sa * d[0] + ca * d[1];
     var up = -se * ca * d[0] - se * sa * d[1] + ce * d[2];
-    var scale = 0.42 * Math.min(canvas.width, canvas.height) / data.extent * view.zoom;
+    var scale = pixelsPerMetre();
     return [canvas.width / 2 + scale * right, canvas.height / 2 - scale * up];
+  }
+
+  function pixelsPerMetre() {
+    return 0.42 * Math.min(canvas.width, canvas.height) / data.extent * view.zoom;
+  }
+
+  function plate(points) {  // a rigid plate: its outline's frame origins, filled
+    ctx.fillStyle = "rgba(170, 183, 196, 0.45)"; ctx.strokeStyle = "#34495e"; ctx.lineWidth = 1;
+    ctx.beginPath();
+    points.forEach(function (p, i) { var s = project(p); if (i === 0) { ctx.moveTo(s[0], s[1]); } else { ctx.lineTo(s[0], s[1]); } });
+    ctx.closePath(); ctx.fill(); ctx.stroke();
+  }
+
+  function scaleBar() {  // a round length (data.scale, m) at the current zoom, bottom left
+    var length = pixelsPerMetre() * data.scale, x = 16, y = canvas.height - 16;
+    ctx.strokeStyle = "#000"; ctx.lineWidth = 3;
+    ctx.beginPath(); ctx.moveTo(x, y); ctx.lineTo(x + length, y); ctx.stroke();
+    ctx.fillStyle = "#000"; ctx.font = "12px sans-serif";
+    ctx.fillText((data.scale * 1000).toPrecision(3).replace(/\.?0+$/, "") + " mm", x, y - 6);
   }
 
   function line(a, b, colour, width) {
@@ -168,7 +187,9 @@
       var tip = [0, 0, 0]; tip[i] = axisLength;
       line([0, 0, 0], tip, colour, 1.5);
     });
-    data.links.forEach(function (pair) { line(o[pair[0]], o[pair[1]], "#34495e", 3); });
+    data.plates.forEach(function (outline) { plate(outline.map(function (name) { return o[name]; })); });
+    data.links.forEach(function (pair) { line(o[pair[0]], o[pair[1]], "#34495e", 1.5); });
+    data.bars.forEach(function (b) { line(o[b.frame], apply(poses[b.frame], b.end), "#2c3e50", 5); });
     data.closures.forEach(function (c) {  // loop closures: a ring where the two frames meet
       var s = project(o[c[0]]);
       ctx.strokeStyle = "#8e44ad"; ctx.lineWidth = 1.5;
@@ -179,6 +200,7 @@
     massCentres(poses).forEach(function (b) { dot(b.p, 3 + 9 * Math.sqrt(b.m / heaviest), "rgba(200, 40, 40, 0.55)"); });
     Object.keys(o).forEach(function (name) { dot(o[name], 2.5, "#7f8c8d"); });
     if (data.end_effector) { dot(o[data.end_effector], 5, "#e67e22"); }
+    scaleBar();
     if (showLabels) {
       ctx.fillStyle = "#222"; ctx.font = "11px sans-serif";
       Object.keys(o).forEach(function (name) { var s = project(o[name]); ctx.fillText(name, s[0] + 4, s[1] - 4); });

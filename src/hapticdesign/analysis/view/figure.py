@@ -1,11 +1,12 @@
-"""The device as a static PNG for papers: links, frame origins, mass centres at one pose (matplotlib 3D)."""
+"""The device as a static PNG for papers: links, bodies as bars, rigid plates, frame origins, mass centres and a
+scale bar at one pose (matplotlib 3D)."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from hapticdesign.files import figure_bytes
-from hapticdesign.analysis.view.skeleton import frame_poses, links, mass_centres
+from hapticdesign.analysis.view.skeleton import bars, frame_poses, links, mass_centres, plates, scale_length
 from hapticdesign.model.device import Device
 
 
@@ -30,10 +31,20 @@ def device_figure(device: Device, q: np.ndarray, dpi: int = 150):
     origins = {name: pose[:3, 3] for name, pose in poses.items()}
     fig = plt.figure(figsize=(6.0, 5.0), dpi=dpi)
     ax = fig.add_subplot(projection="3d", proj_type="ortho")
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    for outline in plates(device, q):
+        ax.add_collection3d(Poly3DCollection([[origins[name] for name in outline]], facecolor="#aab7c4",
+                                             edgecolor="#34495e", alpha=0.45, linewidth=1.0))
     for parent, child in links(device):
         a, b = origins[parent], origins[child]
-        ax.plot(*zip(a, b), color="#34495e", linewidth=2.0)
-    points = np.array(list(origins.values()))
+        ax.plot(*zip(a, b), color="#34495e", linewidth=1.0)
+    ends = []
+    for frame, end in bars(device):
+        tip = (poses[frame] @ np.append(end, 1.0))[:3]
+        ax.plot(*zip(origins[frame], tip), color="#2c3e50", linewidth=3.5, solid_capstyle="round")
+        ends.append(tip)
+    points = np.vstack([np.array(list(origins.values()))] + ([np.array(ends)] if ends else []))
     ax.scatter(*points.T, s=6, color="#7f8c8d", depthshade=False)
     bodies = mass_centres(device, poses)
     if bodies:
@@ -52,6 +63,10 @@ def device_figure(device: Device, q: np.ndarray, dpi: int = 150):
     ax.set_ylim(middle[1] - half, middle[1] + half)
     ax.set_zlim(middle[2] - half, middle[2] + half)
     ax.set_box_aspect((1, 1, 1))
+    length = scale_length(2.0 * half)
+    start = np.array([middle[0] - half, middle[1] - half, middle[2] - half])
+    ax.plot([start[0], start[0] + length], [start[1]] * 2, [start[2]] * 2, color="black", linewidth=3.0)
+    ax.text(start[0], start[1], start[2] + 0.04 * half, f"{length * 1000:g} mm", fontsize=8)
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_zlabel("z [m]")

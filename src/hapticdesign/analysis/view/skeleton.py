@@ -89,6 +89,86 @@ def links(device: Device) -> list[tuple[str, str]]:
     return [(frame.parent or "base", frame.name) for frame in device.mechanism.frames]
 
 
+def bars(device: Device) -> list[tuple[str, np.ndarray]]:
+    """``(frame, end)``: each body with its mass centre off its frame's origin drawn as a uniform bar from that
+    origin to twice the mass centre (``end`` in the frame's axes), e.g. a rod whose far end is no frame."""
+    out = []
+    for attachment in device.mechanism.bodies:
+        body = device.body(attachment.name)
+        if body.m > 0 and np.any(body.r):
+            out.append((attachment.frame, 2.0 * np.asarray(body.r, dtype=float)))
+    return out
+
+
+PLATE_PROBE = 0.05
+"""rad or m: the actuated moves that tell which frame origins move as one rigid body (:func:`plates`)."""
+
+
+def plates(device: Device, q: np.ndarray) -> list[list[str]]:
+    """Rigid plates to fill: per rigid body, the largest set of coplanar, non-collinear frame origins it carries
+    (3 or more distinct points), as the frames of their convex hull in order. A frame origin belongs to the
+    body of frame A (``base`` for the ground) when it keeps its coordinates in A's axes while each actuated
+    coordinate moves by :data:`PLATE_PROBE` from ``q`` (the loops closed); e.g. a delta's base triangle of
+    hip pivots and its platform with the rods' anchors. The ground is a plate only when all its distinct
+    points are coplanar (three chain bases on the three axes and the origin are no plate)."""
+    probes = [np.asarray(q, dtype=float)] + [q + PLATE_PROBE * np.eye(len(q))[k] for k in range(len(q))]
+    try:
+        sampled = [frame_poses(device, p) for p in probes]
+    except UserError:  # a probe the loops cannot reach: no plates, the links still draw the device
+        return []
+    names = list(sampled[0])
+    extent = max(float(np.abs(p[:3, 3]).max()) for p in sampled[0].values()) or 1.0
+    tol = 1e-9 * extent
+    found: list[list[str]] = []
+    seen: set[frozenset[str]] = set()
+    for carrier in names:
+        local = np.array([[np.linalg.solve(s[carrier], np.append(s[name][:3, 3], 1.0))[:3] for name in names]
+                          for s in sampled])
+        rigid = [names[i] for i in range(len(names)) if np.ptp(local[:, i], axis=0).max() <= tol]
+        ground = max(np.ptp(np.array([s[carrier] for s in sampled]), axis=0).max(), 0.0) <= tol
+        outline = _plate_outline(rigid, local[0, [names.index(n) for n in rigid]], tol, whole=ground)
+        if outline and frozenset(outline) not in seen:
+            seen.add(frozenset(outline))
+            found.append(outline)
+    return found
+
+
+def _plate_outline(names: list[str], points: np.ndarray, tol: float, whole: bool = False) -> list[str]:
+    """The convex hull, in order, of the largest coplanar subset of distinct ``points`` (one name per point);
+    with ``whole``, none unless every distinct point lies in that plane."""
+    distinct: list[int] = []
+    for i, p in enumerate(points):
+        if all(np.linalg.norm(p - points[j]) > tol for j in distinct):
+            distinct.append(i)
+    best: list[int] = []
+    for a in range(len(distinct)):
+        for b in range(a + 1, len(distinct)):
+            for c in range(b + 1, len(distinct)):
+                pa, pb, pc = points[distinct[a]], points[distinct[b]], points[distinct[c]]
+                normal = np.cross(pb - pa, pc - pa)
+                if np.linalg.norm(normal) <= tol * max(np.linalg.norm(pb - pa), np.linalg.norm(pc - pa)):
+                    continue
+                normal /= np.linalg.norm(normal)
+                members = [i for i in distinct if abs(float(normal @ (points[i] - pa))) <= tol]
+                if len(members) > len(best):
+                    best = members
+    if len(best) < 3 or (whole and len(best) < len(distinct)):
+        return []
+    plane = points[best] - points[best].mean(axis=0)
+    u, v = np.linalg.svd(plane)[2][:2]
+    from scipy.spatial import ConvexHull
+
+    hull = ConvexHull(np.column_stack([plane @ u, plane @ v]))
+    return [names[best[i]] for i in hull.vertices]
+
+
+def scale_length(extent: float) -> float:
+    """A round length (1, 2 or 5 times a power of ten, m) near a quarter of ``extent``, for a scale bar."""
+    target = max(extent, 1e-6) / 4.0
+    power = 10.0 ** math.floor(math.log10(target))
+    return max(step * power for step in (1.0, 2.0, 5.0) if step * power <= target)
+
+
 def mass_centres(device: Device, poses: dict[str, np.ndarray]) -> list[tuple[str, float, np.ndarray]]:
     """``(body, mass, position)`` of every body with mass at the poses of :func:`frame_poses`."""
     out = []
@@ -136,6 +216,9 @@ def export(device: Device, q: np.ndarray) -> dict:
         "links": [list(pair) for pair in links(device)],
         "bodies": [{"name": a.name, "frame": a.frame, "m": device.body(a.name).m,
                     "r": [float(v) for v in device.body(a.name).r]} for a in mech.bodies if device.body(a.name).m > 0],
+        "bars": [{"frame": frame, "end": [float(v) for v in end]} for frame, end in bars(device)],
+        "plates": plates(device, q),
         "end_effector": mech.end_effector,
         "extent": extent,
+        "scale": scale_length(extent),
     }

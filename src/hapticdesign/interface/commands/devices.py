@@ -107,8 +107,16 @@ def spec(
         pose = None if q is None else parse_vector(q, dev.n_dof, "q")
         sheet = spec_sheet(dev, pose, rate=rate, workspace=workspace)
         if out is not None:
+            figures = []
+            if sheet["workspace"] is not None and sheet["workspace"]["cube"] > 0.0:
+                from hapticdesign.studies.spec_maps import SECTION_SPAN, workspace_png
+
+                figures.append(("Workspace sections", f"Planes through the home handle position, {SECTION_SPAN:g} "
+                                "cube edges wide: blue where the handle gets by inverse kinematics on the home branch "
+                                "(within the joint limits, no singularity), the workspace cube's section in red.",
+                                workspace_png(dev, sheet)))
             write_atomically(out / "spec.json", dumps_json(sheet) + "\n")
-            write_atomically(out / "spec.html", spec_page(sheet))
+            write_atomically(out / "spec.html", spec_page(sheet, figures))
             note(f"wrote {out / 'spec.html'} and {out / 'spec.json'}", quiet)
         if json_out:
             print_json(sheet)

@@ -270,6 +270,7 @@ def maps(out: Path = typer.Option(..., "--out", help="Directory for the PNG imag
          force: bool = FORCE) -> None:
     """Metric maps on the planes z = home - side/2, home, home + side/2 (Figures 7.5-7.19)."""
     from hapticdesign.analysis.rcube.metrics import save_workspace_maps
+    from hapticdesign.interface.report.index import write_folder_index
     from hapticdesign.workload import require_within
 
     with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
@@ -287,10 +288,15 @@ def maps(out: Path = typer.Option(..., "--out", help="Directory for the PNG imag
                 if report:
                     report("planes", k, len(planes))
                 paths += save_workspace_maps(dsg, out, n, h, (plane,))
+        g = dsg.geometry
+        index = write_folder_index(out, "R-CUBE metric maps", (
+            f"Metrics of the design l1, l2, l3 = {g.l1 * 1e3:g}, {g.l2 * 1e3:g}, {g.l3 * 1e3:g} mm on the planes "
+            f"z = home - {h * 1e3:g} mm, home, home + {h * 1e3:g} mm of a {side * 1e3:g} mm cube, {n} x {n} points "
+            "per plane (seed 001 §7.5, Figures 7.5-7.19)."), paths)
         if json_out:
-            print_json({"out": str(out), "files": [str(p) for p in paths]})
+            print_json({"out": str(out), "files": [str(p) for p in paths], "index": str(index)})
             return
-        typer.echo(f"wrote {len(paths)} images to {out}")
+        typer.echo(f"wrote {len(paths)} images to {out}, listed in {index}")
 
 
 def register(app: typer.Typer) -> None:

@@ -335,6 +335,7 @@ def campaign_command(
     import os
 
     from hapticdesign.devices.registry import preset as preset_device
+    from hapticdesign.interface.report.index import write_folder_index
     from hapticdesign.simulation.campaign import CampaignOptions, load_cases, read_designs, run_campaign, summarize
     from hapticdesign.simulation.config import Compensator, LoopConfig, Sensors, compensator_device
     from hapticdesign.simulation.paths import Chirp
@@ -368,15 +369,20 @@ def campaign_command(
             advance = ((lambda done, total: report("cases", done, total)) if report
                        else progress_lines(not (quiet or json_out), "campaign cases"))
             counts = run_campaign(designs, out, options, scheduler, workers, advance, quiet=quiet)
+        index = write_folder_index(out, f"Campaign {designs.name}", (
+            f"{options.method.capitalize()} campaign of the designs in {designs.name} on {options.preset}: both "
+            "criteria and both types (seed 000 §4.1.4, §4.2.4); one JSON file per case in cases/."),
+            [out / name for name in ("results.csv", "summary.csv", "summary.md")]
+            + sorted((out / "figures").iterdir()))
         if json_out:
             chosen = read_designs(designs, options.preset)
-            print_json({**counts, "out": str(out),
+            print_json({**counts, "out": str(out), "index": str(index),
                         "tables": [str(out / name) for name in ("results.csv", "summary.csv", "summary.md")],
                         "figures": sorted(str(f) for f in (out / "figures").iterdir()),
                         "summary": summarize(chosen, load_cases(chosen, out), options)})
             return
         typer.echo(f"{counts['cases']} cases: {counts['run']} run, {counts['skipped']} already done; "
-                   f"tables and figures in {out}")
+                   f"tables and figures in {out}, listed in {index}")
 
 
 def register(app: typer.Typer) -> None:

@@ -74,6 +74,7 @@ def zwidth_command(
     Exact for the sampled-data loop (zero-order hold, delay, compensator), with the passivity bound of
     Colgate & Schenkel beside it (Colgate & Brown 1994). J and b come from the options or from one
     joint of a device at a pose (the other joints held)."""
+    from hapticdesign.interface.report.index import write_folder_index
     from hapticdesign.simulation.figures import zwidth_chart
     from hapticdesign.simulation.zwidth import DisplayLoop, along_wall, zwidth
 
@@ -103,7 +104,7 @@ def zwidth_command(
             loop = along_wall(loop, reach)
         result = zwidth(loop, _dampers(b_values), points)
         units = ("kg", "N s/m", "N/m") if reach is not None else ("kg m^2", "N m s/rad", "N m/rad")
-        figures = []
+        figures, index = [], None
         if out is not None:
             title = (f"J = {loop.inertia:g} {units[0]}, b = {loop.damping:g} {units[1]}, T = {period:g} s, N = {delay}, "
                      f"{velocity} velocity" + (f", compensator c = {fraction:g}" if compensate_inertia else "")
@@ -112,9 +113,11 @@ def zwidth_command(
             if map_joints is not None:
                 figures += _map(preset, device, params, strict, joint, map_joints, map_points, loop, result.B[0],
                                 Path(out))
+            index = str(write_folder_index(Path(out), "Z-width", "Exact Z-width of a 1-DOF haptic display (seed 000 "
+                                           f"ch. 5 future work): {title}.", figures))
         payload = {**result.as_dict(), "loop": {"inertia": loop.inertia, "damping": loop.damping, "period": period,
                                                  "delay": delay, "velocity": velocity, "fraction": fraction},
-                   "figures": figures}
+                   "figures": figures, **({"index": index} if index else {})}
         if reach is not None:
             payload["units"] = {"B": units[1], "K": units[2]}
             payload["loop"]["wall_reach"] = reach
@@ -126,7 +129,7 @@ def zwidth_command(
             p = "-" if result.passivity is None else f"{result.passivity[i]:.6g}"
             lin = "-" if result.linear is None else f"{result.linear[i]:.6g}"
             typer.echo(f"{b:13.5g}   {k:15.6g}   {p:>11}   {lin:>22}")
-        for f in figures:
+        for f in figures + ([index] if index else []):
             note(f"wrote {f}", quiet)
 
 

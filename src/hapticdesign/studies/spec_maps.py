@@ -1,0 +1,128 @@
+"""Sections of the workspace the handle reaches, drawn in the spec sheet beside its workspace cube.
+
+Each section is a plane through the home handle position: the three planes of the base axes for a spatial
+device, the plane it moves in for a planar one. A square of ``3 a`` (``a`` the sheet's cube edge) in each plane
+is sampled on a grid and walked in snake order; a point is reached when the inverse kinematics
+(:func:`hapticdesign.analysis.inverse_kinematics.handle_pose`) gets the handle there within the joint limits and
+without a singularity, continued from the last point reached or, failing that, from home: the region of the
+home branch the handle can reach. The cube's section (a square of edge ``a`` around home) is drawn on top.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from hapticdesign.analysis.inverse_kinematics import handle_pose
+from hapticdesign.errors import UserError
+from hapticdesign.model.device import Device
+
+SECTION_POINTS = 15
+"""Grid points per side of each section."""
+SECTION_SPAN = 3.0
+"""Side of each section in cube edges."""
+AXES = "xyz"
+
+
+@dataclass(frozen=True)
+class Section:
+    """A plane through the home handle position: its axes (world unit vectors and names), grid offsets (m)
+    from home along each, and which grid points the handle reaches (``reached[i, j]`` at ``u[i], v[j]``)."""
+
+    names: tuple[str, str]
+    axes: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+    reached: np.ndarray
+
+
+def planes(basis: np.ndarray) -> list[tuple[tuple[str, str], np.ndarray]]:
+    """The section planes: the base axes' planes for a spatial device, the plane of motion for a planar one."""
+    if basis.shape[1] == 3:
+        return [((AXES[i], AXES[j]), np.eye(3)[[i, j]]) for i, j in ((0, 1), (0, 2), (1, 2))]
+    axes = basis[:, :2].T.copy()
+    names = []
+    for axis in axes:
+        k = int(np.argmax(np.abs(axis)))
+        names.append(AXES[k] if abs(axis[k]) > 1.0 - 1e-9 else "u" if not names else "v")
+        axis *= np.sign(axis[k])
+    return [((names[0], names[1]), axes)]
+
+
+def workspace_sections(device: Device, q: np.ndarray, home: np.ndarray, basis: np.ndarray, edge: float,
+                       points: int = SECTION_POINTS) -> list[Section]:
+    """Sections of :func:`planes` (``basis``: the handle's directions of motion at home) around the handle's home
+    position ``home`` (m), each ``SECTION_SPAN * edge`` wide."""
+    offsets = np.linspace(-0.5, 0.5, points) * SECTION_SPAN * edge
+    out = []
+    for names, axes in planes(basis):
+        reached = np.zeros((points, points), dtype=bool)
+        last = np.asarray(q, dtype=float)
+        for i in range(points):
+            for j in (range(points) if i % 2 == 0 else range(points - 1, -1, -1)):
+                target = home + offsets[i] * axes[0] + offsets[j] * axes[1]
+                pose = _reach(device, target, last, q)
+                if pose is not None:
+                    reached[i, j], last = True, pose
+        out.append(Section(names, axes, offsets, offsets.copy(), reached))
+    return out
+
+
+def _reach(device: Device, target: np.ndarray, last: np.ndarray, home: np.ndarray) -> np.ndarray | None:
+    """Actuated coordinates at ``target`` continued from ``last``, else from ``home``; None out of reach."""
+    for start in (last, home) if last is not home else (home,):
+        try:
+            return handle_pose(device, target, start=start).q
+        except UserError:
+            continue
+    return None
+
+
+def section_figure(sections: list[Section], edge: float, title: str):
+    """A matplotlib figure: one panel per section, reached points filled, the cube's section outlined (mm)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import ListedColormap
+
+    fig, axes = plt.subplots(1, len(sections), figsize=(4.2 * len(sections), 4.2), squeeze=False,
+                             constrained_layout=True)
+    half = 500.0 * edge
+    for ax, section in zip(axes[0], sections):
+        step = 1000.0 * (section.u[1] - section.u[0])
+        extent = (1000.0 * section.u[0] - step / 2, 1000.0 * section.u[-1] + step / 2,
+                  1000.0 * section.v[0] - step / 2, 1000.0 * section.v[-1] + step / 2)
+        ax.imshow(section.reached.T.astype(float), origin="lower", extent=extent, vmin=0.0, vmax=1.0,
+                  cmap=ListedColormap(["#f4f4f6", "#9cc3e6"]), interpolation="nearest")
+        ax.plot([-half, half, half, -half, -half], [-half, -half, half, half, -half], color="#c0392b", linewidth=1.5,
+                label=f"workspace cube, {1000.0 * edge:.4g} mm")
+        ax.plot([0.0], [0.0], marker="+", color="black", markersize=10, label="home")
+        ax.set_xlabel(f"{section.names[0]} - home [mm]")
+        ax.set_ylabel(f"{section.names[1]} - home [mm]")
+        ax.set_title(f"{section.names[0]}-{section.names[1]} plane through home", fontsize=10)
+        ax.set_aspect("equal")
+    axes[0][0].legend(loc="lower left", fontsize=7)
+    fig.suptitle(title, fontsize=10)
+    return fig
+
+
+def workspace_png(device: Device, sheet: dict, points: int = SECTION_POINTS) -> bytes:
+    """PNG of the sections around the sheet's pose (:func:`hapticdesign.studies.spec.spec_sheet` with its
+    workspace cube)."""
+    import matplotlib.pyplot as plt
+
+    from hapticdesign.files import figure_bytes
+    from hapticdesign.studies.spec import handle_at
+
+    h = handle_at(device, sheet["q"])
+    edge = sheet["workspace"]["cube"] / 1000.0
+    if edge <= 0.0:
+        raise UserError("the workspace cube is empty at this pose, so there is no section to draw around it")
+    found = workspace_sections(device, h.q, h.position, h.basis, edge, points)
+    fig = section_figure(found, edge, f"{device.name[:60]}\nworkspace reached on the home branch "
+                                      f"({points} x {points} points per plane)")
+    png = figure_bytes(fig, "png", dpi=110)
+    plt.close(fig)
+    return png

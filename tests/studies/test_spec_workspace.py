@@ -1,0 +1,89 @@
+"""The spec sheet's workspace cube of the Phantom Premium against an oracle that does not use the toolkit: the
+closed-form inverse kinematics of Cavusoglu & Feygin's coordinates (q1 = atan2(y, x); q2 and q3 from the triangle
+shoulder-elbow-handle with sides l1 = 0.215 m and l2 = 0.170 m, the elbow-down branch of home), the file's joint
+limits (q1 in [-90, 90], q2 in [-124, 119], q3 in [-29, 214] deg) and bisection on the cube's half edge."""
+
+from __future__ import annotations
+
+import itertools
+import math
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from hapticdesign.devices.device_file import load_device_file
+from hapticdesign.studies.spec import CUBE_SEARCH, spec_sheet
+
+L1, L2 = 0.215, 0.170
+LIMITS = np.radians([(-90, 90), (-124, 119), (-29, 214)])
+HOME = np.array([L1, 0.0, -L2])  # q = 0: x = l1 cos q2 + l2 sin q3, z = l1 sin q2 - l2 cos q3
+STENCIL = [np.array(s) - 1.0 for s in itertools.product(range(3), repeat=3) if s != (1, 1, 1)]
+
+
+def closed_form(p) -> np.ndarray | None:
+    """(q1, q2, q3) putting the handle at p on home's branch, or None out of the arm's reach."""
+    x, y, z = p
+    rho = math.hypot(x, y)
+    h = math.hypot(rho, z)
+    shoulder = (L1**2 + h**2 - L2**2) / (2 * L1 * h)
+    elbow = (L1**2 + L2**2 - h**2) / (2 * L1 * L2)
+    if abs(shoulder) >= 1 or abs(elbow) >= 1 or rho == 0.0:
+        return None
+    q2 = math.atan2(z, rho) + math.acos(shoulder)
+    return np.array([math.atan2(y, x), q2, q2 - math.pi / 2 + math.acos(elbow)])
+
+
+def reachable(p) -> bool:
+    q = closed_form(p)
+    return q is not None and bool(np.all((LIMITS[:, 0] <= q) & (q <= LIMITS[:, 1])))
+
+
+def oracle_edge() -> float:
+    """Largest edge (m) whose corners, edge midpoints and face centres are reachable, bisected to 1e-9 m."""
+    lo, hi = 0.0, 0.4
+    while hi - lo > 1e-9:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if all(reachable(HOME + mid * s) for s in STENCIL) else (lo, mid)
+    return 2 * lo
+
+
+@pytest.fixture(scope="module")
+def edge_mm():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        device = load_device_file(Path(__file__).resolve().parents[2] / "examples" / "devices" / "phantom-premium.yaml")
+    return spec_sheet(device)["workspace"]["cube"]
+
+
+def test_phantom_cube_edge_equals_the_closed_form_bisection(edge_mm):
+    """Within the sheet's bisection step: 0.4 m / 2^12 on the half edge, twice that on the edge."""
+    lo, hi, halvings = CUBE_SEARCH
+    step = 2 * (hi - lo) / 2**halvings
+    assert 1000 * oracle_edge() - 1000 * step <= edge_mm <= 1000 * oracle_edge()
+
+
+def test_phantom_cube_is_reachable_throughout(edge_mm):
+    """Not only its 26 probe points: every point of an 11 x 11 x 11 grid of the cube has a pose within limits."""
+    half = edge_mm / 2000
+    axis = np.linspace(-half, half, 11)
+    assert all(reachable(HOME + np.array(p)) for p in itertools.product(axis, axis, axis))
+
+
+def test_phantom_workspace_sections_equal_the_closed_form(edge_mm):
+    """The sheet's sections (three planes through home, 7 x 7 points over 3 cube edges): reached exactly where
+    the closed form has a pose within the limits."""
+    from hapticdesign.studies.spec import handle_at
+    from hapticdesign.studies.spec_maps import workspace_sections
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        device = load_device_file(Path(__file__).resolve().parents[2] / "examples" / "devices" / "phantom-premium.yaml")
+    h = handle_at(device, np.zeros(3))
+    sections = workspace_sections(device, h.q, h.position, h.basis, edge_mm / 1000, points=7)
+    assert [s.names for s in sections] == [("x", "y"), ("x", "z"), ("y", "z")]
+    for s in sections:
+        oracle = np.array([[reachable(HOME + a * s.axes[0] + b * s.axes[1]) for b in s.v] for a in s.u])
+        assert 0 < oracle.sum() < oracle.size
+        assert np.array_equal(s.reached, oracle), s.names
