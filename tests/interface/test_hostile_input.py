@@ -463,21 +463,41 @@ def test_ctrl_c_is_one_line(monkeypatch):
     assert result.stderr == "error: interrupted\n" and result.stdout == ""
 
 
-def test_campaign_workers_start_with_ctrl_c_ignored():
-    """Ctrl-C reaches the terminal's whole process group: processes started while the campaign holds
-    interrupts (as its Dask workers are) inherit "ignore" and print no traceback; the handler returns."""
+def test_campaign_workers_start_with_ctrl_c_blocked_and_a_ctrl_c_meanwhile_is_kept():
+    """Ctrl-C reaches the terminal's whole process group: processes spawned while the campaign defers interrupts
+    (as its Dask workers are, by multiprocessing's spawn from a thread started inside) inherit SIGINT blocked and
+    never answer it; a SIGINT that arrives meanwhile is raised once the block ends, and the handler returns."""
+    import multiprocessing
+    import os
     import signal
-    import subprocess
-    import sys
+    import threading
 
-    from hapticdesign.simulation.campaign import _hold_interrupts, _release_interrupts
+    from hapticdesign.simulation.campaign import deferred_interrupts
 
     before = signal.getsignal(signal.SIGINT)
-    previous = _hold_interrupts()
-    try:
-        child = subprocess.run([sys.executable, "-c", "import signal; print(signal.getsignal(signal.SIGINT) == signal.SIG_IGN)"],
-                               capture_output=True, text=True, check=True)
-    finally:
-        _release_interrupts(previous)
-    assert child.stdout.strip() == "True"
+    masks: list[bool] = []
+
+    def spawn():
+        child = multiprocessing.get_context("spawn").Process(target=_report_blocked, args=(queue,))
+        child.start()
+        masks.append(queue.get())
+        child.join()
+
+    queue = multiprocessing.get_context("spawn").Queue()
+    with pytest.raises(KeyboardInterrupt):
+        with deferred_interrupts():
+            starter = threading.Thread(target=spawn)
+            starter.start()
+            starter.join()
+            os.kill(os.getpid(), signal.SIGINT)  # held: the block goes on to its end
+            masks.append(True)
+    assert masks == [True, True]
     assert signal.getsignal(signal.SIGINT) is before
+    assert signal.SIGINT not in signal.pthread_sigmask(signal.SIG_BLOCK, [])
+
+
+def _report_blocked(queue) -> None:
+    """In a spawned process: whether SIGINT is blocked there."""
+    import signal
+
+    queue.put(signal.SIGINT in signal.pthread_sigmask(signal.SIG_BLOCK, []))
