@@ -11,6 +11,7 @@ from __future__ import annotations
 import csv
 import fcntl
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -389,6 +390,24 @@ def test_impedance_range_refuses_a_wall_joint_without_inertia(tmp_path, method):
     params.write_text("".join(f"{name}: 0\n" for name in names + [f"r{b}{a}" for b in bodies for a in "xyz"]))
     one_line_error(["impedance-range", "--method", method, "--params", str(params), "--joint", "2"],
                    "joint 2 has no inertia at the start pose (H22 = 0)")
+
+
+def test_analytic_range_of_a_joint_with_inertia_beside_massless_links_is_the_closed_form(tmp_path):
+    """Links 2, 3, 2a and 3a massless, the wall on joint 1: joints 2 and 3 follow their paths (held, type 1), so
+    their missing inertia does not enter; joint 1 turns body 1 alone, H11 = Iyy1 + m1 r1z^2 (parallel axes,
+    0.009 + 0.25 * 0.15^2), and with full inertial compensation and no delay the sampled wall is stable up to
+    K* = b^2 / H11 (seed 000 ch. 4; :mod:`hapticdesign.simulation.boundary`'s closed form at c = 1): 17.09, so
+    the last stable integer stiffness is 17 N m/rad."""
+    params = tmp_path / "massless.yaml"
+    bodies = ("2", "3", "2a", "3a")
+    names = [f"{n}{b}" for b in bodies for n in ("m", "Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz")]
+    params.write_text("".join(f"{name}: 0\n" for name in names + [f"r{b}{a}" for b in bodies for a in "xyz"]))
+    result = runner.invoke(app, ["impedance-range", "--method", "analytic", "--params", str(params), "--joint", "1",
+                                 "--json"])
+    assert result.exit_code == 0, result.output
+    p, b1 = hd.preset("phantom-3dof").params, 0.5  # b1: Table 4.1
+    h11 = p["Iyy1"] + p["m1"] * (p["r1x"] ** 2 + p["r1z"] ** 2)
+    assert json.loads(result.stdout)["k_max"] == math.floor(b1 ** 2 / h11) == 17
 
 
 def test_rcube_lengths_that_overflow_the_kinematics_are_refused():
