@@ -218,6 +218,9 @@ def write_atomically(path: Path | str, content: str | bytes) -> None:
         except OSError:  # the place itself is broken (a file where a folder should be): nothing was written
             pass
         raise UserError(f"cannot write {path}: {exc.strerror or exc}") from None
+    except BaseException:  # a Ctrl-C between writing and renaming: no .tmp left behind
+        tmp.unlink(missing_ok=True)
+        raise
 
 
 FIGURE_SALT = "hapticdesign"

@@ -11,6 +11,7 @@ from __future__ import annotations
 import csv
 import fcntl
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -391,6 +392,24 @@ def test_impedance_range_refuses_a_wall_joint_without_inertia(tmp_path, method):
                    "joint 2 has no inertia at the start pose (H22 = 0)")
 
 
+def test_analytic_range_of_a_joint_with_inertia_beside_massless_links_is_the_closed_form(tmp_path):
+    """Links 2, 3, 2a and 3a massless, the wall on joint 1: joints 2 and 3 follow their paths (held, type 1), so
+    their missing inertia does not enter; joint 1 turns body 1 alone, H11 = Iyy1 + m1 r1z^2 (parallel axes,
+    0.009 + 0.25 * 0.15^2), and with full inertial compensation and no delay the sampled wall is stable up to
+    K* = b^2 / H11 (seed 000 ch. 4; :mod:`hapticdesign.simulation.boundary`'s closed form at c = 1): 17.09, so
+    the last stable integer stiffness is 17 N m/rad."""
+    params = tmp_path / "massless.yaml"
+    bodies = ("2", "3", "2a", "3a")
+    names = [f"{n}{b}" for b in bodies for n in ("m", "Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz")]
+    params.write_text("".join(f"{name}: 0\n" for name in names + [f"r{b}{a}" for b in bodies for a in "xyz"]))
+    result = runner.invoke(app, ["impedance-range", "--method", "analytic", "--params", str(params), "--joint", "1",
+                                 "--json"])
+    assert result.exit_code == 0, result.output
+    p, b1 = hd.preset("phantom-3dof").params, 0.5  # b1: Table 4.1
+    h11 = p["Iyy1"] + p["m1"] * (p["r1x"] ** 2 + p["r1z"] ** 2)
+    assert json.loads(result.stdout)["k_max"] == math.floor(b1 ** 2 / h11) == 17
+
+
 def test_rcube_lengths_that_overflow_the_kinematics_are_refused():
     one_line_error(["rcube", "ik", "--l1", "1e308", "--l2", "1e308", "--l3", "1e308", "--position", "0,0,0"],
                    "must be a positive length of at most 1000 m, got 1e+308")
@@ -463,21 +482,41 @@ def test_ctrl_c_is_one_line(monkeypatch):
     assert result.stderr == "error: interrupted\n" and result.stdout == ""
 
 
-def test_campaign_workers_start_with_ctrl_c_ignored():
-    """Ctrl-C reaches the terminal's whole process group: processes started while the campaign holds
-    interrupts (as its Dask workers are) inherit "ignore" and print no traceback; the handler returns."""
+def test_campaign_workers_start_with_ctrl_c_blocked_and_a_ctrl_c_meanwhile_is_kept():
+    """Ctrl-C reaches the terminal's whole process group: processes spawned while the campaign defers interrupts
+    (as its Dask workers are, by multiprocessing's spawn from a thread started inside) inherit SIGINT blocked and
+    never answer it; a SIGINT that arrives meanwhile is raised once the block ends, and the handler returns."""
+    import multiprocessing
+    import os
     import signal
-    import subprocess
-    import sys
+    import threading
 
-    from hapticdesign.simulation.campaign import _hold_interrupts, _release_interrupts
+    from hapticdesign.simulation.campaign import deferred_interrupts
 
     before = signal.getsignal(signal.SIGINT)
-    previous = _hold_interrupts()
-    try:
-        child = subprocess.run([sys.executable, "-c", "import signal; print(signal.getsignal(signal.SIGINT) == signal.SIG_IGN)"],
-                               capture_output=True, text=True, check=True)
-    finally:
-        _release_interrupts(previous)
-    assert child.stdout.strip() == "True"
+    masks: list[bool] = []
+
+    def spawn():
+        child = multiprocessing.get_context("spawn").Process(target=_report_blocked, args=(queue,))
+        child.start()
+        masks.append(queue.get())
+        child.join()
+
+    queue = multiprocessing.get_context("spawn").Queue()
+    with pytest.raises(KeyboardInterrupt):
+        with deferred_interrupts():
+            starter = threading.Thread(target=spawn)
+            starter.start()
+            starter.join()
+            os.kill(os.getpid(), signal.SIGINT)  # held: the block goes on to its end
+            masks.append(True)
+    assert masks == [True, True]
     assert signal.getsignal(signal.SIGINT) is before
+    assert signal.SIGINT not in signal.pthread_sigmask(signal.SIG_BLOCK, [])
+
+
+def _report_blocked(queue) -> None:
+    """In a spawned process: whether SIGINT is blocked there."""
+    import signal
+
+    queue.put(signal.SIGINT in signal.pthread_sigmask(signal.SIG_BLOCK, []))

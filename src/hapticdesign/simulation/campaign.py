@@ -243,19 +243,34 @@ def dask_client(scheduler: str | None, workers: int | None, quiet: bool = False)
                                dashboard_address=None, silence_logs=logging.CRITICAL + 1 if quiet else logging.ERROR))
 
 
-def _hold_interrupts():
-    """Ignore Ctrl-C (SIGINT) while the worker processes start, so that they inherit "ignore" and never
-    answer it (it reaches the terminal's whole process group): only this process does, closing the
-    workers, with one line. Returns the handler to restore (None off the main thread, where Python
-    cannot set one). A Ctrl-C during the start itself is not seen."""
+@contextmanager
+def deferred_interrupts() -> Iterator[None]:
+    """Hold Ctrl-C (SIGINT) over the block and raise it after: a Ctrl-C while Dask's worker processes start
+    or stop is kept, not lost, and the block is never cut half-way.
+
+    Ctrl-C reaches the terminal's whole process group. Over the block, SIGINT is blocked in this thread's signal
+    mask, which the threads started inside (Dask's event loop, which spawns the workers) and the worker processes
+    inherit: the workers never answer it (no traceback from them), and this process alone ends the campaign. A
+    SIGINT that another thread receives meanwhile is recorded by a handler instead of interrupting the block; one
+    left pending is delivered once the mask is restored. Off the main thread (where Python cannot set a handler)
+    the block runs as it is."""
     if threading.current_thread() is not threading.main_thread():
-        return None
-    return signal.signal(signal.SIGINT, signal.SIG_IGN)
+        yield
+        return
+    from multiprocessing import resource_tracker
 
-
-def _release_interrupts(previous) -> None:
-    if previous is not None:
+    # started now, unmasked: starting it later (for the first worker) would unblock SIGINT in that thread
+    resource_tracker.ensure_running()
+    caught: list[int] = []
+    previous = signal.signal(signal.SIGINT, lambda signum, frame: caught.append(signum))
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
         signal.signal(signal.SIGINT, previous)
+    if caught:
+        raise KeyboardInterrupt
 
 
 def close_client(client, own_cluster: bool) -> None:
@@ -356,20 +371,18 @@ def _run_locked(designs: list[Design], out: Path, options: CampaignOptions, sche
         if rest:
             from dask.distributed import as_completed
 
-            held = _hold_interrupts()
+            client = None
             try:
-                client = dask_client(scheduler, workers, quiet)
-            except BaseException:
-                _release_interrupts(held)
-                raise
-            try:
-                _release_interrupts(held)
+                with deferred_interrupts():
+                    client = dask_client(scheduler, workers, quiet)
                 futures = {client.submit(run_design_cases, options.preset, d.params, cases, options,
                                          key=f"cases-{d.name}", pure=False): (d, cases) for d, cases in rest}
                 for fut in as_completed(futures):
                     record(*futures[fut], fut.result())
             finally:
-                close_client(client, own_cluster=not scheduler)
+                if client is not None:
+                    with deferred_interrupts():
+                        close_client(client, own_cluster=not scheduler)
     aggregate(designs, out, options)
     return {"cases": total, "run": len(todo), "skipped": total - len(todo)}
 

@@ -118,26 +118,26 @@ class WallProblem:
 
     def __post_init__(self) -> None:
         check_settle_window(self.criteria, self.config.duration)
-        require_inertia(self.device, rest_pose(self.device))
+        require_inertia(self.device, rest_pose(self.device), self.wall_joint)
         if self.config.wall.cartesian:
             require_reach(self.device, self.config, self.wall_joint)
         self.criteria = self.criteria.for_step(self.equilibrium)
 
 
-def require_inertia(device: Device, q: np.ndarray) -> None:
-    """The plant ``H qdd = tau - C qd - G`` needs ``H`` positive definite at the start pose; a joint
-    whose bodies are all massless has no inertia there and no motion to simulate or to bound."""
+def require_inertia(device: Device, q: np.ndarray, wall_joint: int) -> None:
+    """The wall joint is the one free joint of a search (:func:`type_paths` prescribes every other), so the
+    plant ``H_ww qdd_w = tau_w - ...`` needs ``H_ww > 0`` at the start pose: a wall joint whose bodies are all
+    massless has no inertia and no motion to simulate or to bound. The other joints' inertia does not enter
+    (they follow their paths whatever their torques), so massless links elsewhere are not refused."""
     from hapticdesign.analysis.dynamics.device import mass_matrix
 
-    h = np.atleast_2d(mass_matrix(device, q))
-    empty = [k + 1 for k in range(h.shape[0]) if not h[k, k] > 0.0]
-    if empty:
-        raise UserError(f"joint {empty[0]} has no inertia at the start pose (H{empty[0]}{empty[0]} = "
-                        f"{h[empty[0] - 1, empty[0] - 1]:g}): its bodies are massless, so it has no dynamics to simulate")
-    eig = np.linalg.eigvalsh(h)
-    if not eig[0] > 1e-12 * eig[-1]:
-        raise UserError(f"the mass matrix at the start pose is singular (smallest eigenvalue {eig[0]:.3g}): some "
-                        "motion of the joints has no inertia")
+    if not 0 <= wall_joint < device.n_dof:
+        raise UserError(f"unknown joint {wall_joint + 1}; the device has joints 1..{device.n_dof}")
+    h = np.atleast_2d(mass_matrix(device, q))[wall_joint, wall_joint]
+    if not h > 0.0:
+        k = wall_joint + 1
+        raise UserError(f"joint {k} has no inertia at the start pose (H{k}{k} = {h:g}): its bodies are massless, "
+                        "so it has no dynamics to simulate")
 
 
 def require_reach(device: Device, config: LoopConfig, wall_joint: int) -> None:
