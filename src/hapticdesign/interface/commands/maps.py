@@ -33,8 +33,9 @@ def maps(
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
 ) -> None:
-    """Maps of design indices (isotropy, apparent mass, force, stiffness, kmax, ...) over a plane of the workspace of
-    any device, each point reached from home by inverse kinematics; points out of reach are left blank."""
+    """Maps of design indices over a workspace plane of any device (seed 001 ch. 4 metrics, §7.5): isotropy, apparent
+    mass, force, stiffness, kmax, ..., each point reached from home by inverse kinematics; points out of reach are
+    left blank."""
     from hapticdesign.analysis.configuration import configuration_of
     from hapticdesign.analysis.metrics.maps import device_map
     from hapticdesign.analysis.workspace import Workspace
@@ -56,7 +57,8 @@ def maps(
         points = workspace.points()
         found = device_map(dev, points, names, registry=DESIGN_INDICES)
         files = _write(out, found, names, plane)
-        note(f"wrote {len(files)} files to {out} ({int(found.reached.sum())} of {len(points)} points reached)", quiet)
+        note(f"wrote {len(files)} files to {out} ({int(found.reached.sum())} of {len(points)} points reached)",
+             quiet or json_out)
         if json_out:
             print_json({"device": dev.name, "out": str(out), "files": files, "points": len(points),
                         "reached": int(found.reached.sum()),
