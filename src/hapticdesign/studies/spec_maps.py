@@ -3,7 +3,7 @@
 Each section is a plane through the home handle position: the three planes of the base axes for a spatial
 device, the plane it moves in for a planar one. A square of ``3 a`` (``a`` the sheet's cube edge) in each plane
 is sampled on a grid and walked in snake order; a point is reached when the inverse kinematics
-(:func:`hapticdesign.analysis.inverse_kinematics.handle_pose`) gets the handle there within the joint limits and
+(:func:`hapticdesign.analysis.configuration.handle_pose`) gets the handle there within the joint limits and
 without a singularity, continued from the last point reached or, failing that, from home: the region of the
 home branch the handle can reach. The cube's section (a square of edge ``a`` around home) is drawn on top.
 """
@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hapticdesign.analysis.inverse_kinematics import handle_pose
+from hapticdesign.analysis.configuration import handle_pose
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 
