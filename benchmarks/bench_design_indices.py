@@ -11,6 +11,7 @@ agree with the one-at-a-time ones (tests/design/test_design_batch.py). Times are
 (``time.process_time``, one thread), the best of three runs, after a warm-up that compiles the kernels.
 
     python benchmarks/bench_design_indices.py [--designs 2000]
+    python benchmarks/bench_design_indices.py --write docs/indices.md    # replace the table there
 """
 
 from __future__ import annotations
@@ -44,7 +45,10 @@ def _best(run, repeat: int = 3) -> float:
     return out
 
 
-def main(count: int = 2000) -> None:
+START, END = "<!-- design-indices-speed:start -->", "<!-- design-indices-speed:end -->"
+
+
+def main(count: int = 2000, write: Path | None = None) -> None:
     space = design_space(FIVE_BAR, list(BOUNDS))
     points = Workspace((0.0, 0.0, 0.18), (0.06, 0.0, 0.06), 5).points()
     rng = np.random.default_rng(0)
@@ -56,14 +60,20 @@ def main(count: int = 2000) -> None:
     for values in few[:2]:
         evaluate(space.device(values), points, INDICES)
     single = _best(lambda: [evaluate(space.device(values), points, INDICES) for values in few], repeat=1)
+    table = "\n".join(["| path | designs/s (one core, CPU time) |", "|---|---|",
+                       f"| batched (compiled kernels) | {count / batched:.0f} |",
+                       f"| one design at a time | {len(few) / single:.1f} |"])
     print(f"five-bar, {len(points)} points, {', '.join(INDICES)}; {count} designs, {feasible} reach the workspace")
-    print("| path | designs/s (one core, CPU time) |")
-    print("|---|---|")
-    print(f"| batched (compiled kernels) | {count / batched:.0f} |")
-    print(f"| one design at a time | {len(few) / single:.1f} |")
+    print(table)
+    if write is not None:
+        text = write.read_text()
+        head, rest = text.split(START, 1)
+        write.write_text(f"{head}{START}\n{table}\n{END}{rest.split(END, 1)[1]}")
 
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--designs", type=int, default=2000)
-    main(parser.parse_args().designs)
+    parser.add_argument("--write", type=Path, default=None, help="replace the table between the markers of this file")
+    arguments = parser.parse_args()
+    main(arguments.designs, arguments.write)

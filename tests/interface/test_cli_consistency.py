@@ -121,6 +121,8 @@ def _json_cases(tmp: Path) -> dict[tuple[str, ...], list]:
         ("robustness",): ["--designs", _one_design(tmp), "--errors", "0,5"],
         ("show",): ["--out", tmp / "view"],
         ("rcube", "tolerance"): ["--samples", "5", "--seed", "1"],
+        ("maps",): ["--device", RCUBE_FILE.parent / "five-bar.yaml", "--size", "0.02,0,0.02", "--grid", "2", "--out",
+                    tmp / "maps"],
     }
 
 
@@ -282,6 +284,7 @@ def _bad_inputs(tmp: Path) -> dict[tuple[str, ...], list]:
         ("study", "phantom"): ["--out", a_file],
         ("study", "rcube"): ["--out", a_file],
         ("study", "device"): ["--device", tmp / "missing.yaml", "--out", tmp / "s"],
+        ("maps",): ["--device", RCUBE_FILE.parent / "five-bar.yaml", "--size", "0.1,0,0", "--out", tmp / "m"],
     }
 
 

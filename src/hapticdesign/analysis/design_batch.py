@@ -18,7 +18,9 @@ fails at that point) when Newton does not converge or the handle is off the goal
 planar device's plane), when the system's pivot ratio falls below ``IK_SINGULAR`` or the sign of its determinant
 (``det Phi_p det(U^T J_v T)``, Schur's complement) or of ``det Phi_p`` (the assembly branch) changes from home's
 (behind a singularity). At each point it leaves ``J_v T`` (3 x n_a). :func:`mass_designs` gives ``H`` at those
-poses with the closed-loop dynamics' own pose kernels (:mod:`hapticdesign.analysis.dynamics.actuated_kernel`).
+poses with the closed-loop dynamics' own pose kernels (:mod:`hapticdesign.analysis.dynamics.actuated_kernel`). The
+continuation's inner kernels allocate nothing and are compiled without numba's reference counting (``_nrt=False``),
+so that passing the records costs no atomic counts per array.
 ``tests/design/test_design_batch.py`` checks both against the one-design path (:mod:`.metrics.indices`).
 """
 
@@ -89,10 +91,27 @@ class Reached(NamedTuple):
     point: np.ndarray
 
 
-@njit(cache=True)
-def _walk_and_system(q, tree, plan, loops, reach, goal, rot, pos, trig, jac, a, rhs, res):
-    """Node poses, the system ``[Phi; U^T J_v]`` (N x N) into ``a`` and ``[-phi; U^T (goal - p)]`` into ``rhs``;
+class Scratch(NamedTuple):
+    """The continuation's scratch: node poses, cosines and sines, the handle's Jacobian, the system and its right-hand
+    side, the closure residual, ``Phi``, ``Phi_p`` and ``S = -Phi_p^-1 Phi_a``."""
+
+    rot: np.ndarray
+    pos: np.ndarray
+    trig: np.ndarray
+    jac: np.ndarray
+    a: np.ndarray
+    rhs: np.ndarray
+    res: np.ndarray
+    phi: np.ndarray
+    pp: np.ndarray
+    t: np.ndarray
+
+
+@njit(cache=True, _nrt=False)
+def _walk_and_system(q, tree, plan, loops, reach, goal, ws):
+    """Node poses, the system ``[Phi; U^T J_v]`` (N x N) into ``ws.a`` and ``[-phi; U^T (goal - p)]`` into ``ws.rhs``;
     returns the largest closure residual and the 3-D distance of the handle from ``goal``."""
+    rot, pos, trig, jac, a, rhs, res = ws.rot, ws.pos, ws.trig, ws.jac, ws.a, ws.rhs, ws.res
     m = loops.row_loop.shape[0]
     n = q.shape[0]
     planned_poses(q, tree, plan, 0, plan.n_first, rot, pos, trig)
@@ -115,14 +134,13 @@ def _walk_and_system(q, tree, plan, loops, reach, goal, rot, pos, trig, jac, a, 
     return big, np.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _newton(q, tree, plan, loops, settings, reach, goal, mode, tol, ws):
     """Newton on all coordinates to put the handle at ``goal`` within ``tol`` (m) with the loops closed; returns
     (status, sign of the system's determinant). ``mode`` 0: no sign to keep (home)."""
     a, rhs = ws.a, ws.rhs
     for _ in range(reach.max_iter):
-        big, dist = _walk_and_system(q, tree, plan, loops, reach, goal, ws.rot, ws.pos, ws.trig, ws.jac, a, rhs,
-                                     ws.res)
+        big, dist = _walk_and_system(q, tree, plan, loops, reach, goal, ws)
         ratio, sign = lu_in_place(a, rhs)
         if not ratio > reach.singular:
             return SINGULAR, sign
@@ -141,23 +159,7 @@ def _newton(q, tree, plan, loops, settings, reach, goal, mode, tol, ws):
     return OUT_OF_REACH, 0.0
 
 
-class Scratch(NamedTuple):
-    """The continuation's scratch: node poses, cosines and sines, the handle's Jacobian, the system and its right-hand
-    side, the closure residual, ``Phi``, ``Phi_p`` and ``S = -Phi_p^-1 Phi_a``."""
-
-    rot: np.ndarray
-    pos: np.ndarray
-    trig: np.ndarray
-    jac: np.ndarray
-    a: np.ndarray
-    rhs: np.ndarray
-    res: np.ndarray
-    phi: np.ndarray
-    pp: np.ndarray
-    t: np.ndarray
-
-
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _branch(q, tree, plan, loops, ws):
     """Sign of ``det Phi_p`` at the closed pose ``q`` (its poses in ``ws``) and ``S`` into ``ws.t``."""
     ck.closure_jacobian(loops, tree, plan, ws.rot, ws.pos, ws.phi)

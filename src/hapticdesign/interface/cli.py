@@ -26,6 +26,7 @@ CONTENTS = {
     "stability": "Haptic rendering simulation (seed 000 ch. 4)",
     "metrics": "Performance metrics of any device (seed 001 ch. 4)",
     "stiffness": "Performance metrics of any device (seed 001 ch. 4)",
+    "maps": "Performance metrics of any device (seed 001 ch. 4)",
     "show": "Pictures of any device",
     "rcube": "R-CUBE mechanism and its optimization (seed 001)",
     "rcube_optimize": "R-CUBE mechanism and its optimization (seed 001)",

@@ -1,14 +1,19 @@
-"""Metric maps over planes of a workspace, saved as images (seed 001 §7.5, Figures 7.5-7.19)."""
+"""Metric maps over planes of a workspace, saved as images (seed 001 §7.5, Figures 7.5-7.19), for the R-CUBE and
+for any device (:func:`device_map`: the design indices of :mod:`.indices` point by point, issue 28)."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from hapticdesign.analysis.configuration import check_limits, configuration_of
+from hapticdesign.analysis.metrics.indices import INDICES, Index, Request, evaluate_at, requests_of
 from hapticdesign.errors import UserError
 from hapticdesign.files import save_figure
+from hapticdesign.model.device import Device
 
 
 def plane_grid(centre, half_width: float, n: int, normal_axis: int = 2) -> tuple[np.ndarray, np.ndarray]:
@@ -38,14 +43,17 @@ def evaluate_planes(
     return out
 
 
-def save_map(path: Path, values: np.ndarray, offsets: np.ndarray, title: str, labels: tuple[str, str]) -> Path:
-    """One metric map as a PNG heat map (matplotlib Agg backend)."""
+def save_map(path: Path, values: np.ndarray, offsets: np.ndarray, title: str, labels: tuple[str, str],
+             offsets_y: np.ndarray | None = None) -> Path:
+    """One metric map as a PNG heat map (matplotlib Agg backend); ``offsets`` along the first axis (and the second
+    unless ``offsets_y`` is given), m from the centre."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    extent = (offsets[0] * 1e3, offsets[-1] * 1e3, offsets[0] * 1e3, offsets[-1] * 1e3)
+    second = offsets if offsets_y is None else offsets_y
+    extent = (offsets[0] * 1e3, offsets[-1] * 1e3, second[0] * 1e3, second[-1] * 1e3)
     fig, ax = plt.subplots(figsize=(4.8, 4.0), dpi=100)
     image = ax.imshow(np.ma.masked_invalid(values).T, origin="lower", extent=extent, cmap="viridis")
     fig.colorbar(image, ax=ax)
@@ -56,3 +64,44 @@ def save_map(path: Path, values: np.ndarray, offsets: np.ndarray, title: str, la
     path = save_figure(fig, path)
     plt.close(fig)
     return path
+
+
+@dataclass(frozen=True)
+class DeviceMap:
+    """Design indices point by point: values per request key (P,) (NaN where the handle does not reach the point),
+    whether each point is reached, and why not (one line per point, None where reached)."""
+
+    points: np.ndarray
+    values: dict[str, np.ndarray]
+    reached: np.ndarray
+    reasons: list[str | None]
+
+
+def device_map(device: Device, points: np.ndarray, requests: Iterable[str | Request], frame: str | None = None,
+               registry: Mapping[str, Index] = INDICES) -> DeviceMap:
+    """The indices ``requests`` at each of ``points`` (P, 3) that the handle reaches: in order, each from the last
+    point reached (from home at first and after a point out of reach), by the project's inverse kinematics
+    (:meth:`~hapticdesign.analysis.configuration.Configuration.reach`, within the joint limits); a point the
+    handle does not reach is NaN with its reason, and the map goes on."""
+    checked = requests_of(requests, registry)
+    points = np.asarray(points, dtype=float)
+    space = configuration_of(device)
+    full, reasons, start = [], [], None
+    for point in points:
+        try:
+            q_a, q = space.reach(point[None], frame, start)
+            check_limits(device, q_a, point[None])
+        except UserError as exc:
+            reasons.append(str(exc))
+            start = None
+            continue
+        reasons.append(None)
+        full.append(q[0])
+        start = q[0]
+    reached = np.array([r is None for r in reasons], dtype=bool)
+    values = {r.key: np.full(len(points), np.nan) for r in checked}
+    if full:
+        found = evaluate_at(device, np.array(full), checked, frame, registry).values
+        for key, v in found.items():
+            values[key][reached] = v
+    return DeviceMap(points, values, reached, reasons)

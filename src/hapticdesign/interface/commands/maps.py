@@ -1,0 +1,109 @@
+"""Command ``maps``: design indices of any device over a plane of its workspace, as figures and a CSV (issue 28).
+
+The engine is :func:`hapticdesign.analysis.metrics.maps.device_map` with the whole registry of design indices
+(:data:`hapticdesign.simulation.design_indices.DESIGN_INDICES`, docs/indices.md).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+from hapticdesign.errors import UserError
+from hapticdesign.interface.common import note, parse_vector, print_json, user_errors
+from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
+
+AXES = "xyz"
+
+
+def maps(
+    out: Path = typer.Option(..., "--out", help="Folder for map_<index>.png per index and maps.csv."),
+    size: str = typer.Option(..., "--size", help="The plane's size along x,y,z (m): two non-zero, e.g. 0.06,0,0.06."),
+    center: Optional[str] = typer.Option(None, "--center", help="The plane's centre x,y,z (m, base frame); default "
+                                         "the handle at home."),
+    grid: int = typer.Option(11, "--grid", help="Points per side of the plane (edges included)."),
+    index: str = typer.Option("isotropy,apparent_mass", "--index", help="Comma-separated design indices "
+                              "(docs/indices.md), e.g. isotropy,apparent_mass,force,kmax."),
+    preset: Optional[str] = PRESET,
+    device: Optional[Path] = DEVICE,
+    params: Optional[Path] = PARAMS,
+    strict: bool = STRICT,
+    json_out: bool = JSON_OUT,
+    quiet: bool = QUIET,
+) -> None:
+    """Maps of design indices over a workspace plane of any device (seed 001 ch. 4 metrics, §7.5): isotropy, apparent
+    mass, force, stiffness, kmax, ..., each point reached from home by inverse kinematics; points out of reach are
+    left blank."""
+    from hapticdesign.analysis.configuration import configuration_of
+    from hapticdesign.analysis.metrics.maps import device_map
+    from hapticdesign.analysis.workspace import Workspace
+    from hapticdesign.simulation.design_indices import DESIGN_INDICES
+
+    with user_errors(strict=strict, quiet=quiet):
+        from hapticdesign.devices.loading import resolve_device
+
+        dev = resolve_device(preset, device, params, strict=strict)
+        sizes = parse_vector(size, 3, "size")
+        plane = [k for k in range(3) if sizes[k] != 0.0]
+        if len(plane) != 2:
+            raise UserError("--size: give exactly two non-zero sizes (the plane of the map), e.g. 0.06,0,0.06")
+        space = configuration_of(dev)
+        middle = space.position_and_jacobian(space.full(space.home))[0] if center is None else parse_vector(
+            center, 3, "center")
+        names = [name.strip() for name in index.split(",") if name.strip()]
+        workspace = Workspace(tuple(middle), tuple(abs(sizes)), grid)
+        points = workspace.points()
+        found = device_map(dev, points, names, registry=DESIGN_INDICES)
+        files = _write(out, found, names, plane)
+        note(f"wrote {len(files)} files to {out} ({int(found.reached.sum())} of {len(points)} points reached)",
+             quiet or json_out)
+        if json_out:
+            print_json({"device": dev.name, "out": str(out), "files": files, "points": len(points),
+                        "reached": int(found.reached.sum()),
+                        "range": {k: [_finite(v, min), _finite(v, max)] for k, v in found.values.items()},
+                        "units": {k: DESIGN_INDICES[k].unit for k in names}})
+            return
+        for key, values in found.values.items():
+            low, high = _finite(values, min), _finite(values, max)
+            span = "no point reached" if low is None else f"{low:.6g} to {high:.6g} {DESIGN_INDICES[key].unit}"
+            typer.echo(f"{key}: {span}")
+
+
+def _finite(values, how) -> float | None:
+    """The smallest or largest value at the points reached (None when none is)."""
+    kept = [float(v) for v in values if v == v]
+    return how(kept) if kept else None
+
+
+def _write(out: Path, found, names: list[str], plane: list[int]) -> list[str]:
+    """map_<index>.png per index (the grid in its two axes) and maps.csv (every point, its values or why not)."""
+    import numpy as np
+
+    from hapticdesign.analysis.metrics.maps import save_map
+    from hapticdesign.files import write_atomically
+    from hapticdesign.interface.report.tables import csv_text
+    from hapticdesign.studies.steps import Table
+
+    points = found.points
+    first, second = plane
+    xs, ys = np.unique(points[:, first]), np.unique(points[:, second])
+    files = []
+    for key in names:
+        grid = np.full((len(xs), len(ys)), np.nan)
+        grid[np.searchsorted(xs, points[:, first]), np.searchsorted(ys, points[:, second])] = found.values[key]
+        path = save_map(Path(out) / f"map_{key}.png", grid, xs - xs.mean(), f"{key}", (AXES[first], AXES[second]),
+                        ys - ys.mean())
+        files.append(str(path))
+    rows = [[*p, bool(r), *(found.values[k][i] for k in names), reason or ""]
+            for i, (p, r, reason) in enumerate(zip(points, found.reached, found.reasons))]
+    table = Table("maps", "design indices over the plane", ["x (m)", "y (m)", "z (m)", "reached", *names, "reason"],
+                  rows)
+    write_atomically(Path(out) / "maps.csv", csv_text(table))
+    files.append(str(Path(out) / "maps.csv"))
+    return files
+
+
+def register(app: typer.Typer) -> None:
+    app.command("maps")(maps)
