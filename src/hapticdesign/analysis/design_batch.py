@@ -36,7 +36,7 @@ from hapticdesign.analysis.dynamics.actuated_kernel import (
     Bodies, factor_pose, mass_and_gravity, passive_paths, reduce_pose, world_parameters,
 )
 from hapticdesign.analysis.loops import closure_kernel as ck
-from hapticdesign.analysis.loops.records import Closures, Settings, workspace
+from hapticdesign.analysis.loops.records import Closures, workspace
 from hapticdesign.errors import UserError
 from hapticdesign.model.dense import lu_in_place
 from hapticdesign.model.device import Device, build_mechanism

@@ -103,9 +103,9 @@ def evaluate_designs(space: DesignSpace, designs: Sequence[Mapping[str, float]],
     reached = batch.reach_points(offsets, points)
     base = space.base
     mass = batch.mass_matrices(offsets, reached, base.standard_parameters(), base.reflected_inertia)
-    states = HandleStates.of(reached.jvt.reshape(-1, 3, reached.jvt.shape[-1]), mass.reshape(-1, *mass.shape[2:]))
     ok = reached.status == OK
-    states.__dict__.update(jacobian=states.jacobian[np.repeat(ok, len(points))], mass=states.mass[np.repeat(ok, len(points))])
+    states = HandleStates.of(reached.jvt[ok].reshape(-1, 3, reached.jvt.shape[-1]),
+                             mass[ok].reshape(-1, *mass.shape[2:]))
     values = {r.key: DESIGN_INDICES[r.index].values(states, {**DESIGN_INDICES[r.index].options, **r.options})
               .reshape(-1, len(points)) for r in checked}
     out, row = [], 0

@@ -227,7 +227,7 @@ INDICES: dict[str, Index] = {index.name: index for index in (
           _stiffness),
     Index("frequency", "rad/s", "sqrt of the smallest eigenvalue of K v = w^2 Lambda v (U^T K_C[:3, :3] U, Lambda)",
           "seed 001 eq. 4.100-4.107, 7.11-7.13", _frequency),
-    Index("ln", "see docs/linearity.md", "Linearity Number over the joint region (limits, else full turns)",
+    Index("ln", "LN", "Linearity Number over the joint region (limits, else full turns)",
           "seed 000 eq. 3.1-3.4", _ln),
     Index("mass", "kg", "sum of the masses of the bodies the coordinates move", "the device file's bodies", _mass),
 )}
