@@ -1,6 +1,6 @@
 """Regenerates the example studies' reports of docs/optimization.md ("Example studies").
 
-Runs ``hapticdesign optimize`` on examples/studies/five-bar.yaml and examples/studies/delta.yaml with seed 1,
+Runs ``hapticdesign optimize`` on examples/studies/five-bar.yaml, five-bar-geometry.yaml and delta.yaml with seed 1,
 copies each run's report.html, pareto.png, front.csv and selected.yaml to docs/figures/optimization/<study>/,
 and prints the Markdown of the section: the front's size, the evaluations, the selected design and the wall
 time of the whole run (this machine, one process).
@@ -19,7 +19,7 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-STUDIES = ("five-bar", "delta")
+STUDIES = ("five-bar", "five-bar-geometry", "delta")
 KEPT = ("report.html", "pareto.png", "front.csv", "selected.yaml")
 
 

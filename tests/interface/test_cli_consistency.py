@@ -92,8 +92,20 @@ def _one_design(tmp: Path) -> Path:
     return path
 
 
+def _tiny_study(tmp: Path) -> Path:
+    """A study of examples/devices/five-bar.yaml: one variable, one point, 4 designs, 1 generation."""
+    path = tmp / "study.yaml"
+    path.write_text(f"device: {json.dumps(str(RCUBE_FILE.parent / 'five-bar.yaml'))}\n"
+                    "variables: {l1: [0.09, 0.11]}\n"
+                    "workspace: {box: {center: [0.0, 0.0, 0.18], size: [0, 0, 0]}, grid: 1}\n"
+                    "objectives: [{index: isotropy, reduce: min, sense: max}]\n"
+                    "algorithm: {population: 4, generations: 1}\n")
+    return path
+
+
 def _json_cases(tmp: Path) -> dict[tuple[str, ...], list]:
     return {
+        ("optimize",): [_tiny_study(tmp), "--seed", "1"],
         ("dynamics",): ["--q", "0.1,0.2,0.3"],
         ("eom",): ["--symbolic", "none", "--part", "G"],
         ("ln",): [],
@@ -287,6 +299,7 @@ def _bad_inputs(tmp: Path) -> dict[tuple[str, ...], list]:
         ("study", "rcube"): ["--out", a_file],
         ("study", "device"): ["--device", tmp / "missing.yaml", "--out", tmp / "s"],
         ("maps",): ["--device", RCUBE_FILE.parent / "five-bar.yaml", "--size", "0.1,0,0", "--out", tmp / "m"],
+        ("optimize",): [tmp / "missing-study.yaml", "--out", tmp / "o"],
     }
 
 

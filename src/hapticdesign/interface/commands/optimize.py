@@ -24,7 +24,7 @@ def register(app: typer.Typer) -> None:
     @app.command()
     def optimize(study: Path = STUDY, seed: int = SEED, out: Optional[Path] = OUT, scheduler: Optional[str] = SCHEDULER,
                  select: str = SELECT, json_out: bool = JSON_OUT, quiet: bool = QUIET, force: bool = FORCE) -> None:
-        """Optimize a device file's variables for the study's objectives under its constraints (NSGA-II)."""
+        """Optimize a device file's variables for a study file's objectives and constraints (NSGA-II; selection by seed 001 §7.2)."""
         from hapticdesign.interface.commands.optimize_adapter import optimize as run, parse_select, summary_lines
 
         with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
