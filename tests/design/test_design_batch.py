@@ -38,6 +38,20 @@ def test_batched_designs_equal_one_design_at_a_time(name):
             np.testing.assert_allclose(fast.values[key], slow.values[key], rtol=1e-9)
 
 
+def test_bodies_that_are_links_follow_the_geometry_of_each_design():
+    """Link bodies change mass with l1, l2: the batch (which keeps the file's inertial parameters) must not be
+    taken for them; each design's apparent mass is that of its own device, not the file's."""
+    tubes = Path(__file__).resolve().parents[2] / "examples" / "studies" / "five-bar-tubes.yaml"
+    space = design_space(tubes, ["l1", "l2", "d"])
+    points = Workspace((0.0, 0.0, 0.16), (0.02, 0.0, 0.02), 2).points()
+    designs = [{"l1": 0.13, "l2": 0.16, "d": 0.05}, {"l1": 0.09, "l2": 0.2, "d": 0.07}]
+    for values, fast in zip(designs, evaluate_designs(space, designs, points, ["apparent_mass"])):
+        slow = evaluate(space.device(values), points, ["apparent_mass"])
+        np.testing.assert_allclose(fast.values["apparent_mass"], slow.values["apparent_mass"], rtol=1e-9)
+    masses = [evaluate(space.device(v), points, ["mass"]).values["mass"][0] for v in designs]
+    assert masses[0] != masses[1]
+
+
 def test_batched_failures_name_the_point_or_the_design():
     space = design_space(EXAMPLES / "five-bar.yaml", ["l1", "l2"])
     points = np.array([[0.0, 0.0, 0.18], [0.0, 0.0, 0.235], [0.0, 0.0, 0.30]])

@@ -89,7 +89,8 @@ class DesignSpace:
         self.names: tuple[str, ...] = tuple(taken)
         self._index = actuated_index(self.spec)
         self._joint_damping = np.array([j.damping for j in self.spec.joints if j.actuated], dtype=float)
-        self._link_bodies = any(b.link is not None for b in self.spec.bodies)
+        self.link_bodies = any(b.link is not None for b in self.spec.bodies)
+        """Whether bodies are links (``bodies: - {link: ...}``), whose masses follow lengths and sections."""
         self.cache: dict[str, object] = {}
         """What a caller builds once per space (the batched kernels' structure, ...)."""
 
@@ -193,7 +194,7 @@ class DesignSpace:
             device = self._with_actuators(device, changes["actuator"])
         if changes["parameter"]:
             self._check_geometry(device)
-        if self._link_bodies and (changes["parameter"] or changes["section"]):
+        if self.link_bodies and (changes["parameter"] or changes["section"]):
             inertias = link_body_inertias(self.spec, device.mechanism, tubes)
             device = device.with_params({seed_parameter_name(f, body): float(getattr(inertia, f))
                                          for body, inertia in inertias.items() for f in SEED_FIELDS})

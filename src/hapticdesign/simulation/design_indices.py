@@ -12,7 +12,8 @@ this module's :func:`evaluate` and :data:`DESIGN_INDICES`.
 :func:`evaluate_designs` evaluates many designs of a :class:`~hapticdesign.devices.design_space.DesignSpace` at
 once: through the compiled kernels of :mod:`hapticdesign.analysis.design_batch` when the device has closed loops,
 the indices need only ``J_v`` and ``H`` (:data:`~hapticdesign.analysis.metrics.indices.KINEMATIC_DYNAMIC`) and the
-variables are geometry (``parameters``); otherwise design by design (:func:`evaluate`). Both give the same values.
+variables are geometry (``parameters``) of a device without bodies that are links (whose masses follow the
+geometry; the batch keeps the file's inertial parameters); otherwise design by design (:func:`evaluate`). Both give the same values.
 """
 
 from __future__ import annotations
@@ -123,7 +124,7 @@ def evaluate_designs(space: DesignSpace, designs: Sequence[Mapping[str, float]],
 def _batch(space: DesignSpace, requests: list[Request]) -> DesignBatch | None:
     """The space's compiled structure when the batched path applies (see the module docstring), else None."""
     if (space.base.mechanism.loops is None or any(r.index not in KINEMATIC_DYNAMIC for r in requests)
-            or any(v.kind != "parameter" for v in space.variables)):
+            or any(v.kind != "parameter" for v in space.variables) or space.link_bodies):
         return None
     if space.cache.get("batch") is None:
         try:
