@@ -46,6 +46,13 @@ from hapticdesign.simulation.config import (
 from hapticdesign.simulation.tables import evaluate_entries, unpack_entries
 
 
+CALLED = {"cache": True, "error_model": "numpy", "_nrt": False, "forceinline": True}
+"""Options of the record-typed helpers (:func:`_terms`, :func:`_handle`, :func:`_status`): numba compiles each
+once per record type as its own function and LLVM inlines it at every call (``alwaysinline``), as fast as numba's
+own inlining of an overload (``inline="always"``), which copied and typed the helper's code again at every call
+site and took half the loop's compile time (Phantom, type 1: 58 -> 30 CPU-s; ``benchmarks/bench_cold.py``)."""
+
+
 @nb.njit(cache=True, error_model="numpy", inline="always")
 def _tree_plant_terms(q, qd, record):
     """H + M_hand, C, G of a tree's tables at q into the record's workspace, reusing the last evaluation
@@ -161,9 +168,9 @@ def _loop_handle(q, qd, handle, record, jn, want_jn):
     return handle_along(record.loop_ws, handle.tree.parent, handle.tree.axis, handle.node, handle.direction, jn, want_jn)
 
 
-# The plant and the compensator are inlined into the loop by their record type (a tree's tables or a
-# closed-loop plant), which keeps the tree path as fast as a direct call; numba's SSA pass then reports
-# an internal, pedantic scope check on the twice-inlined helpers (its message says so), once per compile.
+# The plant and the compensator are chosen by their record type (a tree's tables or a closed-loop plant) and
+# inlined by LLVM (CALLED), which keeps the tree path as fast as a direct call; numba's SSA pass reports an
+# internal, pedantic scope check on the helpers it inlines itself (its message says so), once per compile.
 warnings.filterwarnings("ignore", category=NumbaIRAssumptionWarning)
 
 
@@ -188,19 +195,19 @@ def _status(record):
     """0 while a closed-loop record's loops close on the assembly branch; always 0 for a tree (numba only)."""
 
 
-@overload(_terms, inline="always")
+@overload(_terms, jit_options=CALLED)
 def _terms_impl(q, qd, record):
     kind = record.instance_class
     return {records.Plant: _tree_plant_terms, records.Controller: _tree_model_terms,
             records.LoopPlant: _loop_plant_terms, records.LoopController: _loop_model_terms}[kind].py_func
 
 
-@overload(_handle, inline="always")
+@overload(_handle, jit_options=CALLED)
 def _handle_impl(q, qd, handle, record, jn, want_jn):
     return (_loop_handle if _is_loop(record) else _tree_handle).py_func
 
 
-@overload(_status, inline="always")
+@overload(_status, jit_options=CALLED)
 def _status_impl(record):
     if _is_loop(record):
         return lambda record: record.status[0]
