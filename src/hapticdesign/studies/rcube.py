@@ -69,9 +69,9 @@ class RCubeSettings:
 
     def estimate_seconds(self) -> float:
         """Run time on a quiet 2-core machine with compiled kernels, dominated by the optimization chain.
-        Measured warm (CPU time, which a quiet machine's wall time follows): quick 50 s; the full chain alone
-        173 s (``benchmarks/speed_table.py``; issue 28 saw `rcube optimize` take 238 s on a quiet machine), the maps
-        20-30 s; smoke runs a fraction of quick's work."""
+        Measured warm (CPU time, which a quiet machine's wall time follows): quick 50 s, full 185 s (of which
+        the chain 173 s in ``benchmarks/speed_table.py``; issue 28 saw `rcube optimize` take 238 s on a quiet
+        machine); smoke runs a fraction of quick's work."""
         return {"full": 300.0, "quick": 75.0, "smoke": 40.0}[self.scale]
 
 
