@@ -142,8 +142,10 @@ def study_rows() -> list[tuple[str, str, str]]:
     estimate = PhantomSettings.for_scale("quick").estimate_seconds()
     with tempfile.TemporaryDirectory() as tmp:
         start = time.perf_counter()
-        subprocess.run([sys.executable, "-m", "hapticdesign.interface.cli", "study", "phantom", "--quick", "--out",
-                        tmp, "--quiet"], check=True, capture_output=True, cwd=ROOT)
+        subprocess.run([sys.executable, "-c", "from hapticdesign.interface.cli import main; main()", "study", "phantom",
+                        "--quick", "--out", tmp, "--quiet"], check=True, capture_output=True, cwd=ROOT)
+        if not (Path(tmp) / "report.html").is_file():
+            raise RuntimeError("study phantom --quick wrote no report")
         seconds = time.perf_counter() - start
     return [("`study phantom --quick` (90 designs, 360 rendering cases, report; process start included)",
              f"announced {estimate / 60:.1f} min", f"{seconds:.0f} s")]

@@ -70,10 +70,13 @@ class PhantomSettings:
         return PHANTOM_NOTE
 
     def estimate_seconds(self) -> float:
-        """Rough run time on a 2-core machine: set-up, design sets, then 4 cases per design at 0.14 s of
-        one worker each (measured: the quick study, 90 designs, took 55 s on a shared machine)."""
+        """Run time on a quiet 2-core machine with compiled kernels: 45 s of set-up (equations, LN,
+        linearization, 6-DOF verdict, design sets), then 4 rendering cases per design of both campaigns at
+        0.45 s of one worker each. Measured warm: the quick study (90 designs, 360 cases) took 166-174 s of
+        CPU in all, about 45 s of it before the campaigns, i.e. 0.34 s per case (wall 462-488 s under a load
+        average of 8-12 from other processes, which the estimate does not include)."""
         designs = (self.designs_per_level + self.appendix_c_per_level) * len(self.levels)
-        return 30.0 + 0.02 * self.designs_per_level * len(self.levels) + 4 * designs * 0.14 / self.workers
+        return 45.0 + 0.02 * self.designs_per_level * len(self.levels) + 4 * designs * 0.45 / self.workers
 
 
 PHANTOM_NOTE = ("The default design is the seed's eq. 3.33 solved exactly with Ixx2 lowered so that every link is a "

@@ -68,8 +68,11 @@ class RCubeSettings:
         return cls(scale=scale, seed=seed, map_points=points, ik_points=ik, optimization_effort=scale)
 
     def estimate_seconds(self) -> float:
-        """Rough run time on a 2-core machine, dominated by the optimization chain."""
-        return {"full": 75.0, "quick": 30.0, "smoke": 15.0}[self.scale]
+        """Run time on a quiet 2-core machine with compiled kernels, dominated by the optimization chain.
+        Measured warm (CPU time, which a quiet machine's wall time follows): quick 50 s, full 185 s (of which
+        the chain 173 s in ``benchmarks/speed_table.py``; issue 28 saw `rcube optimize` take 238 s on a quiet
+        machine); smoke runs a fraction of quick's work."""
+        return {"full": 300.0, "quick": 75.0, "smoke": 40.0}[self.scale]
 
 
 def _final():

@@ -82,7 +82,8 @@ def _run(module, settings, out: Path, quiet: bool, as_json: bool) -> dict:
     if show:
         minutes = settings.estimate_seconds() / 60
         size = f"{settings.scale} run, " if hasattr(settings, "scale") else ""
-        console.print(f"{module.TITLE}\n{size}estimated {minutes:.1f} min on a 2-core machine")
+        console.print(f"{module.TITLE}\n{size}estimated {minutes:.1f} min on a quiet 2-core machine with compiled "
+                      "kernels (longer on a busy machine; a first run compiles them, several minutes more)")
     if show:
         progress = RichProgress(console)
         with progress.bars:
