@@ -101,7 +101,8 @@ def test_spec_page_of_a_closed_loop_device_shows_its_workspace_section(tmp_path)
                                  "--quiet"])
     assert result.exit_code == 0, result.stderr
     page = (tmp_path / "spec.html").read_text()
-    assert "<h2>Workspace sections</h2>" in page and page.count('src="data:image/png;base64,') == 1
+    assert "<h2>Workspace sections</h2>" in page and "<h2>Quantities over the workspace</h2>" in page
+    assert page.count('src="data:image/png;base64,') == 2
 
 
 def test_spec_page_escapes_the_device_name(tmp_path):

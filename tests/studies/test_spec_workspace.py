@@ -87,3 +87,35 @@ def test_phantom_workspace_sections_equal_the_closed_form(edge_mm):
         oracle = np.array([[reachable(HOME + a * s.axes[0] + b * s.axes[1]) for b in s.v] for a in s.u])
         assert 0 < oracle.sum() < oracle.size
         assert np.array_equal(s.reached, oracle), s.names
+
+
+def test_resolution_map_equals_the_closed_form_jacobian_at_every_point_reached():
+    """The sheet's resolution map against Cavusoglu & Feygin's closed-form Jacobian: one count of motor k moves
+    joint k by 2 pi / (4 x 1024 x n_k) rad (1024-line encoders in quadrature, capstans 13.3 / 11.2 / 11.2), so the
+    largest step is max_k |dp/dq_k| 2 pi / (4096 n_k); and at home the map equals the sheet's own figure."""
+    from hapticdesign.studies.spec_maps import quantity_maps, workspace_sections
+    from hapticdesign.studies.spec import handle_at
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        device = load_device_file(Path(__file__).resolve().parents[2] / "examples" / "devices" / "phantom-premium.yaml")
+    sheet = spec_sheet(device, workspace=False)
+    h = handle_at(device, sheet["q"])
+    sections = workspace_sections(device, h.q, h.position, h.basis, 0.08, points=5)
+    maps = quantity_maps(device, sections)
+    ratios = np.array([13.3, 11.2, 11.2])
+    checked = 0
+    for section, resolution in zip(sections, maps["resolution"]):
+        assert np.array_equal(np.isfinite(resolution), section.reached)
+        for i, j in zip(*np.nonzero(section.reached)):
+            q1, q2, q3 = section.poses[i, j]
+            reach = L1 * math.cos(q2) + L2 * math.sin(q3)
+            columns = [np.array([-math.sin(q1) * reach, math.cos(q1) * reach, 0.0]),
+                       np.array([-math.cos(q1) * L1 * math.sin(q2), -math.sin(q1) * L1 * math.sin(q2), L1 * math.cos(q2)]),
+                       np.array([math.cos(q1) * L2 * math.cos(q3), math.sin(q1) * L2 * math.cos(q3), L2 * math.sin(q3)])]
+            expected = max(np.linalg.norm(c) * 2 * math.pi / (4096 * n) for c, n in zip(columns, ratios))
+            assert resolution[i, j] == pytest.approx(1000 * expected, rel=1e-9)
+            checked += 1
+    assert checked > 20
+    centre = len(sections[0].u) // 2
+    assert maps["resolution"][0][centre, centre] == pytest.approx(1000 * sheet["resolution"], rel=1e-12)

@@ -6,6 +6,10 @@ is sampled on a grid and walked in snake order; a point is reached when the inve
 (:func:`hapticdesign.analysis.configuration.handle_pose`) gets the handle there within the joint limits and
 without a singularity, continued from the last point reached or, failing that, from home: the region of the
 home branch the handle can reach. The cube's section (a square of edge ``a`` around home) is drawn on top.
+
+:func:`quantity_png` maps the sheet's pose-dependent quantities (resolution, continuous force, largest apparent
+mass, largest backdrive friction; :mod:`hapticdesign.studies.spec`) over the same sections, each computed at the
+pose the inverse kinematics found there.
 """
 
 from __future__ import annotations
@@ -35,6 +39,8 @@ class Section:
     u: np.ndarray
     v: np.ndarray
     reached: np.ndarray
+    poses: np.ndarray
+    """Actuated coordinates at each grid point reached (``poses[i, j]``; NaN elsewhere)."""
 
 
 def planes(basis: np.ndarray) -> list[tuple[tuple[str, str], np.ndarray]]:
@@ -58,6 +64,7 @@ def workspace_sections(device: Device, q: np.ndarray, home: np.ndarray, basis: n
     out = []
     for names, axes in planes(basis):
         reached = np.zeros((points, points), dtype=bool)
+        poses = np.full((points, points, len(q)), np.nan)
         last = np.asarray(q, dtype=float)
         for i in range(points):
             for j in (range(points) if i % 2 == 0 else range(points - 1, -1, -1)):
@@ -65,7 +72,8 @@ def workspace_sections(device: Device, q: np.ndarray, home: np.ndarray, basis: n
                 pose = _reach(device, target, last, q)
                 if pose is not None:
                     reached[i, j], last = True, pose
-        out.append(Section(names, axes, offsets, offsets.copy(), reached))
+                    poses[i, j] = pose
+        out.append(Section(names, axes, offsets, offsets.copy(), reached, poses))
     return out
 
 
@@ -108,21 +116,94 @@ def section_figure(sections: list[Section], edge: float, title: str):
     return fig
 
 
-def workspace_png(device: Device, sheet: dict, points: int = SECTION_POINTS) -> bytes:
-    """PNG of the sections around the sheet's pose (:func:`hapticdesign.studies.spec.spec_sheet` with its
-    workspace cube)."""
-    import matplotlib.pyplot as plt
-
-    from hapticdesign.files import figure_bytes
+def sheet_sections(device: Device, sheet: dict, points: int = SECTION_POINTS) -> tuple[list[Section], float]:
+    """The sections around the sheet's pose (:func:`hapticdesign.studies.spec.spec_sheet` with its workspace
+    cube) and the cube's edge (m)."""
     from hapticdesign.studies.spec import handle_at
 
     h = handle_at(device, sheet["q"])
     edge = sheet["workspace"]["cube"] / 1000.0
     if edge <= 0.0:
         raise UserError("the workspace cube is empty at this pose, so there is no section to draw around it")
-    found = workspace_sections(device, h.q, h.position, h.basis, edge, points)
-    fig = section_figure(found, edge, f"{device.name[:60]}\nworkspace reached on the home branch "
-                                      f"({points} x {points} points per plane)")
+    return workspace_sections(device, h.q, h.position, h.basis, edge, points), edge
+
+
+def workspace_png(device: Device, sections: list[Section], edge: float) -> bytes:
+    """PNG of the reached sections (:func:`sheet_sections`)."""
+    import matplotlib.pyplot as plt
+
+    from hapticdesign.files import figure_bytes
+
+    points = len(sections[0].u)
+    fig = section_figure(sections, edge, f"{device.name[:60]}\nworkspace reached on the home branch "
+                                         f"({points} x {points} points per plane)")
     png = figure_bytes(fig, "png", dpi=110)
+    plt.close(fig)
+    return png
+
+
+QUANTITIES = (("resolution", "resolution", "mm"), ("force_continuous", "continuous force", "N"),
+              ("apparent_mass", "largest apparent mass", "kg"), ("backdrive_friction", "largest backdrive friction",
+                                                                 "N"))
+"""The quantities :func:`quantity_maps` maps: key, label, unit."""
+
+
+def quantity_at(device: Device, q: np.ndarray) -> dict[str, float | None]:
+    """The sheet's pose-dependent quantities at actuated coordinates ``q`` (None where the file does not state
+    what they need; resolution in mm, the largest apparent mass and backdrive friction)."""
+    from hapticdesign.studies import spec
+
+    h = spec.handle_at(device, q)
+    step = spec.resolution(device, h)
+    friction = spec.backdrive_friction(device, h)
+    return {"resolution": None if step is None else 1000.0 * step,
+            "force_continuous": spec.inscribed_force(device, h, "continuous"),
+            "apparent_mass": spec.apparent_mass(device, h)[1],
+            "backdrive_friction": None if friction is None else friction[1]}
+
+
+def quantity_maps(device: Device, sections: list[Section]) -> dict[str, list[np.ndarray]]:
+    """Each quantity of :data:`QUANTITIES` the file states, per section, on its grid (NaN where not reached)."""
+    maps: dict[str, list[np.ndarray]] = {}
+    for k, section in enumerate(sections):
+        grid = section.reached.shape
+        for i, j in zip(*np.nonzero(section.reached)):
+            for key, value in quantity_at(device, section.poses[i, j]).items():
+                if value is not None:
+                    maps.setdefault(key, [np.full(grid, np.nan) for _ in sections])[k][i, j] = value
+    return maps
+
+
+def quantity_png(device: Device, sections: list[Section], edge: float) -> bytes | None:
+    """PNG of :func:`quantity_maps`: one row per quantity, one panel per section (None when no quantity applies)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from hapticdesign.files import figure_bytes
+
+    maps = quantity_maps(device, sections)
+    rows = [(key, label, unit) for key, label, unit in QUANTITIES if key in maps]
+    if not rows:
+        return None
+    fig, axes = plt.subplots(len(rows), len(sections), figsize=(4.2 * len(sections), 3.6 * len(rows)),
+                             squeeze=False, constrained_layout=True)
+    half = 500.0 * edge
+    for r, (key, label, unit) in enumerate(rows):
+        for ax, section, values in zip(axes[r], sections, maps[key]):
+            step = 1000.0 * (section.u[1] - section.u[0])
+            extent = (1000.0 * section.u[0] - step / 2, 1000.0 * section.u[-1] + step / 2,
+                      1000.0 * section.v[0] - step / 2, 1000.0 * section.v[-1] + step / 2)
+            image = ax.imshow(values.T, origin="lower", extent=extent, interpolation="nearest", cmap="viridis")
+            fig.colorbar(image, ax=ax, label=f"{label} [{unit}]", shrink=0.85)
+            ax.plot([-half, half, half, -half, -half], [-half, -half, half, half, -half], color="#c0392b",
+                    linewidth=1.0)
+            ax.set_xlabel(f"{section.names[0]} - home [mm]")
+            ax.set_ylabel(f"{section.names[1]} - home [mm]")
+            ax.set_title(f"{label}, {section.names[0]}-{section.names[1]} plane", fontsize=9)
+            ax.set_aspect("equal")
+    fig.suptitle(f"{device.name[:60]}: the sheet's quantities over the workspace reached", fontsize=10)
+    png = figure_bytes(fig, "png", dpi=100)
     plt.close(fig)
     return png

@@ -109,12 +109,19 @@ def spec(
         if out is not None:
             figures = []
             if sheet["workspace"] is not None and sheet["workspace"]["cube"] > 0.0:
-                from hapticdesign.studies.spec_maps import SECTION_SPAN, workspace_png
+                from hapticdesign.studies.spec_maps import SECTION_SPAN, quantity_png, sheet_sections, workspace_png
 
+                sections, edge = sheet_sections(dev, sheet)
                 figures.append(("Workspace sections", f"Planes through the home handle position, {SECTION_SPAN:g} "
                                 "cube edges wide: blue where the handle gets by inverse kinematics on the home branch "
                                 "(within the joint limits, no singularity), the workspace cube's section in red.",
-                                workspace_png(dev, sheet)))
+                                workspace_png(dev, sections, edge)))
+                quantities = quantity_png(dev, sections, edge)
+                if quantities is not None:
+                    figures.append(("Quantities over the workspace", "The sheet's resolution, continuous force, "
+                                    "largest apparent mass and largest backdrive friction at each point of the "
+                                    "sections above, at the pose the inverse kinematics finds there (blank: not "
+                                    "reached); the workspace cube's section in red.", quantities))
             write_atomically(out / "spec.json", dumps_json(sheet) + "\n")
             write_atomically(out / "spec.html", spec_page(sheet, figures))
             note(f"wrote {out / 'spec.html'} and {out / 'spec.json'}", quiet)
