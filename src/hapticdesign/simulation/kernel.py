@@ -37,7 +37,7 @@ from numba.extending import overload
 
 from hapticdesign.analysis.dynamics.closed_loop_plant import closed_loop_terms, handle_along
 from hapticdesign.analysis.dynamics.model import velocity_products_into as velocity_products
-from hapticdesign.model.dense import lu_in_place
+from hapticdesign.model.dense import solve_leading
 from hapticdesign.model.walk import frame_jacobian, node_poses
 from hapticdesign.simulation import records
 from hapticdesign.simulation.config import (
@@ -255,13 +255,13 @@ def accelerations(q, qd, qdd_path, u, prescribed, plant, qdd, tau_c, want_tau_c=
         for j in range(n):
             if prescribed[j]:
                 s -= h[i, j] * qdd[j]
-        rhs[r, 0] = s
+        rhs[r] = s
         for cc in range(nf):
             a[r, cc] = h[i, free[cc]]
-    if nf > 0 and lu_in_place(a[:nf, :nf], rhs[:nf])[0] == 0.0:
-        rhs[:nf, 0] = np.nan  # a singular H: the run diverges and says so
+    if nf > 0:
+        solve_leading(a, rhs, nf)
     for r in range(nf):
-        qdd[free[r]] = rhs[r, 0]
+        qdd[free[r]] = rhs[r]
     if not want_tau_c:
         return
     for i in range(n):

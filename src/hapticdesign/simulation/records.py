@@ -39,7 +39,7 @@ class Workspace(NamedTuple):
     qd2: np.ndarray
     a: np.ndarray
     rhs: np.ndarray
-    """(n, 1): the right-hand side, then the solution, of :func:`~hapticdesign.model.dense.lu_in_place`."""
+    """The right-hand side, then the solution, of :func:`~hapticdesign.model.dense.solve_leading`."""
     free: np.ndarray
 
 
@@ -217,7 +217,7 @@ def workspace(n: int, n_values: int, n_basis: int, n_entries: int) -> Workspace:
     return Workspace(
         np.zeros((n, n_values)), np.zeros(n_basis), np.zeros(n_entries), np.zeros(n), np.zeros(n),
         np.zeros(1, dtype=np.int64), np.zeros((n, n)), np.zeros((n, m)), np.zeros(n), np.zeros(m), np.zeros((n, n)),
-        np.zeros((n, 1)), np.zeros(n, dtype=np.int64),
+        np.zeros(n), np.zeros(n, dtype=np.int64),
     )
 
 
@@ -226,7 +226,7 @@ def loop_workspace(n: int) -> Workspace:
     column of ``c`` and its velocity product ``qd2`` the constant 1, so the loop reads it as ``c @ qd2``."""
     return Workspace(
         np.zeros((n, 1)), np.zeros(1), np.zeros(1), np.zeros(n), np.zeros(n), np.zeros(1, dtype=np.int64),
-        np.zeros((n, n)), np.zeros((n, 1)), np.zeros(n), np.ones(1), np.zeros((n, n)), np.zeros((n, 1)),
+        np.zeros((n, n)), np.zeros((n, 1)), np.zeros(n), np.ones(1), np.zeros((n, n)), np.zeros(n),
         np.zeros(n, dtype=np.int64),
     )
 
