@@ -26,9 +26,10 @@ demo: $(STAMP)
 	$(BIN)/hapticdesign demo
 
 # pytest -n 2 compiles the rendering loop once in the controller before its two workers start
-# (tests/conftest.py), so that they load it from numba's cache instead of each compiling it.
+# (tests/conftest.py), so that they load it from numba's cache instead of each compiling it; --dist loadgroup
+# keeps the tests of the shared smoke studies on one worker (tests/studies/conftest.py).
 test: $(STAMP) browser
-	$(BIN)/python -m pytest -n 2
+	$(BIN)/python -m pytest -n 2 --dist loadgroup
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/run_all.py

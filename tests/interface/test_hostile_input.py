@@ -439,8 +439,8 @@ def _frames_file(path: Path, frames: int) -> Path:
 def test_devices_above_the_size_limits_are_refused_on_every_path(tmp_path, monkeypatch, command):
     monkeypatch.delenv("HAPTICDESIGN_FORCE", raising=False)
     command = [a.replace("OUT", str(tmp_path / "out")) for a in command]
-    frames = _frames_file(tmp_path / "frames.yaml", 50_000)
-    one_line_error([*command, "--device", str(frames)], "has 50,000 frames, above the limit of 1,000 frames")
+    frames = _frames_file(tmp_path / "frames.yaml", 1_001)
+    one_line_error([*command, "--device", str(frames)], "has 1,001 frames, above the limit of 1,000 frames")
     chain = _chain_urdf(tmp_path / "chain.urdf", 200)
     one_line_error([*command, "--device", str(chain)], "has 200 joints, above the limit of 32 joints")
     assert not (tmp_path / "out").exists()

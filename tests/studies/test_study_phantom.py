@@ -15,7 +15,9 @@ from hapticdesign.devices.registry import preset
 from hapticdesign.simulation.impedance import impedance_range
 from hapticdesign.studies import phantom
 
-pytestmark = pytest.mark.slow  # end to end: deselect with -m "not slow"
+# end to end: deselect with -m "not slow"; one xdist worker takes every test of the shared smoke studies
+# (`make test` runs --dist loadgroup), so that the other worker is not left waiting on their lock
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("smoke-studies")]
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 

@@ -9,7 +9,9 @@ import pytest
 
 from hapticdesign.studies import rcube
 
-pytestmark = pytest.mark.slow  # end to end: deselect with -m "not slow"
+# end to end: deselect with -m "not slow"; one xdist worker takes every test of the shared smoke studies
+# (`make test` runs --dist loadgroup), so that the other worker is not left waiting on their lock
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("smoke-studies")]
 
 
 def _rows(path):
