@@ -52,6 +52,18 @@ def test_full_inertia_compensation_limit_is_b_squared_over_j():
         assert k == pytest.approx(damping**2 / inertia, rel=1e-8)
 
 
+@pytest.mark.parametrize("x", [0.0, 1e-9, 1e-4, 0.5, 0.999, 1.0, 3.0, 40.0])
+def test_closed_form_discretization_matches_scipy_cont2discrete_at_every_damping(x):
+    """The plant's zero-order hold in closed form (series below x = bT/J = 1) against SciPy's matrix exponential."""
+    j, t = 0.02, 1e-3
+    b = x * j / t
+    phi, gamma, *_ = cont2discrete((np.array([[0, 1], [0, -b / j]]), np.array([[0], [1 / j]]), np.eye(2),
+                                    np.zeros((2, 1))), t)
+    m0, m1 = (closed_loop_matrix(MassDamper(j, b, t), k) for k in (0.0, 1e6))  # m1[:2, 0] = phi[:, 0] - 1e6 gamma
+    np.testing.assert_allclose(m0[:2, :2], phi, rtol=1e-13, atol=1e-300)
+    np.testing.assert_allclose((m0[:2, 0] - m1[:2, 0]) / 1e6, gamma[:, 0], rtol=1e-12)
+
+
 def test_discretization_matches_scipy_cont2discrete():
     j, b, t = 0.01, 0.5, 1e-3
     phi, gamma, *_ = cont2discrete((np.array([[0, 1], [0, -b / j]]), np.array([[0], [1 / j]]), np.eye(2), np.zeros((2, 1))), t)

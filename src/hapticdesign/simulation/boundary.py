@@ -104,10 +104,26 @@ class MassDamper:
 
 @lru_cache(maxsize=64)
 def _discretize(j: float, b: float, t: float, k_p: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
-    """Exact zero-order-hold discretization of ``J qdd + b qd + k_p q = u`` over one period."""
-    a = np.array([[0.0, 1.0, 0.0], [-k_p / j, -b / j, 1.0 / j], [0.0, 0.0, 0.0]])
-    e = expm(a * t)
-    return e[:2, :2], e[:2, 2]
+    """Exact zero-order-hold discretization of ``J qdd + b qd + k_p q = u`` over one period.
+
+    Without a plant spring, in closed form (``x = b T / J``, ``a = e^-x``)::
+
+        Phi = [[1, T h1], [0, a]],   Gamma = [T^2 h2 / J, T h1 / J],
+        h1 = (1 - e^-x) / x,   h2 = (x - 1 + e^-x) / x^2
+
+    (series below x = 1, 1 and 1/2 at x = 0); with one, ``scipy.linalg.expm`` of the augmented matrix.
+    """
+    if k_p != 0.0:
+        e = expm(np.array([[0.0, 1.0, 0.0], [-k_p / j, -b / j, 1.0 / j], [0.0, 0.0, 0.0]]) * t)
+        return e[:2, :2], e[:2, 2]
+    x = b * t / j
+    if x < 1.0:
+        h1 = _series(x, 0, lambda n: (-1) ** n / (n + 1))
+        h2 = _series(x, 0, lambda n: (-1) ** n / ((n + 1) * (n + 2)))
+    else:
+        h1 = -math.expm1(-x) / x
+        h2 = (x + math.expm1(-x)) / x ** 2
+    return np.array([[1.0, t * h1], [0.0, math.exp(-x)]]), np.array([t * t * h2 / j, t * h1 / j])
 
 
 def _series(x: float, first: int, term) -> float:
@@ -198,15 +214,27 @@ def exact_boundary(system: MassDamper, k_max: float = 1e9) -> float:
     what = f"the closed-loop matrix of a {system.delay_samples:,}-sample delay"
     require_memory(what, 8.0 * order * order)
     require_within(what, order, EIGEN_ORDER_LIMIT, "rows")
-    lo = 1e-9
-    if spectral_radius(system, lo) >= 1.0:
+    floor = 1e-9
+    if spectral_radius(system, floor) >= 1.0:
         return 0.0
-    hi = lo
-    while spectral_radius(system, hi) < 1.0:
-        lo, hi = hi, hi * 1.25
-        if hi > k_max:
-            return math.inf
+    lo, hi = _bracket(system, floor, k_max)
+    if hi > k_max:
+        return math.inf
     return brentq(lambda k: spectral_radius(system, k) - 1.0, lo, hi, xtol=1e-12, rtol=1e-10)
+
+
+def _bracket(system: MassDamper, floor: float, k_max: float) -> tuple[float, float]:
+    """A stable ``lo`` and an unstable ``hi = 2 lo`` (``hi > k_max``: stable up to ``k_max``), searched by doubling
+    or halving from the passivity scale ``2 (b + B) / (T (1 + 2 d))`` (Colgate's bound with a delay of ``d``
+    samples), so that a few spectral radii place the limit instead of a sweep up from ``floor``."""
+    guess = 2.0 * (system.damping + system.virtual_damping) / (system.period * (1 + 2 * system.delay_samples))
+    lo = min(max(guess, floor), k_max)
+    while lo > floor and spectral_radius(system, lo) >= 1.0:
+        lo = max(lo / 2.0, floor)
+    hi = 2.0 * lo
+    while hi <= k_max and spectral_radius(system, hi) < 1.0:
+        lo, hi = hi, 2.0 * hi
+    return lo, hi
 
 
 def _config(system: MassDamper, stiffness: float, duration: float, step: float) -> LoopConfig:
