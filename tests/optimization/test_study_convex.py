@@ -100,3 +100,57 @@ def test_six_dof_study_reproduces_the_minimum_under_practical_bounds(tmp_path):
     assert 0 < lower <= ln <= lower * (1 + 1e-3)
     selected = _checked_design(path, tmp_path, summary)
     assert _grid_ln(selected) == pytest.approx(ln, rel=1e-6)
+
+
+def _study(tmp_path: Path, **changes) -> Path:
+    """A small convex study on the 3-DOF device file with ``changes`` to its mapping."""
+    data = {"device": str((STUDIES.parent / "devices" / "phantom-3dof.yaml").resolve()),
+            "variables": {"m2": [0.15, 0.3], "m3a": [0.15, 0.3]},
+            "objectives": [{"index": "ln", "reduce": "max", "sense": "min"}],
+            "algorithm": {"method": "convex"}}
+    data.update(changes)
+    path = tmp_path / "study.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+@pytest.mark.parametrize("changes, message", [
+    ({"objectives": [{"index": "ln", "reduce": "max", "sense": "min"},
+                     {"name": "m", "index": "mass", "reduce": "max", "sense": "min"}]}, "several objectives"),
+    ({"objectives": [{"index": "ln", "reduce": "max", "sense": "max"}]}, "max ln"),
+    ({"objectives": [{"index": "mass", "reduce": "max", "sense": "min"}]}, "min mass"),
+    ({"variables": {"m2": [0.15, 0.3], "l2": [0.2, 0.3]}}, "variable l2 is not an inertial parameter"),
+    ({"variables": {"m2": {"values": [0.15, 0.2]}}}, "variable m2 is a discrete choice"),
+    ({"constraints": [{"index": "isotropy", "reduce": "min", ">=": 0.1}]}, "constraint min_isotropy is an index"),
+    ({"constraints": [{"expression": "m2 + Ixx2", "<=": 0.4}], "variables": {"m2": [0.15, 0.3], "Ixx2": [1e-3, 1e-2]}},
+     "is not convex in the inertial parameters"),
+    ({"algorithm": {"method": "convex", "population": 10}}, "population and generations are settings of method nsga2"),
+    ({"algorithm": {"method": "nsga2", "realizability": "rigid-body"}}, "realizability is a setting of method convex"),
+    ({"algorithm": {"method": "nsga2"}}, "workspace: the region the handle must reach is required"),
+])
+def test_what_method_convex_cannot_do_is_refused_in_one_line(tmp_path, changes, message):
+    result = CliRunner().invoke(app, ["optimize", str(_study(tmp_path, **changes)), "--quiet"])
+    assert result.exit_code == 2, result.output
+    assert message in result.output and len(result.output.strip().splitlines()) == 1, result.output
+
+
+def test_affine_mass_constraint_binds_and_fixed_parameters_keep_their_values(tmp_path):
+    """Masses of links 2 and 3a only, their sum at most 0.35 kg: LN is no longer 0 (the file's linear design has
+    0.398 kg), the constraint binds, and every parameter that is not a variable keeps the file's value."""
+    path = _study(tmp_path, constraints=[{"expression": "m2 + m3a", "<=": 0.35}])
+    summary = _optimize(path, tmp_path / "out")
+    values = summary["selected"]["variables"]
+    assert values["m2"] + values["m3a"] == pytest.approx(0.35, rel=1e-6) and values["m2"] + values["m3a"] <= 0.35 * (1 + 1e-9)
+    selected = load_device_file(tmp_path / "out" / "selected.yaml")
+    original = load_device_file(STUDIES.parent / "devices" / "phantom-3dof.yaml")
+    for name in original.inertial_names():
+        if name not in values:
+            assert selected.params[name] == original.params[name], name
+    ln = summary["selected"]["objectives"]["ln"]
+    assert ln > LN_TOLERANCE and summary["lower_bound"] <= ln * (1 + 1e-6)
+    assert _grid_ln(selected) == pytest.approx(ln, rel=1e-6)
+    # a one-dimensional check of the optimum along the binding constraint (m2 + m3a = 0.35) by brute force
+    grid = np.linspace(0.15, 0.2, 201)
+    form = device_form(original)
+    trials = [form.ln(original.with_params({"m2": m, "m3a": 0.35 - m}).standard_parameters()) for m in grid]
+    assert min(trials) >= ln * (1 - 1e-6)
