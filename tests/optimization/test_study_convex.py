@@ -154,3 +154,20 @@ def test_affine_mass_constraint_binds_and_fixed_parameters_keep_their_values(tmp
     form = device_form(original)
     trials = [form.ln(original.with_params({"m2": m, "m3a": 0.35 - m}).standard_parameters()) for m in grid]
     assert min(trials) >= ln * (1 - 1e-6)
+
+
+def test_positive_definite_realizability_is_the_seeds_eq_3_28(tmp_path):
+    """The 3-DOF study with the seed's weaker condition (eq. 3.28): LN = 0 again, every link's inertia about its
+    mass centre positive definite (the triangle inequality is not asked)."""
+    data = yaml.safe_load((STUDIES / "phantom-3dof-linear.yaml").read_text())
+    data["device"] = str((STUDIES / data["device"]).resolve())
+    data["algorithm"] = {"method": "convex", "realizability": "positive-definite"}
+    path = tmp_path / "study.yaml"
+    path.write_text(yaml.safe_dump(data))
+    summary = _optimize(path, tmp_path / "out")
+    assert summary["selected"]["objectives"]["ln"] < LN_TOLERANCE
+    selected = load_device_file(tmp_path / "out" / "selected.yaml")
+    for body in ("2", "2a", "3", "3a"):
+        assert np.linalg.eigvalsh(selected.body(body).inertia_at_com).min() > 0
+        assert check_body(body, selected.body(body)).error is None
+    assert _grid_ln(selected) < LN_TOLERANCE

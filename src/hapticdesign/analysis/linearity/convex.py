@@ -25,6 +25,7 @@ import cvxpy as cp
 import numpy as np
 
 from hapticdesign.analysis.linearity.bounds import Bounds, as_box
+from hapticdesign.errors import UserError
 from hapticdesign.model.inertia import Realizability
 
 # Typical magnitudes of (m, h, J) used to scale the decision variables.
@@ -34,8 +35,8 @@ SCALE = np.array([0.1, 0.01, 0.01, 0.01, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3])
 def bounds_scale(bounds: dict[str, Bounds], bodies: tuple[str, ...]) -> np.ndarray:
     """Per-parameter scale of the standard parameters from each body's bounds.
 
-    Mass by its upper bound, first moments by ``m_hi r_max``, the inertia entries by the lower
-    bound on the mass-centre moments, so that the active lower bounds (1e-7 kg m^2 for the
+    Mass by its upper bound, first moments by ``m_hi r_max``, the inertia entries by the smallest
+    positive lower bound on the mass-centre moments (a moment without one: its upper bound), so that the active lower bounds (1e-7 kg m^2 for the
     gimbal links next to 0.3 kg masses) are of order one for the interior-point solver; bodies
     without bounds use :data:`SCALE`.
     """
@@ -47,7 +48,9 @@ def bounds_scale(bounds: dict[str, Bounds], bodies: tuple[str, ...]) -> np.ndarr
         box = as_box(bounds[body])
         mass = box.high[0]
         first = mass * max(np.abs(box.low[1:4]).max(), np.abs(box.high[1:4]).max(), 1e-3)
-        out.append(np.array([mass, first, first, first] + [max(box.low[4:7].min(), 1e-9 * box.high[4:7].max(), 1e-30)] * 6))
+        # each moment's positive lower bound, else its upper bound (a box from a study may start at or below 0)
+        moments = np.where(box.low[4:7] > 0, box.low[4:7], box.high[4:7])
+        out.append(np.array([mass, first, first, first] + [max(moments.min(), 1e-9 * box.high[4:7].max(), 1e-30)] * 6))
     return np.concatenate(out)
 
 
@@ -102,8 +105,13 @@ def body_constraints(p, bounds: Bounds | None, kind: Realizability, delta: float
 
 
 def solve(problem: cp.Problem) -> None:
-    """Solve with Clarabel (interior point), falling back to SCS."""
+    """Solve with Clarabel (interior point), falling back to SCS; a one-line UserError when both fail (bounds
+    so far apart that the scaled problem is not a finite one, for instance)."""
     try:
         problem.solve(solver=cp.CLARABEL)
     except cp.SolverError:
-        problem.solve(solver=cp.SCS, eps=1e-9, max_iters=200000)
+        try:
+            problem.solve(solver=cp.SCS, eps=1e-9, max_iters=200000)
+        except (cp.SolverError, ValueError, ArithmeticError) as exc:
+            raise UserError(f"the convex solvers (Clarabel, SCS) failed on this problem ({str(exc)[:80]}); are the "
+                            "bounds of a sensible size?") from None
