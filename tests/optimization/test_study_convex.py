@@ -26,7 +26,7 @@ from hapticdesign.interface.cli import app
 from hapticdesign.model.inertia import SEED_FIELDS, BodyInertia, check_body, pseudo_inertia, seed_parameter_name
 from hapticdesign.optimization.study_file import load_study
 from tests.helpers.ln_grid import brute_force_parts, torus_nodes
-from tests.linearity.test_conditions import seed_equations
+from tests.helpers.seed_linear_conditions import seed_equations
 
 STUDIES = Path(__file__).resolve().parents[2] / "examples" / "studies"
 
