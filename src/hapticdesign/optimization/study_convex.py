@@ -12,7 +12,9 @@ values, and the program's relaxation gives a lower bound on the minimum (:attr:`
 Expression constraints are kept when they are linear in ``pi``: a sum of masses (``m2 + m3a <= 0.4``), or
 of one body's mass-centre coordinates (``r2x - r2y >= 0``, i.e. ``h2x - h2y >= 0 m2``). Anything else the
 program cannot express is refused in one line: several objectives, another index, an index constraint, a
-variable that is not an inertial parameter, a discrete choice.
+variable that is not an inertial parameter, a discrete choice, and a moment or product of inertia that stays
+fixed while a mass-centre coordinate it depends on varies (``Iyy2`` fixed with ``r2x`` varying: the moment about
+the frame origin, ``Iyy2 + m2 (r2x^2 + r2z^2)``, is then not convex in ``pi``).
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from hapticdesign.analysis.linearity.bounds import SeedBox
+from hapticdesign.analysis.linearity.convex import COUPLED
 from hapticdesign.analysis.linearity.form import device_form
 from hapticdesign.analysis.linearity.verdict import minimum_ln
 from hapticdesign.errors import UserError
@@ -71,6 +74,14 @@ def _boxes(spec: StudySpec, bound: BoundStudy, places: dict[str, tuple[int, int]
             low[k] = np.array([getattr(body, field) for field in SEED_FIELDS], dtype=float)
             high[k] = low[k].copy()
         low[k][f], high[k][f] = spec.variables[name]
+    for name, (k, f) in places.items():  # a fixed moment or product of a varying mass centre is not convex
+        if f in (1, 2, 3):
+            body = device.body_names[k]
+            for m, coupled in enumerate(COUPLED):
+                moment = seed_parameter_name(SEED_FIELDS[4 + m], body)
+                if f - 1 in coupled and moment not in places:
+                    raise UserError(f"method convex: {moment} is fixed while {name} varies, which is not convex in the "
+                                    f"inertial parameters; make {moment} a variable too, or fix {name}")
     boxes = {}
     for k in low:
         if high[k][0] <= 0:

@@ -71,8 +71,9 @@ def realizability_lmi(p, kind: Realizability, delta: float) -> cp.Expression:
     return cp.bmat([[j - delta * np.eye(3), cross.T], [cross, p[0] * np.eye(3)]])
 
 
-# The mass-centre coordinates each moment (Ixx, Iyy, Izz) and product (Ixy, Ixz, Iyz) depends on.
-_COUPLED = ((1, 2), (0, 2), (0, 1), (0, 1), (0, 2), (1, 2))
+COUPLED = ((1, 2), (0, 2), (0, 1), (0, 1), (0, 2), (1, 2))
+"""The mass-centre coordinates (0, 1, 2 = x, y, z) that each moment (Ixx, Iyy, Izz) and product (Ixy, Ixz, Iyz)
+about the mass centre depends on in the standard parameters (Table 2.3's parallel-axis terms)."""
 
 
 def body_constraints(p, bounds: Bounds | None, kind: Realizability, delta: float) -> list:
@@ -85,7 +86,7 @@ def body_constraints(p, bounds: Bounds | None, kind: Realizability, delta: float
     m, h = p[0], p[1:4]
     out += [m >= box.low[0], m <= box.high[0], h >= box.low[1:4] * m, h <= box.high[1:4] * m]
     fixed = box.fixed[1:4]
-    for k, (a, b) in enumerate(_COUPLED):
+    for k, (a, b) in enumerate(COUPLED):
         lo, hi = box.low[4 + k], box.high[4 + k]
         if fixed[a] and fixed[b]:
             ra, rb = box.low[1 + a], box.low[1 + b]
@@ -97,7 +98,7 @@ def body_constraints(p, bounds: Bounds | None, kind: Realizability, delta: float
             out.append(p[4 + k] <= hi)
         elif lo != -hi:
             out += [p[4 + k] >= -hi, p[4 + k] <= -lo]
-    symmetric = [k for k in range(3, 6) if not (fixed[_COUPLED[k][0]] and fixed[_COUPLED[k][1]])
+    symmetric = [k for k in range(3, 6) if not (fixed[COUPLED[k][0]] and fixed[COUPLED[k][1]])
                  and box.low[4 + k] == -box.high[4 + k]]
     if symmetric:
         out.append(cp.abs(p[[4 + k for k in symmetric]]) <= box.high[[4 + k for k in symmetric]])

@@ -20,7 +20,7 @@ import cvxpy as cp
 import numpy as np
 
 from hapticdesign.analysis.linearity.bounds import Bounds, SeedBox, as_box, clip_to_bounds, within_bounds
-from hapticdesign.analysis.linearity.convex import SCALE, body_constraints, bounds_scale, realizability_lmi, solve
+from hapticdesign.analysis.linearity.convex import COUPLED, SCALE, body_constraints, bounds_scale, realizability_lmi, solve
 from hapticdesign.analysis.linearity.quadratic import LinearityForm
 from hapticdesign.analysis.linearity.linear_designs import realizable
 from hapticdesign.errors import UserError
@@ -151,7 +151,7 @@ def _relaxed(box: SeedBox) -> SeedBox:
     (the largest parallel-axis terms), where those coordinates are not fixed."""
     r = np.maximum(np.abs(box.low[1:4]), np.abs(box.high[1:4]))
     low, high = box.low.copy(), box.high.copy()
-    for k, (a, b) in enumerate(((1, 2), (0, 2), (0, 1), (0, 1), (0, 2), (1, 2))):
+    for k, (a, b) in enumerate(COUPLED):
         if box.fixed[1 + a] and box.fixed[1 + b]:
             continue  # bounded exactly
         if k < 3:
