@@ -63,6 +63,18 @@ def test_phantom_file_follows_parameter_overrides(phantoms):
     )
 
 
+def test_six_dof_phantom_file_reproduces_the_preset():
+    """examples/devices/phantom-6dof.yaml (the 6-DOF LN study's device) against the built-in preset."""
+    from_file, built_in = load_device_file(EXAMPLES / "phantom-6dof.yaml"), preset("phantom-6dof")
+    assert dict(from_file.params) == dict(built_in.params)
+    assert from_file.body_names == built_in.body_names and from_file.damping == built_in.damping
+    q = np.random.default_rng(6).uniform(-np.pi, np.pi, (20, 6))
+    for quantity in (mass_matrix, coriolis_centrifugal, gravity):
+        np.testing.assert_allclose(quantity(from_file, q), quantity(built_in, q), rtol=1e-13, atol=1e-16)
+    np.testing.assert_allclose(from_file.mechanism.frame_pose(q[0], "stylus"), built_in.mechanism.frame_pose(q[0], "stylus"),
+                               atol=1e-15)
+
+
 def test_loading_twice_gives_an_equal_builder():
     a = load_device_file(EXAMPLES / "phantom-3dof.yaml")
     b = load_device_file(EXAMPLES / "phantom-3dof.yaml")

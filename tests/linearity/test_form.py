@@ -11,6 +11,7 @@ from hapticdesign.analysis.linearity.region import parse_region
 from hapticdesign.analysis.linearity.weights import Weights
 from hapticdesign.errors import UserError
 from tests.helpers.appendix_b import appendix_b1_gravity
+from tests.helpers.ln_grid import brute_force_parts as _brute_force_parts, torus_nodes as _torus_nodes
 
 
 def _seed_vector(device, values):
@@ -71,35 +72,6 @@ def test_appendix_b1_gravity_polynomial(form3, phantom3):
         p = dict(zip(names, x))
         expected = appendix_b1_gravity(p, phantom3.params["l2"], phantom3.params["l3a"], phantom3.params["g"])
         assert form3.parts_seed(x)[2] == pytest.approx(expected, rel=1e-11)
-
-
-def _brute_force_parts(device, pi, nodes_per_axis, weights=None):
-    """Average over a tensor product of nodes: ``nodes_per_axis`` is a list of (points, weights)."""
-    model = dynamics_of(device)
-    n = model.n_dof
-    mesh = np.meshgrid(*[p for p, _ in nodes_per_axis], indexing="ij")
-    wmesh = np.meshgrid(*[w for _, w in nodes_per_axis], indexing="ij")
-    q = np.stack([m.ravel() for m in mesh], axis=-1)
-    w = np.prod(np.stack([m.ravel() for m in wmesh]), axis=0)
-    weights = weights or Weights.unit(n)
-    h, c, g = model.H(q, pi), model.C(q, pi), model.G(q, pi)
-
-    def var(x):
-        mean = np.tensordot(w, x, axes=(0, 0))
-        return np.tensordot(w, (x - mean) ** 2, axes=(0, 0))
-
-    return np.array(
-        [
-            np.sum(weights.H * var(h)),
-            np.sum(weights.C * np.tensordot(w, c**2, axes=(0, 0))),
-            np.sum(weights.G * var(g)),
-        ]
-    )
-
-
-def _torus_nodes(n, points=6):
-    angles = 2 * np.pi * np.arange(points) / points
-    return [(angles, np.full(points, 1 / points)) for _ in range(n)]
 
 
 def _random_standard(device, rng, count):

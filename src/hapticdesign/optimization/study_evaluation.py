@@ -40,15 +40,21 @@ points (each one a design's pose reached and its indices computed; docs/limits.m
 
 
 def require_study_workload(study: Study) -> None:
-    """Refuse a study whose population x generations x workspace points is above :data:`STUDY_LIMIT`."""
+    """Refuse a study whose population x generations x workspace points is above :data:`STUDY_LIMIT` (method
+    convex solves one program, whose size the number of variables bounds)."""
     spec = study.spec
+    if spec.algorithm.method == "convex":
+        return
     points = len(workspace_of(study).points())
     amount = spec.algorithm.population * spec.algorithm.generations * points
     require_within(f"a study of {spec.algorithm.population} designs x {spec.algorithm.generations} generations x "
                    f"{points} workspace points", amount, STUDY_LIMIT, "design-point evaluations")
 
 
-def workspace_of(study: Study) -> Workspace:
+def workspace_of(study: Study) -> Workspace | None:
+    """The study's workspace grid (None for a study without one, method convex)."""
+    if study.spec.workspace is None:
+        return None
     box = study.spec.workspace.box
     try:
         return Workspace(box.center, box.size, study.spec.workspace.grid)
@@ -82,7 +88,8 @@ class BoundStudy:
             self._check_options()
         except UserError as exc:
             raise UserError(f"{study.path}: {exc}") from None
-        self.points = workspace_of(study).points()
+        workspace = workspace_of(study)
+        self.points = np.zeros((0, 3)) if workspace is None else workspace.points()
         self.title = f"{self.space.base.name} ({study.path.name})"
 
     def _check_options(self) -> None:
@@ -148,9 +155,11 @@ class BoundStudy:
         """The selected design's picture at the workspace centre (at home when the centre is out of reach) and
         maps of its indices over the workspace points."""
         device = self.space.device(values)
-        centre = np.asarray(workspace_of(self.study).center, dtype=float)
+        workspace = workspace_of(self.study)
+        if workspace is None:
+            return [(render_png(device, home_pose(device), dpi=100), "The selected design at home")]
         try:
-            q = reach_workspace(device, centre[None, :]).q[0]
+            q = reach_workspace(device, np.asarray(workspace.center, dtype=float)[None, :]).q[0]
             where = "at the workspace centre"
         except UserError:
             q = home_pose(device)

@@ -4,7 +4,8 @@ A study names a device file (relative to the study file), the ``variables`` the 
 (continuous bounds ``[low, high]`` or a discrete choice ``{values: [...]}``), the ``workspace`` the handle
 must reach (a box and a grid), the ``objectives`` (an index reduced over the workspace and a sense), the
 ``constraints`` (an index or an affine expression of the variables, bounded by ``<=`` and/or ``>=``) and
-the ``algorithm`` (NSGA-II, population and generations). Everything is checked here with one-line
+the ``algorithm`` (NSGA-II, population and generations; or ``convex``, seed 000's exact LN minimization over
+inertial parameters, which needs no workspace). Everything is checked here with one-line
 messages naming the field; the names of variables and indices are checked against the device and the
 index registry when the study is bound to them (:mod:`.study_run`).
 
@@ -31,7 +32,7 @@ REDUCTIONS = ("min", "max", "mean")
 """Reductions of an index over the workspace points (``mean``: the arithmetic mean over the uniform
 Cartesian grid, so ``isotropy`` with ``mean`` is the global conditioning index on that measure)."""
 SENSES = ("min", "max")
-MAX_VARIABLES = 64
+MAX_VARIABLES = 128
 MAX_CHOICES = 1000
 MAX_GRID = 101
 
@@ -208,11 +209,25 @@ class Objective(_IndexUse):
 
 
 class AlgorithmSettings(_StudyModel):
-    """NSGA-II (Deb et al. 2002, pymoo) with ``population`` designs over ``generations`` generations."""
+    """``nsga2``: NSGA-II (Deb et al. 2002, pymoo) with ``population`` designs over ``generations``
+    generations. ``convex``: the exact convex program of seed 000's LN minimization over inertial
+    parameters (:mod:`.study_convex`), each body kept ``realizability``: ``rigid-body`` (pseudo-inertia
+    positive semi-definite, Wensing et al. 2017) or ``positive-definite`` (the seed's eq. 3.28)."""
 
-    method: Literal["nsga2"] = "nsga2"
+    method: Literal["nsga2", "convex"] = "nsga2"
     population: Annotated[int, Field(strict=True, ge=4, le=100_000)] = 40
     generations: Annotated[int, Field(strict=True, ge=1, le=100_000)] = 60
+    realizability: Literal["rigid-body", "positive-definite"] = "rigid-body"
+
+    @model_validator(mode="after")
+    def _settings_of_the_method(self) -> "AlgorithmSettings":
+        given = self.model_fields_set
+        if self.method == "convex" and given & {"population", "generations"}:
+            raise ValueError("population and generations are settings of method nsga2; method convex solves once")
+        if self.method == "nsga2" and "realizability" in given:
+            raise ValueError("realizability is a setting of method convex (NSGA-II designs pass the device file's "
+                             "own checks of each body)")
+        return self
 
 
 class StudySpec(_StudyModel):
@@ -220,13 +235,16 @@ class StudySpec(_StudyModel):
 
     device: str = Field(min_length=1, max_length=1000)
     variables: dict[str, Variable] = Field(min_length=1, max_length=MAX_VARIABLES)
-    workspace: WorkspaceSpec
+    workspace: WorkspaceSpec | None = None
     objectives: list[Objective] = Field(min_length=1, max_length=16)
     constraints: list[Constraint] = Field([], max_length=64)
     algorithm: AlgorithmSettings = AlgorithmSettings()
 
     @model_validator(mode="after")
     def _names(self) -> "StudySpec":
+        if self.workspace is None and self.algorithm.method != "convex":
+            raise ValueError("workspace: the region the handle must reach is required (only method convex, whose "
+                             "LN is over the joint region, does without)")
         names = [o.name for o in self.objectives]
         twice = sorted({n for n in names if names.count(n) > 1})
         if twice:

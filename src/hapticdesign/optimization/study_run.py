@@ -237,12 +237,14 @@ class StudyProblem(Problem):
 @dataclass(frozen=True)
 class StudyRun:
     """Every evaluated design (``records``, in evaluation order) and the front (indices into them, feasible
-    and non-dominated over all evaluations, sorted by the first objective)."""
+    and non-dominated over all evaluations, sorted by the first objective); method convex adds ``bound``, a
+    lower bound on the minimized objective (:mod:`.study_convex`)."""
 
     spec: StudySpec
     seed: int
     records: list[Record]
     front: list[int]
+    bound: float | None = None
 
     @property
     def evaluations(self) -> int:

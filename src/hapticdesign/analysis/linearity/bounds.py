@@ -4,6 +4,10 @@ Bounds are per body, in the seed's variables: mass, mass-centre coordinates, the
 moments of inertia about the mass centre and the products of inertia. Bodies without bounds
 (link 1 of the Phantom, which does not enter LN) keep the device's values.
 
+A :class:`SeedBox` is the general form: a lower and an upper value for each of a body's ten seed
+variables (equal values fix a variable); a study file's variables give one (docs/optimization.md),
+and :class:`BodyBounds` is the seed's special case (:meth:`BodyBounds.box`).
+
 Reading of "10^-5 <= I_i <= 10^-2 for all elements" (eq. 3.32, 3.38): the lower bound applies to
 the moments; the products are bounded in magnitude by the upper value (the seed's own example
 design, eq. 3.33, and all its Appendix C designs have zero products, which a positive lower bound
@@ -35,6 +39,47 @@ class BodyBounds:
             raise UserError("bounds: the mass upper bound must be positive")
         if self.products < 0:
             raise UserError("bounds: the product-of-inertia bound must be non-negative")
+
+    def box(self) -> "SeedBox":
+        """The same bounds per seed variable (products ``-products ... products``)."""
+        return SeedBox(
+            np.array([self.mass[0], *[self.centre[0]] * 3, *[self.moments[0]] * 3, *[-self.products] * 3]),
+            np.array([self.mass[1], *[self.centre[1]] * 3, *[self.moments[1]] * 3, *[self.products] * 3]),
+        )
+
+
+@dataclass(frozen=True)
+class SeedBox:
+    """Lower and upper values of one body's ten seed variables (``SEED_FIELDS`` order: m, r, moments
+    about the mass centre, products); ``low == high`` fixes a variable."""
+
+    low: np.ndarray
+    high: np.ndarray
+
+    def __post_init__(self) -> None:
+        low, high = (np.asarray(v, dtype=float) for v in (self.low, self.high))
+        if low.shape != (10,) or high.shape != (10,) or not np.all(np.isfinite(low) & np.isfinite(high)):
+            raise UserError("bounds: a body's box has ten finite lower and upper values")
+        if np.any(low > high):
+            raise UserError(f"bounds: a lower bound exceeds its upper bound ({low[low > high][0]:g})")
+        if high[0] <= 0:
+            raise UserError("bounds: the mass upper bound must be positive")
+        object.__setattr__(self, "low", low)
+        object.__setattr__(self, "high", high)
+
+    @property
+    def fixed(self) -> np.ndarray:
+        """Which variables the box fixes (10,)."""
+        return self.low == self.high
+
+
+Bounds = BodyBounds | SeedBox
+"""A body's bounds, either form."""
+
+
+def as_box(bounds: Bounds) -> SeedBox:
+    """Either form of a body's bounds as a :class:`SeedBox`."""
+    return bounds if isinstance(bounds, SeedBox) else bounds.box()
 
 
 def _phantom_arm(heavy: tuple[float, float], light: tuple[float, float]) -> dict[str, BodyBounds]:
@@ -73,34 +118,24 @@ def coarse_bounds(device: Device) -> dict[str, BodyBounds]:
     return {b: COARSE for b in device.body_names}
 
 
-def within_bounds(seed: np.ndarray, bodies: tuple[str, ...], bounds: dict[str, BodyBounds], rel_tol: float = 1e-9) -> bool:
-    """Whether seed-variable parameters (bodies, 10) meet the bounds (relative slack ``rel_tol``)."""
+def within_bounds(seed: np.ndarray, bodies: tuple[str, ...], bounds: dict[str, Bounds], rel_tol: float = 1e-9) -> bool:
+    """Whether seed-variable parameters (bodies, 10) meet the bounds (relative slack ``rel_tol`` of the
+    larger magnitude of each variable's two bounds)."""
     for k, body in enumerate(bodies):
         if body not in bounds:
             continue
-        b = bounds[body]
-        m, r, moments, products = seed[k, 0], seed[k, 1:4], seed[k, 4:7], seed[k, 7:10]
-        tol_m, tol_r, tol_i = (rel_tol * max(abs(v) for v in pair) for pair in (b.mass, b.centre, b.moments))
-        if not (b.mass[0] - tol_m <= m <= b.mass[1] + tol_m):
-            return False
-        if np.any(r < b.centre[0] - tol_r) or np.any(r > b.centre[1] + tol_r):
-            return False
-        if np.any(moments < b.moments[0] - tol_i) or np.any(moments > b.moments[1] + tol_i):
-            return False
-        if np.any(np.abs(products) > b.products * (1 + rel_tol)):
+        box = as_box(bounds[body])
+        tol = rel_tol * np.maximum(np.abs(box.low), np.abs(box.high))
+        if np.any(seed[k] < box.low - tol) or np.any(seed[k] > box.high + tol):
             return False
     return True
 
 
-def clip_to_bounds(seed: np.ndarray, bodies: tuple[str, ...], bounds: dict[str, BodyBounds]) -> np.ndarray:
+def clip_to_bounds(seed: np.ndarray, bodies: tuple[str, ...], bounds: dict[str, Bounds]) -> np.ndarray:
     """Seed-variable parameters (bodies, 10) with every bounded value clipped into its box."""
     out = np.array(seed, dtype=float)
     for k, body in enumerate(bodies):
-        if body not in bounds:
-            continue
-        b = bounds[body]
-        out[k, 0] = np.clip(out[k, 0], *b.mass)
-        out[k, 1:4] = np.clip(out[k, 1:4], *b.centre)
-        out[k, 4:7] = np.clip(out[k, 4:7], *b.moments)
-        out[k, 7:10] = np.clip(out[k, 7:10], -b.products, b.products)
+        if body in bounds:
+            box = as_box(bounds[body])
+            out[k] = np.clip(out[k], box.low, box.high)
     return out

@@ -19,8 +19,8 @@ from dataclasses import dataclass
 import cvxpy as cp
 import numpy as np
 
-from hapticdesign.analysis.linearity.bounds import BodyBounds, clip_to_bounds, within_bounds
-from hapticdesign.analysis.linearity.convex import SCALE, body_constraints, bounds_scale, realizability_lmi, solve
+from hapticdesign.analysis.linearity.bounds import Bounds, SeedBox, as_box, clip_to_bounds, within_bounds
+from hapticdesign.analysis.linearity.convex import COUPLED, SCALE, body_constraints, bounds_scale, realizability_lmi, solve
 from hapticdesign.analysis.linearity.quadratic import LinearityForm
 from hapticdesign.analysis.linearity.linear_designs import realizable
 from hapticdesign.errors import UserError
@@ -145,22 +145,48 @@ class MinimumLN:
 MOMENT_MARGIN = 1e-4
 
 
+def _relaxed(box: SeedBox) -> SeedBox:
+    """A box whose conservative constraints (:mod:`.convex`) contain every design of ``box``: the upper
+    moment bounds raised by ``m_hi (r_b^2 + r_c^2)`` and the product bounds widened by ``m_hi |r_a r_b|``
+    (the largest parallel-axis terms), where those coordinates are not fixed."""
+    r = np.maximum(np.abs(box.low[1:4]), np.abs(box.high[1:4]))
+    low, high = box.low.copy(), box.high.copy()
+    for k, (a, b) in enumerate(COUPLED):
+        if box.fixed[1 + a] and box.fixed[1 + b]:
+            continue  # bounded exactly
+        if k < 3:
+            high[4 + k] += box.high[0] * (r[a] ** 2 + r[b] ** 2)
+        else:
+            low[4 + k] -= box.high[0] * r[a] * r[b]
+            high[4 + k] += box.high[0] * r[a] * r[b]
+    return SeedBox(low, high)
+
+
+def _with_margin(box: SeedBox) -> SeedBox:
+    """The box with :data:`MOMENT_MARGIN` on the moments' lower bounds (not beyond their upper bounds)."""
+    low = box.low.copy()
+    low[4:7] = np.where(box.fixed[4:7], low[4:7], np.minimum(low[4:7] * (1 + MOMENT_MARGIN), box.high[4:7]))
+    return SeedBox(low, box.high)
+
+
 def minimum_ln(
     device: Device,
     form: LinearityForm,
-    bounds: dict[str, BodyBounds],
+    bounds: dict[str, Bounds],
     kind: Realizability = Realizability.RIGID_BODY,
+    affine: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> MinimumLN:
     """Smallest LN over realizable designs within the bounds (a convex program in ``pi``).
 
     ``min |L pi|`` (``LN = |L pi|^2``, a second-order cone objective that stays well scaled where
     LN itself spans twelve orders of magnitude) in variables scaled per body from its bounds
-    (:func:`.convex.bounds_scale`). The conservative upper bounds on mass-centre moments
-    (:mod:`.convex`) and a small margin on their lower bounds give a design inside the bounds;
-    it is clipped to the bounds in the seed's variables (a no-op up to the solver's tolerance),
-    checked for realizability and its LN re-evaluated exactly: an attained upper bound on the
-    minimum. Replacing the conservative bounds by their valid relaxation
-    ``J_xx <= hi + 2 r_max^2 m`` (and no margin) gives a lower bound on the true minimum.
+    (:func:`.convex.bounds_scale`). Bodies without bounds keep the device's parameters. The
+    conservative upper bounds on mass-centre moments (:mod:`.convex`) and a small margin on their
+    lower bounds give a design inside the bounds; it is clipped to the bounds in the seed's
+    variables (a no-op up to the solver's tolerance), checked for realizability and its LN
+    re-evaluated exactly: an attained upper bound on the minimum. Replacing the conservative bounds
+    by their valid relaxation (:func:`_relaxed`, no margin) gives a lower bound on the true minimum.
+    ``affine = (A, b)`` adds ``A pi <= b`` on the standard parameters of all bodies to both problems.
     """
     bodies = device.body_names
     factor = form.factor()
@@ -176,13 +202,10 @@ def minimum_ln(
             if body not in bounds:
                 constraints.append(x[10 * k : 10 * k + 10] == fixed[10 * k : 10 * k + 10] / scale[10 * k : 10 * k + 10])
                 continue
-            b = bounds[body]
-            if relaxed:
-                r2 = max(abs(b.centre[0]), abs(b.centre[1])) ** 2
-                b = BodyBounds(b.mass, b.centre, (b.moments[0], b.moments[1] + 2 * r2 * b.mass[1]), b.products + r2 * b.mass[1])
-            else:
-                b = BodyBounds(b.mass, b.centre, (b.moments[0] * (1 + MOMENT_MARGIN), b.moments[1]), b.products)
-            constraints += body_constraints(p, b, kind, 0.0)
+            box = as_box(bounds[body])
+            constraints += body_constraints(p, _relaxed(box) if relaxed else _with_margin(box), kind, 0.0)
+        if affine is not None:
+            constraints.append(affine[0] @ pi <= affine[1])
         problem = cp.Problem(cp.Minimize(cp.norm(factor @ pi)), constraints)
         solve(problem)
         if problem.status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):

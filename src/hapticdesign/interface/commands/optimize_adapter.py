@@ -16,6 +16,7 @@ import numpy as np
 from hapticdesign.errors import UserError
 from hapticdesign.files import write_atomically
 from hapticdesign.interface.report.optimization_page import Picture, render
+from hapticdesign.optimization.study_convex import run_convex
 from hapticdesign.optimization.study_evaluation import BoundStudy, bind_study, require_study_workload
 from hapticdesign.optimization.study_file import load_study
 from hapticdesign.optimization.study_outputs import (Selection, evaluations_csv, front_csv, pareto_figure,
@@ -72,8 +73,11 @@ def _design(run: StudyRun, k: int) -> dict:
 def summary_of(run: StudyRun, selection: Selection) -> dict:
     """The ``--json`` answer: the front, the number of evaluations and the selected design, in the
     study's own sense and units."""
-    return {"front": [_design(run, k) for k in run.front], "evaluations": run.evaluations,
-            "selected": {"design": selection.position + 1, "rule": selection.rule, **_design(run, selection.record)}}
+    out = {"front": [_design(run, k) for k in run.front], "evaluations": run.evaluations,
+           "selected": {"design": selection.position + 1, "rule": selection.rule, **_design(run, selection.record)}}
+    if run.bound is not None:
+        out["lower_bound"] = run.bound
+    return out
 
 
 def summary_lines(summary: dict) -> list[str]:
@@ -88,6 +92,8 @@ def summary_lines(summary: dict) -> list[str]:
     s = summary["selected"]
     lines.append(f"selected design {s['design']} ({s['rule']}): "
                  + ", ".join(f"{k} = {v:.6g}" for k, v in {**s["variables"], **s["objectives"]}.items()))
+    if "lower_bound" in summary:
+        lines.append(f"lower bound on the minimum (the convex relaxation): {summary['lower_bound']:.6g}")
     return lines
 
 
@@ -119,8 +125,9 @@ def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Select
     values = run.records[selection.record].values
     write_atomically(out / "selected.yaml", bound.device_file_text(values))
     pictures = [Picture(png, caption) for png, caption in bound.pictures(values)]
+    kept = [] if run.bound is not None else ["checkpoint/ (one file per generation; a rerun into this folder continues)"]
     page = render(run, selection, bound.title, Picture((out / "pareto.png").read_bytes(), "Pareto front"), pictures,
-                  [*FILES, "checkpoint/ (one file per generation; a rerun into this folder continues)"])
+                  [*FILES, *kept])
     write_atomically(out / "report.html", page)
     return [*paths, out / "selected.yaml", out / "report.html"]
 
@@ -135,10 +142,17 @@ def optimize(study_path: Path, seed: int, out: Path | None, scheduler: str | Non
     require_study_workload(study)
     if out is not None:
         _check_out(out)
-    with ExitStack() as stack:
-        evaluate = _evaluator(bound, scheduler, quiet, stack)
-        run = run_study(study, seed, evaluate, out, progress)
+    if study.spec.algorithm.method == "convex":
+        if scheduler is not None:
+            raise UserError("--scheduler distributes NSGA-II's generations; method convex solves one program here")
+        run = run_convex(bound, seed)
+    else:
+        with ExitStack() as stack:
+            evaluate = _evaluator(bound, scheduler, quiet, stack)
+            run = run_study(study, seed, evaluate, out, progress)
     if not run.front:
+        if run.bound is not None:
+            raise UserError(f"{study_path}: the convex program's design is infeasible: {run.records[0].reason}")
         raise _no_front(run, bound)
     selection = select_design(run, **rule)
     written = [] if out is None else write_outputs(out, run, bound, selection)

@@ -56,16 +56,21 @@ def _study_rows(run: StudyRun) -> str:
     constraints = [[c.label + (f" ({_options(c.options)})" if getattr(c, "options", None) else ""),
                     "" if c.at_least is None else c.at_least, "" if c.at_most is None else c.at_most]
                    for c in spec.constraints]
-    box = spec.workspace.box
     parts = [_table("Variables", ["variable", "low or choices", "high"], variables),
              _table("Objectives (reduced over the workspace)", ["name", "index", "options", "reduction", "sense"],
                     objectives)]
     if constraints:
         parts.append(_table("Constraints", ["constrained value", ">=", "<="], constraints))
-    parts.append(f'<p>Workspace: box centred at {escape(str(list(box.center)))} m, edges {escape(str(list(box.size)))} m, '
-                 f"{spec.workspace.grid} points per axis of nonzero size. NSGA-II, population "
-                 f"{spec.algorithm.population}, {spec.algorithm.generations} generations, seed {run.seed}: "
-                 f"{run.evaluations} designs evaluated, {sum(r.feasible for r in run.records)} feasible.</p>")
+    if spec.algorithm.method == "convex":
+        parts.append(f"<p>Method convex: LN minimized exactly over the inertial parameters as one convex program (seed "
+                     f"000 eq. 3.1-3.4), every body {escape(spec.algorithm.realizability)} realizable; the relaxation's "
+                     f"lower bound on the minimum is {escape(cell_text(run.bound))}.</p>")
+    else:
+        box = spec.workspace.box
+        parts.append(f'<p>Workspace: box centred at {escape(str(list(box.center)))} m, edges {escape(str(list(box.size)))} '
+                     f"m, {spec.workspace.grid} points per axis of nonzero size. NSGA-II, population "
+                     f"{spec.algorithm.population}, {spec.algorithm.generations} generations, seed {run.seed}: "
+                     f"{run.evaluations} designs evaluated, {sum(r.feasible for r in run.records)} feasible.</p>")
     return "".join(parts)
 
 
