@@ -137,7 +137,7 @@ def optimize(study_path: Path, seed: int, out: Path | None, scheduler: str | Non
         _check_out(out)
     with ExitStack() as stack:
         evaluate = _evaluator(bound, scheduler, quiet, stack)
-        run = run_study(study, seed, evaluate, out, progress)
+        run = run_study(study, seed, evaluate, out, progress, bound.evaluate_constraints)
     if not run.front:
         raise _no_front(run, bound)
     selection = select_design(run, **rule)
