@@ -29,7 +29,7 @@ from hapticdesign.errors import UserError
 from hapticdesign.files import parse_structured
 from hapticdesign.model.inertia import SEED_FIELDS, seed_parameter_name
 from hapticdesign.optimization.parameter_indices import PARAMETER_INDICES
-from hapticdesign.optimization.study_file import IndexConstraint, Study
+from hapticdesign.optimization.study_file import Choice, IndexConstraint, Study
 from hapticdesign.optimization.study_outputs import index_maps
 from hapticdesign.optimization.study_run import Answer, reduced_keys, violations
 from hapticdesign.simulation.design_indices import DESIGN_INDICES, evaluate, evaluate_designs
@@ -105,11 +105,14 @@ class BoundStudy:
                                 f"{', '.join(PARAMETER_INDICES[r.index].options)})")
 
     def _check_options(self) -> None:
-        """Every index with its options once at the device file's home pose (the parameter indices at the file's
-        parameters), so that an option's bad value is refused before the run (not found in every design)."""
+        """Every index with its options once at the device file's home pose (the parameter indices at the design in
+        the middle of the variables' bounds), so that an option's bad value is refused before the run (not found in every design)."""
         device = self.space.base
         evaluate_at(device, configuration_of(device).full(home_pose(device)), self.requests, None, DESIGN_INDICES)
-        params = {name: np.array([float(value)]) for name, value in device.params.items()}
+        middle = {name: v.values[0] if isinstance(v, Choice) else (v[0] + v[1]) / 2
+                  for name, v in self.study.spec.variables.items()}
+        params = {name: np.array([float(value)]) for name, value in
+                  {**device.params, **self.device_values(middle)}.items()}
         for r in self.parameter_requests:
             index = PARAMETER_INDICES[r.index]
             index.values(params, {**index.options, **r.options}, {})
