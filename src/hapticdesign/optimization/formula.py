@@ -24,6 +24,8 @@ FUNCTIONS = {"sin": np.sin, "cos": np.cos, "tan": np.tan, "asin": np.arcsin, "ac
 """The functions a formula may call."""
 
 MAX_LENGTH = 1000
+MAX_DEPTH = 50
+"""Most nested operations in a formula (the evaluation recurses once per level)."""
 _OPERATORS = {ast.Add: np.add, ast.Sub: np.subtract, ast.Mult: np.multiply, ast.Div: np.divide, ast.Pow: np.power}
 
 
@@ -39,17 +41,25 @@ class Formula:
             raise UserError(f"a formula has at most {MAX_LENGTH} characters")
         try:
             tree = ast.parse(self.text.strip(), mode="eval").body
-        except (SyntaxError, ValueError):
+        except (SyntaxError, ValueError, RecursionError, MemoryError):
             raise UserError(f"cannot read the formula {self.text[:60]!r}") from None
-        for node in ast.walk(tree):
+        levels = [(tree, 1)]
+        while levels:
+            node, depth = levels.pop()
+            if depth > MAX_DEPTH:
+                raise UserError(f"formula {self.text[:60]!r}: more than {MAX_DEPTH} nested operations")
             self._check(node)
+            levels += [(child, depth + 1) for child in ast.iter_child_nodes(node)]
         return tree
 
     def _check(self, node: ast.AST) -> None:
         allowed = (ast.BinOp, ast.UnaryOp, ast.Name, ast.Load, ast.Call, ast.UAdd, ast.USub, *_OPERATORS)
         if isinstance(node, ast.Constant):
             if isinstance(node.value, bool) or not isinstance(node.value, (int, float)):
-                raise UserError(f"formula {self.text[:60]!r}: {node.value!r} is not a number")
+                raise UserError(f"formula {self.text[:60]!r}: {str(node.value)[:20]!r} is not a number")
+            value = node.value
+            if abs(value) >= 2 ** 1000 if isinstance(value, int) else not math.isfinite(value):
+                raise UserError(f"formula {self.text[:60]!r}: a number is too large")
         elif isinstance(node, ast.Call):
             if not isinstance(node.func, ast.Name) or node.func.id not in FUNCTIONS or node.keywords \
                     or len(node.args) != 1:
