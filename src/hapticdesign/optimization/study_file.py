@@ -151,7 +151,9 @@ class IndexConstraint(_Bounded, _IndexUse):
 
     @property
     def label(self) -> str:
-        return f"{self.reduce}_{self.index}"
+        """``min_isotropy``; with options, they follow in brackets: ``max_rcube_constraint[point=C2]``."""
+        shown = ",".join(f"{k}={v}" for k, v in self.request[1])
+        return f"{self.reduce}_{self.index}" + (f"[{shown}]" if shown else "")
 
 
 class ExpressionConstraint(_Bounded):
