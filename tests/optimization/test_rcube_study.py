@@ -18,6 +18,7 @@ from hapticdesign.optimization.formula import formula
 from hapticdesign.optimization.shortest import constrained_minimum
 from hapticdesign.optimization.study_evaluation import bind_study
 from hapticdesign.optimization.study_file import load_study
+from hapticdesign.optimization.study_outputs import front_csv
 from hapticdesign.optimization.study_run import run_study
 from hapticdesign.optimization.synthesis import BOUND_SETS, hypervolume, synthesize
 
@@ -129,3 +130,34 @@ def test_bad_study_parts_are_one_line_errors(tmp_path, change, message):
     with pytest.raises(UserError, match=re.escape(message)) as caught:
         bind_study(load_study(study_file(tmp_path, **change)))
     assert "\n" not in str(caught.value)
+
+
+class Interrupt(Exception):
+    pass
+
+
+def test_an_interrupted_run_of_several_runs_continues_from_its_checkpoint(tmp_path):
+    """The three runs keep their generations apart in the checkpoint: stopped in the second run, the rerun
+    evaluates only the generations not yet kept and ends with the same front as an uninterrupted run."""
+    path = study_file(tmp_path, algorithm={"population": 8, "generations": 3, "start": {"minimize": "l1 + l2 + l3",
+                                                                                        "starts": 4}})
+    study = load_study(path)
+    bound = bind_study(study)
+    whole = run_study(study, SEED, bound.evaluate, None, None, bound.evaluate_constraints)
+    asked = []
+
+    def counting(batch):
+        asked.append(len(batch))
+        return bound.evaluate(batch)
+
+    def stop(generation, total):
+        if generation == 5:  # the second generation of the second run
+            raise Interrupt
+
+    with pytest.raises(Interrupt):
+        run_study(study, SEED, counting, tmp_path / "out", stop, bound.evaluate_constraints)
+    assert len(asked) == 5
+    resumed = run_study(study, SEED, counting, tmp_path / "out", None, bound.evaluate_constraints)
+    assert len(asked) == 5 + 4  # generations 3 of run 2 and 1-3 of run 3
+    assert resumed.front == whole.front and front_csv(resumed) == front_csv(whole)
+    np.testing.assert_array_equal([r.objectives for r in resumed.records], [r.objectives for r in whole.records])
