@@ -130,7 +130,6 @@ class BoundStudy:
         only for them); those only the objectives read are evaluated only for the designs that meet every
         constraint (NSGA-II's constrained domination never reads the objectives of the others), and for none
         without ``objectives``."""
-        spec = self.study.spec
         device_values = [self.device_values(v) for v in batch]
         if self.requests:
             results = evaluate_designs(self.space, device_values, self.points, self.requests)
