@@ -93,6 +93,15 @@ class RoundColumns(Repair):
         return X
 
 
+def initial_population(low, high, population: int, seed: int, designs: np.ndarray | None = None) -> np.ndarray:
+    """``designs`` (rows within the bounds ``low``, ``high``) followed by uniform random rows drawn with ``seed``:
+    ``population`` rows in all (a first population that holds chosen designs)."""
+    low, high = np.asarray(low, dtype=float), np.asarray(high, dtype=float)
+    given = np.zeros((0, len(low))) if designs is None else np.atleast_2d(np.asarray(designs, dtype=float))[:population]
+    rng = np.random.default_rng(seed)
+    return np.vstack([given, rng.uniform(low, high, (population - len(given), len(low)))])
+
+
 def pareto_filter(X: np.ndarray, F: np.ndarray) -> np.ndarray:
     """Indices of the non-dominated rows of ``F`` (minimization), duplicates of ``X`` removed."""
     if len(F) == 0:

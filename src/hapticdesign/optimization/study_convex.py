@@ -41,6 +41,9 @@ def _refuse(spec: StudySpec, bound: BoundStudy) -> None:
                            f"{objectives[0].index}"))
     if objectives[0].options:
         raise UserError("method convex: index ln takes no options")
+    if spec.parameters or spec.keep:
+        raise UserError("method convex: `parameters` and `keep` are settings of method nsga2 (the convex program "
+                        "varies inertial parameters only and has one design)")
     others = [c.label for c in spec.constraints if not isinstance(c, ExpressionConstraint)]
     if others:
         raise UserError(f"method convex: constraint {others[0]} is an index; only affine expressions of masses or of "

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from hapticdesign.analysis.metrics.indices import Request, evaluate_at, reduce, requests_of
+from hapticdesign.analysis.metrics.indices import Evaluation, Request, evaluate_at, reduce, requests_of
 from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.analysis.view.figure import render_png
 from hapticdesign.analysis.view.skeleton import home_pose
@@ -28,9 +28,10 @@ from hapticdesign.devices.design_space import DesignSpace
 from hapticdesign.errors import UserError
 from hapticdesign.files import parse_structured
 from hapticdesign.model.inertia import SEED_FIELDS, seed_parameter_name
-from hapticdesign.optimization.study_file import Study
+from hapticdesign.optimization.parameter_indices import PARAMETER_INDICES
+from hapticdesign.optimization.study_file import Choice, IndexConstraint, Study
 from hapticdesign.optimization.study_outputs import index_maps
-from hapticdesign.optimization.study_run import Answer, reduced_keys
+from hapticdesign.optimization.study_run import Answer, reduced_keys, violations
 from hapticdesign.simulation.design_indices import DESIGN_INDICES, evaluate, evaluate_designs
 from hapticdesign.workload import require_within
 
@@ -40,15 +41,16 @@ points (each one a design's pose reached and its indices computed; docs/limits.m
 
 
 def require_study_workload(study: Study) -> None:
-    """Refuse a study whose population x generations x workspace points is above :data:`STUDY_LIMIT` (method
-    convex solves one program, whose size the number of variables bounds)."""
+    """Refuse a study whose population x generations x runs x workspace points is above :data:`STUDY_LIMIT`
+    (method convex solves one program, whose size the number of variables bounds)."""
     spec = study.spec
     if spec.algorithm.method == "convex":
         return
     points = len(workspace_of(study).points())
-    amount = spec.algorithm.population * spec.algorithm.generations * points
+    runs = max(1, len(spec.algorithm.runs))
+    amount = spec.algorithm.population * spec.algorithm.generations * runs * points
     require_within(f"a study of {spec.algorithm.population} designs x {spec.algorithm.generations} generations x "
-                   f"{points} workspace points", amount, STUDY_LIMIT, "design-point evaluations")
+                   f"{runs} runs x {points} workspace points", amount, STUDY_LIMIT, "design-point evaluations")
 
 
 def workspace_of(study: Study) -> Workspace | None:
@@ -80,11 +82,21 @@ class BoundStudy:
         self.keys = reduced_keys(spec)
         asked = list(dict.fromkeys(key[:2] for key in self.keys))
         self.labels = {request: f"request{k}" for k, request in enumerate(asked)}
-        self.requests = [Request(index, {k: list(v) if isinstance(v, tuple) else v for k, v in options}, label)
-                         for (index, options), label in self.labels.items()]
+        requests = [Request(index, {k: list(v) if isinstance(v, tuple) else v for k, v in options}, label)
+                    for (index, options), label in self.labels.items()]
+        self.requests = [r for r in requests if r.index not in PARAMETER_INDICES]
+        """The indices at the workspace's poses."""
+        self.parameter_requests = [r for r in requests if r.index in PARAMETER_INDICES]
+        """The indices of the parameters alone (:mod:`.parameter_indices`)."""
+        constrained = {c.key[:2] for c in spec.constraints if isinstance(c, IndexConstraint)}
+        self.constrained = {self.labels[request] for request in constrained}
+        parameters = self.mapping.get("parameters") if isinstance(self.mapping.get("parameters"), dict) else {}
+        self.device_names = [v for v in spec.variables if v not in spec.formula_variables or v in parameters]
+        """The variables that are device design variables; the others are read by the ``parameters`` formulas."""
         try:
-            self.space = DesignSpace(self.mapping, spec.variables)
+            self.space = DesignSpace(self.mapping, [*self.device_names, *spec.parameters])
             requests_of(self.requests, DESIGN_INDICES)
+            self._check_parameter_requests()
             self._check_options()
         except UserError as exc:
             raise UserError(f"{study.path}: {exc}") from None
@@ -92,30 +104,97 @@ class BoundStudy:
         self.points = np.zeros((0, 3)) if workspace is None else workspace.points()
         self.title = f"{self.space.base.name} ({study.path.name})"
 
+    def _check_parameter_requests(self) -> None:
+        for r in self.parameter_requests:
+            unknown = [k for k in r.options if k not in PARAMETER_INDICES[r.index].options]
+            if unknown:
+                raise UserError(f"index {r.index}: unknown option {unknown[0]!r} (options: "
+                                f"{', '.join(PARAMETER_INDICES[r.index].options)})")
+
     def _check_options(self) -> None:
-        """Every index with its options once at the device file's home pose, so that an option's bad value
-        is refused before the run (not found in every design)."""
+        """Every index with its options once at the device file's home pose (the parameter indices at the design in
+        the middle of the variables' bounds), so that an option's bad value is refused before the run (not found in every design)."""
         device = self.space.base
         evaluate_at(device, configuration_of(device).full(home_pose(device)), self.requests, None, DESIGN_INDICES)
+        middle = {name: v.values[0] if isinstance(v, Choice) else (v[0] + v[1]) / 2
+                  for name, v in self.study.spec.variables.items()}
+        params = {name: np.array([float(value)]) for name, value in
+                  {**device.params, **self.device_values(middle)}.items()}
+        for r in self.parameter_requests:
+            index = PARAMETER_INDICES[r.index]
+            index.values(params, {**index.options, **r.options}, {})
 
-    def evaluate(self, batch: list[dict[str, float]]) -> list[Answer]:
-        """Answers for a batch of designs, in order: the registry evaluates them together (through the compiled
-        kernels where it can, :func:`~hapticdesign.simulation.design_indices.evaluate_designs`), each reduced
-        here; a design the device file refuses or that misses a workspace point has none, and says why."""
+    def device_values(self, values: dict[str, float]) -> dict[str, float]:
+        """The device design variables' values of a design: its variables' and the ``parameters`` formulas'."""
+        full = self.study.spec.with_parameters(values)
+        return {name: float(full[name]) for name in self.space.names}
+
+    def evaluate(self, batch: list[dict[str, float]], objectives: bool = True) -> list[Answer]:
+        """Answers for a batch of designs, in order: the registry evaluates the pose indices together (through the
+        compiled kernels where it can, :func:`~hapticdesign.simulation.design_indices.evaluate_designs`), each
+        reduced here; a design the device file refuses or that misses a workspace point has none, and says why.
+        The parameter indices are evaluated for the whole batch at once (no device is built when the study asks
+        only for them); those only the objectives read are evaluated only for the designs that meet every
+        constraint (NSGA-II's constrained domination never reads the objectives of the others), and for none
+        without ``objectives``."""
+        device_values = [self.device_values(v) for v in batch]
+        if self.requests:
+            results = evaluate_designs(self.space, device_values, self.points, self.requests)
+        else:
+            results = [Evaluation({}) for _ in batch]
+        valid = [k for k, r in enumerate(results) if r.reason is None]
+        values = {k: dict(results[k].values) for k in valid}
+        first = [r for r in self.parameter_requests if r.key in self.constrained]
+        self._parameter_values(first, [device_values[k] for k in valid], valid, values)
+        if objectives:
+            feasible = [k for k in valid if self._feasible(batch[k], values[k])]
+            later = [r for r in self.parameter_requests if r.key not in self.constrained]
+            self._parameter_values(later, [device_values[k] for k in feasible], feasible, values)
         nothing = (math.nan,) * len(self.keys)
         out = []
-        for result in evaluate_designs(self.space, batch, self.points, self.requests):
+        for k, result in enumerate(results):
             if result.reason is not None:
                 out.append(Answer(nothing, result.reason))
             else:
-                out.append(Answer(tuple(reduce(result.values[self.labels[key[:2]]], key[2]) for key in self.keys)))
+                got = values[k]
+                out.append(Answer(tuple(reduce(got[label], key[2]) if (label := self.labels[key[:2]]) in got
+                                        else math.nan for key in self.keys)))
         return out
+
+    def evaluate_constraints(self, batch: list[dict[str, float]]) -> list[Answer]:
+        """:meth:`evaluate` without the indices that only the objectives read."""
+        return self.evaluate(batch, objectives=False)
+
+    def _parameter_values(self, requests: list[Request], designs: list[dict[str, float]], rows: list[int],
+                          values: dict[int, dict[str, np.ndarray]]) -> None:
+        """The parameter indices ``requests`` of ``designs`` (device values), written to ``values[rows[i]]``."""
+        if not requests or not designs:
+            return
+        base = self.space.base.params
+        params = {name: np.array([float(d.get(name, base[name])) for d in designs]) for name in base}
+        cache: dict = {}
+        for r in requests:
+            index = PARAMETER_INDICES[r.index]
+            column = np.asarray(index.values(params, {**index.options, **r.options}, cache), dtype=float)
+            for i, k in enumerate(rows):
+                values[k][r.key] = column[i:i + 1]
+
+    def _feasible(self, variables: dict[str, float], values: dict[str, np.ndarray]) -> bool:
+        spec = self.study.spec
+        constrained = []
+        for c in spec.constraints:
+            if isinstance(c, IndexConstraint):
+                constrained.append(reduce(values[self.labels[c.key[:2]]], c.reduce))
+            else:
+                constrained.append(c.value(variables))
+        g, _ = violations(spec, constrained)
+        return bool(np.all(np.isfinite(g)) and np.all(g <= 0.0))
 
     def points_reached(self, values: dict[str, float]) -> int:
         """How many workspace points the design reaches, each from home on its own (the closest design of a
         study whose workspace no design reaches)."""
         try:
-            device = self.space.device(values)
+            device = self.space.device(self.device_values(values))
         except UserError:
             return 0
         count = 0
@@ -130,6 +209,7 @@ class BoundStudy:
     def device_mapping(self, values: dict[str, float]) -> dict:
         """The device file's mapping with ``values`` written in: a device file every command reads."""
         data = copy.deepcopy(self.mapping)
+        values = self.device_values(values)
         for v in self.space.variables:
             value = float(values[v.name])
             if v.kind == "parameter":
@@ -154,7 +234,7 @@ class BoundStudy:
     def pictures(self, values: dict[str, float]) -> list[tuple[bytes, str]]:
         """The selected design's picture at the workspace centre (at home when the centre is out of reach) and
         maps of its indices over the workspace points."""
-        device = self.space.device(values)
+        device = self.space.device(self.device_values(values))
         workspace = workspace_of(self.study)
         if workspace is None:
             return [(render_png(device, home_pose(device), dpi=100), "The selected design at home")]
@@ -166,9 +246,9 @@ class BoundStudy:
             where = "at home"
         out = [(render_png(device, q, dpi=100), f"The selected design {where}")]
         result = evaluate(device, self.points, self.requests)
-        if result.reason is None:
-            names = {label: f"{index} ({DESIGN_INDICES[index].unit})" for (index, _), label in self.labels.items()}
-            maps = {names[label]: result.values[label] for label in self.labels.values()}
+        if self.requests and result.reason is None:
+            names = {r.key: f"{r.index} ({DESIGN_INDICES[r.index].unit})" for r in self.requests}
+            maps = {names[key]: result.values[key] for key in names}
             out.append((index_maps(self.points, maps, "The selected design's indices over the workspace"),
                         "The selected design's indices at the workspace points"))
         return out

@@ -27,6 +27,7 @@ from hapticdesign.devices.device_file import describe_validation_error
 from hapticdesign.devices.schema import parse_expression
 from hapticdesign.errors import UserError
 from hapticdesign.files import load_structured, quote, read_text
+from hapticdesign.optimization.formula import Formula, formula
 
 REDUCTIONS = ("min", "max", "mean")
 """Reductions of an index over the workspace points (``mean``: the arithmetic mean over the uniform
@@ -151,7 +152,9 @@ class IndexConstraint(_Bounded, _IndexUse):
 
     @property
     def label(self) -> str:
-        return f"{self.reduce}_{self.index}"
+        """``min_isotropy``; with options, they follow in brackets: ``max_rcube_constraint[point=C2]``."""
+        shown = ",".join(f"{k}={v}" for k, v in self.request[1])
+        return f"{self.reduce}_{self.index}" + (f"[{shown}]" if shown else "")
 
 
 class ExpressionConstraint(_Bounded):
@@ -208,22 +211,56 @@ class Objective(_IndexUse):
         return self
 
 
+def _formula(value: object) -> Formula:
+    if isinstance(value, Formula):
+        return value
+    try:
+        return formula(value)
+    except UserError as exc:
+        raise ValueError(str(exc)) from None
+
+
+FormulaText = Annotated[Formula, BeforeValidator(_formula)]
+
+
+class Keep(_Bounded):
+    """A formula of the variables and parameters, bounded: the front keeps the designs that meet it (the search
+    does not see it)."""
+
+    formula: FormulaText
+
+
+class Start(_StudyModel):
+    """The design that minimizes ``minimize`` (a formula of the variables and parameters) under the study's
+    constraints, found by SciPy's SLSQP from ``starts`` seeded starts and placed in every run's first population."""
+
+    minimize: FormulaText
+    starts: Annotated[int, Field(strict=True, ge=1, le=1000)] = 32
+
+
 class AlgorithmSettings(_StudyModel):
     """``nsga2``: NSGA-II (Deb et al. 2002, pymoo) with ``population`` designs over ``generations``
-    generations. ``convex``: the exact convex program of seed 000's LN minimization over inertial
-    parameters (:mod:`.study_convex`), each body kept ``realizability``: ``rigid-body`` (pseudo-inertia
-    positive semi-definite, Wensing et al. 2017) or ``positive-definite`` (the seed's eq. 3.28)."""
+    generations; ``runs``: several runs, each with its own bounds of some continuous variables (run ``k`` seeded
+    ``seed + k``), merged; ``front``: the front of every evaluated design (``archive``) or of the runs' final
+    populations (``final``); ``start``: a minimized design in the first populations (:class:`Start`).
+    ``convex``: the exact convex program of seed 000's LN minimization over inertial parameters
+    (:mod:`.study_convex`), each body kept ``realizability``: ``rigid-body`` (pseudo-inertia positive
+    semi-definite, Wensing et al. 2017) or ``positive-definite`` (the seed's eq. 3.28)."""
 
     method: Literal["nsga2", "convex"] = "nsga2"
     population: Annotated[int, Field(strict=True, ge=4, le=100_000)] = 40
     generations: Annotated[int, Field(strict=True, ge=1, le=100_000)] = 60
     realizability: Literal["rigid-body", "positive-definite"] = "rigid-body"
+    runs: list[dict[str, Variable]] = Field([], max_length=100)
+    front: Literal["archive", "final"] = "archive"
+    start: Start | None = None
 
     @model_validator(mode="after")
     def _settings_of_the_method(self) -> "AlgorithmSettings":
         given = self.model_fields_set
-        if self.method == "convex" and given & {"population", "generations"}:
-            raise ValueError("population and generations are settings of method nsga2; method convex solves once")
+        if self.method == "convex" and given & {"population", "generations", "runs", "front", "start"}:
+            raise ValueError("population, generations, runs, front and start are settings of method nsga2; method "
+                             "convex solves once")
         if self.method == "nsga2" and "realizability" in given:
             raise ValueError("realizability is a setting of method convex (NSGA-II designs pass the device file's "
                              "own checks of each body)")
@@ -238,6 +275,9 @@ class StudySpec(_StudyModel):
     workspace: WorkspaceSpec | None = None
     objectives: list[Objective] = Field(min_length=1, max_length=16)
     constraints: list[Constraint] = Field([], max_length=64)
+    parameters: dict[str, FormulaText] = Field({}, max_length=MAX_VARIABLES)
+    """Device parameters computed from the variables (and the parameters above them) by a formula."""
+    keep: list[Keep] = Field([], max_length=16)
     algorithm: AlgorithmSettings = AlgorithmSettings()
 
     @model_validator(mode="after")
@@ -258,7 +298,39 @@ class StudySpec(_StudyModel):
                 if unknown:
                     raise ValueError(f"constraints[{i}]: {unknown[0]!r} in {c.expression!r} is not a variable of the study "
                                      f"(variables: {', '.join(self.variables)})")
+        known = list(self.variables)
+        for name, f in self.parameters.items():
+            if name in self.variables:
+                raise ValueError(f"parameters: {name!r} is a variable; a parameter is computed from the variables")
+            self._names_known(f"parameters.{name}", f, known)
+            known.append(name)
+        for where, f in [*((f"keep[{i}]", k.formula) for i, k in enumerate(self.keep)),
+                         *((("algorithm.start", self.algorithm.start.minimize),) if self.algorithm.start else ())]:
+            self._names_known(where, f, known)
+        for k, run in enumerate(self.algorithm.runs):
+            for name, bounds in run.items():
+                if name not in self.variables or isinstance(self.variables[name], Choice) or isinstance(bounds, Choice):
+                    raise ValueError(f"algorithm.runs[{k}]: {name!r} is not a continuous variable of the study")
         return self
+
+    @staticmethod
+    def _names_known(where: str, f: Formula, known: list[str]) -> None:
+        unknown = [n for n in f.names if n not in known]
+        if unknown:
+            raise ValueError(f"{where}: {unknown[0]!r} in {f.text!r} is not a variable or parameter above it")
+
+    @property
+    def formula_variables(self) -> tuple[str, ...]:
+        """The variables the ``parameters`` formulas read."""
+        used = {n for f in self.parameters.values() for n in f.names}
+        return tuple(v for v in self.variables if v in used)
+
+    def with_parameters(self, values: dict[str, float]) -> dict[str, float]:
+        """The variables' ``values`` and the ``parameters`` computed from them, in order."""
+        out = dict(values)
+        for name, f in self.parameters.items():
+            out[name] = f.value(out)
+        return out
 
     @property
     def index_uses(self) -> tuple[_IndexUse, ...]:

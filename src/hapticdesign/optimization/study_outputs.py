@@ -18,6 +18,7 @@ import numpy as np
 
 from hapticdesign.errors import UserError
 from hapticdesign.files import figure_bytes, save_figure
+from hapticdesign.optimization.parameter_indices import PARAMETER_INDICES
 from hapticdesign.optimization.selection import least_rms, normalize
 from hapticdesign.optimization.study_run import StudyRun, constraint_labels
 from hapticdesign.simulation.design_indices import DESIGN_INDICES
@@ -110,7 +111,7 @@ def _pyplot():
 
 
 def _unit(index: str) -> str:
-    unit = DESIGN_INDICES[index].unit
+    unit = (DESIGN_INDICES[index] if index in DESIGN_INDICES else PARAMETER_INDICES[index]).unit
     return "-" if unit == "1" else unit
 
 

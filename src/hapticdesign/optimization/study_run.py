@@ -29,7 +29,8 @@ from pymoo.core.problem import Problem
 
 from hapticdesign.errors import UserError
 from hapticdesign.files import read_text, write_atomically
-from hapticdesign.optimization.pymoo_run import AlgorithmSpec, pareto_filter, run
+from hapticdesign.optimization.pymoo_run import AlgorithmSpec, initial_population, pareto_filter, run
+from hapticdesign.optimization.shortest import minimize_in_boxes
 from hapticdesign.optimization.study_file import Choice, ExpressionConstraint, Study, StudySpec
 
 CHECKPOINT = "checkpoint"
@@ -65,9 +66,10 @@ class Encoding:
     xu: np.ndarray
 
     @classmethod
-    def of(cls, spec: StudySpec) -> "Encoding":
+    def of(cls, spec: StudySpec, bounds: dict | None = None) -> "Encoding":
+        """The study's variables, with ``bounds`` (name -> (low, high)) in place of some continuous ones' (a run's)."""
         low, high, choices = [], [], {}
-        for name, variable in spec.variables.items():
+        for name, variable in {**spec.variables, **(bounds or {})}.items():
             if isinstance(variable, Choice):
                 choices[name] = variable.values
                 low.append(-0.5)  # rounded to 0 ... n - 1, each choice sampled alike
@@ -114,7 +116,7 @@ class Record:
         return self.invalid or self.violated
 
 
-def _violations(spec: StudySpec, constraints: Sequence[float]) -> tuple[np.ndarray, str]:
+def violations(spec: StudySpec, constraints: Sequence[float]) -> tuple[np.ndarray, str]:
     """Scaled ``g <= 0`` columns of the constraints and the first violated one in words."""
     g, first = [], ""
     for c, value in zip(spec.constraints, constraints):
@@ -140,19 +142,23 @@ def record_of(spec: StudySpec, generation: int, x, values: dict[str, float], ans
     objectives = tuple(reduced[o.key] for o in spec.objectives)
     constraints = tuple(c.value(values) if isinstance(c, ExpressionConstraint) else reduced[c.key]
                         for c in spec.constraints)
-    invalid = answer.reason
-    if not invalid:
-        bad = [label for label, v in zip([o.name for o in spec.objectives] + list(constraint_labels(spec)),
-                                         objectives + constraints) if not np.isfinite(v)]
-        invalid = f"{bad[0]} is not a finite number" if bad else ""
-    g, violated = _violations(spec, constraints) if not invalid else (np.zeros(0), "")
+    invalid = answer.reason or _not_finite(constraint_labels(spec), constraints)
+    g, violated = violations(spec, constraints) if not invalid else (np.zeros(0), "")
+    if not invalid and not violated:  # a design that breaks a constraint may have no objectives (module docstring)
+        invalid = _not_finite([o.name for o in spec.objectives], objectives)
     return Record(generation, tuple(float(v) for v in x), values, objectives, constraints, invalid, violated,
                   float(np.sum(np.maximum(g, 0.0))))
 
 
+def _not_finite(labels: Sequence[str], values: Sequence[float]) -> str:
+    bad = [label for label, v in zip(labels, values) if not np.isfinite(v)]
+    return f"{bad[0]} is not a finite number" if bad else ""
+
+
 def minimized(spec: StudySpec, record: Record) -> np.ndarray:
-    """The record's objectives as pymoo minimizes them (a maximized objective negated; 0 without values)."""
-    if record.invalid:
+    """The record's objectives as pymoo minimizes them (a maximized objective negated; 0 without values, which
+    NSGA-II's constrained domination never reads)."""
+    if record.invalid or not np.all(np.isfinite(record.objectives)):
         return np.zeros(len(spec.objectives))
     return np.array([-v if o.sense == "max" else v for o, v in zip(spec.objectives, record.objectives)])
 
@@ -160,15 +166,16 @@ def minimized(spec: StudySpec, record: Record) -> np.ndarray:
 def _g(spec: StudySpec, record: Record) -> np.ndarray:
     """pymoo's ``g <= 0`` row: the validity column, then the scaled constraints (0 for a design without values)."""
     if record.invalid:
-        return np.concatenate([[1.0], np.zeros(len(_violations(spec, [0.0] * len(spec.constraints))[0]))])
-    return np.concatenate([[0.0], _violations(spec, record.constraints)[0]])
+        return np.concatenate([[1.0], np.zeros(len(violations(spec, [0.0] * len(spec.constraints))[0]))])
+    return np.concatenate([[0.0], violations(spec, record.constraints)[0]])
 
 
 class Checkpoint:
     """Each generation's answers in ``folder`` (see the module); None folder: nothing kept."""
 
-    def __init__(self, folder: Path | None, study: Study, seed: int):
+    def __init__(self, folder: Path | None, study: Study, seed: int, prefix: str = ""):
         self.folder = folder
+        self.prefix = prefix
         if folder is None:
             return
         header = {"study": study.fingerprint, "seed": seed}
@@ -185,7 +192,7 @@ class Checkpoint:
             write_atomically(path, json.dumps(header))
 
     def _path(self, generation: int) -> Path:
-        return self.folder / f"generation-{generation:04d}.json"
+        return self.folder / f"{self.prefix}generation-{generation:04d}.json"
 
     def load(self, generation: int, X: np.ndarray) -> list[Answer] | None:
         """The answers kept for ``generation`` if its file holds exactly the designs ``X``."""
@@ -209,14 +216,14 @@ class Checkpoint:
 class StudyProblem(Problem):
     """The study as pymoo's Problem: each call evaluates one generation in one batch and keeps its records."""
 
-    def __init__(self, spec: StudySpec, evaluate: Evaluator, checkpoint: Checkpoint):
+    def __init__(self, spec: StudySpec, evaluate: Evaluator, checkpoint: Checkpoint, bounds: dict | None = None):
         self.spec = spec
-        self.encoding = Encoding.of(spec)
+        self.encoding = Encoding.of(spec, bounds or {})
         self.evaluate_batch = evaluate
         self.checkpoint = checkpoint
         self.records: list[Record] = []
         self.generation = 0
-        n_g = 1 + len(_violations(spec, [0.0] * len(spec.constraints))[0])
+        n_g = 1 + len(violations(spec, [0.0] * len(spec.constraints))[0])
         super().__init__(n_var=len(self.encoding.names), n_obj=len(spec.objectives), n_ieq_constr=n_g,
                          xl=self.encoding.xl, xu=self.encoding.xu)
 
@@ -236,48 +243,108 @@ class StudyProblem(Problem):
 
 @dataclass(frozen=True)
 class StudyRun:
-    """Every evaluated design (``records``, in evaluation order) and the front (indices into them, feasible
-    and non-dominated over all evaluations, sorted by the first objective); method convex adds ``bound``, a
-    lower bound on the minimized objective (:mod:`.study_convex`)."""
+    """Every evaluated design (``records``, in evaluation order, run after run) and the front (indices into them,
+    feasible and non-dominated over all evaluations, or over the runs' final populations with ``front: final``,
+    then filtered by ``keep``, sorted by the first objective); ``start``: the minimized start design's variables
+    (None without ``algorithm.start`` or when no start met the constraints); ``bound``: method convex's lower bound
+    on the minimized objective (:mod:`.study_convex`)."""
 
     spec: StudySpec
     seed: int
     records: list[Record]
     front: list[int]
     bound: float | None = None
+    start: dict[str, float] | None = None
 
     @property
     def evaluations(self) -> int:
         return len(self.records)
 
 
-def front_of(spec: StudySpec, records: list[Record]) -> list[int]:
-    """Feasible, non-dominated records (designs with equal objectives once), by their first objective."""
-    ok = [k for k, r in enumerate(records) if r.feasible]
+def front_of(spec: StudySpec, records: list[Record], among: Sequence[int] | None = None) -> list[int]:
+    """Feasible, non-dominated records (designs with equal objectives once) among ``among`` (all by default) that
+    meet the study's ``keep`` filters, by their first objective."""
+    ok = [k for k in (range(len(records)) if among is None else among) if records[k].feasible]
     if not ok:
         return []
     X = np.array([records[k].x for k in ok])
     F = np.array([minimized(spec, records[k]) for k in ok])
     kept, seen = [], set()
     for i in pareto_filter(X, F):  # designs with the same objectives: the first evaluated stands for them
-        if tuple(F[i]) not in seen:
+        if tuple(F[i]) not in seen and kept_by(spec, records[ok[i]].values):
             seen.add(tuple(F[i]))
             kept.append(ok[i])
     return sorted(kept, key=lambda k: (minimized(spec, records[k])[0], k))
 
 
+def kept_by(spec: StudySpec, values: dict[str, float]) -> bool:
+    """Whether a design of variable ``values`` meets every ``keep`` filter of the study."""
+    full = spec.with_parameters(values)
+    for keep in spec.keep:
+        v = float(keep.formula.value(full))
+        if not ((keep.at_most is None or v <= keep.at_most) and (keep.at_least is None or v >= keep.at_least)):
+            return False
+    return True
+
+
+def start_design(study: Study, seed: int, evaluate: Evaluator, encodings: list[Encoding]) -> np.ndarray | None:
+    """The design vector minimizing ``algorithm.start.minimize`` under the study's constraints (SLSQP from seeded
+    starts over the box holding every run's bounds, :func:`~hapticdesign.optimization.shortest.minimize_in_boxes`),
+    or None when no start meets them. ``evaluate`` answers the constraints (objectives need not be computed)."""
+    spec = study.spec
+    encoding = encodings[0]
+    if encoding.discrete:
+        raise UserError("algorithm.start needs continuous variables only")
+
+    def minimized_value(x: np.ndarray) -> float:
+        return float(spec.algorithm.start.minimize.value(spec.with_parameters(encoding.decode(x))))
+
+    def constraints(x: np.ndarray) -> np.ndarray:
+        values = encoding.decode(x)
+        record = record_of(spec, 0, x, values, evaluate([values])[0])
+        if record.invalid and not any(np.isfinite(record.constraints)):
+            return np.ones(len(_g(spec, record)) - 1)
+        return violations(spec, record.constraints)[0]
+
+    found = minimize_in_boxes([(e.xl, e.xu) for e in encodings], minimized_value, constraints,
+                              spec.algorithm.start.starts, seed)
+    return None if found is None else found[0]
+
+
 def run_study(study: Study, seed: int, evaluate: Evaluator, out: Path | None = None,
-              progress: Callable[[int, int], None] | None = None) -> StudyRun:
+              progress: Callable[[int, int], None] | None = None,
+              evaluate_constraints: Evaluator | None = None) -> StudyRun:
     """Run ``study`` with ``seed``; ``evaluate`` answers batches of designs; ``out`` keeps the checkpoint
-    (``out/checkpoint``); ``progress(generation, generations)`` after each generation."""
+    (``out/checkpoint``); ``progress(generation, generations)`` after each generation; ``evaluate_constraints``
+    answers the constraints of ``algorithm.start``'s minimization (``evaluate`` by default).
+
+    Each run ``k`` of ``algorithm.runs`` (one run without them) is NSGA-II over its bounds seeded ``seed + k``; with
+    ``algorithm.start``, the minimized design joins the first population of every run whose bounds hold it, the
+    rest of that population drawn uniformly with the run's seed (pymoo's own seeded sampling otherwise)."""
     if seed < 0:
         raise UserError(f"the seed must be at least 0, got {seed}")
     spec = study.spec
-    checkpoint = Checkpoint(None if out is None else Path(out) / CHECKPOINT, study, seed)
-    problem = StudyProblem(spec, evaluate, checkpoint)
-    encoding = problem.encoding
-    algorithm = AlgorithmSpec("nsga2", spec.algorithm.population, spec.algorithm.generations,
-                              discrete=encoding.discrete)
-    total = spec.algorithm.generations
-    run(problem, algorithm, seed, (lambda generation: progress(generation, total)) if progress else None)
-    return StudyRun(spec, seed, problem.records, front_of(spec, problem.records))
+    folder = None if out is None else Path(out) / CHECKPOINT
+    bounds = spec.algorithm.runs or [{}]
+    encodings = [Encoding.of(spec, b) for b in bounds]
+    start = None
+    if spec.algorithm.start is not None:
+        start = start_design(study, seed, evaluate_constraints or evaluate, encodings)
+    records, final = [], []
+    total = spec.algorithm.generations * len(bounds)
+    for k, (run_bounds, encoding) in enumerate(zip(bounds, encodings)):
+        checkpoint = Checkpoint(folder, study, seed, f"run{k + 1}-" if len(bounds) > 1 else "")
+        problem = StudyProblem(spec, evaluate, checkpoint, run_bounds)
+        initial = None
+        if start is not None and np.all(encoding.xl <= start) and np.all(start <= encoding.xu):
+            initial = initial_population(encoding.xl, encoding.xu, spec.algorithm.population, seed + k, start[None])
+        algorithm = AlgorithmSpec("nsga2", spec.algorithm.population, spec.algorithm.generations,
+                                  initial=initial, discrete=encoding.discrete)
+        done = k * spec.algorithm.generations
+        result = run(problem, algorithm, seed + k,
+                     (lambda generation, done=done: progress(done + generation, total)) if progress else None)
+        last = {r.x: len(records) + i for i, r in enumerate(problem.records)}
+        final += [last[tuple(float(v) for v in x)] for x in result.X]
+        records += problem.records
+    front = front_of(spec, records, final if spec.algorithm.front == "final" else None)
+    return StudyRun(spec, seed, records, front, start=None if start is None else encodings[0].decode(start))

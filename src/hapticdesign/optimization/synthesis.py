@@ -25,7 +25,7 @@ from pymoo.indicators.hv import HV
 from hapticdesign.errors import UserError
 from hapticdesign.optimization.constraints import Q_MAX_RANGE, Workspace, constraint_values, link1_length
 from hapticdesign.optimization.objectives import EvaluationLinks, objectives
-from hapticdesign.optimization.pymoo_run import AlgorithmSpec, RowObjective, pareto_filter, run
+from hapticdesign.optimization.pymoo_run import AlgorithmSpec, RowObjective, initial_population, pareto_filter, run
 from hapticdesign.optimization.shortest import ConstrainedMinimum, constrained_minimum, design_summary, inside
 
 INFEASIBLE_OBJECTIVE = 1e30
@@ -107,25 +107,16 @@ class Front:
         return design_summary(self.X[k], self.workspace)
 
 
-def initial_population(bounds: Bounds, population: int, seed: int, designs: np.ndarray | None = None) -> np.ndarray:
-    """``designs`` (rows within ``bounds``) followed by uniform random rows drawn with ``seed``:
-    ``population`` rows in all."""
-    given = np.zeros((0, 3)) if designs is None else np.atleast_2d(np.asarray(designs, dtype=float))[:population]
-    rng = np.random.default_rng(seed)
-    rest = rng.uniform(bounds.lower, bounds.upper, (population - len(given), 3))
-    return np.vstack([given, rest])
-
-
 def run_nsga2(bounds: Bounds, population: int, generations: int, seed: int, workspace: Workspace = Workspace(),
               links: EvaluationLinks = EvaluationLinks(), progress: Callable[[int], None] | None = None,
               initial: np.ndarray | None = None, client=None) -> tuple[Front, int]:
     """One NSGA-II run (pymoo) over one bound set; returns its feasible final population and the
     number of objective evaluations. ``initial``: designs placed in the first population (see
-    :func:`initial_population`); without them pymoo's own seeded random sampling is used.
+    :func:`~hapticdesign.optimization.pymoo_run.initial_population`); without them pymoo's own seeded random sampling is used.
     ``client``: a ``dask.distributed.Client`` whose workers evaluate the objectives."""
     spec = AlgorithmSpec("nsga2", population, generations)
     if initial is not None:
-        spec = replace(spec, initial=initial_population(bounds, population, seed, initial))
+        spec = replace(spec, initial=initial_population(bounds.lower, bounds.upper, population, seed, initial))
     problem = SynthesisProblem(bounds, workspace, links, client)
     result = run(problem, spec, seed, progress)
     ok = result.feasible()

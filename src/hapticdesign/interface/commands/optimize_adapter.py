@@ -149,7 +149,7 @@ def optimize(study_path: Path, seed: int, out: Path | None, scheduler: str | Non
     else:
         with ExitStack() as stack:
             evaluate = _evaluator(bound, scheduler, quiet, stack)
-            run = run_study(study, seed, evaluate, out, progress)
+            run = run_study(study, seed, evaluate, out, progress, bound.evaluate_constraints)
     if not run.front:
         if run.bound is not None:
             raise UserError(f"{study_path}: the convex program's design is infeasible: {run.records[0].reason}")

@@ -1,0 +1,113 @@
+"""Indices that are closed forms of a device's parameters (no pose is reached): the R-CUBE's synthesis indices of
+seed 001 §6.1.3 and §6.4, so that its kinematic synthesis runs as a study file (docs/optimization.md,
+docs/indices.md).
+
+These indices are specific to the modified R-CUBE: they read the device file's ``l1``, ``l2``, ``l3`` and ``S``
+(``S = l1``, eq. 6.39, is required) and evaluate the synthesis's own closed forms
+(:mod:`~hapticdesign.optimization.constraints`, :mod:`~hapticdesign.optimization.objectives`; ``M_C`` and ``K_C`` of
+the device's ``l1, l2, l3`` with the evaluation tube) at ``q_max = asin(h / l1)`` (Constraint 1, eq. 6.24, read backward: the active joint travel that covers the cube of half
+edge ``h``). They are not computed from the device file's frames and loops: the passive-joint conditions of
+Constraints 3-7 at points of a virtual cube that the handle need not reach, and the hand-side condition of
+Constraint 8, have no counterpart among the pose indices. Options: ``side`` (the workspace cube's edge, m, 0.120) and
+``virtual_side`` (the virtual cube's edge, m, 0.130); the objectives' links are the synthesis's evaluation tube
+(:class:`~hapticdesign.optimization.objectives.EvaluationLinks`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from hapticdesign.errors import UserError
+from hapticdesign.optimization.constraints import (ERGONOMIC_POINTS, PASSIVE_POINTS, Workspace, constraint_values)
+from hapticdesign.model.rcube import RCubeGeometry
+from hapticdesign.optimization.objectives import EvaluationLinks, o1, o2, o3
+
+POINTS = (*PASSIVE_POINTS, *ERGONOMIC_POINTS)
+"""The critical points of Constraints 3-8, in the column order of :func:`constraint_values`."""
+
+
+@dataclass(frozen=True)
+class ParameterIndex:
+    """An index of a design's parameters: ``values(params, options, cache)`` maps each parameter name to an array
+    (one entry per design) and returns one value per design; ``cache`` is shared by the indices of one batch."""
+
+    name: str
+    unit: str
+    formula: str
+    source: str
+    values: Callable[[Mapping[str, np.ndarray], Mapping[str, object], dict], np.ndarray]
+    options: Mapping[str, object] = field(default_factory=dict)
+
+
+def _workspace(options: Mapping[str, object]) -> Workspace:
+    side, virtual = options["side"], options["virtual_side"]
+    for name, value in (("side", side), ("virtual_side", virtual)):
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise UserError(f"R-CUBE index option {name} is a length in m, got {value!r}")
+    return Workspace(float(side), float(virtual))
+
+
+def design_vectors(params: Mapping[str, np.ndarray], workspace: Workspace) -> np.ndarray:
+    """``(q_max, l2, l3)`` per design (n, 3) from the parameters, ``q_max = asin(h / l1)`` (eq. 6.24 read backward);
+    a design with ``S != l1`` is refused (the closed forms hold for ``S = l1``, eq. 6.39)."""
+    missing = [n for n in ("l1", "l2", "l3", "S") if n not in params]
+    if missing:
+        raise UserError(f"the R-CUBE indices need device parameters l1, l2, l3 and S; {missing[0]} is missing")
+    l1 = np.asarray(params["l1"], dtype=float)
+    if not np.allclose(params["S"], l1, rtol=1e-12, atol=0.0):
+        raise UserError("the R-CUBE indices hold for S = l1 (eq. 6.39): set S from l1 in the study's parameters")
+    with np.errstate(invalid="ignore"):
+        q = np.arcsin(workspace.half / l1)
+    return np.column_stack([q, np.asarray(params["l2"], dtype=float), np.asarray(params["l3"], dtype=float)])
+
+
+def _constraint(params, options, cache) -> np.ndarray:
+    point = options["point"]
+    if point not in POINTS:
+        raise UserError(f"index rcube_constraint: point is one of {', '.join(POINTS)}, got {point!r}")
+    workspace = _workspace(options)
+    key = ("constraints", workspace)
+    if key not in cache:
+        cache[key] = constraint_values(design_vectors(params, workspace), workspace)
+    return cache[key][:, POINTS.index(point)]
+
+
+def _o1(params, options, cache) -> np.ndarray:
+    return o1(design_vectors(params, _workspace(options))[:, 0])
+
+
+def _per_design(params, options, cache, objective: Callable) -> np.ndarray:
+    workspace = _workspace(options)
+    links = EvaluationLinks()
+    out = []
+    for l1, (_, l2, l3) in zip(np.asarray(params["l1"], dtype=float), design_vectors(params, workspace)):
+        key = ("design", float(l1), float(l2), float(l3))
+        if key not in cache:
+            cache[key] = links.design(RCubeGeometry(float(l1), float(l2), float(l3)))
+        out.append(objective(cache[key], workspace.half, links))
+    return np.array(out)
+
+
+def _o2(params, options, cache) -> np.ndarray:
+    return _per_design(params, options, cache, lambda design, half, links: o2(design, half))
+
+
+def _o3(params, options, cache) -> np.ndarray:
+    return _per_design(params, options, cache, lambda design, half, links: o3(design, half, links.passive_eliminated))
+
+
+_CUBE = {"side": 0.120, "virtual_side": 0.130}
+
+PARAMETER_INDICES: dict[str, ParameterIndex] = {index.name: index for index in (
+    ParameterIndex("rcube_o1", "1", "tan q_max, q_max = asin(h / l1)", "seed 001 eq. 6.82, 6.24", _o1, _CUBE),
+    ParameterIndex("rcube_o2", "kg^3", "det M_C with two active links folded (q_i1 = -q_max), the third at home",
+                   "seed 001 eq. 6.83, 5.227", _o2, _CUBE),
+    ParameterIndex("rcube_o3", "m^3/N^3", "1 / det K_CA at the fully extended pose (q_i1 = q_max)",
+                   "seed 001 eq. 6.84, 6.74", _o3, _CUBE),
+    ParameterIndex("rcube_constraint", "1", "cos^2 q_i3 - 1 at C2, C3, C5, B3, B5; sin(q_i2 + q_i3) at C1, B1 "
+                   "(feasible: <= 0)", "seed 001 eq. 6.45-6.49, 6.52", _constraint, {**_CUBE, "point": "C2"}),
+)}
+"""The indices of a device's parameters: name -> :class:`ParameterIndex`."""
