@@ -46,7 +46,8 @@ def require_study_workload(study: Study) -> None:
     spec = study.spec
     if spec.algorithm.method == "convex":
         return
-    points = len(workspace_of(study).points())
+    workspace = workspace_of(study)
+    points = 1 if workspace is None else len(workspace.points())
     runs = max(1, len(spec.algorithm.runs))
     amount = spec.algorithm.population * spec.algorithm.generations * runs * points
     require_within(f"a study of {spec.algorithm.population} designs x {spec.algorithm.generations} generations x "

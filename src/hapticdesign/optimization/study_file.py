@@ -28,6 +28,7 @@ from hapticdesign.devices.schema import parse_expression
 from hapticdesign.errors import UserError
 from hapticdesign.files import load_structured, quote, read_text
 from hapticdesign.optimization.formula import Formula, formula
+from hapticdesign.optimization.parameter_indices import PARAMETER_INDICES
 
 REDUCTIONS = ("min", "max", "mean")
 """Reductions of an index over the workspace points (``mean``: the arithmetic mean over the uniform
@@ -282,9 +283,9 @@ class StudySpec(_StudyModel):
 
     @model_validator(mode="after")
     def _names(self) -> "StudySpec":
-        if self.workspace is None and self.algorithm.method != "convex":
+        if self.workspace is None and self.algorithm.method != "convex" and not self.parameters_only:
             raise ValueError("workspace: the region the handle must reach is required (only method convex, whose "
-                             "LN is over the joint region, does without)")
+                             "LN is over the joint region, and a study of parameter indices alone do without)")
         names = [o.name for o in self.objectives]
         twice = sorted({n for n in names if names.count(n) > 1})
         if twice:
@@ -331,6 +332,12 @@ class StudySpec(_StudyModel):
         for name, f in self.parameters.items():
             out[name] = f.value(out)
         return out
+
+    @property
+    def parameters_only(self) -> bool:
+        """True when every index the study reads is a parameter index (a closed form of the device's parameters,
+        :mod:`.parameter_indices`): no pose is reached, the study needs no workspace."""
+        return all(use.index in PARAMETER_INDICES for use in self.index_uses)
 
     @property
     def index_uses(self) -> tuple[_IndexUse, ...]:

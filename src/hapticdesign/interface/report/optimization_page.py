@@ -66,9 +66,13 @@ def _study_rows(run: StudyRun) -> str:
                      f"000 eq. 3.1-3.4), every body {escape(spec.algorithm.realizability)} realizable; the relaxation's "
                      f"lower bound on the minimum is {escape(cell_text(run.bound))}.</p>")
     else:
-        box = spec.workspace.box
-        parts.append(f'<p>Workspace: box centred at {escape(str(list(box.center)))} m, edges {escape(str(list(box.size)))} '
-                     f"m, {spec.workspace.grid} points per axis of nonzero size. NSGA-II, population "
+        if spec.workspace is None:
+            where = "No workspace: every index is a closed form of the device's parameters. "
+        else:
+            box = spec.workspace.box
+            where = (f"Workspace: box centred at {escape(str(list(box.center)))} m, edges {escape(str(list(box.size)))} "
+                     f"m, {spec.workspace.grid} points per axis of nonzero size. ")
+        parts.append(f"<p>{where}NSGA-II, population "
                      f"{spec.algorithm.population}, {spec.algorithm.generations} generations, seed {run.seed}: "
                      f"{run.evaluations} designs evaluated, {sum(r.feasible for r in run.records)} feasible.</p>")
     return "".join(parts)
