@@ -84,7 +84,8 @@ class HandleStates:
 
     @cached_property
     def damping(self) -> np.ndarray:
-        """``B`` (n_a, n_a): the joints' and motors' viscous damping (:attr:`~hapticdesign.model.device.Device.damping_matrix`)."""
+        """``B`` (n_a, n_a): the joints' and motors' viscous damping
+        (:attr:`~hapticdesign.model.device.Device.damping_matrix`)."""
         return self.device.damping_matrix
 
     @cached_property
