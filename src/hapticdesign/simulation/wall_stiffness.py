@@ -48,8 +48,9 @@ def wall_directions(mobility: np.ndarray, damping: np.ndarray) -> np.ndarray:
     return np.concatenate([fixed[0], *principal, fixed[1]], axis=-2)
 
 
-CHUNK = 1 << 15
-"""Loops searched at once by :func:`wall_limits` (their matrices take ``8 (3 + 3 d)^2`` bytes each)."""
+CHUNK_BYTES = 1 << 24
+"""The closed-loop matrices :func:`wall_limits` searches at once (``8 (3 + 3 d)^2`` bytes a loop), at least one
+point's."""
 
 
 def wall_limit(mobility: np.ndarray, damping: np.ndarray, period: float, delay: int, virtual_damping: float = 0.0,
@@ -65,11 +66,11 @@ def wall_limits(mobility: np.ndarray, damping: np.ndarray, period: float, delay:
     """:func:`wall_limit` at P points at once: ``mobility`` and ``damping`` (P, k, k), ``along`` None (the worst
     of :func:`wall_directions`) or (P, C, k) unit rows (the smallest over them); (P,) in N/m. The loops of all
     points and directions go through :func:`~hapticdesign.simulation.boundary.exact_boundaries` together, in
-    chunks of about :data:`CHUNK` loops."""
+    chunks of about :data:`CHUNK_BYTES` of matrices."""
     rows = wall_directions(mobility, damping) if along is None else np.asarray(along, dtype=float)
     mass = 1.0 / np.einsum("pck,pkl,pcl->pc", rows, mobility, rows)
     along = np.einsum("pck,pkl,pcl->pc", rows, damping, rows)
-    per = max(1, CHUNK // rows.shape[1])
+    per = max(1, CHUNK_BYTES // (8 * (3 + 3 * delay) ** 2 * rows.shape[1]))
     out = np.empty(len(mass))
     for start in range(0, len(mass), per):
         part = slice(start, start + per)
