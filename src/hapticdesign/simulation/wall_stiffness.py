@@ -69,11 +69,11 @@ def wall_limits(mobility: np.ndarray, damping: np.ndarray, period: float, delay:
     chunks of about :data:`CHUNK_BYTES` of matrices."""
     rows = wall_directions(mobility, damping) if along is None else np.asarray(along, dtype=float)
     mass = 1.0 / np.einsum("pck,pkl,pcl->pc", rows, mobility, rows)
-    along = np.einsum("pck,pkl,pcl->pc", rows, damping, rows)
+    damped = np.einsum("pck,pkl,pcl->pc", rows, damping, rows)
     per = max(1, CHUNK_BYTES // (8 * (3 + 3 * delay) ** 2 * rows.shape[1]))
     out = np.empty(len(mass))
     for start in range(0, len(mass), per):
         part = slice(start, start + per)
-        systems = MassDampers(mass[part].ravel(), along[part].ravel(), period, delay, virtual_damping)
+        systems = MassDampers(mass[part].ravel(), damped[part].ravel(), period, delay, virtual_damping)
         out[part] = exact_boundaries(systems, np.repeat(np.arange(len(mass[part])), rows.shape[1]))
     return out
