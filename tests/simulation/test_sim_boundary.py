@@ -15,10 +15,12 @@ from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
 from hapticdesign.simulation.boundary import (
-    MassDamper, closed_loop_matrix, compensated_boundary, compensated_limit, exact_boundary, simulated_boundary,
+    MassDamper, MassDampers, closed_loop_matrix, compensated_boundary, compensated_limit, exact_boundaries,
+    exact_boundary, simulated_boundary,
 )
 from hapticdesign.simulation.config import Compensator, Hand, LoopConfig
 from hapticdesign.simulation.impedance import ImpedanceProblem, growth_boundary
+from hapticdesign.simulation.zwidth import DisplayLoop, max_stiffness
 
 CASES = [
     (0.01, 0.5, 1e-3, 0, False),
@@ -201,3 +203,45 @@ def test_hand_on_a_one_dof_device_meets_the_exact_discrete_analysis():
     without_mass = exact_boundary(MassDamper(j, 0.3 + hand.damping * r2, 1e-3, compensate_inertia=True,
                                              plant_stiffness=hand.stiffness * r2))
     assert abs(without_mass - exact) > 0.2 * exact
+
+
+def _random_systems(rng, count: int, delay: int, compensate: bool) -> list[MassDamper]:
+    """Mass-dampers over three decades of inertia, damping and period, with a virtual damper half the time and,
+    compensated, a model inertia 90-100 % of the plant's."""
+    out = []
+    for _ in range(count):
+        j, b, t = 10 ** rng.uniform(-3, -1), 10 ** rng.uniform(-2, 0), 10 ** rng.uniform(-4, -3)
+        out.append(MassDamper(j, b, t, delay, float(rng.choice([0.0, rng.uniform(0.0, b)])), compensate,
+                              rng.uniform(0.9, 1.0) * j if compensate else None))
+    return out
+
+
+@pytest.mark.parametrize("delay", [0, 1, 2, 3])
+@pytest.mark.parametrize("compensate", [False, True])
+def test_batched_limits_are_each_systems_limit_and_python_controls(delay, compensate):
+    """One batched search over random loops gives each loop's own limit (searched alone) and the limit of the loop
+    built independently by python-control (zwidth: c2d of the plant, feedback of the delayed law), to 1e-8."""
+    systems = _random_systems(np.random.default_rng(10 * delay + compensate), 4, delay, compensate)
+    batched = exact_boundaries(MassDampers.of(systems))
+    for system, limit in zip(systems, batched):
+        assert limit == pytest.approx(exact_boundary(system), rel=1e-9)
+        fraction = system.j_model / system.inertia if compensate else 0.0
+        loop = DisplayLoop(system.inertia, system.damping, system.period, delay, "sampled", fraction)
+        assert limit == pytest.approx(max_stiffness(loop, system.virtual_damping), rel=1e-8)
+
+
+def test_grouped_search_gives_each_groups_smallest_limit():
+    """The smallest limit per group (loops leave the search once another loop of their group is unstable below their
+    stable spring) equals the smallest of the loops searched alone; a loop with no stable spring (a compensator
+    over-estimating the inertia by 5 % at x = 0.0128: 0) settles its group at 0, and loops stable up to ``k_max``
+    give inf."""
+    rng = np.random.default_rng(3)
+    systems = _random_systems(rng, 11, 1, True)
+    systems.append(MassDamper(0.039, 0.5, 1e-3, 1, 0.0, True, 1.05 * 0.039))
+    systems += [MassDamper(1e-3, 50.0, 1e-4, 1, 0.0, True, 1e-3)] * 2  # about 4.8e5 N m/rad
+    groups = np.array([0] * 5 + [1] * 6 + [1] + [2] * 2)
+    alone = np.array([exact_boundary(s, k_max=1e5) for s in systems])
+    smallest = exact_boundaries(MassDampers.of(systems), groups, k_max=1e5)
+    expected = [alone[groups == g].min() for g in range(3)]
+    np.testing.assert_allclose(smallest, expected, rtol=1e-12)
+    assert 0.0 < smallest[0] < math.inf and smallest[1] == 0.0 and smallest[2] == math.inf

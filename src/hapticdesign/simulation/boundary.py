@@ -50,12 +50,11 @@ against the spectral radius of the exactly discretized loop and the simulated lo
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
 from scipy.linalg import expm
-from scipy.optimize import brentq
 
 from hapticdesign.errors import InputError, UserError
 from hapticdesign.simulation.config import Compensator, LoopConfig, Sensors, Wall
@@ -80,31 +79,89 @@ class MassDamper:
     plant_stiffness: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("inertia", "period"):
-            value = getattr(self, name)
-            if not (value > 0 and math.isfinite(value)):
-                raise UserError(f"the {name} must be positive, got {value}")
-        if not (self.damping >= 0 and math.isfinite(self.damping)):
-            raise UserError(f"the damping must be non-negative, got {self.damping}")
-        if self.delay_samples < 0:
-            raise InputError(f"the sensor delay must be a non-negative number of samples, got {self.delay_samples}",
-                             "delay")
-        if not (self.virtual_damping >= 0 and math.isfinite(self.virtual_damping)):
-            raise InputError(f"the wall damping must be a finite number >= 0, got {self.virtual_damping}",
-                             "wall_damping")
-        if not (self.plant_stiffness >= 0 and math.isfinite(self.plant_stiffness)):
-            raise UserError(f"the plant stiffness must be non-negative, got {self.plant_stiffness}")
-        if self.model_inertia is not None and not (self.model_inertia >= 0 and math.isfinite(self.model_inertia)):
-            raise UserError(f"the model inertia must be non-negative, got {self.model_inertia}")
+        _check(self)
 
     @property
     def j_model(self) -> float:
         return self.inertia if self.model_inertia is None else self.model_inertia
 
 
-@lru_cache(maxsize=64)
-def _discretize(j: float, b: float, t: float, k_p: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
-    """Exact zero-order-hold discretization of ``J qdd + b qd + k_p q = u`` over one period.
+@dataclass(frozen=True)
+class MassDampers:
+    """Many :class:`MassDamper` s at once (each numeric field a number or an array of S values) that share the delay
+    and the use of the compensator: the systems of one batched boundary search."""
+
+    inertia: np.ndarray
+    damping: np.ndarray
+    period: np.ndarray | float
+    delay_samples: int = 0
+    virtual_damping: np.ndarray | float = 0.0
+    compensate_inertia: bool = False
+    model_inertia: np.ndarray | None = None
+    plant_stiffness: np.ndarray | float = 0.0
+
+    def __post_init__(self) -> None:
+        size = np.broadcast_shapes(*(np.shape(getattr(self, name)) for name in _NUMERIC
+                                     if getattr(self, name) is not None))
+        for name in _NUMERIC:
+            value = getattr(self, name)
+            if value is not None:
+                object.__setattr__(self, name, np.broadcast_to(np.asarray(value, dtype=float), size).ravel())
+        _check(self)
+
+    @classmethod
+    def of(cls, systems: Sequence[MassDamper]) -> "MassDampers":
+        """The systems ``systems`` (one delay, compensated all or none) as one batch."""
+        if len({(s.delay_samples, s.compensate_inertia) for s in systems}) > 1:
+            raise UserError("a batch of mass-dampers shares the delay and the use of the compensator")
+        first = systems[0]
+        return cls(*(np.array([getattr(s, name) for s in systems], dtype=float) for name in _NUMERIC[:3]),
+                   first.delay_samples, np.array([s.virtual_damping for s in systems], dtype=float),
+                   first.compensate_inertia, np.array([s.j_model for s in systems], dtype=float),
+                   np.array([s.plant_stiffness for s in systems], dtype=float))
+
+    def __len__(self) -> int:
+        return len(self.inertia)
+
+    @property
+    def j_model(self) -> np.ndarray:
+        return self.inertia if self.model_inertia is None else self.model_inertia
+
+
+_NUMERIC = ("inertia", "damping", "period", "virtual_damping", "model_inertia", "plant_stiffness")
+
+
+def _check(system: MassDamper | MassDampers) -> None:
+    """The one-line refusals of a mass-damper's (or a batch's) values."""
+    for name in ("inertia", "period"):
+        value = getattr(system, name)
+        if not np.all((np.asarray(value) > 0) & np.isfinite(value)):
+            raise UserError(f"the {name} must be positive, got {_worst(value)}")
+    if not np.all((np.asarray(system.damping) >= 0) & np.isfinite(system.damping)):
+        raise UserError(f"the damping must be non-negative, got {_worst(system.damping)}")
+    if system.delay_samples < 0:
+        raise InputError(f"the sensor delay must be a non-negative number of samples, got {system.delay_samples}",
+                         "delay")
+    if not np.all((np.asarray(system.virtual_damping) >= 0) & np.isfinite(system.virtual_damping)):
+        raise InputError(f"the wall damping must be a finite number >= 0, got {_worst(system.virtual_damping)}",
+                         "wall_damping")
+    if not np.all((np.asarray(system.plant_stiffness) >= 0) & np.isfinite(system.plant_stiffness)):
+        raise UserError(f"the plant stiffness must be non-negative, got {_worst(system.plant_stiffness)}")
+    if system.model_inertia is not None and not np.all((np.asarray(system.model_inertia) >= 0)
+                                                       & np.isfinite(system.model_inertia)):
+        raise UserError(f"the model inertia must be non-negative, got {_worst(system.model_inertia)}")
+
+
+def _worst(value) -> float:
+    """The value a refusal names: the number itself, or a batch's smallest (or first non-finite) value."""
+    values = np.ravel(np.asarray(value, dtype=float))
+    bad = values[~np.isfinite(values)]
+    return float(bad[0] if bad.size else values.min())
+
+
+def _discretize(j: np.ndarray, b: np.ndarray, t: np.ndarray, k_p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Exact zero-order-hold discretization of ``J qdd + b qd + k_p q = u`` over one period, for S systems at once
+    (arrays of S values): ``Phi`` (S, 2, 2) and ``Gamma`` (S, 2).
 
     Without a plant spring, in closed form (``x = b T / J``, ``a = e^-x``)::
 
@@ -113,37 +170,54 @@ def _discretize(j: float, b: float, t: float, k_p: float = 0.0) -> tuple[np.ndar
 
     (series below x = 1, 1 and 1/2 at x = 0); with one, ``scipy.linalg.expm`` of the augmented matrix.
     """
-    if k_p != 0.0:
-        e = expm(np.array([[0.0, 1.0, 0.0], [-k_p / j, -b / j, 1.0 / j], [0.0, 0.0, 0.0]]) * t)
-        return e[:2, :2], e[:2, 2]
     x = b * t / j
-    if x < 1.0:
-        h1 = _series(x, 0, lambda n: (-1) ** n / (n + 1))
-        h2 = _series(x, 0, lambda n: (-1) ** n / ((n + 1) * (n + 2)))
-    else:
-        h1 = -math.expm1(-x) / x
-        h2 = (x + math.expm1(-x)) / x ** 2
-    return np.array([[1.0, t * h1], [0.0, math.exp(-x)]]), np.array([t * t * h2 / j, t * h1 / j])
+    small = x < 1.0
+    xs, xl = np.where(small, x, 0.0), np.where(small, 1.0, x)
+    h1 = np.where(small, _series(xs, _H1), -np.expm1(-xl) / xl)
+    h2 = np.where(small, _series(xs, _H2), (xl + np.expm1(-xl)) / xl ** 2)
+    phi = np.zeros((len(x), 2, 2))
+    phi[:, 0, 0] = 1.0
+    phi[:, 0, 1] = t * h1
+    phi[:, 1, 1] = np.exp(-x)
+    gamma = np.stack([t * t * h2 / j, t * h1 / j], axis=1)
+    spring = np.flatnonzero(k_p != 0.0)
+    if spring.size:
+        aug = np.zeros((spring.size, 3, 3))
+        aug[:, 0, 1] = 1.0
+        aug[:, 1, 0] = -k_p[spring] / j[spring]
+        aug[:, 1, 1] = -b[spring] / j[spring]
+        aug[:, 1, 2] = 1.0 / j[spring]
+        e = expm(aug * t[spring, None, None])
+        phi[spring], gamma[spring] = e[:, :2, :2], e[:, :2, 2]
+    return phi, gamma
 
 
-def _series(x: float, first: int, term) -> float:
-    """``sum_(n >= first) term(n) x^n / n!`` to double precision (for ``0 <= x < 1``)."""
-    total, power = 0.0, x ** first / math.factorial(first)
-    for n in range(first, first + 40):
-        total += term(n) * power
-        power *= x / (n + 1)
-    return total
+def _taylor(first: int, term) -> np.ndarray:
+    """The coefficients of ``sum_(n >= first) term(n) x^n / n!`` up to ``x^(first + 39)`` (zeros below ``first``):
+    double precision for ``0 <= x < 1``."""
+    return np.array([term(n) / math.factorial(n) if n >= first else 0.0 for n in range(first + 40)])
+
+
+_H1 = _taylor(0, lambda n: (-1) ** n / (n + 1))
+_H2 = _taylor(0, lambda n: (-1) ** n / ((n + 1) * (n + 2)))
+_G = _taylor(2, lambda n: (-1) ** n * (n - 1))
+_F = _taylor(3, lambda n: (-1) ** (n - 1) * (n - 2))
+
+
+def _series(x, coefficients: np.ndarray):
+    """The power series ``coefficients`` at ``x`` (a number or an array), by Horner's rule."""
+    return np.polynomial.polynomial.polyval(x, coefficients)
 
 
 def _g(x: float) -> float:
     """``1 - (1 + x) e^-x`` (series ``sum (-1)^n (n - 1) x^n / n!`` from n = 2 below x = 1)."""
-    return _series(x, 2, lambda n: (-1) ** n * (n - 1)) if x < 1.0 else 1.0 - (1.0 + x) * math.exp(-x)
+    return float(_series(x, _G)) if x < 1.0 else 1.0 - (1.0 + x) * math.exp(-x)
 
 
 def _f(x: float) -> float:
     """``x (1 + e^-x) - 2 (1 - e^-x)`` (series ``sum (-1)^(n-1) (n - 2) x^n / n!`` from n = 3 below x = 1)."""
     if x < 1.0:
-        return _series(x, 3, lambda n: (-1) ** (n - 1) * (n - 2))
+        return float(_series(x, _F))
     return x * (1.0 + math.exp(-x)) + 2.0 * math.expm1(-x)
 
 
@@ -181,60 +255,168 @@ def compensated_boundary(inertia: float, damping: float, period: float, fraction
     return compensated_limit(inertia, damping, period, fraction).stiffness
 
 
+class ClosedLoops:
+    """The one-sample maps of S sampled loops, state ``[q, qd, u_prev, s_(k-1), ..., s_(k-d)]`` with ``s = (q, qd,
+    a)``: ``m(K) = m(0) - K g e_c^T`` (the spring enters one column ``c``, that of ``q`` in the law, through
+    ``g = (Gamma, 1)``), so a search builds the spring-free maps once."""
+
+    def __init__(self, systems: MassDampers):
+        j, b, d = systems.inertia, systems.damping, systems.delay_samples
+        phi, gamma = _discretize(j, b, systems.period, systems.plant_stiffness)
+        count, size = len(j), 3 + 3 * d
+        sense = np.zeros((count, 3, 3))  # s_k from z_k
+        sense[:, 0, 0] = 1.0
+        sense[:, 1, 1] = 1.0
+        sense[:, 2, 0] = -systems.plant_stiffness / j
+        sense[:, 2, 1] = -b / j
+        sense[:, 2, 2] = 1.0 / j
+        gains = np.stack([np.zeros(count), -systems.virtual_damping,
+                          float(systems.compensate_inertia) * systems.j_model], axis=1)
+        law = np.einsum("si,sij->sj", gains, sense) if d == 0 else np.concatenate(
+            [np.zeros((count, 3 + 3 * (d - 1))), gains], axis=1)
+        m = np.zeros((count, size, size))
+        m[:, :2, :2] = phi
+        m[:, :2] += gamma[:, :, None] * law[:, None, :]
+        m[:, 2] = law
+        if d > 0:
+            m[:, 3:6, :3] = sense
+            m[:, 6:, 3:size - 3] = np.eye(size)[3:size - 3, 3:size - 3]
+        self.base, self.column = m, 0 if d == 0 else size - 3
+        self.spring = np.concatenate([gamma, np.ones((count, 1))], axis=1)
+
+    def matrices(self, stiffness: np.ndarray, index: np.ndarray | slice = slice(None)) -> np.ndarray:
+        """The maps (S', n, n) of the systems ``index`` under the springs ``stiffness`` (S',)."""
+        m = self.base[index].copy()
+        m[:, :3, self.column] -= np.asarray(stiffness, dtype=float)[:, None] * self.spring[index]
+        return m
+
+    def radii(self, stiffness: np.ndarray, index: np.ndarray | slice = slice(None)) -> np.ndarray:
+        """Spectral radii (S',) of :meth:`matrices` (the loop is stable below 1)."""
+        return np.abs(np.linalg.eigvals(self.matrices(stiffness, index))).max(axis=-1)
+
+
 def closed_loop_matrix(system: MassDamper, stiffness: float) -> np.ndarray:
-    """One-sample map of ``[q, qd, u_prev, s_(k-1), ..., s_(k-d)]`` with ``s = (q, qd, a)``."""
-    j, b, d = system.inertia, system.damping, system.delay_samples
-    phi, gamma = _discretize(j, b, system.period, system.plant_stiffness)
-    size = 3 + 3 * d
-    sense = np.zeros((3, size))  # s_k from z_k
-    sense[0, 0] = 1.0
-    sense[1, 1] = 1.0
-    sense[2, 0] = -system.plant_stiffness / j
-    sense[2, 1] = -b / j
-    sense[2, 2] = 1.0 / j
-    gains = np.array([-stiffness, -system.virtual_damping, float(system.compensate_inertia) * system.j_model])
-    law = gains @ sense if d == 0 else np.concatenate([np.zeros(3 + 3 * (d - 1)), gains])
-    m = np.zeros((size, size))
-    m[:2, :2] = phi
-    m[:2] += np.outer(gamma, law)
-    m[2] = law
-    if d > 0:
-        m[3:6] = sense
-        m[6:] = np.eye(size)[3:size - 3]
-    return m
+    """One-sample map of ``[q, qd, u_prev, s_(k-1), ..., s_(k-d)]`` with ``s = (q, qd, a)`` (:class:`ClosedLoops`)."""
+    return ClosedLoops(MassDampers.of([system])).matrices(np.array([stiffness]))[0]
 
 
 def spectral_radius(system: MassDamper, stiffness: float) -> float:
-    return float(np.max(np.abs(np.linalg.eigvals(closed_loop_matrix(system, stiffness)))))
+    return float(ClosedLoops(MassDampers.of([system])).radii(np.array([stiffness]))[0])
+
+
+FLOOR = 1e-9
+"""The smallest spring of the search: a loop unstable already there has the limit 0."""
+RTOL, XTOL = 1e-10, 1e-12
+"""The search stops when the stable and unstable springs are within ``XTOL + RTOL K`` of each other."""
 
 
 def exact_boundary(system: MassDamper, k_max: float = 1e9) -> float:
-    """Smallest spring stiffness at which the exactly discretized loop loses stability."""
-    order = 3 + 3 * system.delay_samples
-    what = f"the closed-loop matrix of a {system.delay_samples:,}-sample delay"
-    require_memory(what, 8.0 * order * order)
+    """Smallest spring stiffness at which the exactly discretized loop loses stability (:func:`exact_boundaries`)."""
+    return float(exact_boundaries(MassDampers.of([system]), k_max=k_max)[0])
+
+
+def exact_boundaries(systems: MassDampers, groups: np.ndarray | None = None, k_max: float = 1e9) -> np.ndarray:
+    """The exact limit of each system (S,), or the smallest in each group (``groups``: S labels 0 ... G - 1; (G,)).
+
+    A system unstable at :data:`FLOOR` has the limit 0; otherwise a stable ``lo`` and an unstable ``hi`` are
+    bracketed by halving or doubling from the passivity scale ``2 (b + B) / (T (1 + 2 d))`` (Colgate's bound with a
+    delay of ``d`` samples; ``hi > k_max``: stable up to ``k_max``, the limit is inf), and the crossing of the
+    spectral radius through 1 is found by the Illinois variant of regula falsi (a bisection after two steps that
+    did not halve the bracket) to ``XTOL + RTOL K``; the limit is the bracket's middle. All systems move at once
+    (one batched eigenvalue call per step). In a group, a system whose stable ``lo`` reaches the smallest unstable
+    ``hi`` of another cannot hold the group's smallest limit and leaves the search.
+    """
+    order = 3 + 3 * systems.delay_samples
+    what = f"the closed-loop matrices of {len(systems):,} loops with a {systems.delay_samples:,}-sample delay"
+    require_memory(what, 8.0 * order * order * len(systems))
     require_within(what, order, EIGEN_ORDER_LIMIT, "rows")
-    floor = 1e-9
-    if spectral_radius(system, floor) >= 1.0:
-        return 0.0
-    lo, hi = _bracket(system, floor, k_max)
-    if hi > k_max:
-        return math.inf
-    return brentq(lambda k: spectral_radius(system, k) - 1.0, lo, hi, xtol=1e-12, rtol=1e-10)
+    count = len(systems)
+    group = np.arange(count) if groups is None else np.asarray(groups, dtype=np.int64)
+    n_group = int(group.max()) + 1 if count else 0
+    loops = ClosedLoops(systems)
+    f_floor = loops.radii(np.full(count, FLOOR)) - 1.0
+    limit = np.full(count, np.nan)
+    limit[f_floor >= 0.0] = 0.0
+    guess = 2.0 * (systems.damping + systems.virtual_damping) / (systems.period * (1 + 2 * systems.delay_samples))
+    lo = np.minimum(np.maximum(guess, FLOOR), k_max)
+    hi, f_lo, f_hi = 2.0 * lo, np.where(lo == FLOOR, f_floor, np.nan), np.full(count, np.nan)
+    search = _Search(group, n_group, limit)
+    todo = np.flatnonzero(search.open() & (lo > FLOOR))
+    while todo.size:  # halve lo until it is stable
+        f = loops.radii(lo[todo], todo) - 1.0
+        stable, unstable = todo[f < 0.0], todo[f >= 0.0]
+        f_lo[stable] = f[f < 0.0]
+        halved = np.maximum(lo[unstable] / 2.0, FLOOR)
+        known = halved == lo[unstable] / 2.0
+        f_hi[unstable[known]] = f[f >= 0.0][known]
+        lo[unstable], hi[unstable] = halved, 2.0 * halved
+        f_lo[unstable[halved == FLOOR]] = f_floor[unstable[halved == FLOOR]]
+        todo = unstable[known & (halved > FLOOR)]
+    while True:  # double hi until it is unstable
+        todo = np.flatnonzero(search.open() & np.isnan(f_hi))
+        beyond = todo[hi[todo] > k_max]
+        limit[beyond] = np.inf
+        todo = todo[hi[todo] <= k_max]
+        if not todo.size:
+            break
+        f = loops.radii(hi[todo], todo) - 1.0
+        stable, unstable = todo[f < 0.0], todo[f >= 0.0]
+        f_hi[unstable] = f[f >= 0.0]
+        lo[stable], f_lo[stable], hi[stable] = hi[stable], f[f < 0.0], 2.0 * hi[stable]
+        if groups is not None:
+            search.prune(lo, hi, f_hi)
+    side, stall = np.zeros(count, dtype=np.int8), np.zeros(count, dtype=np.int8)
+    while True:  # Illinois regula falsi
+        if groups is not None:
+            search.prune(lo, hi, f_hi)
+        todo = np.flatnonzero(search.open())
+        done = todo[hi[todo] - lo[todo] <= XTOL + RTOL * hi[todo]]
+        limit[done] = 0.5 * (lo[done] + hi[done])
+        todo = todo[hi[todo] - lo[todo] > XTOL + RTOL * hi[todo]]
+        if not todo.size:
+            break
+        a, b, fa, fb = lo[todo], hi[todo], f_lo[todo], f_hi[todo]
+        x = (a * fb - b * fa) / (fb - fa)
+        x = np.where((stall[todo] >= 2) | ~(x > a) | ~(x < b), 0.5 * (a + b), x)
+        f = loops.radii(x, todo) - 1.0
+        up = f >= 0.0
+        stall[todo] = np.where(np.maximum(np.where(up, x, b) - np.where(up, a, x), 0.0) > 0.5 * (b - a),
+                               stall[todo] + 1, 0)
+        rise, fall = todo[up], todo[~up]
+        f_lo[rise[side[rise] == 2]] *= 0.5
+        f_hi[fall[side[fall] == 1]] *= 0.5
+        hi[rise], f_hi[rise], side[rise] = x[up], f[up], 2
+        lo[fall], f_lo[fall], side[fall] = x[~up], f[~up], 1
+    return limit if groups is None else search.smallest(limit)
 
 
-def _bracket(system: MassDamper, floor: float, k_max: float) -> tuple[float, float]:
-    """A stable ``lo`` and an unstable ``hi = 2 lo`` (``hi > k_max``: stable up to ``k_max``), searched by doubling
-    or halving from the passivity scale ``2 (b + B) / (T (1 + 2 d))`` (Colgate's bound with a delay of ``d``
-    samples), so that a few spectral radii place the limit instead of a sweep up from ``floor``."""
-    guess = 2.0 * (system.damping + system.virtual_damping) / (system.period * (1 + 2 * system.delay_samples))
-    lo = min(max(guess, floor), k_max)
-    while lo > floor and spectral_radius(system, lo) >= 1.0:
-        lo = max(lo / 2.0, floor)
-    hi = 2.0 * lo
-    while hi <= k_max and spectral_radius(system, hi) < 1.0:
-        lo, hi = hi, 2.0 * hi
-    return lo, hi
+class _Search:
+    """Which systems of :func:`exact_boundaries` still search: not done (``limit`` NaN, 0 for those unstable at the
+    floor, set before), their group not settled at 0, and not left behind by another system of their group."""
+
+    def __init__(self, group: np.ndarray, n_group: int, limit: np.ndarray):
+        self.group, self.n_group, self.limit = group, n_group, limit
+        self.zero = np.zeros(n_group, dtype=bool)
+        self.zero[group[limit == 0.0]] = True
+        self.out = np.zeros(len(group), dtype=bool)
+        self.settled = self.zero[group]
+
+    def open(self) -> np.ndarray:
+        return np.isnan(self.limit) & ~self.out & ~self.settled
+
+    def prune(self, lo: np.ndarray, hi: np.ndarray, f_hi: np.ndarray) -> None:
+        """Leave out the systems whose stable ``lo`` is at or above their group's smallest known unstable ``hi``."""
+        unstable = np.full(self.n_group, np.inf)
+        known = self.open() & ~np.isnan(f_hi)
+        np.minimum.at(unstable, self.group[known], hi[known])
+        self.out |= self.open() & (lo >= unstable[self.group])
+
+    def smallest(self, limit: np.ndarray) -> np.ndarray:
+        """Each group's smallest limit over the systems that finished (the ones left behind hold larger ones)."""
+        out = np.full(self.n_group, np.inf)
+        np.minimum.at(out, self.group[~self.out & ~self.settled], limit[~self.out & ~self.settled])
+        out[self.zero] = 0.0
+        return out
 
 
 def _config(system: MassDamper, stiffness: float, duration: float, step: float) -> LoopConfig:

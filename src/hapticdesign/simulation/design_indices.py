@@ -11,9 +11,12 @@ this module's :func:`evaluate` and :data:`DESIGN_INDICES`.
 
 :func:`evaluate_designs` evaluates many designs of a :class:`~hapticdesign.devices.design_space.DesignSpace` at
 once: through the compiled kernels of :mod:`hapticdesign.analysis.design_batch` when the device has closed loops,
-the indices need only ``J_v`` and ``H`` (:data:`~hapticdesign.analysis.metrics.indices.KINEMATIC_DYNAMIC`) and the
-variables are geometry (``parameters``) of a device without bodies that are links (whose masses follow the
-geometry; the batch keeps the file's inertial parameters); otherwise design by design (:func:`evaluate`). Both give the same values.
+the indices need only ``J_v``, ``H`` and ``B`` (:data:`BATCHED`: those of
+:data:`~hapticdesign.analysis.metrics.indices.KINEMATIC_DYNAMIC` and ``kmax``) and the variables are geometry
+(``parameters``) of a device without bodies that are links (whose masses follow the geometry; the batch keeps the
+file's inertial parameters, and its damping ``B``, numbers of the file that no geometry changes); otherwise design
+by design (:func:`evaluate`). Both give the same values; ``kmax`` of all designs' points is one search
+(:func:`~hapticdesign.simulation.wall_stiffness.wall_limits`).
 """
 
 from __future__ import annotations
@@ -31,7 +34,7 @@ from hapticdesign.analysis.metrics.indices import evaluate as evaluate_with
 from hapticdesign.devices.design_space import DesignSpace
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
-from hapticdesign.simulation.wall_stiffness import wall_limit
+from hapticdesign.simulation.wall_stiffness import wall_limits
 
 
 def _options(options: Mapping[str, object]) -> tuple[float, int, float, np.ndarray | None]:
@@ -54,19 +57,19 @@ def _options(options: Mapping[str, object]) -> tuple[float, int, float, np.ndarr
 def _kmax(h: HandleStates, options: Mapping[str, object]) -> np.ndarray:
     period, delay, virtual, direction = _options(options)
     basis = h.svd[0]
-    damping = h.device.damping_matrix
-    out = []
-    for u, jv, mobility in zip(basis, h.jacobian, h.mobility):
-        pinv = np.linalg.pinv(jv) @ u
-        along = None
-        if direction is not None:
-            along = u.T @ direction
-            if not abs(np.linalg.norm(along) - 1.0) <= 1e-9:
-                raise UserError(f"index kmax: the direction {np.round(direction, 6).tolist()} is not one the handle "
-                                "moves in")
-        out.append(wall_limit(mobility, pinv.T @ damping @ pinv, period, delay, virtual, along))
-    return np.array(out)
+    pinv = np.linalg.pinv(h.jacobian) @ basis
+    along = None
+    if direction is not None:
+        along = np.swapaxes(basis, 1, 2) @ direction
+        if not np.all(np.abs(np.linalg.norm(along, axis=1) - 1.0) <= 1e-9):
+            raise UserError(f"index kmax: the direction {np.round(direction, 6).tolist()} is not one the handle "
+                            "moves in")
+        along = along[:, None, :]
+    return wall_limits(h.mobility, np.swapaxes(pinv, 1, 2) @ h.damping @ pinv, period, delay, virtual, along)
 
+
+BATCHED = (*KINEMATIC_DYNAMIC, "kmax")
+"""The indices :func:`evaluate_designs` computes from the compiled kernels' ``J_v`` and ``H`` (and the file's ``B``)."""
 
 DESIGN_INDICES: dict[str, Index] = {**INDICES, "kmax": Index(
     "kmax", "N/m", "exact stable wall stiffness of the sampled loop along a direction (or the worst)",
@@ -106,7 +109,7 @@ def evaluate_designs(space: DesignSpace, designs: Sequence[Mapping[str, float]],
     mass = batch.mass_matrices(offsets, reached, base.standard_parameters(), base.reflected_inertia)
     ok = reached.status == OK
     states = HandleStates.of(reached.jvt[ok].reshape(-1, 3, reached.jvt.shape[-1]),
-                             mass[ok].reshape(-1, *mass.shape[2:]))
+                             mass[ok].reshape(-1, *mass.shape[2:]), base.damping_matrix)
     values = {r.key: DESIGN_INDICES[r.index].values(states, {**DESIGN_INDICES[r.index].options, **r.options})
               .reshape(-1, len(points)) for r in checked}
     out, row = [], 0
@@ -123,7 +126,7 @@ def evaluate_designs(space: DesignSpace, designs: Sequence[Mapping[str, float]],
 
 def _batch(space: DesignSpace, requests: list[Request]) -> DesignBatch | None:
     """The space's compiled structure when the batched path applies (see the module docstring), else None."""
-    if (space.base.mechanism.loops is None or any(r.index not in KINEMATIC_DYNAMIC for r in requests)
+    if (space.base.mechanism.loops is None or any(r.index not in BATCHED for r in requests)
             or any(v.kind != "parameter" for v in space.variables) or space.link_bodies):
         return None
     if space.cache.get("batch") is None:

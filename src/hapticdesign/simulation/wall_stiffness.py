@@ -7,6 +7,9 @@ damping ``u^T D u`` (``D = U^T J_v^+T B J_v^+ U``, ``B`` the joints' and motors'
 (:func:`hapticdesign.simulation.boundary.exact_boundary`: the plant discretized exactly, the closed loop's spectral
 radius reaching 1). The worst direction is searched over the axes, the principal directions of ``M`` and of ``D``
 and :data:`DIRECTIONS` evenly spread directions (a Fibonacci sphere; a half circle for a planar device).
+:func:`wall_limits` takes many points at once: the loops of all their directions are searched together
+(:func:`~hapticdesign.simulation.boundary.exact_boundaries`, one batched eigenvalue call per step), and a
+direction whose stable bracket lies above another's unstable one leaves the search early.
 """
 
 from __future__ import annotations
@@ -15,7 +18,7 @@ import math
 
 import numpy as np
 
-from hapticdesign.simulation.boundary import MassDamper, exact_boundary
+from hapticdesign.simulation.boundary import MassDampers, exact_boundaries
 
 DIRECTIONS = 60
 """Directions spread over the sphere (circle for a planar device) for the worst wall direction."""
@@ -36,16 +39,41 @@ def directions(dim: int, count: int = DIRECTIONS) -> np.ndarray:
 
 
 def wall_directions(mobility: np.ndarray, damping: np.ndarray) -> np.ndarray:
-    """The axes, the principal directions of the mobility and of the damping, and evenly spread ones (rows)."""
-    dim = mobility.shape[0]
-    return np.vstack([np.eye(dim), np.linalg.eigh(mobility)[1].T, np.linalg.eigh(damping)[1].T, directions(dim)])
+    """The axes, the principal directions of the mobility and of the damping, and evenly spread ones (rows; (..., C,
+    k) for a stack of matrices (..., k, k))."""
+    dim = mobility.shape[-1]
+    stack = mobility.shape[:-2]
+    principal = [np.swapaxes(np.linalg.eigh(m)[1], -1, -2) for m in (mobility, damping)]
+    fixed = [np.broadcast_to(rows, (*stack, *rows.shape)) for rows in (np.eye(dim), directions(dim))]
+    return np.concatenate([fixed[0], *principal, fixed[1]], axis=-2)
+
+
+CHUNK_BYTES = 1 << 24
+"""The closed-loop matrices :func:`wall_limits` searches at once (``8 (3 + 3 d)^2`` bytes a loop), at least one
+point's."""
 
 
 def wall_limit(mobility: np.ndarray, damping: np.ndarray, period: float, delay: int, virtual_damping: float = 0.0,
                direction: np.ndarray | None = None) -> float:
     """The exact stable wall stiffness (N/m) along ``direction`` (unit, in the basis of ``mobility``), or the smallest
     over :func:`wall_directions` when it is None (see the module docstring)."""
-    candidates = wall_directions(mobility, damping) if direction is None else np.atleast_2d(direction)
-    return float(min(exact_boundary(MassDamper(1.0 / float(u @ mobility @ u), float(u @ damping @ u), period, delay,
-                                               virtual_damping))
-                     for u in candidates))
+    along = None if direction is None else np.atleast_2d(direction)[None]
+    return float(wall_limits(mobility[None], damping[None], period, delay, virtual_damping, along)[0])
+
+
+def wall_limits(mobility: np.ndarray, damping: np.ndarray, period: float, delay: int, virtual_damping: float = 0.0,
+                along: np.ndarray | None = None) -> np.ndarray:
+    """:func:`wall_limit` at P points at once: ``mobility`` and ``damping`` (P, k, k), ``along`` None (the worst
+    of :func:`wall_directions`) or (P, C, k) unit rows (the smallest over them); (P,) in N/m. The loops of all
+    points and directions go through :func:`~hapticdesign.simulation.boundary.exact_boundaries` together, in
+    chunks of about :data:`CHUNK_BYTES` of matrices."""
+    rows = wall_directions(mobility, damping) if along is None else np.asarray(along, dtype=float)
+    mass = 1.0 / np.einsum("pck,pkl,pcl->pc", rows, mobility, rows)
+    damped = np.einsum("pck,pkl,pcl->pc", rows, damping, rows)
+    per = max(1, CHUNK_BYTES // (8 * (3 + 3 * delay) ** 2 * rows.shape[1]))
+    out = np.empty(len(mass))
+    for start in range(0, len(mass), per):
+        part = slice(start, start + per)
+        systems = MassDampers(mass[part].ravel(), damped[part].ravel(), period, delay, virtual_damping)
+        out[part] = exact_boundaries(systems, np.repeat(np.arange(len(mass[part])), rows.shape[1]))
+    return out

@@ -83,6 +83,12 @@ class HandleStates:
         return mass_matrix_at(self.device, self.full)
 
     @cached_property
+    def damping(self) -> np.ndarray:
+        """``B`` (n_a, n_a): the joints' and motors' viscous damping
+        (:attr:`~hapticdesign.model.device.Device.damping_matrix`)."""
+        return self.device.damping_matrix
+
+    @cached_property
     def mobility(self) -> np.ndarray:
         """``U^T J_v H^-1 J_v^T U`` (P, k, k), the inverse of ``Lambda`` (1/kg)."""
         u, _ = self.svd
@@ -109,11 +115,15 @@ class HandleStates:
 
 
     @classmethod
-    def of(cls, jacobian: np.ndarray, mass: np.ndarray) -> "HandleStates":
-        """The states of poses whose ``J_v`` (P, 3, n_a) and ``H`` (P, n_a, n_a) are known already (many designs'
-        poses at once, :mod:`hapticdesign.analysis.design_batch`): enough for the :data:`KINEMATIC_DYNAMIC` indices."""
+    def of(cls, jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray | None = None) -> "HandleStates":
+        """The states of poses whose ``J_v`` (P, 3, n_a), ``H`` (P, n_a, n_a) and ``B`` (n_a, n_a) are known already
+        (many designs' poses at once, :mod:`hapticdesign.analysis.design_batch`): enough for the
+        :data:`KINEMATIC_DYNAMIC` indices (and, with ``B``, for the wall stiffness ``kmax`` of the simulation
+        layer)."""
         states = cls(None, np.zeros((len(jacobian), 0)))
         states.__dict__.update(jacobian=jacobian, mass=mass)
+        if damping is not None:
+            states.__dict__["damping"] = damping
         return states
 
 
