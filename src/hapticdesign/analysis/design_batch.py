@@ -114,10 +114,10 @@ def _walk_and_system(q, tree, plan, loops, reach, goal, ws):
     rot, pos, trig, jac, a, rhs, res = ws.rot, ws.pos, ws.trig, ws.jac, ws.a, ws.rhs, ws.res
     m = loops.row_loop.shape[0]
     n = q.shape[0]
-    planned_poses(q, tree, plan, 0, plan.n_first, rot, pos, trig)
+    planned_poses(q, tree, plan, np.int64(0), plan.n_first, rot, pos, trig)  # a literal would compile its own copy
     ck.closure_residual(loops, rot, pos, res)
     ck.closure_jacobian(loops, tree, plan, rot, pos, a[:m])
-    frame_jacobian(reach.handle, tree.parent, tree.axis, tree.coef, rot, pos, False, jac)
+    frame_jacobian(reach.handle, tree.parent, tree.axis, tree.coef, rot, pos, np.bool_(False), jac)
     big = 0.0
     for i in range(m):
         rhs[i, 0] = -res[i]
@@ -188,7 +188,7 @@ def reach_designs(offsets, targets, shape, plan, loops, settings, reach, out):
         if code != ck.OK:
             out.status[d] = NO_HOME
             continue
-        planned_poses(q, tree, plan, 0, plan.n_first, ws.rot, ws.pos, ws.trig)
+        planned_poses(q, tree, plan, np.int64(0), plan.n_first, ws.rot, ws.pos, ws.trig)
         branch = _branch(q, tree, plan, loops, ws)
         for c in range(3):
             here[c] = ws.pos[reach.handle, c]
@@ -245,7 +245,7 @@ def mass_designs(offsets, full, status, shape, plan, bodies, loops, params, out)
         for p in range(n_pose):
             factor_pose(full[d, p], tree, plan, loops, ws)
             reduce_pose(tree, plan, body_node, loops, ws)
-            world_parameters(ws.rot, body_node, sets, 0, pw)
+            world_parameters(ws.rot, body_node, sets, np.int64(0), pw)
             h[:] = 0.0
             for b in range(n_body):
                 if body_node[b] >= 0:

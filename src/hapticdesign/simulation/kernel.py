@@ -154,7 +154,7 @@ def _tree_handle(q, qd, handle, record, jn, want_jn):
     if want_jn:
         jac, n = handle.jac, handle.direction
         tree = handle.tree
-        frame_jacobian(handle.node, tree.parent, tree.axis, tree.coef, handle.rot, handle.pos, False, jac)
+        frame_jacobian(handle.node, tree.parent, tree.axis, tree.coef, handle.rot, handle.pos, np.bool_(False), jac)
         for k in range(q.shape[0]):
             jn[k] = n[0] * jac[0, k] + n[1] * jac[1, k] + n[2] * jac[2, k]
     return x

@@ -12,6 +12,11 @@ process on the machine loads it from there in milliseconds. What this module add
   (numba rewrites the index whole: two writers compiling different record types could lose one entry);
 - :func:`compile_notice`: calls back once, when a kernel of the rendering loop actually starts compiling
   (a cache miss), so that a command can say why its first run takes longer.
+
+What a first run compiles is kept small where the kernels call each other: a constant argument written
+as a literal (``0``, ``True``) to a separately compiled kernel makes numba compile that kernel once more
+for the literal (``Literal[int](0)`` beside ``int64``), so such calls pass ``np.int64(0)`` or
+``np.bool_(True)``; and wrappers that only allocate scratch for a compiled loop stay Python functions.
 """
 
 from __future__ import annotations

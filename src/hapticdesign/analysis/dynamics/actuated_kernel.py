@@ -155,7 +155,7 @@ def factor_pose(q, tree, plan, loops, ws):
     rot, pos, phi, lu, pinv = ws.rot, ws.pos, ws.phi, ws.lu, ws.pinv
     passive = loops.passive
     npas = passive.shape[0]
-    planned_poses(q, tree, plan, 0, tree.parent.shape[0], rot, pos, ws.trig)
+    planned_poses(q, tree, plan, np.int64(0), tree.parent.shape[0], rot, pos, ws.trig)  # a literal would compile its own copy
     closure_jacobian(loops, tree, plan, rot, pos, phi)
     for i in range(npas):
         for j in range(npas):
@@ -531,7 +531,6 @@ def entries_into(qs, tree, plan, bodies, loops, params, active, ws, scratch, out
             pose_entries(tree, plan, bodies, loops, params, active, ws, scratch, out[p])
 
 
-@njit(cache=True)
 def motion_entries(path, q_start, branch, tree, plan, bodies, loops, settings, params):
     """Entries (unique H, C, G, eq. 2.44-2.50) in actuated coordinates along a motion: the actuated poses
     ``path`` (P, n_a) in order, the passive values continued from the closed full pose ``q_start`` on the
@@ -548,6 +547,11 @@ def motion_entries(path, q_start, branch, tree, plan, bodies, loops, settings, p
     ``Phi_p^-1`` and the closures' node poses for the entries. A second-order term above half the step or a
     step ``correct`` refuses hands the pose to ``continue_to`` (tangent predictor, step halving), as does the
     first pose.
+
+    A Python function: it only allocates the scratch and calls the compiled pose loop
+    (:func:`motion_entries_into`), whose pieces (:func:`active_bodies`, :func:`entries_scratch`,
+    :func:`~hapticdesign.analysis.loops.records.workspace`) the closed-loop plant compiles too; compiled, this
+    wrapper alone took about 4 CPU-s of a fresh install's first closed-loop run (``benchmarks/bench_cold.py``).
     """
     passive = loops.passive
     n_pose = path.shape[0]
@@ -559,13 +563,14 @@ def motion_entries(path, q_start, branch, tree, plan, bodies, loops, settings, p
     m = na * (na + 1) // 2
     out = np.zeros((n_pose, n_sets, m + na * m + na))
     status = np.zeros(n_pose, dtype=np.int64)
-    ws = workspace(tree.parent.shape[0], n_dof, na, passive, n_body)
-    work = MotionWork(active_bodies(params), ws, entries_scratch(n_sets, na, npas, n_body), np.empty(n_dof),
-                      np.empty(npas), np.empty(npas), workspace(tree.parent.shape[0], n_dof, na, passive, 0),
+    n_node = tree.parent.shape[0]
+    work = MotionWork(active_bodies(params), workspace(n_node, n_dof, na, passive, n_body),
+                      entries_scratch(n_sets, na, npas, n_body), np.empty(n_dof), np.empty(npas), np.empty(npas),
+                      workspace(n_node, n_dof, na, passive, 0),
                       np.empty((npas, na)), np.empty(na), np.empty(n_dof))
     q = q_start.copy()
     first = motion_entries_into(path, q, branch, tree, plan, bodies, loops, settings, params, work, out, status)
-    return out, status, first
+    return out, status, int(first)
 
 
 @njit(cache=True, _nrt=False)

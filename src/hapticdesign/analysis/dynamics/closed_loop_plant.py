@@ -111,7 +111,7 @@ def closed_loop_terms(qa, qda, structure, ws, h, cqd, g):
     # Newton left Phi, Phi_p^-1 and the closures' node poses at q: the other nodes complete factor_pose
     planned_poses(q, tree, plan, plan.n_first, tree.parent.shape[0], dyn.rot, dyn.pos, dyn.trig)
     reduce_pose(tree, plan, body_node, loops, dyn)
-    world_parameters(dyn.rot, body_node, params, 0, pw)
+    world_parameters(dyn.rot, body_node, params, np.int64(0), pw)  # a literal would compile its own copy
     for i in range(na):
         g[i] = 0.0
         cqd[i] = 0.0

@@ -29,7 +29,7 @@ def body_jacobian(b, body_node, parent, axis, coef, rot, pos, eye, jac):
     the base; no allocation.
     """
     nb = body_node[b]
-    frame_jacobian(nb, parent, axis, coef, rot, pos, True, jac)
+    frame_jacobian(nb, parent, axis, coef, rot, pos, np.bool_(True), jac)  # a literal would compile its own copy
     return rot[nb] if nb >= 0 else eye
 
 

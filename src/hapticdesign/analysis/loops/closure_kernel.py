@@ -147,7 +147,7 @@ def velocity_map_into(phi, actuated, passive, pp, s):
 @njit(cache=True)
 def newton(q, tree, plan, loops, settings):
     """:func:`newton_into` on a workspace of its own."""
-    ws = workspace(tree.parent.shape[0], q.shape[0], loops.actuated.shape[0], loops.passive, 0)
+    ws = workspace(tree.parent.shape[0], q.shape[0], loops.actuated.shape[0], loops.passive, np.int64(0))
     return newton_into(q, tree, plan, loops, settings, ws)
 
 
@@ -247,7 +247,7 @@ def correct(q, tree, plan, loops, settings, ws, branch, bound):
 @njit(cache=True, _nrt=False)
 def tangent_into(q, tree, plan, loops, ws, s):
     """``S = -Phi_p^-1 Phi_a`` (n_p x n_a) into ``s`` at the closed full pose ``q`` (the continuation's tangent)."""
-    planned_poses(q, tree, plan, 0, plan.n_first, ws.rot, ws.pos, ws.trig)
+    planned_poses(q, tree, plan, np.int64(0), plan.n_first, ws.rot, ws.pos, ws.trig)  # a literal would compile its own copy
     closure_jacobian(loops, tree, plan, ws.rot, ws.pos, ws.phi)
     velocity_map_into(ws.phi, loops.actuated, loops.passive, ws.lu, s)
 
@@ -312,7 +312,7 @@ def solve_path(qa_path, q_start, branch, tree, plan, loops, settings):
     n_dof = q_start.shape[0]
     m = loops.passive.shape[0]
     na = loops.actuated.shape[0]
-    ws = workspace(tree.parent.shape[0], n_dof, na, loops.passive, 0)
+    ws = workspace(tree.parent.shape[0], n_dof, na, loops.passive, np.int64(0))
     s = np.empty((m, na))
     start = np.empty(na)
     out = np.empty((n_pose, n_dof))
