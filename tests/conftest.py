@@ -17,15 +17,20 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "devices"
 
 def pytest_configure(config):
     """With pytest-xdist workers (``-n``), compile the rendering loop here first, for a tree and for a closed-loop
-    device, each with a joint and a Cartesian wall, so that the workers load it from numba's cache instead of
-    each compiling it (an empty cache costs one compile, not one per worker; a warm one milliseconds)."""
+    device, each with a joint and a Cartesian wall, and the closed-loop model's equations along a motion (the
+    growth check's linearization), so that the workers load them from numba's cache instead of each compiling
+    them (an empty cache costs one compile, not one per worker; a warm one milliseconds)."""
     if hasattr(config, "workerinput") or not config.getoption("numprocesses", None):
         return
+    from hapticdesign.analysis.dynamics.device import mass_matrix
+    from hapticdesign.analysis.view.skeleton import home_pose
     from hapticdesign.devices.device_file import load_device_file
     from hapticdesign.simulation.loop import warm_up
 
-    for device in (preset("phantom-3dof"), load_device_file(EXAMPLES / "five-bar.yaml")):
+    five_bar = load_device_file(EXAMPLES / "five-bar.yaml")
+    for device in (preset("phantom-3dof"), five_bar):
         warm_up(device)
+    mass_matrix(five_bar, home_pose(five_bar))
 
 
 @pytest.fixture(scope="session")
