@@ -24,13 +24,20 @@ CASES_PER_DESIGN = len(CRITERIA) * len(TYPES)
 QUICK = ["--workers", "2", "--duration", "1", "--k-limit", "20", "--sweep", "2", "--f1", "5"]
 
 
+def _foreground_signals() -> None:
+    """In the child before it runs: SIGINT at its default, as a terminal gives its foreground job (a signal that
+    this test process ignores would stay ignored in the child: an in-process test of a library may have left it so)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _start(designs: Path, out: Path, *extra: str) -> subprocess.Popen:
     """The CLI in its own process group (its Dask workers join it), as a terminal's foreground job."""
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT / "src"), os.environ.get("PYTHONPATH", "")])}
     return subprocess.Popen(
         [sys.executable, "-c", "from hapticdesign.interface.cli import main; main()", "campaign", "--designs",
          str(designs), "--out", str(out), *QUICK, *extra],
-        env=env, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+        env=env, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+        preexec_fn=_foreground_signals)
 
 
 def _case_files(out: Path) -> list[Path]:
