@@ -12,8 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from typer.testing import CliRunner
 
 from hapticdesign.errors import UserError
+from hapticdesign.interface.cli import app
 from hapticdesign.optimization.formula import formula
 from hapticdesign.optimization.shortest import constrained_minimum
 from hapticdesign.optimization.study_evaluation import bind_study
@@ -134,6 +136,17 @@ def test_bad_study_parts_are_one_line_errors(tmp_path, change, message):
 
 class Interrupt(Exception):
     pass
+
+
+def test_a_formula_that_gives_no_finite_length_leaves_no_design_and_writes_no_result(tmp_path):
+    """Parameter indices build no device: a design whose formula gives l1 = inf (sin(q)^inf = 0) is refused as the
+    device file would refuse it, so no design is feasible and nothing but the checkpoint is written."""
+    path = study_file(tmp_path, parameters={"l1": "0.06 / sin(q_max) ** 10 ** 10", "S": "l1"},
+                      objectives=[{"name": "O1", "index": "rcube_o1", "reduce": "max", "sense": "min"}], constraints=[],
+                      keep=[], algorithm={"population": 8, "generations": 2, "runs": [], "start": None})
+    result = CliRunner().invoke(app, ["optimize", str(path), "--out", str(tmp_path / "out"), "--quiet"])
+    assert result.exit_code == 2 and len(result.output.strip().splitlines()) == 1, result.output
+    assert not (tmp_path / "out" / "front.csv").exists() and not (tmp_path / "out" / "selected.yaml").exists()
 
 
 def test_an_interrupted_run_of_several_runs_continues_from_its_checkpoint(tmp_path):

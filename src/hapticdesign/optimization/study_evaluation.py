@@ -142,7 +142,7 @@ class BoundStudy:
         if self.requests:
             results = evaluate_designs(self.space, device_values, self.points, self.requests)
         else:
-            results = [Evaluation({}) for _ in batch]
+            results = [self._checked(v) for v in device_values]
         valid = [k for k, r in enumerate(results) if r.reason is None]
         values = {k: dict(results[k].values) for k in valid}
         first = [r for r in self.parameter_requests if r.key in self.constrained]
@@ -161,6 +161,15 @@ class BoundStudy:
                 out.append(Answer(tuple(reduce(got[label], key[2]) if (label := self.labels[key[:2]]) in got
                                         else math.nan for key in self.keys)))
         return out
+
+    def _checked(self, device_values: dict[str, float]) -> Evaluation:
+        """A design of a study of parameter indices alone, whose device is not built: its device values must pass the
+        design space's check (finite numbers; a formula may give inf or NaN), or it has none, and says why."""
+        try:
+            self.space.checked_values(device_values)
+        except UserError as exc:
+            return Evaluation({}, str(exc))
+        return Evaluation({})
 
     def evaluate_constraints(self, batch: list[dict[str, float]]) -> list[Answer]:
         """:meth:`evaluate` without the indices that only the objectives read."""
