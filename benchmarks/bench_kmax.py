@@ -4,7 +4,7 @@ with its defaults (1 kHz, one sample of delay, the worst of 66 directions per po
 
 - batched: :func:`hapticdesign.simulation.design_indices.evaluate_designs` (the compiled kernels' ``J_v`` and
   ``H``, all designs' points and directions in one boundary search,
-  :func:`hapticdesign.simulation.wall_stiffness.wall_limits`);
+  :func:`hapticdesign.analysis.wall_stiffness.wall_limits`);
 - one at a time: ``DesignSpace.device`` then :func:`hapticdesign.simulation.design_indices.evaluate` per design.
 
 CPU time of this process (``time.process_time``, one thread), the best of three runs (one for one at a time).

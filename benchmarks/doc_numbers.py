@@ -2,7 +2,7 @@
 
 Computes the Z-width table of the Phantom's joint 1 and the passivity / linear-approximation
 findings from :mod:`hapticdesign.simulation.zwidth` (exact spectral-radius boundaries), and the
-closed-form wall limits from :mod:`hapticdesign.simulation.boundary`; writes them into the marked
+closed-form wall limits from :mod:`hapticdesign.analysis.sampled_loop`; writes them into the marked
 blocks of docs/simulation.md (``<!-- NAME:start -->`` ... ``<!-- NAME:end -->``) and checks that
 README.md states the same figures.
 
@@ -17,7 +17,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from hapticdesign.simulation.boundary import compensated_limit
+from hapticdesign.analysis.sampled_loop import compensated_limit
 from hapticdesign.simulation.zwidth import (DisplayLoop, damping_grid, linear_approximation, max_stiffness,
                                             passivity_stiffness)
 

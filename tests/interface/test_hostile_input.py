@@ -396,7 +396,7 @@ def test_analytic_range_of_a_joint_with_inertia_beside_massless_links_is_the_clo
     """Links 2, 3, 2a and 3a massless, the wall on joint 1: joints 2 and 3 follow their paths (held, type 1), so
     their missing inertia does not enter; joint 1 turns body 1 alone, H11 = Iyy1 + m1 r1z^2 (parallel axes,
     0.009 + 0.25 * 0.15^2), and with full inertial compensation and no delay the sampled wall is stable up to
-    K* = b^2 / H11 (seed 000 ch. 4; :mod:`hapticdesign.simulation.boundary`'s closed form at c = 1): 17.09, so
+    K* = b^2 / H11 (seed 000 ch. 4; :mod:`hapticdesign.analysis.sampled_loop`'s closed form at c = 1): 17.09, so
     the last stable integer stiffness is 17 N m/rad."""
     params = tmp_path / "massless.yaml"
     bodies = ("2", "3", "2a", "3a")

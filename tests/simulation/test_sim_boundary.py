@@ -14,10 +14,11 @@ from scipy.signal import cont2discrete
 from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
-from hapticdesign.simulation.boundary import (
+from hapticdesign.analysis.sampled_loop import (
     MassDamper, MassDampers, closed_loop_matrix, compensated_boundary, compensated_limit, exact_boundaries,
-    exact_boundary, simulated_boundary,
+    exact_boundary,
 )
+from hapticdesign.simulation.boundary import simulated_boundary
 from hapticdesign.simulation.config import Compensator, Hand, LoopConfig
 from hapticdesign.simulation.impedance import ImpedanceProblem, growth_boundary
 from hapticdesign.simulation.zwidth import DisplayLoop, max_stiffness

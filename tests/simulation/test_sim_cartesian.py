@@ -136,7 +136,7 @@ def test_cli_cartesian_wall(tmp_path):
     from typer.testing import CliRunner
 
     from hapticdesign.interface.cli import app
-    from hapticdesign.simulation.boundary import compensated_boundary
+    from hapticdesign.analysis.sampled_loop import compensated_boundary
 
     runner = CliRunner()
     path = SLIDER

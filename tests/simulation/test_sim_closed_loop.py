@@ -2,7 +2,7 @@
 
 References, none of which imports the numba loop: the plain SciPy loop (:mod:`hapticdesign.simulation.reference`,
 ``solve_ivp`` RK45 with H, C, G from the closed-loop model's slow exact path); the 1-DOF limit
-``b^2 / H_ww`` of full inertial compensation (seed 000 §4.1.2, :mod:`hapticdesign.simulation.boundary`)
+``b^2 / H_ww`` of full inertial compensation (seed 000 §4.1.2, :mod:`hapticdesign.analysis.sampled_loop`)
 with ``H_ww`` from :func:`hapticdesign.mass_matrix`; the kinetic energy ``qd^T H qd / 2`` of a free,
 undamped motion without gravity, which must stay constant.
 """

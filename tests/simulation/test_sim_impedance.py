@@ -7,7 +7,7 @@ from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.devices.registry import preset
 from hapticdesign.errors import UserError
 from hapticdesign.devices.loading import resolve_device
-from hapticdesign.simulation.boundary import compensated_boundary
+from hapticdesign.analysis.sampled_loop import compensated_boundary
 from hapticdesign.simulation.config import Compensator, LoopConfig, Wall
 from hapticdesign.simulation.impedance import (
     Criteria, ImpedanceProblem, fast_search, grid_search, impedance_range, linear_scan, growth_boundary,

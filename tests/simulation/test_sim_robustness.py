@@ -8,7 +8,7 @@ from scipy import stats
 
 from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.devices.registry import preset
-from hapticdesign.simulation.boundary import compensated_limit
+from hapticdesign.analysis.sampled_loop import compensated_limit
 from hapticdesign.simulation.robustness import error_cases, summarize_errors
 
 DESIGNS = [("a", 0.0, {}), ("b", 1.0, {"r3y": 0.01, "Ixy2": 4e-4, "m3": 0.05}), ("c", 1.0, {"m2": 0.2})]

@@ -10,7 +10,7 @@ from scipy.linalg import expm
 
 from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.errors import UserError
-from hapticdesign.simulation.boundary import MassDamper, closed_loop_matrix
+from hapticdesign.analysis.sampled_loop import MassDamper, closed_loop_matrix
 from hapticdesign.simulation.zwidth import DisplayLoop, max_stiffness, passivity_stiffness, spectral_radius, zwidth
 
 
@@ -43,7 +43,7 @@ def _recursion_grows(j, b, t, delay, velocity, c, k, damper, samples=6000) -> bo
 @pytest.mark.parametrize("delay", [0, 1, 3])
 @pytest.mark.parametrize("fraction", [0.0, 0.9, 1.0])
 def test_control_interconnection_equals_the_hand_derived_map(delay, fraction):
-    """python-control (c2d + feedback) against the one-sample map derived by hand in boundary.py."""
+    """python-control (c2d + feedback) against the one-sample map derived by hand in analysis/sampled_loop.py."""
     j, b, t = 0.02, 0.3, 1e-3
     for k, damper in ((50.0, 0.0), (150.0, 0.2), (3.0, 0.05)):
         ours = spectral_radius(DisplayLoop(j, b, t, delay, "sampled", fraction), k, damper)

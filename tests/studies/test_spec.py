@@ -21,7 +21,7 @@ import pytest
 from scipy.optimize import linprog
 
 from hapticdesign.devices.device_file import load_device_file
-from hapticdesign.simulation.boundary import MassDamper, exact_boundary
+from hapticdesign.analysis.sampled_loop import MassDamper, exact_boundary
 from hapticdesign.studies.spec import handle_at, inscribed_force, spec_sheet
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "devices"

@@ -2,11 +2,11 @@
 ``kmax``, the stable Cartesian wall stiffness, which needs the sampled loop's exact analysis of this layer.
 
 ``kmax`` (N/m) = the exact stable stiffness of a virtual wall at the handle
-(:func:`hapticdesign.simulation.wall_stiffness.wall_limit`: the 1-DOF model of the handle along a direction, mass
+(:func:`hapticdesign.analysis.wall_stiffness.wall_limit`: the 1-DOF model of the handle along a direction, mass
 ``1 / (u^T J_v H^-1 J_v^T u)`` and damping ``u^T J_v^+T B J_v^+ u``, the loop discretized exactly) with the
 options ``period`` (s, default 0.001), ``delay`` (samples, default 1), ``damping`` (the wall's virtual damper, N s/m,
 default 0) and ``direction`` (a base-frame vector; default: the worst direction). The index lives here, above the
-analysis layer, because its engine (:mod:`hapticdesign.simulation.boundary`) does; an optimization or a study asks
+analysis layer, because its engine (:mod:`hapticdesign.analysis.sampled_loop`) does; an optimization or a study asks
 this module's :func:`evaluate` and :data:`DESIGN_INDICES`.
 
 :func:`evaluate_designs` evaluates many designs of a :class:`~hapticdesign.devices.design_space.DesignSpace` at
@@ -16,7 +16,7 @@ the indices need only ``J_v``, ``H`` and ``B`` (:data:`BATCHED`: those of
 (``parameters``) of a device without bodies that are links (whose masses follow the geometry; the batch keeps the
 file's inertial parameters, and its damping ``B``, numbers of the file that no geometry changes); otherwise design
 by design (:func:`evaluate`). Both give the same values; ``kmax`` of all designs' points is one search
-(:func:`~hapticdesign.simulation.wall_stiffness.wall_limits`).
+(:func:`~hapticdesign.analysis.wall_stiffness.wall_limits`).
 """
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ from hapticdesign.analysis.metrics.indices import evaluate as evaluate_with
 from hapticdesign.devices.design_space import DesignSpace
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
-from hapticdesign.simulation.wall_stiffness import wall_limits
+from hapticdesign.analysis.wall_stiffness import wall_limits
 
 
 def _options(options: Mapping[str, object]) -> tuple[float, int, float, np.ndarray | None]:
@@ -73,7 +73,7 @@ BATCHED = (*KINEMATIC_DYNAMIC, "kmax")
 
 DESIGN_INDICES: dict[str, Index] = {**INDICES, "kmax": Index(
     "kmax", "N/m", "exact stable wall stiffness of the sampled loop along a direction (or the worst)",
-    "seed 000 ch. 4-5; hapticdesign.simulation.boundary.exact_boundary", _kmax,
+    "seed 000 ch. 4-5; hapticdesign.analysis.sampled_loop.exact_boundary", _kmax,
     {"period": 0.001, "delay": 1, "damping": 0.0, "direction": None})}
 """Every design index: name -> :class:`~hapticdesign.analysis.metrics.indices.Index`."""
 

@@ -14,11 +14,8 @@ import numpy as np
 from hapticdesign.analysis.linearity.form import device_form
 from hapticdesign.errors import PhysicalConsistencyWarning
 from hapticdesign.model.inertia import SEED_FIELDS, seed_parameter_name
-from hapticdesign.simulation.boundary import (
-    MassDamper,
-    exact_boundary,
-    simulated_boundary,
-)
+from hapticdesign.analysis.sampled_loop import MassDamper, exact_boundary
+from hapticdesign.simulation.boundary import simulated_boundary
 from hapticdesign.simulation.campaign import (
     CampaignOptions,
     load_cases,

@@ -23,10 +23,10 @@ friction reach the handle as follows:
   kinematics (:func:`hapticdesign.analysis.configuration.handle_pose`) within the joint limits and without a
   singularity, found by bisection.
 - ``renderable_stiffness`` (N/m): the exact stability limit of a virtual spring sampled every T with a
-  delay of one sample (:func:`hapticdesign.simulation.boundary.exact_boundary`) on the 1-DOF model of the
+  delay of one sample (:func:`hapticdesign.analysis.sampled_loop.exact_boundary`) on the 1-DOF model of the
   handle along a direction u: mass ``1 / (u^T J_v H^-1 J_v^T u)`` and damping ``u^T J_v^+T B J_v^+ u`` (B the
   joint and motor viscous damping); the smallest over the axes, the principal directions and 60 evenly
-  spread directions (:mod:`hapticdesign.simulation.wall_stiffness`, the ``kmax`` design index's too). A pure
+  spread directions (:mod:`hapticdesign.analysis.wall_stiffness`, the ``kmax`` design index's too). A pure
   spring uses the position only, so the velocity estimate does not enter. Beside it the passivity bounds of Abbott & Okamura (2005):
   ``2 b / T`` (viscous) and ``2 f_c / Delta`` (Coulomb friction against encoder quantization), with the
   smallest damping (eigenvalue) and friction over directions and the resolution ``Delta``.
@@ -44,7 +44,7 @@ from hapticdesign.analysis.metrics import force as polytope
 from hapticdesign.errors import UserError
 from hapticdesign.model.actuators import transmission
 from hapticdesign.model.device import Device
-from hapticdesign.simulation.wall_stiffness import wall_limit
+from hapticdesign.analysis.wall_stiffness import wall_limit
 
 SERVO_RATE = 1000.0
 """Hz, the default sampling rate of the renderable-stiffness limit."""
@@ -121,7 +121,7 @@ def _cartesian(device: Device, h: Handle) -> tuple[np.ndarray, np.ndarray]:
 
 
 def renderable_stiffness(device: Device, h: Handle, rate: float = SERVO_RATE, delay: int = 1) -> float:
-    """The smallest exact wall limit over directions (:func:`hapticdesign.simulation.wall_stiffness.wall_limit`)."""
+    """The smallest exact wall limit over directions (:func:`hapticdesign.analysis.wall_stiffness.wall_limit`)."""
     mobility, damping = _cartesian(device, h)
     return wall_limit(mobility, damping, 1.0 / rate, delay)
 

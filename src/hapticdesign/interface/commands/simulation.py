@@ -233,7 +233,8 @@ def stability_boundary_command(
     force: bool = FORCE,
 ) -> None:
     """Exact vs simulated stiffness limit of a 1-DOF mass-damper under a sampled spring (check of seed 000 ch. 4)."""
-    from hapticdesign.simulation.boundary import MassDamper, compensated_limit, exact_boundary, simulated_boundary
+    from hapticdesign.analysis.sampled_loop import MassDamper, compensated_limit, exact_boundary
+    from hapticdesign.simulation.boundary import simulated_boundary
 
     with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
         if substeps < 1 or samples < 40:

@@ -4,11 +4,11 @@ Along a unit direction ``u`` of the directions the handle moves (basis ``U``), t
 of mass ``1 / (u^T M u)`` (``M = U^T J_v H^-1 J_v^T U``, the mobility: the inverse of the Cartesian mass) and
 damping ``u^T D u`` (``D = U^T J_v^+T B J_v^+ U``, ``B`` the joints' and motors' viscous damping). A virtual spring
 ``K`` (and damper) sampled every ``T`` with a delay of ``d`` samples is stable below the exact limit of that loop
-(:func:`hapticdesign.simulation.boundary.exact_boundary`: the plant discretized exactly, the closed loop's spectral
+(:func:`hapticdesign.analysis.sampled_loop.exact_boundary`: the plant discretized exactly, the closed loop's spectral
 radius reaching 1). The worst direction is searched over the axes, the principal directions of ``M`` and of ``D``
 and :data:`DIRECTIONS` evenly spread directions (a Fibonacci sphere; a half circle for a planar device).
 :func:`wall_limits` takes many points at once: the loops of all their directions are searched together
-(:func:`~hapticdesign.simulation.boundary.exact_boundaries`, one batched eigenvalue call per step), and a
+(:func:`~hapticdesign.analysis.sampled_loop.exact_boundaries`, one batched eigenvalue call per step), and a
 direction whose stable bracket lies above another's unstable one leaves the search early.
 """
 
@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from hapticdesign.simulation.boundary import MassDampers, exact_boundaries
+from hapticdesign.analysis.sampled_loop import MassDampers, exact_boundaries
 
 DIRECTIONS = 60
 """Directions spread over the sphere (circle for a planar device) for the worst wall direction."""
@@ -65,7 +65,7 @@ def wall_limits(mobility: np.ndarray, damping: np.ndarray, period: float, delay:
                 along: np.ndarray | None = None) -> np.ndarray:
     """:func:`wall_limit` at P points at once: ``mobility`` and ``damping`` (P, k, k), ``along`` None (the worst
     of :func:`wall_directions`) or (P, C, k) unit rows (the smallest over them); (P,) in N/m. The loops of all
-    points and directions go through :func:`~hapticdesign.simulation.boundary.exact_boundaries` together, in
+    points and directions go through :func:`~hapticdesign.analysis.sampled_loop.exact_boundaries` together, in
     chunks of about :data:`CHUNK_BYTES` of matrices."""
     rows = wall_directions(mobility, damping) if along is None else np.asarray(along, dtype=float)
     mass = 1.0 / np.einsum("pck,pkl,pcl->pc", rows, mobility, rows)
