@@ -8,11 +8,11 @@ import time
 import numpy as np
 
 from hapticdesign.model.rcube import RCubeGeometry
-from hapticdesign.optimization.chain import Settings, run_chain
-from hapticdesign.optimization.constraints import constraint_values
-from hapticdesign.optimization.cross_section import cs1, cs2
-from hapticdesign.optimization.objectives import EvaluationLinks, geometry_of, o1, o2, o3
-from hapticdesign.optimization.plies import PlyEvaluator
+from hapticdesign.optimization.rcube.chain import Settings, run_chain
+from hapticdesign.optimization.rcube.constraints import constraint_values
+from hapticdesign.optimization.rcube.cross_section import cs1, cs2
+from hapticdesign.optimization.rcube.objectives import EvaluationLinks, geometry_of, o1, o2, o3
+from hapticdesign.optimization.rcube.plies import PlyEvaluator
 
 
 def _rate(fn, items) -> float:

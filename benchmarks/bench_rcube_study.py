@@ -1,5 +1,5 @@
 """Seed 001's R-CUBE synthesis through the generic study path (examples/studies/rcube-synthesis.yaml) against the
-specific path (:func:`hapticdesign.optimization.synthesis.synthesize`) on the same seed and settings (Table 7.1's
+specific path (:func:`hapticdesign.optimization.rcube.synthesis.synthesize`) on the same seed and settings (Table 7.1's
 three bound sets, population 100, 150 generations, the shortest design in the first populations): wall and CPU time
 of each and the ratio (goal: the generic path within 1.5 times the specific one), with the fronts compared.
 
@@ -17,7 +17,7 @@ import numpy as np
 from hapticdesign.optimization.study_evaluation import bind_study
 from hapticdesign.optimization.study_file import Study, load_study
 from hapticdesign.optimization.study_run import run_study
-from hapticdesign.optimization.synthesis import BOUND_SETS, hypervolume, synthesize
+from hapticdesign.optimization.rcube.synthesis import BOUND_SETS, hypervolume, synthesize
 
 STUDY = Path(__file__).resolve().parents[1] / "examples" / "studies" / "rcube-synthesis.yaml"
 SEED = 1

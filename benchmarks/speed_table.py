@@ -165,7 +165,7 @@ def rcube_rows() -> list[tuple[str, str, str]]:
     from hapticdesign.analysis.rcube.design import final_design
     from hapticdesign.analysis.rcube.metrics import workspace_maps
     from hapticdesign.analysis.rcube.stiffness import cartesian_stiffness
-    from hapticdesign.optimization.chain import Settings, run_chain
+    from hapticdesign.optimization.rcube.chain import Settings, run_chain
 
     design = final_design()
     position = design.geometry.home + np.array([0.02, -0.03, 0.01])

@@ -9,8 +9,8 @@ import pytest
 from typer.testing import CliRunner
 
 from hapticdesign.interface.cli import app
-from hapticdesign.optimization.constraints import constraint_values
-from hapticdesign.optimization.cross_section import ratio_for_upper_limit
+from hapticdesign.optimization.rcube.constraints import constraint_values
+from hapticdesign.optimization.rcube.cross_section import ratio_for_upper_limit
 
 runner = CliRunner()
 

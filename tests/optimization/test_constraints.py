@@ -8,7 +8,7 @@ import pytest
 
 from hapticdesign.analysis.rcube.kinematics import inverse_kinematics, passive_reach
 from hapticdesign.model.rcube import RCubeGeometry
-from hapticdesign.optimization.constraints import (
+from hapticdesign.optimization.rcube.constraints import (
     ERGONOMIC_POINTS,
     PASSIVE_POINTS,
     Workspace,

@@ -8,7 +8,7 @@ import pytest
 
 from hapticdesign.analysis.stiffness.sections import Tube
 from hapticdesign.errors import UserError
-from hapticdesign.optimization.cross_section import cs1, cs2, exact_ratio, optimize_ratio, ratio_for_upper_limit
+from hapticdesign.optimization.rcube.cross_section import cs1, cs2, exact_ratio, optimize_ratio, ratio_for_upper_limit
 
 
 def test_objectives_against_the_tube_section():

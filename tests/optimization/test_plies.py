@@ -11,7 +11,7 @@ from hapticdesign.analysis.stiffness.materials import laminate
 from hapticdesign.analysis.stiffness.sections import tube_from_plies
 from hapticdesign.errors import UserError
 from hapticdesign.model.rcube import RCubeGeometry
-from hapticdesign.optimization.plies import PlyEvaluator, optimize_plies, ply_design, ply_tube
+from hapticdesign.optimization.rcube.plies import PlyEvaluator, optimize_plies, ply_design, ply_tube
 from tests.helpers.optimization_seed_tables import table
 
 GEOMETRY = RCubeGeometry(0.1117, 0.0741, 0.1218)  # Table 7.8

@@ -8,10 +8,10 @@ from pymoo.core.problem import Problem
 
 from hapticdesign.errors import UserError
 from hapticdesign.model.rcube import RCubeGeometry
-from hapticdesign.optimization.objectives import objectives
-from hapticdesign.optimization.plies import optimize_plies
+from hapticdesign.optimization.rcube.objectives import objectives
+from hapticdesign.optimization.rcube.plies import optimize_plies
 from hapticdesign.optimization.pymoo_run import AlgorithmSpec, RowObjective, RunResult, run
-from hapticdesign.optimization.synthesis import BOUND_SETS, run_nsga2
+from hapticdesign.optimization.rcube.synthesis import BOUND_SETS, run_nsga2
 
 
 class Schaffer(Problem):

@@ -1,6 +1,6 @@
 """Seed 001's R-CUBE synthesis as a study file (examples/studies/rcube-synthesis.yaml) through the generic path:
-the same front as the specific path (:func:`hapticdesign.optimization.synthesis.synthesize`) on the same seed,
-its shortest design the KKT-certified constrained minimum (:mod:`hapticdesign.optimization.shortest`, found
+the same front as the specific path (:func:`hapticdesign.optimization.rcube.synthesis.synthesize`) on the same seed,
+its shortest design the KKT-certified constrained minimum (:mod:`hapticdesign.optimization.rcube.shortest`, found
 without NSGA-II), and the study file's new parts (formulas, runs, keep) refusing bad input in one line."""
 
 from __future__ import annotations
@@ -17,17 +17,17 @@ from typer.testing import CliRunner
 from hapticdesign.errors import UserError
 from hapticdesign.interface.cli import app
 from hapticdesign.optimization.formula import formula
-from hapticdesign.optimization.shortest import constrained_minimum
+from hapticdesign.optimization.rcube.shortest import constrained_minimum
 from hapticdesign.optimization.study_evaluation import bind_study
 from hapticdesign.optimization.study_file import load_study
 from hapticdesign.optimization.study_outputs import front_csv
 from hapticdesign.optimization.study_run import run_study
-from hapticdesign.optimization.synthesis import BOUND_SETS, hypervolume, synthesize
+from hapticdesign.optimization.rcube.synthesis import BOUND_SETS, hypervolume, synthesize
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 STUDY = EXAMPLES / "studies" / "rcube-synthesis.yaml"
 POPULATION, GENERATIONS, SEED = 24, 15, 1
-"""The specific path's --quick synthesis size (hapticdesign.optimization.chain.Settings.quick)."""
+"""The specific path's --quick synthesis size (hapticdesign.optimization.rcube.chain.Settings.quick)."""
 
 
 def study_file(folder: Path, **changes) -> Path:

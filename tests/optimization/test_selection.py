@@ -6,15 +6,9 @@ import numpy as np
 import pytest
 
 from hapticdesign.errors import UserError
-from hapticdesign.optimization.objectives import SEED_EVALUATION_MATERIAL, EvaluationLinks
-from hapticdesign.optimization.selection import (
-    METRIC_NAMES,
-    normalize,
-    normalized_indices,
-    post_evaluate,
-    select,
-    weighted_rms,
-)
+from hapticdesign.optimization.rcube.objectives import SEED_EVALUATION_MATERIAL, EvaluationLinks
+from hapticdesign.optimization.front_selection import normalize, weighted_rms
+from hapticdesign.optimization.rcube.selection import METRIC_NAMES, normalized_indices, post_evaluate, select
 from tests.helpers.optimization_seed_tables import table, table_7_2_designs
 
 

@@ -8,9 +8,9 @@ import pytest
 from scipy.optimize import brentq
 
 from hapticdesign.errors import UserError
-from hapticdesign.optimization.constraints import Q_MAX_RANGE, Workspace, constraint_values
-from hapticdesign.optimization.shortest import FEASIBILITY_MARGIN, constrained_minimum
-from hapticdesign.optimization.synthesis import BOUND_SETS, synthesize
+from hapticdesign.optimization.rcube.constraints import Q_MAX_RANGE, Workspace, constraint_values
+from hapticdesign.optimization.rcube.shortest import FEASIBILITY_MARGIN, constrained_minimum
+from hapticdesign.optimization.rcube.synthesis import BOUND_SETS, synthesize
 from tests.helpers.optimization_seed_tables import table, table_7_2_designs
 
 H, V = 0.060, 0.065  # half edges of the workspace and of the virtual cube (§6.1.3)

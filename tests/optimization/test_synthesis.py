@@ -9,10 +9,10 @@ from pymoo.indicators.hv import HV
 from hapticdesign.analysis.rcube.design import uniform_design
 from hapticdesign.analysis.rcube.dynamics import cartesian_mass_matrix
 from hapticdesign.errors import UserError
-from hapticdesign.optimization.constraints import constraint_values, link1_length
-from hapticdesign.optimization.objectives import geometry_of, objectives
-from hapticdesign.optimization.swarm import weighted_sum_swarm
-from hapticdesign.optimization.synthesis import Bounds, hypervolume, merge_fronts, pareto_filter, synthesize
+from hapticdesign.optimization.rcube.constraints import constraint_values, link1_length
+from hapticdesign.optimization.rcube.objectives import geometry_of, objectives
+from hapticdesign.optimization.rcube.swarm import weighted_sum_swarm
+from hapticdesign.optimization.rcube.synthesis import Bounds, hypervolume, merge_fronts, pareto_filter, synthesize
 
 
 @pytest.fixture(scope="module")

@@ -110,7 +110,7 @@ def test_every_metric_key_is_in_the_one_vocabulary(phantom3):
     from hapticdesign.analysis.rcube.design import final_design
     from hapticdesign.analysis.rcube.metrics import METRIC_NAMES, metrics_at
     from hapticdesign.interface.commands.metrics import device_metrics
-    from hapticdesign.optimization import selection
+    from hapticdesign.optimization.rcube import selection
 
     design = final_design()
     assert set(metrics_at(design, design.geometry.home[None])) == set(METRIC_NAMES) <= set(METRICS)

@@ -1,3 +1,5 @@
-"""R-CUBE design optimization (seed 001 ch. 6-7): kinematic synthesis by NSGA-II, post-evaluation
-and selection of a Pareto solution, the weighted-sum particle-swarm route, the hollow cross-section
-ratio and the composite ply counts, chained by :mod:`hapticdesign.optimization.chain`."""
+"""Design optimization of any device: study files (:mod:`.study_file`), their evaluation against a device file
+(:mod:`.study_evaluation`), runs (:mod:`.study_run`, NSGA-II through :mod:`.pymoo_run`; the convex LN program,
+:mod:`.study_convex`), outputs and front selection (:mod:`.study_outputs`, :mod:`.front_selection`). The modified
+R-CUBE's chain of seed 001 ch. 6-7 (synthesis, selection, cross-section, plies) is its own room,
+:mod:`hapticdesign.optimization.rcube`."""

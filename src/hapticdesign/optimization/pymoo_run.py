@@ -1,7 +1,7 @@
 """One way to set up, run and filter pymoo's ``minimize`` (Problem, Algorithm, minimize, Result).
 
-The searches of :mod:`~hapticdesign.optimization.synthesis`, :mod:`~hapticdesign.optimization.swarm`,
-:mod:`~hapticdesign.optimization.cross_section` and :mod:`~hapticdesign.optimization.plies` all run
+The searches of :mod:`~hapticdesign.optimization.rcube.synthesis`, :mod:`~hapticdesign.optimization.rcube.swarm`,
+:mod:`~hapticdesign.optimization.rcube.cross_section` and :mod:`~hapticdesign.optimization.rcube.plies` all run
 through :func:`run`: an :class:`AlgorithmSpec` names the algorithm and its size, ``minimize`` runs
 it with a seed (the same seed gives the same numbers), and the final population comes back as a
 plain :class:`RunResult` whose :meth:`RunResult.feasible` and :meth:`RunResult.front` filter it.

@@ -28,7 +28,7 @@ from hapticdesign.devices.design_space import DesignSpace
 from hapticdesign.errors import UserError
 from hapticdesign.files import parse_structured
 from hapticdesign.model.inertia import SEED_FIELDS, seed_parameter_name
-from hapticdesign.optimization.parameter_indices import PARAMETER_INDICES
+from hapticdesign.optimization.rcube.parameter_indices import PARAMETER_INDICES
 from hapticdesign.optimization.study_file import Choice, IndexConstraint, Study
 from hapticdesign.optimization.study_outputs import index_maps
 from hapticdesign.optimization.study_run import Answer, reduced_keys, violations

@@ -28,7 +28,7 @@ from hapticdesign.devices.schema import parse_expression
 from hapticdesign.errors import UserError
 from hapticdesign.files import load_structured, quote, read_text
 from hapticdesign.optimization.formula import Formula, formula
-from hapticdesign.optimization.parameter_indices import PARAMETER_INDICES
+from hapticdesign.optimization.rcube.parameter_indices import PARAMETER_INDICES
 
 REDUCTIONS = ("min", "max", "mean")
 """Reductions of an index over the workspace points (``mean``: the arithmetic mean over the uniform

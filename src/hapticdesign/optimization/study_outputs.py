@@ -2,7 +2,7 @@
 
 The selected design follows seed 001's rule (§7.2, Figures 7.2-7.3): each objective is normalized over
 the front (eq. 7.1) and turned so that 0 is its best value (eq. 7.2-7.4), and the design with the least
-RMS of these, or the least weighted RMS, is chosen (:func:`~hapticdesign.optimization.selection.least_rms`).
+RMS of these, or the least weighted RMS, is chosen (:func:`~hapticdesign.optimization.front_selection.least_rms`).
 Numbers in the CSV files are written with Python's shortest round-trip representation, so the same run
 gives the same bytes and reading them back gives the same floats.
 """
@@ -18,8 +18,8 @@ import numpy as np
 
 from hapticdesign.errors import UserError
 from hapticdesign.files import figure_bytes, save_figure
-from hapticdesign.optimization.parameter_indices import PARAMETER_INDICES
-from hapticdesign.optimization.selection import least_rms, normalize
+from hapticdesign.optimization.rcube.parameter_indices import PARAMETER_INDICES
+from hapticdesign.optimization.front_selection import least_rms, normalize
 from hapticdesign.optimization.study_run import StudyRun, constraint_labels
 from hapticdesign.simulation.design_indices import DESIGN_INDICES
 

@@ -21,15 +21,15 @@ from hapticdesign.analysis.rcube import stiffness as rcube_stiffness
 from hapticdesign.analysis.rcube.design import final_design, seed_final_design
 from hapticdesign.errors import UserError
 from hapticdesign.model.rcube import RCubeGeometry
-from hapticdesign.optimization.chain import (
+from hapticdesign.optimization.rcube.chain import (
     Settings,
     chain_summary,
     run_chain,
     write_chain,
 )
-from hapticdesign.optimization.constraints import Workspace, constraint_values
-from hapticdesign.optimization.plies import ply_design
-from hapticdesign.optimization.selection import METRIC_NAMES as TABLE_7_3_METRICS
+from hapticdesign.optimization.rcube.constraints import Workspace, constraint_values
+from hapticdesign.optimization.rcube.plies import ply_design
+from hapticdesign.optimization.rcube.selection import METRIC_NAMES as TABLE_7_3_METRICS
 from hapticdesign.studies.plots import plt
 from hapticdesign.studies.seed_reference import (
     RCUBE_FINAL,

@@ -30,7 +30,7 @@ about 1.4e5 and takes about a minute on 2 cores; docs/limits.md)."""
 
 
 def _settings(quick: bool, population: Optional[int], generations: Optional[int]):
-    from hapticdesign.optimization.chain import Settings
+    from hapticdesign.optimization.rcube.chain import Settings
     from hapticdesign.workload import require_within
 
     s = (Settings.quick() if quick else Settings()).with_population(population, generations)
@@ -41,7 +41,7 @@ def _settings(quick: bool, population: Optional[int], generations: Optional[int]
 
 
 def _bound_sets(text: Optional[str]):
-    from hapticdesign.optimization.synthesis import BOUND_SETS, Bounds
+    from hapticdesign.optimization.rcube.synthesis import BOUND_SETS, Bounds
 
     if text is None:
         return BOUND_SETS
@@ -87,8 +87,8 @@ def register(app: typer.Typer) -> None:
                  max_deflection: Optional[float] = typer.Option(None, "--max-deflection", help="Ply choice: fewest plies with CF1 below this (m) under 20 N."),
                  json_out: bool = JSON_OUT, quiet: bool = QUIET, force: bool = FORCE) -> None:
         """The whole chain: synthesis, selection, swarm, cross-section and plies (seed 001 ch. 7)."""
-        from hapticdesign.optimization.chain import chain_summary, run_chain, write_chain
-        from hapticdesign.optimization.constraints import Workspace
+        from hapticdesign.optimization.rcube.chain import chain_summary, run_chain, write_chain
+        from hapticdesign.optimization.rcube.constraints import Workspace
 
         with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
             settings = _settings(quick, population, generations)
@@ -117,9 +117,9 @@ def register(app: typer.Typer) -> None:
                    side: float = SIDE, virtual_side: float = VIRTUAL, json_out: bool = JSON_OUT, quiet: bool = QUIET,
                    force: bool = FORCE) -> None:
         """Kinematic synthesis by NSGA-II over Table 7.1's bounds, post-evaluation and selection (§7.1-7.2)."""
-        from hapticdesign.optimization import chain
-        from hapticdesign.optimization.constraints import Workspace
-        from hapticdesign.optimization.synthesis import synthesize as run
+        from hapticdesign.optimization.rcube import chain
+        from hapticdesign.optimization.rcube.constraints import Workspace
+        from hapticdesign.optimization.rcube.synthesis import synthesize as run
 
         with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
             s = _settings(quick, population, generations)
@@ -151,8 +151,8 @@ def register(app: typer.Typer) -> None:
                       upper: float = typer.Option(0.9, "--upper", help="Upper bound of d/D (thin-wall limit)."),
                       json_out: bool = JSON_OUT, quiet: bool = QUIET, force: bool = FORCE) -> None:
         """Inner/outer diameter ratio from CS1 = 1/S_l and CS2 = I_l (eq. 6.85-6.90, Figure 7.4)."""
-        from hapticdesign.optimization import chain
-        from hapticdesign.optimization.cross_section import exact_ratio, optimize_ratio
+        from hapticdesign.optimization.rcube import chain
+        from hapticdesign.optimization.rcube.cross_section import exact_ratio, optimize_ratio
 
         with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
             s = _settings(quick, population, generations)
@@ -176,8 +176,8 @@ def register(app: typer.Typer) -> None:
               json_out: bool = JSON_OUT, quiet: bool = QUIET, force: bool = FORCE) -> None:
         """Integer ply counts at 0, 90, +-45 deg per link under 20 N at full extension (eq. 6.91-6.96)."""
         from hapticdesign.model.rcube import RCubeGeometry
-        from hapticdesign.optimization import chain
-        from hapticdesign.optimization.plies import optimize_plies, ply_design
+        from hapticdesign.optimization.rcube import chain
+        from hapticdesign.optimization.rcube.plies import optimize_plies, ply_design
 
         with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
             s = _settings(quick, population, generations)

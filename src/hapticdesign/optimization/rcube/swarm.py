@@ -14,10 +14,10 @@ import numpy as np
 from pymoo.core.problem import Problem
 
 from hapticdesign.errors import UserError
-from hapticdesign.optimization.constraints import Workspace, constraint_values
-from hapticdesign.optimization.objectives import EvaluationLinks, objectives
+from hapticdesign.optimization.rcube.constraints import Workspace, constraint_values
+from hapticdesign.optimization.rcube.objectives import EvaluationLinks, objectives
 from hapticdesign.optimization.pymoo_run import AlgorithmSpec, RowObjective, run
-from hapticdesign.optimization.synthesis import BOUND_SETS, Bounds, Front
+from hapticdesign.optimization.rcube.synthesis import BOUND_SETS, Bounds, Front
 
 PENALTY = 1e3
 

@@ -22,7 +22,7 @@ from hapticdesign.analysis.rcube.dynamics import cartesian_mass_matrix
 from hapticdesign.analysis.rcube.stiffness import cartesian_stiffness
 from hapticdesign.analysis.stiffness.materials import STRUCTURAL_STEEL, LinkModuli, laminate
 from hapticdesign.errors import UserError
-from hapticdesign.optimization.constraints import Workspace, link1_length
+from hapticdesign.optimization.rcube.constraints import Workspace, link1_length
 
 OBJECTIVE_NAMES = ("O1", "O2", "O3")
 

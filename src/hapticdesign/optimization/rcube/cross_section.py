@@ -25,7 +25,7 @@ from pymoo.core.problem import Problem
 from scipy.optimize import minimize_scalar
 
 from hapticdesign.errors import UserError
-from hapticdesign.optimization.selection import normalize, weighted_rms
+from hapticdesign.optimization.front_selection import normalize, weighted_rms
 from hapticdesign.optimization.pymoo_run import AlgorithmSpec, run
 
 RATIO_BOUNDS = (0.0, 0.9)

@@ -1,12 +1,12 @@
 """Kinematic synthesis of the R-CUBE by NSGA-II (seed 001 §6.4, §7.1, Table 7.1-7.2).
 
 Design vector ``(q_max, l2, l3)`` (rad, m, m) within one of the bound sets of Table 7.1;
-constraints 3-8 of :mod:`hapticdesign.optimization.constraints`; objectives ``O1, O2, O3`` of
-:mod:`hapticdesign.optimization.objectives`. The fronts of the three bound sets are merged, reduced
+constraints 3-8 of :mod:`hapticdesign.optimization.rcube.constraints`; objectives ``O1, O2, O3`` of
+:mod:`hapticdesign.optimization.rcube.objectives`. The fronts of the three bound sets are merged, reduced
 to the non-dominated designs and to those with ``l1 + l2 + l3 < 400 mm`` (§7.1).
 
 Before the runs, the shortest feasible design is found by direct constrained minimization
-(:mod:`hapticdesign.optimization.shortest`) and placed in the initial population of every bound set
+(:mod:`hapticdesign.optimization.rcube.shortest`) and placed in the initial population of every bound set
 that holds it; the rest of each initial population is uniform random, drawn with the run's seed. The
 shortest design minimizes ``O3`` on the front, so NSGA-II's elitism keeps it.
 """
@@ -23,10 +23,10 @@ from pymoo.core.problem import Problem
 from pymoo.indicators.hv import HV
 
 from hapticdesign.errors import UserError
-from hapticdesign.optimization.constraints import Q_MAX_RANGE, Workspace, constraint_values, link1_length
-from hapticdesign.optimization.objectives import EvaluationLinks, objectives
+from hapticdesign.optimization.rcube.constraints import Q_MAX_RANGE, Workspace, constraint_values, link1_length
+from hapticdesign.optimization.rcube.objectives import EvaluationLinks, objectives
 from hapticdesign.optimization.pymoo_run import AlgorithmSpec, RowObjective, initial_population, pareto_filter, run
-from hapticdesign.optimization.shortest import ConstrainedMinimum, constrained_minimum, design_summary, inside
+from hapticdesign.optimization.rcube.shortest import ConstrainedMinimum, constrained_minimum, design_summary, inside
 
 INFEASIBLE_OBJECTIVE = 1e30
 """Objective value given to designs that break a constraint (pymoo ranks them by violation only)."""
@@ -167,7 +167,7 @@ def synthesize(bound_sets=BOUND_SETS, population: int = 100, generations: int = 
                starts: int = MINIMIZATION_STARTS, client=None) -> SynthesisResult:
     """NSGA-II over each bound set (seed ``seed + k`` for set ``k``), merged as in §7.1.
 
-    The shortest feasible design (:func:`hapticdesign.optimization.shortest.constrained_minimum`,
+    The shortest feasible design (:func:`hapticdesign.optimization.rcube.shortest.constrained_minimum`,
     ``starts`` starts drawn with ``seed``; 0 skips it) joins the initial population of every bound
     set that holds it. ``progress(set_index, generation)`` is called after each generation; ``client``
     (a ``dask.distributed.Client``, none by default) evaluates the objectives on its workers. Raises

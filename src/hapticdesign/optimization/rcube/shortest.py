@@ -4,7 +4,7 @@
 The kinematic synthesis keeps Table 7.2's designs sorted by total link length ``l1 + l2 + l3``
 with ``l1 = h / sin q_max`` (Constraint 1, eq. 6.24). Its short end is where Constraints 3-8
 (eq. 6.45-6.49, 6.52) bind. This module minimizes the total length under exactly the constraints of
-:func:`hapticdesign.optimization.constraints.constraint_values` and the bounds of the synthesis
+:func:`hapticdesign.optimization.rcube.constraints.constraint_values` and the bounds of the synthesis
 (Table 7.1, Constraint 2, eq. 6.28) with SciPy's SLSQP from many seeded starts, then certifies the
 result by the Karush-Kuhn-Tucker conditions: the active constraint gradients span the design
 space and their multipliers are positive, so the point is a strict local minimum (a vertex of the
@@ -20,7 +20,7 @@ import numpy as np
 from scipy.optimize import minimize
 
 from hapticdesign.errors import UserError
-from hapticdesign.optimization.constraints import CONSTRAINT_NAMES, Workspace, constraint_values, is_feasible, link1_length
+from hapticdesign.optimization.rcube.constraints import CONSTRAINT_NAMES, Workspace, constraint_values, is_feasible, link1_length
 
 FEASIBILITY_MARGIN = 1e-10
 """The local solver keeps ``g <= -margin`` so that its answer meets ``g <= 0`` exactly (constraint units)."""

@@ -14,15 +14,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from hapticdesign.errors import UserError
 from hapticdesign.analysis.metrics import names
 from hapticdesign.analysis.metrics.dynamic import inertia_frobenius, natural_frequency_index
 from hapticdesign.analysis.metrics.stiffness import frobenius, translational_block
 from hapticdesign.analysis.rcube.dynamics import chain_cartesian_mass
 from hapticdesign.analysis.rcube.kinematics import critical_condition_number, critical_manipulability, inverse_kinematics
 from hapticdesign.analysis.rcube.stiffness import chain_stiffness_matrices
-from hapticdesign.optimization.constraints import Workspace
-from hapticdesign.optimization.objectives import EvaluationLinks, geometry_of
+from hapticdesign.optimization.front_selection import normalize, weighted_rms
+from hapticdesign.optimization.rcube.constraints import Workspace
+from hapticdesign.optimization.rcube.objectives import EvaluationLinks, geometry_of
 
 METRIC_NAMES = (names.INERTIA_FROBENIUS, names.STIFFNESS_FROBENIUS, names.FREQUENCY_INDEX,
                 names.CRITICAL_MANIPULABILITY, names.CRITICAL_CONDITION_NUMBER)
@@ -50,15 +50,6 @@ def post_evaluate(X, workspace: Workspace = Workspace(), links: EvaluationLinks 
     return out
 
 
-def normalize(values) -> np.ndarray:
-    """``p_n = (p - p_min) / (p_max - p_min)`` over the solutions (eq. 7.1); constant columns give 0."""
-    p = np.asarray(values, dtype=float)
-    if p.size == 0:
-        raise UserError("nothing to normalize: the front is empty")
-    span = p.max() - p.min()
-    return np.zeros_like(p) if span == 0.0 else (p - p.min()) / span
-
-
 def normalized_indices(metrics: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     """Table 7.4 (eq. 7.1) followed by eq. 7.2-7.4 (``1 - p_n`` for the larger-is-better indices):
     0 is the best value of every returned index."""
@@ -67,30 +58,6 @@ def normalized_indices(metrics: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         n = normalize(values)
         out[name] = 1.0 - n if name in LARGER_IS_BETTER else n
     return out
-
-
-def weighted_rms(primary, secondary, weight: float = 1.0) -> np.ndarray:
-    """``sqrt((a^2 + w b^2) / 2)`` (Figures 7.2-7.3): ``w = 1`` is the plain RMS of ``a`` and ``b``.
-
-    With ``a = omega_nn*`` and ``b = mu_vn*`` this reproduces the seed's choices from Table 7.3:
-    Sol. 29 at ``w = 1`` and Sol. 1, 2, 6, 16 at ``w = 0, 0.25, 0.5, 0.75`` (Table 7.5).
-    """
-    if not 0.0 <= weight:
-        raise UserError(f"a weight must be non-negative, got {weight!r}")
-    a, b = np.asarray(primary, dtype=float), np.asarray(secondary, dtype=float)
-    return np.sqrt((a**2 + weight * b**2) / 2.0)
-
-
-def least_rms(normalized: np.ndarray, weights=None) -> int:
-    """Row of the least weighted RMS ``sqrt(sum_i w_i a_i^2 / k)`` of ``normalized (n, k)`` (0 best in
-    every column, eq. 7.1-7.4): Figures 7.2-7.3's rule over any number of indices (all weights 1: the
-    plain RMS of Figure 7.2; ``k = 2`` with weights ``(1, w)`` is :func:`weighted_rms`). Ties go to the
-    first row."""
-    a = np.atleast_2d(np.asarray(normalized, dtype=float))
-    w = np.ones(a.shape[1]) if weights is None else np.asarray(weights, dtype=float)
-    if w.shape != (a.shape[1],) or not np.all(w >= 0.0) or not np.any(w > 0.0):
-        raise UserError(f"give one non-negative weight per index, not all 0 (indices: {a.shape[1]})")
-    return int(np.argmin(np.sqrt((a**2 @ w) / a.shape[1])))
 
 
 def select(metrics: dict[str, np.ndarray], weights=(0.0, 0.25, 0.5, 0.75)) -> dict[str, int | dict[float, int]]:

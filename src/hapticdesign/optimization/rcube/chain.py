@@ -20,14 +20,15 @@ from hapticdesign.analysis.rcube.dynamics import cartesian_mass_matrix
 from hapticdesign.analysis.rcube.kinematics import dexterous_cube
 from hapticdesign.analysis.rcube.stiffness import cartesian_stiffness
 from hapticdesign.files import to_jsonable, write_atomically
-from hapticdesign.optimization import figures
-from hapticdesign.optimization.constraints import Workspace
-from hapticdesign.optimization.cross_section import RATIO_BOUNDS, CrossSectionResult, optimize_ratio
-from hapticdesign.optimization.objectives import EvaluationLinks, geometry_of
-from hapticdesign.optimization.plies import PlyResult, choose, optimize_plies, ply_design
-from hapticdesign.optimization.selection import METRIC_NAMES, normalize, normalized_indices, post_evaluate, weighted_rms
-from hapticdesign.optimization.swarm import SwarmResult, weighted_sum_swarm
-from hapticdesign.optimization.synthesis import BOUND_SETS, SynthesisResult, synthesize
+from hapticdesign.optimization.rcube import figures
+from hapticdesign.optimization.rcube.constraints import Workspace
+from hapticdesign.optimization.rcube.cross_section import RATIO_BOUNDS, CrossSectionResult, optimize_ratio
+from hapticdesign.optimization.rcube.objectives import EvaluationLinks, geometry_of
+from hapticdesign.optimization.rcube.plies import PlyResult, choose, optimize_plies, ply_design
+from hapticdesign.optimization.front_selection import normalize, weighted_rms
+from hapticdesign.optimization.rcube.selection import METRIC_NAMES, normalized_indices, post_evaluate
+from hapticdesign.optimization.rcube.swarm import SwarmResult, weighted_sum_swarm
+from hapticdesign.optimization.rcube.synthesis import BOUND_SETS, SynthesisResult, synthesize
 
 WEIGHTS = (0.0, 0.25, 0.5, 0.75)
 """Weights on ``mu_vn*`` of Table 7.5."""

@@ -4,13 +4,13 @@ docs/indices.md).
 
 These indices are specific to the modified R-CUBE: they read the device file's ``l1``, ``l2``, ``l3`` and ``S``
 (``S = l1``, eq. 6.39, is required) and evaluate the synthesis's own closed forms
-(:mod:`~hapticdesign.optimization.constraints`, :mod:`~hapticdesign.optimization.objectives`; ``M_C`` and ``K_C`` of
+(:mod:`~hapticdesign.optimization.rcube.constraints`, :mod:`~hapticdesign.optimization.rcube.objectives`; ``M_C`` and ``K_C`` of
 the device's ``l1, l2, l3`` with the evaluation tube) at ``q_max = asin(h / l1)`` (Constraint 1, eq. 6.24, read backward: the active joint travel that covers the cube of half
 edge ``h``). They are not computed from the device file's frames and loops: the passive-joint conditions of
 Constraints 3-7 at points of a virtual cube that the handle need not reach, and the hand-side condition of
 Constraint 8, have no counterpart among the pose indices. Options: ``side`` (the workspace cube's edge, m, 0.120) and
 ``virtual_side`` (the virtual cube's edge, m, 0.130); the objectives' links are the synthesis's evaluation tube
-(:class:`~hapticdesign.optimization.objectives.EvaluationLinks`).
+(:class:`~hapticdesign.optimization.rcube.objectives.EvaluationLinks`).
 """
 
 from __future__ import annotations
@@ -21,9 +21,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from hapticdesign.errors import UserError
-from hapticdesign.optimization.constraints import (ERGONOMIC_POINTS, PASSIVE_POINTS, Workspace, constraint_values)
+from hapticdesign.optimization.rcube.constraints import (ERGONOMIC_POINTS, PASSIVE_POINTS, Workspace, constraint_values)
 from hapticdesign.model.rcube import RCubeGeometry
-from hapticdesign.optimization.objectives import EvaluationLinks, o1, o2, o3
+from hapticdesign.optimization.rcube.objectives import EvaluationLinks, o1, o2, o3
 
 POINTS = (*PASSIVE_POINTS, *ERGONOMIC_POINTS)
 """The critical points of Constraints 3-8, in the column order of :func:`constraint_values`."""
