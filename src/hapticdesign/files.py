@@ -195,22 +195,76 @@ def dumps_json(value, **kwargs) -> str:
     return json.dumps(require_finite(value), **kwargs)
 
 
+def _refuse_in_place(path: Path) -> None:
+    """Refuse an output ``path`` that exists and is not a regular file (or a link to one, or to nothing): a
+    directory, a named pipe, a device, a socket is never replaced or opened (replacing ``/dev/full`` as root
+    would remove the machine's device)."""
+    try:
+        mode = os.lstat(path).st_mode
+    except FileNotFoundError:
+        return
+    except OSError as exc:
+        raise UserError(f"cannot write {path}: {exc.strerror or exc}") from None
+    if stat.S_ISLNK(mode):  # the link is replaced, never followed; but a link to a special file says a mistake
+        try:
+            mode = os.stat(path).st_mode
+        except OSError:
+            return
+    if stat.S_ISDIR(mode):
+        raise UserError(f"cannot write {path}: it is a directory")
+    if not stat.S_ISREG(mode):
+        raise UserError(f"cannot write {path}: it is {_special_kind(mode)}, not a regular file; it is left as it is")
+
+
+def output_folder(path: Path | str) -> Path:
+    """``path`` as a real folder to write into (created when missing): a symbolic link or a file in its place is
+    refused, so that nothing is written through a link out of the output folder (``OUT/checkpoint`` linked to
+    another place)."""
+    path = Path(path)
+    if path.is_symlink() or (path.exists() and not path.is_dir()):
+        kind = "a symbolic link" if path.is_symlink() else "not a folder"
+        raise UserError(f"{path} is {kind}; outputs go only into real folders inside the output folder (remove it "
+                        "or choose another output folder)")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise UserError(f"cannot write into {path}: {exc.strerror or exc}") from None
+    return path
+
+
+def _write_new(path: Path, data: bytes) -> None:
+    """Write ``data`` to a file that this call creates (never through a file, link or pipe already there)."""
+    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0)
+    try:
+        fd = os.open(path, flags, 0o666)
+    except FileExistsError:  # a leftover of an earlier run of this process id (or something put there): replaced
+        path.unlink()
+        fd = os.open(path, flags, 0o666)
+    with os.fdopen(fd, "wb") as handle:
+        handle.write(data)
+
+
 def write_atomically(path: Path | str, content: str | bytes) -> None:
     """Write a file so that an interruption or a failure never leaves it (or a ``.tmp``) half-written.
 
-    Any problem with the output place (a directory in the way, a read-only folder, a full disk) is
-    a one-line :class:`UserError`.
+    The content goes to a new temporary file beside ``path``, which then replaces ``path``: a symbolic link
+    at ``path`` is replaced, not followed; a directory, named pipe, device or socket there is refused
+    (:func:`_refuse_in_place`). Any problem with the output place (a read-only folder, a full disk) is a
+    one-line :class:`UserError`; text that cannot be UTF-8 (a lone surrogate) is refused before anything is
+    written.
     """
     path = Path(path)
-    if path.is_dir():
-        raise UserError(f"cannot write {path}: it is a directory")
+    _refuse_in_place(path)
+    if isinstance(content, str):
+        try:
+            content = content.encode("utf-8")
+        except UnicodeEncodeError as exc:
+            raise UserError(f"cannot write {path}: the text holds {quote(exc.object[exc.start:exc.end])}, "
+                            "which is not a character (a lone surrogate)") from None
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        if isinstance(content, bytes):
-            tmp.write_bytes(content)
-        else:
-            tmp.write_text(content, encoding="utf-8")
+        _write_new(tmp, content)
         tmp.replace(path)
     except OSError as exc:
         try:

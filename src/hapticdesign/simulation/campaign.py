@@ -34,7 +34,7 @@ import numpy as np
 from hapticdesign.analysis.dynamics.device import coriolis_centrifugal, gravity, mass_matrix
 from hapticdesign.devices.registry import preset
 from hapticdesign.errors import InputError, PhysicalConsistencyWarning, UserError
-from hapticdesign.files import read_text, write_atomically
+from hapticdesign.files import output_folder, read_text, write_atomically
 from hapticdesign.simulation.analytic import AnalyticProblem
 from hapticdesign.simulation.config import LoopConfig
 from hapticdesign.simulation.impedance import (ImpedanceProblem, fast_search, planned_simulations,
@@ -291,7 +291,10 @@ def close_client(client, own_cluster: bool) -> None:
 def campaign_lock(out: Path) -> Iterator[None]:
     """An exclusive lock on ``out`` for the run: a second campaign in the same folder is refused."""
     out.mkdir(parents=True, exist_ok=True)
-    handle = (out / LOCK_FILE).open("a")
+    try:  # never through a link: the lock file is created in ``out`` itself
+        handle = os.fdopen(os.open(out / LOCK_FILE, os.O_WRONLY | os.O_CREAT | os.O_APPEND | os.O_NOFOLLOW, 0o666), "a")
+    except OSError as exc:
+        raise UserError(f"cannot write {out / LOCK_FILE}: {exc.strerror or exc}") from None
     try:
         try:
             fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
@@ -336,11 +339,8 @@ def run_campaign(designs_path: Path, out: Path, options: CampaignOptions | None 
 def _run_locked(designs: list[Design], out: Path, options: CampaignOptions, scheduler: str | None,
                 workers: int | None, progress: Callable[[int, int], None] | None, quiet: bool) -> dict:
     cases_dir = out / "cases"
-    for place in (cases_dir, out / "figures"):
-        if place.is_symlink() or (place.exists() and not place.is_dir()):
-            raise UserError(f"{place} is a symbolic link or a file; a campaign writes only into real folders inside "
-                            "its output folder (remove it or choose another output folder)")
-    cases_dir.mkdir(parents=True, exist_ok=True)
+    output_folder(cases_dir)
+    output_folder(out / "figures")
     settings = json.dumps({**asdict(options), "designs": [asdict(d) for d in designs]}, sort_keys=True)
     stamp = out / "campaign.json"
     if stamp.exists() and stamp.read_text() != settings:
