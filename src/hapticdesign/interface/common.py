@@ -17,7 +17,7 @@ import numpy as np
 import typer
 from typer._click.globals import get_current_context
 
-from hapticdesign.errors import InputError, PhysicalConsistencyWarning, UserError
+from hapticdesign.errors import InputError, PhysicalConsistencyWarning, RunWarning, UserError
 from hapticdesign.files import dumps_json, to_jsonable, write_atomically
 
 
@@ -26,6 +26,7 @@ def user_errors(strict: bool = False, quiet: bool = False) -> Iterator[None]:
     """Turn user mistakes into ``error: ...`` on stderr and exit 2; consistency warnings into one line."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", PhysicalConsistencyWarning)
+        warnings.simplefilter("always", RunWarning)
         try:
             yield
         except UserError as exc:
@@ -34,7 +35,7 @@ def user_errors(strict: bool = False, quiet: bool = False) -> Iterator[None]:
         finally:
             if not quiet:
                 for w in caught:
-                    if issubclass(w.category, PhysicalConsistencyWarning):
+                    if issubclass(w.category, (PhysicalConsistencyWarning, RunWarning)):
                         typer.echo(f"warning: {w.message}", err=True)
 
 
