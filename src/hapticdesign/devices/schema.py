@@ -29,7 +29,7 @@ from hapticdesign.analysis.stiffness.sections import Tube
 from hapticdesign.devices.builder import BODY_NAME_PATTERN, IDENTIFIER_PATTERN, LinearExpr, TransformSpec
 from hapticdesign.errors import UserError
 from hapticdesign.model.inertia import SEED_FIELDS, BodyInertia, check_body
-from hapticdesign.model.loops import component_indices
+from hapticdesign.model.loops import component_indices, handle_position
 from hapticdesign.model.transforms import Axis
 
 RESERVED = ("pi", "g", "base")
@@ -471,6 +471,10 @@ def _check_loops(spec: DeviceFileSpec, frames: list[str]) -> None:
                                  f"home: {{{HOME_POSITION}: [x, y, z]}})")
             if len(value) != 3:
                 raise ValueError(f"home.{HOME_POSITION}: a handle position is 3 numbers [x, y, z] (m), got {len(value)}")
+            try:
+                handle_position(value, f"home.{HOME_POSITION}")
+            except UserError as exc:
+                raise ValueError(str(exc)) from None
         elif name not in actuated:
             raise ValueError(f"home: {name!r} is not an actuated joint (actuated: {', '.join(actuated)})")
     if spec.home and not spec.loops:
