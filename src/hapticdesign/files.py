@@ -53,6 +53,8 @@ def read_text(path: Path | str, what: str = "file") -> str:
     end). At most ``MAX_FILE_BYTES + 1`` bytes are read, whatever size the file reports.
     """
     path = Path(path)
+    if "\x00" in str(path):
+        raise UserError(f"cannot read {what} {quote(str(path))}: a file name holds no NUL character")
     try:
         mode = os.stat(path).st_mode
         if stat.S_ISDIR(mode):

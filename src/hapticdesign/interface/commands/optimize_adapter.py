@@ -31,7 +31,7 @@ def parse_select(text: str) -> dict:
     text = text.strip()
     if text == "rms":
         return {}
-    if text.isdigit():
+    if text.isascii() and text.isdigit():
         return {"design": int(text)}
     weights = {}
     for part in text.split(","):
