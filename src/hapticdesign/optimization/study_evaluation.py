@@ -146,16 +146,18 @@ class BoundStudy:
         valid = [k for k, r in enumerate(results) if r.reason is None]
         values = {k: dict(results[k].values) for k in valid}
         first = [r for r in self.parameter_requests if r.key in self.constrained]
-        self._parameter_values(first, [device_values[k] for k in valid], valid, values)
+        failed = self._parameter_values(first, [device_values[k] for k in valid], valid, values)
+        valid = [k for k in valid if k not in failed]
         if objectives:
             feasible = [k for k in valid if self._feasible(batch[k], values[k])]
             later = [r for r in self.parameter_requests if r.key not in self.constrained]
-            self._parameter_values(later, [device_values[k] for k in feasible], feasible, values)
+            failed |= self._parameter_values(later, [device_values[k] for k in feasible], feasible, values)
         nothing = (math.nan,) * len(self.keys)
         out = []
         for k, result in enumerate(results):
-            if result.reason is not None:
-                out.append(Answer(nothing, result.reason))
+            reason = result.reason if result.reason is not None else failed.get(k)
+            if reason is not None:
+                out.append(Answer(nothing, reason))
             else:
                 got = values[k]
                 out.append(Answer(tuple(reduce(got[label], key[2]) if (label := self.labels[key[:2]]) in got
@@ -176,10 +178,27 @@ class BoundStudy:
         return self.evaluate(batch, objectives=False)
 
     def _parameter_values(self, requests: list[Request], designs: list[dict[str, float]], rows: list[int],
-                          values: dict[int, dict[str, np.ndarray]]) -> None:
-        """The parameter indices ``requests`` of ``designs`` (device values), written to ``values[rows[i]]``."""
+                          values: dict[int, dict[str, np.ndarray]]) -> dict[int, str]:
+        """The parameter indices ``requests`` of ``designs`` (device values), written to ``values[rows[i]]``; a design
+        whose index cannot be computed (a pose its links do not reach, a length its formulas make negative) has
+        none: the rows of such designs -> why (each design then evaluated alone, the others keep their values)."""
         if not requests or not designs:
-            return
+            return {}
+        try:
+            self._parameter_columns(requests, designs, rows, values)
+            return {}
+        except UserError:
+            pass
+        failed = {}
+        for design, k in zip(designs, rows):
+            try:
+                self._parameter_columns(requests, [design], [k], values)
+            except UserError as exc:
+                failed[k] = str(exc)
+        return failed
+
+    def _parameter_columns(self, requests: list[Request], designs: list[dict[str, float]], rows: list[int],
+                           values: dict[int, dict[str, np.ndarray]]) -> None:
         base = self.space.base.params
         params = {name: np.array([float(d.get(name, base[name])) for d in designs]) for name in base}
         cache: dict = {}

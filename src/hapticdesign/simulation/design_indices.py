@@ -138,8 +138,8 @@ def _batch(space: DesignSpace, requests: list[Request]) -> DesignBatch | None:
 
 
 def _one(space: DesignSpace, values: Mapping[str, float], points: np.ndarray, requests: list[Request]) -> Evaluation:
+    """One design's evaluation, or why it has none: the device file refuses it or an index cannot be computed."""
     try:
-        device = space.device(values)
+        return evaluate(space.device(values), points, requests)
     except UserError as exc:
         return Evaluation({}, str(exc))
-    return evaluate(device, points, requests)
