@@ -9,7 +9,8 @@ goes through :func:`write_atomically`. The limits are stated here once:
   with one line, and so are named pipes and devices (``/dev/zero``), even through a symlink;
 - YAML aliases and anchors are refused (data files are data: an alias "bomb" of a few lines
   expands to gigabytes), as are Python-specific tags (``yaml.SafeLoader`` already refuses them);
-- structures nested deeper than ``MAX_DEPTH`` (64) levels are refused;
+- structures nested deeper than ``MAX_DEPTH`` (64) levels are refused, and so are texts holding a character
+  of :data:`NOT_TEXT` (control characters, lone surrogates: a name that XML or UTF-8 cannot carry);
 - a message quotes at most ``QUOTE_LIMIT`` (60) characters of a user's value (:func:`quote`);
 - a figure is rendered by :func:`figure_bytes`: the same figure gives the same bytes (SVG ids
   hashed with a fixed salt, no creation date in SVG or PDF).
@@ -123,6 +124,29 @@ def _depth(value: object, limit: int) -> int:
     return deepest
 
 
+NOT_TEXT = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ud800-\udfff\ufffe\uffff]")
+"""Characters no text of a data file may hold: control characters other than tab and line breaks, lone
+surrogates (not characters: they cannot be written as UTF-8) and U+FFFE/U+FFFF (XML 1.0 forbids all of them,
+so a name holding one would make a malformed MJCF or URDF file)."""
+
+
+def _first_not_text(value: object) -> tuple[str, str] | None:
+    """The first string (key or value) holding a :data:`NOT_TEXT` character, and that character."""
+    stack = [value]
+    while stack:
+        item = stack.pop()
+        if isinstance(item, str):
+            found = NOT_TEXT.search(item)
+            if found:
+                return item, found.group()
+        elif isinstance(item, dict):
+            stack.extend(item.keys())
+            stack.extend(item.values())
+        elif isinstance(item, list):
+            stack.extend(item)
+    return None
+
+
 def parse_structured(text: str, kind: str, where: str) -> object:
     """Parse JSON, YAML or TOML text (``kind``: json, yaml, toml) with the limits above."""
     try:
@@ -141,6 +165,10 @@ def parse_structured(text: str, kind: str, where: str) -> object:
         raise UserError(f"{where}: malformed {kind.upper()} ({first[:200]})") from None
     if _depth(data, MAX_DEPTH) > MAX_DEPTH:
         raise UserError(f"{where}: nested too deeply (at most {MAX_DEPTH} levels)")
+    bad = _first_not_text(data)
+    if bad is not None:
+        raise UserError(f"{where}: {quote(bad[0])} holds the character U+{ord(bad[1]):04X}, which no text of a data "
+                        "file may hold (a control character, a lone surrogate or a non-character)")
     return data
 
 
