@@ -12,12 +12,15 @@ goes through :func:`write_atomically`. The limits are stated here once:
 - structures nested deeper than ``MAX_DEPTH`` (64) levels are refused, and so are texts holding a character
   of :data:`NOT_TEXT` (control characters, lone surrogates: a name that XML or UTF-8 cannot carry);
 - a message quotes at most ``QUOTE_LIMIT`` (60) characters of a user's value (:func:`quote`);
+- a CSV output is written by :func:`csv_rows`: a text cell that a spreadsheet would run as a formula is
+  written as text (:func:`csv_cell`);
 - a figure is rendered by :func:`figure_bytes`: the same figure gives the same bytes (SVG ids
   hashed with a fixed salt, no creation date in SVG or PDF).
 """
 
 from __future__ import annotations
 
+import csv
 import io
 import json
 import math
@@ -180,6 +183,33 @@ def load_structured(path: Path | str, what: str = "file") -> object:
     if kind is None:
         raise UserError(f"{path}: unknown file type {quote(path.suffix)} (use .json, .yaml, .yml or .toml)")
     return parse_structured(read_text(path, what), kind, str(path))
+
+
+FORMULA_START = ("=", "+", "-", "@", "\t", "\r")
+"""First characters by which a spreadsheet takes a cell for a formula (OWASP's CSV injection rule)."""
+
+
+def csv_cell(value: object) -> object:
+    """A CSV cell a spreadsheet shows as it is: a text that begins with a :data:`FORMULA_START` character and is not
+    a number (an objective named ``=HYPERLINK(...)``, an expression ``-l1 + l2``) gets a leading ``'``; numbers
+    (``-0.5``) and other values are unchanged."""
+    if not isinstance(value, str) or not value.startswith(FORMULA_START):
+        return value
+    try:
+        float(value)
+        return value
+    except ValueError:
+        return "'" + value
+
+
+def csv_rows(header: list[str], rows) -> str:
+    """CSV text (newline-terminated lines) of ``header`` and ``rows``, every cell through :func:`csv_cell`: the one
+    CSV writer of the outputs."""
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow([csv_cell(v) for v in header])
+    writer.writerows([csv_cell(v) for v in row] for row in rows)
+    return buffer.getvalue()
 
 
 def to_jsonable(value):

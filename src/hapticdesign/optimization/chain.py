@@ -4,8 +4,6 @@ and selection (Tables 7.3-7.5), the weighted-sum swarm, the cross-section ratio 
 
 from __future__ import annotations
 
-import csv
-import io
 import json
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
@@ -19,7 +17,7 @@ from hapticdesign.analysis.rcube.design import RCubeDesign
 from hapticdesign.analysis.rcube.dynamics import cartesian_mass_matrix
 from hapticdesign.analysis.rcube.kinematics import dexterous_cube
 from hapticdesign.analysis.rcube.stiffness import cartesian_stiffness
-from hapticdesign.files import to_jsonable, write_atomically
+from hapticdesign.files import csv_rows, to_jsonable, write_atomically
 from hapticdesign.optimization import figures
 from hapticdesign.optimization.constraints import Workspace
 from hapticdesign.optimization.cross_section import RATIO_BOUNDS, CrossSectionResult, optimize_ratio
@@ -183,12 +181,8 @@ def run_chain(seed: int = 1, settings: Settings = Settings(), weight: float = 0.
 
 
 def _write_csv(path: Path, header: list[str], rows) -> Path:
-    buffer = io.StringIO()
-    writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow(header)
-    for row in rows:
-        writer.writerow([f"{v:.10g}" if isinstance(v, (float, np.floating)) else v for v in row])
-    write_atomically(path, buffer.getvalue())
+    write_atomically(path, csv_rows(header, ([f"{v:.10g}" if isinstance(v, (float, np.floating)) else v for v in row]
+                                             for row in rows)))
     return path
 
 

@@ -34,7 +34,7 @@ import numpy as np
 from hapticdesign.analysis.dynamics.device import coriolis_centrifugal, gravity, mass_matrix
 from hapticdesign.devices.registry import preset
 from hapticdesign.errors import InputError, PhysicalConsistencyWarning, UserError
-from hapticdesign.files import output_folder, read_text, write_atomically
+from hapticdesign.files import csv_rows, output_folder, read_text, write_atomically
 from hapticdesign.simulation.analytic import AnalyticProblem
 from hapticdesign.simulation.config import LoopConfig
 from hapticdesign.simulation.impedance import (ImpedanceProblem, fast_search, planned_simulations,
@@ -442,14 +442,14 @@ def aggregate(designs: list[Design], out: Path, options: CampaignOptions) -> Non
     cases = load_cases(designs, out)
     header = ["design", *META_COLUMNS, "k_max_type1", "k_max_type2", "criterion_type1", "criterion_type2",
               "bandwidth_hz_type1", "bandwidth_hz_type2"]
-    lines = [",".join(header)]
+    lines = []
     for d in designs:
         imp1, imp2 = cases[(d.name, "impedance", 1)], cases[(d.name, "impedance", 2)]
         bw1, bw2 = cases[(d.name, "transparency", 1)]["value"], cases[(d.name, "transparency", 2)]["value"]
         row = [d.name, *(repr(d.meta[c]) for c in META_COLUMNS), _fmt(imp1["value"], 6), _fmt(imp2["value"], 6),
                imp1.get("limiting_criterion", ""), imp2.get("limiting_criterion", ""), _fmt(bw1, 6), _fmt(bw2, 6)]
-        lines.append(",".join(row))
-    write_atomically(out / "results.csv", "\n".join(lines) + "\n")
+        lines.append(row)
+    write_atomically(out / "results.csv", csv_rows(header, lines))
     summary = summarize(designs, cases, options)
     keys = list(summary[0])
     write_atomically(out / "summary.csv", "\n".join([",".join(keys)] + [
