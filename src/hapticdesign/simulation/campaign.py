@@ -22,7 +22,10 @@ import math
 import os
 import re
 import signal
+import socket
+import struct
 import threading
+import time
 import warnings
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -227,6 +230,51 @@ def check_scheduler(address: str) -> None:
         raise UserError(f"{address[:80]!r} is not a Dask scheduler address (expected e.g. tcp://host:8786)")
 
 
+SCHEDULER_ANSWER_SECONDS = 10.0
+"""How long the service at a TCP ``--scheduler`` address has to greet a new connection as a Dask scheduler does
+before it is refused (docs/limits.md): a service that is not Dask (a web server, which waits for a request) never
+greets, or greets with bytes that Dask's client would read as a message of exabytes."""
+HANDSHAKE_MOST_BYTES = 1 << 16
+"""Largest first message taken for a Dask handshake (Dask's is about a hundred bytes)."""
+
+
+def check_dask_answers(address: str, seconds: float = SCHEDULER_ANSWER_SECONDS) -> None:
+    """Refuse a TCP scheduler address whose service does not greet as Dask within ``seconds``: a Dask server writes
+    its handshake first, a message framed by its 8-byte length (``struct`` ``Q``, as Dask's TCP comm) that names
+    the ``pickle-protocol``. Other transports (tls, ws, ucx) are left to Dask's client."""
+    text = address.strip()
+    scheme, _, rest = text.rpartition("://")
+    if scheme not in ("", "tcp"):
+        return
+    host, _, port = rest.rpartition(":")
+    try:
+        sock = socket.create_connection((host.strip("[]"), int(port)), timeout=seconds)
+    except OSError as exc:
+        raise UserError(f"cannot reach the Dask scheduler at {text}: {exc.strerror or exc}") from None
+    deadline = time.monotonic() + seconds
+    with sock:
+        try:
+            (size,) = struct.unpack("Q", _received(sock, struct.calcsize("Q"), deadline))
+            greets = 0 < size <= HANDSHAKE_MOST_BYTES and b"pickle-protocol" in _received(sock, size, deadline)
+        except OSError:
+            greets = False
+    if not greets:
+        raise UserError(f"the service at {text} did not answer as a Dask scheduler within {seconds:g} s (is it a "
+                        "Dask scheduler's address?)")
+
+
+def _received(sock: socket.socket, size: int, deadline: float) -> bytes:
+    """``size`` bytes from ``sock`` before ``deadline`` (time.monotonic), else OSError (a timeout or a closed peer)."""
+    data = b""
+    while len(data) < size:
+        sock.settimeout(max(deadline - time.monotonic(), 1e-3))
+        chunk = sock.recv(size - len(data))
+        if not chunk:
+            raise OSError("closed")
+        data += chunk
+    return data
+
+
 def dask_client(scheduler: str | None, workers: int | None, quiet: bool = False):
     """A client of the Dask scheduler at ``scheduler`` (a one-line error when it cannot be reached), or of a
     local cluster of ``workers`` processes (one thread each) when ``scheduler`` is None."""
@@ -234,6 +282,7 @@ def dask_client(scheduler: str | None, workers: int | None, quiet: bool = False)
 
     if scheduler:
         check_scheduler(scheduler)
+        check_dask_answers(scheduler)
         try:
             return Client(scheduler.strip(), timeout="20s")
         except (OSError, TimeoutError, ValueError, TypeError) as exc:
