@@ -26,7 +26,7 @@ from hapticdesign.analysis.view.skeleton import home_pose
 from hapticdesign.analysis.workspace import Workspace, reach_workspace
 from hapticdesign.devices.design_space import DesignSpace
 from hapticdesign.errors import UserError
-from hapticdesign.files import parse_structured
+from hapticdesign.files import parse_structured, quote
 from hapticdesign.model.inertia import SEED_FIELDS, seed_parameter_name
 from hapticdesign.optimization.parameter_indices import PARAMETER_INDICES
 from hapticdesign.optimization.study_file import Choice, IndexConstraint, Study
@@ -119,6 +119,11 @@ class BoundStudy:
         evaluate_at(device, configuration_of(device).full(home_pose(device)), self.requests, None, DESIGN_INDICES)
         middle = {name: v.values[0] if isinstance(v, Choice) else (v[0] + v[1]) / 2
                   for name, v in self.study.spec.variables.items()}
+        full = self.study.spec.with_parameters(middle)
+        for name, f in self.study.spec.parameters.items():  # the formula that fails, not an index reading its value
+            if not math.isfinite(float(full[name])):
+                raise UserError(f"parameters.{name}: {quote(f.text)} is {float(full[name])} at the middle of the "
+                                "variables' bounds; a parameter must be a finite number")
         params = {name: np.array([float(value)]) for name, value in
                   {**device.params, **self.device_values(middle)}.items()}
         for r in self.parameter_requests:
