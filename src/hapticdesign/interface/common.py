@@ -9,6 +9,7 @@ errors name no flag; :func:`flagged` adds the flags of the running command's opt
 from __future__ import annotations
 
 import math
+import re
 import warnings
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -30,13 +31,24 @@ def user_errors(strict: bool = False, quiet: bool = False) -> Iterator[None]:
         try:
             yield
         except UserError as exc:
-            typer.echo(f"error: {flagged(exc)}", err=True)
+            typer.echo(f"error: {shortened(flagged(exc))}", err=True)
             raise typer.Exit(2) from None
         finally:
             if not quiet:
                 for w in caught:
                     if issubclass(w.category, (PhysicalConsistencyWarning, RunWarning)):
                         typer.echo(f"warning: {w.message}", err=True)
+
+
+LONGEST_WORD = 200
+"""Most characters of one word (a run without spaces) of an error line: a file path fits, a hostile value of 100,000
+characters quoted by some message is cut (the line stays one short line)."""
+
+
+def shortened(message: str) -> str:
+    """``message`` on one line with each word longer than :data:`LONGEST_WORD` cut (``...`` marks the cut)."""
+    flat = " ".join(message.splitlines())
+    return re.sub(rf"\S{{{LONGEST_WORD + 1},}}", lambda m: m.group()[:LONGEST_WORD - 3] + "...", flat)
 
 
 def flagged(exc: UserError) -> str:
