@@ -176,6 +176,17 @@ class ActuatorSpec(_FileModel):
     encoder_cpr: Annotated[int, Field(strict=True, gt=0, le=10**9)] | None = None
     quadrature: Literal[1, 2, 4] = 4
 
+    @model_validator(mode="after")
+    def _reflected_finite(self) -> "ActuatorSpec":
+        """The rotor inertia reflected through the ratio and the largest coefficient of ``drives``,
+        ``rotor_inertia gear_ratio^2 c^2``, must be a finite number (it enters the mass matrix)."""
+        reflected = self.rotor_inertia * self.gear_ratio ** 2 * MAX_COEFFICIENT ** 2
+        if not math.isfinite(reflected):
+            raise ValueError(f"the actuator of {self.joint or self.drives}: rotor_inertia {self.rotor_inertia:g} "
+                             f"reflected through gear_ratio {self.gear_ratio:g} overflows (rotor_inertia x "
+                             "gear_ratio^2 must be a finite number)")
+        return self
+
 
 def _components(value: object) -> tuple[int, ...]:
     if isinstance(value, tuple) and all(isinstance(v, int) for v in value):
