@@ -238,10 +238,12 @@ HANDSHAKE_MOST_BYTES = 1 << 16
 """Largest first message taken for a Dask handshake (Dask's is about a hundred bytes)."""
 
 
-def check_dask_answers(address: str, seconds: float = SCHEDULER_ANSWER_SECONDS) -> None:
-    """Refuse a TCP scheduler address whose service does not greet as Dask within ``seconds``: a Dask server writes
-    its handshake first, a message framed by its 8-byte length (``struct`` ``Q``, as Dask's TCP comm) that names
-    the ``pickle-protocol``. Other transports (tls, ws, ucx) are left to Dask's client."""
+def check_dask_answers(address: str, seconds: float | None = None) -> None:
+    """Refuse a TCP scheduler address whose service does not greet as Dask within ``seconds`` (default
+    :data:`SCHEDULER_ANSWER_SECONDS`): a Dask server writes its handshake first, a message framed by its 8-byte length
+    (``struct`` ``Q``, as Dask's TCP comm) that names the ``pickle-protocol``. Other transports (tls, ws, ucx) are
+    left to Dask's client."""
+    seconds = SCHEDULER_ANSWER_SECONDS if seconds is None else seconds
     text = address.strip()
     scheme, _, rest = text.rpartition("://")
     if scheme not in ("", "tcp"):
