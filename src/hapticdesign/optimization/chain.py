@@ -17,7 +17,7 @@ from hapticdesign.analysis.rcube.design import RCubeDesign
 from hapticdesign.analysis.rcube.dynamics import cartesian_mass_matrix
 from hapticdesign.analysis.rcube.kinematics import dexterous_cube
 from hapticdesign.analysis.rcube.stiffness import cartesian_stiffness
-from hapticdesign.files import csv_rows, to_jsonable, write_atomically
+from hapticdesign.files import csv_rows, output_folder, to_jsonable, write_atomically
 from hapticdesign.optimization import figures
 from hapticdesign.optimization.constraints import Workspace
 from hapticdesign.optimization.cross_section import RATIO_BOUNDS, CrossSectionResult, optimize_ratio
@@ -310,7 +310,7 @@ def chain_summary(result: ChainResult) -> dict:
 
 def write_chain(out: Path, result: ChainResult) -> list[Path]:
     """Every table (CSV), figure (PNG and SVG) and ``summary.json`` of the chain."""
-    out = Path(out)
+    out = output_folder(out)
     paths = write_synthesis(out, result.synthesis) + write_selection(out, result.selection)
     paths += write_cross_section(out, result.cross_section) + write_plies(out, result.plies, result.ply_choice, result.ply_limit)
     paths += write_final(out, result.design, result.plies.counts[result.ply_choice], result.specs)

@@ -341,7 +341,7 @@ def close_client(client, own_cluster: bool) -> None:
 @contextmanager
 def campaign_lock(out: Path) -> Iterator[None]:
     """An exclusive lock on ``out`` for the run: a second campaign in the same folder is refused."""
-    out.mkdir(parents=True, exist_ok=True)
+    output_folder(out)
     try:  # never through a link: the lock file is created in ``out`` itself
         handle = os.fdopen(os.open(out / LOCK_FILE, os.O_WRONLY | os.O_CREAT | os.O_APPEND | os.O_NOFOLLOW, 0o666), "a")
     except OSError as exc:
