@@ -129,6 +129,7 @@ def test_an_altered_checkpoint_is_evaluated_again_and_the_run_says_so(tmp_path, 
     again = runner.invoke(app, ["optimize", str(study), "--seed", "3", "--out", str(out)])
     assert again.exit_code == 0, again.output
     assert f"checkpoint {path} is not trusted" in again.output and "generation 2 is evaluated again" in again.output
+    assert "generation 1 " not in again.output  # the unaltered files are trusted
     assert files(out) == files(tmp_path / "clean")  # the front and every output as an unaltered run's
 
 
@@ -238,6 +239,12 @@ def test_far_targets_are_refused_at_the_readers_of_positions(tmp_path):
 ])
 def test_study_files_of_careless_values_are_one_line(tmp_path, change, fragment):
     one_error(["optimize", changed_study(tmp_path, change)], fragment)
+
+
+def test_a_study_whose_device_file_is_a_list_is_one_line(tmp_path):
+    study = small_study(tmp_path)
+    (tmp_path / "arm.yaml").write_text("- a\n- b\n")
+    one_error(["optimize", study], "arm.yaml: expected a mapping (name: value) at the top level")
 
 
 def test_a_file_name_with_a_nul_byte_is_one_line():

@@ -80,6 +80,8 @@ class BoundStudy:
             raise UserError(f"{study.path}: device {study.device_path.name!r} must be a device file (.yaml, .yml, "
                             ".toml or .json)")
         self.mapping = parse_structured(study.device_text, kind, str(study.device_path))
+        if not isinstance(self.mapping, dict):  # as every reader of a device file says it
+            raise UserError(f"{study.device_path}: expected a mapping (name: value) at the top level")
         self.keys = reduced_keys(spec)
         asked = list(dict.fromkeys(key[:2] for key in self.keys))
         self.labels = {request: f"request{k}" for k, request in enumerate(asked)}
