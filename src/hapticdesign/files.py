@@ -279,7 +279,7 @@ def _refuse_in_place(path: Path) -> None:
 def output_folder(path: Path | str) -> Path:
     """``path`` as a real folder to write into (created when missing): a symbolic link or a file in its place is
     refused, so that nothing is written through a link out of the output folder (``OUT/checkpoint`` linked to
-    another place)."""
+    another place), and so is a folder this process may not write into."""
     path = Path(path)
     if path.is_symlink() or (path.exists() and not path.is_dir()):
         kind = "a symbolic link" if path.is_symlink() else "not a folder"
@@ -289,6 +289,8 @@ def output_folder(path: Path | str) -> Path:
         path.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise UserError(f"cannot write into {path}: {exc.strerror or exc}") from None
+    if not os.access(path, os.W_OK | os.X_OK):  # said now, not after the work (a read-only folder)
+        raise UserError(f"cannot write into {path}: permission denied")
     return path
 
 

@@ -328,3 +328,11 @@ def test_keep_with_both_sides_unbounded_is_one_line(tmp_path):
     study = changed_study(tmp_path, lambda d: d.update(keep=[{"formula": "l2", "<=": None}]))
     one_error(["optimize", study], "a bound is needed")
 
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root writes into read-only folders")
+def test_rcube_tolerance_names_a_read_only_output_folder_before_any_note(tmp_path):
+    place = tmp_path / "read-only"
+    place.mkdir()
+    place.chmod(0o555)
+    one_error(["rcube", "tolerance", "--samples", "2", "--grid", "2", "--out", place], f"cannot write into {place}")
