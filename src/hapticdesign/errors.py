@@ -12,6 +12,11 @@ class PhysicalConsistencyWarning(UserWarning):
     """Positive definite inertia that no rigid body can have (triangle inequality violated)."""
 
 
+class RunWarning(UserWarning):
+    """Something a run did differently from what its user may expect, and still finished (a checkpoint file that
+    failed verification, evaluated again)."""
+
+
 class InputError(UserError):
     """Bad value of named inputs (``samples``, ``region``, ``q``): the message says the input in
     words and names no command-line flag; ``inputs`` lets a command line name the flags that carry

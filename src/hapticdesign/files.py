@@ -9,14 +9,18 @@ goes through :func:`write_atomically`. The limits are stated here once:
   with one line, and so are named pipes and devices (``/dev/zero``), even through a symlink;
 - YAML aliases and anchors are refused (data files are data: an alias "bomb" of a few lines
   expands to gigabytes), as are Python-specific tags (``yaml.SafeLoader`` already refuses them);
-- structures nested deeper than ``MAX_DEPTH`` (64) levels are refused;
+- structures nested deeper than ``MAX_DEPTH`` (64) levels are refused, and so are texts holding a character
+  of :data:`NOT_TEXT` (control characters, lone surrogates: a name that XML or UTF-8 cannot carry);
 - a message quotes at most ``QUOTE_LIMIT`` (60) characters of a user's value (:func:`quote`);
+- a CSV output is written by :func:`csv_rows`: a text cell that a spreadsheet would run as a formula is
+  written as text (:func:`csv_cell`);
 - a figure is rendered by :func:`figure_bytes`: the same figure gives the same bytes (SVG ids
   hashed with a fixed salt, no creation date in SVG or PDF).
 """
 
 from __future__ import annotations
 
+import csv
 import io
 import json
 import math
@@ -53,6 +57,8 @@ def read_text(path: Path | str, what: str = "file") -> str:
     end). At most ``MAX_FILE_BYTES + 1`` bytes are read, whatever size the file reports.
     """
     path = Path(path)
+    if "\x00" in str(path):
+        raise UserError(f"cannot read {what} {quote(str(path))}: a file name holds no NUL character")
     try:
         mode = os.stat(path).st_mode
         if stat.S_ISDIR(mode):
@@ -121,6 +127,29 @@ def _depth(value: object, limit: int) -> int:
     return deepest
 
 
+NOT_TEXT = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ud800-\udfff\ufffe\uffff]")
+"""Characters no text of a data file may hold: control characters other than tab and line breaks, lone
+surrogates (not characters: they cannot be written as UTF-8) and U+FFFE/U+FFFF (XML 1.0 forbids all of them,
+so a name holding one would make a malformed MJCF or URDF file)."""
+
+
+def _first_not_text(value: object) -> tuple[str, str] | None:
+    """The first string (key or value) holding a :data:`NOT_TEXT` character, and that character."""
+    stack = [value]
+    while stack:
+        item = stack.pop()
+        if isinstance(item, str):
+            found = NOT_TEXT.search(item)
+            if found:
+                return item, found.group()
+        elif isinstance(item, dict):
+            stack.extend(item.keys())
+            stack.extend(item.values())
+        elif isinstance(item, list):
+            stack.extend(item)
+    return None
+
+
 def parse_structured(text: str, kind: str, where: str) -> object:
     """Parse JSON, YAML or TOML text (``kind``: json, yaml, toml) with the limits above."""
     try:
@@ -139,6 +168,10 @@ def parse_structured(text: str, kind: str, where: str) -> object:
         raise UserError(f"{where}: malformed {kind.upper()} ({first[:200]})") from None
     if _depth(data, MAX_DEPTH) > MAX_DEPTH:
         raise UserError(f"{where}: nested too deeply (at most {MAX_DEPTH} levels)")
+    bad = _first_not_text(data)
+    if bad is not None:
+        raise UserError(f"{where}: {quote(bad[0])} holds the character U+{ord(bad[1]):04X}, which no text of a data "
+                        "file may hold (a control character, a lone surrogate or a non-character)")
     return data
 
 
@@ -150,6 +183,33 @@ def load_structured(path: Path | str, what: str = "file") -> object:
     if kind is None:
         raise UserError(f"{path}: unknown file type {quote(path.suffix)} (use .json, .yaml, .yml or .toml)")
     return parse_structured(read_text(path, what), kind, str(path))
+
+
+FORMULA_START = ("=", "+", "-", "@", "\t", "\r")
+"""First characters by which a spreadsheet takes a cell for a formula (OWASP's CSV injection rule)."""
+
+
+def csv_cell(value: object) -> object:
+    """A CSV cell a spreadsheet shows as it is: a text that begins with a :data:`FORMULA_START` character and is not
+    a number (an objective named ``=HYPERLINK(...)``, an expression ``-l1 + l2``) gets a leading ``'``; numbers
+    (``-0.5``) and other values are unchanged."""
+    if not isinstance(value, str) or not value.startswith(FORMULA_START):
+        return value
+    try:
+        float(value)
+        return value
+    except ValueError:
+        return "'" + value
+
+
+def csv_rows(header: list[str], rows) -> str:
+    """CSV text (newline-terminated lines) of ``header`` and ``rows``, every cell through :func:`csv_cell`: the one
+    CSV writer of the outputs."""
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow([csv_cell(v) for v in header])
+    writer.writerows([csv_cell(v) for v in row] for row in rows)
+    return buffer.getvalue()
 
 
 def to_jsonable(value):
@@ -195,22 +255,78 @@ def dumps_json(value, **kwargs) -> str:
     return json.dumps(require_finite(value), **kwargs)
 
 
+def _refuse_in_place(path: Path) -> None:
+    """Refuse an output ``path`` that exists and is not a regular file (or a link to one, or to nothing): a
+    directory, a named pipe, a device, a socket is never replaced or opened (replacing ``/dev/full`` as root
+    would remove the machine's device)."""
+    try:
+        mode = os.lstat(path).st_mode
+    except FileNotFoundError:
+        return
+    except OSError as exc:
+        raise UserError(f"cannot write {path}: {exc.strerror or exc}") from None
+    if stat.S_ISLNK(mode):  # the link is replaced, never followed; but a link to a special file says a mistake
+        try:
+            mode = os.stat(path).st_mode
+        except OSError:
+            return
+    if stat.S_ISDIR(mode):
+        raise UserError(f"cannot write {path}: it is a directory")
+    if not stat.S_ISREG(mode):
+        raise UserError(f"cannot write {path}: it is {_special_kind(mode)}, not a regular file; it is left as it is")
+
+
+def output_folder(path: Path | str) -> Path:
+    """``path`` as a real folder to write into (created when missing): a symbolic link or a file in its place is
+    refused, so that nothing is written through a link out of the output folder (``OUT/checkpoint`` linked to
+    another place), and so is a folder this process may not write into."""
+    path = Path(path)
+    if path.is_symlink() or (path.exists() and not path.is_dir()):
+        kind = "a symbolic link" if path.is_symlink() else "not a folder"
+        raise UserError(f"{path} is {kind}; outputs go only into real folders inside the output folder (remove it "
+                        "or choose another output folder)")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise UserError(f"cannot write into {path}: {exc.strerror or exc}") from None
+    if not os.access(path, os.W_OK | os.X_OK):  # said now, not after the work (a read-only folder)
+        raise UserError(f"cannot write into {path}: permission denied")
+    return path
+
+
+def _write_new(path: Path, data: bytes) -> None:
+    """Write ``data`` to a file that this call creates (never through a file, link or pipe already there)."""
+    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0)
+    try:
+        fd = os.open(path, flags, 0o666)
+    except FileExistsError:  # a leftover of an earlier run of this process id (or something put there): replaced
+        path.unlink()
+        fd = os.open(path, flags, 0o666)
+    with os.fdopen(fd, "wb") as handle:
+        handle.write(data)
+
+
 def write_atomically(path: Path | str, content: str | bytes) -> None:
     """Write a file so that an interruption or a failure never leaves it (or a ``.tmp``) half-written.
 
-    Any problem with the output place (a directory in the way, a read-only folder, a full disk) is
-    a one-line :class:`UserError`.
+    The content goes to a new temporary file beside ``path``, which then replaces ``path``: a symbolic link
+    at ``path`` is replaced, not followed; a directory, named pipe, device or socket there is refused
+    (:func:`_refuse_in_place`). Any problem with the output place (a read-only folder, a full disk) is a
+    one-line :class:`UserError`; text that cannot be UTF-8 (a lone surrogate) is refused before anything is
+    written.
     """
     path = Path(path)
-    if path.is_dir():
-        raise UserError(f"cannot write {path}: it is a directory")
+    _refuse_in_place(path)
+    if isinstance(content, str):
+        try:
+            content = content.encode("utf-8")
+        except UnicodeEncodeError as exc:
+            raise UserError(f"cannot write {path}: the text holds {quote(exc.object[exc.start:exc.end])}, "
+                            "which is not a character (a lone surrogate)") from None
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        if isinstance(content, bytes):
-            tmp.write_bytes(content)
-        else:
-            tmp.write_text(content, encoding="utf-8")
+        _write_new(tmp, content)
         tmp.replace(path)
     except OSError as exc:
         try:

@@ -18,8 +18,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from hapticdesign.analysis.configuration import check_limits, configuration_of
-from hapticdesign.errors import InputError
+from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.device import Device
+from hapticdesign.model.loops import handle_position
 
 POINT_LIMIT = 10_000
 """Most workspace points (``grid`` to the power of the axes whose size is not 0)."""
@@ -50,6 +51,11 @@ class Workspace:
                              "grid")
         if axes and float(self.grid) ** axes > POINT_LIMIT:
             raise InputError(f"workspace: {self.grid}^{axes} points is above the limit of {POINT_LIMIT}", "grid")
+        for corner in (np.array(center) - np.array(size) / 2, np.array(center) + np.array(size) / 2):
+            try:
+                handle_position(corner, "workspace")
+            except UserError as exc:
+                raise InputError(f"{exc} (a corner of the box, centre +- size / 2)", "center", "size") from None
         object.__setattr__(self, "center", center)
         object.__setattr__(self, "size", size)
         object.__setattr__(self, "grid", int(self.grid))

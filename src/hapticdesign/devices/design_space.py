@@ -43,6 +43,7 @@ from hapticdesign.devices.device_file import (
 )
 from hapticdesign.devices.schema import ActuatorSpec, DeviceFileSpec
 from hapticdesign.errors import UserError
+from hapticdesign.files import quote
 from hapticdesign.model.actuators import damping_matrix
 from hapticdesign.model.device import Device
 from hapticdesign.model.elastic import Elasticity, ElasticLink
@@ -112,7 +113,7 @@ class DesignSpace:
         if len(parts) == 3 and parts[0] == "actuators":
             return self._actuator(name, parts[1], parts[2])
         known = ", ".join(spec.parameters) or "none"
-        raise UserError(f"unknown design variable {name!r} for device {base.name}: use a parameter ({known}), an "
+        raise UserError(f"unknown design variable {quote(name)} for device {base.name}: use a parameter ({known}), an "
                         "inertial parameter by its seed name (such as m2), links.<link>.D or .d, or "
                         "actuators.<joint>.<field>")
 

@@ -19,6 +19,7 @@ from hapticdesign.analysis.stiffness.sections import Tube
 from hapticdesign.devices.builder import ChainBuilder, DHRowTemplate, FrameTemplate, assemble_device
 from hapticdesign.devices.schema import HOME_POSITION, ActuatorSpec, DeviceFileSpec, body_frame, motor_terms
 from hapticdesign.errors import UserError
+from hapticdesign.files import QUOTE_LIMIT, quote
 from hapticdesign.model.actuators import Actuator
 from hapticdesign.model.device import Device, build_mechanism
 from hapticdesign.model.inertia import BodyInertia, tube_body
@@ -165,6 +166,7 @@ def actuator_from_spec(a: ActuatorSpec, index: dict[str, int]) -> Actuator:
 def _location(loc: tuple) -> str:
     out = ""
     for part in loc:
+        part = part if isinstance(part, int) or len(str(part)) <= QUOTE_LIMIT else quote(str(part))
         out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else str(part))
     return out
 

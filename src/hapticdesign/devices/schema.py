@@ -29,7 +29,7 @@ from hapticdesign.analysis.stiffness.sections import Tube
 from hapticdesign.devices.builder import BODY_NAME_PATTERN, IDENTIFIER_PATTERN, LinearExpr, TransformSpec
 from hapticdesign.errors import UserError
 from hapticdesign.model.inertia import SEED_FIELDS, BodyInertia, check_body
-from hapticdesign.model.loops import component_indices
+from hapticdesign.model.loops import component_indices, handle_position
 from hapticdesign.model.transforms import Axis
 
 RESERVED = ("pi", "g", "base")
@@ -175,6 +175,17 @@ class ActuatorSpec(_FileModel):
     torque_peak: Annotated[Number, Field(gt=0.0)] | None = None
     encoder_cpr: Annotated[int, Field(strict=True, gt=0, le=10**9)] | None = None
     quadrature: Literal[1, 2, 4] = 4
+
+    @model_validator(mode="after")
+    def _reflected_finite(self) -> "ActuatorSpec":
+        """The rotor inertia reflected through the ratio and the largest coefficient of ``drives``,
+        ``rotor_inertia gear_ratio^2 c^2``, must be a finite number (it enters the mass matrix)."""
+        reflected = self.rotor_inertia * self.gear_ratio ** 2 * MAX_COEFFICIENT ** 2
+        if not math.isfinite(reflected):
+            raise ValueError(f"the actuator of {self.joint or self.drives}: rotor_inertia {self.rotor_inertia:g} "
+                             f"reflected through gear_ratio {self.gear_ratio:g} overflows (rotor_inertia x "
+                             "gear_ratio^2 must be a finite number)")
+        return self
 
 
 def _components(value: object) -> tuple[int, ...]:
@@ -471,6 +482,10 @@ def _check_loops(spec: DeviceFileSpec, frames: list[str]) -> None:
                                  f"home: {{{HOME_POSITION}: [x, y, z]}})")
             if len(value) != 3:
                 raise ValueError(f"home.{HOME_POSITION}: a handle position is 3 numbers [x, y, z] (m), got {len(value)}")
+            try:
+                handle_position(value, f"home.{HOME_POSITION}")
+            except UserError as exc:
+                raise ValueError(str(exc)) from None
         elif name not in actuated:
             raise ValueError(f"home: {name!r} is not an actuated joint (actuated: {', '.join(actuated)})")
     if spec.home and not spec.loops:

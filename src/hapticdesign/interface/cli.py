@@ -9,6 +9,7 @@ into the sections of ``hapticdesign --help``, following the seeds' chapters.
 from __future__ import annotations
 
 import importlib
+import math
 import os
 import pkgutil
 import sys
@@ -50,7 +51,8 @@ class OneLineErrors(TyperGroup):
             sys.exit(exc.exit_code)
         except ClickException as exc:
             command = exc.ctx.command_path if getattr(exc, "ctx", None) is not None else "hapticdesign"
-            typer.echo(f"error: {exc.format_message()} (see {command} --help)", err=True)
+            message = _not_a_number(exc, sys.argv[1:] if args is None else list(args)) or exc.format_message()
+            typer.echo(f"error: {message} (see {command} --help)", err=True)
             sys.exit(exc.exit_code)
         sys.exit(code if isinstance(code, int) else 0)
 
@@ -68,6 +70,22 @@ class OneLineErrors(TyperGroup):
         sections = [*dict.fromkeys(CONTENTS.values()), OTHER]
         names = super().list_commands(ctx)
         return sorted(names, key=lambda n: sections.index(getattr(self.commands[n], "rich_help_panel", None) or OTHER))
+
+
+def _not_a_number(exc, args: list[str]) -> str | None:
+    """The message for an option given NaN, whose range check would otherwise say a bound it does not break
+    (``--rate nan`` "should be <= 1000000"); None when the option's value is not NaN."""
+    param = getattr(exc, "param", None)
+    for k, arg in enumerate(args):
+        for opt in getattr(param, "opts", ()):
+            value = args[k + 1] if arg == opt and k + 1 < len(args) else arg[len(opt) + 1:] if (
+                arg.startswith(opt + "=")) else None
+            try:
+                if value is not None and math.isnan(float(value)):
+                    return f"Invalid value for '{opt}': {value[:20]!r} is not a number"
+            except ValueError:
+                pass
+    return None
 
 
 app = typer.Typer(

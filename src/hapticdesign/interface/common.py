@@ -9,6 +9,7 @@ errors name no flag; :func:`flagged` adds the flags of the running command's opt
 from __future__ import annotations
 
 import math
+import re
 import warnings
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -17,7 +18,7 @@ import numpy as np
 import typer
 from typer._click.globals import get_current_context
 
-from hapticdesign.errors import InputError, PhysicalConsistencyWarning, UserError
+from hapticdesign.errors import InputError, PhysicalConsistencyWarning, RunWarning, UserError
 from hapticdesign.files import dumps_json, to_jsonable, write_atomically
 
 
@@ -26,16 +27,28 @@ def user_errors(strict: bool = False, quiet: bool = False) -> Iterator[None]:
     """Turn user mistakes into ``error: ...`` on stderr and exit 2; consistency warnings into one line."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", PhysicalConsistencyWarning)
+        warnings.simplefilter("always", RunWarning)
         try:
             yield
         except UserError as exc:
-            typer.echo(f"error: {flagged(exc)}", err=True)
+            typer.echo(f"error: {shortened(flagged(exc))}", err=True)
             raise typer.Exit(2) from None
         finally:
             if not quiet:
                 for w in caught:
-                    if issubclass(w.category, PhysicalConsistencyWarning):
+                    if issubclass(w.category, (PhysicalConsistencyWarning, RunWarning)):
                         typer.echo(f"warning: {w.message}", err=True)
+
+
+LONGEST_WORD = 200
+"""Most characters of one word (a run without spaces) of an error line: a file path fits, a hostile value of 100,000
+characters quoted by some message is cut (the line stays one short line)."""
+
+
+def shortened(message: str) -> str:
+    """``message`` on one line with each word longer than :data:`LONGEST_WORD` cut (``...`` marks the cut)."""
+    flat = " ".join(message.splitlines())
+    return re.sub(rf"\S{{{LONGEST_WORD + 1},}}", lambda m: m.group()[:LONGEST_WORD - 3] + "...", flat)
 
 
 def flagged(exc: UserError) -> str:

@@ -25,8 +25,22 @@ COMPONENTS = ("x", "y", "z", "rx", "ry", "rz")
 """Closure components in the base frame: origin difference, then rotation-vector difference."""
 COMPONENT_SETS = {"position": ("x", "y", "z"), "pose": COMPONENTS}
 POSE_LIMIT = 1000.0
-"""Largest magnitude of a home or assembly value (rad or m): the solver follows the loops from the
-assembly at home to every pose asked for in steps of 0.1 rad, so a far-off home is work without end."""
+"""Largest magnitude of a home or assembly value (rad or m) and of a handle position's coordinates (m): the solver
+follows the loops from the assembly at home to every pose asked for in steps of 0.1 rad, and the inverse kinematics
+walks to a position in steps of millimetres, so a far-off home or target is work without end (or an overflow)."""
+
+
+def handle_position(value, what: str) -> list[float]:
+    """``value`` as a handle position [x, y, z] of finite numbers within +-:data:`POSE_LIMIT` m, or a one-line
+    :class:`UserError` naming ``what`` (a target, a home position, a workspace point)."""
+    try:
+        numbers = [float(v) for v in value]
+    except (TypeError, ValueError):
+        raise UserError(f"{what}: a handle position is 3 numbers [x, y, z] (m), got {str(value)[:60]}") from None
+    if len(numbers) != 3 or not all(math.isfinite(v) and abs(v) <= POSE_LIMIT for v in numbers):
+        raise UserError(f"{what}: a handle position is 3 finite numbers within +-{POSE_LIMIT:g} m, got "
+                        f"{', '.join(f'{v:g}' for v in numbers[:6])}")
+    return numbers
 
 
 def component_indices(close: str | list[str] | tuple[str, ...]) -> tuple[int, ...]:

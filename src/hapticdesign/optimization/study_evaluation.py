@@ -26,7 +26,7 @@ from hapticdesign.analysis.view.skeleton import home_pose
 from hapticdesign.analysis.workspace import Workspace, reach_workspace
 from hapticdesign.devices.design_space import DesignSpace
 from hapticdesign.errors import UserError
-from hapticdesign.files import parse_structured
+from hapticdesign.files import parse_structured, quote
 from hapticdesign.model.inertia import SEED_FIELDS, seed_parameter_name
 from hapticdesign.optimization.rcube.parameter_indices import PARAMETER_INDICES
 from hapticdesign.optimization.study_file import Choice, IndexConstraint, Study
@@ -80,6 +80,8 @@ class BoundStudy:
             raise UserError(f"{study.path}: device {study.device_path.name!r} must be a device file (.yaml, .yml, "
                             ".toml or .json)")
         self.mapping = parse_structured(study.device_text, kind, str(study.device_path))
+        if not isinstance(self.mapping, dict):  # as every reader of a device file says it
+            raise UserError(f"{study.device_path}: expected a mapping (name: value) at the top level")
         self.keys = reduced_keys(spec)
         asked = list(dict.fromkeys(key[:2] for key in self.keys))
         self.labels = {request: f"request{k}" for k, request in enumerate(asked)}
@@ -119,6 +121,11 @@ class BoundStudy:
         evaluate_at(device, configuration_of(device).full(home_pose(device)), self.requests, None, DESIGN_INDICES)
         middle = {name: v.values[0] if isinstance(v, Choice) else (v[0] + v[1]) / 2
                   for name, v in self.study.spec.variables.items()}
+        full = self.study.spec.with_parameters(middle)
+        for name, f in self.study.spec.parameters.items():  # the formula that fails, not an index reading its value
+            if not math.isfinite(float(full[name])):
+                raise UserError(f"parameters.{name}: {quote(f.text)} is {float(full[name])} at the middle of the "
+                                "variables' bounds; a parameter must be a finite number")
         params = {name: np.array([float(value)]) for name, value in
                   {**device.params, **self.device_values(middle)}.items()}
         for r in self.parameter_requests:
@@ -146,16 +153,18 @@ class BoundStudy:
         valid = [k for k, r in enumerate(results) if r.reason is None]
         values = {k: dict(results[k].values) for k in valid}
         first = [r for r in self.parameter_requests if r.key in self.constrained]
-        self._parameter_values(first, [device_values[k] for k in valid], valid, values)
+        failed = self._parameter_values(first, [device_values[k] for k in valid], valid, values)
+        valid = [k for k in valid if k not in failed]
         if objectives:
             feasible = [k for k in valid if self._feasible(batch[k], values[k])]
             later = [r for r in self.parameter_requests if r.key not in self.constrained]
-            self._parameter_values(later, [device_values[k] for k in feasible], feasible, values)
+            failed |= self._parameter_values(later, [device_values[k] for k in feasible], feasible, values)
         nothing = (math.nan,) * len(self.keys)
         out = []
         for k, result in enumerate(results):
-            if result.reason is not None:
-                out.append(Answer(nothing, result.reason))
+            reason = result.reason if result.reason is not None else failed.get(k)
+            if reason is not None:
+                out.append(Answer(nothing, reason))
             else:
                 got = values[k]
                 out.append(Answer(tuple(reduce(got[label], key[2]) if (label := self.labels[key[:2]]) in got
@@ -176,10 +185,27 @@ class BoundStudy:
         return self.evaluate(batch, objectives=False)
 
     def _parameter_values(self, requests: list[Request], designs: list[dict[str, float]], rows: list[int],
-                          values: dict[int, dict[str, np.ndarray]]) -> None:
-        """The parameter indices ``requests`` of ``designs`` (device values), written to ``values[rows[i]]``."""
+                          values: dict[int, dict[str, np.ndarray]]) -> dict[int, str]:
+        """The parameter indices ``requests`` of ``designs`` (device values), written to ``values[rows[i]]``; a design
+        whose index cannot be computed (a pose its links do not reach, a length its formulas make negative) has
+        none: the rows of such designs -> why (each design then evaluated alone, the others keep their values)."""
         if not requests or not designs:
-            return
+            return {}
+        try:
+            self._parameter_columns(requests, designs, rows, values)
+            return {}
+        except UserError:
+            pass
+        failed = {}
+        for design, k in zip(designs, rows):
+            try:
+                self._parameter_columns(requests, [design], [k], values)
+            except UserError as exc:
+                failed[k] = str(exc)
+        return failed
+
+    def _parameter_columns(self, requests: list[Request], designs: list[dict[str, float]], rows: list[int],
+                           values: dict[int, dict[str, np.ndarray]]) -> None:
         base = self.space.base.params
         params = {name: np.array([float(d.get(name, base[name])) for d in designs]) for name in base}
         cache: dict = {}

@@ -121,6 +121,8 @@ class _Bounded(_StudyModel):
 
     @model_validator(mode="after")
     def _ordered(self) -> "_Bounded":
+        if self.at_most is None and self.at_least is None:
+            raise ValueError("a bound is needed: '<=' and/or '>=' (without one it removes nothing)")
         if self.at_most is not None and self.at_least is not None and not self.at_least <= self.at_most:
             raise ValueError(f"'>=' {self.at_least:g} is above '<=' {self.at_most:g}: nothing can meet both")
         return self

@@ -9,15 +9,13 @@ gives the same bytes and reading them back gives the same floats.
 
 from __future__ import annotations
 
-import csv
-import io
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from hapticdesign.errors import UserError
-from hapticdesign.files import figure_bytes, save_figure
+from hapticdesign.files import csv_rows, figure_bytes, save_figure
 from hapticdesign.optimization.rcube.parameter_indices import PARAMETER_INDICES
 from hapticdesign.optimization.front_selection import least_rms, normalize
 from hapticdesign.optimization.study_run import StudyRun, constraint_labels
@@ -68,14 +66,6 @@ def _number(value: float) -> str:
     return repr(float(value)) if np.isfinite(value) else ""
 
 
-def _csv(header: list[str], rows: list[list[str]]) -> str:
-    buffer = io.StringIO()
-    writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow(header)
-    writer.writerows(rows)
-    return buffer.getvalue()
-
-
 def front_csv(run: StudyRun) -> str:
     """One row per front design: its number, variables, objectives and constrained values."""
     spec = run.spec
@@ -85,7 +75,7 @@ def front_csv(run: StudyRun) -> str:
         r = run.records[k]
         rows.append([str(n), *(_number(r.values[v]) for v in spec.variables), *map(_number, r.objectives),
                      *map(_number, r.constraints)])
-    return _csv(header, rows)
+    return csv_rows(header, rows)
 
 
 def evaluations_csv(run: StudyRun) -> str:
@@ -98,7 +88,7 @@ def evaluations_csv(run: StudyRun) -> str:
         rows.append([str(n), str(r.generation), *(_number(r.values[v]) for v in spec.variables),
                      *map(_number, r.objectives), *map(_number, r.constraints), "yes" if r.feasible else "no",
                      r.reason])
-    return _csv(header, rows)
+    return csv_rows(header, rows)
 
 
 def _pyplot():

@@ -11,7 +11,8 @@ design.
 
 Checkpoint: with an output folder, each generation's answers are written to
 ``checkpoint/generation-NNNN.json`` as they arrive. A rerun replays the same seeded algorithm and takes
-each generation's answers from its file when the file holds exactly the designs asked for, so an
+each generation's answers from its file when the file passes verification (a checksum over its content, the study
+and the seed) and holds exactly the designs asked for, so an
 interrupted run continues where it stopped and ends with the same front as an uninterrupted run (the
 algorithm between evaluations is deterministic for a seed). The front is the feasible, non-dominated set
 of every design evaluated (an archive), not only of the last population.
@@ -19,7 +20,9 @@ of every design evaluated (an archive), not only of the last population.
 
 from __future__ import annotations
 
+import hashlib
 import json
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -27,8 +30,8 @@ from pathlib import Path
 import numpy as np
 from pymoo.core.problem import Problem
 
-from hapticdesign.errors import UserError
-from hapticdesign.files import read_text, write_atomically
+from hapticdesign.errors import RunWarning, UserError
+from hapticdesign.files import output_folder, read_text, write_atomically
 from hapticdesign.optimization.pymoo_run import AlgorithmSpec, initial_population, pareto_filter, run
 from hapticdesign.optimization.rcube.shortest import minimize_in_boxes
 from hapticdesign.optimization.study_file import Choice, ExpressionConstraint, Study, StudySpec
@@ -171,13 +174,21 @@ def _g(spec: StudySpec, record: Record) -> np.ndarray:
 
 
 class Checkpoint:
-    """Each generation's answers in ``folder`` (see the module); None folder: nothing kept."""
+    """Each generation's answers in ``folder`` (see the module); None folder: nothing kept.
+
+    Each file carries a SHA-256 checksum over its content, the study's fingerprint and the seed. A file that fails
+    it (edited answers, a file of another run), that holds other designs than those asked for, or whose answers are
+    not numbers and texts of the study's shape is not trusted: its generation is evaluated again, and a
+    :class:`~hapticdesign.errors.RunWarning` says so."""
 
     def __init__(self, folder: Path | None, study: Study, seed: int, prefix: str = ""):
         self.folder = folder
         self.prefix = prefix
+        self.key = f"{study.fingerprint}:{seed}"
+        self.width = len(reduced_keys(study.spec))
         if folder is None:
             return
+        output_folder(folder)
         header = {"study": study.fingerprint, "seed": seed}
         path = folder / RUN_FILE
         if path.exists():
@@ -194,23 +205,52 @@ class Checkpoint:
     def _path(self, generation: int) -> Path:
         return self.folder / f"{self.prefix}generation-{generation:04d}.json"
 
+    def _checksum(self, X: list, reduced: list, reasons: list) -> str:
+        return hashlib.sha256(json.dumps([self.key, X, reduced, reasons]).encode()).hexdigest()
+
     def load(self, generation: int, X: np.ndarray) -> list[Answer] | None:
-        """The answers kept for ``generation`` if its file holds exactly the designs ``X``."""
+        """The answers kept for ``generation`` if its file passes verification (see the class), else None."""
         if self.folder is None or not self._path(generation).exists():
             return None
+        path = self._path(generation)
         try:
-            kept = json.loads(read_text(self._path(generation), "checkpoint"))
+            kept = json.loads(read_text(path, "checkpoint"))
+            problem = self._problem(kept, X)
+        except (ValueError, UserError) as exc:
+            problem = f"it is not a checkpoint ({str(exc)[:80]})"
+        if problem is None:
+            return [Answer(tuple(float(v) for v in r), s) for r, s in zip(kept["reduced"], kept["reasons"])]
+        warnings.warn(f"checkpoint {path} is not trusted ({problem}); generation {generation} is evaluated again",
+                      RunWarning, stacklevel=2)
+        return None
+
+    def _problem(self, kept: object, X: np.ndarray) -> str | None:
+        """Why the parsed file ``kept`` cannot answer the designs ``X``, or None."""
+        if not isinstance(kept, dict) or not {"X", "reduced", "reasons", "checksum"} <= kept.keys():
+            return "it lacks the designs, answers or checksum"
+        if kept["checksum"] != self._checksum(kept["X"], kept["reduced"], kept["reasons"]):
+            return "its checksum does not match its content, the study and the seed"
+        reduced, reasons = kept["reduced"], kept["reasons"]
+        if not (isinstance(reduced, list) and isinstance(reasons, list) and len(reduced) == len(reasons) == len(X)
+                and all(isinstance(r, list) and len(r) == self.width and all(_number(v) for v in r) for r in reduced)
+                and all(isinstance(s, str) for s in reasons)):
+            return "its answers are not numbers and reasons of this study"
+        try:
             same = np.array_equal(np.array(kept["X"], dtype=float).reshape(X.shape), X)
-            answers = zip(kept["reduced"], kept["reasons"], strict=True)
-            return [Answer(tuple(r), s) for r, s in answers] if same else None
-        except (ValueError, KeyError, TypeError, UserError):
-            return None
+        except (ValueError, TypeError):
+            same = False
+        return None if same else "it holds other designs"
 
     def save(self, generation: int, X: np.ndarray, answers: list[Answer]) -> None:
         if self.folder is None:
             return
-        kept = {"X": X.tolist(), "reduced": [list(a.reduced) for a in answers], "reasons": [a.reason for a in answers]}
+        x, reduced, reasons = X.tolist(), [list(a.reduced) for a in answers], [a.reason for a in answers]
+        kept = {"X": x, "reduced": reduced, "reasons": reasons, "checksum": self._checksum(x, reduced, reasons)}
         write_atomically(self._path(generation), json.dumps(kept))
+
+
+def _number(value: object) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
 class StudyProblem(Problem):

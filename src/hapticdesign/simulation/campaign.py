@@ -22,7 +22,10 @@ import math
 import os
 import re
 import signal
+import socket
+import struct
 import threading
+import time
 import warnings
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -34,7 +37,7 @@ import numpy as np
 from hapticdesign.analysis.dynamics.device import coriolis_centrifugal, gravity, mass_matrix
 from hapticdesign.devices.registry import preset
 from hapticdesign.errors import InputError, PhysicalConsistencyWarning, UserError
-from hapticdesign.files import read_text, write_atomically
+from hapticdesign.files import csv_rows, output_folder, read_text, write_atomically
 from hapticdesign.simulation.analytic import AnalyticProblem
 from hapticdesign.simulation.config import LoopConfig
 from hapticdesign.simulation.impedance import (ImpedanceProblem, fast_search, planned_simulations,
@@ -227,6 +230,53 @@ def check_scheduler(address: str) -> None:
         raise UserError(f"{address[:80]!r} is not a Dask scheduler address (expected e.g. tcp://host:8786)")
 
 
+SCHEDULER_ANSWER_SECONDS = 10.0
+"""How long the service at a TCP ``--scheduler`` address has to greet a new connection as a Dask scheduler does
+before it is refused (docs/limits.md): a service that is not Dask (a web server, which waits for a request) never
+greets, or greets with bytes that Dask's client would read as a message of exabytes."""
+HANDSHAKE_MOST_BYTES = 1 << 16
+"""Largest first message taken for a Dask handshake (Dask's is about a hundred bytes)."""
+
+
+def check_dask_answers(address: str, seconds: float | None = None) -> None:
+    """Refuse a TCP scheduler address whose service does not greet as Dask within ``seconds`` (default
+    :data:`SCHEDULER_ANSWER_SECONDS`): a Dask server writes its handshake first, a message framed by its 8-byte length
+    (``struct`` ``Q``, as Dask's TCP comm) that names the ``pickle-protocol``. Other transports (tls, ws, ucx) are
+    left to Dask's client."""
+    seconds = SCHEDULER_ANSWER_SECONDS if seconds is None else seconds
+    text = address.strip()
+    scheme, _, rest = text.rpartition("://")
+    if scheme not in ("", "tcp"):
+        return
+    host, _, port = rest.rpartition(":")
+    try:
+        sock = socket.create_connection((host.strip("[]"), int(port)), timeout=seconds)
+    except OSError as exc:
+        raise UserError(f"cannot reach the Dask scheduler at {text}: {exc.strerror or exc}") from None
+    deadline = time.monotonic() + seconds
+    with sock:
+        try:
+            (size,) = struct.unpack("Q", _received(sock, struct.calcsize("Q"), deadline))
+            greets = 0 < size <= HANDSHAKE_MOST_BYTES and b"pickle-protocol" in _received(sock, size, deadline)
+        except OSError:
+            greets = False
+    if not greets:
+        raise UserError(f"the service at {text} did not answer as a Dask scheduler within {seconds:g} s (is it a "
+                        "Dask scheduler's address?)")
+
+
+def _received(sock: socket.socket, size: int, deadline: float) -> bytes:
+    """``size`` bytes from ``sock`` before ``deadline`` (time.monotonic), else OSError (a timeout or a closed peer)."""
+    data = b""
+    while len(data) < size:
+        sock.settimeout(max(deadline - time.monotonic(), 1e-3))
+        chunk = sock.recv(size - len(data))
+        if not chunk:
+            raise OSError("closed")
+        data += chunk
+    return data
+
+
 def dask_client(scheduler: str | None, workers: int | None, quiet: bool = False):
     """A client of the Dask scheduler at ``scheduler`` (a one-line error when it cannot be reached), or of a
     local cluster of ``workers`` processes (one thread each) when ``scheduler`` is None."""
@@ -234,6 +284,7 @@ def dask_client(scheduler: str | None, workers: int | None, quiet: bool = False)
 
     if scheduler:
         check_scheduler(scheduler)
+        check_dask_answers(scheduler)
         try:
             return Client(scheduler.strip(), timeout="20s")
         except (OSError, TimeoutError, ValueError, TypeError) as exc:
@@ -290,8 +341,11 @@ def close_client(client, own_cluster: bool) -> None:
 @contextmanager
 def campaign_lock(out: Path) -> Iterator[None]:
     """An exclusive lock on ``out`` for the run: a second campaign in the same folder is refused."""
-    out.mkdir(parents=True, exist_ok=True)
-    handle = (out / LOCK_FILE).open("a")
+    output_folder(out)
+    try:  # never through a link: the lock file is created in ``out`` itself
+        handle = os.fdopen(os.open(out / LOCK_FILE, os.O_WRONLY | os.O_CREAT | os.O_APPEND | os.O_NOFOLLOW, 0o666), "a")
+    except OSError as exc:
+        raise UserError(f"cannot write {out / LOCK_FILE}: {exc.strerror or exc}") from None
     try:
         try:
             fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
@@ -336,11 +390,8 @@ def run_campaign(designs_path: Path, out: Path, options: CampaignOptions | None 
 def _run_locked(designs: list[Design], out: Path, options: CampaignOptions, scheduler: str | None,
                 workers: int | None, progress: Callable[[int, int], None] | None, quiet: bool) -> dict:
     cases_dir = out / "cases"
-    for place in (cases_dir, out / "figures"):
-        if place.is_symlink() or (place.exists() and not place.is_dir()):
-            raise UserError(f"{place} is a symbolic link or a file; a campaign writes only into real folders inside "
-                            "its output folder (remove it or choose another output folder)")
-    cases_dir.mkdir(parents=True, exist_ok=True)
+    output_folder(cases_dir)
+    output_folder(out / "figures")
     settings = json.dumps({**asdict(options), "designs": [asdict(d) for d in designs]}, sort_keys=True)
     stamp = out / "campaign.json"
     if stamp.exists() and stamp.read_text() != settings:
@@ -442,14 +493,14 @@ def aggregate(designs: list[Design], out: Path, options: CampaignOptions) -> Non
     cases = load_cases(designs, out)
     header = ["design", *META_COLUMNS, "k_max_type1", "k_max_type2", "criterion_type1", "criterion_type2",
               "bandwidth_hz_type1", "bandwidth_hz_type2"]
-    lines = [",".join(header)]
+    lines = []
     for d in designs:
         imp1, imp2 = cases[(d.name, "impedance", 1)], cases[(d.name, "impedance", 2)]
         bw1, bw2 = cases[(d.name, "transparency", 1)]["value"], cases[(d.name, "transparency", 2)]["value"]
         row = [d.name, *(repr(d.meta[c]) for c in META_COLUMNS), _fmt(imp1["value"], 6), _fmt(imp2["value"], 6),
                imp1.get("limiting_criterion", ""), imp2.get("limiting_criterion", ""), _fmt(bw1, 6), _fmt(bw2, 6)]
-        lines.append(",".join(row))
-    write_atomically(out / "results.csv", "\n".join(lines) + "\n")
+        lines.append(row)
+    write_atomically(out / "results.csv", csv_rows(header, lines))
     summary = summarize(designs, cases, options)
     keys = list(summary[0])
     write_atomically(out / "summary.csv", "\n".join([",".join(keys)] + [

@@ -37,10 +37,16 @@ from hapticdesign.model.device import Device
 from hapticdesign.analysis.wall_stiffness import wall_limits
 
 
+MAX_PERIOD = 1.0
+"""Longest sample period (s) of ``kmax``'s loop: a haptic loop samples far faster than 1 Hz, and the exact
+discretization of a handle's mass over much longer periods overflows."""
+
+
 def _options(options: Mapping[str, object]) -> tuple[float, int, float, np.ndarray | None]:
     period, delay, damping, direction = (options[k] for k in ("period", "delay", "damping", "direction"))
-    if isinstance(period, bool) or not isinstance(period, (int, float)) or not (math.isfinite(period) and period > 0):
-        raise UserError(f"index kmax: the sample period is a positive number of seconds, got {period!r}")
+    if isinstance(period, bool) or not isinstance(period, (int, float)) or not 0 < period <= MAX_PERIOD:
+        raise UserError(f"index kmax: the sample period is a positive number of seconds, at most {MAX_PERIOD:g} s, "
+                        f"got {period!r}")
     if isinstance(delay, bool) or not isinstance(delay, int) or not 0 <= delay <= 100:
         raise UserError(f"index kmax: the delay is a whole number of samples from 0 to 100, got {delay!r}")
     if isinstance(damping, bool) or not isinstance(damping, (int, float)) or not (math.isfinite(damping)
@@ -138,8 +144,8 @@ def _batch(space: DesignSpace, requests: list[Request]) -> DesignBatch | None:
 
 
 def _one(space: DesignSpace, values: Mapping[str, float], points: np.ndarray, requests: list[Request]) -> Evaluation:
+    """One design's evaluation, or why it has none: the device file refuses it or an index cannot be computed."""
     try:
-        device = space.device(values)
+        return evaluate(space.device(values), points, requests)
     except UserError as exc:
         return Evaluation({}, str(exc))
-    return evaluate(device, points, requests)

@@ -21,6 +21,7 @@ from hapticdesign.analysis.linearity.design_sets import design_set
 from hapticdesign.analysis.linearity.form import device_form
 from hapticdesign.devices.registry import preset
 from hapticdesign.errors import InputError, PhysicalConsistencyWarning, UserError
+from hapticdesign.files import write_atomically
 from hapticdesign.studies import device_steps, phantom_rendering
 from hapticdesign.studies.plots import plt
 from hapticdesign.studies.seed_reference import (
@@ -248,7 +249,7 @@ def design_sets(ctx: Context) -> Outcome:
     result = design_set(device, form, linear_conditions(device, form), practical_bounds(device), s.levels,
                         s.designs_per_level, s.seed)
     path = ctx.work_dir / f"designs_{s.scale}_{s.seed}.csv"
-    path.write_text(result.to_csv(device.inertial_names()))
+    write_atomically(path, result.to_csv(device.inertial_names()))
     ctx.shared["designs_csv"] = path
     rows = []
     for level in s.levels:

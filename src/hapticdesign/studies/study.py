@@ -9,6 +9,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
 
+from hapticdesign.files import output_folder
 from hapticdesign.studies.steps import STATUS_DONE, Context, Progress, SilentProgress, Step, StepResult, run_steps
 
 
@@ -38,8 +39,7 @@ class StudyResult:
 def run_study(name: str, title: str, intro: str, steps: Sequence[Step], settings: Any, work_dir: Path,
               progress: Progress | None = None) -> StudyResult:
     """Run ``steps`` in order with a shared context; scratch files go to ``work_dir``."""
-    work_dir = Path(work_dir)
-    work_dir.mkdir(parents=True, exist_ok=True)
+    work_dir = output_folder(work_dir)
     started = datetime.now(timezone.utc).isoformat(timespec="seconds")
     context = Context(settings, work_dir, progress or SilentProgress())
     t0 = time.perf_counter()

@@ -27,12 +27,14 @@ def ik(
     passive) joint coordinates that put the handle at a position, on the branch of the home pose (continued from
     home along the straight segment)."""
     from hapticdesign.analysis.configuration import handle_pose
+    from hapticdesign.model.loops import handle_position
 
     with user_errors(strict=strict, quiet=quiet):
         from hapticdesign.devices.loading import resolve_device
 
         dev = resolve_device(preset, device, params, strict=strict)
         target = parse_vector(position, 3, "position")
+        handle_position(target, "--position")
         pose = handle_pose(dev, target)
         result = {"device": dev.name, "position": target, "q": pose.q, "passive": pose.passive,
                   "coordinates": list(dev.mechanism.actuated_coordinates),

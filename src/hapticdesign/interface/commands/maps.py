@@ -53,6 +53,8 @@ def maps(
         middle = space.position_and_jacobian(space.full(space.home))[0] if center is None else parse_vector(
             center, 3, "center")
         names = [name.strip() for name in index.split(",") if name.strip()]
+        if not names:
+            raise UserError(f"--index: give at least one design index (docs/indices.md), got {index[:60]!r}")
         workspace = Workspace(tuple(middle), tuple(abs(sizes)), grid)
         points = workspace.points()
         found = device_map(dev, points, names, registry=DESIGN_INDICES)

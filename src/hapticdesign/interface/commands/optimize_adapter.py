@@ -31,7 +31,7 @@ def parse_select(text: str) -> dict:
     text = text.strip()
     if text == "rms":
         return {}
-    if text.isdigit():
+    if text.isascii() and text.isdigit():
         return {"design": int(text)}
     weights = {}
     for part in text.split(","):
@@ -112,9 +112,37 @@ def _no_front(run: StudyRun, bound: BoundStudy) -> UserError:
         shown = ", ".join(f"{k} = {v:.6g}" for k, v in last[best].values.items())
         return UserError(f"no design of {run.evaluations} reaches the whole workspace; the closest ({shown}) reaches "
                          f"{counts[best]} of {len(bound.points)} points ({last[best].invalid})")
+    feasible = [r for r in valid if r.feasible]
+    if feasible:
+        return _kept_none(run, feasible)
     closest = min(valid, key=lambda r: r.violation)
     shown = ", ".join(f"{k} = {v:.6g}" for k, v in closest.values.items())
     return UserError(f"no design of {run.evaluations} meets the constraints; the closest ({shown}) has {closest.violated}")
+
+
+def _kept_none(run: StudyRun, feasible: list) -> UserError:
+    """Why the front is empty when designs meet the constraints: the ``keep`` filters remove them all; the design
+    closest to passing them (least scaled excess) and the filter it fails."""
+    spec = run.spec
+
+    def misses(record) -> tuple[float, str]:
+        full = spec.with_parameters(record.values)
+        total, first = 0.0, ""
+        for keep in spec.keep:
+            v = float(keep.formula.value(full))
+            for bound, sign, word in ((keep.at_most, 1.0, "<="), (keep.at_least, -1.0, ">=")):
+                if bound is None:
+                    continue
+                excess = math.inf if not math.isfinite(v) else sign * (v - bound) / (abs(bound) or 1.0)
+                if excess > 0.0:
+                    total += excess
+                    first = first or f"{keep.formula.text} = {v:.6g}, not {word} {bound:g}"
+        return total, first
+
+    closest = min(feasible, key=lambda r: misses(r)[0])
+    shown = ", ".join(f"{k} = {v:.6g}" for k, v in closest.values.items())
+    return UserError(f"{len(feasible)} of {run.evaluations} designs meet the constraints, but the keep filters remove "
+                     f"every one; the closest ({shown}) has {misses(closest)[1]}")
 
 
 def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Selection) -> list[Path]:

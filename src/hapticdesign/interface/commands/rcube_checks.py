@@ -13,6 +13,7 @@ import numpy as np
 import typer
 
 from hapticdesign.errors import UserError
+from hapticdesign.files import output_folder
 from hapticdesign.interface.common import note, parse_vector, print_json, progress_bar, user_errors
 from hapticdesign.interface.options import JSON_OUT, QUIET, SEED
 
@@ -77,13 +78,14 @@ def fem(position: Optional[list[str]] = typer.Option(
         if not (np.isfinite(load) and load > 0.0):
             raise UserError(f"--load must be a positive force in newtons, got {load!r}")
         dsg = _design(design)
+        if out is not None:
+            output_folder(out)
         agreements = [compare(dsg, r, load, locked) for r in _positions(dsg, position)]
         rows = [_fem_row(k, a) for k, a in enumerate(agreements)]
         result = {"locked": locked, "load": load, "poses": rows,
                   "max_difference": max(max(r["translational_difference"], r["rotational_difference"],
                                             r["deflection_difference"]) for r in rows)}
         if out is not None:
-            Path(out).mkdir(parents=True, exist_ok=True)
             save_correlation_figure(agreements, Path(out) / FEM_FIGURE)
             result["figure"] = str(Path(out) / FEM_FIGURE)
             note(f"wrote {result['figure']}", quiet)
@@ -152,6 +154,8 @@ def tolerance(samples: int = typer.Option(200, "--samples", help="Number of Mont
         dsg = _design(design)
         tolerances = _tolerances(design, dsg, tol_l1, tol_l2, tol_l3, tol_joint)
         nominal = tol.evaluate_sample(dsg, *tol.nominal_errors(), side, grid)
+        if out is not None:  # the output place is checked (and named) before the run is announced
+            output_folder(out)
         note(f"rcube tolerance: {samples} Monte Carlo samples, estimated {seconds:.0f} s", quiet or json_out)
         with progress_bar(not (quiet or json_out)) as report:
             results = tol.monte_carlo(dsg, tolerances, samples, seed, side, grid, report)
@@ -159,7 +163,6 @@ def tolerance(samples: int = typer.Option(200, "--samples", help="Number of Mont
         s.update(seed=seed, tolerances={"lengths": list(tolerances.lengths), "joint_offset": tolerances.joint_offset},
                  grid=grid, side=side)
         if out is not None:
-            Path(out).mkdir(parents=True, exist_ok=True)
             tol.save_figure(nominal, results, Path(out) / TOLERANCE_FIGURE)
             s["figure"] = str(Path(out) / TOLERANCE_FIGURE)
             note(f"wrote {s['figure']}", quiet)

@@ -170,11 +170,8 @@ def robustness_command(
     Does a linear device keep its range better when the compensator's masses and inertias are wrong?
     Draw d of design i takes its error signs from seed + i draws + d; the table gives 95 % confidence
     intervals of the mean change."""
-    import csv
-    import io
-
     from hapticdesign.devices.registry import preset
-    from hapticdesign.files import write_atomically
+    from hapticdesign.files import csv_rows, write_atomically
     from hapticdesign.interface.common import progress_bar
     from hapticdesign.simulation.campaign import read_designs
     from hapticdesign.simulation.figures import robustness_chart
@@ -202,11 +199,7 @@ def robustness_command(
         rows = summarize_errors(cases)
         files = []
         if out is not None:
-            buffer = io.StringIO()
-            writer = csv.DictWriter(buffer, list(rows[0]))
-            writer.writeheader()
-            writer.writerows(rows)
-            write_atomically(Path(out) / "robustness.csv", buffer.getvalue())
+            write_atomically(Path(out) / "robustness.csv", csv_rows(list(rows[0]), [list(r.values()) for r in rows]))
             files = [str(Path(out) / "robustness.csv"),
                      *map(str, robustness_chart(rows, Path(out) / "robustness", sim_type))]
         if json_out:

@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 from numbers import Integral, Real
 from typing import Any
 
+from hapticdesign.files import csv_rows
 from hapticdesign.studies.steps import Table
 
 
@@ -29,10 +28,6 @@ def cell_text(value: Any, digits: int = 6) -> str:
 
 def csv_text(table: Table) -> str:
     """The table as CSV; floats keep full precision (``repr``)."""
-    buffer = io.StringIO()
-    writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow(table.columns)
-    for row in table.rows:
-        writer.writerow(["" if v is None else repr(float(v)) if isinstance(v, Real) and not isinstance(v, (bool, Integral))
-                         else v for v in row])
-    return buffer.getvalue()
+    return csv_rows(list(table.columns), (["" if v is None else repr(float(v)) if isinstance(v, Real)
+                                           and not isinstance(v, (bool, Integral)) else v for v in row]
+                                          for row in table.rows))

@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from hapticdesign.files import to_jsonable, write_atomically
+from hapticdesign.files import output_folder, to_jsonable, write_atomically
 from hapticdesign.interface.report.html import render
 from hapticdesign.interface.report.tables import csv_text
 from hapticdesign.interface.report.versions import versions
@@ -19,14 +19,14 @@ def _stem(step_key: str, name: str) -> str:
 def write_report(study: StudyResult, out: Path) -> Path:
     """Write every artefact of ``study`` under ``out`` and return the path of ``report.html``."""
     out = Path(out)
-    (out / "tables").mkdir(parents=True, exist_ok=True)
-    (out / "figures").mkdir(parents=True, exist_ok=True)
+    output_folder(out / "tables")
+    output_folder(out / "figures")
     for step in study.steps:
         for table in step.outcome.tables:
             write_atomically(out / "tables" / f"{_stem(step.key, table.name)}.csv", csv_text(table))
         for figure in step.outcome.figures:
             stem = out / "figures" / _stem(step.key, figure.name)
-            stem.with_suffix(".png").write_bytes(figure.png)
+            write_atomically(stem.with_suffix(".png"), figure.png)
             write_atomically(stem.with_suffix(".svg"), figure.svg)
         for page in step.outcome.pages:
             write_atomically(out / "pages" / f"{_stem(step.key, page.name)}.html", page.html)

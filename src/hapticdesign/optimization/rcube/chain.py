@@ -4,8 +4,6 @@ and selection (Tables 7.3-7.5), the weighted-sum swarm, the cross-section ratio 
 
 from __future__ import annotations
 
-import csv
-import io
 import json
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
@@ -19,7 +17,7 @@ from hapticdesign.analysis.rcube.design import RCubeDesign
 from hapticdesign.analysis.rcube.dynamics import cartesian_mass_matrix
 from hapticdesign.analysis.rcube.kinematics import dexterous_cube
 from hapticdesign.analysis.rcube.stiffness import cartesian_stiffness
-from hapticdesign.files import to_jsonable, write_atomically
+from hapticdesign.files import csv_rows, output_folder, to_jsonable, write_atomically
 from hapticdesign.optimization.rcube import figures
 from hapticdesign.optimization.rcube.constraints import Workspace
 from hapticdesign.optimization.rcube.cross_section import RATIO_BOUNDS, CrossSectionResult, optimize_ratio
@@ -184,12 +182,8 @@ def run_chain(seed: int = 1, settings: Settings = Settings(), weight: float = 0.
 
 
 def _write_csv(path: Path, header: list[str], rows) -> Path:
-    buffer = io.StringIO()
-    writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow(header)
-    for row in rows:
-        writer.writerow([f"{v:.10g}" if isinstance(v, (float, np.floating)) else v for v in row])
-    write_atomically(path, buffer.getvalue())
+    write_atomically(path, csv_rows(header, ([f"{v:.10g}" if isinstance(v, (float, np.floating)) else v for v in row]
+                                             for row in rows)))
     return path
 
 
@@ -317,7 +311,7 @@ def chain_summary(result: ChainResult) -> dict:
 
 def write_chain(out: Path, result: ChainResult) -> list[Path]:
     """Every table (CSV), figure (PNG and SVG) and ``summary.json`` of the chain."""
-    out = Path(out)
+    out = output_folder(out)
     paths = write_synthesis(out, result.synthesis) + write_selection(out, result.selection)
     paths += write_cross_section(out, result.cross_section) + write_plies(out, result.plies, result.ply_choice, result.ply_limit)
     paths += write_final(out, result.design, result.plies.counts[result.ply_choice], result.specs)

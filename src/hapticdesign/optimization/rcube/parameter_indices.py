@@ -57,7 +57,7 @@ def design_vectors(params: Mapping[str, np.ndarray], workspace: Workspace) -> np
     if missing:
         raise UserError(f"the R-CUBE indices need device parameters l1, l2, l3 and S; {missing[0]} is missing")
     l1 = np.asarray(params["l1"], dtype=float)
-    if not np.allclose(params["S"], l1, rtol=1e-12, atol=0.0):
+    if not np.allclose(params["S"], l1, rtol=1e-12, atol=0.0, equal_nan=True):
         raise UserError("the R-CUBE indices hold for S = l1 (eq. 6.39): set S from l1 in the study's parameters")
     with np.errstate(invalid="ignore"):
         q = np.arcsin(workspace.half / l1)
