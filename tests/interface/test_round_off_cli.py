@@ -45,3 +45,22 @@ def test_dynamics_without_q_is_at_home_as_spec():
     assert at_home["q"] == home
     explicit = _json("dynamics", "--device", falcon, "--q", ",".join(repr(v) for v in home))
     assert at_home["H"] == explicit["H"] and at_home["G"] == explicit["G"]
+
+
+def test_eom_refuses_to_flood_a_terminal_and_writes_a_file_instead(tmp_path, monkeypatch):
+    """Equations longer than the limit are not printed to a terminal (one line saying how long and what to do);
+    with --out they are written to the file, the same text a pipe would get."""
+    from hapticdesign.interface.commands import dynamics
+
+    piped = runner.invoke(app, ["eom", "--preset", "phantom-3dof", "--format", "latex"])
+    assert piped.exit_code == 0
+    text = piped.stdout
+    monkeypatch.setattr(dynamics, "TERMINAL_LIMIT", len(text) // 2)
+    monkeypatch.setattr(dynamics, "_terminal", lambda: True)
+    refused = runner.invoke(app, ["eom", "--preset", "phantom-3dof", "--format", "latex"])
+    assert refused.exit_code == 2 and refused.stdout == ""
+    lines = refused.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: the equations are ") and "--out FILE" in lines[0]
+    written = runner.invoke(app, ["eom", "--preset", "phantom-3dof", "--format", "latex", "--out", str(tmp_path / "e.tex")])
+    assert written.exit_code == 0 and written.stdout == ""
+    assert (tmp_path / "e.tex").read_text() == text

@@ -8,7 +8,8 @@ from typing import Optional
 import numpy as np
 import typer
 
-from hapticdesign.files import require_finite
+from hapticdesign.errors import UserError
+from hapticdesign.files import require_finite, write_atomically
 from hapticdesign.interface.options import DEVICE, FORCE, FORCE_HINT, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
 from hapticdesign.workload import allow_large
 from hapticdesign.interface.common import joint_units, note as stderr_note, parse_vector, print_json, user_errors
@@ -102,6 +103,16 @@ def _row(values: np.ndarray) -> str:
     return " ".join(f"{v: .6e}" for v in np.ravel(values))
 
 
+TERMINAL_LIMIT = 100_000  # characters of equations printed to a terminal; more go to a file (--out) or a pipe
+
+
+def _terminal() -> bool:
+    """True when stdout is a terminal (where megabytes of equations are no use)."""
+    import sys
+
+    return sys.stdout.isatty()
+
+
 def eom(
     preset: Optional[str] = PRESET,
     device: Optional[Path] = DEVICE,
@@ -111,12 +122,15 @@ def eom(
     ),
     fmt: str = typer.Option("latex", "--format", help="latex, python or text."),
     part: str = typer.Option("tau", help="What to print: tau, H, C, G or all."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Write the equations to this file instead of stdout "
+                                       "(needed for more than 100 kB on a terminal)."),
     strict: bool = STRICT,
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
     force: bool = FORCE,
 ) -> None:
-    """Equations of motion as LaTeX, Python or text, symbols as chosen (seed 000 eq. 2.50, Appendix A)."""
+    """Equations of motion as LaTeX, Python or text, symbols as chosen (seed 000 eq. 2.50, Appendix A). More than
+    100 kB is not printed to a terminal: give --out FILE or pipe it."""
     from hapticdesign.analysis.dynamics.symbolic import derive, export
 
     with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
@@ -124,7 +138,14 @@ def eom(
 
         dev = resolve_device(preset, device, params, strict=strict)
         text = export(derive(dev, symbolic), fmt, part)
+        if out is not None and not json_out:
+            write_atomically(out, text + "\n")
+            stderr_note(f"wrote {out} ({_size(len(text))} of {fmt})", quiet)
+            return
         if not json_out:
+            if len(text) > TERMINAL_LIMIT and _terminal():
+                raise UserError(f"the equations are {_size(len(text))} of {fmt}, too long to read on a terminal; "
+                                "write them to a file with --out FILE (or pipe them)")
             typer.echo(text)
             return
         result = {"device": dev.name, "format": fmt, "part": part}
@@ -133,6 +154,10 @@ def eom(
         else:
             result["equations"] = dict(_equation_entry(line) for line in text.splitlines())
         print_json(result)
+
+
+def _size(characters: int) -> str:
+    return f"{characters / 1e6:.1f} MB" if characters >= 1e6 else f"{characters / 1e3:.0f} kB"
 
 
 def _equation_entry(line: str) -> tuple[str, str]:
