@@ -181,6 +181,7 @@ def quantity_png(device: Device, sections: list[Section], edge: float) -> bytes 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from hapticdesign.analysis.metrics.maps import draw_map
     from hapticdesign.files import figure_bytes
 
     maps = quantity_maps(device, sections)
@@ -195,8 +196,7 @@ def quantity_png(device: Device, sections: list[Section], edge: float) -> bytes 
             step = 1000.0 * (section.u[1] - section.u[0])
             extent = (1000.0 * section.u[0] - step / 2, 1000.0 * section.u[-1] + step / 2,
                       1000.0 * section.v[0] - step / 2, 1000.0 * section.v[-1] + step / 2)
-            image = ax.imshow(values.T, origin="lower", extent=extent, interpolation="nearest", cmap="viridis")
-            fig.colorbar(image, ax=ax, label=f"{label} [{unit}]", shrink=0.85)
+            draw_map(fig, ax, values, extent, f"{label} [{unit}]")
             ax.plot([-half, half, half, -half, -half], [-half, -half, half, half, -half], color="#c0392b",
                     linewidth=1.0)
             ax.set_xlabel(f"{section.names[0]} - home [mm]")

@@ -84,5 +84,5 @@ def save_workspace_maps(design: RCubeDesign, out_dir: Path, n: int = 21, half_wi
         for name in names:
             tag = f"{o * 1e3:+.0f}".replace("+", "p").replace("-", "m")
             paths.append(save_map(Path(out_dir) / f"{name}_plane{tag}.png", maps[name], grid_offsets,
-                                  f"{name}, plane {o * 1e3:+.0f} mm", ("x", "y")))
+                                  f"{name}, plane {o * 1e3:+.0f} mm", ("x", "y"), unit=names.METRICS[name].unit))
     return paths
