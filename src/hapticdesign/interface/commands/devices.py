@@ -98,7 +98,7 @@ def spec(
     stiffness beside the passivity bounds."""
     from hapticdesign.files import dumps_json, write_atomically
     from hapticdesign.studies.spec import spec_sheet
-    from hapticdesign.studies.spec_page import spec_page
+    from hapticdesign.interface.report.spec_page import spec_page
 
     with user_errors(strict=strict, quiet=quiet):
         from hapticdesign.devices.loading import resolve_device
