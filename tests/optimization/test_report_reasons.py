@@ -33,3 +33,20 @@ def test_names_keep_their_digits():
     assert reason_kind("l1 + l2 = 0.300198, not <= 0.3") == ("l1 + l2 = #, not <= #", [0.300198, 0.3])
     assert reason_kind("the handle cannot reach (-0.03, 0, 1e-05) m") == ("the handle cannot reach (#, #, #) m",
                                                                            [-0.03, 0.0, 1e-05])
+
+
+def test_the_front_table_shows_the_objectives_first(tmp_path):
+    """A front is its objectives: the report's front table has them right after the design number, before the
+    variables (which used to push them off the page)."""
+    from typer.testing import CliRunner
+
+    from hapticdesign.interface.cli import app
+    from tests.optimization.test_study_run import small_study
+
+    done = CliRunner().invoke(app, ["optimize", str(small_study(tmp_path)), "--seed", "7", "--out",
+                                    str(tmp_path / "out"), "--quiet"])
+    assert done.exit_code == 0, done.output
+    page = (tmp_path / "out" / "report.html").read_text()
+    table = page[page.index("<caption>The front:"):]
+    heads = [unescape(h) for h in re.findall(r"<th>(.*?)</th>", table[:table.index("</thead>")])]
+    assert heads[:5] == ["design", "iso", "mass", "l2", "actuators.q2.gear_ratio"]
