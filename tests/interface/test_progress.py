@@ -39,6 +39,8 @@ def test_durations_read_as_seconds_minutes_or_hours():
 
 
 def test_progress_in_a_log_states_the_estimate_once_then_each_tenth_with_the_time_left(capsys, monkeypatch):
+    """One item a second: nothing in the first 2 s (short work needs no log), then the estimate, then a line at
+    each tenth with the time left."""
     clock = Clock()
     monkeypatch.setattr("time.monotonic", clock)
     with progress_bar(True) as report:  # stderr is captured: not a terminal
@@ -46,12 +48,22 @@ def test_progress_in_a_log_states_the_estimate_once_then_each_tenth_with_the_tim
             clock.now = 1.0 * done
             report("cases", done, 100)
     lines = capsys.readouterr().err.strip().splitlines()
-    assert lines[0] == "cases: 1 of 100"
-    assert lines[1] == "cases: 100 in all; at the pace so far, about 1.6 min left"  # 98 s: 2 of 100 after 1 s
+    assert lines[0] == "cases: 100 in all; at the pace so far, about 1.6 min left"  # 98 s: 2 of 100 after 2 s
+    assert lines[1] == "cases: 2 of 100, about 1.6 min left"
     assert lines[2] == "cases: 10 of 100, about 1.5 min left"
     assert lines[-1] == "cases: 100 of 100" and len(lines) == 12
     with progress_bar(False) as report:
         assert report is None
+
+
+def test_work_that_ends_within_two_seconds_writes_no_progress_to_a_log(capsys, monkeypatch):
+    clock = Clock()
+    monkeypatch.setattr("time.monotonic", clock)
+    with progress_bar(True) as report:
+        for done in range(1, 11):
+            clock.now = 0.1 * done
+            report("cases", done, 10)
+    assert capsys.readouterr().err == ""
 
 
 def test_robustness_states_its_size_and_the_time_left(tmp_path):
@@ -60,13 +72,13 @@ def test_robustness_states_its_size_and_the_time_left(tmp_path):
     designs = write_designs(tmp_path / "designs.csv")
     env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
     args = [sys.executable, "-c", "from hapticdesign.interface.cli import main; main()", "robustness", "--designs", str(designs), "--errors", "0,5",
-            "--draws", "3"]
+            "--draws", "40"]
     run = subprocess.run(args, capture_output=True, text=True, env=env, cwd=tmp_path, check=False)
     assert run.returncode == 0, run.stderr
     err = run.stderr.splitlines()
-    assert err[0] == ("robustness: 4 designs x 2 error levels (3 draws at each level above 0) = 16 stable-range "
+    assert err[0] == ("robustness: 4 designs x 2 error levels (40 draws at each level above 0) = 164 stable-range "
                       "searches (analytic)")
-    assert any(line.startswith("robustness searches: 16 in all; at the pace so far, about ") for line in err)
-    assert err[-1] == "robustness searches: 16 of 16"
+    assert any(line.startswith("robustness searches: 164 in all; at the pace so far, about ") for line in err)
+    assert err[-1] == "robustness searches: 164 of 164"
     quiet = subprocess.run([*args, "--json"], capture_output=True, text=True, env=env, cwd=tmp_path, check=False)
     assert quiet.returncode == 0 and quiet.stderr == ""

@@ -122,13 +122,17 @@ def estimate_line(step: str, total: int, seconds_left: float) -> str:
     return f"{step}: {total} in all; at the pace so far, about {duration_text(seconds_left)} left"
 
 
+LOG_AFTER = 2.0
+"""Seconds of work after which progress is written to a log (work that ends sooner needs none)."""
+
+
 @contextmanager
 def progress_bar(enabled: bool) -> Iterator[Report | None]:
     """Progress of long work on stderr, fed by ``report(step, done, total)`` (``total`` None: unknown).
 
     Each step with a known total first states its size and the time it will take, once its pace is known
     (:class:`TimeLeft`). On a terminal a rich bar follows with the time elapsed and the time left; in a log or
-    a pipe one line each tenth, with the time left. Yields None (nothing on stderr) when ``enabled`` is false
+    a pipe one line each tenth, with the time left, once the work has run :data:`LOG_AFTER` seconds. Yields None (nothing on stderr) when ``enabled`` is false
     (``--quiet`` or ``--json``), so progress never mixes with a command's output on stdout."""
     from rich.console import Console
 
@@ -146,9 +150,12 @@ def progress_bar(enabled: bool) -> Iterator[Report | None]:
 
     if not console.is_terminal:
         tenths: dict[str, set[int]] = {}
+        began = left.clock()
 
         def lines(step: str, done: int, total: int | None) -> None:
             seconds = left(step, done, total)
+            if left.clock() - began < LOG_AFTER:
+                return
             first_estimate(step, done, total, seconds, lambda text: typer.echo(text, err=True))
             if total is None:
                 return
