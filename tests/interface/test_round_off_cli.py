@@ -40,7 +40,9 @@ def test_stiffness_of_the_rcube_file_has_the_zeros_of_rcube_stiffness():
 
 def test_dynamics_without_q_is_at_home_as_spec():
     falcon = str(ROOT / "examples" / "devices" / "falcon.yaml")
-    home = _json("spec", "--device", falcon)["q"]
+    sheet = _json("spec", "--device", falcon, "--no-workspace")
+    home = sheet["q"]
+    assert sheet["handle"][:2] == [0.0, 0.0]  # on the axis of the Falcon's threefold symmetry (y was -1.7e-18)
     at_home = _json("dynamics", "--device", falcon)
     assert at_home["q"] == home
     explicit = _json("dynamics", "--device", falcon, "--q", ",".join(repr(v) for v in home))
