@@ -272,18 +272,6 @@ def test_rcube_fk_refuses_a_pose_the_passive_links_cannot_reach():
     assert runner.invoke(app, ["rcube", "fk", "--q1", "0.1", "--q2", "0", "--q3", "-0.1"]).exit_code == 0
 
 
-def test_progress_lines_for_logs_print_each_tenth(capsys):
-    from hapticdesign.interface.common import progress_lines
-
-    assert progress_lines(False, "x") is None
-    report = progress_lines(True, "campaign cases")
-    for done in range(1, 101):
-        report(done, 100)
-    lines = capsys.readouterr().err.strip().splitlines()
-    assert lines[0] == "campaign cases: 1 of 100" and lines[1] == "campaign cases: 10 of 100"  # started, then tenths
-    assert len(lines) == 11 and lines[-1] == "campaign cases: 100 of 100"
-
-
 @pytest.mark.parametrize("command", [["dynamics"], ["eom"], ["metrics"], ["show"], ["study", "device"], ["ln"],
                                      ["impedance-range"], ["rcube", "optimize"], ["rcube", "maps"]])
 def test_commands_whose_work_can_grow_take_force(command):

@@ -87,12 +87,12 @@ def test_the_report_escapes_user_strings(tmp_path):
 
 
 def test_a_dask_cluster_gives_the_same_front(tmp_path):
-    from dask.distributed import LocalCluster
+    from hapticdesign.simulation.campaign import local_cluster
 
     study = small_study(tmp_path)
     local = optimize(study, "--seed", 2, "--out", tmp_path / "local")
     assert local.exit_code == 0, local.output
-    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, protocol="tcp", dashboard_address=None) as cluster:
+    with local_cluster(1, processes=False) as cluster:
         remote = optimize(study, "--seed", 2, "--out", tmp_path / "remote", "--scheduler", cluster.scheduler_address)
     assert remote.exit_code == 0, remote.output
     for name in ("front.csv", "evaluations.csv", "selected.yaml"):

@@ -70,9 +70,11 @@ def test_row_objective_matches_direct_evaluation():
 
 def test_dask_client_gives_the_numbers_of_the_loop():
     distributed = pytest.importorskip("dask.distributed")
+    from hapticdesign.simulation.campaign import local_cluster
+
     looped_front, looped_n = run_nsga2(BOUND_SETS[1], 12, 3, seed=4)
     looped_plies = optimize_plies(RCubeGeometry(0.1117, 0.0741, 0.1218), 0.768, population=8, generations=2, seed=5)
-    with distributed.Client(processes=False, n_workers=1, threads_per_worker=2, dashboard_address=None) as client:
+    with local_cluster(2, processes=False) as cluster, distributed.Client(cluster) as client:
         front, n = run_nsga2(BOUND_SETS[1], 12, 3, seed=4, client=client)
         plies = optimize_plies(RCubeGeometry(0.1117, 0.0741, 0.1218), 0.768, population=8, generations=2, seed=5,
                                client=client)

@@ -32,9 +32,9 @@ def test_design_file_errors(tmp_path):
 
 @pytest.fixture(scope="module")
 def cluster():
-    from dask.distributed import LocalCluster
+    from hapticdesign.simulation.campaign import local_cluster
 
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as c:
+    with local_cluster(2) as c:
         yield c
 
 

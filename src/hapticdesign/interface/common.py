@@ -94,29 +94,104 @@ def print_json(value) -> None:
 Report = Callable[[str, int, int | None], None]
 
 
+def duration_text(seconds: float) -> str:
+    """A duration for people: ``"40 s"``, ``"3.5 min"``, ``"2.1 h"``."""
+    if seconds < 90:
+        return f"{seconds:.0f} s"
+    if seconds < 5400:
+        return f"{seconds / 60:.1f} min"
+    return f"{seconds / 3600:.1f} h"
+
+
+class TimeLeft:
+    """Estimates of the time left in the steps of a long run, from the pace since each step's first report.
+
+    The first item of a step often carries one-off work (numba loads or compiles its kernels), so the pace
+    is measured from the first report on: the estimate is the items still to do at the mean time per item
+    since then. It is given once ``min_seconds`` have passed or a tenth of the step is done, whichever
+    comes first; before that it is None."""
+
+    def __init__(self, clock: Callable[[], float] | None = None, min_seconds: float = 1.0):
+        import time
+
+        self.clock = clock or time.monotonic
+        self.min_seconds = min_seconds
+        self.first: dict[str, tuple[float, int]] = {}
+
+    def __call__(self, step: str, done: int, total: int | None) -> float | None:
+        """Seconds left in ``step`` after ``done`` of ``total`` items, or None while unknown."""
+        now = self.clock()
+        start, start_done = self.first.setdefault(step, (now, done))
+        if total is None or done <= start_done:
+            return None
+        elapsed = now - start
+        if elapsed < self.min_seconds and 10 * done < total:
+            return None
+        return elapsed / (done - start_done) * (total - done)
+
+
+def estimate_line(step: str, total: int, seconds_left: float) -> str:
+    """The line that states a run's size and the time it will take, once its pace is known."""
+    return f"{step}: {total} in all; at the pace so far, about {duration_text(seconds_left)} left"
+
+
+LOG_AFTER = 2.0
+"""Seconds of work after which progress is written to a log (work that ends sooner needs none)."""
+
+
 @contextmanager
 def progress_bar(enabled: bool) -> Iterator[Report | None]:
-    """Rich progress bars on a terminal's stderr, fed by ``report(step, done, total)`` (``total`` None: unknown).
+    """Progress of long work on stderr, fed by ``report(step, done, total)`` (``total`` None: unknown).
 
-    Yields None (no bars) when ``enabled`` is false (``--quiet`` or ``--json``) or stderr is not a terminal,
-    so progress never mixes with a command's output on stdout.
-    """
+    Each step with a known total first states its size and the time it will take, once its pace is known
+    (:class:`TimeLeft`). On a terminal a rich bar follows with the time elapsed and the time left; in a log or
+    a pipe one line each tenth, with the time left, once the work has run :data:`LOG_AFTER` seconds. Yields None (nothing on stderr) when ``enabled`` is false
+    (``--quiet`` or ``--json``), so progress never mixes with a command's output on stdout."""
     from rich.console import Console
 
-    console = Console(stderr=True)
-    if not (enabled and console.is_terminal):
+    if not enabled:
         yield None
         return
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+    console = Console(stderr=True)
+    left = TimeLeft()
+    estimated: set[str] = set()
+
+    def first_estimate(step: str, done: int, total: int | None, seconds: float | None, say) -> None:
+        if seconds is not None and total is not None and step not in estimated and done < total:
+            estimated.add(step)
+            say(estimate_line(step, total, seconds))
+
+    if not console.is_terminal:
+        tenths: dict[str, set[int]] = {}
+        began = left.clock()
+
+        def lines(step: str, done: int, total: int | None) -> None:
+            seconds = left(step, done, total)
+            if left.clock() - began < LOG_AFTER:
+                return
+            first_estimate(step, done, total, seconds, lambda text: typer.echo(text, err=True))
+            if total is None:
+                return
+            tenth = (10 * done) // max(total, 1)
+            if tenth not in tenths.setdefault(step, set()):
+                tenths[step].add(tenth)
+                after = f", about {duration_text(seconds)} left" if seconds is not None and done < total else ""
+                typer.echo(f"{step}: {done} of {total}{after}", err=True)
+
+        yield lines
+        return
+    from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn,
+                               TimeRemainingColumn)
 
     with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-                  console=console, transient=True) as bars:
+                  TextColumn("left"), TimeRemainingColumn(), console=console, transient=True) as bars:
         tasks: dict[str, int] = {}
 
         def report(step: str, done: int, total: int | None) -> None:
             if step not in tasks:
                 tasks[step] = bars.add_task(step, total=total)
             bars.update(tasks[step], completed=done, total=total)
+            first_estimate(step, done, total, left(step, done, total), bars.console.print)
 
         yield report
 
@@ -159,18 +234,3 @@ def joint_units(device) -> list[dict[str, str]]:
         out.append({"joint": name, "position": "m" if prismatic else "rad", "effort": "N" if prismatic else "N m",
                     "stiffness": "N/m" if prismatic else "N m/rad", "damping": "N s/m" if prismatic else "N m s/rad"})
     return out
-
-
-def progress_lines(enabled: bool, label: str, steps: int = 10) -> Callable[[int, int], None] | None:
-    """Progress for a long run whose stderr is not a terminal (a log, CI): one line each tenth."""
-    if not enabled:
-        return None
-    shown = {-1}
-
-    def report(done: int, total: int) -> None:
-        tenth = (steps * done) // max(total, 1)
-        if tenth not in shown:
-            shown.add(tenth)
-            typer.echo(f"{label}: {done} of {total}", err=True)
-
-    return report

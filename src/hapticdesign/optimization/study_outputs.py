@@ -105,9 +105,18 @@ def _unit(index: str) -> str:
     return "-" if unit == "1" else unit
 
 
+def front_limits(values: np.ndarray, pad: float = 0.08) -> tuple[float, float]:
+    """Axis limits from the front's own range, ``pad`` of it on each side (a front of one value: 5 % of its
+    magnitude, or 1 at 0): the feasible designs far from the front no longer squash it into a band."""
+    low, high = float(np.min(values)), float(np.max(values))
+    margin = pad * (high - low) if high > low else 0.05 * (abs(high) or 1.0)
+    return low - margin, high + margin
+
+
 def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: str = "pareto") -> list[Path]:
     """The front in pairs of objectives (every feasible design in grey, the front in blue, the selected
-    design as a red star); one objective: its value per evaluation; more than three: parallel coordinates
+    design as a red star; the axes span the front's range, :func:`front_limits`, and the legend counts the
+    feasible designs beyond them); one objective: its value per evaluation; more than three: parallel coordinates
     of the normalized front (0 best)."""
     plt = _pyplot()
     spec = run.spec
@@ -130,10 +139,16 @@ def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: s
         pairs = [(0, 1)] if k == 2 else [(0, 1), (0, 2), (1, 2)]
         fig, axes = plt.subplots(1, len(pairs), figsize=(5.5 * len(pairs), 4.5), dpi=100, squeeze=False)
         for ax, (i, j) in zip(axes[0], pairs):
-            ax.scatter(F_all[:, i], F_all[:, j], s=6, color="0.75", label="feasible designs")
+            (x_low, x_high), (y_low, y_high) = front_limits(F[:, i]), front_limits(F[:, j])
+            beyond = int(np.sum((F_all[:, i] < x_low) | (F_all[:, i] > x_high) | (F_all[:, j] < y_low)
+                                | (F_all[:, j] > y_high)))
+            ax.scatter(F_all[:, i], F_all[:, j], s=6, color="0.75",
+                       label=f"feasible designs ({beyond} beyond the axes)" if beyond else "feasible designs")
             ax.scatter(F[:, i], F[:, j], s=22, color="tab:blue", label="front")
             if pick is not None:
                 ax.scatter([pick[i]], [pick[j]], marker="*", s=160, color="red", label="selected")
+            ax.set_xlim(x_low, x_high)
+            ax.set_ylim(y_low, y_high)
             ax.set_xlabel(labels[i])
             ax.set_ylabel(labels[j])
             ax.legend(fontsize=8)

@@ -277,10 +277,23 @@ def _received(sock: socket.socket, size: int, deadline: float) -> bytes:
     return data
 
 
+def local_cluster(workers: int | None, quiet: bool = False, processes: bool = True):
+    """A Dask cluster on this machine, quiet and on free ports: ``workers`` processes (or threads when ``processes``
+    is false) of one thread each, the scheduler and its HTTP server on ports the system picks on 127.0.0.1, no
+    dashboard (Dask's default binds port 8787 even without one, and warns when another run holds it). A context
+    manager: leaving it stops the workers, then the scheduler."""
+    from dask.distributed import LocalCluster
+
+    return LocalCluster(n_workers=worker_count(workers), threads_per_worker=1, processes=processes,
+                        host="127.0.0.1", protocol="tcp://", dashboard_address=None,
+                        scheduler_kwargs={"dashboard": False, "dashboard_address": "127.0.0.1:0"},
+                        silence_logs=logging.CRITICAL + 1 if quiet else logging.ERROR)
+
+
 def dask_client(scheduler: str | None, workers: int | None, quiet: bool = False):
     """A client of the Dask scheduler at ``scheduler`` (a one-line error when it cannot be reached), or of a
-    local cluster of ``workers`` processes (one thread each) when ``scheduler`` is None."""
-    from dask.distributed import Client, LocalCluster
+    :func:`local_cluster` of ``workers`` processes when ``scheduler`` is None."""
+    from dask.distributed import Client
 
     if scheduler:
         check_scheduler(scheduler)
@@ -290,8 +303,7 @@ def dask_client(scheduler: str | None, workers: int | None, quiet: bool = False)
         except (OSError, TimeoutError, ValueError, TypeError) as exc:
             first = str(exc).splitlines()[0][:200] if str(exc) else type(exc).__name__
             raise UserError(f"cannot reach the Dask scheduler at {scheduler}: {first}") from None
-    return Client(LocalCluster(n_workers=worker_count(workers), threads_per_worker=1, processes=True,
-                               dashboard_address=None, silence_logs=logging.CRITICAL + 1 if quiet else logging.ERROR))
+    return Client(local_cluster(workers, quiet))
 
 
 @contextmanager
@@ -325,14 +337,9 @@ def deferred_interrupts() -> Iterator[None]:
 
 
 def close_client(client, own_cluster: bool) -> None:
-    """Stop the client, then the local cluster it started (workers first, so none heartbeats a closed
-    scheduler)."""
+    """Stop the client, then the local cluster it started, as Dask orders it (the cluster retires its workers
+    before it stops the scheduler, so none heartbeats a closed scheduler)."""
     cluster = getattr(client, "cluster", None) if own_cluster else None
-    if cluster is not None:
-        try:
-            client.retire_workers(close_workers=True)
-        except Exception:  # a worker that is already gone needs no retiring  # noqa: BLE001
-            pass
     client.close()
     if cluster is not None:
         cluster.close()

@@ -12,6 +12,7 @@ import numpy as np  # noqa: E402
 
 from hapticdesign.files import save_figure  # noqa: E402
 
+MIN_RELATIVE_SPAN = 0.1  # a value axis spans at least this share of the values' mean magnitude
 LABELS = {"impedance": ("Maximum stable impedance [N m/rad]", "k_max"),
           "transparency": ("Transparency bandwidth [Hz]", "bandwidth")}
 
@@ -47,6 +48,31 @@ def swarm_offsets(values: np.ndarray, width: float = 0.35, resolution: float | N
     return offsets
 
 
+def value_limits(values, relative: float = MIN_RELATIVE_SPAN) -> tuple[float, float] | None:
+    """Axis limits that span at least ``relative`` of the values' mean magnitude, centred on their range (None when
+    the values already span more, or there are none): a spread of a fraction of a percent, round-off or the
+    resolution of a search, is then drawn flat instead of as a trend across the whole axis."""
+    finite = np.asarray(values, dtype=float)
+    finite = finite[np.isfinite(finite)]
+    if finite.size == 0:
+        return None
+    low, high = float(finite.min()), float(finite.max())
+    span = relative * float(np.abs(finite).mean())
+    if high - low >= span or span == 0.0:
+        return None
+    middle = 0.5 * (low + high)
+    return middle - 0.5 * span, middle + 0.5 * span
+
+
+def _floor_span(ax, values) -> str:
+    """Apply :func:`value_limits` to ``ax``'s y axis; the caption's words for it when it applied."""
+    limits = value_limits(values)
+    if limits is None:
+        return ""
+    ax.set_ylim(*limits)
+    return f"; axis spans {100 * MIN_RELATIVE_SPAN:.0f} % of the mean, the values' spread is smaller"
+
+
 def _levels(designs) -> list[float]:
     return sorted({d.level for d in designs})
 
@@ -61,9 +87,11 @@ def beeswarm(designs, cases, criterion: str, path: Path) -> None:
     ylabel, _ = LABELS[criterion]
     levels = _levels(designs)
     fig, ax = plt.subplots(figsize=(7, 4))
+    shown = []
     for x, level in enumerate(levels):
         members = [d for d in designs if d.level == level]
         v = _values(members, cases, criterion, 1)
+        shown.append(v)
         ax.scatter(x + swarm_offsets(v), v, s=14, facecolors="none", edgecolors="tab:blue")
         finite = v[np.isfinite(v)]
         if finite.size:
@@ -72,7 +100,8 @@ def beeswarm(designs, cases, criterion: str, path: Path) -> None:
     ax.set_xticks(range(len(levels)), [f"{lv:g}" for lv in levels])
     ax.set_xlabel("Linearity Number")
     ax.set_ylabel(ylabel)
-    ax.set_title(f"{ylabel.split(' [')[0]} vs LN, type 1 (mean and 1 sigma in red)")
+    span = _floor_span(ax, np.concatenate(shown) if shown else [])
+    ax.set_title(f"{ylabel.split(' [')[0]} vs LN, type 1 (mean and 1 sigma in red{span})", fontsize=10)
     _save(fig, path)
 
 
@@ -86,9 +115,12 @@ def type_comparison(designs, cases, criterion: str, path: Path) -> None:
     for ax, level in zip(axes.ravel(), levels):
         members = [d for d in designs if d.level == level]
         x = np.arange(1, len(members) + 1)
-        ax.plot(x, _values(members, cases, criterion, 1), "o", mfc="none", label="type 1")
-        ax.plot(x, _values(members, cases, criterion, 2), "x", label="type 2")
-        ax.set_title(f"LN = {level:g}")
+        one, two = _values(members, cases, criterion, 1), _values(members, cases, criterion, 2)
+        ax.plot(x, one, "o", mfc="none", label="type 1")
+        ax.plot(x, two, "x", label="type 2")
+        flat = _floor_span(ax, np.concatenate([one, two]))
+        flat = f" (axis: {100 * MIN_RELATIVE_SPAN:.0f} % of the mean)" if flat else ""
+        ax.set_title(f"LN = {level:g}{flat}", fontsize=9)
         ax.set_xlabel("design")
         ax.set_ylabel(ylabel)
     for ax in axes.ravel()[len(levels):]:

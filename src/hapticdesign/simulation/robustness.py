@@ -55,6 +55,11 @@ def inertia_share(device: Device, compensator: Compensator, joint: int = 0) -> f
     return float(mass_matrix(model, q0)[joint, joint] / mass_matrix(device, q0)[joint, joint])
 
 
+def case_count(designs: int, errors: list[float], draws: int) -> int:
+    """How many searches :func:`error_cases` runs: each design once at E = 0, ``draws`` times at every other E."""
+    return designs * sum(1 if e == 0 else draws for e in errors)
+
+
 def error_cases(devices: list[tuple[str, float, Device]], errors: list[float], seed: int,
                 groups: tuple[str, ...] = ("mass", "inertia"), method: str = "analytic", k_limit: int = 400,
                 progress: Callable[[int, int], None] | None = None, sim_type: int = 2,
@@ -69,7 +74,7 @@ def error_cases(devices: list[tuple[str, float, Device]], errors: list[float], s
     if not (isinstance(draws, int) and 1 <= draws <= MAX_DRAWS):
         raise UserError(f"the number of error draws must be a whole number from 1 to {MAX_DRAWS}, got {draws}")
     cases, done = [], 0
-    total = len(devices) * sum(1 if e == 0 else draws for e in errors)
+    total = case_count(len(devices), errors, draws)
     for i, (name, level, device) in enumerate(devices):
         for error in errors:
             for d in range(1 if error == 0 else draws):

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from hapticdesign.analysis.dynamics.device import gravity, inverse_dynamics, mass_matrix
-from hapticdesign.analysis.dynamics.symbolic import derive, export
+from hapticdesign.analysis.dynamics.symbolic import derive, export, rounded
 from hapticdesign.analysis.linearity.bounds import practical_bounds
 from hapticdesign.analysis.linearity.conditions import (
     linear_conditions,
@@ -50,6 +50,9 @@ def device_view(ctx: Context) -> Outcome:
     )
 
 
+READABLE_RELATIVE = 1e-8
+READABLE = ("to 6 significant digits, terms below 1e-8 of the matrix's largest dropped (below the precision of "
+            "values given to 9 significant digits, as seed 000's tables give them)")
 NO_SYMBOLIC_LOOPS = ("a closed-loop device has no symbolic tree equations: its passive joints are solved numerically "
                      "from the loop closures, so H, C and G are not closed-form expressions of the actuated joints")
 
@@ -111,14 +114,15 @@ def equations_of_motion(ctx: Context) -> Outcome:
         summary=f"{device.name}: tau = H(theta) thetadd + C(theta) thetad^2 + G(theta) (eq. 2.50), "
                 f"{n} joints; the symbolic and compiled forms agree to {worst:.1e}.",
         paragraphs=[
-            "H and G below are exact in the joint coordinates with the design's numbers substituted "
+            "H and G below are exact in the joint coordinates with the design's numbers substituted, shown "
+            f"{READABLE} "
             "(`hapticdesign eom --symbolic none`). " + ctx.settings.design_note(),
             f"With every length and inertial parameter kept as a symbol (`--symbolic all`) the equations have "
             f"{terms} terms ({len(full_text)} characters of text).",
             f"Evaluations in SI units (rad or m, N m or N): joint rates {qd[0]} and accelerations {qdd[0]} on every joint.",
         ],
-        listings=[("H, exact:", export(numeric, "text", "H")),
-                  ("G, exact:", export(numeric, "text", "G")),
+        listings=[(f"H, {READABLE}:", export(rounded(numeric, relative=READABLE_RELATIVE), "text", "H")),
+                  (f"G, {READABLE}:", export(rounded(numeric, relative=READABLE_RELATIVE), "text", "G")),
                   ("H at q = 0 (compiled model):", matrix_text("H", mass_matrix(device, np.zeros(n))))],
         tables=[Table("evaluations", "H diagonal, G and tau at three poses", columns, rows)],
         numbers={"symbolic_terms": terms, "symbolic_characters": len(full_text), "max_symbolic_vs_compiled": worst,

@@ -14,6 +14,7 @@ import numpy as np
 from hapticdesign.analysis.metrics import names
 from hapticdesign.analysis.metrics.dynamic import modes
 from hapticdesign.analysis.metrics.globalization import global_indices
+from hapticdesign.analysis.metrics.maps import draw_map
 from hapticdesign.analysis.rcube import dynamics as rcube_dynamics
 from hapticdesign.analysis.rcube import kinematics as rcube_kinematics
 from hapticdesign.analysis.rcube import metrics as rcube_metrics
@@ -242,16 +243,16 @@ def maps_step(ctx: Context) -> Outcome:
     for name in MAP_METRICS:
         fig, axes = plt.subplots(1, 3, figsize=(11, 3.4), constrained_layout=True)
         for ax, o, maps in zip(axes, offsets, planes):
-            image = ax.imshow(np.ma.masked_invalid(maps[name]).T, origin="lower", extent=extent, cmap="viridis")
+            draw_map(fig, ax, maps[name], extent, f"{name} [{names.METRICS[name].unit}]")
             ax.set_title(f"plane z {o * 1e3:+.0f} mm")
             ax.set_xlabel("x [mm]")
             ax.set_ylabel("y [mm]")
-            fig.colorbar(image, ax=ax, shrink=0.8, label=f"{name} [{names.METRICS[name].unit}]")
         label, unit = names.METRICS[name]
         figures.append(figure_from_matplotlib(
             fig, f"map_{name}", f"{label[0].upper()}{label[1:]} over the workspace of the final design",
             f"Table 7.8's design on the planes z = -60, 0, +60 mm through the 120 mm cube (§7.5), {n} x {n} points "
-            f"per plane; colour: {name} in {unit}; blank cells are unreachable or singular poses."))
+            f"per plane; colour: {name} in {unit}, scaled between the 2 % and 98 % points of its values (the few beyond "
+            f"in their own colours, counted in the legend); grey cells are unreachable or singular poses."))
     merged = {k: np.concatenate([p[k].ravel() for p in planes]) for k in planes[0]}
     glob = global_indices(merged)
     rows = [[k, float(v), names.METRICS[k].unit, names.METRICS[k].description] for k, v in glob.items()]

@@ -44,13 +44,16 @@ class Section:
 
 
 def planes(basis: np.ndarray) -> list[tuple[tuple[str, str], np.ndarray]]:
-    """The section planes: the base axes' planes for a spatial device, the plane of motion for a planar one."""
+    """The section planes: the base axes' planes for a spatial device, the plane of motion for a planar one (its
+    axes in the base's order, x before y before z, each pointing along its base axis: an x-z plane, never "z-x")."""
     if basis.shape[1] == 3:
         return [((AXES[i], AXES[j]), np.eye(3)[[i, j]]) for i, j in ((0, 1), (0, 2), (1, 2))]
     axes = basis[:, :2].T.copy()
+    dominant = [int(np.argmax(np.abs(axis))) for axis in axes]
+    if dominant[0] > dominant[1]:
+        axes, dominant = axes[::-1].copy(), dominant[::-1]
     names = []
-    for axis in axes:
-        k = int(np.argmax(np.abs(axis)))
+    for axis, k in zip(axes, dominant):
         names.append(AXES[k] if abs(axis[k]) > 1.0 - 1e-9 else "u" if not names else "v")
         axis *= np.sign(axis[k])
     return [((names[0], names[1]), axes)]
@@ -87,6 +90,23 @@ def _reach(device: Device, target: np.ndarray, last: np.ndarray, home: np.ndarra
     return None
 
 
+MIN_WIDTH = 6.0
+"""Inches: a planar device's single panel is drawn this wide, so titles fit."""
+
+
+def panel_width(panels: int) -> float:
+    """Figure width (inches) for ``panels`` panels side by side."""
+    return max(4.2 * panels, MIN_WIDTH)
+
+
+def wrapped(title: str, fig) -> str:
+    """``title`` broken into lines that fit the figure's width at 10 pt (about 0.085 inch per character)."""
+    import textwrap
+
+    width = max(20, int(fig.get_size_inches()[0] / 0.085))
+    return "\n".join(textwrap.fill(line, width) for line in title.split("\n"))
+
+
 def section_figure(sections: list[Section], edge: float, title: str):
     """A matplotlib figure: one panel per section, reached points filled, the cube's section outlined (mm)."""
     import matplotlib
@@ -95,7 +115,7 @@ def section_figure(sections: list[Section], edge: float, title: str):
     import matplotlib.pyplot as plt
     from matplotlib.colors import ListedColormap
 
-    fig, axes = plt.subplots(1, len(sections), figsize=(4.2 * len(sections), 4.2), squeeze=False,
+    fig, axes = plt.subplots(1, len(sections), figsize=(panel_width(len(sections)), 4.2), squeeze=False,
                              constrained_layout=True)
     half = 500.0 * edge
     for ax, section in zip(axes[0], sections):
@@ -112,7 +132,7 @@ def section_figure(sections: list[Section], edge: float, title: str):
         ax.set_title(f"{section.names[0]}-{section.names[1]} plane through home", fontsize=10)
         ax.set_aspect("equal")
     axes[0][0].legend(loc="lower left", fontsize=7)
-    fig.suptitle(title, fontsize=10)
+    fig.suptitle(wrapped(title, fig), fontsize=10)
     return fig
 
 
@@ -181,13 +201,14 @@ def quantity_png(device: Device, sections: list[Section], edge: float) -> bytes 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from hapticdesign.analysis.metrics.maps import draw_map
     from hapticdesign.files import figure_bytes
 
     maps = quantity_maps(device, sections)
     rows = [(key, label, unit) for key, label, unit in QUANTITIES if key in maps]
     if not rows:
         return None
-    fig, axes = plt.subplots(len(rows), len(sections), figsize=(4.2 * len(sections), 3.6 * len(rows)),
+    fig, axes = plt.subplots(len(rows), len(sections), figsize=(panel_width(len(sections)), 3.6 * len(rows)),
                              squeeze=False, constrained_layout=True)
     half = 500.0 * edge
     for r, (key, label, unit) in enumerate(rows):
@@ -195,15 +216,14 @@ def quantity_png(device: Device, sections: list[Section], edge: float) -> bytes 
             step = 1000.0 * (section.u[1] - section.u[0])
             extent = (1000.0 * section.u[0] - step / 2, 1000.0 * section.u[-1] + step / 2,
                       1000.0 * section.v[0] - step / 2, 1000.0 * section.v[-1] + step / 2)
-            image = ax.imshow(values.T, origin="lower", extent=extent, interpolation="nearest", cmap="viridis")
-            fig.colorbar(image, ax=ax, label=f"{label} [{unit}]", shrink=0.85)
+            draw_map(fig, ax, values, extent, f"{label} [{unit}]")
             ax.plot([-half, half, half, -half, -half], [-half, -half, half, half, -half], color="#c0392b",
                     linewidth=1.0)
             ax.set_xlabel(f"{section.names[0]} - home [mm]")
             ax.set_ylabel(f"{section.names[1]} - home [mm]")
             ax.set_title(f"{label}, {section.names[0]}-{section.names[1]} plane", fontsize=9)
             ax.set_aspect("equal")
-    fig.suptitle(f"{device.name[:60]}: the sheet's quantities over the workspace reached", fontsize=10)
+    fig.suptitle(wrapped(f"{device.name[:60]}: the sheet's quantities over the workspace reached", fig), fontsize=10)
     png = figure_bytes(fig, "png", dpi=100)
     plt.close(fig)
     return png

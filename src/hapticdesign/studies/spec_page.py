@@ -1,4 +1,5 @@
-"""The spec sheet as an HTML page: our numbers beside the vendor's, with the reason for each difference.
+"""What the spec sheet's page shows (the page itself: :mod:`hapticdesign.interface.report.spec_page`): its rows,
+each value in words, and the vendor's numbers beside ours with the reason for each difference.
 
 Vendor numbers (stated where they are known): the Phantom Premium 1.5's data sheet (nominal position
 resolution 0.03 mm, continuous force 1.4 N, peak force 8.5 N, apparent mass at the tip under 75 g) and the
@@ -6,9 +7,6 @@ stiffness CHAI3D recommends for rendering on it (800 N/m) and on the Novint Falc
 """
 
 from __future__ import annotations
-
-import base64
-import html
 
 VENDOR = {
     "phantom-premium": {
@@ -38,62 +36,31 @@ VENDOR = {
     },
 }
 
-ROWS = [("resolution", "resolution", "m"), ("force_continuous", "continuous force", "N"),
+ROWS = [("resolution", "resolution", "mm"), ("force_continuous", "continuous force", "N"),
         ("force_peak", "peak force", "N"), ("apparent_mass", "apparent mass (min - max)", "kg"),
         ("backdrive_friction", "backdrive friction (min - max)", "N"), ("stiffness", "stiffness (VJM)", "N/m"),
         ("workspace", "workspace cube edge", "mm"), ("renderable_stiffness", "renderable stiffness (exact)", "N/m")]
 
 
-def _value(sheet: dict, key: str) -> str:
+def value_text(sheet: dict, key: str) -> str:
+    """The sheet's ``key`` in words (resolution in mm): "not stated in the file" where the file lacks what it needs,
+    the renderable stiffness too when the file states no damping and no friction (its exact limit and passivity
+    bounds would print as 0 N/m, which would read as a measured zero)."""
     value = sheet.get(key)
     if value is None:
         return "not stated in the file"
+    if key == "resolution":
+        return f"{1000 * value:.4g}"
     if key in ("apparent_mass", "backdrive_friction"):
         return f"{value['min']:.4g} - {value['max']:.4g}"
     if key == "workspace":
         return f"{value['cube']:.4g}"
     if key == "renderable_stiffness":
+        if value["passivity_viscous"] == 0.0 and not value["passivity_coulomb"]:
+            return "not stated: the file has no damping or friction, which bound it"
         return (f"{value['exact']:.4g} (at {value['rate']:g} Hz, one sample of delay); passivity: 2b/T = "
                 f"{value['passivity_viscous']:.4g}, 2 f_c / Delta = "
                 + ("n/a" if value["passivity_coulomb"] is None else f"{value['passivity_coulomb']:.4g}"))
     return f"{value:.4g}"
 
 
-def _figures(figures) -> str:
-    """``(title, caption, png bytes)`` as embedded images (the page stays one self-contained file)."""
-    out = []
-    for title, caption, png in figures:
-        data = base64.b64encode(png).decode("ascii")
-        out.append(f"<h2>{html.escape(title)}</h2>\n<figure><img src=\"data:image/png;base64,{data}\" "
-                   f"alt=\"{html.escape(title)}\" style=\"max-width: 100%\"><figcaption>{html.escape(caption)}"
-                   "</figcaption></figure>\n")
-    return "".join(out)
-
-
-def spec_page(sheet: dict, figures=()) -> str:
-    """A self-contained HTML page of ``sheet`` (:func:`hapticdesign.studies.spec.spec_sheet`) and ``figures``
-    (``(title, caption, png bytes)``, e.g. :func:`hapticdesign.studies.spec_maps.workspace_png`); text escaped."""
-    vendor = VENDOR.get(sheet["device"], {})
-    rows = []
-    for key, label, unit in ROWS:
-        ours = _value(sheet, key)
-        if key == "resolution" and sheet.get(key) is not None:
-            ours = f"{1000 * sheet[key]:.4g}"
-            unit = "mm"
-        theirs, note = ("", "")
-        if key in vendor:
-            number, vendor_unit, note = vendor[key]
-            theirs = f"{number:g} {vendor_unit}"
-        rows.append("<tr>" + "".join(f"<td>{html.escape(str(cell))}</td>" for cell in (label, ours, unit, theirs, note))
-                    + "</tr>")
-    pose = ", ".join(f"{v:.4g}" for v in sheet["q"])
-    handle = ", ".join(f"{1000 * v:.4g}" for v in sheet["handle"])
-    return (
-        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>"
-        f"{html.escape(sheet['device'])} spec sheet</title></head><body>\n"
-        f"<h1>{html.escape(sheet['device'])}: spec sheet</h1>\n"
-        f"<p>At q = ({html.escape(pose)}), handle at ({html.escape(handle)}) mm. Forces exclude gravity; "
-        "definitions in hapticdesign.studies.spec.</p>\n"
-        "<table border=\"1\"><tr><th>quantity</th><th>ours</th><th>unit</th><th>vendor</th><th>why they differ</th>"
-        "</tr>\n" + "\n".join(rows) + "\n</table>\n" + _figures(figures) + "</body></html>\n"
-    )

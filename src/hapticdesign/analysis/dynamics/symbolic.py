@@ -14,7 +14,7 @@ inertia about the mass centre with products of inertia entering with a minus sig
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from fractions import Fraction
 from math import pi
 
@@ -407,6 +407,23 @@ def derive(device: Device, symbolic: str = "all") -> SymbolicEquations:
         thetadd=[sp.Symbol(f"{name}dd", real=True) for name in coordinates],
         parameters=[sym[nm] for nm in aff.names + inertial],
     )
+
+
+def rounded(eqs: SymbolicEquations, digits: int = 6, relative: float = 1e-12) -> SymbolicEquations:
+    """``eqs`` for reading: each of H, C and G with the terms whose number is below ``relative`` times the
+    matrix's largest dropped (the exact rationals of a design's floating-point values carry their round-off,
+    e.g. ``17*sin(theta3)/31250000000000`` beside terms of order 0.01) and numbers to ``digits`` significant
+    digits."""
+
+    def matrix(m: sp.Matrix) -> sp.Matrix:
+        expanded = m.applyfunc(sp.expand)
+        terms = [[t.as_coeff_Mul() for t in sp.Add.make_args(e)] for e in expanded]
+        largest = max((abs(float(c)) for entry in terms for c, _ in entry), default=0.0)
+        kept = [sp.Add(*[sp.Float(c, digits) * rest for c, rest in entry if abs(float(c)) >= relative * largest])
+                for entry in terms]
+        return sp.Matrix(m.shape[0], m.shape[1], kept)
+
+    return replace(eqs, H=matrix(eqs.H), C=matrix(eqs.C), G=matrix(eqs.G))
 
 
 def export(eqs: SymbolicEquations, fmt: str, part: str = "tau") -> str:

@@ -43,10 +43,55 @@ def evaluate_planes(
     return out
 
 
+ROBUST_PERCENTILES = (2.0, 98.0)
+"""A map's colour scale runs between these percentiles of its values; the few beyond (near-singular points) are
+marked in their own colours instead of flattening the rest into one colour."""
+UNREACHED, ABOVE, BELOW = "#d0d0d0", "#e7298a", "#000000"
+
+
+def robust_limits(values) -> tuple[float, float] | None:
+    """The colour scale's limits: :data:`ROBUST_PERCENTILES` of the finite values (their whole range when the
+    percentiles coincide; None when there is no finite value)."""
+    finite = np.asarray(values, dtype=float)
+    finite = finite[np.isfinite(finite)]
+    if finite.size == 0:
+        return None
+    low, high = (float(v) for v in np.percentile(finite, ROBUST_PERCENTILES))
+    return (low, high) if high > low else (float(finite.min()), float(finite.max()))
+
+
+def draw_map(fig, ax, values: np.ndarray, extent, label: str):
+    """``values`` (first index along x) as a heat map on ``ax`` with a colour bar labelled ``label`` (name and
+    unit): the scale from :func:`robust_limits`, values beyond it in :data:`ABOVE` / :data:`BELOW` (the colour
+    bar's arrows), points not reached (NaN) in grey, each named with its count in a legend under the map."""
+    from matplotlib.patches import Patch
+    import matplotlib.pyplot as plt
+
+    values = np.asarray(values, dtype=float)
+    limits = robust_limits(values)
+    low, high = limits if limits is not None else (0.0, 1.0)
+    cmap = plt.get_cmap("viridis").with_extremes(bad=UNREACHED, over=ABOVE, under=BELOW)
+    finite = values[np.isfinite(values)]
+    above, below = int(np.sum(finite > high)), int(np.sum(finite < low))
+    missing = int(np.sum(~np.isfinite(values)))
+    image = ax.imshow(np.ma.masked_invalid(values).T, origin="lower", extent=extent, cmap=cmap, vmin=low, vmax=high,
+                      interpolation="nearest")
+    extend = {(False, False): "neither", (True, False): "max", (False, True): "min", (True, True): "both"}
+    fig.colorbar(image, ax=ax, label=label, shrink=0.85, extend=extend[(above > 0, below > 0)])
+    handles = [Patch(color=colour, label=f"{text} ({count})") for colour, text, count in (
+        (UNREACHED, "not reached", missing), (ABOVE, f"above {ROBUST_PERCENTILES[1]:g} % of the values", above),
+        (BELOW, f"below {100 - ROBUST_PERCENTILES[0]:g} % of the values", below)) if count]
+    if handles:
+        ax.legend(handles=handles, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=len(handles),
+                  frameon=False)
+    return image
+
+
 def save_map(path: Path, values: np.ndarray, offsets: np.ndarray, title: str, labels: tuple[str, str],
-             offsets_y: np.ndarray | None = None) -> Path:
-    """One metric map as a PNG heat map (matplotlib Agg backend); ``offsets`` along the first axis (and the second
-    unless ``offsets_y`` is given), m from the centre."""
+             offsets_y: np.ndarray | None = None, unit: str = "") -> Path:
+    """One metric map as a PNG heat map (matplotlib Agg backend, :func:`draw_map`); ``offsets`` along the first
+    axis (and the second unless ``offsets_y`` is given), m from the centre; ``unit`` of the values for the colour
+    bar."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -54,9 +99,8 @@ def save_map(path: Path, values: np.ndarray, offsets: np.ndarray, title: str, la
 
     second = offsets if offsets_y is None else offsets_y
     extent = (offsets[0] * 1e3, offsets[-1] * 1e3, second[0] * 1e3, second[-1] * 1e3)
-    fig, ax = plt.subplots(figsize=(4.8, 4.0), dpi=100)
-    image = ax.imshow(np.ma.masked_invalid(values).T, origin="lower", extent=extent, cmap="viridis")
-    fig.colorbar(image, ax=ax)
+    fig, ax = plt.subplots(figsize=(4.8, 4.4), dpi=100)
+    draw_map(fig, ax, values, extent, f"{title.split(',')[0]} [{unit or '-'}]")
     ax.set_title(title)
     ax.set_xlabel(f"{labels[0]} (mm from centre)")
     ax.set_ylabel(f"{labels[1]} (mm from centre)")

@@ -11,6 +11,7 @@ import numpy as np
 
 from hapticdesign.analysis.metrics import dynamic, kinematic, names, stiffness
 from hapticdesign.analysis.metrics.maps import evaluate_planes, plane_grid, save_map
+from hapticdesign.analysis.metrics.names import METRICS
 from hapticdesign.analysis.rcube.design import RCubeDesign
 from hapticdesign.analysis.rcube.dynamics import cartesian_mass_matrix
 from hapticdesign.analysis.rcube.kinematics import active_jacobian, inverse_kinematics, is_reachable, is_singular
@@ -84,5 +85,5 @@ def save_workspace_maps(design: RCubeDesign, out_dir: Path, n: int = 21, half_wi
         for name in names:
             tag = f"{o * 1e3:+.0f}".replace("+", "p").replace("-", "m")
             paths.append(save_map(Path(out_dir) / f"{name}_plane{tag}.png", maps[name], grid_offsets,
-                                  f"{name}, plane {o * 1e3:+.0f} mm", ("x", "y")))
+                                  f"{name}, plane {o * 1e3:+.0f} mm", ("x", "y"), unit=METRICS[name].unit))
     return paths

@@ -100,7 +100,8 @@ def spec(
     stiffness beside the passivity bounds."""
     from hapticdesign.files import dumps_json, write_atomically
     from hapticdesign.studies.spec import spec_sheet
-    from hapticdesign.studies.spec_page import spec_page
+    from hapticdesign.interface.report.spec_page import spec_page
+    from hapticdesign.interface.round_off import without_round_off
 
     with user_errors(strict=strict, quiet=quiet):
         from hapticdesign.devices.loading import resolve_device
@@ -108,6 +109,7 @@ def spec(
         dev = resolve_device(preset, device, params, strict=strict)
         pose = None if q is None else parse_vector(q, dev.n_dof, "q")
         sheet = spec_sheet(dev, pose, rate=rate, workspace=workspace)
+        sheet["handle"] = without_round_off(sheet["handle"])  # a position's 1e-18 m residue is 0
         if out is not None:
             figures = []
             if sheet["workspace"] is not None and sheet["workspace"]["cube"] > 0.0:

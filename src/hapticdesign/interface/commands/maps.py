@@ -85,6 +85,7 @@ def _write(out: Path, found, names: list[str], plane: list[int]) -> list[str]:
 
     from hapticdesign.analysis.metrics.maps import save_map
     from hapticdesign.files import write_atomically
+    from hapticdesign.simulation.design_indices import DESIGN_INDICES
     from hapticdesign.interface.report.tables import csv_text
     from hapticdesign.studies.steps import Table
 
@@ -96,7 +97,7 @@ def _write(out: Path, found, names: list[str], plane: list[int]) -> list[str]:
         grid = np.full((len(xs), len(ys)), np.nan)
         grid[np.searchsorted(xs, points[:, first]), np.searchsorted(ys, points[:, second])] = found.values[key]
         path = save_map(Path(out) / f"map_{key}.png", grid, xs - xs.mean(), f"{key}", (AXES[first], AXES[second]),
-                        ys - ys.mean())
+                        ys - ys.mean(), unit=DESIGN_INDICES[key].unit)
         files.append(str(path))
     rows = [[*p, bool(r), *(found.values[k][i] for k in names), reason or ""]
             for i, (p, r, reason) in enumerate(zip(points, found.reached, found.reasons))]

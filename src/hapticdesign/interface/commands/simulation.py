@@ -10,7 +10,7 @@ import typer
 
 from hapticdesign.interface.options import DEVICE, FORCE, FORCE_HINT, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
 from hapticdesign.errors import UserError
-from hapticdesign.interface.common import (joint_units, note, parse_vector, print_json, progress_bar, progress_lines,
+from hapticdesign.interface.common import (joint_units, note, parse_vector, print_json, progress_bar,
                                            user_errors, write_atomically)
 from hapticdesign.workload import allow_large
 
@@ -367,8 +367,7 @@ def campaign_command(
         options = CampaignOptions(preset or "phantom-3dof", k_limit, stiffness, Chirp(0.3, 0.1, f1, sweep), duration,
                                   method=method, conditions=conditions)
         with progress_bar(not (quiet or json_out)) as report:
-            advance = ((lambda done, total: report("cases", done, total)) if report
-                       else progress_lines(not (quiet or json_out), "campaign cases"))
+            advance = (lambda done, total: report("campaign cases", done, total)) if report else None
             counts = run_campaign(designs, out, options, scheduler, workers, advance, quiet=quiet)
         index = write_folder_index(out, f"Campaign {designs.name}", (
             f"{options.method.capitalize()} campaign of the designs in {designs.name} on {options.preset}: both "

@@ -175,7 +175,7 @@ def robustness_command(
     from hapticdesign.interface.common import progress_bar
     from hapticdesign.simulation.campaign import read_designs
     from hapticdesign.simulation.figures import robustness_chart
-    from hapticdesign.simulation.robustness import error_cases, summarize_errors
+    from hapticdesign.simulation.robustness import case_count, error_cases, summarize_errors
 
     with user_errors(quiet=quiet):
         if method not in ("analytic", "fast"):
@@ -193,8 +193,11 @@ def robustness_command(
             seen[d.level] = seen.get(d.level, 0) + 1
             if per_level is None or seen[d.level] <= per_level:
                 chosen.append((d.name, d.level, base.with_params(d.params)))
+        cases = case_count(len(chosen), levels, draws)
+        note(f"robustness: {len(chosen)} designs x {len(levels)} error levels ({draws} draws at each level above 0) = "
+             f"{cases} stable-range searches ({method})", quiet or json_out)
         with progress_bar(not (quiet or json_out)) as report:
-            advance = (lambda done, total: report("designs x errors", done, total)) if report else None
+            advance = (lambda done, total: report("robustness searches", done, total)) if report else None
             cases = error_cases(chosen, levels, seed, method=method, progress=advance, sim_type=sim_type, draws=draws)
         rows = summarize_errors(cases)
         files = []

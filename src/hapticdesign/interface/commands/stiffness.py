@@ -50,9 +50,11 @@ def stiffness(
     quiet: bool = QUIET,
 ) -> None:
     """Cartesian stiffness K_C of a device's end effector by the virtual joint method (seed 001 eq. 5.98-5.123):
-    elastic links and joint springs from the device file, passive joints free, loops closed."""
+    elastic links and joint springs from the device file, passive joints free, loops closed. Entries below 1e-12
+    of the largest are round-off and shown as 0, as in `rcube stiffness`."""
     from hapticdesign.analysis.configuration import configuration_of
     from hapticdesign.analysis.stiffness.device import cartesian_stiffness, deflection
+    from hapticdesign.interface.round_off import RELATIVE, without_round_off
 
     with user_errors(quiet=quiet):
         from hapticdesign.devices.loading import resolve_device
@@ -63,7 +65,7 @@ def stiffness(
             note(f"warning: {message}", quiet)
         if frame is not None and frame not in dev.mechanism.compiled.frame_node:
             raise UserError(f"--frame: unknown frame {frame!r} (frames: {', '.join(f.name for f in dev.mechanism.frames)})")
-        K = cartesian_stiffness(dev, qv, frame)
+        K = without_round_off(cartesian_stiffness(dev, qv, frame))
         result = {"device": dev.name, "frame": frame or dev.mechanism.end_effector, "q": qv,
                   "K_C": K[:3, :3] if translational else K}
         if wrench is not None:
@@ -72,7 +74,8 @@ def stiffness(
                 raise UserError(f"--wrench: give Fx,Fy,Fz or Fx,Fy,Fz,Mx,My,Mz, got {len(w)} values")
             w = np.concatenate([w, np.zeros(6 - len(w))])
             result["wrench"], result["deflection"] = w, deflection(K, w)
-        result["units"] = {**UNITS, "K_C": TRANSLATIONAL} if translational else UNITS
+        result["units"] = {**UNITS, "K_C": TRANSLATIONAL} if translational else dict(UNITS)
+        result["units"]["round_off"] = f"entries of K_C below {RELATIVE:g} of its largest are shown as 0"
         if json_out:
             print_json(result)
             return

@@ -24,13 +24,14 @@ SCALE = typer.Option(None, "--scale", hidden=True, help="full, quick or smoke (t
 
 
 class RichProgress:
-    """Study progress on stderr: one line per step, a bar where the step reports its progress."""
+    """Study progress on stderr: one line per step, a bar with the time left where the step reports its progress."""
 
     def __init__(self, console) -> None:
-        from rich.progress import BarColumn, MofNCompleteColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
+        from rich.progress import (BarColumn, MofNCompleteColumn, Progress, SpinnerColumn, TextColumn,
+                                   TimeElapsedColumn, TimeRemainingColumn)
 
         self.bars = Progress(SpinnerColumn(), TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                             TimeElapsedColumn(), console=console)
+                             TimeElapsedColumn(), TextColumn("left"), TimeRemainingColumn(), console=console)
         self.task = None
 
     def begin(self, title: str) -> None:

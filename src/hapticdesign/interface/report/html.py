@@ -22,7 +22,8 @@ td:first-child, th:first-child, td.text { text-align: left; }
 table.wide { font-size: .75em; }
 table.wide th { white-space: normal; }
 caption { caption-side: top; text-align: left; font-weight: bold; padding: .3em 0; }
-pre { background: #f6f6f8; border: 1px solid #dde; padding: .6em; overflow-x: auto; font-size: .85em; }
+pre { background: #f6f6f8; border: 1px solid #dde; padding: .6em; overflow-x: auto; font-size: .85em;
+      white-space: pre-wrap; overflow-wrap: anywhere; }
 figure { margin: 1em 0; }
 figure img { max-width: 100%; border: 1px solid #dde; }
 figcaption { font-size: .9em; color: #444; }

@@ -5,6 +5,7 @@ string (names, expressions, reasons, the device's name) is escaped."""
 from __future__ import annotations
 
 import base64
+import re
 from dataclasses import dataclass
 from html import escape
 
@@ -78,16 +79,33 @@ def _study_rows(run: StudyRun) -> str:
     return "".join(parts)
 
 
+NUMBER = re.compile(r"(?<![\w.])[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?(?![\w.])")
+"""A number in a reason (not the digits of a name such as ``l1``)."""
+
+
+def reason_kind(reason: str) -> tuple[str, list[float]]:
+    """A reason without its numbers (each shown as ``#``) and the numbers, in order: ``"l1 + l2 = 0.300198, not <=
+    0.3"`` is ``("l1 + l2 = #, not <= #", [0.300198, 0.3])``."""
+    return NUMBER.sub("#", reason), [float(n) for n in NUMBER.findall(reason)]
+
+
 def _reasons(run: StudyRun) -> str:
-    counts: dict[str, int] = {}
+    """Infeasible designs grouped by the kind of reason (numbers aside: the designs of one kind differ only in
+    them), the most frequent first, with the range of each number over the group."""
+    groups: dict[str, list[list[float]]] = {}
     for r in run.records:
         if not r.feasible:
-            key = r.reason.split(":")[0]
-            counts[key] = counts.get(key, 0) + 1
-    if not counts:
+            kind, numbers = reason_kind(r.reason.split(":")[0])
+            groups.setdefault(kind, []).append(numbers)
+    if not groups:
         return "<p>Every evaluated design was feasible.</p>"
-    rows = [[k, v] for k, v in sorted(counts.items(), key=lambda kv: (-kv[1], kv[0]))[:12]]
-    return _table("Why designs were infeasible (evaluations.csv has each design's reason)", ["reason", "designs"], rows)
+    rows = []
+    for kind, numbers in sorted(groups.items(), key=lambda kv: (-len(kv[1]), kv[0]))[:12]:
+        columns = list(zip(*numbers)) if len({len(n) for n in numbers}) == 1 else []
+        ranges = "; ".join(f"{min(c):.6g}" if min(c) == max(c) else f"{min(c):.6g} to {max(c):.6g}" for c in columns)
+        rows.append([kind, len(numbers), ranges])
+    return _table("Why designs were infeasible, by kind of reason (# stands for the numbers; evaluations.csv has "
+                  "each design's reason)", ["reason", "designs", "numbers (#, in order: range)"], rows)
 
 
 def render(run: StudyRun, selection: Selection, title: str, pareto: Picture, pictures: list[Picture],
@@ -95,8 +113,8 @@ def render(run: StudyRun, selection: Selection, title: str, pareto: Picture, pic
     """The report as one HTML document."""
     spec = run.spec
     names = [o.name for o in spec.objectives]
-    columns = ["design", *spec.variables, *names, *constraint_labels(spec)]
-    rows = [[n, *(run.records[k].values[v] for v in spec.variables), *run.records[k].objectives,
+    columns = ["design", *names, *spec.variables, *constraint_labels(spec)]  # the objectives first: what a front is
+    rows = [[n, *run.records[k].objectives, *(run.records[k].values[v] for v in spec.variables),
              *run.records[k].constraints] for n, k in enumerate(run.front, start=1)]
     chosen = run.records[selection.record]
     selected_rows = ([[name, chosen.values[name]] for name in spec.variables]

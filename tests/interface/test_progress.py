@@ -1,0 +1,84 @@
+"""Long work says so: its size and an estimate of the time left first, then progress with the time left."""
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from hapticdesign.interface.common import TimeLeft, duration_text, progress_bar
+from tests.helpers.sim_designs import write_designs
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+class Clock:
+    def __init__(self):
+        self.now = 0.0
+
+    def __call__(self) -> float:
+        return self.now
+
+
+def test_time_left_is_the_pace_since_the_first_item_times_the_items_to_do():
+    """A first item that takes 30 s (a compile) and 2 s for each one after: the estimate is 2 s per item left."""
+    clock = Clock()
+    left = TimeLeft(clock, min_seconds=5.0)
+    clock.now = 30.0
+    assert left("cases", 1, 100) is None  # no pace yet
+    clock.now = 32.0
+    assert left("cases", 2, 100) is None  # under 5 s and under a tenth: too early to say
+    clock.now = 30.0 + 2 * 5
+    assert left("cases", 6, 100) == pytest.approx(2.0 * 94)
+    assert left("other", 3, None) is None  # an unknown total has no time left
+
+
+def test_durations_read_as_seconds_minutes_or_hours():
+    assert [duration_text(s) for s in (40, 210, 7560)] == ["40 s", "3.5 min", "2.1 h"]
+
+
+def test_progress_in_a_log_states_the_estimate_once_then_each_tenth_with_the_time_left(capsys, monkeypatch):
+    """One item a second: nothing in the first 2 s (short work needs no log), then the estimate, then a line at
+    each tenth with the time left."""
+    clock = Clock()
+    monkeypatch.setattr("time.monotonic", clock)
+    with progress_bar(True) as report:  # stderr is captured: not a terminal
+        for done in range(1, 101):
+            clock.now = 1.0 * done
+            report("cases", done, 100)
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert lines[0] == "cases: 100 in all; at the pace so far, about 1.6 min left"  # 98 s: 2 of 100 after 2 s
+    assert lines[1] == "cases: 2 of 100, about 1.6 min left"
+    assert lines[2] == "cases: 10 of 100, about 1.5 min left"
+    assert lines[-1] == "cases: 100 of 100" and len(lines) == 12
+    with progress_bar(False) as report:
+        assert report is None
+
+
+def test_work_that_ends_within_two_seconds_writes_no_progress_to_a_log(capsys, monkeypatch):
+    clock = Clock()
+    monkeypatch.setattr("time.monotonic", clock)
+    with progress_bar(True) as report:
+        for done in range(1, 11):
+            clock.now = 0.1 * done
+            report("cases", done, 10)
+    assert capsys.readouterr().err == ""
+
+
+def test_robustness_states_its_size_and_the_time_left(tmp_path):
+    """The README's robustness run, small: before the searches their number, then the estimate (stderr of a
+    child process, as in a log); --json stays quiet."""
+    designs = write_designs(tmp_path / "designs.csv")
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
+    args = [sys.executable, "-c", "from hapticdesign.interface.cli import main; main()", "robustness", "--designs", str(designs), "--errors", "0,5",
+            "--draws", "40"]
+    run = subprocess.run(args, capture_output=True, text=True, env=env, cwd=tmp_path, check=False)
+    assert run.returncode == 0, run.stderr
+    err = run.stderr.splitlines()
+    assert err[0] == ("robustness: 4 designs x 2 error levels (40 draws at each level above 0) = 164 stable-range "
+                      "searches (analytic)")
+    assert any(line.startswith("robustness searches: 164 in all; at the pace so far, about ") for line in err)
+    assert err[-1] == "robustness searches: 164 of 164"
+    quiet = subprocess.run([*args, "--json"], capture_output=True, text=True, env=env, cwd=tmp_path, check=False)
+    assert quiet.returncode == 0 and quiet.stderr == ""
