@@ -30,7 +30,7 @@ from pymoo.core.problem import Problem
 from hapticdesign.errors import UserError
 from hapticdesign.files import read_text, write_atomically
 from hapticdesign.optimization.pymoo_run import AlgorithmSpec, initial_population, pareto_filter, run
-from hapticdesign.optimization.shortest import minimize_in_boxes
+from hapticdesign.optimization.local_search import minimize_in_boxes
 from hapticdesign.optimization.study_file import Choice, ExpressionConstraint, Study, StudySpec
 
 CHECKPOINT = "checkpoint"
@@ -289,7 +289,7 @@ def kept_by(spec: StudySpec, values: dict[str, float]) -> bool:
 
 def start_design(study: Study, seed: int, evaluate: Evaluator, encodings: list[Encoding]) -> np.ndarray | None:
     """The design vector minimizing ``algorithm.start.minimize`` under the study's constraints (SLSQP from seeded
-    starts over the box holding every run's bounds, :func:`~hapticdesign.optimization.shortest.minimize_in_boxes`),
+    starts over the box holding every run's bounds, :func:`~hapticdesign.optimization.local_search.minimize_in_boxes`),
     or None when no start meets them. ``evaluate`` answers the constraints (objectives need not be computed)."""
     spec = study.spec
     encoding = encodings[0]
