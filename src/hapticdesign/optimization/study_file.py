@@ -4,9 +4,9 @@ A study names a device file (relative to the study file), the ``variables`` the 
 (continuous bounds ``[low, high]`` or a discrete choice ``{values: [...]}``), the ``workspace`` the handle
 must reach (a box and a grid), the ``objectives`` (an index reduced over the workspace and a sense), the
 ``constraints`` (an index or an affine expression of the variables, bounded by ``<=`` and/or ``>=``) and
-the ``algorithm`` (one record per method, :data:`SETTINGS`: NSGA-II or NSGA-III, population and generations; or
-``convex``, seed 000's exact LN minimization over inertial parameters, which needs no workspace). Everything is checked here with one-line
-messages naming the field; the names of variables and indices are checked against the device and the
+the ``algorithm`` (one record per method, :data:`SETTINGS`: NSGA-II, NSGA-III or particle swarm, population and
+generations; or ``convex``, seed 000's exact LN minimization over inertial parameters, which needs no workspace).
+Everything is checked here with one-line messages naming the field; the names of variables and indices are checked against the device and the
 index registry when the study is bound to them (:mod:`.study_run`).
 
 Expressions use the device files' grammar (:func:`hapticdesign.devices.schema.parse_expression`):
@@ -260,6 +260,8 @@ class _PopulationSearch(_StudyModel):
 
     over_poses: ClassVar[bool] = True
     """Whether the method evaluates designs at the workspace's poses (a study then needs a workspace)."""
+    one_objective: ClassVar[bool] = False
+    """Whether the method minimizes a single objective."""
 
     @property
     def designs(self) -> int:
@@ -291,6 +293,15 @@ class Nsga3(_PopulationSearch):
         return {"partitions": self.partitions}
 
 
+class Pso(_PopulationSearch):
+    """``pso``: particle swarm optimization (Kennedy & Eberhart 1995, pymoo) of one objective; continuous variables
+    only."""
+
+    method: Literal["pso"]
+
+    one_objective: ClassVar[bool] = True
+
+
 class Convex(_StudyModel):
     """``convex``: the exact convex program of seed 000's LN minimization over inertial parameters
     (:mod:`.study_convex`), each body kept ``realizability``: ``rigid-body`` (pseudo-inertia positive
@@ -308,11 +319,11 @@ class Convex(_StudyModel):
         return 1
 
 
-SETTINGS = {"nsga2": Nsga2, "nsga3": Nsga3, "convex": Convex}
+SETTINGS = {"nsga2": Nsga2, "nsga3": Nsga3, "pso": Pso, "convex": Convex}
 """Each method's settings record, by name (the methods themselves: :mod:`.study_methods`)."""
 
 
-def algorithm_settings(value: dict) -> Nsga2 | Nsga3 | Convex:
+def algorithm_settings(value: dict) -> Nsga2 | Nsga3 | Pso | Convex:
     """The ``algorithm`` mapping as its method's record (``nsga2`` without ``method``); a setting of another method
     is refused in one line naming the methods it belongs to."""
     method = value.get("method", "nsga2")
@@ -330,7 +341,7 @@ def algorithm_settings(value: dict) -> Nsga2 | Nsga3 | Convex:
         raise ValueError(f"algorithm.{describe_validation_error(exc)}") from None
 
 
-AlgorithmSettings = Annotated[Nsga2 | Nsga3 | Convex, Field(discriminator="method")]
+AlgorithmSettings = Annotated[Nsga2 | Nsga3 | Pso | Convex, Field(discriminator="method")]
 """The ``algorithm`` of a study: one record per method, chosen by ``method`` (:func:`algorithm_settings`)."""
 
 
@@ -359,6 +370,9 @@ class StudySpec(_StudyModel):
         if self.workspace is None and self.algorithm.over_poses and not self.parameters_only:
             raise ValueError("workspace: the region the handle must reach is required (only method convex, whose "
                              "LN is over the joint region, and a study of parameter indices alone do without)")
+        if isinstance(self.algorithm, _PopulationSearch) and self.algorithm.one_objective and len(self.objectives) > 1:
+            raise ValueError(f"objectives: method {self.algorithm.method} minimizes one objective, not "
+                             f"{len(self.objectives)} (use method nsga2 or nsga3)")
         names = [o.name for o in self.objectives]
         twice = sorted({n for n in names if names.count(n) > 1})
         if twice:

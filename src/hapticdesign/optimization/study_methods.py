@@ -2,7 +2,7 @@
 method object with one :meth:`~PopulationSearch.run` (pymoo's style: the study is the Problem, the method the
 Algorithm, the :class:`~hapticdesign.optimization.study_run.StudyRun` the Result that keeps them).
 
-- ``nsga2``, ``nsga3``: a population search of pymoo (:data:`~hapticdesign.optimization.pymoo_run.ALGORITHMS`),
+- ``nsga2``, ``nsga3``, ``pso``: a population search of pymoo (:data:`~hapticdesign.optimization.pymoo_run.ALGORITHMS`),
   each generation checkpointed, then the front polished as ``algorithm.polish`` asks (:mod:`.study_polish`).
 - ``convex``: seed 000's LN minimization over inertial parameters as one exact convex program (:mod:`.study_convex`).
 
@@ -110,7 +110,7 @@ class ConvexProgram:
 
 
 METHODS = {method.name: method for method in (PopulationSearch("nsga2", "NSGA-II"), PopulationSearch("nsga3", "NSGA-III"),
-                                               ConvexProgram())}
+                                               PopulationSearch("pso", "Particle swarm"), ConvexProgram())}
 """The study file's methods by name (their settings: :data:`~hapticdesign.optimization.study_file.SETTINGS`)."""
 
 
