@@ -129,7 +129,7 @@ def _study(tmp_path: Path, **changes) -> Path:
     ({"variables": {"m2": [0.15, 0.3], "r2y": [-0.1, 0.1], "Ixx2": [1e-3, 1e-2], "Izz2": [1e-3, 1e-2]}},
      "Ixy2 is fixed while r2y varies"),
     ({"algorithm": {"method": "convex", "population": 10}},
-     "algorithm.population: a setting of method nsga2 and nsga3, not of method convex (its settings: realizability)"),
+     "algorithm.population: a setting of method nsga2, nsga3 and pso, not of method convex (its settings: realizability)"),
     ({"algorithm": {"method": "convex", "runs": [{"m2": [0.15, 0.2]}]}}, "algorithm.runs: a setting of method nsga2"),
     ({"parameters": {"m3": "2 * m2"}}, "`parameters` and `keep` are settings of method nsga2"),
     ({"keep": [{"formula": "m2", "<=": 0.2}]}, "`parameters` and `keep` are settings of method nsga2"),

@@ -189,7 +189,7 @@ def test_every_method_of_the_table_is_reachable_from_a_study_file():
     ({"method": "nsga2", "partitions": 4}, "algorithm.partitions: a setting of method nsga3, not of method nsga2"),
     ({"method": "pso", "realizability": "rigid-body"}, "algorithm.realizability: a setting of method convex, not of "
                                                        "method pso"),
-    ({"method": "convex", "polish": "ends"}, "algorithm.polish: a setting of method nsga2 and nsga3 and pso, not of "
+    ({"method": "convex", "polish": "ends"}, "algorithm.polish: a setting of method nsga2, nsga3 and pso, not of "
                                              "method convex"),
     ({"method": "nsga2", "polish": "middle"}, "algorithm.polish: Input should be 'none', 'ends' or 'all'"),
     ({"method": "annealing"}, "algorithm.method: unknown method 'annealing'; choose one of nsga2, nsga3, pso, convex"),

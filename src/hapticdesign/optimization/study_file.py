@@ -333,7 +333,8 @@ def algorithm_settings(value: dict) -> Nsga2 | Nsga3 | Pso | Convex:
     for key in value:
         owners = [name for name, other in SETTINGS.items() if key in other.model_fields]
         if key not in record.model_fields and owners:
-            raise ValueError(f"algorithm.{key}: a setting of method {' and '.join(owners)}, not of method {method} "
+            named = " and ".join([", ".join(owners[:-1]), owners[-1]] if len(owners) > 1 else owners)
+            raise ValueError(f"algorithm.{key}: a setting of method {named}, not of method {method} "
                              f"(its settings: {', '.join(k for k in record.model_fields if k != 'method')})")
     try:
         return record.model_validate({**value, "method": method})
