@@ -13,7 +13,8 @@ choices held at the design's values, within the box holding every run's bounds, 
 
 Variables are scaled to the unit box. Derivatives are forward differences of step :data:`STEP` (of each variable's
 range), the neighbours of a design evaluated in one batch by the study's evaluator (a loop or a Dask cluster).
-SLSQP is deterministic, so the same front asks for the same batches: each batch is checkpointed as
+The search stops after :data:`BATCHES` batches; the best admissible design it evaluated is the
+polished one. SLSQP is deterministic, so the same front asks for the same batches: each batch is checkpointed as
 ``checkpoint/polish-generation-NNNN.json`` like a generation, and a rerun replays them. A polished design is kept
 (a record marked ``polished``) only when it is feasible and better: a smaller objective for an end, dominating the
 design for ``all``; the front is then chosen again among the same records and the kept polished designs.
@@ -36,6 +37,15 @@ STEP = 1e-6
 
 ITERATIONS = 100
 """Most SLSQP iterations per polished design."""
+
+BATCHES = 100
+"""Most batches of designs the evaluator is asked for per polished design: SLSQP on a reduction that is not smooth
+(the least isotropy over the workspace points) may take many short line-search steps; the search then stops, and the
+best design it evaluated stands."""
+
+
+class _Spent(Exception):
+    """The local search used its batches."""
 
 
 class _Designs:
@@ -77,6 +87,23 @@ class _Target:
         self.m0 = minimized(self.spec, start)
         self.f0 = float(weights @ self.m0)
         self.n_g = len(violations(self.spec, [0.0] * len(self.spec.constraints))[0])
+        self.first_batch = designs.batches
+        self.best: Record | None = None
+
+    def _evaluated(self, X: np.ndarray) -> list[Record]:
+        """The records of ``X`` (see :class:`_Designs`), the best feasible one kept; :class:`_Spent` past
+        :data:`BATCHES`."""
+        if self.designs.batches - self.first_batch >= BATCHES:
+            raise _Spent
+        records = self.designs(X)
+        for r in records:
+            if self.admissible(r) and (self.best is None or self.value(r) < self.value(self.best)):
+                self.best = r
+        return records
+
+    def admissible(self, record: Record) -> bool:
+        """Feasible, and no objective worse than the start's when bounded."""
+        return record.feasible and bool(np.all(self.g(record) <= 0.0))
 
     def x(self, u: np.ndarray) -> np.ndarray:
         x = np.array(self.start.x, dtype=float)
@@ -106,34 +133,33 @@ class _Target:
         return np.concatenate([g, np.broadcast_to(worse, self.m0.shape)])
 
     def record(self, u: np.ndarray) -> Record:
-        return self.designs(self.x(u)[None])[0]
+        return self._evaluated(self.x(u)[None])[0]
 
     def gradients(self) -> Gradients:
         def both(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             rows, steps = self._rows(np.asarray(u, dtype=float))
-            records = self.designs(np.array([self.x(r) for r in rows]))
+            records = self._evaluated(np.array([self.x(r) for r in rows]))
             f = np.array([self.value(r) for r in records])
             g = np.array([self.g(r) for r in records])
             return (f[1:] - f[0]) / steps, ((g[1:] - g[0]) / steps[:, None]).T
 
         return Gradients(lambda u: both(u)[0], lambda u: both(u)[1])
 
-    def feasible(self, u: np.ndarray) -> bool:
-        record = self.record(u)
-        return record.feasible and bool(np.all(self.g(record) <= 0.0))
-
     def search(self) -> Record | None:
-        """The polished design, when the local search found a feasible and better one."""
+        """The polished design: the best admissible design the local search evaluated, when it is better than the
+        start (dominating it when bounded)."""
         u0 = (np.array(self.start.x)[self.columns] - self.lower) / self.span
-        found = minimize_in_boxes([(np.zeros(len(u0)), np.ones(len(u0)))], lambda u: self.value(self.record(u)),
-                                  lambda u: self.g(self.record(u)), 0, 0, self.feasible, u0[None], self.gradients(),
-                                  ITERATIONS)
-        if found is None:
+        try:
+            minimize_in_boxes([(np.zeros(len(u0)), np.ones(len(u0)))], lambda u: self.value(self.record(u)),
+                              lambda u: self.g(self.record(u)), 0, 0, lambda u: self.admissible(self.record(u)),
+                              u0[None], self.gradients(), ITERATIONS)
+        except _Spent:
+            pass
+        if self.best is None:
             return None
-        polished = self.record(found[0])
-        m, m0 = minimized(self.spec, polished), self.m0
+        m, m0 = minimized(self.spec, self.best), self.m0
         better = np.all(m <= m0) and np.any(m < m0) if self.bounded else float(self.weights @ m) < self.f0
-        return polished if better else None
+        return self.best if better else None
 
 
 def _targets(run: StudyRun) -> list[tuple[int, np.ndarray, bool]]:
