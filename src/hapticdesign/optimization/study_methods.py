@@ -65,9 +65,10 @@ class PopulationSearch:
         polished = [n for n, k in enumerate(run.front, start=1) if run.records[k].polished]
         polishing = ("" if settings.polish == "none" else
                      f" Polished ({settings.polish} of the front, SLSQP under the constraints): "
-                     + (f"front designs {', '.join(map(str, polished))}." if polished else "no design improved."))
+                     + (f"front designs {', '.join(map(str, polished))}" if polished else "no design improved")
+                     + f"; the local search evaluated {run.probes} more designs, not listed in evaluations.csv.")
         return (f"{where}{self.title}, population {settings.population}, {settings.generations} generations, seed "
-                f"{run.seed}: {run.evaluations} designs evaluated, {sum(r.feasible for r in run.records)} "
+                f"{run.seed}: {len(run.records)} designs evaluated, {sum(r.feasible for r in run.records)} "
                 f"feasible.{polishing}")
 
     def empty_front(self, run: StudyRun, bound: BoundStudy) -> UserError:
