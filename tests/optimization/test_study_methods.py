@@ -107,6 +107,26 @@ def test_ends_of_a_two_objective_front_are_polished_and_marked(tmp_path):
     assert sum(row.endswith(",yes") for row in rows) == len(polished)
     assert sum(line.endswith(",yes") for line in evaluations_csv(run).splitlines()[1:]) == sum(
         r.polished for r in run.records)
+    numbers = ", ".join(str(n) for n, k in enumerate(run.front, start=1) if run.records[k].polished)
+    assert f"Polished (ends of the front, SLSQP under the constraints): front designs {numbers};" in (
+        METHODS["nsga2"].describe(run))
+
+
+def test_polishing_holds_the_discrete_choices(tmp_path):
+    (tmp_path / "plain").mkdir()
+    plain = run_of(small_study(tmp_path / "plain"), 2)  # l2 continuous, the elbow's gear ratio one of 4, 8, 16
+    path = small_study(tmp_path)
+    data = yaml.safe_load(path.read_text())
+    data["algorithm"]["polish"] = "ends"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    run = run_of(path, 2)
+    assert run.records[:len(plain.records)] == plain.records
+    polished = run.records[len(plain.records):]
+    iso_end = max(plain.front, key=lambda k: plain.records[k].objectives[0])
+    mass_end = min(plain.front, key=lambda k: plain.records[k].objectives[1])
+    assert polished and all(r.polished for r in polished)
+    assert {r.values["actuators.q2.gear_ratio"] for r in polished} <= {
+        plain.records[k].values["actuators.q2.gear_ratio"] for k in (iso_end, mass_end)}
 
 
 def test_polishing_every_front_design_dominates_each_design_it_replaces(tmp_path):
