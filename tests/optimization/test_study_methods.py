@@ -27,7 +27,7 @@ from typer.testing import CliRunner
 import hapticdesign as hd
 from hapticdesign.errors import UserError
 from hapticdesign.interface.cli import app
-from hapticdesign.optimization.study_evaluation import bind_study
+from hapticdesign.optimization.study_evaluation import STUDY_LIMIT, bind_study, require_study_workload
 from hapticdesign.optimization.study_file import load_study, study_from_mapping
 from hapticdesign.optimization.study_methods import METHODS, method_of
 from hapticdesign.optimization.study_outputs import evaluations_csv, front_csv
@@ -259,3 +259,18 @@ def test_the_python_door_is_the_command(tmp_path, capsys):
         hd.optimize(study, seed=-1)
     with pytest.raises(UserError, match="no objective named 'speed'"):
         hd.optimize(study, seed=2, weights={"speed": 1.0})
+
+
+def test_the_polishing_counts_in_the_workload_limit(tmp_path):
+    variables = {"l2": [0.09, 0.3], "actuators.q2.gear_ratio": [4.0, 20.0]}
+    path = write_study(tmp_path, variables, [ISOTROPY, MASS], population=40, generations=60, center=point(0.15),
+                       size=(0.04, 0.0, 0.04), grid=5)
+    data = yaml.safe_load(path.read_text())
+    data["algorithm"]["polish"] = "ends"  # (2400 + 2 ends x 100 batches x 3 designs) x 25 points = 75 000
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    require_study_workload(load_study(path))
+    data["algorithm"]["polish"] = "all"  # (2400 + 40 x 100 x 3) x 25 = 360 000
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    with pytest.raises(UserError, match="a study of 14400 designs .* x 25 workspace points .*above the limit of"):
+        require_study_workload(load_study(path))
+    assert 75_000 <= STUDY_LIMIT < 360_000

@@ -30,7 +30,7 @@ import numpy as np
 from hapticdesign.optimization.local_search import Gradients, minimize_in_boxes
 from hapticdesign.optimization.study_run import (CHECKPOINT, Checkpoint, Encoding, Evaluator, Record, StudyRun,
                                                  front_of, minimized, record_of, violations)
-from hapticdesign.optimization.study_file import Study
+from hapticdesign.optimization.study_file import Choice, Study, StudySpec
 
 STEP = 1e-6
 """Forward-difference step, as a fraction of each continuous variable's range."""
@@ -42,6 +42,16 @@ BATCHES = 100
 """Most batches of designs the evaluator is asked for per polished design: SLSQP on a reduction that is not smooth
 (the least isotropy over the workspace points) may take many short line-search steps; the search then stops, and the
 best design it evaluated stands."""
+
+
+def most_designs(spec: StudySpec) -> int:
+    """At most how many designs the polishing evaluates: :data:`BATCHES` batches of at most one design and its
+    neighbours per polished design (each objective's end, or at most a population of front designs for ``all``)."""
+    if spec.algorithm.polish == "none":
+        return 0
+    continuous = sum(not isinstance(v, Choice) for v in spec.variables.values())
+    designs = len(spec.objectives) if spec.algorithm.polish == "ends" else spec.algorithm.population
+    return designs * BATCHES * (continuous + 1)
 
 
 class _Spent(Exception):
