@@ -1,8 +1,9 @@
 """One way to set up, run and filter pymoo's ``minimize`` (Problem, Algorithm, minimize, Result).
 
 The searches of :mod:`~hapticdesign.optimization.synthesis`, :mod:`~hapticdesign.optimization.swarm`,
-:mod:`~hapticdesign.optimization.cross_section` and :mod:`~hapticdesign.optimization.plies` all run
-through :func:`run`: an :class:`AlgorithmSpec` names the algorithm and its size, ``minimize`` runs
+:mod:`~hapticdesign.optimization.cross_section`, :mod:`~hapticdesign.optimization.plies` and the study files'
+population searches (:mod:`~hapticdesign.optimization.study_run`) all run through :func:`run`: an
+:class:`AlgorithmSpec` names the algorithm (:data:`ALGORITHMS`) and its size, ``minimize`` runs
 it with a seed (the same seed gives the same numbers), and the final population comes back as a
 plain :class:`RunResult` whose :meth:`RunResult.feasible` and :meth:`RunResult.front` filter it.
 
@@ -35,6 +36,7 @@ from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 from pymoo.util.ref_dirs import get_reference_directions
 
 from hapticdesign.errors import UserError
+
 
 @dataclass(frozen=True)
 class AlgorithmSpec:
@@ -181,8 +183,8 @@ def run(problem: Problem, spec: AlgorithmSpec, seed: int, progress: Callable[[in
     """``minimize`` ``problem`` with the algorithm of ``spec`` for ``spec.generations`` generations,
     seeded with ``seed``; ``progress(generation)`` is called after each generation."""
     options = {"callback": _Progress(progress)} if progress else {}
-    result = minimize(problem, build_algorithm(spec, problem.n_obj), ("n_gen", spec.generations), seed=seed, verbose=False,
-                      **options)
+    result = minimize(problem, build_algorithm(spec, problem.n_obj), ("n_gen", spec.generations), seed=seed,
+                      verbose=False, **options)
     pop = result.pop
     X, F = pop.get("X"), pop.get("F")
     X = np.round(X).astype(int) if spec.integer else X

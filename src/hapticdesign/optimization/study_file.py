@@ -6,8 +6,8 @@ must reach (a box and a grid), the ``objectives`` (an index reduced over the wor
 ``constraints`` (an index or an affine expression of the variables, bounded by ``<=`` and/or ``>=``) and
 the ``algorithm`` (one record per method, :data:`SETTINGS`: NSGA-II, NSGA-III or particle swarm, population and
 generations; or ``convex``, seed 000's exact LN minimization over inertial parameters, which needs no workspace).
-Everything is checked here with one-line messages naming the field; the names of variables and indices are checked against the device and the
-index registry when the study is bound to them (:mod:`.study_run`).
+Everything is checked here with one-line messages naming the field; the names of variables and indices are
+checked against the device and the index registry when the study is bound to them (:mod:`.study_run`).
 
 Expressions use the device files' grammar (:func:`hapticdesign.devices.schema.parse_expression`):
 ``l1 + l2``, ``2*l1 - d``; their names are variables of the study.

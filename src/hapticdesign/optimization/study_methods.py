@@ -110,7 +110,8 @@ class ConvexProgram:
         return UserError(f"{bound.study.path}: the convex program's design is infeasible: {run.records[0].reason}")
 
 
-METHODS = {method.name: method for method in (PopulationSearch("nsga2", "NSGA-II"), PopulationSearch("nsga3", "NSGA-III"),
+METHODS = {method.name: method for method in (PopulationSearch("nsga2", "NSGA-II"),
+                                               PopulationSearch("nsga3", "NSGA-III"),
                                                PopulationSearch("pso", "Particle swarm"), ConvexProgram())}
 """The study file's methods by name (their settings: :data:`~hapticdesign.optimization.study_file.SETTINGS`)."""
 

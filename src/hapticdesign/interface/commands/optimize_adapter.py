@@ -87,11 +87,13 @@ def summary_lines(summary: dict) -> list[str]:
     """The answer as text: the front as a table and the selected design."""
     front = summary["front"]
     names = list(front[0]["variables"]) + list(front[0]["objectives"])
+    polished = ["polished"] if "polished" in front[0] else []
     lines = [f"front: {len(front)} designs of {summary['evaluations']} evaluated",
-             " ".join(f"{n[:14]:>14s}" for n in ["design", *names])]
+             " ".join(f"{n[:14]:>14s}" for n in ["design", *names, *polished])]
     for n, d in enumerate(front, start=1):
         values = list(d["variables"].values()) + list(d["objectives"].values())
-        lines.append(" ".join([f"{n:14d}", *(f"{v:14.6g}" for v in values)]))
+        marks = [f"{'yes' if d['polished'] else 'no':>14s}"] if polished else []
+        lines.append(" ".join([f"{n:14d}", *(f"{v:14.6g}" for v in values), *marks]))
     s = summary["selected"]
     lines.append(f"selected design {s['design']} ({s['rule']}): "
                  + ", ".join(f"{k} = {v:.6g}" for k, v in {**s["variables"], **s["objectives"]}.items()))
@@ -108,7 +110,8 @@ def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Select
     values = run.records[selection.record].values
     write_atomically(out / "selected.yaml", bound.device_file_text(values))
     pictures = [Picture(png, caption) for png, caption in bound.pictures(values)]
-    kept = ["checkpoint/ (one file per generation; a rerun into this folder continues)"] if method_of(run.spec).checkpointed else []
+    kept = (["checkpoint/ (one file per generation; a rerun into this folder continues)"]
+            if method_of(run.spec).checkpointed else [])
     page = render(run, selection, bound.title, Picture((out / "pareto.png").read_bytes(), "Pareto front"), pictures,
                   [*FILES, *kept])
     write_atomically(out / "report.html", page)
