@@ -10,6 +10,9 @@ command's ``--json`` (for the Python door).
 from __future__ import annotations
 
 import json
+import os
+import subprocess
+import sys
 import math
 from pathlib import Path
 
@@ -274,3 +277,11 @@ def test_the_polishing_counts_in_the_workload_limit(tmp_path):
     with pytest.raises(UserError, match="a study of 14400 designs .* x 25 workspace points .*above the limit of"):
         require_study_workload(load_study(path))
     assert 75_000 <= STUDY_LIMIT < 360_000
+
+
+def test_the_python_door_loads_on_first_use():
+    code = ("import sys, hapticdesign as hd; assert 'pymoo' not in sys.modules; f = hd.optimize; "
+            "assert 'pymoo' in sys.modules and 'optimize' in dir(hd); print(f.__module__)")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                          env={**os.environ, "PYTHONPATH": str(Path(hd.__file__).parents[1])})
+    assert done.stdout.strip() == "hapticdesign.interface.commands.optimize_adapter"
