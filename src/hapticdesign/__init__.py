@@ -10,6 +10,7 @@ R-CUBE):
 - :func:`linearity_form` (LN as a quadratic form; ``form.ln``, ``form.parts``) and
   :func:`linear_conditions` (the linear equations of LN = 0).
 - :func:`impedance_range`, :func:`transparency`: the sampled-data rendering criteria.
+- :func:`optimize`: a study file's optimization (docs/optimization.md), answering the front as ``optimize --json``.
 - :mod:`hapticdesign.analysis.rcube` and :mod:`hapticdesign.optimization`: the R-CUBE.
 """
 
@@ -27,6 +28,7 @@ _HOMES = {
     "linear_conditions": "hapticdesign.analysis.linearity.conditions",
     "load_device": "hapticdesign.devices.loading",
     "preset": "hapticdesign.devices.registry",
+    "optimize": "hapticdesign.interface.commands.optimize_adapter",
     "UserError": "hapticdesign.errors",
     "Device": "hapticdesign.model.device",
     "impedance_range": "hapticdesign.simulation.impedance",
@@ -67,6 +69,7 @@ __all__ = [
     "linearity_form",
     "load_device",
     "mass_matrix",
+    "optimize",
     "preset",
     "transparency",
 ]

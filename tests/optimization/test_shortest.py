@@ -9,7 +9,8 @@ from scipy.optimize import brentq
 
 from hapticdesign.errors import UserError
 from hapticdesign.optimization.rcube.constraints import Q_MAX_RANGE, Workspace, constraint_values
-from hapticdesign.optimization.rcube.shortest import FEASIBILITY_MARGIN, constrained_minimum
+from hapticdesign.optimization.local_search import FEASIBILITY_MARGIN
+from hapticdesign.optimization.rcube.shortest import constrained_minimum
 from hapticdesign.optimization.rcube.synthesis import BOUND_SETS, synthesize
 from tests.helpers.optimization_seed_tables import table, table_7_2_designs
 

@@ -128,11 +128,12 @@ def _study(tmp_path: Path, **changes) -> Path:
      "Izz2 is fixed while r2x varies, which is not convex"),
     ({"variables": {"m2": [0.15, 0.3], "r2y": [-0.1, 0.1], "Ixx2": [1e-3, 1e-2], "Izz2": [1e-3, 1e-2]}},
      "Ixy2 is fixed while r2y varies"),
-    ({"algorithm": {"method": "convex", "population": 10}}, "population, generations, runs, front and start are settings"),
-    ({"algorithm": {"method": "convex", "runs": [{"m2": [0.15, 0.2]}]}}, "runs, front and start are settings"),
+    ({"algorithm": {"method": "convex", "population": 10}},
+     "algorithm.population: a setting of method nsga2, nsga3 and pso, not of method convex (its settings: realizability)"),
+    ({"algorithm": {"method": "convex", "runs": [{"m2": [0.15, 0.2]}]}}, "algorithm.runs: a setting of method nsga2"),
     ({"parameters": {"m3": "2 * m2"}}, "`parameters` and `keep` are settings of method nsga2"),
     ({"keep": [{"formula": "m2", "<=": 0.2}]}, "`parameters` and `keep` are settings of method nsga2"),
-    ({"algorithm": {"method": "nsga2", "realizability": "rigid-body"}}, "realizability is a setting of method convex"),
+    ({"algorithm": {"method": "nsga2", "realizability": "rigid-body"}}, "algorithm.realizability: a setting of method convex, not of method nsga2"),
     ({"algorithm": {"method": "nsga2"}}, "workspace: the region the handle must reach is required"),
 ])
 def test_what_method_convex_cannot_do_is_refused_in_one_line(tmp_path, changes, message):

@@ -1,8 +1,9 @@
 """One way to set up, run and filter pymoo's ``minimize`` (Problem, Algorithm, minimize, Result).
 
 The searches of :mod:`~hapticdesign.optimization.rcube.synthesis`, :mod:`~hapticdesign.optimization.rcube.swarm`,
-:mod:`~hapticdesign.optimization.rcube.cross_section` and :mod:`~hapticdesign.optimization.rcube.plies` all run
-through :func:`run`: an :class:`AlgorithmSpec` names the algorithm and its size, ``minimize`` runs
+:mod:`~hapticdesign.optimization.rcube.cross_section`, :mod:`~hapticdesign.optimization.rcube.plies` and the study files'
+population searches (:mod:`~hapticdesign.optimization.study_run`) all run through :func:`run`: an
+:class:`AlgorithmSpec` names the algorithm (:data:`ALGORITHMS`) and its size, ``minimize`` runs
 it with a seed (the same seed gives the same numbers), and the final population comes back as a
 plain :class:`RunResult` whose :meth:`RunResult.feasible` and :meth:`RunResult.front` filter it.
 
@@ -13,11 +14,13 @@ on the workers of a Dask client that the caller passes (none is started here).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 from pymoo.algorithms.moo.nsga2 import NSGA2
+from pymoo.algorithms.moo.nsga3 import NSGA3
 from pymoo.algorithms.soo.nonconvex.pso import PSO
 from pymoo.core.algorithm import Algorithm
 from pymoo.core.callback import Callback
@@ -30,20 +33,20 @@ from pymoo.operators.sampling.rnd import IntegerRandomSampling
 from pymoo.optimize import minimize
 from pymoo.parallelization import DaskParallelization
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
+from pymoo.util.ref_dirs import get_reference_directions
 
 from hapticdesign.errors import UserError
-
-METHODS = ("nsga2", "pso")
 
 
 @dataclass(frozen=True)
 class AlgorithmSpec:
-    """The algorithm of one run: ``method`` (NSGA-II or particle swarm), ``population`` and
-    ``generations``. ``integer``: integer variables, NSGA-II only (integer sampling, SBX and polynomial
-    mutation with distribution index 3 and rounding repair, duplicates eliminated). ``discrete``: columns
-    that hold whole numbers among real ones (the index of a discrete choice), NSGA-II only: sampled and
-    varied as reals and rounded by :class:`RoundColumns`, duplicates eliminated. ``initial``: the first
-    population's rows; without it pymoo's own seeded random sampling is used."""
+    """The algorithm of one run: ``method`` (a name of :data:`ALGORITHMS`), ``population`` and ``generations``.
+    ``integer``: integer variables, genetic methods only (integer sampling, SBX and polynomial mutation with
+    distribution index 3 and rounding repair, duplicates eliminated). ``discrete``: columns that hold whole numbers
+    among real ones (the index of a discrete choice), genetic methods only: sampled and varied as reals and rounded
+    by :class:`RoundColumns`, duplicates eliminated. ``initial``: the first population's rows; without it pymoo's
+    own seeded random sampling is used. ``partitions``: NSGA-III's Das-Dennis divisions per objective axis (None:
+    the most whose reference directions fit in the population)."""
 
     method: str = "nsga2"
     population: int = 100
@@ -51,23 +54,57 @@ class AlgorithmSpec:
     integer: bool = False
     initial: np.ndarray | None = None
     discrete: tuple[int, ...] = ()
+    partitions: int | None = None
 
     def __post_init__(self) -> None:
-        if self.method not in METHODS:
-            raise UserError(f"unknown optimization method {self.method!r}; choose one of {', '.join(METHODS)}")
-        if (self.integer or self.discrete) and self.method != "nsga2":
-            raise UserError("integer variables need the nsga2 method")
+        if self.method not in ALGORITHMS:
+            raise UserError(f"unknown optimization method {self.method!r}; choose one of {', '.join(ALGORITHMS)}")
+        if (self.integer or self.discrete) and not ALGORITHMS[self.method].genetic:
+            raise UserError(f"integer variables and discrete choices need a genetic method "
+                            f"({', '.join(n for n, a in ALGORITHMS.items() if a.genetic)}), not {self.method}")
         if self.population < 2:
             raise UserError(f"population must be at least 2, got {self.population}")
         if self.generations < 1:
             raise UserError(f"generations must be at least 1, got {self.generations}")
 
 
-def build_algorithm(spec: AlgorithmSpec) -> Algorithm:
-    """The pymoo algorithm of ``spec``."""
+def reference_directions(n_obj: int, population: int, partitions: int | None = None) -> np.ndarray:
+    """Das-Dennis reference directions of ``n_obj`` objectives with ``partitions`` divisions of each axis (None: the
+    most divisions whose directions fit in ``population``); refused when they outnumber the population."""
+    def count(p: int) -> int:
+        return math.comb(p + n_obj - 1, n_obj - 1)
+
+    if partitions is None:
+        partitions = 1
+        while n_obj > 1 and count(partitions + 1) <= population:
+            partitions += 1
+    if count(partitions) > population:
+        raise UserError(f"method nsga3: {count(partitions)} reference directions ({partitions} partitions of "
+                        f"{n_obj} objectives) need a population of at least {count(partitions)}, got {population}")
+    return get_reference_directions("das-dennis", n_obj, n_partitions=partitions)
+
+
+@dataclass(frozen=True)
+class PymooAlgorithm:
+    """One of pymoo's algorithms: ``build(spec, n_obj, options)`` makes it; ``genetic``: it takes sampling,
+    crossover, mutation and repair operators (integer and discrete variables)."""
+
+    build: Callable[[AlgorithmSpec, int, dict], Algorithm]
+    genetic: bool
+
+
+ALGORITHMS = {
+    "nsga2": PymooAlgorithm(lambda spec, n_obj, options: NSGA2(pop_size=spec.population, **options), True),
+    "nsga3": PymooAlgorithm(lambda spec, n_obj, options: NSGA3(
+        reference_directions(n_obj, spec.population, spec.partitions), pop_size=spec.population, **options), True),
+    "pso": PymooAlgorithm(lambda spec, n_obj, options: PSO(pop_size=spec.population, **options), False),
+}
+"""pymoo's algorithms by name: NSGA-II (Deb et al. 2002), NSGA-III (Deb & Jain 2014) and particle swarm."""
+
+
+def build_algorithm(spec: AlgorithmSpec, n_obj: int) -> Algorithm:
+    """The pymoo algorithm of ``spec`` for ``n_obj`` objectives."""
     options = {} if spec.initial is None else {"sampling": spec.initial}
-    if spec.method == "pso":
-        return PSO(pop_size=spec.population, **options)
     if spec.integer:
         options = {"sampling": IntegerRandomSampling(),
                    "crossover": SBX(prob=1.0, eta=3.0, vtype=float, repair=RoundingRepair()),
@@ -75,7 +112,7 @@ def build_algorithm(spec: AlgorithmSpec) -> Algorithm:
                    "eliminate_duplicates": True, **options}
     elif spec.discrete:
         options = {"repair": RoundColumns(spec.discrete), "eliminate_duplicates": True, **options}
-    return NSGA2(pop_size=spec.population, **options)
+    return ALGORITHMS[spec.method].build(spec, n_obj, options)
 
 
 class RoundColumns(Repair):
@@ -146,8 +183,8 @@ def run(problem: Problem, spec: AlgorithmSpec, seed: int, progress: Callable[[in
     """``minimize`` ``problem`` with the algorithm of ``spec`` for ``spec.generations`` generations,
     seeded with ``seed``; ``progress(generation)`` is called after each generation."""
     options = {"callback": _Progress(progress)} if progress else {}
-    result = minimize(problem, build_algorithm(spec), ("n_gen", spec.generations), seed=seed, verbose=False,
-                      **options)
+    result = minimize(problem, build_algorithm(spec, problem.n_obj), ("n_gen", spec.generations), seed=seed,
+                      verbose=False, **options)
     pop = result.pop
     X, F = pop.get("X"), pop.get("F")
     X = np.round(X).astype(int) if spec.integer else X

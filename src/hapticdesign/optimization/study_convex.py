@@ -7,7 +7,7 @@ semi-definite) or the seed's eq. 3.28 (positive definite inertia about the mass 
 objective is ``ln`` (``sense: min``) over inertial-parameter variables is therefore solved exactly by
 :func:`~hapticdesign.analysis.linearity.verdict.minimum_ln`: each variable's ``[low, high]`` bounds its seed
 variable (eq. 3.29-3.32 are such bounds), the parameters that are not variables stay at the device file's
-values, and the program's relaxation gives a lower bound on the minimum (:attr:`StudyRun.bound`).
+values, and the program's relaxation gives a lower bound on the minimum (the run's ``notes["lower_bound"]``).
 
 Expression constraints are kept when they are linear in ``pi``: a sum of masses (``m2 + m3a <= 0.4``), or
 of one body's mass-centre coordinates (``r2x - r2y >= 0``, i.e. ``h2x - h2y >= 0 m2``). Anything else the
@@ -146,4 +146,4 @@ def run_convex(bound: BoundStudy, seed: int) -> StudyRun:
               f"the solver's design is {'not within the bounds' if not result.within_bounds else 'not realizable'}")
     x = [values[name] for name in spec.variables]
     record = record_of(spec, 1, x, values, Answer((result.ln,), reason))
-    return StudyRun(spec, seed, [record], [0] if record.feasible else [], bound=result.lower_bound)
+    return StudyRun(spec, seed, [record], [0] if record.feasible else [], notes={"lower_bound": result.lower_bound})

@@ -31,6 +31,7 @@ from hapticdesign.model.inertia import SEED_FIELDS, seed_parameter_name
 from hapticdesign.optimization.rcube.parameter_indices import PARAMETER_INDICES
 from hapticdesign.optimization.study_file import Choice, IndexConstraint, Study
 from hapticdesign.optimization.study_outputs import index_maps
+from hapticdesign.optimization.study_polish import most_designs
 from hapticdesign.optimization.study_run import Answer, reduced_keys, violations
 from hapticdesign.simulation.design_indices import DESIGN_INDICES, evaluate, evaluate_designs
 from hapticdesign.workload import require_within
@@ -41,17 +42,15 @@ points (each one a design's pose reached and its indices computed; docs/limits.m
 
 
 def require_study_workload(study: Study) -> None:
-    """Refuse a study whose population x generations x runs x workspace points is above :data:`STUDY_LIMIT`
-    (method convex solves one program, whose size the number of variables bounds)."""
+    """Refuse a study whose designs (population x generations x runs of a population search and at most as many as
+    its polishing may ask, :func:`~.study_polish.most_designs`; one for method convex, whose program the number of
+    variables bounds) x workspace points is above :data:`STUDY_LIMIT`."""
     spec = study.spec
-    if spec.algorithm.method == "convex":
-        return
-    workspace = workspace_of(study)
+    workspace = workspace_of(study) if spec.algorithm.over_poses else None
     points = 1 if workspace is None else len(workspace.points())
-    runs = max(1, len(spec.algorithm.runs))
-    amount = spec.algorithm.population * spec.algorithm.generations * runs * points
-    require_within(f"a study of {spec.algorithm.population} designs x {spec.algorithm.generations} generations x "
-                   f"{runs} runs x {points} workspace points", amount, STUDY_LIMIT, "design-point evaluations")
+    designs = spec.algorithm.designs + most_designs(spec)
+    require_within(f"a study of {designs} designs (population x generations x runs, and the polishing's most) x "
+                   f"{points} workspace points", designs * points, STUDY_LIMIT, "design-point evaluations")
 
 
 def workspace_of(study: Study) -> Workspace | None:

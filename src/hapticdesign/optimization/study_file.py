@@ -4,10 +4,10 @@ A study names a device file (relative to the study file), the ``variables`` the 
 (continuous bounds ``[low, high]`` or a discrete choice ``{values: [...]}``), the ``workspace`` the handle
 must reach (a box and a grid), the ``objectives`` (an index reduced over the workspace and a sense), the
 ``constraints`` (an index or an affine expression of the variables, bounded by ``<=`` and/or ``>=``) and
-the ``algorithm`` (NSGA-II, population and generations; or ``convex``, seed 000's exact LN minimization over
-inertial parameters, which needs no workspace). Everything is checked here with one-line
-messages naming the field; the names of variables and indices are checked against the device and the
-index registry when the study is bound to them (:mod:`.study_run`).
+the ``algorithm`` (one record per method, :data:`SETTINGS`: NSGA-II, NSGA-III or particle swarm, population and
+generations; or ``convex``, seed 000's exact LN minimization over inertial parameters, which needs no workspace).
+Everything is checked here with one-line messages naming the field; the names of variables and indices are
+checked against the device and the index registry when the study is bound to them (:mod:`.study_run`).
 
 Expressions use the device files' grammar (:func:`hapticdesign.devices.schema.parse_expression`):
 ``l1 + l2``, ``2*l1 - d``; their names are variables of the study.
@@ -18,7 +18,7 @@ from __future__ import annotations
 import hashlib
 import math
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated, ClassVar, Literal
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError, field_validator, model_validator
 
@@ -241,33 +241,111 @@ class Start(_StudyModel):
     starts: Annotated[int, Field(strict=True, ge=1, le=1000)] = 32
 
 
-class AlgorithmSettings(_StudyModel):
-    """``nsga2``: NSGA-II (Deb et al. 2002, pymoo) with ``population`` designs over ``generations``
-    generations; ``runs``: several runs, each with its own bounds of some continuous variables (run ``k`` seeded
-    ``seed + k``), merged; ``front``: the front of every evaluated design (``archive``) or of the runs' final
-    populations (``final``); ``start``: a minimized design in the first populations (:class:`Start`).
-    ``convex``: the exact convex program of seed 000's LN minimization over inertial parameters
-    (:mod:`.study_convex`), each body kept ``realizability``: ``rigid-body`` (pseudo-inertia positive
-    semi-definite, Wensing et al. 2017) or ``positive-definite`` (the seed's eq. 3.28)."""
+POLISH = ("none", "ends", "all")
+"""What a population search's front has refined by a local search (:mod:`.study_polish`): nothing, the best design
+of each objective, or every front design."""
 
-    method: Literal["nsga2", "convex"] = "nsga2"
+
+class _PopulationSearch(_StudyModel):
+    """The settings every population search shares: ``population`` designs over ``generations`` generations;
+    ``runs``: several runs, each with its own bounds of some continuous variables (run ``k`` seeded ``seed + k``),
+    merged; ``front``: the front of every evaluated design (``archive``) or of the runs' final populations
+    (``final``); ``start``: a minimized design in the first populations (:class:`Start`); ``polish``: the front
+    designs refined by a local search under the study's constraints afterwards (:data:`POLISH`)."""
+
     population: Annotated[int, Field(strict=True, ge=4, le=100_000)] = 40
     generations: Annotated[int, Field(strict=True, ge=1, le=100_000)] = 60
-    realizability: Literal["rigid-body", "positive-definite"] = "rigid-body"
     runs: list[dict[str, Variable]] = Field([], max_length=100)
     front: Literal["archive", "final"] = "archive"
     start: Start | None = None
+    polish: Literal["none", "ends", "all"] = "none"
 
-    @model_validator(mode="after")
-    def _settings_of_the_method(self) -> "AlgorithmSettings":
-        given = self.model_fields_set
-        if self.method == "convex" and given & {"population", "generations", "runs", "front", "start"}:
-            raise ValueError("population, generations, runs, front and start are settings of method nsga2; method "
-                             "convex solves once")
-        if self.method == "nsga2" and "realizability" in given:
-            raise ValueError("realizability is a setting of method convex (NSGA-II designs pass the device file's "
-                             "own checks of each body)")
-        return self
+    over_poses: ClassVar[bool] = True
+    """Whether the method evaluates designs at the workspace's poses (a study then needs a workspace)."""
+    one_objective: ClassVar[bool] = False
+    """Whether the method minimizes a single objective."""
+
+    @property
+    def designs(self) -> int:
+        """How many designs the search evaluates (polishing aside)."""
+        return self.population * self.generations * max(1, len(self.runs))
+
+    @property
+    def options(self) -> dict:
+        """The method's own settings as pymoo's algorithm takes them (:class:`~.pymoo_run.AlgorithmSpec`)."""
+        return {}
+
+
+class Nsga2(_PopulationSearch):
+    """``nsga2``: NSGA-II (Deb et al. 2002, pymoo), constrained domination."""
+
+    method: Literal["nsga2"] = "nsga2"
+
+
+class Nsga3(_PopulationSearch):
+    """``nsga3``: NSGA-III (Deb & Jain 2014, pymoo) for many objectives: survival by the niches of Das-Dennis
+    reference directions with ``partitions`` divisions of each objective axis (by default the most whose directions
+    fit in the population)."""
+
+    method: Literal["nsga3"]
+    partitions: Annotated[int, Field(strict=True, ge=1, le=1000)] | None = None
+
+    @property
+    def options(self) -> dict:
+        return {"partitions": self.partitions}
+
+
+class Pso(_PopulationSearch):
+    """``pso``: particle swarm optimization (Kennedy & Eberhart 1995, pymoo) of one objective; continuous variables
+    only."""
+
+    method: Literal["pso"]
+
+    one_objective: ClassVar[bool] = True
+
+
+class Convex(_StudyModel):
+    """``convex``: the exact convex program of seed 000's LN minimization over inertial parameters
+    (:mod:`.study_convex`), each body kept ``realizability``: ``rigid-body`` (pseudo-inertia positive
+    semi-definite, Wensing et al. 2017) or ``positive-definite`` (the seed's eq. 3.28)."""
+
+    method: Literal["convex"]
+    realizability: Literal["rigid-body", "positive-definite"] = "rigid-body"
+
+    over_poses: ClassVar[bool] = False
+    polish: ClassVar[str] = "none"
+    """The program's design is the exact minimum: nothing to polish."""
+
+    @property
+    def designs(self) -> int:
+        return 1
+
+
+SETTINGS = {"nsga2": Nsga2, "nsga3": Nsga3, "pso": Pso, "convex": Convex}
+"""Each method's settings record, by name (the methods themselves: :mod:`.study_methods`)."""
+
+
+def algorithm_settings(value: dict) -> Nsga2 | Nsga3 | Pso | Convex:
+    """The ``algorithm`` mapping as its method's record (``nsga2`` without ``method``); a setting of another method
+    is refused in one line naming the methods it belongs to."""
+    method = value.get("method", "nsga2")
+    if method not in SETTINGS:
+        raise ValueError(f"algorithm.method: unknown method {quote(method)}; choose one of {', '.join(SETTINGS)}")
+    record = SETTINGS[method]
+    for key in value:
+        owners = [name for name, other in SETTINGS.items() if key in other.model_fields]
+        if key not in record.model_fields and owners:
+            named = " and ".join([", ".join(owners[:-1]), owners[-1]] if len(owners) > 1 else owners)
+            raise ValueError(f"algorithm.{key}: a setting of method {named}, not of method {method} "
+                             f"(its settings: {', '.join(k for k in record.model_fields if k != 'method')})")
+    try:
+        return record.model_validate({**value, "method": method})
+    except ValidationError as exc:
+        raise ValueError(f"algorithm.{describe_validation_error(exc)}") from None
+
+
+AlgorithmSettings = Annotated[Nsga2 | Nsga3 | Pso | Convex, Field(discriminator="method")]
+"""The ``algorithm`` of a study: one record per method, chosen by ``method`` (:func:`algorithm_settings`)."""
 
 
 class StudySpec(_StudyModel):
@@ -281,13 +359,23 @@ class StudySpec(_StudyModel):
     parameters: dict[str, FormulaText] = Field({}, max_length=MAX_VARIABLES)
     """Device parameters computed from the variables (and the parameters above them) by a formula."""
     keep: list[Keep] = Field([], max_length=16)
-    algorithm: AlgorithmSettings = AlgorithmSettings()
+    algorithm: AlgorithmSettings = Nsga2()
+
+    @model_validator(mode="before")
+    @classmethod
+    def _algorithm(cls, data: object) -> object:
+        if isinstance(data, dict) and isinstance(data.get("algorithm"), dict):
+            return {**data, "algorithm": algorithm_settings(data["algorithm"])}
+        return data
 
     @model_validator(mode="after")
     def _names(self) -> "StudySpec":
-        if self.workspace is None and self.algorithm.method != "convex" and not self.parameters_only:
+        if self.workspace is None and self.algorithm.over_poses and not self.parameters_only:
             raise ValueError("workspace: the region the handle must reach is required (only method convex, whose "
                              "LN is over the joint region, and a study of parameter indices alone do without)")
+        if isinstance(self.algorithm, _PopulationSearch) and self.algorithm.one_objective and len(self.objectives) > 1:
+            raise ValueError(f"objectives: method {self.algorithm.method} minimizes one objective, not "
+                             f"{len(self.objectives)} (use method nsga2 or nsga3)")
         names = [o.name for o in self.objectives]
         twice = sorted({n for n in names if names.count(n) > 1})
         if twice:
@@ -307,10 +395,11 @@ class StudySpec(_StudyModel):
                 raise ValueError(f"parameters: {name!r} is a variable; a parameter is computed from the variables")
             self._names_known(f"parameters.{name}", f, known)
             known.append(name)
+        search = self.algorithm if isinstance(self.algorithm, _PopulationSearch) else _PopulationSearch()
         for where, f in [*((f"keep[{i}]", k.formula) for i, k in enumerate(self.keep)),
-                         *((("algorithm.start", self.algorithm.start.minimize),) if self.algorithm.start else ())]:
+                         *((("algorithm.start", search.start.minimize),) if search.start else ())]:
             self._names_known(where, f, known)
-        for k, run in enumerate(self.algorithm.runs):
+        for k, run in enumerate(search.runs):
             for name, bounds in run.items():
                 if name not in self.variables or isinstance(self.variables[name], Choice) or isinstance(bounds, Choice):
                     raise ValueError(f"algorithm.runs[{k}]: {name!r} is not a continuous variable of the study")

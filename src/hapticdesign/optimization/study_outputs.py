@@ -9,6 +9,7 @@ gives the same bytes and reading them back gives the same floats.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -18,7 +19,7 @@ from hapticdesign.errors import UserError
 from hapticdesign.files import csv_rows, figure_bytes, save_figure
 from hapticdesign.optimization.rcube.parameter_indices import PARAMETER_INDICES
 from hapticdesign.optimization.front_selection import least_rms, normalize
-from hapticdesign.optimization.study_run import StudyRun, constraint_labels
+from hapticdesign.optimization.study_run import Record, StudyRun, constraint_labels
 from hapticdesign.simulation.design_indices import DESIGN_INDICES
 
 
@@ -66,28 +67,40 @@ def _number(value: float) -> str:
     return repr(float(value)) if np.isfinite(value) else ""
 
 
+def _polished(run: StudyRun) -> tuple[list[str], Callable[[Record], list[str]]]:
+    """The ``polished`` column (yes or no) of a study that polishes its front, none otherwise."""
+    if run.spec.algorithm.polish == "none":
+        return [], lambda r: []
+    return ["polished"], lambda r: ["yes" if r.polished else "no"]
+
+
 def front_csv(run: StudyRun) -> str:
-    """One row per front design: its number, variables, objectives and constrained values."""
+    """One row per front design: its number, variables, objectives and constrained values (and whether it was
+    polished, for a study that polishes)."""
     spec = run.spec
-    header = ["design", *spec.variables, *(o.name for o in spec.objectives), *constraint_labels(spec)]
+    polished, cell = _polished(run)
+    header = ["design", *spec.variables, *(o.name for o in spec.objectives), *constraint_labels(spec), *polished]
     rows = []
     for n, k in enumerate(run.front, start=1):
         r = run.records[k]
         rows.append([str(n), *(_number(r.values[v]) for v in spec.variables), *map(_number, r.objectives),
-                     *map(_number, r.constraints)])
+                     *map(_number, r.constraints), *cell(r)])
     return csv_rows(header, rows)
 
 
 def evaluations_csv(run: StudyRun) -> str:
-    """Every evaluated design: generation, variables, objectives, constrained values, feasible or why not."""
+    """Every evaluated design: generation, variables, objectives, constrained values, feasible or why not (and
+    whether it was polished, for a study that polishes: the polished designs follow the last generation; the
+    polishing's other probes are counted in the run's evaluations, not listed)."""
     spec = run.spec
+    polished, cell = _polished(run)
     header = ["evaluation", "generation", *spec.variables, *(o.name for o in spec.objectives),
-              *constraint_labels(spec), "feasible", "reason"]
+              *constraint_labels(spec), "feasible", "reason", *polished]
     rows = []
     for n, r in enumerate(run.records, start=1):
         rows.append([str(n), str(r.generation), *(_number(r.values[v]) for v in spec.variables),
                      *map(_number, r.objectives), *map(_number, r.constraints), "yes" if r.feasible else "no",
-                     r.reason])
+                     r.reason, *cell(r)])
     return csv_rows(header, rows)
 
 

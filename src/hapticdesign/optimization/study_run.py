@@ -1,4 +1,4 @@
-"""Running a study: NSGA-II over the study's variables, each generation checkpointed (docs/optimization.md).
+"""Running a study: a population search over the study's variables, each generation checkpointed (docs/optimization.md).
 
 The study's variables become pymoo's design vector: a continuous variable its value, a discrete one the
 index of its choice (a whole number, :class:`~hapticdesign.optimization.pymoo_run.RoundColumns`). Each
@@ -6,7 +6,7 @@ generation's designs go to an evaluator in one batch (a loop here, or a Dask clu
 which answers every reduced index the study reads, or why the design has none (a workspace point out of
 reach, an invalid device). Objectives enter pymoo as minimized values (a maximized one negated);
 constraints as ``g <= 0`` scaled by their bound, plus one column that is 1 for a design without values
-(0 otherwise), so that NSGA-II's constrained domination (Deb et al. 2002) ranks it behind every valid
+(0 otherwise), so that constrained domination (Deb et al. 2002; NSGA-II and NSGA-III) ranks it behind every valid
 design.
 
 Checkpoint: with an output folder, each generation's answers are written to
@@ -24,7 +24,7 @@ import hashlib
 import json
 import warnings
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -33,7 +33,7 @@ from pymoo.core.problem import Problem
 from hapticdesign.errors import RunWarning, UserError
 from hapticdesign.files import output_folder, read_text, write_atomically
 from hapticdesign.optimization.pymoo_run import AlgorithmSpec, initial_population, pareto_filter, run
-from hapticdesign.optimization.rcube.shortest import minimize_in_boxes
+from hapticdesign.optimization.local_search import minimize_in_boxes
 from hapticdesign.optimization.study_file import Choice, ExpressionConstraint, Study, StudySpec
 
 CHECKPOINT = "checkpoint"
@@ -109,6 +109,8 @@ class Record:
     invalid: str
     violated: str
     violation: float
+    polished: bool = False
+    """Whether the design is a front design refined by the local search (:mod:`.study_polish`)."""
 
     @property
     def feasible(self) -> bool:
@@ -285,20 +287,25 @@ class StudyProblem(Problem):
 class StudyRun:
     """Every evaluated design (``records``, in evaluation order, run after run) and the front (indices into them,
     feasible and non-dominated over all evaluations, or over the runs' final populations with ``front: final``,
-    then filtered by ``keep``, sorted by the first objective); ``start``: the minimized start design's variables
-    (None without ``algorithm.start`` or when no start met the constraints); ``bound``: method convex's lower bound
-    on the minimized objective (:mod:`.study_convex`)."""
+    then filtered by ``keep``, sorted by the first objective); ``among``: the records the front was chosen among
+    (None: every record); ``start``: the minimized start design's variables (None without ``algorithm.start`` or
+    when no start met the constraints); ``notes``: the method's own results by name, as ``optimize --json`` prints
+    them (method convex: ``lower_bound``, :mod:`.study_convex`); ``probes``: designs the polishing evaluated beside
+    the polished ones it kept (:mod:`.study_polish`)."""
 
     spec: StudySpec
     seed: int
     records: list[Record]
     front: list[int]
-    bound: float | None = None
+    among: list[int] | None = None
     start: dict[str, float] | None = None
+    notes: dict[str, float] = field(default_factory=dict)
+    probes: int = 0
 
     @property
     def evaluations(self) -> int:
-        return len(self.records)
+        """Every design evaluated: the records and the polishing's probes."""
+        return len(self.records) + self.probes
 
 
 def front_of(spec: StudySpec, records: list[Record], among: Sequence[int] | None = None) -> list[int]:
@@ -329,7 +336,7 @@ def kept_by(spec: StudySpec, values: dict[str, float]) -> bool:
 
 def start_design(study: Study, seed: int, evaluate: Evaluator, encodings: list[Encoding]) -> np.ndarray | None:
     """The design vector minimizing ``algorithm.start.minimize`` under the study's constraints (SLSQP from seeded
-    starts over the box holding every run's bounds, :func:`~hapticdesign.optimization.rcube.shortest.minimize_in_boxes`),
+    starts over the box holding every run's bounds, :func:`~hapticdesign.optimization.local_search.minimize_in_boxes`),
     or None when no start meets them. ``evaluate`` answers the constraints (objectives need not be computed)."""
     spec = study.spec
     encoding = encodings[0]
@@ -358,7 +365,8 @@ def run_study(study: Study, seed: int, evaluate: Evaluator, out: Path | None = N
     (``out/checkpoint``); ``progress(generation, generations)`` after each generation; ``evaluate_constraints``
     answers the constraints of ``algorithm.start``'s minimization (``evaluate`` by default).
 
-    Each run ``k`` of ``algorithm.runs`` (one run without them) is NSGA-II over its bounds seeded ``seed + k``; with
+    Each run ``k`` of ``algorithm.runs`` (one run without them) is the study's population search (NSGA-II or
+    NSGA-III, :data:`~hapticdesign.optimization.pymoo_run.ALGORITHMS`) over its bounds seeded ``seed + k``; with
     ``algorithm.start``, the minimized design joins the first population of every run whose bounds hold it, the
     rest of that population drawn uniformly with the run's seed (pymoo's own seeded sampling otherwise)."""
     if seed < 0:
@@ -378,13 +386,14 @@ def run_study(study: Study, seed: int, evaluate: Evaluator, out: Path | None = N
         initial = None
         if start is not None and np.all(encoding.xl <= start) and np.all(start <= encoding.xu):
             initial = initial_population(encoding.xl, encoding.xu, spec.algorithm.population, seed + k, start[None])
-        algorithm = AlgorithmSpec("nsga2", spec.algorithm.population, spec.algorithm.generations,
-                                  initial=initial, discrete=encoding.discrete)
+        algorithm = AlgorithmSpec(spec.algorithm.method, spec.algorithm.population, spec.algorithm.generations,
+                                  initial=initial, discrete=encoding.discrete, **spec.algorithm.options)
         done = k * spec.algorithm.generations
         result = run(problem, algorithm, seed + k,
                      (lambda generation, done=done: progress(done + generation, total)) if progress else None)
         last = {r.x: len(records) + i for i, r in enumerate(problem.records)}
         final += [last[tuple(float(v) for v in x)] for x in result.X]
         records += problem.records
-    front = front_of(spec, records, final if spec.algorithm.front == "final" else None)
-    return StudyRun(spec, seed, records, front, start=None if start is None else encodings[0].decode(start))
+    among = final if spec.algorithm.front == "final" else None
+    return StudyRun(spec, seed, records, front_of(spec, records, among), among,
+                    start=None if start is None else encodings[0].decode(start))

@@ -24,18 +24,18 @@ def register(app: typer.Typer) -> None:
     @app.command()
     def optimize(study: Path = STUDY, seed: int = SEED, out: Optional[Path] = OUT, scheduler: Optional[str] = SCHEDULER,
                  select: str = SELECT, json_out: bool = JSON_OUT, quiet: bool = QUIET, force: bool = FORCE) -> None:
-        """Optimize a device file's variables for a study file's objectives and constraints (NSGA-II; selection by seed 001 §7.2)."""
+        """Optimize a device file's variables for a study file's objectives and constraints (NSGA-II, NSGA-III or the convex LN program; selection by seed 001 §7.2)."""
         from hapticdesign.interface.commands.optimize_adapter import optimize as run, parse_select, summary_lines
 
         with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
             rule = parse_select(select)
             with progress_bar(not (quiet or json_out)) as report:
                 progress = (lambda done, total: report("generations", done, total)) if report else None
-                summary, written = run(study, seed, out, scheduler, rule, progress, quiet)
+                result = run(study, seed, out, scheduler=scheduler, progress=progress, quiet=quiet, **rule)
             if out is not None:
-                note(f"wrote {len(written)} files to {out}", quiet)
+                note(f"wrote {len(result.files)} files to {out}", quiet)
             if json_out:
-                print_json(summary)
+                print_json(result.summary)
                 return
-            for line in summary_lines(summary):
+            for line in summary_lines(result.summary):
                 typer.echo(line)

@@ -1,27 +1,29 @@
-"""The work of ``optimize``: read the study, run it (here or on a Dask cluster), select, write the outputs.
+"""The work of ``optimize`` and its Python door ``hapticdesign.optimize``: read the study, run its method (here or
+on a Dask cluster), select, write the outputs, and answer an :class:`OptimizationResult`.
 
-Every file goes into the output folder through :func:`~hapticdesign.files.write_atomically`; the
-final files are written only after the run succeeded, so a failed or interrupted run leaves complete
-checkpoint files and nothing half-written.
+The command and the Python door are one function, :func:`optimize`: it never prints, and a user error raises
+:class:`~hapticdesign.errors.UserError`. Every file goes into the output folder through
+:func:`~hapticdesign.files.write_atomically`; the final files are written only after the run succeeded, so a
+failed or interrupted run leaves complete checkpoint files and nothing half-written.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from contextlib import ExitStack
+from dataclasses import dataclass
 from pathlib import Path
-
-import numpy as np
 
 from hapticdesign.errors import UserError
 from hapticdesign.files import write_atomically
 from hapticdesign.interface.report.optimization_page import Picture, render
-from hapticdesign.optimization.study_convex import run_convex
 from hapticdesign.optimization.study_evaluation import BoundStudy, bind_study, require_study_workload
-from hapticdesign.optimization.study_file import load_study
+from hapticdesign.optimization.study_file import Study, load_study
+from hapticdesign.optimization.study_methods import ConvexProgram, PopulationSearch, method_of
 from hapticdesign.optimization.study_outputs import (Selection, evaluations_csv, front_csv, pareto_figure,
                                                      select_design)
-from hapticdesign.optimization.study_run import StudyRun, run_study
+from hapticdesign.optimization.study_run import Record, StudyRun
 
 FILES = ("front.csv", "evaluations.csv", "pareto.png", "pareto.svg", "selected.yaml", "report.html")
 
@@ -67,82 +69,37 @@ def _check_out(out: Path) -> None:
 
 def _design(run: StudyRun, k: int) -> dict:
     r = run.records[k]
-    return {"variables": dict(r.values), "objectives": dict(zip((o.name for o in run.spec.objectives), r.objectives))}
+    out = {"variables": dict(r.values), "objectives": dict(zip((o.name for o in run.spec.objectives), r.objectives))}
+    if run.spec.algorithm.polish != "none":
+        out["polished"] = r.polished
+    return out
 
 
 def summary_of(run: StudyRun, selection: Selection) -> dict:
     """The ``--json`` answer: the front, the number of evaluations and the selected design, in the
-    study's own sense and units."""
-    out = {"front": [_design(run, k) for k in run.front], "evaluations": run.evaluations,
-           "selected": {"design": selection.position + 1, "rule": selection.rule, **_design(run, selection.record)}}
-    if run.bound is not None:
-        out["lower_bound"] = run.bound
-    return out
+    study's own sense and units, and the method's own results (:attr:`StudyRun.notes`)."""
+    return {"front": [_design(run, k) for k in run.front], "evaluations": run.evaluations,
+            "selected": {"design": selection.position + 1, "rule": selection.rule, **_design(run, selection.record)},
+            **run.notes}
 
 
 def summary_lines(summary: dict) -> list[str]:
     """The answer as text: the front as a table and the selected design."""
     front = summary["front"]
     names = list(front[0]["variables"]) + list(front[0]["objectives"])
+    polished = ["polished"] if "polished" in front[0] else []
     lines = [f"front: {len(front)} designs of {summary['evaluations']} evaluated",
-             " ".join(f"{n[:14]:>14s}" for n in ["design", *names])]
+             " ".join(f"{n[:14]:>14s}" for n in ["design", *names, *polished])]
     for n, d in enumerate(front, start=1):
         values = list(d["variables"].values()) + list(d["objectives"].values())
-        lines.append(" ".join([f"{n:14d}", *(f"{v:14.6g}" for v in values)]))
+        marks = [f"{'yes' if d['polished'] else 'no':>14s}"] if polished else []
+        lines.append(" ".join([f"{n:14d}", *(f"{v:14.6g}" for v in values), *marks]))
     s = summary["selected"]
     lines.append(f"selected design {s['design']} ({s['rule']}): "
                  + ", ".join(f"{k} = {v:.6g}" for k, v in {**s["variables"], **s["objectives"]}.items()))
     if "lower_bound" in summary:
         lines.append(f"lower bound on the minimum (the convex relaxation): {summary['lower_bound']:.6g}")
     return lines
-
-
-CLOSEST_CANDIDATES = 12
-"""Designs of the last generation tried point by point when no design reaches the workspace."""
-
-
-def _no_front(run: StudyRun, bound: BoundStudy) -> UserError:
-    """Why the front is empty, with the closest design: the most workspace points reached (each from home),
-    or the least constraint violation."""
-    valid = [r for r in run.records if not r.invalid]
-    if not valid:
-        last = [r for r in run.records if r.generation == run.records[-1].generation][:CLOSEST_CANDIDATES]
-        counts = [bound.points_reached(r.values) for r in last]
-        best = int(np.argmax(counts))
-        shown = ", ".join(f"{k} = {v:.6g}" for k, v in last[best].values.items())
-        return UserError(f"no design of {run.evaluations} reaches the whole workspace; the closest ({shown}) reaches "
-                         f"{counts[best]} of {len(bound.points)} points ({last[best].invalid})")
-    feasible = [r for r in valid if r.feasible]
-    if feasible:
-        return _kept_none(run, feasible)
-    closest = min(valid, key=lambda r: r.violation)
-    shown = ", ".join(f"{k} = {v:.6g}" for k, v in closest.values.items())
-    return UserError(f"no design of {run.evaluations} meets the constraints; the closest ({shown}) has {closest.violated}")
-
-
-def _kept_none(run: StudyRun, feasible: list) -> UserError:
-    """Why the front is empty when designs meet the constraints: the ``keep`` filters remove them all; the design
-    closest to passing them (least scaled excess) and the filter it fails."""
-    spec = run.spec
-
-    def misses(record) -> tuple[float, str]:
-        full = spec.with_parameters(record.values)
-        total, first = 0.0, ""
-        for keep in spec.keep:
-            v = float(keep.formula.value(full))
-            for bound, sign, word in ((keep.at_most, 1.0, "<="), (keep.at_least, -1.0, ">=")):
-                if bound is None:
-                    continue
-                excess = math.inf if not math.isfinite(v) else sign * (v - bound) / (abs(bound) or 1.0)
-                if excess > 0.0:
-                    total += excess
-                    first = first or f"{keep.formula.text} = {v:.6g}, not {word} {bound:g}"
-        return total, first
-
-    closest = min(feasible, key=lambda r: misses(r)[0])
-    shown = ", ".join(f"{k} = {v:.6g}" for k, v in closest.values.items())
-    return UserError(f"{len(feasible)} of {run.evaluations} designs meet the constraints, but the keep filters remove "
-                     f"every one; the closest ({shown}) has {misses(closest)[1]}")
 
 
 def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Selection) -> list[Path]:
@@ -153,35 +110,70 @@ def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Select
     values = run.records[selection.record].values
     write_atomically(out / "selected.yaml", bound.device_file_text(values))
     pictures = [Picture(png, caption) for png, caption in bound.pictures(values)]
-    kept = [] if run.bound is not None else ["checkpoint/ (one file per generation; a rerun into this folder continues)"]
+    kept = (["checkpoint/ (one file per generation; a rerun into this folder continues)"]
+            if method_of(run.spec).checkpointed else [])
     page = render(run, selection, bound.title, Picture((out / "pareto.png").read_bytes(), "Pareto front"), pictures,
                   [*FILES, *kept])
     write_atomically(out / "report.html", page)
     return [*paths, out / "selected.yaml", out / "report.html"]
 
 
-def optimize(study_path: Path, seed: int, out: Path | None, scheduler: str | None, rule: dict,
-             progress: Callable[[int, int], None] | None, quiet: bool) -> tuple[dict, list[Path]]:
-    """Run the study file ``study_path`` with ``seed``; write the outputs into ``out`` (when given)."""
-    from contextlib import ExitStack
+@dataclass(frozen=True)
+class OptimizationResult:
+    """What :func:`optimize` answers: the ``study`` (the problem), its ``method`` (the algorithm), the ``run`` (every
+    evaluated design and the front), the ``selection`` and the ``files`` written (none without an output folder)."""
 
-    study = load_study(study_path)
+    study: Study
+    method: PopulationSearch | ConvexProgram
+    run: StudyRun
+    selection: Selection
+    files: list[Path]
+
+    @property
+    def records(self) -> list[Record]:
+        """Every evaluated design, in evaluation order (evaluations.csv)."""
+        return self.run.records
+
+    @property
+    def summary(self) -> dict:
+        """The answer of ``optimize --json``."""
+        return summary_of(self.run, self.selection)
+
+    @property
+    def front(self) -> list[dict]:
+        """The front as ``optimize --json`` prints it: ``[{"variables": {...}, "objectives": {...}}, ...]``."""
+        return self.summary["front"]
+
+    @property
+    def selected(self) -> dict:
+        """The selected design: its number on the front, the rule, its variables and objectives."""
+        return self.summary["selected"]
+
+
+def optimize(study: Path | str, seed: int = 1, out: Path | str | None = None, *, scheduler: str | None = None,
+             weights: dict[str, float] | None = None, design: int | None = None,
+             progress: Callable[[int, int], None] | None = None, quiet: bool = True) -> OptimizationResult:
+    """Run the study file ``study`` with ``seed`` by its method and select a front design: the least RMS of the
+    normalized objectives, the least weighted RMS with ``weights`` (objective name -> weight), or the front's
+    ``design``-th (seed 001 §7.2). ``out``: a folder for the outputs and the checkpoint (a rerun into it
+    continues); ``scheduler``: a Dask scheduler's address whose workers evaluate the designs;
+    ``progress(generation, generations)``; ``quiet``: Dask's own logging silenced. Nothing is printed; a bad
+    study, seed or selection raises :class:`~hapticdesign.errors.UserError`."""
+    study = load_study(study)
     bound = bind_study(study)
     require_study_workload(study)
+    out = None if out is None else Path(out)
     if out is not None:
         _check_out(out)
-    if study.spec.algorithm.method == "convex":
-        if scheduler is not None:
-            raise UserError("--scheduler distributes NSGA-II's generations; method convex solves one program here")
-        run = run_convex(bound, seed)
-    else:
-        with ExitStack() as stack:
-            evaluate = _evaluator(bound, scheduler, quiet, stack)
-            run = run_study(study, seed, evaluate, out, progress, bound.evaluate_constraints)
+    method = method_of(study.spec)
+    if scheduler is not None and not method.evaluates_designs:
+        raise UserError(f"a scheduler distributes the evaluation of designs; method {method.name} solves one program "
+                        "here")
+    with ExitStack() as stack:
+        evaluate = _evaluator(bound, scheduler, quiet, stack)
+        run = method.run(bound, seed, evaluate, out, progress)
     if not run.front:
-        if run.bound is not None:
-            raise UserError(f"{study_path}: the convex program's design is infeasible: {run.records[0].reason}")
-        raise _no_front(run, bound)
-    selection = select_design(run, **rule)
+        raise method.empty_front(run, bound)
+    selection = select_design(run, weights, design)
     written = [] if out is None else write_outputs(out, run, bound, selection)
-    return summary_of(run, selection), written
+    return OptimizationResult(study, method, run, selection, written)

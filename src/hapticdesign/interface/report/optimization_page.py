@@ -12,6 +12,7 @@ from html import escape
 from hapticdesign.interface.report.html import STYLE
 from hapticdesign.interface.report.tables import cell_text
 from hapticdesign.optimization.study_file import Choice
+from hapticdesign.optimization.study_methods import method_of
 from hapticdesign.optimization.study_outputs import Selection
 from hapticdesign.optimization.study_run import StudyRun, constraint_labels
 
@@ -62,20 +63,7 @@ def _study_rows(run: StudyRun) -> str:
                     objectives)]
     if constraints:
         parts.append(_table("Constraints", ["constrained value", ">=", "<="], constraints))
-    if spec.algorithm.method == "convex":
-        parts.append(f"<p>Method convex: LN minimized exactly over the inertial parameters as one convex program (seed "
-                     f"000 eq. 3.1-3.4), every body {escape(spec.algorithm.realizability)} realizable; the relaxation's "
-                     f"lower bound on the minimum is {escape(cell_text(run.bound))}.</p>")
-    else:
-        if spec.workspace is None:
-            where = "No workspace: every index is a closed form of the device's parameters. "
-        else:
-            box = spec.workspace.box
-            where = (f"Workspace: box centred at {escape(str(list(box.center)))} m, edges {escape(str(list(box.size)))} "
-                     f"m, {spec.workspace.grid} points per axis of nonzero size. ")
-        parts.append(f"<p>{where}NSGA-II, population "
-                     f"{spec.algorithm.population}, {spec.algorithm.generations} generations, seed {run.seed}: "
-                     f"{run.evaluations} designs evaluated, {sum(r.feasible for r in run.records)} feasible.</p>")
+    parts.append(f"<p>{escape(method_of(spec).describe(run), quote=False)}</p>")
     return "".join(parts)
 
 

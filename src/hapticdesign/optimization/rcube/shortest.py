@@ -13,23 +13,16 @@ feasible set), and it is the best of all starts.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import minimize
 
-from hapticdesign.errors import UserError
 from hapticdesign.optimization.rcube.constraints import CONSTRAINT_NAMES, Workspace, constraint_values, is_feasible, link1_length
-
-FEASIBILITY_MARGIN = 1e-10
-"""The local solver keeps ``g <= -margin`` so that its answer meets ``g <= 0`` exactly (constraint units)."""
+from hapticdesign.optimization.local_search import minimize_in_boxes
 
 ACTIVE_TOLERANCE = 1e-7
 """A constraint with ``g > -tolerance`` at the answer counts as active."""
-
-SAME_POINT = 1e-6
-"""Starts whose answers differ from the best by less than this (m of total length) found the same minimum."""
 
 GRADIENT_STEP = 1e-7
 """Central-difference step (rad, m) of the KKT check."""
@@ -114,78 +107,15 @@ def design_summary(x, workspace: Workspace = Workspace()) -> dict[str, float]:
     return {"l1": l1, "l2": l2, "l3": l3, "q_max": q, "total_length": l1 + l2 + l3}
 
 
-def _hull(boxes: Sequence[tuple[np.ndarray, np.ndarray]]) -> tuple[np.ndarray, np.ndarray]:
-    """The smallest box holding every box ``(lower, upper)`` (Table 7.1's bound sets)."""
-    return (np.min([b[0] for b in boxes], axis=0), np.max([b[1] for b in boxes], axis=0))
-
-
 def inside(x, bounds) -> bool:
     """Whether ``x`` lies within one bound set."""
     return bool(np.all(np.asarray(bounds.lower) <= x) and np.all(x <= np.asarray(bounds.upper)))
 
 
-Function = Callable[[np.ndarray], float]
-Constraints = Callable[[np.ndarray], np.ndarray]
-
-
-def _local_minimum(x0: np.ndarray, lower: np.ndarray, upper: np.ndarray, objective: Function,
-                   constraints: Constraints, feasible: Callable[[np.ndarray], bool] | None) -> np.ndarray | None:
-    """SLSQP from ``x0``; the answer if it is ``feasible`` (by default: meets ``g(x) <= 0``), else None."""
-    constraint = {"type": "ineq", "fun": lambda x: -constraints(x) - FEASIBILITY_MARGIN}
-    result = minimize(objective, x0, method="SLSQP", constraints=[constraint],
-                      bounds=list(zip(lower, upper)), options={"ftol": 1e-14, "maxiter": 500})
-    x = np.clip(result.x, lower, upper)
-    ok = feasible(x) if feasible is not None else bool(np.all(constraints(x) <= 0.0))
-    return x if ok else None
-
-
-def _minimize_in_box(lower: np.ndarray, upper: np.ndarray, starts: int, seed: int, objective: Function,
-                     constraints: Constraints, feasible) -> tuple[np.ndarray, int] | None:
-    """Best feasible local minimum over ``starts`` uniform starts drawn with ``seed``, and how many
-    starts reached it."""
-    rng = np.random.default_rng(seed)
-    found = [x for x in (_local_minimum(x0, lower, upper, objective, constraints, feasible)
-                         for x0 in rng.uniform(lower, upper, (starts, len(lower)))) if x is not None]
-    if not found:
-        return None
-    values = np.array([objective(x) for x in found])
-    best = int(np.argmin(values))
-    return found[best], int(np.sum(values - values[best] < SAME_POINT))
-
-
-def minimize_in_boxes(boxes: Sequence[tuple[np.ndarray, np.ndarray]], objective: Function, constraints: Constraints,
-                      starts: int, seed: int, feasible: Callable[[np.ndarray], bool] | None = None
-                      ) -> tuple[np.ndarray, int] | None:
-    """The least ``objective(x)`` under ``constraints(x) <= 0`` over the union of ``boxes`` (``(lower, upper)``
-    pairs) by SLSQP from ``starts`` uniform starts drawn with ``seed``, and how many starts reached it; None when
-    no start reaches a ``feasible`` design (by default: one that meets the constraints).
-
-    The box holding every box is searched first; if its minimum lies outside every box (only possible for
-    boxes that are not nested, unlike Table 7.1's), each box is searched on its own.
-    """
-    if starts < 1:
-        raise UserError(f"the constrained minimization needs at least one start, got {starts}")
-    boxes = [(np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)) for lo, hi in boxes]
-    found = _minimize_in_box(*_hull(boxes), starts, seed, objective, constraints, feasible)
-    if found is None and len(boxes) == 1:
-        return None
-
-    def held(x) -> bool:
-        return any(bool(np.all(lo <= x) and np.all(x <= hi)) for lo, hi in boxes)
-
-    if found is None or not held(found[0]):
-        per_box = [_minimize_in_box(lo, hi, starts, seed, objective, constraints, feasible) for lo, hi in boxes]
-        per_box = [p for p in per_box if p is not None]
-        if not per_box:
-            return None
-        found = min(per_box, key=lambda p: objective(p[0]))
-    return found
-
-
 def constrained_minimum(bound_sets: Sequence, workspace: Workspace = Workspace(), starts: int = 32,
                         seed: int = 1) -> ConstrainedMinimum | None:
     """The minimum of ``l1 + l2 + l3`` (eq. 6.24) under Constraints 2-8 (eq. 6.28, 6.45-6.52) over
-    the union of ``bound_sets`` (:func:`minimize_in_boxes`); None when no start reaches a feasible design."""
+    the union of ``bound_sets`` (:func:`~hapticdesign.optimization.local_search.minimize_in_boxes`); None when no start reaches a feasible design."""
     found = minimize_in_boxes([(np.array(b.lower), np.array(b.upper)) for b in bound_sets],
                               lambda x: float(total_length(x, workspace)[0]),
                               lambda x: constraint_values(x[None], workspace)[0], starts, seed,

@@ -1,0 +1,150 @@
+"""The study's optimization methods as a table: :data:`METHODS` maps the ``algorithm.method`` of a study file to a
+method object with one :meth:`~PopulationSearch.run` (pymoo's style: the study is the Problem, the method the
+Algorithm, the :class:`~hapticdesign.optimization.study_run.StudyRun` the Result that keeps them).
+
+- ``nsga2``, ``nsga3``, ``pso``: a population search of pymoo (:data:`~hapticdesign.optimization.pymoo_run.ALGORITHMS`),
+  each generation checkpointed, then the front polished as ``algorithm.polish`` asks (:mod:`.study_polish`).
+- ``convex``: seed 000's LN minimization over inertial parameters as one exact convex program (:mod:`.study_convex`).
+
+Each method's settings are its record of the study file (:data:`~hapticdesign.optimization.study_file.SETTINGS`);
+what a method does differently (how it runs, how its report and its empty front read, whether it keeps a
+checkpoint or evaluates designs on a cluster) is asked of its object here, nowhere by its name.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from hapticdesign.errors import UserError
+from hapticdesign.optimization.study_convex import run_convex
+from hapticdesign.optimization.study_evaluation import BoundStudy
+from hapticdesign.optimization.study_file import StudySpec
+from hapticdesign.optimization.study_polish import polish
+from hapticdesign.optimization.study_run import Evaluator, StudyRun, run_study
+
+Progress = Callable[[int, int], None]
+
+CLOSEST_CANDIDATES = 12
+"""Designs of the last generation tried point by point when no design reaches the workspace."""
+
+
+class PopulationSearch:
+    """A pymoo population search over the study's variables (``name`` in
+    :data:`~hapticdesign.optimization.pymoo_run.ALGORITHMS`; ``title`` names it in the report)."""
+
+    checkpointed = True
+    """A run keeps each generation in the output folder's checkpoint, and a rerun continues."""
+    evaluates_designs = True
+    """Its designs go to an evaluator in batches (here, or on a Dask cluster)."""
+
+    def __init__(self, name: str, title: str):
+        self.name = name
+        self.title = title
+
+    def run(self, bound: BoundStudy, seed: int, evaluate: Evaluator | None = None, out: Path | None = None,
+            progress: Progress | None = None) -> StudyRun:
+        """The search seeded ``seed`` (:func:`~hapticdesign.optimization.study_run.run_study`), its front polished;
+        ``evaluate`` answers batches of designs (the bound study's own by default), ``out`` keeps the checkpoint,
+        ``progress(generation, generations)``."""
+        evaluate = evaluate or bound.evaluate
+        run = run_study(bound.study, seed, evaluate, out, progress, bound.evaluate_constraints)
+        return polish(run, bound.study, evaluate, out)
+
+    def describe(self, run: StudyRun) -> str:
+        """The run in words (the report)."""
+        spec, settings = run.spec, run.spec.algorithm
+        if spec.workspace is None:
+            where = "No workspace: every index is a closed form of the device's parameters. "
+        else:
+            box = spec.workspace.box
+            where = (f"Workspace: box centred at {list(box.center)} m, edges {list(box.size)} m, {spec.workspace.grid} "
+                     "points per axis of nonzero size. ")
+        polished = [n for n, k in enumerate(run.front, start=1) if run.records[k].polished]
+        polishing = ("" if settings.polish == "none" else
+                     f" Polished ({settings.polish} of the front, SLSQP under the constraints): "
+                     + (f"front designs {', '.join(map(str, polished))}" if polished else "no design improved")
+                     + f"; the local search evaluated {run.probes} more designs, not listed in evaluations.csv.")
+        return (f"{where}{self.title}, population {settings.population}, {settings.generations} generations, seed "
+                f"{run.seed}: {len(run.records)} designs evaluated, {sum(r.feasible for r in run.records)} "
+                f"feasible.{polishing}")
+
+    def empty_front(self, run: StudyRun, bound: BoundStudy) -> UserError:
+        """Why the front is empty, with the closest design: the most workspace points reached (each from home),
+        or the least constraint violation."""
+        valid = [r for r in run.records if not r.invalid]
+        if not valid:
+            last = [r for r in run.records if r.generation == run.records[-1].generation][:CLOSEST_CANDIDATES]
+            counts = [bound.points_reached(r.values) for r in last]
+            best = int(np.argmax(counts))
+            shown = ", ".join(f"{k} = {v:.6g}" for k, v in last[best].values.items())
+            return UserError(f"no design of {run.evaluations} reaches the whole workspace; the closest ({shown}) "
+                             f"reaches {counts[best]} of {len(bound.points)} points ({last[best].invalid})")
+        feasible = [r for r in valid if r.feasible]
+        if feasible:
+            return _kept_none(run, feasible)
+        closest = min(valid, key=lambda r: r.violation)
+        shown = ", ".join(f"{k} = {v:.6g}" for k, v in closest.values.items())
+        return UserError(f"no design of {run.evaluations} meets the constraints; the closest ({shown}) has "
+                         f"{closest.violated}")
+
+
+def _kept_none(run: StudyRun, feasible: list) -> UserError:
+    """Why the front is empty when designs meet the constraints: the ``keep`` filters remove them all; the design
+    closest to passing them (least scaled excess) and the filter it fails."""
+    spec = run.spec
+
+    def misses(record) -> tuple[float, str]:
+        full = spec.with_parameters(record.values)
+        total, first = 0.0, ""
+        for keep in spec.keep:
+            v = float(keep.formula.value(full))
+            for bound, sign, word in ((keep.at_most, 1.0, "<="), (keep.at_least, -1.0, ">=")):
+                if bound is None:
+                    continue
+                excess = math.inf if not math.isfinite(v) else sign * (v - bound) / (abs(bound) or 1.0)
+                if excess > 0.0:
+                    total += excess
+                    first = first or f"{keep.formula.text} = {v:.6g}, not {word} {bound:g}"
+        return total, first
+
+    closest = min(feasible, key=lambda r: misses(r)[0])
+    shown = ", ".join(f"{k} = {v:.6g}" for k, v in closest.values.items())
+    return UserError(f"{len(feasible)} of {run.evaluations} designs meet the constraints, but the keep filters remove "
+                     f"every one; the closest ({shown}) has {misses(closest)[1]}")
+
+
+class ConvexProgram:
+    """Seed 000's LN minimization as one exact convex program (:mod:`.study_convex`): one design, no generations."""
+
+    name = "convex"
+    checkpointed = False
+    evaluates_designs = False
+
+    def run(self, bound: BoundStudy, seed: int, evaluate: Evaluator | None = None, out: Path | None = None,
+            progress: Progress | None = None) -> StudyRun:
+        """The program's design (``seed`` kept for the record; ``evaluate``, ``out`` and ``progress`` unused: the
+        program is solved here at once)."""
+        return run_convex(bound, seed)
+
+    def describe(self, run: StudyRun) -> str:
+        return (f"Method convex: LN minimized exactly over the inertial parameters as one convex program (seed 000 eq. "
+                f"3.1-3.4), every body {run.spec.algorithm.realizability} realizable; the relaxation's lower bound on "
+                f"the minimum is {run.notes['lower_bound']:.6g}.")
+
+    def empty_front(self, run: StudyRun, bound: BoundStudy) -> UserError:
+        return UserError(f"{bound.study.path}: the convex program's design is infeasible: {run.records[0].reason}")
+
+
+METHODS = {method.name: method for method in (PopulationSearch("nsga2", "NSGA-II"),
+                                               PopulationSearch("nsga3", "NSGA-III"),
+                                               PopulationSearch("pso", "Particle swarm"), ConvexProgram())}
+"""The study file's methods by name (their settings: :data:`~hapticdesign.optimization.study_file.SETTINGS`)."""
+
+
+def method_of(spec: StudySpec) -> PopulationSearch | ConvexProgram:
+    """The method object of the study's ``algorithm``."""
+    return METHODS[spec.algorithm.method]
