@@ -89,7 +89,6 @@ def test_branch_is_kept_along_a_motion():
 
 # -- command line -------------------------------------------------------------------------------------
 def test_dynamics_command_in_actuated_coordinates():
-    device = load_device_file(EXAMPLES / "five-bar.yaml")
     result = CliRunner().invoke(app, ["dynamics", "--device", str(EXAMPLES / "five-bar.yaml"), "--q", "2.0,1.1",
                                       "--qd", "1,0.5", "--qdd", "0.2,-0.3", "--json"])
     assert result.exit_code == 0, result.output

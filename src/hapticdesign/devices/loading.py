@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from hapticdesign.devices.registry import DEFAULT_PRESET, preset
-from hapticdesign.errors import InputError, UserError
+from hapticdesign.errors import InputError
 from hapticdesign.model.device import Device
 from hapticdesign.model.params_io import read_parameters
 

@@ -33,7 +33,6 @@ from hapticdesign.errors import InputError, UserError
 from hapticdesign.analysis.rcube.design import RCubeDesign
 from hapticdesign.analysis.rcube.kinematics import chain_angles, chain_jacobian, cube_grid, passive_reach
 from hapticdesign.analysis.rcube.stiffness import chain_stiffness_matrices
-from hapticdesign.errors import UserError
 from hapticdesign.files import parse_structured, quote, read_text, save_figure as write_figure
 from hapticdesign.model.rcube import RCubeGeometry, axis_permutation, chain_mechanism
 
