@@ -283,12 +283,14 @@ class DesignSpace:
             except UserError as exc:
                 refused[d] = str(exc)
                 kinematic[d], seed[d], diameters[d], motors[d] = batch.p0, seed_file, diameters_file, ()
-        vectors = batch.frame_vectors(batch.offsets(kinematic), [(link.start, link.end) for link in self.spec.links])
+        pairs = [(link.start, link.end) for link in self.spec.links]
+        vectors = batch.frame_vectors(batch.offsets(kinematic), pairs)
         lengths = np.linalg.norm(vectors[:, :, 0], axis=-1)
         for d, k in zip(*np.nonzero(lengths <= LENGTH_TOLERANCE)):
             if refused[d] is None:
                 link = self.spec.links[k]
                 refused[d] = f"link {link.name}: frames {link.start!r} and {link.end!r} coincide (zero length)"
+                kinematic[d], vectors[d] = batch.p0, batch.frame_vectors(batch.offsets(batch.p0), pairs)[0]
         rigidity = np.zeros((count, len(self.spec.links), 3))
         for k, link in enumerate(self.spec.links):
             rigidity[:, k] = np.stack(tube_rigidities(link.material, diameters[:, k, 0], diameters[:, k, 1]), axis=-1)
