@@ -11,9 +11,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.analysis.metrics.indices import Request
 from hapticdesign.analysis.workspace import Workspace
 from hapticdesign.devices.design_space import design_space
+from hapticdesign.errors import UserError
 from hapticdesign.simulation.design_indices import evaluate, evaluate_designs
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -134,3 +136,28 @@ def test_batched_failures_name_the_point_or_the_design():
     assert "(0, 0, 0.3) m" in fast[0].reason and "(0, 0, 0.3) m" in slow.reason
     assert "cannot close" in fast[1].reason
     assert "finite" in fast[2].reason
+
+
+def test_a_way_across_a_working_mode_singularity_is_refused_one_design_and_batched():
+    """The Phantom's handle taken straight from home (in front of the base axis, theta1 = 0) to the point mirrored
+    behind that axis: along the straight way the arm would swing over the axis (theta1 kept, the shoulder's working
+    mode changed: det(U^T J_v) changes sign where the handle crosses the axis). The inverse kinematics keeps the
+    working mode of its start, so the point is refused, by the one IK and by the batch alike; the same point is
+    reached on home's working mode by a way around the axis, where the handle stays in front of the shoulder
+    along theta1's azimuth (the closed-form sign of the arm's reach, independent of the IK's determinant test)."""
+    space = design_space(EXAMPLES / "phantom-3dof.yaml", ["l2"])
+    device = space.base
+    home = configuration_of(device).pose(np.zeros(3))[:3, 3]
+    assert home[0] > 0.1 and abs(home[1]) < 1e-12
+    behind = np.array([-0.6 * home[0], 0.0, home[2]])
+    with pytest.raises(UserError, match="behind a singularity"):
+        configuration_of(device).reach(behind[None])
+    batched = evaluate_designs(space, [{"l2": device.params["l2"]}], behind[None], ["isotropy"])[0]
+    assert space.cache.get("batch") and "behind a singularity" in batched.reason
+    radius = np.hypot(home[0], home[1])
+    around = [radius * np.array([np.cos(a), np.sin(a), 0.0]) + [0.0, 0.0, home[2]] for a in np.linspace(0, np.pi, 19)]
+    q_a, _ = configuration_of(device).reach(np.array([*around, behind]))
+    reached = configuration_of(device).pose(q_a[-1])[:3, 3]
+    np.testing.assert_allclose(reached, behind, atol=1e-9)
+    azimuth = np.array([np.cos(q_a[-1, 0]), np.sin(q_a[-1, 0]), 0.0])
+    assert reached @ azimuth > 0.1
