@@ -161,3 +161,15 @@ def test_a_way_across_a_working_mode_singularity_is_refused_one_design_and_batch
     np.testing.assert_allclose(reached, behind, atol=1e-9)
     azimuth = np.array([np.cos(q_a[-1, 0]), np.sin(q_a[-1, 0]), 0.0])
     assert reached @ azimuth > 0.1
+
+
+def test_an_index_the_device_cannot_give_fails_each_design_as_design_by_design():
+    space = design_space(EXAMPLES / "five-bar.yaml", ["l1", "l2"])
+    points = np.array([[0.0, 0.0, 0.18]])
+    designs = [{"l1": 0.10, "l2": 0.14}, {"l1": 0.11, "l2": 0.15}]
+    for request in ("force", "stiffness"):
+        fast = evaluate_designs(space, designs, points, [request])
+        slow = [evaluate(space.device(v), points, [request]) for v in designs]
+        assert [f.reason for f in fast] == [s.reason for s in slow]
+        assert all(s.reason for s in slow)
+    assert evaluate_designs(space, [], points, ["isotropy"]) == []

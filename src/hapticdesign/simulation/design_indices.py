@@ -89,7 +89,7 @@ def evaluate_designs(space: DesignSpace, designs: Sequence[Mapping[str, float]],
     device file refuses fails with its reason (see the module docstring for the batched path)."""
     checked = requests_of(requests, DESIGN_INDICES)
     points = np.asarray(points, dtype=float)
-    batch = _batch(space, checked)
+    batch = _batch(space, checked) if designs else None
     if batch is None:
         return [_one(space, values, points, checked) for values in designs]
     stiffness = any(r.index in ("stiffness", "frequency") for r in checked)
@@ -107,7 +107,7 @@ def evaluate_designs(space: DesignSpace, designs: Sequence[Mapping[str, float]],
         states.__dict__["stiffness"] = np.swapaxes(u, 1, 2) @ got.stiffness[ok].reshape(-1, 6, 6)[:, :3, :3] @ u
     values, failed = {}, None
     try:
-        for r in checked:
+        for r in checked if ok.any() else ():
             index = DESIGN_INDICES[r.index]
             values[r.key] = np.asarray(index.values(states, {**index.options, **r.options}),
                                        dtype=float).reshape(-1, len(points))
@@ -129,8 +129,11 @@ def _batch(space: DesignSpace, requests: list[Request]) -> DesignBatch | None:
     """The space's compiled structure when the batched path applies (every index but those of
     :data:`~hapticdesign.analysis.metrics.indices.PER_DESIGN`; a device whose handle moves in as many directions
     as it has actuated coordinates, at most 3), else None."""
-    if any(r.index in PER_DESIGN for r in requests):
-        return None
+    elastic = space.base.elasticity
+    if any(r.index in PER_DESIGN for r in requests) or (
+            any(r.index in ("stiffness", "frequency") for r in requests)
+            and (elastic is None or not (elastic.links or elastic.joints))):
+        return None  # design by design (an index of the whole device; or one the device cannot give, said there)
     if space.cache.get("batch") is None:
         try:
             space.cache["batch"] = DesignBatch(space.base)
