@@ -1,4 +1,4 @@
-"""Many designs of one closed-loop device through compiled kernels: workspace poses, ``J_v T`` and ``H`` per design.
+"""Many designs of one device through compiled kernels: workspace poses, ``J_v T``, ``H`` and ``K_C`` per design.
 
 An optimization evaluates thousands of designs that differ only in numbers: lengths, masses, motors. Building each
 design's mechanism, loop solver and models in Python costs milliseconds, so :class:`DesignBatch` builds the
@@ -7,7 +7,13 @@ and takes per design only what changes:
 
 - the node offsets, affine in the kinematic parameters (a device file's values are affine expressions, so
   ``offset = offset_0 + S (p - p_0)`` exactly; ``S`` is found once by building the mechanism at ``p_0 + e_k``);
-- the standard inertial parameters and the motors' reflected inertia.
+- the standard inertial parameters, the motors' reflected inertia, damping and torque limits, and the elastic
+  links' rigidities (:class:`DesignValues`, which a design space fills from its variables).
+
+A tree is a closed-loop device without loops (no closures, no passive coordinates: Pinocchio's view), so trees and
+closed loops take the same kernels. The statuses are those every loop kernel returns (:mod:`.loops.records`), the
+closures the loop solver's record on this tree's node numbering, the Newton start at home
+:meth:`~hapticdesign.model.loops.ClosedLoops.guess` and the solver's :func:`~.loops.solver.settings_of`.
 
 :func:`reach_designs` then reaches the workspace points of every design in one compiled call, by the same
 continuation as :meth:`~hapticdesign.analysis.configuration.Configuration.reach` (straight Cartesian segments in
@@ -18,10 +24,14 @@ fails at that point) when Newton does not converge or the handle is off the goal
 planar device's plane), when the system's pivot ratio falls below ``IK_SINGULAR`` or the sign of its determinant
 (``det Phi_p det(U^T J_v T)``, Schur's complement) or of ``det Phi_p`` (the assembly branch) changes from home's
 (behind a singularity). At each point it leaves ``J_v T`` (3 x n_a). :func:`mass_designs` gives ``H`` at those
-poses with the closed-loop dynamics' own pose kernels (:mod:`hapticdesign.analysis.dynamics.actuated_kernel`). The
+poses with the closed-loop dynamics' own pose kernels (:mod:`hapticdesign.analysis.dynamics.actuated_kernel`), and
+:func:`vjm_designs` the virtual joint method's rows there (the handle's and the closures' Jacobians over the
+coordinates and the six virtual coordinates of each elastic link), from which ``K_C`` follows as
+:func:`~hapticdesign.analysis.stiffness.device.cartesian_stiffness_at` gives it one pose at a time. The
 continuation's inner kernels allocate nothing and are compiled without numba's reference counting (``_nrt=False``),
 so that passing the records costs no atomic counts per array.
-``tests/design/test_design_batch.py`` checks both against the one-design path (:mod:`.metrics.indices`).
+``tests/design/test_design_batch.py`` checks them against the one-design path (:mod:`.metrics.indices`) for every
+kind of design variable.
 """
 
 from __future__ import annotations
