@@ -16,7 +16,8 @@ file's own validation checks it (a finite number, ``D > d >= 0``, ``gear_ratio >
 consistency, the loops closing at home, ...), and an invalid design raises a one-line :class:`UserError`. Bodies
 that are links (``bodies: - {name: b, link: l}``) follow the lengths and sections: their mass and inertia are
 computed again (:func:`~hapticdesign.devices.device_file.link_body_inertias`) whenever a parameter or a section
-changes.
+changes. :meth:`DesignSpace.batch_values` gives the same numbers and refusals for a whole generation of designs at
+once, as the arrays the compiled kernels take (:class:`~hapticdesign.analysis.design_batch.DesignValues`).
 """
 
 from __future__ import annotations
