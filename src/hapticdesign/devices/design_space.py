@@ -54,6 +54,9 @@ from hapticdesign.model.params_io import read_mapping
 
 ACTUATOR_FIELDS = ("rotor_inertia", "gear_ratio", "coulomb", "damping", "torque_continuous", "torque_peak")
 """The numeric fields of a motor a design variable may change (units as in the device file)."""
+MOTOR_SETS = 4096
+"""Distinct sets of motor values whose matrices :meth:`DesignSpace.batch_values` keeps (a study's discrete ratios are
+a few; continuous motor variables give one per design, so the oldest are dropped past this many)."""
 
 
 @dataclass(frozen=True)
@@ -320,6 +323,8 @@ class DesignSpace:
         (actuator index and its changed fields), built once per distinct set."""
         motors = self.cache.setdefault("motors", {})
         if key not in motors:
+            if len(motors) >= MOTOR_SETS:
+                motors.clear()
             device = self._with_actuators(self.base, {k: dict(f) for k, f in key}) if key else self.base
             motors[key] = (device.reflected_inertia, device.damping_matrix, force.motor_map(device),
                            {which: force.torque_limits(device, which) for which in ("continuous", "peak")})
