@@ -56,7 +56,7 @@ ACTUATOR_FIELDS = ("rotor_inertia", "gear_ratio", "coulomb", "damping", "torque_
 """The numeric fields of a motor a design variable may change (units as in the device file)."""
 MOTOR_SETS = 4096
 """Distinct sets of motor values whose matrices :meth:`DesignSpace.batch_values` keeps (a study's discrete ratios are
-a few; continuous motor variables give one per design, so the oldest are dropped past this many)."""
+a few; continuous motor variables give one per design, so the cache starts again past this many)."""
 
 
 @dataclass(frozen=True)
