@@ -58,7 +58,7 @@ from hapticdesign.errors import UserError
 from hapticdesign.model.dense import lu_in_place
 from hapticdesign.model.device import Device, build_mechanism
 from hapticdesign.model.walk import (
-    KinematicTree, MotionPlan, Tree, frame_jacobian, node_poses, planned_poses, trig_workspace, unit_twist,
+    KinematicTree, MotionPlan, Tree, frame_jacobian, node_poses, planned_poses, trig_workspace,
 )
 
 SINGULAR_PIVOTS = 1e-9
