@@ -1,6 +1,6 @@
 """Study evaluation speed: designs evaluated per second in one process for the example studies
 (examples/studies/five-bar.yaml: 25 workspace points, isotropy, apparent mass and stiffness over lengths,
-spacing, tube sections and capstan ratios, design by design; delta.yaml: 27 points, geometry only, batched)
+spacing, tube sections and capstan ratios; delta.yaml: 27 points, geometry only; all batched since issue 36)
 and for the five-bar study restricted to its geometry (l1, l2, d) with isotropy and apparent mass on
 examples/devices/five-bar.yaml (bodies of their own, not tubes: the issue's benchmark, 25 points, batched
 through the compiled kernels; goal 2000 designs/s), on designs drawn uniformly within the bounds (seeded). The whole run's time comes from docs/scripts/example_studies.py.

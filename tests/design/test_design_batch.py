@@ -1,6 +1,8 @@
 """Many designs through the compiled kernels (:mod:`hapticdesign.analysis.design_batch`) against one design at a
-time (:func:`hapticdesign.simulation.design_indices.evaluate`, whose indices are checked against closed forms,
-finite differences and kinetic energy in test_indices.py): same values, same failures."""
+time (:func:`hapticdesign.simulation.design_indices.evaluate` of ``DesignSpace.device``, whose indices are checked
+against closed forms, finite differences, kinetic energy and the VJM's own references in test_indices.py and
+test_indices_force_stiffness.py): same values, same failures, for every kind of design variable, trees and closed
+loops."""
 
 from __future__ import annotations
 
@@ -9,12 +11,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from hapticdesign.analysis.configuration import configuration_of
+from hapticdesign.analysis.metrics.indices import Request
 from hapticdesign.analysis.workspace import Workspace
 from hapticdesign.devices.design_space import design_space
-from hapticdesign.analysis.metrics.indices import Request
+from hapticdesign.errors import UserError
 from hapticdesign.simulation.design_indices import evaluate, evaluate_designs
 
-EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "devices"
+ROOT = Path(__file__).resolve().parents[2]
+EXAMPLES = ROOT / "examples" / "devices"
+TUBES = ROOT / "examples" / "studies" / "five-bar-tubes.yaml"
 INDICES = ["isotropy", "apparent_mass", "condition", "manipulability", "inertia_uniformity", "kmax",
            Request("kmax", {"period": 0.0005, "delay": 2, "damping": 0.05}, "kmax_damped")]
 KEYS = [r if isinstance(r, str) else r.key for r in INDICES]
@@ -26,34 +32,99 @@ CASES = {
 }
 
 
+def _same(space, designs, points, requests, keys):
+    """The batched evaluation of ``designs`` equals the one-design path's, design by design (values to 1e-9,
+    failures alike); returns the batched answers."""
+    batched = evaluate_designs(space, designs, points, requests)
+    assert space.cache.get("batch"), "the compiled path serves these indices and variables"
+    for values, fast in zip(designs, batched):
+        try:
+            slow = evaluate(space.device(values), points, requests)
+        except Exception as exc:  # noqa: BLE001 - the design's device is refused: the batch says so too
+            assert fast.reason is not None and str(exc) in fast.reason, (fast.reason, exc)
+            continue
+        assert (fast.reason is None) == (slow.reason is None), (fast.reason, slow.reason)
+        for key in keys if slow.reason is None else ():
+            np.testing.assert_allclose(fast.values[key], slow.values[key], rtol=1e-9, err_msg=key)
+    return batched
+
+
 @pytest.mark.parametrize("name", sorted(CASES))
 def test_batched_designs_equal_one_design_at_a_time(name):
     names, workspace, bounds = CASES[name]
     space = design_space(EXAMPLES / f"{name}.yaml", names)
     rng = np.random.default_rng(7)
     designs = [{k: float(rng.uniform(*bounds[k])) for k in names} for _ in range(6)]
-    points = workspace.points()
-    batched = evaluate_designs(space, designs, points, INDICES)
-    assert space.cache.get("batch"), "the compiled path serves these indices (kmax with J_v, H and the file's B)"
-    for values, fast in zip(designs, batched):
-        slow = evaluate(space.device(values), points, INDICES)
-        assert (fast.reason is None) == (slow.reason is None), (fast.reason, slow.reason)
-        for key in KEYS if slow.reason is None else ():
-            np.testing.assert_allclose(fast.values[key], slow.values[key], rtol=1e-9)
+    _same(space, designs, workspace.points(), INDICES, KEYS)
 
 
-def test_bodies_that_are_links_follow_the_geometry_of_each_design():
-    """Link bodies change mass with l1, l2: the batch (which keeps the file's inertial parameters) must not be
-    taken for them; each design's apparent mass is that of its own device, not the file's."""
-    tubes = Path(__file__).resolve().parents[2] / "examples" / "studies" / "five-bar-tubes.yaml"
-    space = design_space(tubes, ["l1", "l2", "d"])
+TUBE_INDICES = ["isotropy", "apparent_mass", "mass", "force", Request("force", {"torque": "peak"}, "peak"),
+                "stiffness", "frequency", "kmax"]
+TUBE_KEYS = [r if isinstance(r, str) else r.key for r in TUBE_INDICES]
+
+
+def test_every_variable_kind_follows_each_design():
+    """Geometry with tube bodies (masses follow the lengths), sections (masses and K_C follow), a point mass, and
+    every motor field (discrete gear ratios, rotor inertia, damping, torques): each design's values are its own
+    device's, and they differ from design to design (so the file's inertial parameters, B or torques would not
+    pass)."""
+    names = ["l1", "l2", "d", "links.prox1.D", "links.dist2.d", "mh", "rhz", "actuators.q1.gear_ratio",
+             "actuators.q2.gear_ratio", "actuators.q1.rotor_inertia", "actuators.q2.damping",
+             "actuators.q1.torque_continuous", "actuators.q2.torque_peak", "actuators.q1.torque_peak"]
+    space = design_space(TUBES, names)
+    rng = np.random.default_rng(11)
+    designs = [{"l1": rng.uniform(0.08, 0.13), "l2": rng.uniform(0.12, 0.17), "d": rng.uniform(0.05, 0.1),
+                "links.prox1.D": rng.uniform(0.009, 0.02), "links.dist2.d": rng.uniform(0.004, 0.009),
+                "mh": rng.uniform(0.005, 0.05), "rhz": rng.uniform(0.0, 0.02),
+                "actuators.q1.gear_ratio": float(rng.choice([5.0, 13.3])),
+                "actuators.q2.gear_ratio": float(rng.choice([5.0, 13.3])),
+                "actuators.q1.rotor_inertia": rng.uniform(5e-7, 3e-6), "actuators.q2.damping": rng.uniform(0, 0.01),
+                "actuators.q1.torque_continuous": rng.uniform(0.01, 0.05),
+                "actuators.q2.torque_peak": rng.uniform(0.05, 0.1), "actuators.q1.torque_peak": rng.uniform(0.05, 0.1)}
+               for _ in range(5)]
+    points = Workspace((0.0, 0.0, 0.16), (0.04, 0.0, 0.04), 3).points()
+    batched = _same(space, designs, points, TUBE_INDICES, TUBE_KEYS)
+    valid = [b for b in batched if b.reason is None]
+    assert len(valid) >= 3
+    for key in TUBE_KEYS:
+        firsts = [b.values[key][0] for b in valid]
+        assert len(set(np.round(firsts, 12))) == len(firsts), key
+
+
+def test_a_tree_goes_through_the_same_batch():
+    """A tree (the Phantom with its motors, a coupled one among them, and joint limits) is a closed-loop device
+    without loops: geometry, inertial parameters and motor fields through the compiled batch, as design by design;
+    a design beyond a joint limit fails the same way."""
+    names = ["l2", "l3", "m2", "m3a", "Ixx3a", "actuators.theta1.gear_ratio", "actuators.2.rotor_inertia",
+             "actuators.theta2.damping"]
+    space = design_space(EXAMPLES / "phantom-3dof-motors.yaml", names)
+    home = np.array([0.12327604, 0.01236886, 0.08727412])
+    points = home + np.array([[0.0, 0.0, 0.0], [0.02, 0.0, 0.01], [-0.02, 0.02, 0.0], [0.0, -0.02, -0.02]])
+    rng = np.random.default_rng(3)
+    designs = [{"l2": rng.uniform(0.19, 0.24), "l3": rng.uniform(0.15, 0.2), "m2": rng.uniform(0.1, 0.2),
+                "m3a": rng.uniform(0.2, 0.3), "Ixx3a": rng.uniform(0.0045, 0.0055),
+                "actuators.theta1.gear_ratio": float(rng.choice([10.0, 13.3])),
+                "actuators.2.rotor_inertia": rng.uniform(5e-7, 2e-6),
+                "actuators.theta2.damping": rng.uniform(0.0, 0.001)} for _ in range(5)]
+    designs.append({"l2": 0.215, "m2": -1.0})  # refused by the file's checks
+    designs.append({"l2": 0.12, "l3": 0.12})  # reaches the points only beyond a joint limit, or not at all
+    batched = _same(space, designs, points, INDICES + ["mass"], KEYS + ["mass"])
+    assert sum(b.reason is None for b in batched) == 5
+    assert "negative mass" in batched[5].reason
+
+
+def test_refused_designs_say_why_in_the_batch():
+    space = design_space(TUBES, ["l1", "links.prox1.D", "links.prox1.d", "actuators.q1.gear_ratio"])
     points = Workspace((0.0, 0.0, 0.16), (0.02, 0.0, 0.02), 2).points()
-    designs = [{"l1": 0.13, "l2": 0.16, "d": 0.05}, {"l1": 0.09, "l2": 0.2, "d": 0.07}]
-    for values, fast in zip(designs, evaluate_designs(space, designs, points, ["apparent_mass"])):
-        slow = evaluate(space.device(values), points, ["apparent_mass"])
-        np.testing.assert_allclose(fast.values["apparent_mass"], slow.values["apparent_mass"], rtol=1e-9)
-    masses = [evaluate(space.device(v), points, ["mass"]).values["mass"][0] for v in designs]
-    assert masses[0] != masses[1]
+    designs = [{"l1": 0.1, "links.prox1.D": 0.008, "links.prox1.d": 0.009},
+               {"l1": 0.1, "actuators.q1.gear_ratio": -2.0},
+               {"l1": 0.0},
+               {"l1": 0.1}]
+    fast = _same(space, designs, points, ["apparent_mass", "stiffness"], ["apparent_mass", "stiffness"])
+    assert "link prox1: inner diameter d" in fast[0].reason
+    assert "gear_ratio" in fast[1].reason
+    assert "zero length" in fast[2].reason
+    assert fast[3].reason is None
 
 
 def test_batched_failures_name_the_point_or_the_design():
@@ -65,3 +136,40 @@ def test_batched_failures_name_the_point_or_the_design():
     assert "(0, 0, 0.3) m" in fast[0].reason and "(0, 0, 0.3) m" in slow.reason
     assert "cannot close" in fast[1].reason
     assert "finite" in fast[2].reason
+
+
+def test_a_way_across_a_working_mode_singularity_is_refused_one_design_and_batched():
+    """The Phantom's handle taken straight from home (in front of the base axis, theta1 = 0) to the point mirrored
+    behind that axis: along the straight way the arm would swing over the axis (theta1 kept, the shoulder's working
+    mode changed: det(U^T J_v) changes sign where the handle crosses the axis). The inverse kinematics keeps the
+    working mode of its start, so the point is refused, by the one IK and by the batch alike; the same point is
+    reached on home's working mode by a way around the axis, where the handle stays in front of the shoulder
+    along theta1's azimuth (the closed-form sign of the arm's reach, independent of the IK's determinant test)."""
+    space = design_space(EXAMPLES / "phantom-3dof.yaml", ["l2"])
+    device = space.base
+    home = configuration_of(device).pose(np.zeros(3))[:3, 3]
+    assert home[0] > 0.1 and abs(home[1]) < 1e-12
+    behind = np.array([-0.6 * home[0], 0.0, home[2]])
+    with pytest.raises(UserError, match="behind a singularity"):
+        configuration_of(device).reach(behind[None])
+    batched = evaluate_designs(space, [{"l2": device.params["l2"]}], behind[None], ["isotropy"])[0]
+    assert space.cache.get("batch") and "behind a singularity" in batched.reason
+    radius = np.hypot(home[0], home[1])
+    around = [radius * np.array([np.cos(a), np.sin(a), 0.0]) + [0.0, 0.0, home[2]] for a in np.linspace(0, np.pi, 19)]
+    q_a, _ = configuration_of(device).reach(np.array([*around, behind]))
+    reached = configuration_of(device).pose(q_a[-1])[:3, 3]
+    np.testing.assert_allclose(reached, behind, atol=1e-9)
+    azimuth = np.array([np.cos(q_a[-1, 0]), np.sin(q_a[-1, 0]), 0.0])
+    assert reached @ azimuth > 0.1
+
+
+def test_an_index_the_device_cannot_give_fails_each_design_as_design_by_design():
+    space = design_space(EXAMPLES / "five-bar.yaml", ["l1", "l2"])
+    points = np.array([[0.0, 0.0, 0.18]])
+    designs = [{"l1": 0.10, "l2": 0.14}, {"l1": 0.11, "l2": 0.15}]
+    for request in ("force", "stiffness"):
+        fast = evaluate_designs(space, designs, points, [request])
+        slow = [evaluate(space.device(v), points, [request]) for v in designs]
+        assert [f.reason for f in fast] == [s.reason for s in slow]
+        assert all(s.reason for s in slow)
+    assert evaluate_designs(space, [], points, ["isotropy"]) == []

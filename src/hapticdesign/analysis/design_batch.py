@@ -1,4 +1,4 @@
-"""Many designs of one closed-loop device through compiled kernels: workspace poses, ``J_v T`` and ``H`` per design.
+"""Many designs of one device through compiled kernels: workspace poses, ``J_v T``, ``H`` and ``K_C`` per design.
 
 An optimization evaluates thousands of designs that differ only in numbers: lengths, masses, motors. Building each
 design's mechanism, loop solver and models in Python costs milliseconds, so :class:`DesignBatch` builds the
@@ -7,7 +7,13 @@ and takes per design only what changes:
 
 - the node offsets, affine in the kinematic parameters (a device file's values are affine expressions, so
   ``offset = offset_0 + S (p - p_0)`` exactly; ``S`` is found once by building the mechanism at ``p_0 + e_k``);
-- the standard inertial parameters and the motors' reflected inertia.
+- the standard inertial parameters, the motors' reflected inertia, damping and torque limits, and the elastic
+  links' rigidities (:class:`DesignValues`, which a design space fills from its variables).
+
+A tree is a closed-loop device without loops (no closures, no passive coordinates: Pinocchio's view), so trees and
+closed loops take the same kernels. The statuses are those every loop kernel returns (:mod:`.loops.records`), the
+closures the loop solver's record on this tree's node numbering, the Newton start at home
+:meth:`~hapticdesign.model.loops.ClosedLoops.guess` and the solver's :func:`~.loops.solver.settings_of`.
 
 :func:`reach_designs` then reaches the workspace points of every design in one compiled call, by the same
 continuation as :meth:`~hapticdesign.analysis.configuration.Configuration.reach` (straight Cartesian segments in
@@ -18,10 +24,14 @@ fails at that point) when Newton does not converge or the handle is off the goal
 planar device's plane), when the system's pivot ratio falls below ``IK_SINGULAR`` or the sign of its determinant
 (``det Phi_p det(U^T J_v T)``, Schur's complement) or of ``det Phi_p`` (the assembly branch) changes from home's
 (behind a singularity). At each point it leaves ``J_v T`` (3 x n_a). :func:`mass_designs` gives ``H`` at those
-poses with the closed-loop dynamics' own pose kernels (:mod:`hapticdesign.analysis.dynamics.actuated_kernel`). The
+poses with the closed-loop dynamics' own pose kernels (:mod:`hapticdesign.analysis.dynamics.actuated_kernel`), and
+:func:`vjm_designs` the virtual joint method's rows there (the handle's and the closures' Jacobians over the
+coordinates and the six virtual coordinates of each elastic link), from which ``K_C`` follows as
+:func:`~hapticdesign.analysis.stiffness.device.cartesian_stiffness_at` gives it one pose at a time. The
 continuation's inner kernels allocate nothing and are compiled without numba's reference counting (``_nrt=False``),
 so that passing the records costs no atomic counts per array.
-``tests/design/test_design_batch.py`` checks both against the one-design path (:mod:`.metrics.indices`).
+``tests/design/test_design_batch.py`` checks them against the one-design path (:mod:`.metrics.indices`) for every
+kind of design variable.
 """
 
 from __future__ import annotations
@@ -31,25 +41,33 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from hapticdesign.analysis.configuration import IK_JOINT_STEP, IK_STEP, IK_WAY, configuration_of
+from hapticdesign.analysis.configuration import (
+    IK_JOINT_STEP, IK_SINGULAR, IK_STEP, IK_WAY, check_limits, configuration_of,
+)
 from hapticdesign.analysis.dynamics.actuated_kernel import (
     Bodies, factor_pose, mass_and_gravity, passive_paths, reduce_pose, world_parameters,
 )
 from hapticdesign.analysis.loops import closure_kernel as ck
-from hapticdesign.analysis.loops.records import Closures, workspace
+from hapticdesign.analysis.loops.solver import settings_of
+from hapticdesign.analysis.loops.records import (
+    BRANCH_CHANGE, NO_HOME, OK, OUT_OF_REACH, SINGULAR, Closures, workspace,
+)
+from hapticdesign.analysis.stiffness import vjm
+from hapticdesign.analysis.stiffness.device import end_compliance
 from hapticdesign.errors import UserError
 from hapticdesign.model.dense import lu_in_place
 from hapticdesign.model.device import Device, build_mechanism
-from hapticdesign.model.walk import KinematicTree, MotionPlan, Tree, frame_jacobian, planned_poses, trig_workspace
+from hapticdesign.model.walk import (
+    KinematicTree, MotionPlan, Tree, frame_jacobian, node_poses, planned_poses, trig_workspace,
+)
 
-OK, NO_HOME, OUT_OF_REACH, SINGULAR, BRANCH = 0, 1, 2, 3, 4
 SINGULAR_PIVOTS = 1e-9
 """Pivot ratio of the system ``[Phi; U^T J_v]`` below which a pose counts as singular."""
 MESSAGES = {
     NO_HOME: "the loops cannot close at the home pose from the assembly guess",
     OUT_OF_REACH: "it is out of reach",
     SINGULAR: "it is out of reach or behind a singularity",
-    BRANCH: "the way leaves the loops' assembly branch",
+    BRANCH_CHANGE: "the way leaves the loops' assembly branch",
 }
 
 
@@ -161,7 +179,9 @@ def _newton(q, tree, plan, loops, settings, reach, goal, mode, tol, ws):
 
 @njit(cache=True, _nrt=False)
 def _branch(q, tree, plan, loops, ws):
-    """Sign of ``det Phi_p`` at the closed pose ``q`` (its poses in ``ws``) and ``S`` into ``ws.t``."""
+    """Sign of ``det Phi_p`` at the closed pose ``q`` (its poses in ``ws``) and ``S`` into ``ws.t`` (1 for a tree)."""
+    if loops.passive.shape[0] == 0:
+        return 1.0
     ck.closure_jacobian(loops, tree, plan, ws.rot, ws.pos, ws.phi)
     ratio, sign = ck.velocity_map_into(ws.phi, loops.actuated, loops.passive, ws.pp, ws.t)
     return sign if ratio > 0.0 else 0.0
@@ -184,10 +204,11 @@ def reach_designs(offsets, targets, shape, plan, loops, settings, reach, out):
         q = reach.guess.copy()
         out.status[d] = OK
         out.point[d] = -1
-        code, _, _ = ck.newton(q, tree, plan, loops, settings)
-        if code != ck.OK:
-            out.status[d] = NO_HOME
-            continue
+        if m > 0:
+            code, _, _ = ck.newton(q, tree, plan, loops, settings)
+            if code != OK:
+                out.status[d] = NO_HOME
+                continue
         planned_poses(q, tree, plan, np.int64(0), plan.n_first, ws.rot, ws.pos, ws.trig)
         branch = _branch(q, tree, plan, loops, ws)
         for c in range(3):
@@ -207,7 +228,7 @@ def reach_designs(offsets, targets, shape, plan, loops, settings, reach, out):
                 if code != OK:
                     break
             if code == OK and _branch(q, tree, plan, loops, ws) != branch:
-                code = BRANCH
+                code = BRANCH_CHANGE
             if code != OK:
                 out.point[d] = p
                 break
@@ -232,7 +253,8 @@ def mass_designs(offsets, full, status, shape, plan, bodies, loops, params, out)
     na = loops.actuated.shape[0]
     body_node = bodies.body_node
     n_body = body_node.shape[0]
-    ws = workspace(shape.parent.shape[0], n, na, loops.passive, n_body)
+    n_node = shape.parent.shape[0]
+    ws = workspace(n_node, n, na, loops.passive, n_body)
     pw = np.zeros((1, n_body, 10))
     h = np.zeros((na, na))
     g = np.zeros(na)
@@ -243,7 +265,10 @@ def mass_designs(offsets, full, status, shape, plan, bodies, loops, params, out)
         tree = Tree(shape.parent, shape.axis, shape.coef, offsets[d], shape.const_rot, shape.const_pos)
         sets = params[d:d + 1]
         for p in range(n_pose):
-            factor_pose(full[d, p], tree, plan, loops, ws)
+            if loops.passive.shape[0] > 0:
+                factor_pose(full[d, p], tree, plan, loops, ws)
+            else:
+                planned_poses(full[d, p], tree, plan, np.int64(0), n_node, ws.rot, ws.pos, ws.trig)
             reduce_pose(tree, plan, body_node, loops, ws)
             world_parameters(ws.rot, body_node, sets, np.int64(0), pw)
             h[:] = 0.0
@@ -253,18 +278,141 @@ def mass_designs(offsets, full, status, shape, plan, bodies, loops, params, out)
             out[d, p] = h
 
 
+@njit(cache=True)
+def frame_vectors(offsets, shape, start, end, out):
+    """Per design (offsets D x nodes) and pair of nodes ``start[l]``, ``end[l]`` (-1: the base), the origin of
+    ``end`` from that of ``start`` at ``q = 0`` in ``start``'s axes and in ``end``'s, into ``out`` (D, L, 2, 3)."""
+    n_node = shape.parent.shape[0]
+    rot, pos = np.zeros((n_node, 3, 3)), np.zeros((n_node, 3))
+    q = np.zeros(shape.coef.shape[1])
+    for d in range(offsets.shape[0]):
+        node_poses(q, shape.parent, shape.axis, shape.coef, offsets[d], shape.const_rot, shape.const_pos,
+                   n_node - 1, rot, pos)
+        for k in range(start.shape[0]):
+            a, b = start[k], end[k]
+            for i in range(3):
+                out[d, k, 0, i] = 0.0
+                out[d, k, 1, i] = 0.0
+                for c in range(3):
+                    delta = pos[b, c] - (pos[a, c] if a >= 0 else 0.0)
+                    out[d, k, 0, i] += (rot[a, c, i] if a >= 0 else (1.0 if c == i else 0.0)) * delta
+                    out[d, k, 1, i] += rot[b, c, i] * delta
+
+
+@njit(cache=True, inline="always")
+def _moves(parent, node, point):
+    """Whether ``node`` is ``point`` or one of its ancestors (a joint at ``node`` moves ``point``)."""
+    while point >= 0:
+        if point == node:
+            return True
+        point = parent[point]
+    return False
+
+
+@njit(cache=True, inline="always")
+def _virtual_twist(rot, pos, node, i, point, c):
+    """Component ``c`` of the unit twist (v, w) at the origin of ``point`` of virtual coordinate ``i`` (tx ty tz Rx
+    Ry Rz in ``node``'s axes) appended to ``node``."""
+    a = i % 3
+    if c >= 3:
+        return rot[node, c - 3, a] if i >= 3 else 0.0
+    if i < 3:
+        return rot[node, c, a]
+    u0, u1, u2 = rot[node, 0, a], rot[node, 1, a], rot[node, 2, a]
+    r0, r1, r2 = pos[point, 0] - pos[node, 0], pos[point, 1] - pos[node, 1], pos[point, 2] - pos[node, 2]
+    if c == 0:
+        return u1 * r2 - u2 * r1
+    if c == 1:
+        return u2 * r0 - u0 * r2
+    return u0 * r1 - u1 * r0
+
+
+@njit(cache=True)
+def vjm_designs(offsets, full, status, shape, plan, loops, handle, ends, rows, virtual):
+    """The rows of the virtual joint method at the poses ``full`` (D, P, N) of the designs whose status is OK: the
+    handle's twist Jacobian over the coordinates and the closures' ``Phi`` into ``rows`` (D, P, 6 + m, N), and the
+    columns of the six virtual coordinates appended to each elastic link's end node ``ends[l]`` into ``virtual``
+    (D, P, 6 + m, 6 L) (:mod:`hapticdesign.analysis.stiffness.device`, eq. 5.93-5.97)."""
+    n_design, n_pose, n = full.shape
+    n_node = shape.parent.shape[0]
+    m = loops.row_loop.shape[0]
+    rot, pos, trig = np.zeros((n_node, 3, 3)), np.zeros((n_node, 3)), trig_workspace(n_node)
+    jac, phi = np.zeros((6, n)), np.zeros((m, n))
+    parent = shape.parent
+    for d in range(n_design):
+        if status[d] != OK:
+            continue
+        tree = Tree(shape.parent, shape.axis, shape.coef, offsets[d], shape.const_rot, shape.const_pos)
+        for p in range(n_pose):
+            planned_poses(full[d, p], tree, plan, np.int64(0), n_node, rot, pos, trig)
+            frame_jacobian(handle, shape.parent, shape.axis, shape.coef, rot, pos, np.bool_(False), jac)
+            rows[d, p, :6] = jac
+            if m > 0:
+                ck.closure_jacobian(loops, tree, plan, rot, pos, phi)
+                rows[d, p, 6:] = phi
+            for k in range(ends.shape[0]):
+                e = ends[k]
+                at_handle = _moves(parent, e, handle)
+                for i in range(6):
+                    col = 6 * k + i
+                    for c in range(6):
+                        virtual[d, p, c, col] = _virtual_twist(rot, pos, e, i, handle, c) if at_handle else 0.0
+                    for r in range(m):
+                        a, b = loops.frame_a[loops.row_loop[r]], loops.frame_b[loops.row_loop[r]]
+                        c = loops.row_comp[r]
+                        value = 0.0
+                        if a >= 0 and _moves(parent, e, a):
+                            value += _virtual_twist(rot, pos, e, i, a, c)
+                        if b >= 0 and _moves(parent, e, b):
+                            value -= _virtual_twist(rot, pos, e, i, b, c)
+                        virtual[d, p, 6 + r, col] = value
+
+
+class DesignValues(NamedTuple):
+    """What changes from design to design, for :meth:`DesignBatch.evaluate` (D designs; filled from a design space's
+    variables by :meth:`hapticdesign.devices.design_space.DesignSpace.batch_values`): kinematic parameters (D, K) in
+    the order of :attr:`DesignBatch.names`, standard inertial parameters (D, 10 B), the motors' reflected inertia
+    and the damping ``B`` (D, n_a, n_a), the motors' ``A^-1`` (D, n_a, n_a; None unless one motor per coordinate),
+    ``n_k tau_k`` per torque kind (``continuous``, ``peak``: (D, n_a), or None where a motor lacks it), the
+    elastic links' rigidities ``E A, E I, G J`` (D, L, 3; None without elastic links), and per design the reason
+    the device file refuses it (None: a valid design)."""
+
+    kinematic: np.ndarray
+    standard: np.ndarray
+    reflected: np.ndarray
+    damping: np.ndarray
+    motor_map: np.ndarray | None
+    torques: dict
+    rigidity: np.ndarray | None
+    refused: list
+
+
+class Evaluated(NamedTuple):
+    """Many designs at the workspace points (:meth:`DesignBatch.evaluate`): ``J_v`` (D, P, 3, n_a), ``H`` with the
+    reflected rotor inertia (D, P, n_a, n_a), the VJM's ``K_C`` (D, P, 6, 6; None unless asked), the mass the
+    coordinates move (D,), whether each design reached every point (D,) and else why not (one line), and the
+    design values it was given (``B``, the motors)."""
+
+    jacobian: np.ndarray
+    mass: np.ndarray
+    stiffness: np.ndarray | None
+    moving_mass: np.ndarray
+    ok: np.ndarray
+    reasons: list
+    values: DesignValues
+
+
 class DesignBatch:
-    """The compiled structure of a closed-loop device's geometry family (see the module docstring): designs that
-    share the file's frames, loops and bodies and differ in kinematic parameters, inertial parameters and motors."""
+    """The compiled structure of a device's geometry family (see the module docstring): designs that share the
+    file's frames, loops and bodies and differ in kinematic parameters, inertial parameters, sections and motors.
+    A tree is a closed-loop device without loops (no closures, no passive coordinates)."""
 
     def __init__(self, device: Device, frame: str | None = None):
         mech = device.mechanism
-        if mech.loops is None:
-            raise UserError("the batched design kernels take closed-loop devices (a tree takes the one-design path)")
         space = configuration_of(device)
         c = mech.compiled
         n_a = mech.n_actuated
-        if n_a > 3 or len(mech.loops.passive) + n_a != mech.n_dof:
+        if n_a > 3:
             raise UserError("the batched design kernels take devices whose handle moves in as many directions as they "
                             "have actuated coordinates (at most 3)")
         self.device, self.names = device, tuple(device.kinematic)
@@ -277,16 +425,10 @@ class DesignBatch:
         raw = KinematicTree(c.node_parent, c.node_axis, c.node_coef, c.node_offset, self.shape.const_rot,
                             self.shape.const_pos, dict(c.frame_node), c.body_node)
         loops = mech.loops
-        rows = [(i, comp) for i, closure in enumerate(loops.closures) for comp in closure.components]
-        self.closures = Closures(
-            frame_a=np.array([c.frame_node[cl.frames[0]] for cl in loops.closures], dtype=np.int64),
-            frame_b=np.array([c.frame_node[cl.frames[1]] for cl in loops.closures], dtype=np.int64),
-            row_loop=np.array([r[0] for r in rows], dtype=np.int64),
-            row_comp=np.array([r[1] for r in rows], dtype=np.int64),
-            actuated=np.array(loops.actuated(mech.n_dof), dtype=np.int64),
-            passive=np.array(loops.passive, dtype=np.int64),
-        )
-        handle = c.frame_node[frame or mech.end_effector]
+        self.closures = Closures.of(mech, c.frame_node) if loops is not None else Closures(
+            *(np.zeros(0, dtype=np.int64),) * 4, np.arange(mech.n_dof, dtype=np.int64), np.zeros(0, dtype=np.int64))
+        self.frame = frame or mech.end_effector
+        self.handle = handle = c.frame_node[self.frame]
         plan = raw.plan([*self.closures.frame_a, *self.closures.frame_b, handle], list(self.closures.passive))
         self.plan = self._unshared(plan)
         body_node = c.body_node.astype(np.int64)
@@ -294,14 +436,21 @@ class DesignBatch:
         self.bodies = Bodies(body_node=body_node, gravity=c.gravity,
                              motion=MotionPlan.of(raw, [*body_node, *self.closures.frame_a, *self.closures.frame_b]),
                              path_ptr=ptr, path_nodes=nodes)
-        self.settings = space.solver.settings
-        guess = np.zeros(mech.n_dof)
-        guess[self.closures.actuated] = loops.home
-        guess[self.closures.passive] = loops.assembly
+        self.moving = [b for b in range(len(device.body_names)) if np.any(c.body_path[b] >= 0)]
+        """The bodies some coordinate moves (:func:`~hapticdesign.analysis.metrics.indices.moving_mass`)."""
+        self.settings = settings_of(mech)
+        guess = np.zeros(mech.n_dof) if loops is None else loops.guess(mech.n_dof)
         jac = space.position_and_jacobian(space.full(space.home), frame)[1]
         u, s, _ = np.linalg.svd(jac)
+        if not s[-1] > IK_SINGULAR * s[0]:
+            raise UserError("the batched design kernels take devices whose handle moves in as many directions as they "
+                            "have actuated coordinates at home")
         self.reach = Reach(IK_STEP, self.settings.tol, IK_WAY * IK_STEP, 60, IK_JOINT_STEP, SINGULAR_PIVOTS, int(handle),
                            np.ascontiguousarray(u[:, :n_a]), guess)
+        elastic = device.elasticity
+        self.elastic_links = () if elastic is None else elastic.links
+        self.springs = () if elastic is None else tuple(elastic.joints)
+        self.ends = np.array([c.frame_node[link.end] for link in self.elastic_links], dtype=np.int64)
 
     def _sensitivity(self, device: Device) -> np.ndarray:
         """``d offset / d p`` (nodes x parameters), exact for the affine values of a device file."""
@@ -323,6 +472,16 @@ class DesignBatch:
         """Node offsets (D, nodes) of designs with kinematic parameters ``kinematic`` (D, parameters) in the order of
         ``names``."""
         return self.offset0 + (np.atleast_2d(kinematic) - self.p0) @ self.sensitivity.T
+
+    def frame_vectors(self, offsets: np.ndarray, pairs: list[tuple[str, str]]) -> np.ndarray:
+        """Per design and pair of frames ``(start, end)``, the origin of ``end`` from that of ``start`` (at q = 0),
+        in ``start``'s axes and in ``end``'s: (D, L, 2, 3)."""
+        nodes = self.device.mechanism.compiled.frame_node
+        start = np.array([nodes[a] for a, _ in pairs], dtype=np.int64)
+        end = np.array([nodes[b] for _, b in pairs], dtype=np.int64)
+        out = np.zeros((len(offsets), len(pairs), 2, 3))
+        frame_vectors(np.ascontiguousarray(offsets, dtype=float), self.shape, start, end, out)
+        return out
 
     def reach_points(self, offsets: np.ndarray, points: np.ndarray) -> Reached:
         """:func:`reach_designs` of the designs' offsets (D, nodes) to ``points`` (P, 3)."""
@@ -346,6 +505,76 @@ class DesignBatch:
                      self.bodies, self.closures, params, h)
         return h + (reflected[:, None] if np.ndim(reflected) == 3 else reflected)
 
+    def stiffness(self, offsets: np.ndarray, reached: Reached, rigidity: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The VJM's ``K_C`` (D, P, 6, 6) at the reached poses of the designs whose status is OK, for the elastic
+        links' rigidities (D, L, 3) (:func:`~hapticdesign.analysis.stiffness.device.cartesian_stiffness_at`), and
+        per design whether it is defined at every point (False: the handle is rigid in some direction there)."""
+        d, p, n = reached.full.shape
+        m, links = len(self.closures.row_loop), len(self.elastic_links)
+        rows, virtual = np.zeros((d, p, 6 + m, n)), np.zeros((d, p, 6 + m, 6 * links))
+        vjm_designs(np.ascontiguousarray(offsets, dtype=float), reached.full, reached.status, self.shape, self.plan,
+                    self.closures, self.handle, self.ends, rows, virtual)
+        axis = self.frame_vectors(offsets, [(link.start, link.end) for link in self.elastic_links])[:, :, 1]
+        compliance = end_compliance(axis, *np.moveaxis(rigidity, -1, 0))
+        index = {name: k for k, name in enumerate(self.device.mechanism.coordinates)}
+        spring_columns = [index[name] for name, _ in self.springs]
+        size = 6 * links + len(self.springs)
+        c_theta = np.zeros((d, size, size))
+        for k in range(links):
+            c_theta[:, 6 * k:6 * k + 6, 6 * k:6 * k + 6] = compliance[:, k]
+        for k, (_, value) in enumerate(self.springs):
+            c_theta[:, 6 * links + k, 6 * links + k] = 1.0 / value
+        j_theta = np.concatenate([virtual, rows[..., spring_columns]], axis=-1)
+        j_p = rows[..., self.closures.passive]
+        out, defined = np.zeros((d, p, 6, 6)), reached.status == OK
+        chosen = np.flatnonzero(defined)
+        try:
+            out[chosen] = self._cartesian(j_theta[chosen], c_theta[chosen, None], j_p[chosen])
+        except UserError:  # some pose is singular: design by design, to tell which
+            for k in chosen:
+                try:
+                    out[k] = self._cartesian(j_theta[k], c_theta[k], j_p[k])
+                except UserError:
+                    defined[k] = False
+        return out, defined
+
+    def _cartesian(self, j_theta: np.ndarray, c_theta: np.ndarray, j_p: np.ndarray) -> np.ndarray:
+        if len(self.closures.passive):
+            return vjm.chain_stiffness(j_theta, c_theta, j_p)[..., :6, :6]
+        return vjm.locked_stiffness(j_theta, c_theta)[..., :6, :6]
+
+    def evaluate(self, values: DesignValues, points: np.ndarray, stiffness: bool = False) -> Evaluated:
+        """Every design of ``values`` at the workspace ``points`` (P, 3), reached in order from home: ``J_v``, ``H``
+        (the design's inertial parameters and motors), ``K_C`` when ``stiffness`` (the design's sections), the
+        moving mass, and the reason of each design that fails (refused by the device file, a point not reached or
+        outside the joint limits, a pose where the handle is rigid in some direction)."""
+        points = np.asarray(points, dtype=float)
+        offsets = self.offsets(values.kinematic)
+        reached = self.reach_points(offsets, points)
+        reasons = list(values.refused)
+        limited = any(span is not None for span in self.device.joint_limits())
+        for d in range(len(reasons)):
+            if reasons[d] is None and reached.status[d] != OK:
+                reasons[d] = self.reason(reached, d, points)
+            elif reasons[d] is None and limited:
+                try:
+                    check_limits(self.device, reached.full[d][:, self.closures.actuated], points)
+                except UserError as exc:
+                    reasons[d] = str(exc)
+        ok = np.array([r is None for r in reasons], dtype=bool)
+        reached = reached._replace(status=np.where(ok, OK, NO_HOME))
+        mass = self.mass_matrices(offsets, reached, values.standard, values.reflected)
+        masses = values.standard.reshape(len(ok), -1, 10)[:, :, 0]
+        moving = sum((masses[:, b] for b in self.moving), np.zeros(len(ok)))
+        k_c = None
+        if stiffness:
+            k_c, defined = self.stiffness(offsets, reached, values.rigidity)
+            for d in np.flatnonzero(ok & ~defined):
+                reasons[d] = (f"the end effector {self.frame!r} is rigid in some direction at this pose: the elastic "
+                              "links and joint springs do not reach it, or the pose is singular")
+            ok &= defined
+        return Evaluated(reached.jvt, mass, k_c, moving, ok, reasons, values)
+
     def reason(self, reached: Reached, design: int, points: np.ndarray) -> str | None:
         """One line on why ``design`` failed (naming the point), or None."""
         code = int(reached.status[design])
@@ -356,3 +585,4 @@ class DesignBatch:
         index = int(reached.point[design])
         where = "home" if index < 0 else "(" + ", ".join(f"{v:.6g}" for v in points[index]) + ") m"
         return f"the handle cannot reach {where}: {MESSAGES[code]}"
+

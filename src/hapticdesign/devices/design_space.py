@@ -16,13 +16,14 @@ file's own validation checks it (a finite number, ``D > d >= 0``, ``gear_ratio >
 consistency, the loops closing at home, ...), and an invalid design raises a one-line :class:`UserError`. Bodies
 that are links (``bodies: - {name: b, link: l}``) follow the lengths and sections: their mass and inertia are
 computed again (:func:`~hapticdesign.devices.device_file.link_body_inertias`) whenever a parameter or a section
-changes.
+changes. :meth:`DesignSpace.batch_values` gives the same numbers and refusals for a whole generation of designs at
+once, as the arrays the compiled kernels take (:class:`~hapticdesign.analysis.design_batch.DesignValues`).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -30,8 +31,10 @@ import numpy as np
 from pydantic import ValidationError
 
 from hapticdesign.analysis.configuration import configuration_of
-from hapticdesign.analysis.stiffness.device import check_elasticity
-from hapticdesign.analysis.stiffness.link import rigidities
+from hapticdesign.analysis.design_batch import DesignBatch, DesignValues
+from hapticdesign.analysis.metrics import force
+from hapticdesign.analysis.stiffness.device import LENGTH_TOLERANCE, check_elasticity
+from hapticdesign.analysis.stiffness.link import rigidities, tube_rigidities
 from hapticdesign.analysis.stiffness.sections import Tube
 from hapticdesign.devices.device_file import (
     actuated_index,
@@ -47,11 +50,14 @@ from hapticdesign.files import quote
 from hapticdesign.model.actuators import damping_matrix
 from hapticdesign.model.device import Device
 from hapticdesign.model.elastic import Elasticity, ElasticLink
-from hapticdesign.model.inertia import SEED_FIELDS, check_body, seed_parameter_name
+from hapticdesign.model.inertia import SEED_FIELDS, check_body, seed_parameter_name, standard_from_seed, tube_seed
 from hapticdesign.model.params_io import read_mapping
 
 ACTUATOR_FIELDS = ("rotor_inertia", "gear_ratio", "coulomb", "damping", "torque_continuous", "torque_peak")
 """The numeric fields of a motor a design variable may change (units as in the device file)."""
+MOTOR_SETS = 4096
+"""Distinct sets of motor values whose matrices :meth:`DesignSpace.batch_values` keeps (a study's discrete ratios are
+a few; continuous motor variables give one per design, so the cache starts again past this many)."""
 
 
 @dataclass(frozen=True)
@@ -236,6 +242,94 @@ class DesignSpace:
             actuators[k] = actuator_from_spec(checked, self._index)
         damping = self._joint_damping + np.diag(damping_matrix(tuple(actuators), len(self._joint_damping)))
         return replace(device, actuators=tuple(actuators), damping=tuple(float(b) for b in damping))
+
+    def batch_values(self, designs: Sequence[Mapping[str, float]], batch: DesignBatch) -> DesignValues:
+        """What :meth:`device` gives each of ``designs``, as the arrays of many designs ``batch`` takes
+        (:class:`~hapticdesign.analysis.design_batch.DesignValues`): the same numbers and the same refusals, with
+        the links' bodies and sections computed for all designs at once and each distinct set of motor values built
+        once. A design the device file refuses keeps the file's values and says why."""
+        count, base = len(designs), self.base
+        column = {name: k for k, name in enumerate(batch.names)}
+        kinematic = np.tile(batch.p0, (count, 1))
+        seed_file = base.seed_parameters()
+        diameters_file = np.array([[link.section.D, link.section.d] for link in self.spec.links]).reshape(-1, 2)
+        seed, diameters = np.tile(seed_file, (count, 1, 1)), np.tile(diameters_file, (count, 1, 1))
+        refused: list[str | None] = [None] * count
+        motors: list[tuple] = [()] * count
+        by_name = {v.name: v for v in self.variables}
+        inertial = [v for v in self.variables if v.kind == "inertial"]
+        for d, values in enumerate(designs):
+            try:
+                checked = self.checked_values(values)
+                changed: dict[int, dict[str, float]] = {}
+                for name, value in checked.items():
+                    v = by_name[name]
+                    if v.kind == "parameter":
+                        kinematic[d, column[name]] = value
+                    elif v.kind == "section":
+                        diameters[d, v.target, ("D", "d").index(v.field)] = value
+                    elif v.kind == "actuator":
+                        changed.setdefault(v.target, {})[v.field] = value
+                if inertial:
+                    overrides = {name: value for name, value in checked.items() if by_name[name].kind == "inertial"}
+                    device = base.with_params(overrides)
+                    for body in sorted({by_name[name].target for name in overrides}):
+                        report = check_body(body, device.body(body))
+                        if report.error:
+                            raise UserError(report.error)
+                    seed[d] = device.seed_parameters()
+                for k in sorted({by_name[name].target for name in checked if by_name[name].kind == "section"}):
+                    try:
+                        Tube(*(float(v) for v in diameters[d, k]))
+                    except UserError as exc:
+                        raise UserError(f"link {self.spec.links[k].name}: {exc}") from None
+                motors[d] = tuple(sorted((k, tuple(sorted(f.items()))) for k, f in changed.items()))
+                self._motors(motors[d])
+            except UserError as exc:
+                refused[d] = str(exc)
+                kinematic[d], seed[d], diameters[d], motors[d] = batch.p0, seed_file, diameters_file, ()
+        pairs = [(link.start, link.end) for link in self.spec.links]
+        vectors = batch.frame_vectors(batch.offsets(kinematic), pairs)
+        lengths = np.linalg.norm(vectors[:, :, 0], axis=-1)
+        for d, k in zip(*np.nonzero(lengths <= LENGTH_TOLERANCE)):
+            if refused[d] is None:
+                link = self.spec.links[k]
+                refused[d] = f"link {link.name}: frames {link.start!r} and {link.end!r} coincide (zero length)"
+                kinematic[d], vectors[d] = batch.p0, batch.frame_vectors(batch.offsets(batch.p0), pairs)[0]
+        rigidity = np.zeros((count, len(self.spec.links), 3))
+        for k, link in enumerate(self.spec.links):
+            rigidity[:, k] = np.stack(tube_rigidities(link.material, diameters[:, k, 0], diameters[:, k, 1]), axis=-1)
+        if self.link_bodies:
+            rows = {name: b for b, name in enumerate(base.body_names)}
+            links = {link.name: k for k, link in enumerate(self.spec.links)}
+            for body in self.spec.bodies:
+                if body.link is not None:
+                    k = links[body.link]
+                    seed[:, rows[body.name]] = tube_seed(vectors[:, k, 0], diameters[:, k, 0], diameters[:, k, 1],
+                                                         self.spec.links[k].material.density)
+        with np.errstate(over="ignore", invalid="ignore"):
+            standard = standard_from_seed(seed).reshape(count, -1)
+        for d in np.flatnonzero(~np.all(np.isfinite(standard), axis=1)):
+            if refused[d] is None:
+                refused[d] = f"the inertial parameters of {base.name} overflow (m r or m r^2 is not a finite number)"
+        built = [self._motors(key) for key in motors]
+        torques = {which: None if any(b[3][which] is None for b in built) else np.array([b[3][which] for b in built])
+                   for which in ("continuous", "peak")}
+        inverse = None if any(b[2] is None for b in built) else np.array([b[2] for b in built])
+        return DesignValues(kinematic, standard, np.array([b[0] for b in built]), np.array([b[1] for b in built]),
+                            inverse, torques, rigidity, refused)
+
+    def _motors(self, key: tuple) -> tuple:
+        """The reflected inertia, damping matrix, ``A^-1`` and torque limits of the motors with the changes ``key``
+        (actuator index and its changed fields), built once per distinct set."""
+        motors = self.cache.setdefault("motors", {})
+        if key not in motors:
+            if len(motors) >= MOTOR_SETS:
+                motors.clear()
+            device = self._with_actuators(self.base, {k: dict(f) for k, f in key}) if key else self.base
+            motors[key] = (device.reflected_inertia, device.damping_matrix, force.motor_map(device),
+                           {which: force.torque_limits(device, which) for which in ("continuous", "peak")})
+        return motors[key]
 
     @staticmethod
     def _check_geometry(device: Device) -> None:

@@ -39,22 +39,31 @@ def seed_parameter_name(field: str, body: str) -> str:
 
 def tube_body(axis, D: float, d: float, density: float) -> BodyInertia:
     """A straight tube (``d = 0``: a rod) of outer and inner diameters ``D``, ``d`` (m) and ``density`` (kg/m^3) from
-    the frame origin to the point ``axis`` (m, in the frame), in the seed's convention (Table 2.3).
+    the frame origin to the point ``axis`` (m, in the frame), in the seed's convention (Table 2.3): the one body of
+    :func:`tube_seed`."""
+    return BodyInertia(*(float(v) for v in tube_seed(axis, D, d, density)))
+
+
+def tube_seed(axis, D, d, density: float) -> np.ndarray:
+    """The ten seed parameters ``(..., 10)`` (:data:`SEED_FIELDS`) of tubes from the frame origin to ``axis``
+    ``(..., 3)`` with diameters ``D``, ``d`` ``(...)`` (many designs' tubes at once).
 
     Length ``L = |axis|``, mass ``m = rho pi (D^2 - d^2) / 4 L``, mass centre at mid-link ``axis / 2``, moments about
     the mass centre ``m (D^2 + d^2) / 8`` about the axis ``u = axis / L`` and ``m (3 (D^2 + d^2) / 4 + L^2) / 12``
     about any transverse axis (a thick-walled cylinder), i.e. ``I_c = I_t 1 + (I_a - I_t) u u^T``.
     """
     axis = np.asarray(axis, dtype=float)
-    length = float(np.linalg.norm(axis))
-    u = axis / length
+    D, d = np.asarray(D, dtype=float), np.asarray(d, dtype=float)
+    length = np.linalg.norm(axis, axis=-1)
+    u = axis / length[..., None]
     m = density * math.pi * (D**2 - d**2) / 4.0 * length
     axial = m * (D**2 + d**2) / 8.0
     transverse = m * (3.0 * (D**2 + d**2) / 4.0 + length**2) / 12.0
-    tensor = transverse * np.eye(3) + (axial - transverse) * np.outer(u, u)
-    rx, ry, rz = axis / 2.0
-    return BodyInertia(m, rx, ry, rz, tensor[0, 0], tensor[1, 1], tensor[2, 2], -tensor[0, 1], -tensor[0, 2],
-                       -tensor[1, 2])
+    tensor = (transverse[..., None, None] * np.eye(3)
+              + (axial - transverse)[..., None, None] * u[..., :, None] * u[..., None, :])
+    r = axis / 2.0
+    return np.stack([m, r[..., 0], r[..., 1], r[..., 2], tensor[..., 0, 0], tensor[..., 1, 1], tensor[..., 2, 2],
+                     -tensor[..., 0, 1], -tensor[..., 0, 2], -tensor[..., 1, 2]], axis=-1)
 
 
 class Realizability(str, Enum):

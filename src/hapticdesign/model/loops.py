@@ -19,6 +19,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from hapticdesign.errors import UserError
 
 COMPONENTS = ("x", "y", "z", "rx", "ry", "rz")
@@ -90,6 +92,13 @@ class ClosedLoops:
 
     def actuated(self, n_coordinates: int) -> tuple[int, ...]:
         return tuple(k for k in range(n_coordinates) if k not in self.passive)
+
+    def guess(self, n_coordinates: int) -> np.ndarray:
+        """The Newton start at home (every coordinate): ``home``'s actuated values, ``assembly``'s passive ones."""
+        q = np.zeros(n_coordinates)
+        q[list(self.actuated(n_coordinates))] = self.home
+        q[list(self.passive)] = self.assembly
+        return q
 
     def validate(self, coordinates: tuple[str, ...], frames: set[str]) -> None:
         """Square closure system and known frames; raises a one-line UserError."""

@@ -10,13 +10,14 @@ analysis layer, because its engine (:mod:`hapticdesign.analysis.sampled_loop`) d
 this module's :func:`evaluate` and :data:`DESIGN_INDICES`.
 
 :func:`evaluate_designs` evaluates many designs of a :class:`~hapticdesign.devices.design_space.DesignSpace` at
-once: through the compiled kernels of :mod:`hapticdesign.analysis.design_batch` when the device has closed loops,
-the indices need only ``J_v``, ``H`` and ``B`` (:data:`BATCHED`: those of
-:data:`~hapticdesign.analysis.metrics.indices.KINEMATIC_DYNAMIC` and ``kmax``) and the variables are geometry
-(``parameters``) of a device without bodies that are links (whose masses follow the geometry; the batch keeps the
-file's inertial parameters, and its damping ``B``, numbers of the file that no geometry changes); otherwise design
-by design (:func:`evaluate`). Both give the same values; ``kmax`` of all designs' points is one search
-(:func:`~hapticdesign.analysis.wall_stiffness.wall_limits`).
+once, a generation at a time, through the compiled kernels of :mod:`hapticdesign.analysis.design_batch` (trees and
+closed loops alike, every kind of design variable: geometry, sections, inertial parameters, link bodies, motors):
+:meth:`~hapticdesign.devices.design_space.DesignSpace.batch_values` gives each design's inertial parameters,
+reflected rotor inertia, damping ``B``, motors and sections, the batch each design's ``J_v``, ``H`` and ``K_C`` at
+the points, and every index but ``ln`` (:data:`~hapticdesign.analysis.metrics.indices.PER_DESIGN`) follows from
+them; ``ln``, and a device whose handle moves in fewer directions than it has actuated coordinates (or more than
+3), go design by design (:func:`evaluate`). Both give the same values; ``kmax`` of all designs' points is one
+search (:func:`~hapticdesign.analysis.wall_stiffness.wall_limits`).
 """
 
 from __future__ import annotations
@@ -26,9 +27,9 @@ from collections.abc import Iterable, Mapping, Sequence
 
 import numpy as np
 
-from hapticdesign.analysis.design_batch import OK, DesignBatch
+from hapticdesign.analysis.design_batch import DesignBatch
 from hapticdesign.analysis.metrics.indices import (
-    INDICES, KINEMATIC_DYNAMIC, Evaluation, HandleStates, Index, Request, requests_of,
+    INDICES, PER_DESIGN, Evaluation, HandleStates, Index, Request, requests_of,
 )
 from hapticdesign.analysis.metrics.indices import evaluate as evaluate_with
 from hapticdesign.devices.design_space import DesignSpace
@@ -74,9 +75,6 @@ def _kmax(h: HandleStates, options: Mapping[str, object]) -> np.ndarray:
     return wall_limits(h.mobility, np.swapaxes(pinv, 1, 2) @ h.damping @ pinv, period, delay, virtual, along)
 
 
-BATCHED = (*KINEMATIC_DYNAMIC, "kmax")
-"""The indices :func:`evaluate_designs` computes from the compiled kernels' ``J_v`` and ``H`` (and the file's ``B``)."""
-
 DESIGN_INDICES: dict[str, Index] = {**INDICES, "kmax": Index(
     "kmax", "N/m", "exact stable wall stiffness of the sampled loop along a direction (or the worst)",
     "seed 000 ch. 4-5; hapticdesign.analysis.sampled_loop.exact_boundary", _kmax,
@@ -97,44 +95,51 @@ def evaluate_designs(space: DesignSpace, designs: Sequence[Mapping[str, float]],
     device file refuses fails with its reason (see the module docstring for the batched path)."""
     checked = requests_of(requests, DESIGN_INDICES)
     points = np.asarray(points, dtype=float)
-    batch = _batch(space, checked)
+    batch = _batch(space, checked) if designs else None
     if batch is None:
         return [_one(space, values, points, checked) for values in designs]
-    kinematic = np.tile(batch.p0, (len(designs), 1))
-    column = {name: k for k, name in enumerate(batch.names)}
-    refused: dict[int, str] = {}
-    for d, values in enumerate(designs):
-        try:
-            for name, value in space.checked_values(values).items():
-                kinematic[d, column[name]] = value
-        except UserError as exc:
-            refused[d] = str(exc)
-    offsets = batch.offsets(kinematic)
-    reached = batch.reach_points(offsets, points)
-    base = space.base
-    mass = batch.mass_matrices(offsets, reached, base.standard_parameters(), base.reflected_inertia)
-    ok = reached.status == OK
-    states = HandleStates.of(reached.jvt[ok].reshape(-1, 3, reached.jvt.shape[-1]),
-                             mass[ok].reshape(-1, *mass.shape[2:]), base.damping_matrix)
-    values = {r.key: DESIGN_INDICES[r.index].values(states, {**DESIGN_INDICES[r.index].options, **r.options})
-              .reshape(-1, len(points)) for r in checked}
+    stiffness = any(r.index in ("stiffness", "frequency") for r in checked)
+    got = batch.evaluate(space.batch_values(designs, batch), points, stiffness)
+    ok, v = got.ok, got.values
+    per_pose = np.repeat(np.flatnonzero(ok), len(points))
+    n_a = got.jacobian.shape[-1]
+    states = HandleStates.of(
+        got.jacobian[ok].reshape(-1, 3, n_a), got.mass[ok].reshape(-1, n_a, n_a), damping=v.damping[per_pose],
+        motor_map=None if v.motor_map is None else v.motor_map[per_pose],
+        torque_limits={k: None if t is None else t[per_pose] for k, t in v.torques.items()},
+        moving_mass=got.moving_mass[per_pose], name=space.base.name)
+    if stiffness:
+        u = states.svd[0]
+        states.__dict__["stiffness"] = np.swapaxes(u, 1, 2) @ got.stiffness[ok].reshape(-1, 6, 6)[:, :3, :3] @ u
+    values, failed = {}, None
+    try:
+        for r in checked if ok.any() else ():
+            index = DESIGN_INDICES[r.index]
+            values[r.key] = np.asarray(index.values(states, {**index.options, **r.options}),
+                                       dtype=float).reshape(-1, len(points))
+    except UserError as exc:  # an index no design of the space can give (the same for each, as design by design)
+        failed = str(exc)
     out, row = [], 0
     for d in range(len(designs)):
-        if d in refused:
-            out.append(Evaluation({}, refused[d]))
-        elif not ok[d]:
-            out.append(Evaluation({}, batch.reason(reached, d, points)))
+        if not ok[d]:
+            out.append(Evaluation({}, got.reasons[d]))
+        elif failed is not None:
+            out.append(Evaluation({}, failed))
         else:
-            out.append(Evaluation({key: v[row] for key, v in values.items()}))
+            out.append(Evaluation({key: value[row] for key, value in values.items()}))
         row += int(ok[d])
     return out
 
 
 def _batch(space: DesignSpace, requests: list[Request]) -> DesignBatch | None:
-    """The space's compiled structure when the batched path applies (see the module docstring), else None."""
-    if (space.base.mechanism.loops is None or any(r.index not in BATCHED for r in requests)
-            or any(v.kind != "parameter" for v in space.variables) or space.link_bodies):
-        return None
+    """The space's compiled structure when the batched path applies (every index but those of
+    :data:`~hapticdesign.analysis.metrics.indices.PER_DESIGN`; a device whose handle moves in as many directions
+    as it has actuated coordinates, at most 3), else None."""
+    elastic = space.base.elasticity
+    if any(r.index in PER_DESIGN for r in requests) or (
+            any(r.index in ("stiffness", "frequency") for r in requests)
+            and (elastic is None or not (elastic.links or elastic.joints))):
+        return None  # design by design (an index of the whole device; or one the device cannot give, said there)
     if space.cache.get("batch") is None:
         try:
             space.cache["batch"] = DesignBatch(space.base)

@@ -31,11 +31,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from hapticdesign.analysis.loops.records import workspace
+from hapticdesign.analysis.loops.records import BRANCH_CHANGE, ILL_CONDITIONED, NO_CLOSURE, OK, SINGULAR, workspace
 from hapticdesign.model.dense import lu_in_place
 from hapticdesign.model.walk import planned_poses, unit_twist
 
-OK, NO_CLOSURE, SINGULAR, BRANCH_CHANGE, ILL_CONDITIONED = 0, 1, 2, 3, 4
 POLISH = 3
 """Newton iterations past the closure tolerance, at most, to bring the error bound within the accuracy."""
 MAX_NEWTON_STEP = 0.25

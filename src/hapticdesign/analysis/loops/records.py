@@ -10,6 +10,7 @@ records built once per geometry (the folded tree :class:`~hapticdesign.model.wal
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import NamedTuple
 
 import numpy as np
@@ -18,6 +19,12 @@ from numba import njit
 from hapticdesign.model.loops import ClosedLoops
 from hapticdesign.model.mechanism import Mechanism
 from hapticdesign.model.walk import trig_workspace
+
+OK, NO_CLOSURE, SINGULAR, BRANCH_CHANGE, ILL_CONDITIONED, NO_HOME, OUT_OF_REACH = 0, 1, 2, 3, 4, 5, 6
+"""The status every loop kernel returns (one enum for the closure kernels, the plant and the design batch): a pose
+closed; the loops cannot close; ``Phi_p`` (or the inverse kinematics' system) singular; the way left the assembly
+branch (or the working mode); too close to a singularity for the accuracy; the loops do not close at home from the
+assembly guess; the handle does not reach a point."""
 
 
 class Closures(NamedTuple):
@@ -32,9 +39,11 @@ class Closures(NamedTuple):
     passive: np.ndarray
 
     @classmethod
-    def of(cls, mech: Mechanism) -> "Closures":
+    def of(cls, mech: Mechanism, nodes: Mapping[str, int] | None = None) -> "Closures":
+        """The closures of ``mech`` on the folded tree's nodes, or on the node numbering ``nodes`` (frame name to
+        node; the unfolded tree's ``compiled.frame_node``, as the design batch walks it)."""
         loops: ClosedLoops = mech.loops
-        nodes = mech.compiled.tree.frame_node
+        nodes = mech.compiled.tree.frame_node if nodes is None else nodes
         rows = [(i, c) for i, closure in enumerate(loops.closures) for c in closure.components]
         return cls(
             frame_a=np.array([nodes[c.frames[0]] for c in loops.closures], dtype=np.int64),

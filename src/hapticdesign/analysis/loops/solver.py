@@ -51,6 +51,15 @@ MESSAGES = {
 }
 
 
+def settings_of(mechanism: Mechanism) -> Settings:
+    """The solver's :class:`~.records.Settings` for a mechanism: the closure tolerance is 1e-12 of its largest
+    length (at least 1 mm)."""
+    compiled = mechanism.compiled
+    lengths = np.abs(compiled.node_offset[compiled.node_axis >= 3])
+    tol = 1e-12 * max(float(lengths.max(initial=0.0)), 1e-3)
+    return Settings(MAX_STEP, tol, MAX_ITER, SINGULAR_RATIO, MIN_FRACTION, ACCURACY, ROUNDING * tol / 1e-12)
+
+
 class LoopSolver:
     """Passive coordinates of a closed-loop mechanism (see the module docstring).
 
@@ -71,14 +80,10 @@ class LoopSolver:
         """Walk of the tree, the closures' nodes first (:class:`~hapticdesign.model.walk.WalkPlan`)."""
         self.n_dof = mechanism.n_dof
         self.n_actuated = mechanism.n_actuated
-        lengths = np.abs(self.compiled.node_offset[self.compiled.node_axis >= 3])
-        self.tol = 1e-12 * max(float(lengths.max(initial=0.0)), 1e-3)
-        self.settings = Settings(MAX_STEP, self.tol, MAX_ITER, SINGULAR_RATIO, MIN_FRACTION, ACCURACY,
-                                 ROUNDING * self.tol / 1e-12)
+        self.settings = settings_of(mechanism)
+        self.tol = self.settings.tol
         loops = mechanism.loops
-        q = np.zeros(self.n_dof)
-        q[self.closures.actuated] = loops.home
-        q[self.closures.passive] = loops.assembly
+        q = loops.guess(self.n_dof)
         status, sign, _ = ck.newton(q, self.tree, self.plan, self.closures, self.settings)
         names = ", ".join(f"{mechanism.coordinates[k]} = {q[k]:.4g}" for k in self.closures.passive)
         if status == ck.NO_CLOSURE:

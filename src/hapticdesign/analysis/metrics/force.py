@@ -36,6 +36,6 @@ def torque_limits(device: Device, which: str = "continuous") -> np.ndarray | Non
 
 def inscribed_force(jacobian: np.ndarray, basis: np.ndarray, inverse_map: np.ndarray, limits: np.ndarray) -> np.ndarray:
     """The force polytope's inscribed radius (N) at poses with ``J_v`` (..., 3, n_a), ``U`` (..., 3, k), ``A^-1``
-    (n_a, n_a) and ``n_k tau_k`` (n_a,) (see the module docstring)."""
-    g = inverse_map.T @ np.swapaxes(jacobian, -1, -2) @ basis
+    (n_a, n_a) and ``n_k tau_k`` (n_a,), or those per pose (..., n_a, n_a), (..., n_a) (see the module docstring)."""
+    g = np.swapaxes(inverse_map, -1, -2) @ np.swapaxes(jacobian, -1, -2) @ basis
     return np.min(limits / np.linalg.norm(g, axis=-1), axis=-1)

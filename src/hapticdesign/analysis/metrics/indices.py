@@ -89,6 +89,28 @@ class HandleStates:
         return self.device.damping_matrix
 
     @cached_property
+    def name(self) -> str:
+        """The device's name (for messages)."""
+        return self.device.name
+
+    @cached_property
+    def motor_map(self) -> np.ndarray | None:
+        """The motors' ``A^-1`` (n_a, n_a), or (P, n_a, n_a) per pose; None unless one motor per coordinate
+        (:func:`~hapticdesign.analysis.metrics.force.motor_map`)."""
+        return force.motor_map(self.device)
+
+    @cached_property
+    def torque_limits(self) -> dict[str, np.ndarray | None]:
+        """``n_k tau_k`` (n_a,), or (P, n_a) per pose, for ``continuous`` and ``peak`` torques; None where a motor
+        lacks it (:func:`~hapticdesign.analysis.metrics.force.torque_limits`)."""
+        return {which: force.torque_limits(self.device, which) for which in ("continuous", "peak")}
+
+    @cached_property
+    def moving_mass(self) -> np.ndarray:
+        """The mass the coordinates move (:func:`moving_mass`) at each pose (P,)."""
+        return np.full(len(self.full), moving_mass(self.device))
+
+    @cached_property
     def mobility(self) -> np.ndarray:
         """``U^T J_v H^-1 J_v^T U`` (P, k, k), the inverse of ``Lambda`` (1/kg)."""
         u, _ = self.svd
@@ -115,15 +137,16 @@ class HandleStates:
 
 
     @classmethod
-    def of(cls, jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray | None = None) -> "HandleStates":
-        """The states of poses whose ``J_v`` (P, 3, n_a), ``H`` (P, n_a, n_a) and ``B`` (n_a, n_a) are known already
-        (many designs' poses at once, :mod:`hapticdesign.analysis.design_batch`): enough for the
-        :data:`KINEMATIC_DYNAMIC` indices (and, with ``B``, for the wall stiffness ``kmax`` of the simulation
-        layer)."""
+    def of(cls, jacobian: np.ndarray, mass: np.ndarray, **known) -> "HandleStates":
+        """The states of poses whose ``J_v`` (P, 3, n_a) and ``H`` (P, n_a, n_a) are known already (many designs'
+        poses at once, :mod:`hapticdesign.analysis.design_batch`), with any other quantity known per pose by its
+        name (``damping`` (P, n_a, n_a), ``stiffness`` (P, k, k), ``motor_map``, ``torque_limits``, ``moving_mass``,
+        ``name``): enough for the indices those quantities give."""
         states = cls(None, np.zeros((len(jacobian), 0)))
-        states.__dict__.update(jacobian=jacobian, mass=mass)
-        if damping is not None:
-            states.__dict__["damping"] = damping
+        unknown = set(known) - {"damping", "stiffness", "motor_map", "torque_limits", "moving_mass", "name"}
+        if unknown:
+            raise TypeError(f"HandleStates.of: unknown quantities {sorted(unknown)}")
+        states.__dict__.update(jacobian=jacobian, mass=mass, **known)
         return states
 
 
@@ -189,15 +212,15 @@ def _force(h: HandleStates, options) -> np.ndarray:
     which = options["torque"]
     if which not in ("continuous", "peak"):
         raise UserError(f"index force: torque is continuous or peak, got {which!r}")
-    inverse, limits = force.motor_map(h.device), force.torque_limits(h.device, str(which))
+    inverse, limits = h.motor_map, h.torque_limits[str(which)]
     if inverse is None or limits is None:
         raise UserError(f"index force needs one motor per actuated coordinate, each with torque_{which} (device "
-                        f"{h.device.name})")
+                        f"{h.name})")
     return force.inscribed_force(h.jacobian, h.svd[0], inverse, limits)
 
 
 def _stiffness(h: HandleStates, options) -> np.ndarray:
-    return np.array([np.linalg.eigvalsh(k)[0] for k in h.stiffness])
+    return np.linalg.eigvalsh(h.stiffness)[:, 0]
 
 
 def _frequency(h: HandleStates, options) -> np.ndarray:
@@ -210,7 +233,7 @@ def _ln(h: HandleStates, options) -> np.ndarray:
 
 
 def _mass(h: HandleStates, options) -> np.ndarray:
-    return np.full(len(h.full), moving_mass(h.device))
+    return h.moving_mass
 
 
 def moving_mass(device: Device) -> float:
@@ -244,8 +267,9 @@ INDICES: dict[str, Index] = {index.name: index for index in (
 """The registry of the analysis layer: index name -> :class:`Index` (``kmax`` needs the simulation layer:
 :mod:`hapticdesign.simulation.design_indices` holds the whole registry)."""
 
-KINEMATIC_DYNAMIC = ("isotropy", "condition", "manipulability", "apparent_mass", "inertia_uniformity")
-"""The indices that need only ``J_v`` and ``H`` at the poses (:meth:`HandleStates.of`)."""
+PER_DESIGN = ("ln",)
+"""The indices of a whole device (its exact dynamics), not of quantities :meth:`HandleStates.of` takes: the
+batched design kernels do not give them."""
 
 REDUCTIONS: dict[str, Callable[[np.ndarray], float]] = {
     "min": lambda v: float(np.min(v)),

@@ -43,7 +43,7 @@ from hapticdesign.model.elastic import Elasticity, ElasticLink
 from hapticdesign.model.mechanism import JointType, Mechanism
 from hapticdesign.model.transforms import Rx, Ry, Rz, joint, tx, ty, tz
 
-_LENGTH_TOLERANCE = 1e-12
+LENGTH_TOLERANCE = 1e-12
 
 
 def check_elasticity(mech: Mechanism, elasticity: Elasticity) -> None:
@@ -59,7 +59,7 @@ def check_elasticity(mech: Mechanism, elasticity: Elasticity) -> None:
         if end[: len(start)] != start or np.any(compiled.node_coef[between] != 0.0):
             raise UserError(f"link {link.name}: frame {link.end!r} must follow {link.start!r} with no joint "
                             "between them (a link is one rigid piece of the tree)")
-        if _length(mech, link, np.zeros(mech.n_dof)) <= _LENGTH_TOLERANCE:
+        if _length(mech, link, np.zeros(mech.n_dof)) <= LENGTH_TOLERANCE:
             raise UserError(f"link {link.name}: frames {link.start!r} and {link.end!r} coincide (zero length)")
     actuated = set(mech.actuated_coordinates)
     for name, _ in elasticity.joints:
@@ -100,15 +100,23 @@ def _link_compliance(mech: Mechanism, link: ElasticLink, q: np.ndarray) -> np.nd
     c = mech.compiled
     end = c.frame_pose(q, link.end)
     axis = end[:3, :3].T @ (end[:3, 3] - c.frame_pose(q, link.start)[:3, 3])
-    length = float(np.linalg.norm(axis))
-    x = axis / length
-    helper = np.eye(3)[int(np.argmin(np.abs(x)))]
+    return end_compliance(axis, link.axial, link.bending, link.torsion)
+
+
+def end_compliance(axis, axial, bending, torsion) -> np.ndarray:
+    """Compliance (..., 6, 6) of links' virtual joints in their end frames' axes, from each link's vector ``axis``
+    (..., 3) from its start frame's origin to its end frame's, in the end frame's axes, and its rigidities: the
+    cantilever's (eq. 4.58-4.59, :func:`~hapticdesign.analysis.stiffness.link.beam_stiffness`) turned from the
+    link's axes (x along the link) into the end frame's."""
+    axis = np.asarray(axis, dtype=float)
+    length = np.linalg.norm(axis, axis=-1)
+    x = axis / length[..., None]
+    helper = np.eye(3)[np.argmin(np.abs(x), axis=-1)]
     y = np.cross(x, helper)
-    y /= np.linalg.norm(y)
-    R = np.column_stack([x, y, np.cross(x, y)])  # link axes in the end frame's axes
-    T = np.zeros((6, 6))
-    T[:3, :3] = T[3:, 3:] = R
-    return T @ np.linalg.inv(beam_stiffness(link.axial, link.bending, link.torsion, length)) @ T.T
+    y /= np.linalg.norm(y, axis=-1)[..., None]
+    T = np.zeros(axis.shape[:-1] + (6, 6))
+    T[..., :3, :3] = T[..., 3:, 3:] = np.stack([x, y, np.cross(x, y)], axis=-1)  # link axes in the end frame's axes
+    return T @ np.linalg.inv(beam_stiffness(axial, bending, torsion, length)) @ np.swapaxes(T, -1, -2)
 
 
 def cartesian_stiffness(device: Device, q_a, frame: str | None = None) -> np.ndarray:

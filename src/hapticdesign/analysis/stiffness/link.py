@@ -20,7 +20,7 @@ import numpy as np
 
 from hapticdesign.errors import UserError
 from hapticdesign.analysis.stiffness.materials import LinkModuli
-from hapticdesign.analysis.stiffness.sections import Tube
+from hapticdesign.analysis.stiffness.sections import Tube, tube_area, tube_polar_moment, tube_second_moment
 
 
 BENDING_RULES = ("E_x", "eq. 4.59")
@@ -40,25 +40,33 @@ def beam_stiffness(axial: float, bending: float, torsion: float, length: float) 
     ``axial = E A`` (N), ``bending = E I`` and ``torsion = G J`` (N m^2): ``E A / L`` along the link,
     ``12 E I / L^3`` with the ``-+6 E I / L^2`` couplings and ``4 E I / L`` in bending, ``G J / L``
     in torsion. Coordinates ``(psi_1, psi_2, psi_3, phi_1, phi_2, phi_3)`` of eq. 5.76, x along the
-    link; with ``I_y = I_z`` the matrix does not change when the section turns about x.
+    link; with ``I_y = I_z`` the matrix does not change when the section turns about x. The arguments may be
+    arrays of many links (then ``(..., 6, 6)``).
     """
-    if not isfinite(length) or length <= 0.0:
-        raise UserError(f"link length must be positive, got {length!r}")
+    length = np.asarray(length, dtype=float)
+    if not np.all(np.isfinite(length) & (length > 0.0)):
+        raise UserError(f"link length must be positive, got {np.ravel(length).tolist()}")
     L = length
-    K = np.zeros((6, 6))
-    K[0, 0] = axial / L
-    K[1, 1] = K[2, 2] = 12.0 * bending / L**3
-    K[1, 5] = K[5, 1] = -6.0 * bending / L**2
-    K[2, 4] = K[4, 2] = 6.0 * bending / L**2
-    K[3, 3] = torsion / L
-    K[4, 4] = K[5, 5] = 4.0 * bending / L
+    axial, bending, torsion = (np.asarray(v, dtype=float) for v in (axial, bending, torsion))
+    K = np.zeros(np.broadcast_shapes(L.shape, axial.shape, bending.shape, torsion.shape) + (6, 6))
+    K[..., 0, 0] = axial / L
+    K[..., 1, 1] = K[..., 2, 2] = 12.0 * bending / L**3
+    K[..., 1, 5] = K[..., 5, 1] = -6.0 * bending / L**2
+    K[..., 2, 4] = K[..., 4, 2] = 6.0 * bending / L**2
+    K[..., 3, 3] = torsion / L
+    K[..., 4, 4] = K[..., 5, 5] = 4.0 * bending / L
     return K
 
 
 def rigidities(moduli: LinkModuli, section: Tube, bending: str = "E_x") -> tuple[float, float, float]:
     """``(E_x A, E_b I, G_xy J)`` of a tube; ``E_b`` from :func:`bending_modulus` (eq. 4.59, 5.162-5.165)."""
-    return (moduli.E_x * section.area, bending_modulus(moduli, bending) * section.second_moment,
-            moduli.G_xy * section.polar_moment)
+    return tube_rigidities(moduli, section.D, section.d, bending)
+
+
+def tube_rigidities(moduli: LinkModuli, D, d, bending: str = "E_x") -> tuple:
+    """:func:`rigidities` of tubes of diameters ``D``, ``d`` (floats or arrays of many designs' sections)."""
+    return (moduli.E_x * tube_area(D, d), bending_modulus(moduli, bending) * tube_second_moment(D, d),
+            moduli.G_xy * tube_polar_moment(D, d))
 
 
 def link_stiffness(moduli: LinkModuli, section: Tube, length: float, bending: str = "E_x") -> np.ndarray:

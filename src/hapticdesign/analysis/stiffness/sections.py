@@ -9,6 +9,21 @@ from hapticdesign.errors import UserError
 from hapticdesign.analysis.stiffness.materials import PLY_THICKNESS, check_plies
 
 
+def tube_area(D, d):
+    """Cross-section area ``A`` of tubes of outer and inner diameters ``D``, ``d`` (eq. 5.165; floats or arrays)."""
+    return pi * ((D / 2) ** 2 - (d / 2) ** 2)
+
+
+def tube_second_moment(D, d):
+    """``I_y = I_z`` of tubes (eq. 5.162-5.163; floats or arrays)."""
+    return pi / 4 * ((D / 2) ** 4 - (d / 2) ** 4)
+
+
+def tube_polar_moment(D, d):
+    """``J`` of tubes (eq. 5.164; floats or arrays)."""
+    return pi / 2 * ((D / 2) ** 4 - (d / 2) ** 4)
+
+
 @dataclass(frozen=True)
 class Tube:
     """Outer diameter ``D`` and inner diameter ``d`` (m), ``0 <= d < D``."""
@@ -27,17 +42,17 @@ class Tube:
     @property
     def area(self) -> float:
         """Cross-section area ``A`` (eq. 5.165)."""
-        return pi * ((self.D / 2) ** 2 - (self.d / 2) ** 2)
+        return tube_area(self.D, self.d)
 
     @property
     def second_moment(self) -> float:
         """``I_y = I_z`` (eq. 5.162-5.163)."""
-        return pi / 4 * ((self.D / 2) ** 4 - (self.d / 2) ** 4)
+        return tube_second_moment(self.D, self.d)
 
     @property
     def polar_moment(self) -> float:
         """``J`` (eq. 5.164)."""
-        return pi / 2 * ((self.D / 2) ** 4 - (self.d / 2) ** 4)
+        return tube_polar_moment(self.D, self.d)
 
     def mass(self, length: float, density: float) -> float:
         """Tube mass ``rho pi l (R^2 - r^2)`` (eq. 5.230)."""
