@@ -1,5 +1,5 @@
 """Many designs through the compiled kernels (:mod:`hapticdesign.analysis.design_batch`) against one design at a
-time (:func:`hapticdesign.simulation.design_indices.evaluate`, whose indices are checked against closed forms,
+time (:func:`hapticdesign.analysis.metrics.indices.evaluate`, whose indices are checked against closed forms,
 finite differences and kinetic energy in test_indices.py): same values, same failures."""
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ import pytest
 from hapticdesign.analysis.workspace import Workspace
 from hapticdesign.devices.design_space import design_space
 from hapticdesign.analysis.metrics.indices import Request
-from hapticdesign.simulation.design_indices import evaluate, evaluate_designs
+from hapticdesign.analysis.metrics.indices import evaluate, evaluate_designs
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "devices"
 INDICES = ["isotropy", "apparent_mass", "condition", "manipulability", "inertia_uniformity", "kmax",

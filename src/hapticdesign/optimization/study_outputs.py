@@ -11,17 +11,17 @@ from __future__ import annotations
 
 import csv
 import io
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from hapticdesign.analysis.metrics.indices import INDICES, Index
 from hapticdesign.errors import UserError
 from hapticdesign.files import figure_bytes, save_figure
-from hapticdesign.optimization.rcube.parameter_indices import PARAMETER_INDICES
 from hapticdesign.optimization.front_selection import least_rms, normalize
 from hapticdesign.optimization.study_run import StudyRun, constraint_labels
-from hapticdesign.simulation.design_indices import DESIGN_INDICES
 
 
 @dataclass(frozen=True)
@@ -110,18 +110,16 @@ def _pyplot():
     return plt
 
 
-def _unit(index: str) -> str:
-    unit = (DESIGN_INDICES[index] if index in DESIGN_INDICES else PARAMETER_INDICES[index]).unit
-    return "-" if unit == "1" else unit
-
-
-def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: str = "pareto") -> list[Path]:
+def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: str = "pareto",
+                  registry: Mapping[str, Index] = INDICES) -> list[Path]:
     """The front in pairs of objectives (every feasible design in grey, the front in blue, the selected
     design as a red star); one objective: its value per evaluation; more than three: parallel coordinates
     of the normalized front (0 best)."""
     plt = _pyplot()
     spec = run.spec
-    labels = [f"{o.name}: {o.reduce} {o.index} ({_unit(o.index)}), {o.sense}imize" for o in spec.objectives]
+    units = {o.index: registry[o.index].unit for o in spec.objectives}
+    labels = [f"{o.name}: {o.reduce} {o.index} ({'-' if units[o.index] == '1' else units[o.index]}), {o.sense}imize"
+              for o in spec.objectives]
     feasible = [r for r in run.records if r.feasible]
     F_all = np.array([r.objectives for r in feasible]).reshape(len(feasible), len(labels))
     F = np.array([run.records[k].objectives for k in run.front]).reshape(len(run.front), len(labels))

@@ -1,7 +1,7 @@
 """Command ``maps``: design indices of any device over a plane of its workspace, as figures and a CSV (issue 28).
 
-The engine is :func:`hapticdesign.analysis.metrics.maps.device_map` with the whole registry of design indices
-(:data:`hapticdesign.simulation.design_indices.DESIGN_INDICES`, docs/indices.md).
+The engine is :func:`hapticdesign.analysis.metrics.maps.device_map` with the one registry of design indices
+(:data:`hapticdesign.analysis.metrics.indices.INDICES`, docs/indices.md).
 """
 
 from __future__ import annotations
@@ -39,7 +39,7 @@ def maps(
     from hapticdesign.analysis.configuration import configuration_of
     from hapticdesign.analysis.metrics.maps import device_map
     from hapticdesign.analysis.workspace import Workspace
-    from hapticdesign.simulation.design_indices import DESIGN_INDICES
+    from hapticdesign.analysis.metrics.indices import INDICES
 
     with user_errors(strict=strict, quiet=quiet):
         from hapticdesign.devices.loading import resolve_device
@@ -55,7 +55,7 @@ def maps(
         names = [name.strip() for name in index.split(",") if name.strip()]
         workspace = Workspace(tuple(middle), tuple(abs(sizes)), grid)
         points = workspace.points()
-        found = device_map(dev, points, names, registry=DESIGN_INDICES)
+        found = device_map(dev, points, names)
         files = _write(out, found, names, plane)
         note(f"wrote {len(files)} files to {out} ({int(found.reached.sum())} of {len(points)} points reached)",
              quiet or json_out)
@@ -63,11 +63,11 @@ def maps(
             print_json({"device": dev.name, "out": str(out), "files": files, "points": len(points),
                         "reached": int(found.reached.sum()),
                         "range": {k: [_finite(v, min), _finite(v, max)] for k, v in found.values.items()},
-                        "units": {k: DESIGN_INDICES[k].unit for k in names}})
+                        "units": {k: INDICES[k].unit for k in names}})
             return
         for key, values in found.values.items():
             low, high = _finite(values, min), _finite(values, max)
-            span = "no point reached" if low is None else f"{low:.6g} to {high:.6g} {DESIGN_INDICES[key].unit}"
+            span = "no point reached" if low is None else f"{low:.6g} to {high:.6g} {INDICES[key].unit}"
             typer.echo(f"{key}: {span}")
 
 

@@ -121,7 +121,7 @@ def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Select
     """Every output file of the run in ``out`` (see :data:`FILES`)."""
     write_atomically(out / "front.csv", front_csv(run))
     write_atomically(out / "evaluations.csv", evaluations_csv(run))
-    paths = [out / "front.csv", out / "evaluations.csv", *pareto_figure(run, selection, out)]
+    paths = [out / "front.csv", out / "evaluations.csv", *pareto_figure(run, selection, out, registry=bound.registry)]
     values = run.records[selection.record].values
     write_atomically(out / "selected.yaml", bound.device_file_text(values))
     pictures = [Picture(png, caption) for png, caption in bound.pictures(values)]
