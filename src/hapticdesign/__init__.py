@@ -10,6 +10,7 @@ R-CUBE):
 - :func:`linearity_form` (LN as a quadratic form; ``form.ln``, ``form.parts``) and
   :func:`linear_conditions` (the linear equations of LN = 0).
 - :func:`impedance_range`, :func:`transparency`: the sampled-data rendering criteria.
+- :func:`index`: register your own design index (a decorator; docs/indices.md), usable in study files.
 - :mod:`hapticdesign.analysis.rcube` and :mod:`hapticdesign.optimization`: the R-CUBE.
 """
 
@@ -30,6 +31,7 @@ _HOMES = {
     "UserError": "hapticdesign.errors",
     "Device": "hapticdesign.model.device",
     "impedance_range": "hapticdesign.simulation.impedance",
+    "index": "hapticdesign.analysis.metrics.indices",
     "transparency": "hapticdesign.simulation.transparency",
 }
 _RENAMED = {"linearity_form": ("hapticdesign.analysis.linearity.form", "device_form")}
@@ -62,6 +64,7 @@ __all__ = [
     "forward_dynamics",
     "gravity",
     "impedance_range",
+    "index",
     "inverse_dynamics",
     "linear_conditions",
     "linearity_form",

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from hapticdesign.analysis.metrics.indices import Index
 from hapticdesign.errors import UserError
 from hapticdesign.files import write_atomically
 from hapticdesign.interface.report.optimization_page import Picture, render
@@ -132,13 +133,41 @@ def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Select
     return [*paths, out / "selected.yaml", out / "report.html"]
 
 
+def index_module(path: Path) -> list[Index]:
+    """Run the Python file ``path`` (its code, as ``python path`` would) and return the design indices it defines with
+    :func:`hapticdesign.index`."""
+    import importlib.util
+
+    path = Path(path)
+    if path.suffix != ".py" or not path.is_file():
+        raise UserError(f"--indices: {path} is not a Python file (.py) of design indices")
+    spec = importlib.util.spec_from_file_location(f"hapticdesign_user_indices_{path.stem}", path)
+    module = importlib.util.module_from_spec(spec)
+    try:
+        spec.loader.exec_module(module)
+    except UserError as exc:
+        raise UserError(f"--indices {path}: {exc}") from None
+    except Exception as exc:  # the user's code: one line saying where it failed
+        raise UserError(f"--indices {path}: running it failed: {type(exc).__name__}: {exc}") from None
+    found = [value for value in vars(module).values() if isinstance(value, Index)]
+    if not found:
+        raise UserError(f"--indices {path}: it defines no index (decorate a function with @hapticdesign.index)")
+    return found
+
+
 def optimize(study_path: Path, seed: int, out: Path | None, scheduler: str | None, rule: dict,
-             progress: Callable[[int, int], None] | None, quiet: bool) -> tuple[dict, list[Path]]:
-    """Run the study file ``study_path`` with ``seed``; write the outputs into ``out`` (when given)."""
+             progress: Callable[[int, int], None] | None, quiet: bool,
+             indices: Path | None = None) -> tuple[dict, list[Path]]:
+    """Run the study file ``study_path`` with ``seed`` (and the design indices the Python file ``indices`` defines,
+    running its code); write the outputs into ``out`` (when given)."""
     from contextlib import ExitStack
 
+    if indices is not None and scheduler is not None:
+        raise UserError("--indices runs a Python file in this process; the workers of --scheduler would not have its "
+                        "indices")
+    own = [] if indices is None else index_module(indices)
     study = load_study(study_path)
-    bound = bind_study(study)
+    bound = bind_study(study, indices=own)
     require_study_workload(study)
     if out is not None:
         _check_out(out)
