@@ -22,6 +22,7 @@ import numpy as np
 
 from hapticdesign.analysis import kinematics
 from hapticdesign.analysis.configuration import configuration_of
+from hapticdesign.analysis.dynamics.cartesian import mobility
 from hapticdesign.analysis.dynamics.device import mass_matrix_at
 from hapticdesign.analysis.stiffness.device import cartesian_stiffness_at
 from hapticdesign.errors import UserError
@@ -75,9 +76,7 @@ class HandleStates:
     @cached_property
     def mobility(self) -> np.ndarray:
         """``U^T J_v H^-1 J_v^T U`` (P, k, k), the inverse of ``Lambda`` (1/kg)."""
-        u, _ = self.svd
-        jv = self.J_v
-        return np.swapaxes(u, 1, 2) @ jv @ np.linalg.solve(self.H, np.swapaxes(jv, 1, 2)) @ u
+        return mobility(self.H, np.swapaxes(self.svd[0], 1, 2) @ self.J_v)
 
     @cached_property
     def cartesian_mass(self) -> np.ndarray:
