@@ -46,12 +46,12 @@ from hapticdesign.model.device import Device
 @index(unit="1", formula="sigma_min(J_v) / sigma_max(J_v)",
        source="seed 001 eq. 4.40 (inverse of the condition number)", needs=("kinematics",))
 def isotropy(pose: HandleStates) -> np.ndarray:
-    return 1.0 / kinematic.condition_number(pose.J_v)
+    return 1.0 / kinematic.condition_of_singular_values(pose.svd[1])
 
 
 @index(unit="1", formula="sigma_max(J_v) / sigma_min(J_v)", source="seed 001 eq. 4.39-4.40", needs=("kinematics",))
 def condition(pose: HandleStates) -> np.ndarray:
-    return kinematic.condition_number(pose.J_v)
+    return kinematic.condition_of_singular_values(pose.svd[1])
 
 
 @index(unit="m^k/rad^k", formula="sqrt(det(U^T J_v J_v^T U))", source="seed 001 eq. 4.36 (Yoshikawa 1985)",
