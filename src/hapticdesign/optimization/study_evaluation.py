@@ -3,8 +3,7 @@
 :func:`bind_study` checks what the study file alone cannot: every variable is one the device file has
 (:class:`~hapticdesign.devices.design_space.DesignSpace`), every index is registered
 (:data:`hapticdesign.analysis.metrics.indices.INDICES`, with the caller's own indices beside it), the workspace box
-is a valid grid
-(:class:`~hapticdesign.analysis.workspace.Workspace`), and the work is within the stated limit. A design is
+is a valid grid (:class:`~hapticdesign.analysis.workspace.Workspace`), and the work is within the stated limit. A design is
 then the device at its values; the registry reaches the workspace points by the project's inverse
 kinematics and gives each index per point, reduced here as the study asks. A design the device file's own
 checks refuse, or one that does not reach a point, has no values and says why.

@@ -73,11 +73,12 @@ def evaluate_at(device: Device, full: np.ndarray, requests: list[Request], frame
     """The checked ``requests`` at closed full poses (P, N); an index the design cannot give raises UserError. An
     index of the parameters alone has the design's one value at every pose."""
     states = HandleStates(device, np.atleast_2d(full), frame)
-    parameters = ParameterStates.of_device(device)
+    parameters = None
     values = {}
     for request in requests:
         index = registry[request.index]
         if index.of_parameters:
+            parameters = parameters or ParameterStates.of_device(device)
             values[request.key] = np.full(len(states.full), index.values(parameters, request.options)[0])
         else:
             values[request.key] = index.values(states, request.options)

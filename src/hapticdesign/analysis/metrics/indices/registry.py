@@ -127,7 +127,7 @@ class Registry(Mapping[str, Index]):
     def __iter__(self) -> Iterator[str]:
         if not self._discovered:
             self._discover()
-        names = dict.fromkeys(self._parent or ())
+        names = dict.fromkeys(self._parent if self._parent is not None else ())
         names.update(dict.fromkeys(self._own))
         return iter(names)
 
