@@ -1,9 +1,9 @@
 """Designs evaluated per second (issue 23): the five-bar with its link lengths and motor spacing as variables, 25
 workspace points (a 5 x 5 grid of 60 mm x 60 mm in its plane), isotropy and apparent mass.
 
-- batched: :func:`hapticdesign.simulation.design_indices.evaluate_designs`, the compiled kernels of
+- batched: :func:`hapticdesign.analysis.metrics.indices.evaluate_designs`, the compiled kernels of
   :mod:`hapticdesign.analysis.design_batch` (goal >= 2000 designs/s on one core);
-- one at a time: ``DesignSpace.device`` then :func:`hapticdesign.simulation.design_indices.evaluate` per design (the
+- one at a time: ``DesignSpace.device`` then :func:`hapticdesign.analysis.metrics.indices.evaluate` per design (the
   path every other index and device takes).
 
 Random designs (seed 0) within l1 in [0.08, 0.13] m, l2 in [0.12, 0.17] m, d in [0.05, 0.10] m; the batched values
@@ -29,7 +29,7 @@ import numpy as np  # noqa: E402
 
 from hapticdesign.analysis.workspace import Workspace  # noqa: E402
 from hapticdesign.devices.design_space import design_space  # noqa: E402
-from hapticdesign.simulation.design_indices import evaluate, evaluate_designs  # noqa: E402
+from hapticdesign.analysis.metrics.indices import evaluate, evaluate_designs  # noqa: E402
 
 FIVE_BAR = Path(__file__).resolve().parents[1] / "examples" / "devices" / "five-bar.yaml"
 BOUNDS = {"l1": (0.08, 0.13), "l2": (0.12, 0.17), "d": (0.05, 0.10)}

@@ -2,10 +2,10 @@
 benchmarks/bench_design_indices.py (link lengths and motor spacing, the same random designs, 25 points), ``kmax``
 with its defaults (1 kHz, one sample of delay, the worst of 66 directions per point).
 
-- batched: :func:`hapticdesign.simulation.design_indices.evaluate_designs` (the compiled kernels' ``J_v`` and
+- batched: :func:`hapticdesign.analysis.metrics.indices.evaluate_designs` (the compiled kernels' ``J_v`` and
   ``H``, all designs' points and directions in one boundary search,
   :func:`hapticdesign.analysis.wall_stiffness.wall_limits`);
-- one at a time: ``DesignSpace.device`` then :func:`hapticdesign.simulation.design_indices.evaluate` per design.
+- one at a time: ``DesignSpace.device`` then :func:`hapticdesign.analysis.metrics.indices.evaluate` per design.
 
 CPU time of this process (``time.process_time``, one thread), the best of three runs (one for one at a time).
 Run it with another checkout's ``src`` on ``PYTHONPATH`` to time that version (before the batched search, both rows
@@ -28,7 +28,7 @@ import numpy as np  # noqa: E402
 from bench_design_indices import BOUNDS, FIVE_BAR, _best  # noqa: E402
 from hapticdesign.analysis.workspace import Workspace  # noqa: E402
 from hapticdesign.devices.design_space import design_space  # noqa: E402
-from hapticdesign.simulation.design_indices import evaluate, evaluate_designs  # noqa: E402
+from hapticdesign.analysis.metrics.indices import evaluate, evaluate_designs  # noqa: E402
 
 
 def main(count: int = 200) -> None:

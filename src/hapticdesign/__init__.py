@@ -11,6 +11,7 @@ R-CUBE):
   :func:`linear_conditions` (the linear equations of LN = 0).
 - :func:`impedance_range`, :func:`transparency`: the sampled-data rendering criteria.
 - :func:`optimize`: a study file's optimization (docs/optimization.md), answering the front as ``optimize --json``.
+- :func:`index`: register your own design index (a decorator; docs/indices.md), usable in study files.
 - :mod:`hapticdesign.analysis.rcube` and :mod:`hapticdesign.optimization`: the R-CUBE.
 """
 
@@ -32,6 +33,7 @@ _HOMES = {
     "UserError": "hapticdesign.errors",
     "Device": "hapticdesign.model.device",
     "impedance_range": "hapticdesign.simulation.impedance",
+    "index": "hapticdesign.analysis.metrics.indices",
     "transparency": "hapticdesign.simulation.transparency",
 }
 _RENAMED = {"linearity_form": ("hapticdesign.analysis.linearity.form", "device_form")}
@@ -64,6 +66,7 @@ __all__ = [
     "forward_dynamics",
     "gravity",
     "impedance_range",
+    "index",
     "inverse_dynamics",
     "linear_conditions",
     "linearity_form",

@@ -1,5 +1,5 @@
 """Many designs through the compiled kernels (:mod:`hapticdesign.analysis.design_batch`) against one design at a
-time (:func:`hapticdesign.simulation.design_indices.evaluate` of ``DesignSpace.device``, whose indices are checked
+time (:func:`hapticdesign.analysis.metrics.indices.evaluate` of ``DesignSpace.device``, whose indices are checked
 against closed forms, finite differences, kinetic energy and the VJM's own references in test_indices.py and
 test_indices_force_stiffness.py): same values, same failures, for every kind of design variable, trees and closed
 loops."""
@@ -16,7 +16,7 @@ from hapticdesign.analysis.metrics.indices import Request
 from hapticdesign.analysis.workspace import Workspace
 from hapticdesign.devices.design_space import design_space
 from hapticdesign.errors import UserError
-from hapticdesign.simulation.design_indices import evaluate, evaluate_designs
+from hapticdesign.analysis.metrics.indices import evaluate, evaluate_designs
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples" / "devices"

@@ -23,7 +23,7 @@ from hapticdesign.analysis.metrics.dynamic import modes
 from hapticdesign.devices.device_file import device_from_mapping, load_device_file
 from hapticdesign.devices.registry import preset
 from hapticdesign.analysis.sampled_loop import MassDamper, exact_boundary
-from hapticdesign.simulation.design_indices import Request, evaluate
+from hapticdesign.analysis.metrics.indices import Request, evaluate
 from tests.helpers.handle_energy import cartesian_damping, cartesian_mass
 from tests.helpers.planar_arm import planar_arm
 

@@ -1,6 +1,6 @@
 """``hapticdesign maps``: design indices over a plane of any device's workspace (issue 28).
 
-Oracles: the indices at each reached point equal :func:`hapticdesign.simulation.design_indices.evaluate` at that
+Oracles: the indices at each reached point equal :func:`hapticdesign.analysis.metrics.indices.evaluate` at that
 point alone (checked against closed forms in test_indices.py); points beyond the five-bar's reach (``l1 + l2``
 from both motor axes) carry a reason; bad input is one line with exit status 2.
 """
@@ -17,7 +17,7 @@ from typer.testing import CliRunner
 
 from hapticdesign.devices.device_file import load_device_file
 from hapticdesign.interface.cli import app
-from hapticdesign.simulation.design_indices import evaluate
+from hapticdesign.analysis.metrics.indices import evaluate
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "devices"
 runner = CliRunner()

@@ -118,7 +118,7 @@ class Configuration:
         if targets.ndim != 2 or targets.shape[1] != 3 or not np.all(np.isfinite(targets)):
             raise UserError(f"a handle position is 3 finite numbers, got {np.ravel(positions).tolist()[:6]}")
         q = self.full(self.home) if start is None else np.array(start, dtype=float)
-        q_a = q[self._actuated_index()]
+        q_a = q[self.actuated_index()]
         p, jac = self.position_and_jacobian(q, frame)
         walk = _Walk(self, frame, _moving_directions(jac), q_a, q, p)
         out_a = np.empty((len(targets), self.n_actuated))
@@ -128,7 +128,8 @@ class Configuration:
             out_a[i], out[i] = walk.q_a, walk.q
         return out_a, out
 
-    def _actuated_index(self) -> np.ndarray:
+    def actuated_index(self) -> np.ndarray:
+        """The places of the actuated coordinates among the full ones."""
         return np.arange(self.n_actuated)
 
 
@@ -243,7 +244,7 @@ class LoopConfiguration(Configuration):
     def _home(self) -> np.ndarray:
         return np.array(self.mechanism.loops.home, dtype=float)
 
-    def _actuated_index(self) -> np.ndarray:
+    def actuated_index(self) -> np.ndarray:
         return self.solver.closures.actuated
 
     def full(self, q_a, start: np.ndarray | None = None) -> np.ndarray:

@@ -389,12 +389,14 @@ class DesignValues(NamedTuple):
 
 class Evaluated(NamedTuple):
     """Many designs at the workspace points (:meth:`DesignBatch.evaluate`): ``J_v`` (D, P, 3, n_a), ``H`` with the
-    reflected rotor inertia (D, P, n_a, n_a), the VJM's ``K_C`` (D, P, 6, 6; None unless asked), the mass the
+    reflected rotor inertia (D, P, n_a, n_a), the actuated coordinates ``q`` (D, P, n_a), the VJM's ``K_C``
+    (D, P, 6, 6; None unless asked), the mass the
     coordinates move (D,), whether each design reached every point (D,) and else why not (one line), and the
     design values it was given (``B``, the motors)."""
 
     jacobian: np.ndarray
     mass: np.ndarray
+    q: np.ndarray
     stiffness: np.ndarray | None
     moving_mass: np.ndarray
     ok: np.ndarray
@@ -573,7 +575,7 @@ class DesignBatch:
                 reasons[d] = (f"the end effector {self.frame!r} is rigid in some direction at this pose: the elastic "
                               "links and joint springs do not reach it, or the pose is singular")
             ok &= defined
-        return Evaluated(reached.jvt, mass, k_c, moving, ok, reasons, values)
+        return Evaluated(reached.jvt, mass, reached.full[..., self.closures.actuated], k_c, moving, ok, reasons, values)
 
     def reason(self, reached: Reached, design: int, points: np.ndarray) -> str | None:
         """One line on why ``design`` failed (naming the point), or None."""

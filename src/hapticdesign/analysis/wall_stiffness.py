@@ -19,9 +19,15 @@ import math
 import numpy as np
 
 from hapticdesign.analysis.sampled_loop import MassDampers, exact_boundaries
+from hapticdesign.errors import UserError
 
 DIRECTIONS = 60
 """Directions spread over the sphere (circle for a planar device) for the worst wall direction."""
+
+
+MAX_PERIOD = 1.0
+"""Longest sample period (s) of ``kmax``'s loop: a haptic loop samples far faster than 1 Hz, and the exact
+discretization of a handle's mass over much longer periods overflows."""
 
 
 def directions(dim: int, count: int = DIRECTIONS) -> np.ndarray:
@@ -77,3 +83,29 @@ def wall_limits(mobility: np.ndarray, damping: np.ndarray, period: float, delay:
         systems = MassDampers(mass[part].ravel(), damped[part].ravel(), period, delay, virtual_damping)
         out[part] = exact_boundaries(systems, np.repeat(np.arange(len(mass[part])), rows.shape[1]))
     return out
+
+
+def handle_wall_limits(mobility: np.ndarray, damping: np.ndarray, basis: np.ndarray, period: float, delay: int,
+                       virtual_damping: float = 0.0, direction=None) -> np.ndarray:
+    """:func:`wall_limits` at P handle poses (the ``kmax`` design index): ``mobility`` and ``damping`` (P, k, k) on
+    the directions ``basis`` (P, 3, k) the handle moves, along ``direction`` (a base-frame vector, one the handle
+    moves in) or the worst direction when it is None; the settings are checked here (one-line UserError)."""
+    if isinstance(period, bool) or not isinstance(period, (int, float)) or not 0 < period <= MAX_PERIOD:
+        raise UserError(f"index kmax: the sample period is a positive number of seconds, at most {MAX_PERIOD:g} s, "
+                        f"got {period!r}")
+    if isinstance(delay, bool) or not isinstance(delay, int) or not 0 <= delay <= 100:
+        raise UserError(f"index kmax: the delay is a whole number of samples from 0 to 100, got {delay!r}")
+    if isinstance(virtual_damping, bool) or not isinstance(virtual_damping, (int, float)) or not (
+            math.isfinite(virtual_damping) and virtual_damping >= 0):
+        raise UserError(f"index kmax: the wall's damping is a number >= 0 (N s/m), got {virtual_damping!r}")
+    along = None
+    if direction is not None:
+        unit = np.asarray(direction, dtype=float)
+        if unit.shape != (3,) or not np.all(np.isfinite(unit)) or not np.linalg.norm(unit) > 0:
+            raise UserError(f"index kmax: the direction is 3 finite numbers, not all 0, got {direction!r}")
+        unit = unit / np.linalg.norm(unit)
+        along = np.swapaxes(basis, 1, 2) @ unit
+        if not np.all(np.abs(np.linalg.norm(along, axis=1) - 1.0) <= 1e-9):
+            raise UserError(f"index kmax: the direction {np.round(unit, 6).tolist()} is not one the handle moves in")
+        along = along[:, None, :]
+    return wall_limits(mobility, damping, float(period), delay, float(virtual_damping), along)

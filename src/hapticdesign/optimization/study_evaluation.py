@@ -2,8 +2,8 @@
 
 :func:`bind_study` checks what the study file alone cannot: every variable is one the device file has
 (:class:`~hapticdesign.devices.design_space.DesignSpace`), every index is registered
-(:mod:`hapticdesign.analysis.metrics.indices`), the workspace box is a valid grid
-(:class:`~hapticdesign.analysis.workspace.Workspace`), and the work is within the stated limit. A design is
+(:data:`hapticdesign.analysis.metrics.indices.INDICES`, with the caller's own indices beside it), the workspace box
+is a valid grid (:class:`~hapticdesign.analysis.workspace.Workspace`), and the work is within the stated limit. A design is
 then the device at its values; the registry reaches the workspace points by the project's inverse
 kinematics and gives each index per point, reduced here as the study asks. A design the device file's own
 checks refuse, or one that does not reach a point, has no values and says why.
@@ -14,12 +14,16 @@ from __future__ import annotations
 import copy
 import json
 import math
+from collections.abc import Iterable
 from pathlib import Path
 
 import numpy as np
 import yaml
 
-from hapticdesign.analysis.metrics.indices import Evaluation, Request, evaluate_at, reduce, requests_of
+from hapticdesign.analysis.metrics.indices import (
+    INDICES, Evaluation, Index, Registry, Request, evaluate, evaluate_at, evaluate_designs, evaluate_parameters, reduce,
+    requests_of,
+)
 from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.analysis.view.figure import render_png
 from hapticdesign.analysis.view.skeleton import home_pose
@@ -28,12 +32,10 @@ from hapticdesign.devices.design_space import DesignSpace
 from hapticdesign.errors import UserError
 from hapticdesign.files import parse_structured, quote
 from hapticdesign.model.inertia import SEED_FIELDS, seed_parameter_name
-from hapticdesign.optimization.rcube.parameter_indices import PARAMETER_INDICES
 from hapticdesign.optimization.study_file import Choice, IndexConstraint, Study
 from hapticdesign.optimization.study_outputs import index_maps
 from hapticdesign.optimization.study_polish import most_designs
 from hapticdesign.optimization.study_run import Answer, reduced_keys, violations
-from hapticdesign.simulation.design_indices import DESIGN_INDICES, evaluate, evaluate_designs
 from hapticdesign.workload import require_within
 
 STUDY_LIMIT = 1e5
@@ -71,8 +73,10 @@ def _kind(path: Path) -> str:
 class BoundStudy:
     """A study with its device file's design space, its workspace points and its index names checked."""
 
-    def __init__(self, study: Study):
+    def __init__(self, study: Study, registry: Registry = INDICES):
         self.study = study
+        self.registry = registry
+        """The indices the study may name."""
         spec = study.spec
         kind = _kind(study.device_path)
         if not kind:
@@ -86,10 +90,14 @@ class BoundStudy:
         self.labels = {request: f"request{k}" for k, request in enumerate(asked)}
         requests = [Request(index, {k: list(v) if isinstance(v, tuple) else v for k, v in options}, label)
                     for (index, options), label in self.labels.items()]
-        self.requests = [r for r in requests if r.index not in PARAMETER_INDICES]
+        try:
+            requests_of(requests, registry)
+        except UserError as exc:
+            raise UserError(f"{study.path}: {exc}") from None
+        self.requests = [r for r in requests if not registry[r.index].of_parameters]
         """The indices at the workspace's poses."""
-        self.parameter_requests = [r for r in requests if r.index in PARAMETER_INDICES]
-        """The indices of the parameters alone (:mod:`.parameter_indices`)."""
+        self.parameter_requests = [r for r in requests if registry[r.index].of_parameters]
+        """The indices of the parameters alone."""
         constrained = {c.key[:2] for c in spec.constraints if isinstance(c, IndexConstraint)}
         self.constrained = {self.labels[request] for request in constrained}
         parameters = self.mapping.get("parameters") if isinstance(self.mapping.get("parameters"), dict) else {}
@@ -97,8 +105,6 @@ class BoundStudy:
         """The variables that are device design variables; the others are read by the ``parameters`` formulas."""
         try:
             self.space = DesignSpace(self.mapping, [*self.device_names, *spec.parameters])
-            requests_of(self.requests, DESIGN_INDICES)
-            self._check_parameter_requests()
             self._check_options()
         except UserError as exc:
             raise UserError(f"{study.path}: {exc}") from None
@@ -106,18 +112,11 @@ class BoundStudy:
         self.points = np.zeros((0, 3)) if workspace is None else workspace.points()
         self.title = f"{self.space.base.name} ({study.path.name})"
 
-    def _check_parameter_requests(self) -> None:
-        for r in self.parameter_requests:
-            unknown = [k for k in r.options if k not in PARAMETER_INDICES[r.index].options]
-            if unknown:
-                raise UserError(f"index {r.index}: unknown option {unknown[0]!r} (options: "
-                                f"{', '.join(PARAMETER_INDICES[r.index].options)})")
-
     def _check_options(self) -> None:
         """Every index with its options once at the device file's home pose (the parameter indices at the design in
         the middle of the variables' bounds), so that an option's bad value is refused before the run (not found in every design)."""
         device = self.space.base
-        evaluate_at(device, configuration_of(device).full(home_pose(device)), self.requests, None, DESIGN_INDICES)
+        evaluate_at(device, configuration_of(device).full(home_pose(device)), self.requests, None, self.registry)
         middle = {name: v.values[0] if isinstance(v, Choice) else (v[0] + v[1]) / 2
                   for name, v in self.study.spec.variables.items()}
         full = self.study.spec.with_parameters(middle)
@@ -127,9 +126,7 @@ class BoundStudy:
                                 "variables' bounds; a parameter must be a finite number")
         params = {name: np.array([float(value)]) for name, value in
                   {**device.params, **self.device_values(middle)}.items()}
-        for r in self.parameter_requests:
-            index = PARAMETER_INDICES[r.index]
-            index.values(params, {**index.options, **r.options}, {})
+        evaluate_parameters(params, self.parameter_requests, self.registry)
 
     def device_values(self, values: dict[str, float]) -> dict[str, float]:
         """The device design variables' values of a design: its variables' and the ``parameters`` formulas'."""
@@ -138,7 +135,7 @@ class BoundStudy:
 
     def evaluate(self, batch: list[dict[str, float]], objectives: bool = True) -> list[Answer]:
         """Answers for a batch of designs, in order: the registry evaluates the pose indices together (through the
-        compiled kernels where it can, :func:`~hapticdesign.simulation.design_indices.evaluate_designs`), each
+        compiled kernels where it can, :func:`~hapticdesign.analysis.metrics.indices.evaluate_designs`), each
         reduced here; a design the device file refuses or that misses a workspace point has none, and says why.
         The parameter indices are evaluated for the whole batch at once (no device is built when the study asks
         only for them); those only the objectives read are evaluated only for the designs that meet every
@@ -146,7 +143,7 @@ class BoundStudy:
         without ``objectives``."""
         device_values = [self.device_values(v) for v in batch]
         if self.requests:
-            results = evaluate_designs(self.space, device_values, self.points, self.requests)
+            results = evaluate_designs(self.space, device_values, self.points, self.requests, self.registry)
         else:
             results = [self._checked(v) for v in device_values]
         valid = [k for k, r in enumerate(results) if r.reason is None]
@@ -207,12 +204,9 @@ class BoundStudy:
                            values: dict[int, dict[str, np.ndarray]]) -> None:
         base = self.space.base.params
         params = {name: np.array([float(d.get(name, base[name])) for d in designs]) for name in base}
-        cache: dict = {}
-        for r in requests:
-            index = PARAMETER_INDICES[r.index]
-            column = np.asarray(index.values(params, {**index.options, **r.options}, cache), dtype=float)
+        for key, column in evaluate_parameters(params, requests, self.registry).items():
             for i, k in enumerate(rows):
-                values[k][r.key] = column[i:i + 1]
+                values[k][key] = column[i:i + 1]
 
     def _feasible(self, variables: dict[str, float], values: dict[str, np.ndarray]) -> bool:
         spec = self.study.spec
@@ -280,15 +274,16 @@ class BoundStudy:
             q = home_pose(device)
             where = "at home"
         out = [(render_png(device, q, dpi=100), f"The selected design {where}")]
-        result = evaluate(device, self.points, self.requests)
+        result = evaluate(device, self.points, self.requests, registry=self.registry)
         if self.requests and result.reason is None:
-            names = {r.key: f"{r.index} ({DESIGN_INDICES[r.index].unit})" for r in self.requests}
+            names = {r.key: f"{r.index} ({self.registry[r.index].unit})" for r in self.requests}
             maps = {names[key]: result.values[key] for key in names}
             out.append((index_maps(self.points, maps, "The selected design's indices over the workspace"),
                         "The selected design's indices at the workspace points"))
         return out
 
 
-def bind_study(study: Study) -> BoundStudy:
-    """The study bound to its device file and the index registry (see the module)."""
-    return BoundStudy(study)
+def bind_study(study: Study, indices: Iterable[Index] = (), registry: Registry = INDICES) -> BoundStudy:
+    """The study bound to its device file and ``registry`` with ``indices`` (a caller's own, made with
+    :func:`hapticdesign.index`) beside it (see the module)."""
+    return BoundStudy(study, registry.with_indices(indices) if indices else registry)

@@ -22,13 +22,13 @@ from typing import Annotated, ClassVar, Literal
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError, field_validator, model_validator
 
+from hapticdesign.analysis.metrics.indices import INDICES
 from hapticdesign.devices.builder import LinearExpr
 from hapticdesign.devices.device_file import describe_validation_error
 from hapticdesign.devices.schema import parse_expression
 from hapticdesign.errors import UserError
 from hapticdesign.files import load_structured, quote, read_text
 from hapticdesign.optimization.formula import Formula, formula
-from hapticdesign.optimization.rcube.parameter_indices import PARAMETER_INDICES
 
 REDUCTIONS = ("min", "max", "mean")
 """Reductions of an index over the workspace points (``mean``: the arithmetic mean over the uniform
@@ -426,9 +426,9 @@ class StudySpec(_StudyModel):
 
     @property
     def parameters_only(self) -> bool:
-        """True when every index the study reads is a parameter index (a closed form of the device's parameters,
-        :mod:`.parameter_indices`): no pose is reached, the study needs no workspace."""
-        return all(use.index in PARAMETER_INDICES for use in self.index_uses)
+        """True when every index the study reads is registered and an index of the parameters alone (a closed form
+        of the device's parameters, such as the R-CUBE's): no pose is reached, the study needs no workspace."""
+        return all(use.index in INDICES and INDICES[use.index].of_parameters for use in self.index_uses)
 
     @property
     def index_uses(self) -> tuple[_IndexUse, ...]:

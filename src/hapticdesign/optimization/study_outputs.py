@@ -9,18 +9,17 @@ gives the same bytes and reading them back gives the same floats.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from hapticdesign.analysis.metrics.indices import INDICES, Index
 from hapticdesign.errors import UserError
 from hapticdesign.files import csv_rows, figure_bytes, save_figure
-from hapticdesign.optimization.rcube.parameter_indices import PARAMETER_INDICES
 from hapticdesign.optimization.front_selection import least_rms, normalize
 from hapticdesign.optimization.study_run import Record, StudyRun, constraint_labels
-from hapticdesign.simulation.design_indices import DESIGN_INDICES
 
 
 @dataclass(frozen=True)
@@ -113,11 +112,6 @@ def _pyplot():
     return plt
 
 
-def _unit(index: str) -> str:
-    unit = (DESIGN_INDICES[index] if index in DESIGN_INDICES else PARAMETER_INDICES[index]).unit
-    return "-" if unit == "1" else unit
-
-
 def front_limits(values: np.ndarray, pad: float = 0.08) -> tuple[float, float]:
     """Axis limits from the front's own range, ``pad`` of it on each side (a front of one value: 5 % of its
     magnitude, or 1 at 0): the feasible designs far from the front no longer squash it into a band."""
@@ -126,14 +120,17 @@ def front_limits(values: np.ndarray, pad: float = 0.08) -> tuple[float, float]:
     return low - margin, high + margin
 
 
-def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: str = "pareto") -> list[Path]:
+def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: str = "pareto",
+                  registry: Mapping[str, Index] = INDICES) -> list[Path]:
     """The front in pairs of objectives (every feasible design in grey, the front in blue, the selected
     design as a red star; the axes span the front's range, :func:`front_limits`, and the legend counts the
     feasible designs beyond them); one objective: its value per evaluation; more than three: parallel coordinates
     of the normalized front (0 best)."""
     plt = _pyplot()
     spec = run.spec
-    labels = [f"{o.name}: {o.reduce} {o.index} ({_unit(o.index)}), {o.sense}imize" for o in spec.objectives]
+    units = {o.index: registry[o.index].unit for o in spec.objectives}
+    labels = [f"{o.name}: {o.reduce} {o.index} ({'-' if units[o.index] == '1' else units[o.index]}), {o.sense}imize"
+              for o in spec.objectives]
     feasible = [r for r in run.records if r.feasible]
     F_all = np.array([r.objectives for r in feasible]).reshape(len(feasible), len(labels))
     F = np.array([run.records[k].objectives for k in run.front]).reshape(len(run.front), len(labels))

@@ -8,16 +8,18 @@ friction reach the handle as follows:
 - ``resolution`` (m): one count of motor k turns ``a_k^T q`` by ``Delta_k = 2 pi / (cpr_k quadrature_k n_k)``
   and moves the handle by ``J_v A^-1 e_k Delta_k``; the sheet gives the largest of these over k.
 - ``force_continuous`` / ``force_peak`` (N): the radius of the largest ball inside the force polytope
-  ``{F : |(A^-T J_v^T F)_k| <= n_k tau_k}`` (motor torques at their rating; gravity not included;
-  :mod:`hapticdesign.analysis.metrics.force`, the ``force`` design index's too). A device of fewer than three
+  ``{F : |(A^-T J_v^T F)_k| <= n_k tau_k}`` (motor torques at their rating; gravity not included): the ``force``
+  design index (:mod:`hapticdesign.analysis.metrics.indices`, option ``torque``). A device of fewer than three
   actuated coordinates is measured in the plane (or line) its handle moves in.
-- ``apparent_mass`` (kg): the eigenvalues of ``(J_v H^-1 J_v^T)^+`` on that range.
+- ``apparent_mass`` (kg): the smallest and largest eigenvalue of ``(J_v H^-1 J_v^T)^+`` on that range (the largest
+  is the ``apparent_mass`` design index).
 - ``backdrive_friction`` (N): the motors' Coulomb friction ``f_k`` (on ``a_k^T q``) as a force at the handle:
   moving along a unit direction ``u`` at speed v dissipates ``sum_k f_k |a_k^T qd|`` with ``J_v qd = u v``,
   so the handle feels ``sum_k f_k |(A J_v^+ u)_k|``; its smallest and largest value over directions
   (exact, :func:`backdrive_friction`).
-- ``stiffness`` (N/m): the smallest eigenvalue of the translational block of the VJM ``K_C`` where the file's
-  links carry sections (:mod:`hapticdesign.analysis.stiffness.device`).
+- ``stiffness`` (N/m): the ``stiffness`` design index, the smallest eigenvalue of the translational block of the VJM
+  ``K_C`` on the directions the handle moves, where the file's links carry sections
+  (:mod:`hapticdesign.analysis.stiffness.device`).
 - ``workspace`` (mm): the edge of the largest cube (square for a planar device) centred on the home handle
   position whose corners, edge midpoints and face centres the handle reaches from home by inverse
   kinematics (:func:`hapticdesign.analysis.configuration.handle_pose`) within the joint limits and without a
@@ -26,7 +28,7 @@ friction reach the handle as follows:
   delay of one sample (:func:`hapticdesign.analysis.sampled_loop.exact_boundary`) on the 1-DOF model of the
   handle along a direction u: mass ``1 / (u^T J_v H^-1 J_v^T u)`` and damping ``u^T J_v^+T B J_v^+ u`` (B the
   joint and motor viscous damping); the smallest over the axes, the principal directions and 60 evenly
-  spread directions (:mod:`hapticdesign.analysis.wall_stiffness`, the ``kmax`` design index's too). A pure
+  spread directions: the ``kmax`` design index (:mod:`hapticdesign.analysis.wall_stiffness`). A pure
   spring uses the position only, so the velocity estimate does not enter. Beside it the passivity bounds of Abbott & Okamura (2005):
   ``2 b / T`` (viscous) and ``2 f_c / Delta`` (Coulomb friction against encoder quantization), with the
   smallest damping (eigenvalue) and friction over directions and the resolution ``Delta``.
@@ -38,13 +40,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.analysis.configuration import configuration_of, handle_pose
 from hapticdesign.analysis.metrics import force as polytope
+from hapticdesign.analysis.metrics.indices import INDICES, HandleStates
 from hapticdesign.errors import UserError
 from hapticdesign.model.actuators import transmission
 from hapticdesign.model.device import Device
-from hapticdesign.analysis.wall_stiffness import wall_limit
 
 SERVO_RATE = 1000.0
 """Hz, the default sampling rate of the renderable-stiffness limit."""
@@ -54,25 +55,32 @@ CUBE_SEARCH = (0.0, 0.4, 12)
 
 @dataclass(frozen=True)
 class Handle:
-    """The handle's kinematics and dynamics at one pose, in the range of ``J_v`` (basis ``U``)."""
+    """The handle at one pose: its actuated coordinates, position, ``J_v``, the basis ``U`` of its range and the
+    design indices' states there (one pose)."""
 
     q: np.ndarray
     position: np.ndarray
     jacobian: np.ndarray
     basis: np.ndarray
-    mass: np.ndarray
+    states: HandleStates
 
 
 def handle_at(device: Device, q) -> Handle:
     q = np.asarray(q, dtype=float)
     configuration = configuration_of(device)
-    jv = configuration.jacobian(q)[:3]
-    u, s, _ = np.linalg.svd(jv)
-    rank = int(np.sum(s > 1e-9 * s[0]))
+    states = HandleStates(device, configuration.full(q)[None])
+    jv = states.J_v[0]
+    u, s = states.svd
+    rank = int(np.sum(s[0] > 1e-9 * s[0, 0]))
     if rank < device.n_dof:
         raise UserError(f"the pose ({', '.join(f'{v:.6g}' for v in q)}) is singular: the handle's Jacobian has rank "
                         f"{rank} < {device.n_dof}")
-    return Handle(q, configuration.pose(q)[:3, 3], jv, u[:, :rank], mass_matrix(device, q))
+    return Handle(q, configuration.pose(q)[:3, 3], jv, u[0], states)
+
+
+def _index(name: str, h: Handle, **options) -> float:
+    """The design index ``name`` at the handle's pose (:data:`~hapticdesign.analysis.metrics.indices.INDICES`)."""
+    return float(INDICES[name].values(h.states, options)[0])
 
 
 def resolution(device: Device, h: Handle) -> float | None:
@@ -84,18 +92,15 @@ def resolution(device: Device, h: Handle) -> float | None:
 
 
 def inscribed_force(device: Device, h: Handle, which: str) -> float | None:
-    """Radius of the largest ball in the force polytope (in the handle's range;
-    :func:`hapticdesign.analysis.metrics.force.inscribed_force`)."""
-    inv, limits = polytope.motor_map(device), polytope.torque_limits(device, which)
-    if inv is None or limits is None:
+    """Radius of the largest ball in the force polytope (the ``force`` index), None without the motors' limits."""
+    if polytope.motor_map(device) is None or polytope.torque_limits(device, which) is None:
         return None
-    return float(polytope.inscribed_force(h.jacobian, h.basis, inv, limits))
+    return _index("force", h, torque=which)
 
 
 def apparent_mass(device: Device, h: Handle) -> tuple[float, float]:
-    mobility, _ = _cartesian(device, h)
-    eig = 1.0 / np.linalg.eigvalsh(mobility)
-    return float(eig.min()), float(eig.max())
+    """The smallest eigenvalue of the handle's Cartesian mass and the largest (the ``apparent_mass`` index)."""
+    return float(h.states.cartesian_mass[0].min()), _index("apparent_mass", h)
 
 
 def backdrive_friction(device: Device, h: Handle) -> tuple[float, float] | None:
@@ -113,17 +118,9 @@ def backdrive_friction(device: Device, h: Handle) -> tuple[float, float] | None:
     return float(1.0 / np.linalg.norm(inv, axis=0).max()), float(np.linalg.norm(signs @ c, axis=1).max())
 
 
-def _cartesian(device: Device, h: Handle) -> tuple[np.ndarray, np.ndarray]:
-    """The handle's mobility ``U^T J_v H^-1 J_v^T U`` and damping ``U^T J_v^+T B J_v^+ U`` in its range."""
-    mobility = h.basis.T @ h.jacobian @ np.linalg.solve(h.mass, h.jacobian.T) @ h.basis
-    pinv = np.linalg.pinv(h.jacobian) @ h.basis
-    return mobility, pinv.T @ device.damping_matrix @ pinv
-
-
 def renderable_stiffness(device: Device, h: Handle, rate: float = SERVO_RATE, delay: int = 1) -> float:
-    """The smallest exact wall limit over directions (:func:`hapticdesign.analysis.wall_stiffness.wall_limit`)."""
-    mobility, damping = _cartesian(device, h)
-    return wall_limit(mobility, damping, 1.0 / rate, delay)
+    """The smallest exact wall limit over directions: the ``kmax`` index sampled at ``rate``."""
+    return _index("kmax", h, period=1.0 / rate, delay=delay)
 
 
 def workspace_cube(device: Device, h: Handle) -> float:
@@ -155,8 +152,7 @@ def spec_sheet(device: Device, q=None, rate: float = SERVO_RATE, workspace: bool
     h = handle_at(device, q)
     res = resolution(device, h)
     friction = backdrive_friction(device, h)
-    _, damping = _cartesian(device, h)
-    smallest_damping = float(np.linalg.eigvalsh(damping).min())
+    smallest_damping = float(np.linalg.eigvalsh(h.states.cartesian_damping[0]).min())
     mass = apparent_mass(device, h)
     sheet = {
         "device": device.name, "q": q, "handle": h.position, "dimensions": h.basis.shape[1],
@@ -165,7 +161,7 @@ def spec_sheet(device: Device, q=None, rate: float = SERVO_RATE, workspace: bool
         "force_peak": inscribed_force(device, h, "peak"),
         "apparent_mass": {"min": mass[0], "max": mass[1]},
         "backdrive_friction": None if friction is None else {"min": friction[0], "max": friction[1]},
-        "stiffness": _stiffness(device, q),
+        "stiffness": _stiffness(device, h),
         "workspace": {"cube": 1000.0 * workspace_cube(device, h)} if workspace else None,
         "renderable_stiffness": {
             "exact": renderable_stiffness(device, h, rate), "rate": rate, "delay_samples": 1,
@@ -179,10 +175,9 @@ def spec_sheet(device: Device, q=None, rate: float = SERVO_RATE, workspace: bool
     return sheet
 
 
-def _stiffness(device: Device, q: np.ndarray) -> float | None:
+def _stiffness(device: Device, h: Handle) -> float | None:
+    """The ``stiffness`` index where the file's links or joints are elastic, else None."""
     elasticity = device.elasticity
     if elasticity is None or not (elasticity.links or elasticity.joints):
         return None
-    from hapticdesign.analysis.stiffness.device import cartesian_stiffness
-
-    return float(np.linalg.eigvalsh(cartesian_stiffness(device, q)[:3, :3]).min())
+    return _index("stiffness", h)

@@ -51,5 +51,11 @@ def cartesian_inertia(mass_matrix, jacobian) -> np.ndarray:
     if m == n:
         Jinv = _inverse(J, "the Jacobian")
         return np.swapaxes(Jinv, -1, -2) @ H @ Jinv
-    mobility = J @ np.linalg.solve(H, np.swapaxes(J, -1, -2))
-    return _inverse(mobility, "J H^-1 J^T")
+    return _inverse(mobility(H, J), "J H^-1 J^T")
+
+
+def mobility(mass_matrix: np.ndarray, jacobian: np.ndarray) -> np.ndarray:
+    """``J H^-1 J^T`` (..., m, m): the inverse of the Cartesian inertia of a full-row-rank ``J`` (1/kg for a
+    translational task), batched over the leading axes."""
+    J = np.asarray(jacobian, dtype=float)
+    return J @ np.linalg.solve(np.asarray(mass_matrix, dtype=float), np.swapaxes(J, -1, -2))

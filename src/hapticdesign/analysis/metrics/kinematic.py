@@ -52,7 +52,11 @@ def absolute_manipulability(J) -> np.ndarray:
 
 def condition_number(J) -> np.ndarray:
     """``c_v = ||J|| ||J^-1||`` (eq. 4.33; equal to ``c_f`` of eq. 4.35), infinite at a singularity."""
-    s = np.linalg.svd(_square(J), compute_uv=False)
+    return condition_of_singular_values(np.linalg.svd(_square(J), compute_uv=False))
+
+
+def condition_of_singular_values(s: np.ndarray) -> np.ndarray:
+    """The condition number ``sigma_max / sigma_min`` of singular values (..., k), largest first (eq. 4.33)."""
     with np.errstate(divide="ignore"):
         return s[..., 0] / s[..., -1]
 

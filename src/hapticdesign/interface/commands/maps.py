@@ -1,7 +1,7 @@
 """Command ``maps``: design indices of any device over a plane of its workspace, as figures and a CSV (issue 28).
 
-The engine is :func:`hapticdesign.analysis.metrics.maps.device_map` with the whole registry of design indices
-(:data:`hapticdesign.simulation.design_indices.DESIGN_INDICES`, docs/indices.md).
+The engine is :func:`hapticdesign.analysis.metrics.maps.device_map` with the one registry of design indices
+(:data:`hapticdesign.analysis.metrics.indices.INDICES`, docs/indices.md).
 """
 
 from __future__ import annotations
@@ -39,7 +39,7 @@ def maps(
     from hapticdesign.analysis.configuration import configuration_of
     from hapticdesign.analysis.metrics.maps import device_map
     from hapticdesign.analysis.workspace import Workspace
-    from hapticdesign.simulation.design_indices import DESIGN_INDICES
+    from hapticdesign.analysis.metrics.indices import INDICES
 
     with user_errors(strict=strict, quiet=quiet):
         from hapticdesign.devices.loading import resolve_device
@@ -57,7 +57,7 @@ def maps(
             raise UserError(f"--index: give at least one design index (docs/indices.md), got {index[:60]!r}")
         workspace = Workspace(tuple(middle), tuple(abs(sizes)), grid)
         points = workspace.points()
-        found = device_map(dev, points, names, registry=DESIGN_INDICES)
+        found = device_map(dev, points, names)
         files = _write(out, found, names, plane)
         note(f"wrote {len(files)} files to {out} ({int(found.reached.sum())} of {len(points)} points reached)",
              quiet or json_out)
@@ -65,11 +65,11 @@ def maps(
             print_json({"device": dev.name, "out": str(out), "files": files, "points": len(points),
                         "reached": int(found.reached.sum()),
                         "range": {k: [_finite(v, min), _finite(v, max)] for k, v in found.values.items()},
-                        "units": {k: DESIGN_INDICES[k].unit for k in names}})
+                        "units": {k: INDICES[k].unit for k in names}})
             return
         for key, values in found.values.items():
             low, high = _finite(values, min), _finite(values, max)
-            span = "no point reached" if low is None else f"{low:.6g} to {high:.6g} {DESIGN_INDICES[key].unit}"
+            span = "no point reached" if low is None else f"{low:.6g} to {high:.6g} {INDICES[key].unit}"
             typer.echo(f"{key}: {span}")
 
 
@@ -85,7 +85,7 @@ def _write(out: Path, found, names: list[str], plane: list[int]) -> list[str]:
 
     from hapticdesign.analysis.metrics.maps import save_map
     from hapticdesign.files import write_atomically
-    from hapticdesign.simulation.design_indices import DESIGN_INDICES
+    from hapticdesign.analysis.metrics.indices import INDICES
     from hapticdesign.interface.report.tables import csv_text
     from hapticdesign.studies.steps import Table
 
@@ -97,7 +97,7 @@ def _write(out: Path, found, names: list[str], plane: list[int]) -> list[str]:
         grid = np.full((len(xs), len(ys)), np.nan)
         grid[np.searchsorted(xs, points[:, first]), np.searchsorted(ys, points[:, second])] = found.values[key]
         path = save_map(Path(out) / f"map_{key}.png", grid, xs - xs.mean(), f"{key}", (AXES[first], AXES[second]),
-                        ys - ys.mean(), unit=DESIGN_INDICES[key].unit)
+                        ys - ys.mean(), unit=INDICES[key].unit)
         files.append(str(path))
     rows = [[*p, bool(r), *(found.values[k][i] for k in names), reason or ""]
             for i, (p, r, reason) in enumerate(zip(points, found.reached, found.reasons))]

@@ -10,11 +10,12 @@ failed or interrupted run leaves complete checkpoint files and nothing half-writ
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from contextlib import ExitStack
 from dataclasses import dataclass
 from pathlib import Path
 
+from hapticdesign.analysis.metrics.indices import Index
 from hapticdesign.errors import UserError
 from hapticdesign.files import write_atomically
 from hapticdesign.interface.report.optimization_page import Picture, render
@@ -106,7 +107,7 @@ def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Select
     """Every output file of the run in ``out`` (see :data:`FILES`)."""
     write_atomically(out / "front.csv", front_csv(run))
     write_atomically(out / "evaluations.csv", evaluations_csv(run))
-    paths = [out / "front.csv", out / "evaluations.csv", *pareto_figure(run, selection, out)]
+    paths = [out / "front.csv", out / "evaluations.csv", *pareto_figure(run, selection, out, registry=bound.registry)]
     values = run.records[selection.record].values
     write_atomically(out / "selected.yaml", bound.device_file_text(values))
     pictures = [Picture(png, caption) for png, caption in bound.pictures(values)]
@@ -150,17 +151,47 @@ class OptimizationResult:
         return self.summary["selected"]
 
 
+def index_module(path: Path) -> list[Index]:
+    """Run the Python file ``path`` (its code, as ``python path`` would) and return the design indices it defines with
+    :func:`hapticdesign.index`."""
+    import importlib.util
+
+    path = Path(path)
+    if path.suffix != ".py" or not path.is_file():
+        raise UserError(f"--indices: {path} is not a Python file (.py) of design indices")
+    spec = importlib.util.spec_from_file_location(f"hapticdesign_user_indices_{path.stem}", path)
+    module = importlib.util.module_from_spec(spec)
+    try:
+        spec.loader.exec_module(module)
+    except UserError as exc:
+        raise UserError(f"--indices {path}: {exc}") from None
+    except Exception as exc:  # the user's code: one line saying where it failed
+        raise UserError(f"--indices {path}: running it failed: {type(exc).__name__}: {exc}") from None
+    found = [value for value in vars(module).values() if isinstance(value, Index)]
+    if not found:
+        raise UserError(f"--indices {path}: it defines no index (decorate a function with @hapticdesign.index)")
+    return found
+
+
 def optimize(study: Path | str, seed: int = 1, out: Path | str | None = None, *, scheduler: str | None = None,
              weights: dict[str, float] | None = None, design: int | None = None,
-             progress: Callable[[int, int], None] | None = None, quiet: bool = True) -> OptimizationResult:
+             progress: Callable[[int, int], None] | None = None, quiet: bool = True,
+             indices: Sequence[Index] | Path | str = ()) -> OptimizationResult:
     """Run the study file ``study`` with ``seed`` by its method and select a front design: the least RMS of the
     normalized objectives, the least weighted RMS with ``weights`` (objective name -> weight), or the front's
     ``design``-th (seed 001 §7.2). ``out``: a folder for the outputs and the checkpoint (a rerun into it
     continues); ``scheduler``: a Dask scheduler's address whose workers evaluate the designs;
-    ``progress(generation, generations)``; ``quiet``: Dask's own logging silenced. Nothing is printed; a bad
-    study, seed or selection raises :class:`~hapticdesign.errors.UserError`."""
+    ``progress(generation, generations)``; ``quiet``: Dask's own logging silenced; ``indices``: your own design
+    indices (functions decorated with :func:`hapticdesign.index`, or a Python file defining them, run in this
+    process), which the study may name beside the registered ones. Nothing is printed; a bad study, seed or
+    selection raises :class:`~hapticdesign.errors.UserError`."""
+    if isinstance(indices, (str, Path)):
+        indices = index_module(Path(indices))
+    own = list(indices)
+    if own and scheduler is not None:
+        raise UserError("your own indices live in this process; the workers of a scheduler would not have them")
     study = load_study(study)
-    bound = bind_study(study)
+    bound = bind_study(study, indices=own)
     require_study_workload(study)
     out = None if out is None else Path(out)
     if out is not None:

@@ -11,46 +11,39 @@ Constraints 3-7 at points of a virtual cube that the handle need not reach, and 
 Constraint 8, have no counterpart among the pose indices. Options: ``side`` (the workspace cube's edge, m, 0.120) and
 ``virtual_side`` (the virtual cube's edge, m, 0.130); the objectives' links are the synthesis's evaluation tube
 (:class:`~hapticdesign.optimization.rcube.objectives.EvaluationLinks`).
+
+They are registered in the one registry of design indices (:mod:`hapticdesign.analysis.metrics.indices`) as any
+package's own indices are: this module is named by the ``hapticdesign.indices`` entry point of pyproject.toml, and
+the registry imports it the first time a study asks for an index it does not hold.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from collections.abc import Callable
 
 import numpy as np
 
+from hapticdesign.analysis.metrics.indices import ParameterStates, index
 from hapticdesign.errors import UserError
-from hapticdesign.optimization.rcube.constraints import (ERGONOMIC_POINTS, PASSIVE_POINTS, Workspace, constraint_values)
 from hapticdesign.model.rcube import RCubeGeometry
+from hapticdesign.optimization.rcube.constraints import ERGONOMIC_POINTS, PASSIVE_POINTS, Workspace, constraint_values
 from hapticdesign.optimization.rcube.objectives import EvaluationLinks, o1, o2, o3
 
 POINTS = (*PASSIVE_POINTS, *ERGONOMIC_POINTS)
 """The critical points of Constraints 3-8, in the column order of :func:`constraint_values`."""
+SIDE, VIRTUAL_SIDE = 0.120, 0.130
+"""The workspace cube's and the virtual cube's edges (m), the options' defaults."""
+PARAMETERS = ("parameters",)
 
 
-@dataclass(frozen=True)
-class ParameterIndex:
-    """An index of a design's parameters: ``values(params, options, cache)`` maps each parameter name to an array
-    (one entry per design) and returns one value per design; ``cache`` is shared by the indices of one batch."""
-
-    name: str
-    unit: str
-    formula: str
-    source: str
-    values: Callable[[Mapping[str, np.ndarray], Mapping[str, object], dict], np.ndarray]
-    options: Mapping[str, object] = field(default_factory=dict)
-
-
-def _workspace(options: Mapping[str, object]) -> Workspace:
-    side, virtual = options["side"], options["virtual_side"]
-    for name, value in (("side", side), ("virtual_side", virtual)):
+def _workspace(side: object, virtual_side: object) -> Workspace:
+    for name, value in (("side", side), ("virtual_side", virtual_side)):
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise UserError(f"R-CUBE index option {name} is a length in m, got {value!r}")
-    return Workspace(float(side), float(virtual))
+    return Workspace(float(side), float(virtual_side))
 
 
-def design_vectors(params: Mapping[str, np.ndarray], workspace: Workspace) -> np.ndarray:
+def design_vectors(params, workspace: Workspace) -> np.ndarray:
     """``(q_max, l2, l3)`` per design (n, 3) from the parameters, ``q_max = asin(h / l1)`` (eq. 6.24 read backward);
     a design with ``S != l1`` is refused (the closed forms hold for ``S = l1``, eq. 6.39)."""
     missing = [n for n in ("l1", "l2", "l3", "S") if n not in params]
@@ -64,50 +57,43 @@ def design_vectors(params: Mapping[str, np.ndarray], workspace: Workspace) -> np
     return np.column_stack([q, np.asarray(params["l2"], dtype=float), np.asarray(params["l3"], dtype=float)])
 
 
-def _constraint(params, options, cache) -> np.ndarray:
-    point = options["point"]
+@index(unit="1", formula="cos^2 q_i3 - 1 at C2, C3, C5, B3, B5; sin(q_i2 + q_i3) at C1, B1 (feasible: <= 0)",
+       source="seed 001 eq. 6.45-6.49, 6.52", needs=PARAMETERS)
+def rcube_constraint(design: ParameterStates, side: float = SIDE, virtual_side: float = VIRTUAL_SIDE,
+                     point: str = "C2") -> np.ndarray:
     if point not in POINTS:
         raise UserError(f"index rcube_constraint: point is one of {', '.join(POINTS)}, got {point!r}")
-    workspace = _workspace(options)
+    workspace = _workspace(side, virtual_side)
     key = ("constraints", workspace)
-    if key not in cache:
-        cache[key] = constraint_values(design_vectors(params, workspace), workspace)
-    return cache[key][:, POINTS.index(point)]
+    if key not in design.cache:
+        design.cache[key] = constraint_values(design_vectors(design.params, workspace), workspace)
+    return design.cache[key][:, POINTS.index(point)]
 
 
-def _o1(params, options, cache) -> np.ndarray:
-    return o1(design_vectors(params, _workspace(options))[:, 0])
+@index(unit="1", formula="tan q_max, q_max = asin(h / l1)", source="seed 001 eq. 6.82, 6.24", needs=PARAMETERS)
+def rcube_o1(design: ParameterStates, side: float = SIDE, virtual_side: float = VIRTUAL_SIDE) -> np.ndarray:
+    return o1(design_vectors(design.params, _workspace(side, virtual_side))[:, 0])
 
 
-def _per_design(params, options, cache, objective: Callable) -> np.ndarray:
-    workspace = _workspace(options)
+def _per_design(design: ParameterStates, side, virtual_side, objective: Callable) -> np.ndarray:
+    workspace = _workspace(side, virtual_side)
     links = EvaluationLinks()
     out = []
-    for l1, (_, l2, l3) in zip(np.asarray(params["l1"], dtype=float), design_vectors(params, workspace)):
+    for l1, (_, l2, l3) in zip(np.asarray(design.params["l1"], dtype=float), design_vectors(design.params, workspace)):
         key = ("design", float(l1), float(l2), float(l3))
-        if key not in cache:
-            cache[key] = links.design(RCubeGeometry(float(l1), float(l2), float(l3)))
-        out.append(objective(cache[key], workspace.half, links))
+        if key not in design.cache:
+            design.cache[key] = links.design(RCubeGeometry(float(l1), float(l2), float(l3)))
+        out.append(objective(design.cache[key], workspace.half, links))
     return np.array(out)
 
 
-def _o2(params, options, cache) -> np.ndarray:
-    return _per_design(params, options, cache, lambda design, half, links: o2(design, half))
+@index(unit="kg^3", formula="det M_C with two active links folded (q_i1 = -q_max), the third at home",
+       source="seed 001 eq. 6.83, 5.227", needs=PARAMETERS)
+def rcube_o2(design: ParameterStates, side: float = SIDE, virtual_side: float = VIRTUAL_SIDE) -> np.ndarray:
+    return _per_design(design, side, virtual_side, lambda built, half, links: o2(built, half))
 
 
-def _o3(params, options, cache) -> np.ndarray:
-    return _per_design(params, options, cache, lambda design, half, links: o3(design, half, links.passive_eliminated))
-
-
-_CUBE = {"side": 0.120, "virtual_side": 0.130}
-
-PARAMETER_INDICES: dict[str, ParameterIndex] = {index.name: index for index in (
-    ParameterIndex("rcube_o1", "1", "tan q_max, q_max = asin(h / l1)", "seed 001 eq. 6.82, 6.24", _o1, _CUBE),
-    ParameterIndex("rcube_o2", "kg^3", "det M_C with two active links folded (q_i1 = -q_max), the third at home",
-                   "seed 001 eq. 6.83, 5.227", _o2, _CUBE),
-    ParameterIndex("rcube_o3", "m^3/N^3", "1 / det K_CA at the fully extended pose (q_i1 = q_max)",
-                   "seed 001 eq. 6.84, 6.74", _o3, _CUBE),
-    ParameterIndex("rcube_constraint", "1", "cos^2 q_i3 - 1 at C2, C3, C5, B3, B5; sin(q_i2 + q_i3) at C1, B1 "
-                   "(feasible: <= 0)", "seed 001 eq. 6.45-6.49, 6.52", _constraint, {**_CUBE, "point": "C2"}),
-)}
-"""The indices of a device's parameters: name -> :class:`ParameterIndex`."""
+@index(unit="m^3/N^3", formula="1 / det K_CA at the fully extended pose (q_i1 = q_max)", source="seed 001 eq. 6.84, 6.74",
+       needs=PARAMETERS)
+def rcube_o3(design: ParameterStates, side: float = SIDE, virtual_side: float = VIRTUAL_SIDE) -> np.ndarray:
+    return _per_design(design, side, virtual_side, lambda built, half, links: o3(built, half, links.passive_eliminated))

@@ -1,0 +1,116 @@
+"""The built-in design indices, registered with :func:`~.registry.index` as a user's would be (docs/indices.md).
+
+With ``U``, ``sigma_1 >= ... >= sigma_k`` and ``Lambda`` of :mod:`.states`:
+
+======================  ==================================================  =========  ===========================
+index                   formula                                             unit       source
+======================  ==================================================  =========  ===========================
+``isotropy``            ``sigma_k / sigma_1``                               1          seed 001 eq. 4.40 (inverse)
+``condition``           ``sigma_1 / sigma_k``                               1          seed 001 eq. 4.39-4.40
+``manipulability``      ``sigma_1 ... sigma_k`` (``sqrt det(U^T J_v J_v^T U)``)  m^k/rad^k  seed 001 eq. 4.36
+``apparent_mass``       largest eigenvalue of ``Lambda``                    kg         Khatib (1987)
+``inertia_uniformity``  smallest / largest eigenvalue of ``Lambda``         1          seed 001 eq. 4.99 (inverse)
+``force``               the force polytope's inscribed radius               N          :mod:`..force`
+``stiffness``           smallest eigenvalue of ``K = U^T K_C[:3, :3] U``    N/m        seed 001 eq. 5.117-5.123
+``frequency``           ``sqrt`` of the smallest eigenvalue of (K, Lambda)  rad/s      seed 001 eq. 4.100-4.107
+``kmax``                the exact stable wall stiffness                     N/m        seed 000 ch. 4-5
+``ln``                  the Linearity Number over the joint region          LN         seed 000 eq. 3.1-3.4
+``mass``                the mass of the bodies the coordinates move         kg         the device's bodies
+======================  ==================================================  =========  ===========================
+
+``force`` takes ``torque`` (``continuous``, default, or ``peak``): the motors' torque limits, one motor per actuated
+coordinate. ``stiffness`` and ``frequency`` need links with sections (``K_C`` of the virtual joint method at the
+handle, :func:`~hapticdesign.analysis.stiffness.device.cartesian_stiffness_at`; ``K_C[:3, :3]`` holds the
+rotations, seed 001's ``K_CA``). ``kmax`` is :func:`hapticdesign.analysis.wall_stiffness.handle_wall_limits` of the
+handle's mobility and damping (options ``period``, ``delay``, ``damping``, ``direction``). ``ln`` and ``mass`` are one
+value per design (the same at every point); ``ln`` takes the region of the joint limits (full turns where none) and
+unit weights (:func:`~hapticdesign.analysis.linearity.form.device_form`). ``m^k/rad^k``: metres per radian for
+revolute coordinates (m/m for prismatic ones).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hapticdesign.analysis.linearity.form import device_form
+from hapticdesign.analysis.metrics import force as polytope
+from hapticdesign.analysis.metrics import kinematic
+from hapticdesign.analysis.metrics.dynamic import modes
+from hapticdesign.analysis.metrics.indices.registry import index
+from hapticdesign.analysis.metrics.indices.states import HandleStates
+from hapticdesign.analysis.wall_stiffness import handle_wall_limits
+from hapticdesign.errors import UserError
+
+
+@index(unit="1", formula="sigma_min(J_v) / sigma_max(J_v)",
+       source="seed 001 eq. 4.40 (inverse of the condition number)", needs=("kinematics",))
+def isotropy(pose: HandleStates) -> np.ndarray:
+    return 1.0 / kinematic.condition_of_singular_values(pose.svd[1])
+
+
+@index(unit="1", formula="sigma_max(J_v) / sigma_min(J_v)", source="seed 001 eq. 4.39-4.40", needs=("kinematics",))
+def condition(pose: HandleStates) -> np.ndarray:
+    return kinematic.condition_of_singular_values(pose.svd[1])
+
+
+@index(unit="m^k/rad^k", formula="sqrt(det(U^T J_v J_v^T U))", source="seed 001 eq. 4.36 (Yoshikawa 1985)",
+       needs=("kinematics",))
+def manipulability(pose: HandleStates) -> np.ndarray:
+    return kinematic.manipulability(np.swapaxes(pose.svd[0], 1, 2) @ pose.J_v)
+
+
+@index(unit="kg", formula="largest eigenvalue of Lambda = (J_v H^-1 J_v^T)^+", source="Khatib (1987); seed 001 §4.3")
+def apparent_mass(pose: HandleStates) -> np.ndarray:
+    return pose.cartesian_mass.max(axis=1)
+
+
+@index(unit="1", formula="smallest / largest eigenvalue of Lambda", source="inverse of seed 001 eq. 4.99 (I_e)")
+def inertia_uniformity(pose: HandleStates) -> np.ndarray:
+    m = pose.cartesian_mass
+    return m.min(axis=1) / m.max(axis=1)
+
+
+@index(unit="N", formula="min_k n_k tau_k / |(A^-T J_v^T U)_k|: the force polytope's inscribed radius",
+       source="force polytope (Chiacchio et al. 1997); hapticdesign.analysis.metrics.force",
+       needs=("kinematics", "motors"))
+def force(pose: HandleStates, torque: str = "continuous") -> np.ndarray:
+    if torque not in ("continuous", "peak"):
+        raise UserError(f"index force: torque is continuous or peak, got {torque!r}")
+    inverse, limits = pose.motor_map, pose.torque_limits[str(torque)]
+    if inverse is None or limits is None:
+        raise UserError(f"index force needs one motor per actuated coordinate, each with torque_{torque} (device "
+                        f"{pose.name})")
+    return polytope.inscribed_force(pose.J_v, pose.svd[0], inverse, limits)
+
+
+@index(unit="N/m", formula="smallest eigenvalue of U^T K_C[:3, :3] U (VJM)", source="seed 001 eq. 5.117-5.123 (K_CA)",
+       needs=("kinematics", "sections"))
+def stiffness(pose: HandleStates) -> np.ndarray:
+    return np.linalg.eigvalsh(pose.stiffness)[:, 0]
+
+
+@index(unit="rad/s", formula="sqrt of the smallest eigenvalue of K v = w^2 Lambda v (U^T K_C[:3, :3] U, Lambda)",
+       source="seed 001 eq. 4.100-4.107, 7.11-7.13", needs=("kinematics", "dynamics", "sections"))
+def frequency(pose: HandleStates) -> np.ndarray:
+    return np.array([modes(m, k).frequencies[0] for m, k in zip(pose.cartesian_mass_matrix, pose.stiffness)])
+
+
+@index(unit="N/m", formula="exact stable wall stiffness of the sampled loop along a direction (or the worst)",
+       source="seed 000 ch. 4-5; hapticdesign.analysis.sampled_loop.exact_boundary",
+       needs=("kinematics", "dynamics", "damping"))
+def kmax(pose: HandleStates, period: float = 0.001, delay: int = 1, damping: float = 0.0,
+         direction: list[float] | None = None) -> np.ndarray:
+    return handle_wall_limits(pose.mobility, pose.cartesian_damping, pose.svd[0], period, delay, damping, direction)
+
+
+@index(unit="LN", formula="Linearity Number over the joint region (limits, else full turns)",
+       source="seed 000 eq. 3.1-3.4", needs=("device",))
+def ln(pose: HandleStates) -> np.ndarray:
+    device = pose.device
+    return np.full(len(pose.full), float(device_form(device).ln(device.standard_parameters())))
+
+
+@index(unit="kg", formula="sum of the masses of the bodies the coordinates move", source="the device file's bodies",
+       needs=("bodies",))
+def mass(pose: HandleStates) -> np.ndarray:
+    return pose.moving_mass

@@ -1,0 +1,172 @@
+"""Design indices evaluated: one design at workspace points (:func:`evaluate`, :func:`evaluate_at`), many designs at
+once (:func:`evaluate_designs`), the parameters of many designs (:func:`evaluate_parameters`), and the reductions
+over the points (docs/indices.md).
+
+:func:`evaluate_designs` evaluates many designs of a :class:`~hapticdesign.devices.design_space.DesignSpace` at once,
+a generation at a time, through the compiled kernels of :mod:`hapticdesign.analysis.design_batch` (trees and closed
+loops alike, every kind of design variable: geometry, sections, inertial parameters, link bodies, motors):
+:meth:`~hapticdesign.devices.design_space.DesignSpace.batch_values` gives each design's inertial parameters,
+reflected rotor inertia, damping ``B``, motors and sections, the batch each design's ``J_v``, ``H`` and ``K_C`` at
+the points, and every index that needs at most what they give (:data:`~.states.BATCH_NEEDS`) follows from them; an
+index of the whole device (``ln``, which needs the ``device``), and a device whose handle moves in fewer directions
+than it has actuated coordinates (or more than 3), go design by design (:func:`evaluate`). Both give the same
+values; ``kmax`` of all designs' points is one search (:func:`~hapticdesign.analysis.wall_stiffness.wall_limits`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from typing import NamedTuple, Protocol
+
+import numpy as np
+
+from hapticdesign.analysis.design_batch import DesignBatch
+from hapticdesign.analysis.metrics.indices.registry import INDICES, Index, Request, requests_of
+from hapticdesign.analysis.metrics.indices.states import BATCH_NEEDS, HandleStates, ParameterStates
+from hapticdesign.analysis.workspace import reach_workspace
+from hapticdesign.errors import UserError
+from hapticdesign.model.device import Device
+
+REDUCTIONS: dict[str, Callable[[np.ndarray], float]] = {
+    "min": lambda v: float(np.min(v)),
+    "max": lambda v: float(np.max(v)),
+    "mean": lambda v: float(np.mean(v)),
+}
+"""Reductions of an index over the workspace points (the mean weighs each grid point alike; ``isotropy`` with
+``mean`` over a uniform Cartesian grid is the global conditioning index of Gosselin & Angeles (1991))."""
+
+
+class Evaluation(NamedTuple):
+    """Values per request key per point (P,), or ``reason`` (one line) when the design fails (``values`` empty)."""
+
+    values: dict[str, np.ndarray]
+    reason: str | None = None
+
+
+class DesignFamily(Protocol):
+    """What :func:`evaluate_designs` reads of a family of designs
+    (:class:`hapticdesign.devices.design_space.DesignSpace`)."""
+
+    base: Device
+    cache: dict
+
+    def batch_values(self, designs: Sequence[Mapping[str, float]], batch: DesignBatch): ...
+
+    def device(self, values: Mapping[str, float]) -> Device: ...
+
+
+def evaluate(device: Device, points: np.ndarray, requests: Iterable[str | Request], frame: str | None = None,
+             registry: Mapping[str, Index] = INDICES) -> Evaluation:
+    """The indices ``requests`` at the workspace ``points`` (P, 3), reached in order from home
+    (:func:`~hapticdesign.analysis.workspace.reach_workspace`). A point the handle does not reach (out of reach,
+    behind a singularity, outside the joint limits), or an index the design cannot give, makes the design fail:
+    the reason says why (naming the point)."""
+    checked = requests_of(requests, registry)
+    try:
+        poses = reach_workspace(device, points, frame)
+        return evaluate_at(device, poses.full, checked, frame, registry)
+    except UserError as exc:
+        return Evaluation({}, str(exc))
+
+
+def evaluate_at(device: Device, full: np.ndarray, requests: list[Request], frame: str | None = None,
+                registry: Mapping[str, Index] = INDICES) -> Evaluation:
+    """The checked ``requests`` at closed full poses (P, N); an index the design cannot give raises UserError. An
+    index of the parameters alone has the design's one value at every pose."""
+    states = HandleStates(device, np.atleast_2d(full), frame)
+    parameters = None
+    values = {}
+    for request in requests:
+        index = registry[request.index]
+        if index.of_parameters:
+            parameters = parameters or ParameterStates.of_device(device)
+            values[request.key] = np.full(len(states.full), index.values(parameters, request.options)[0])
+        else:
+            values[request.key] = index.values(states, request.options)
+    return Evaluation(values)
+
+
+def evaluate_parameters(params: Mapping[str, np.ndarray], requests: list[Request],
+                        registry: Mapping[str, Index] = INDICES) -> dict[str, np.ndarray]:
+    """The checked ``requests`` of indices of the parameters alone, for the designs whose parameters are ``params``
+    (name -> (D,) values): (D,) values per request key, the closed forms they share computed once."""
+    states = ParameterStates(params)
+    return {r.key: registry[r.index].values(states, r.options) for r in requests}
+
+
+def evaluate_designs(space: DesignFamily, designs: Sequence[Mapping[str, float]], points: np.ndarray,
+                     requests: Iterable[str | Request], registry: Mapping[str, Index] = INDICES) -> list[Evaluation]:
+    """:func:`evaluate` of each design (variable values) of ``space`` at the workspace ``points`` (P, 3); a design the
+    device file refuses fails with its reason (see the module docstring for the batched path)."""
+    checked = requests_of(requests, registry)
+    points = np.asarray(points, dtype=float)
+    batch = _batch(space, checked, registry) if designs else None
+    if batch is None:
+        return [_one(space, values, points, checked, registry) for values in designs]
+    sections = any("sections" in registry[r.index].needs for r in checked)
+    got = batch.evaluate(space.batch_values(designs, batch), points, sections)
+    ok, v = got.ok, got.values
+    per_pose = np.repeat(np.flatnonzero(ok), len(points))
+    n_a = got.jacobian.shape[-1]
+    states = HandleStates.of(
+        got.jacobian[ok].reshape(-1, 3, n_a), got.mass[ok].reshape(-1, n_a, n_a), v.damping[per_pose],
+        got.q[ok].reshape(-1, n_a), motor_map=None if v.motor_map is None else v.motor_map[per_pose],
+        torque_limits={k: None if t is None else t[per_pose] for k, t in v.torques.items()},
+        moving_mass=got.moving_mass[per_pose], name=space.base.name)
+    if sections:
+        u = states.svd[0]
+        states.__dict__["stiffness"] = np.swapaxes(u, 1, 2) @ got.stiffness[ok].reshape(-1, 6, 6)[:, :3, :3] @ u
+    values, failed = {}, None
+    try:
+        for r in checked if ok.any() else ():
+            values[r.key] = np.asarray(registry[r.index].values(states, r.options), dtype=float).reshape(-1, len(points))
+    except UserError as exc:  # an index no design of the space can give (the same for each, as design by design)
+        failed = str(exc)
+    out, row = [], 0
+    for d in range(len(designs)):
+        if not ok[d]:
+            out.append(Evaluation({}, got.reasons[d]))
+        elif failed is not None:
+            out.append(Evaluation({}, failed))
+        else:
+            out.append(Evaluation({key: value[row] for key, value in values.items()}))
+        row += int(ok[d])
+    return out
+
+
+def batched(requests: list[Request], registry: Mapping[str, Index] = INDICES) -> bool:
+    """True when every index of ``requests`` needs at most what the compiled kernels give (:data:`BATCH_NEEDS`)."""
+    return all(registry[r.index].needs <= BATCH_NEEDS for r in requests)
+
+
+def _batch(space: DesignFamily, requests: list[Request], registry: Mapping[str, Index]) -> DesignBatch | None:
+    """The space's compiled structure when the batched path applies (see the module docstring), else None: design
+    by design for an index of the whole device, and for one that needs the sections of a device without elastic
+    links or joints (where the device's own evaluation says why)."""
+    elastic = space.base.elasticity
+    if not batched(requests, registry) or (
+            any("sections" in registry[r.index].needs for r in requests)
+            and (elastic is None or not (elastic.links or elastic.joints))):
+        return None
+    if space.cache.get("batch") is None:
+        try:
+            space.cache["batch"] = DesignBatch(space.base)
+        except UserError:
+            space.cache["batch"] = False
+    return space.cache["batch"] or None
+
+
+def _one(space: DesignFamily, values: Mapping[str, float], points: np.ndarray, requests: list[Request],
+         registry: Mapping[str, Index]) -> Evaluation:
+    """One design's evaluation, or why it has none: the device file refuses it or an index cannot be computed."""
+    try:
+        return evaluate(space.device(values), points, requests, registry=registry)
+    except UserError as exc:
+        return Evaluation({}, str(exc))
+
+
+def reduce(values: np.ndarray, how: str) -> float:
+    """An index over the workspace points reduced by ``min``, ``max`` or ``mean``."""
+    if how not in REDUCTIONS:
+        raise UserError(f"unknown reduction {how!r} (use {', '.join(REDUCTIONS)})")
+    return REDUCTIONS[how](values)

@@ -1,0 +1,211 @@
+"""The one registry of design indices: :class:`Index`, :class:`Registry`, :data:`INDICES` and the :func:`index`
+decorator that registers one (docs/indices.md).
+
+An index is one function over a design state (:mod:`.states`): ``function(state, **options)`` gives one value per
+pose (or per design, for an index of the parameters alone). It declares its unit, formula, source, its options (the
+function's keyword parameters and their defaults) and what it ``needs`` of the state: ``kinematics``, ``dynamics``,
+``damping``, ``sections``, ``motors``, ``bodies`` (a device at poses; the batch of many designs gives the first
+three), or ``parameters`` alone. The built-in indices (:mod:`.builtin`), a device family's own (the R-CUBE's) and a
+user's all register the same way, with :func:`index` or :func:`register`.
+
+Indices of installed packages are found through the entry-point group :data:`ENTRY_POINTS` (``[project.entry-points.
+"hapticdesign.indices"] name = "package.module"``): the first lookup of a name the registry does not hold imports
+every such module once, whose :func:`index` calls register its indices. A study file names indices; it never runs
+code.
+"""
+
+from __future__ import annotations
+
+import importlib.metadata
+import inspect
+import re
+from collections.abc import Callable, Iterable, Iterator, Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from hapticdesign.analysis.metrics.indices.states import PARAMETER_NEEDS, POSE_NEEDS
+from hapticdesign.errors import UserError
+
+ENTRY_POINTS = "hapticdesign.indices"
+"""The entry-point group of the packages that register indices."""
+NEEDS = POSE_NEEDS | PARAMETER_NEEDS
+"""What an index may need of its state (:mod:`.states`)."""
+NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,63}")
+
+
+@dataclass(frozen=True)
+class Index:
+    """A design index (see the module): ``function(state, **options)`` and what describes it."""
+
+    name: str
+    unit: str
+    formula: str
+    source: str
+    function: Callable[..., np.ndarray]
+    options: Mapping[str, object] = field(default_factory=dict)
+    needs: frozenset[str] = frozenset({"kinematics"})
+
+    def values(self, state, options: Mapping[str, object] | None = None) -> np.ndarray:
+        """The index of ``state`` with ``options`` over its defaults, as floats."""
+        return np.asarray(self.function(state, **{**self.options, **(options or {})}), dtype=float)
+
+    def __call__(self, state, **options) -> np.ndarray:
+        return self.values(state, options)
+
+    @property
+    def of_parameters(self) -> bool:
+        """True for an index of the parameters alone (no pose is reached)."""
+        return self.needs == PARAMETER_NEEDS
+
+
+@dataclass(frozen=True)
+class Request:
+    """An index asked for, with options (``kmax``'s sample period, ...); its values are keyed by ``key``."""
+
+    index: str
+    options: Mapping[str, object] = field(default_factory=dict)
+    label: str | None = None
+
+    @property
+    def key(self) -> str:
+        return self.label or self.index
+
+
+class Registry(Mapping[str, Index]):
+    """Index name -> :class:`Index`. :data:`INDICES` is the one registry; :meth:`with_indices` gives a view with a
+    study's own indices beside it. Looking up a name it does not hold loads the :data:`ENTRY_POINTS` plugins once."""
+
+    def __init__(self, parent: "Registry | None" = None):
+        self._own: dict[str, Index] = {}
+        self._parent = parent
+        self._discovered = parent is not None
+
+    def register(self, index: Index) -> Index:
+        """Add ``index``; a name registered already is refused, unless by the same function (a module imported again,
+        a notebook cell run again), which replaces it."""
+        if not isinstance(index, Index):
+            raise UserError(f"an index is made by hapticdesign.index or Index(...), got {type(index).__name__}")
+        held = self._find(index.name, discover=False)
+        if held is not None and held is not index and _origin(held.function) != _origin(index.function):
+            raise UserError(f"index {index.name!r} is registered already (by {held.source}); give yours another name")
+        self._own[index.name] = index
+        return index
+
+    def with_indices(self, indices: Iterable[Index]) -> "Registry":
+        """This registry with ``indices`` beside it (each by its name; this one is left as it is)."""
+        out = Registry(self)
+        for one in indices:
+            out.register(one)
+        return out
+
+    def _find(self, name: str, discover: bool = True) -> Index | None:
+        found = self._own.get(name)
+        if found is None and self._parent is not None:
+            found = self._parent._find(name, discover)
+        if found is None and discover and not self._discovered:
+            self._discover()
+            found = self._own.get(name)
+        return found
+
+    def _discover(self) -> None:
+        """Import every module of the :data:`ENTRY_POINTS` group (each registers its indices)."""
+        self._discovered = True
+        for point in importlib.metadata.entry_points(group=ENTRY_POINTS):
+            try:
+                point.load()
+            except Exception as exc:  # an installed package's failure, reported as one line naming it
+                raise UserError(f"the indices of {point.name!r} ({point.value}) failed to load: "
+                                f"{type(exc).__name__}: {exc}") from None
+
+    def __getitem__(self, name: str) -> Index:
+        found = self._find(name) if isinstance(name, str) else None
+        if found is None:
+            raise KeyError(name)
+        return found
+
+    def __iter__(self) -> Iterator[str]:
+        if not self._discovered:
+            self._discover()
+        names = dict.fromkeys(self._parent if self._parent is not None else ())
+        names.update(dict.fromkeys(self._own))
+        return iter(names)
+
+    def __len__(self) -> int:
+        return sum(1 for _ in self)
+
+
+def _origin(function: Callable) -> tuple[str, str]:
+    return (getattr(function, "__module__", ""), getattr(function, "__qualname__", repr(function)))
+
+
+INDICES = Registry()
+"""The one registry of design indices (built-ins, plugins, a user's own)."""
+
+
+def index(function: Callable | None = None, *, unit: str, formula: str | None = None, source: str | None = None,
+          name: str | None = None, needs: Iterable[str] = ("kinematics", "dynamics"),
+          registry: Registry = INDICES):
+    """Register ``function(state, **options)`` as an index (a decorator; the :class:`Index` it returns is callable
+    like the function). Its name is the function's (or ``name``), its options its keyword parameters with their
+    defaults; ``formula`` defaults to the first line of its docstring, ``source`` to where it is defined. A pose
+    index reads ``state.J_v`` (P, 3, n_a), ``state.H`` (P, n_a, n_a), ``state.q`` (P, n_a), ... and returns (P,)
+    values; an index that ``needs`` ``parameters`` reads ``state.params`` (name -> (D,) values) and returns (D,)."""
+
+    def make(f: Callable) -> Index:
+        label = name or getattr(f, "__name__", "")
+        if not NAME.fullmatch(label):
+            raise UserError(f"an index name is a Python identifier of at most 64 characters, got {label!r}")
+        wanted = frozenset(needs)
+        if not wanted or not wanted <= NEEDS or ("parameters" in wanted and len(wanted) > 1):
+            raise UserError(f"index {label}: needs is some of {', '.join(sorted(POSE_NEEDS))}, or parameters alone; "
+                            f"got {sorted(wanted)}")
+        if not isinstance(unit, str) or not unit:
+            raise UserError(f"index {label}: unit is a text such as '1', 'kg' or 'N/m'")
+        doc = (inspect.getdoc(f) or "").strip().splitlines()
+        made = Index(label, unit, formula or (doc[0] if doc else label), source or ".".join(_origin(f)), f,
+                     _options(f, label), wanted)
+        return registry.register(made)
+
+    return make if function is None else make(function)
+
+
+def register(made: Index, registry: Registry = INDICES) -> Index:
+    """Add an :class:`Index` made otherwise to ``registry`` (see :meth:`Registry.register`)."""
+    return registry.register(made)
+
+
+def _options(function: Callable, label: str) -> dict[str, object]:
+    """The keyword parameters after the state, each with its default: the index's options."""
+    parameters = list(inspect.signature(function).parameters.values())
+    if not parameters or parameters[0].kind not in (inspect.Parameter.POSITIONAL_ONLY,
+                                                     inspect.Parameter.POSITIONAL_OR_KEYWORD):
+        raise UserError(f"index {label}: the function takes the design state as its first argument")
+    options = {}
+    for p in parameters[1:]:
+        if p.default is inspect.Parameter.empty or p.kind in (inspect.Parameter.VAR_POSITIONAL,
+                                                              inspect.Parameter.VAR_KEYWORD):
+            raise UserError(f"index {label}: an option is a keyword parameter with a default, {p.name!r} is not")
+        options[p.name] = p.default
+    return options
+
+
+def requests_of(requests: Iterable[str | Request], registry: Mapping[str, Index] = INDICES) -> list[Request]:
+    """The requests (index names or :class:`Request`), each of a registered index with known options; an unknown
+    index or option raises a one-line UserError."""
+    out = []
+    for request in requests:
+        request = Request(request) if isinstance(request, str) else request
+        if request.index not in registry:
+            raise UserError(f"unknown index {request.index!r} (indices: {', '.join(registry)})")
+        known = registry[request.index].options
+        unknown = [k for k in request.options if k not in known]
+        if unknown:
+            raise UserError(f"index {request.index}: unknown option {unknown[0]!r} (options: "
+                            f"{', '.join(known) or 'none'})")
+        out.append(request)
+    keys = [r.key for r in out]
+    twice = sorted({k for k in keys if keys.count(k) > 1})
+    if twice:
+        raise UserError(f"index {twice[0]} is asked twice (give each request its own label)")
+    return out

@@ -1,0 +1,184 @@
+"""The design states an index is a function of, built one of three ways (docs/indices.md):
+
+- :class:`HandleStates` of a device at closed full poses (one design, its workspace points);
+- :meth:`HandleStates.of`: the handle Jacobians, mass matrices, damping, sections' stiffness, motors and moving
+  masses of many designs' poses at once, from the compiled kernels (:mod:`hapticdesign.analysis.design_batch`),
+  without a device;
+- :class:`ParameterStates`: the parameters of many designs alone (no pose reached).
+
+At a pose, ``J_v`` is the handle's translational Jacobian over the actuated coordinates (3 x n_a, base frame; ``J T``
+with loops, ``qd = T qd_a``) and ``H`` the mass matrix over the actuated coordinates with the reflected rotor inertia.
+With ``k = min(3, n_a)`` the directions the handle moves are the ``k`` left singular vectors ``U`` of ``J_v`` (a
+planar device's plane), and the handle's Cartesian mass on them is ``Lambda = (U^T J_v H^-1 J_v^T U)^-1`` (k x k;
+``(J_v H^-1 J_v^T)^+`` in that basis). Each quantity is computed once, when an index first asks for it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+
+from hapticdesign.analysis import kinematics
+from hapticdesign.analysis.configuration import configuration_of
+from hapticdesign.analysis.dynamics.cartesian import mobility
+from hapticdesign.analysis.dynamics.device import mass_matrix_at
+from hapticdesign.analysis.metrics import force
+from hapticdesign.analysis.stiffness.device import cartesian_stiffness_at
+from hapticdesign.errors import UserError
+from hapticdesign.model.device import Device
+
+BATCH_NEEDS = frozenset({"kinematics", "dynamics", "damping", "sections", "motors", "bodies"})
+"""What :meth:`HandleStates.of` gives of many designs' poses: ``J_v`` and ``q`` (kinematics), ``H`` (dynamics),
+``B`` (damping), the links' sections (``stiffness``, ``U^T K_C[:3, :3] U``), the motors (``motor_map``,
+``torque_limits``) and the bodies (``moving_mass``)."""
+POSE_NEEDS = BATCH_NEEDS | {"device"}
+"""What a device at poses gives an index: all of :data:`BATCH_NEEDS`, and the ``device`` itself (an index of the
+whole device, such as its exact Linearity Number, is evaluated design by design)."""
+PARAMETER_NEEDS = frozenset({"parameters"})
+"""What :class:`ParameterStates` gives: the device parameters alone."""
+
+
+@dataclass
+class HandleStates:
+    """The handle's kinematics and dynamics at closed full poses ``full`` (P, N) of ``device`` (see the module)."""
+
+    device: Device | None
+    full: np.ndarray
+    frame: str | None = None
+
+    @cached_property
+    def J_v(self) -> np.ndarray:
+        """``J_v`` (P, 3, n_a)."""
+        return handle_jacobians(self._device, self.full, self.frame)
+
+    @cached_property
+    def q(self) -> np.ndarray:
+        """The actuated coordinates (P, n_a)."""
+        return self.full[:, configuration_of(self._device).actuated_index()]
+
+    @cached_property
+    def svd(self) -> tuple[np.ndarray, np.ndarray]:
+        """``U`` (P, 3, k) and the singular values (P, k) of ``J_v``, largest first."""
+        u, s, _ = np.linalg.svd(self.J_v)
+        k = s.shape[-1]
+        return u[:, :, :k], s
+
+    @cached_property
+    def H(self) -> np.ndarray:
+        """``H`` (P, n_a, n_a) with the reflected rotor inertia."""
+        return mass_matrix_at(self._device, self.full)
+
+    @cached_property
+    def B(self) -> np.ndarray:
+        """``B`` (n_a, n_a), or (P, n_a, n_a) per pose: the joints' and motors' viscous damping
+        (:attr:`~hapticdesign.model.device.Device.damping_matrix`)."""
+        return self._device.damping_matrix
+
+    @cached_property
+    def name(self) -> str:
+        """The device's name (for messages)."""
+        return self._device.name
+
+    @cached_property
+    def motor_map(self) -> np.ndarray | None:
+        """The motors' ``A^-1`` (n_a, n_a), or (P, n_a, n_a) per pose; None unless one motor per coordinate
+        (:func:`~hapticdesign.analysis.metrics.force.motor_map`)."""
+        return force.motor_map(self._device)
+
+    @cached_property
+    def torque_limits(self) -> dict[str, np.ndarray | None]:
+        """``n_k tau_k`` (n_a,), or (P, n_a) per pose, for ``continuous`` and ``peak`` torques; None where a motor
+        lacks it (:func:`~hapticdesign.analysis.metrics.force.torque_limits`)."""
+        return {which: force.torque_limits(self._device, which) for which in ("continuous", "peak")}
+
+    @cached_property
+    def moving_mass(self) -> np.ndarray:
+        """The mass (kg) the coordinates move (:func:`moving_mass`) at each pose (P,)."""
+        return np.full(len(self.full), moving_mass(self._device))
+
+    @cached_property
+    def mobility(self) -> np.ndarray:
+        """``U^T J_v H^-1 J_v^T U`` (P, k, k), the inverse of ``Lambda`` (1/kg)."""
+        return mobility(self.H, np.swapaxes(self.svd[0], 1, 2) @ self.J_v)
+
+    @cached_property
+    def cartesian_mass(self) -> np.ndarray:
+        """Eigenvalues (P, k) of ``Lambda`` (kg), ascending."""
+        return 1.0 / np.linalg.eigvalsh(self.mobility)[:, ::-1]
+
+    @cached_property
+    def cartesian_mass_matrix(self) -> np.ndarray:
+        """``Lambda`` (P, k, k) in kg."""
+        return np.linalg.inv(self.mobility)
+
+    @cached_property
+    def cartesian_damping(self) -> np.ndarray:
+        """``U^T J_v^+T B J_v^+ U`` (P, k, k) in N s/m: the joints' and motors' damping felt at the handle."""
+        pinv = np.linalg.pinv(self.J_v) @ self.svd[0]
+        return np.swapaxes(pinv, 1, 2) @ self.B @ pinv
+
+    @cached_property
+    def stiffness(self) -> np.ndarray:
+        """``U^T K_C[:3, :3] U`` (P, k, k) in N/m: the VJM's translational stiffness on the directions the handle
+        moves (:func:`~hapticdesign.analysis.stiffness.device.cartesian_stiffness_at`)."""
+        u, _ = self.svd
+        k = np.array([cartesian_stiffness_at(self._device, q, self.frame)[:3, :3] for q in self.full])
+        return np.swapaxes(u, 1, 2) @ k @ u
+
+    @property
+    def _device(self) -> Device:
+        if self.device is None:
+            raise UserError("this index needs the device itself (bodies, sections or motors), which the states of "
+                            "many designs' poses do not carry: declare what it needs")
+        return self.device
+
+    @classmethod
+    def of(cls, J_v: np.ndarray, H: np.ndarray, B: np.ndarray | None = None, q: np.ndarray | None = None,
+           **known) -> "HandleStates":
+        """The states of poses whose ``J_v`` (P, 3, n_a), ``H`` (P, n_a, n_a), ``B`` ((n_a, n_a) or per pose) and
+        actuated coordinates ``q`` (P, n_a) are known already (many designs' poses at once,
+        :mod:`hapticdesign.analysis.design_batch`), with any other quantity of :data:`BATCH_NEEDS` known per pose by
+        its name (``stiffness`` (P, k, k), ``motor_map``, ``torque_limits``, ``moving_mass``, ``name``): enough for an
+        index that needs at most :data:`BATCH_NEEDS`, of those quantities given."""
+        unknown = set(known) - {"stiffness", "motor_map", "torque_limits", "moving_mass", "name"}
+        if unknown:
+            raise TypeError(f"HandleStates.of: unknown quantities {sorted(unknown)}")
+        states = cls(None, np.zeros((len(J_v), 0)))
+        states.__dict__.update(J_v=J_v, H=H, **known)
+        for name, value in (("B", B), ("q", q)):
+            if value is not None:
+                states.__dict__[name] = value
+        return states
+
+
+@dataclass
+class ParameterStates:
+    """The device parameters of many designs (name -> (D,) values, one per design) and a ``cache`` the indices of
+    one evaluation share (a closed form of the parameters that several indices read is computed once)."""
+
+    params: Mapping[str, np.ndarray]
+    cache: dict = field(default_factory=dict)
+
+    @classmethod
+    def of_device(cls, device: Device) -> "ParameterStates":
+        """The one design ``device`` (its parameters as 1-element arrays)."""
+        return cls({name: np.array([float(value)]) for name, value in device.params.items()})
+
+
+def moving_mass(device: Device) -> float:
+    """The mass (kg) of the bodies some coordinate moves (those fixed to the base's frames do not count)."""
+    compiled = device.mechanism.compiled
+    moving = [bool(np.any(compiled.body_path[b] >= 0)) for b in range(len(device.body_names))]
+    return float(sum(device.body(name).m for name, moves in zip(device.body_names, moving) if moves))
+
+
+def handle_jacobians(device: Device, full: np.ndarray, frame: str | None = None) -> np.ndarray:
+    """``J_v T`` (P, 3, n_a): the handle's (or ``frame``'s) translational Jacobian over the actuated coordinates at
+    closed full poses (P, N)."""
+    space = configuration_of(device)
+    full = np.atleast_2d(np.asarray(full, dtype=float))
+    _, jac = kinematics.poses_and_jacobians(space.mechanism, full, frame)
+    return jac[:, :3] @ space.velocity_transform(full)
