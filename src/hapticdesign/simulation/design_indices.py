@@ -1,11 +1,12 @@
 """The whole registry of design indices: the analysis layer's (:mod:`hapticdesign.analysis.metrics.indices`) and
 ``kmax``, the stable Cartesian wall stiffness, which needs the sampled loop's exact analysis of this layer.
 
-``kmax`` (N/m) = the exact stable stiffness of a virtual wall at the handle
-(:func:`hapticdesign.analysis.wall_stiffness.wall_limit`: the 1-DOF model of the handle along a direction, mass
-``1 / (u^T J_v H^-1 J_v^T u)`` and damping ``u^T J_v^+T B J_v^+ u``, the loop discretized exactly) with the
-options ``period`` (s, default 0.001), ``delay`` (samples, default 1), ``damping`` (the wall's virtual damper, N s/m,
-default 0) and ``direction`` (a base-frame vector; default: the worst direction). The index lives here, above the
+``kmax`` (N/m) = the exact stable stiffness of a virtual wall at the handle, every joint free
+(:func:`hapticdesign.analysis.wall_stiffness.kmax`: the n-joint sampled loop discretized exactly) with the options
+of :data:`~hapticdesign.analysis.wall_stiffness.KMAX_OPTIONS` (the loop's settings, practice's by default: 1 kHz,
+one sample of delay, backward-difference velocity, gravity compensation, no hand; ``hand: grasp`` adds the default
+grasp) and ``direction`` (a base-frame vector; default: the worst direction). Dry friction and quantization are
+not in it: their limit is the simulated loop's, too slow for a study's many designs. The index lives here, above the
 analysis layer, because its engine (:mod:`hapticdesign.analysis.sampled_loop`) does; an optimization or a study asks
 this module's :func:`evaluate` and :data:`DESIGN_INDICES`.
 
@@ -21,7 +22,6 @@ by design (:func:`evaluate`). Both give the same values; ``kmax`` of all designs
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable, Mapping, Sequence
 
 import numpy as np
@@ -34,38 +34,11 @@ from hapticdesign.analysis.metrics.indices import evaluate as evaluate_with
 from hapticdesign.devices.design_space import DesignSpace
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
-from hapticdesign.analysis.wall_stiffness import wall_limits
-
-
-def _options(options: Mapping[str, object]) -> tuple[float, int, float, np.ndarray | None]:
-    period, delay, damping, direction = (options[k] for k in ("period", "delay", "damping", "direction"))
-    if isinstance(period, bool) or not isinstance(period, (int, float)) or not (math.isfinite(period) and period > 0):
-        raise UserError(f"index kmax: the sample period is a positive number of seconds, got {period!r}")
-    if isinstance(delay, bool) or not isinstance(delay, int) or not 0 <= delay <= 100:
-        raise UserError(f"index kmax: the delay is a whole number of samples from 0 to 100, got {delay!r}")
-    if isinstance(damping, bool) or not isinstance(damping, (int, float)) or not (math.isfinite(damping)
-                                                                                   and damping >= 0):
-        raise UserError(f"index kmax: the wall's damping is a number >= 0 (N s/m), got {damping!r}")
-    if direction is not None:
-        direction = np.asarray(direction, dtype=float)
-        if direction.shape != (3,) or not np.all(np.isfinite(direction)) or not np.linalg.norm(direction) > 0:
-            raise UserError(f"index kmax: the direction is 3 finite numbers, not all 0, got {options['direction']!r}")
-        direction = direction / np.linalg.norm(direction)
-    return float(period), delay, float(damping), direction
+from hapticdesign.analysis.wall_stiffness import KMAX_OPTIONS, kmax
 
 
 def _kmax(h: HandleStates, options: Mapping[str, object]) -> np.ndarray:
-    period, delay, virtual, direction = _options(options)
-    basis = h.svd[0]
-    pinv = np.linalg.pinv(h.jacobian) @ basis
-    along = None
-    if direction is not None:
-        along = np.swapaxes(basis, 1, 2) @ direction
-        if not np.all(np.abs(np.linalg.norm(along, axis=1) - 1.0) <= 1e-9):
-            raise UserError(f"index kmax: the direction {np.round(direction, 6).tolist()} is not one the handle "
-                            "moves in")
-        along = along[:, None, :]
-    return wall_limits(h.mobility, np.swapaxes(pinv, 1, 2) @ h.damping @ pinv, period, delay, virtual, along)
+    return kmax(h.jacobian, h.mass, h.damping, h.svd[0], options)
 
 
 BATCHED = (*KINEMATIC_DYNAMIC, "kmax")
@@ -73,8 +46,7 @@ BATCHED = (*KINEMATIC_DYNAMIC, "kmax")
 
 DESIGN_INDICES: dict[str, Index] = {**INDICES, "kmax": Index(
     "kmax", "N/m", "exact stable wall stiffness of the sampled loop along a direction (or the worst)",
-    "seed 000 ch. 4-5; hapticdesign.analysis.sampled_loop.exact_boundary", _kmax,
-    {"period": 0.001, "delay": 1, "damping": 0.0, "direction": None})}
+    "seed 000 ch. 4-5; hapticdesign.analysis.sampled_loop.handle_limits", _kmax, KMAX_OPTIONS)}
 """Every design index: name -> :class:`~hapticdesign.analysis.metrics.indices.Index`."""
 
 

@@ -34,7 +34,7 @@ friction reach the handle as follows:
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -44,10 +44,9 @@ from hapticdesign.analysis.metrics import force as polytope
 from hapticdesign.errors import UserError
 from hapticdesign.model.actuators import transmission
 from hapticdesign.model.device import Device
+from hapticdesign.analysis.sampled_loop import GRASP, SampledLoop
 from hapticdesign.analysis.wall_stiffness import wall_limit
 
-SERVO_RATE = 1000.0
-"""Hz, the default sampling rate of the renderable-stiffness limit."""
 CUBE_SEARCH = (0.0, 0.4, 12)
 """Bisection of the workspace cube's half edge: lower and upper bound (m) and number of halvings."""
 
@@ -120,10 +119,10 @@ def _cartesian(device: Device, h: Handle) -> tuple[np.ndarray, np.ndarray]:
     return mobility, pinv.T @ device.damping_matrix @ pinv
 
 
-def renderable_stiffness(device: Device, h: Handle, rate: float = SERVO_RATE, delay: int = 1) -> float:
-    """The smallest exact wall limit over directions (:func:`hapticdesign.analysis.wall_stiffness.wall_limit`)."""
-    mobility, damping = _cartesian(device, h)
-    return wall_limit(mobility, damping, 1.0 / rate, delay)
+def renderable_stiffness(device: Device, h: Handle, loop: SampledLoop | None = None) -> float:
+    """The smallest exact wall limit over directions, every joint free
+    (:func:`hapticdesign.analysis.wall_stiffness.wall_limit`)."""
+    return wall_limit(h.jacobian, h.mass, device.damping_matrix, loop or SampledLoop())
 
 
 def workspace_cube(device: Device, h: Handle) -> float:
@@ -149,8 +148,10 @@ def workspace_cube(device: Device, h: Handle) -> float:
     return 2 * lo
 
 
-def spec_sheet(device: Device, q=None, rate: float = SERVO_RATE, workspace: bool = True) -> dict:
-    """Every quantity of the module docstring at pose ``q`` (default: home), as a JSON-ready dict."""
+def spec_sheet(device: Device, q=None, loop: SampledLoop | None = None, workspace: bool = True) -> dict:
+    """Every quantity of the module docstring at pose ``q`` (default: home), as a JSON-ready dict; the renderable
+    stiffness under the loop settings ``loop`` (default: practice's, :class:`SampledLoop`)."""
+    loop = loop or SampledLoop()
     q = configuration_of(device).home.copy() if q is None else np.asarray(q, dtype=float)
     h = handle_at(device, q)
     res = resolution(device, h)
@@ -168,8 +169,11 @@ def spec_sheet(device: Device, q=None, rate: float = SERVO_RATE, workspace: bool
         "stiffness": _stiffness(device, q),
         "workspace": {"cube": 1000.0 * workspace_cube(device, h)} if workspace else None,
         "renderable_stiffness": {
-            "exact": renderable_stiffness(device, h, rate), "rate": rate, "delay_samples": 1,
-            "passivity_viscous": 2.0 * smallest_damping * rate,
+            "exact": renderable_stiffness(device, h, replace(loop, hand=None)),
+            "exact_with_hand": renderable_stiffness(device, h, replace(loop, hand=loop.hand or GRASP)),
+            "settings": loop.as_dict(), "hand": (loop.hand or GRASP).as_dict(), "rate": loop.rate,
+            "delay_samples": loop.delay,
+            "passivity_viscous": 2.0 * smallest_damping * loop.rate,
             "passivity_coulomb": None if friction is None or res is None else 2.0 * friction[0] / res,
         },
         "units": {"resolution": "m", "force_continuous": "N", "force_peak": "N", "apparent_mass": "kg",

@@ -97,6 +97,7 @@ def spec(
     force, apparent mass, backdrive friction, VJM stiffness (seed 001 §5.2), workspace cube and renderable
     stiffness beside the passivity bounds."""
     from hapticdesign.files import dumps_json, write_atomically
+    from hapticdesign.analysis.sampled_loop import SampledLoop
     from hapticdesign.studies.spec import spec_sheet
     from hapticdesign.studies.spec_page import spec_page
 
@@ -105,7 +106,7 @@ def spec(
 
         dev = resolve_device(preset, device, params, strict=strict)
         pose = None if q is None else parse_vector(q, dev.n_dof, "q")
-        sheet = spec_sheet(dev, pose, rate=rate, workspace=workspace)
+        sheet = spec_sheet(dev, pose, SampledLoop(period=1.0 / rate), workspace=workspace)
         if out is not None:
             figures = []
             if sheet["workspace"] is not None and sheet["workspace"]["cube"] > 0.0:
