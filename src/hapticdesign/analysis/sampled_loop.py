@@ -551,16 +551,17 @@ class SampledLoop:
                 f"velocity, {comp} compensation, wall damper {self.virtual_damping:g}, {hand}{held}")
 
 
-def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, direction: np.ndarray,
+def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, spring: np.ndarray,
                  loop: SampledLoop) -> tuple[ClosedLoops, np.ndarray]:
-    """The sampled loops of S handles under a wall along ``direction`` (S, 3; unit), every joint free but
-    ``loop.held``, and a starting guess of their limits (S,).
+    """The sampled loops of S handles under a wall whose spring acts on the joints as ``K w w^T`` (``spring``: the
+    rows ``w`` (S, n); ``J_v^T u`` for a Cartesian wall along a unit ``u``, ``e_j`` for a wall on joint j), every
+    joint free but ``loop.held``, and a starting guess of their limits (S,).
 
     ``jacobian`` ``J_v`` (S, 3, n), ``mass`` ``H`` (S, n, n) and ``damping`` ``B`` (n, n) or (S, n, n) of the
     actuated coordinates at the pose the wall holds. The plant ``H_h qdd + B_h qd + K_h q = u`` (the hand's mass,
     damping and stiffness added as ``x J_v^T J_v``) is discretized exactly under a zero-order hold
     (``scipy.linalg.expm`` of the augmented matrix). Every period the controller holds, ``d`` samples late,
-    ``u_k = c H a_(k-d) - K w w^T q_(k-d) - B_w w w^T v^_(k-d)`` with ``w = J_v^T u``, ``a`` the acceleration sampled
+    ``u_k = c H a_(k-d) - K w w^T q_(k-d) - B_w w w^T v^_(k-d)``, ``a`` the acceleration sampled
     under the previous torque, ``v^`` the sampled velocity or the backward difference of positions. The state is
     ``[x_k, ..., x_(k-L), u_(k-1), ..., u_(k-d-1)]`` (``x = (q, qd)``; the torques only with the compensator), and
     ``K`` enters as the rank-one term of :class:`ClosedLoops`. Without a hand's stiffness the displacements along
@@ -578,7 +579,7 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, di
     jtj = np.swapaxes(jv, 1, 2) @ jv
     hand = loop.hand or Hand()
     hh, bh, kp = h + hand.mass * jtj, b + hand.damping * jtj, hand.stiffness * jtj
-    w = np.einsum("sk,skn->sn", np.asarray(direction, dtype=float), jv)
+    w = np.asarray(spring, dtype=float)[:, free]
     aug = np.zeros((count, 3 * n, 3 * n))
     aug[:, :n, n:2 * n] = np.eye(n)
     aug[:, n:2 * n, :n] = -np.linalg.solve(hh, kp)
@@ -621,9 +622,8 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, di
     hvec[:, nx * d:nx * d + n] = w
     if hand.stiffness == 0.0 and n > 1:
         m, g, hvec = _deflated(m, g, hvec, w, n, depth)
-    pinv = np.linalg.pinv(jv)
-    along = np.einsum("sk,snk->sn", np.asarray(direction, dtype=float), pinv)
-    viscous = np.einsum("sn,snm,sm->s", along, bh, along) + loop.virtual_damping
+    reach = np.einsum("sn,sn->s", w, w)
+    viscous = np.einsum("sn,snm,sm->s", w, bh, w) / np.maximum(reach, 1e-300) ** 2 + loop.virtual_damping
     guess = np.maximum(2.0 * viscous / (loop.period * (1 + 2 * d)), FLOOR)
     return ClosedLoops(m, g, hvec), guess
 
@@ -643,11 +643,11 @@ def _deflated(m: np.ndarray, g: np.ndarray, h: np.ndarray, w: np.ndarray, n: int
     return qt @ m @ q, np.einsum("sji,sj->si", q, g), np.einsum("sji,sj->si", q, h)
 
 
-def handle_limits(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, direction: np.ndarray,
+def handle_limits(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, spring: np.ndarray,
                   loop: SampledLoop, groups: np.ndarray | None = None, k_max: float = 1e9) -> np.ndarray:
     """The exact stable wall stiffness (N/m) of each handle loop of :func:`handle_loops` (S,), or the smallest in
     each group (:func:`loop_limits`)."""
-    loops, guess = handle_loops(jacobian, mass, damping, direction, loop)
+    loops, guess = handle_loops(jacobian, mass, damping, spring, loop)
     order = loops.base.shape[-1]
     what = f"the closed-loop matrices of {len(loops):,} handle loops of order {order}"
     require_memory(what, 8.0 * order * order * len(loops))

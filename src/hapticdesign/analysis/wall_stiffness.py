@@ -101,9 +101,26 @@ def wall_limits(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, loo
         part = slice(start, start + per)
         size = len(along[part])
         rows = np.repeat(np.arange(start, start + size), per_point)
-        out[part] = handle_limits(jacobian[rows], mass[rows], damping[rows], along[part].reshape(-1, 3), loop,
+        spring = np.einsum("sk,skn->sn", along[part].reshape(-1, 3), jacobian[rows])
+        out[part] = handle_limits(jacobian[rows], mass[rows], damping[rows], spring, loop,
                                   np.repeat(np.arange(size), per_point))
     return out
+
+
+def worst_direction(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray,
+                    loop: SampledLoop | None = None) -> tuple[float, np.ndarray]:
+    """The smallest exact wall limit at one pose over :func:`wall_directions` and the direction (unit, base frame)
+    that gives it (every direction searched to the end)."""
+    loop = loop or SampledLoop()
+    jacobian, mass = np.asarray(jacobian, dtype=float)[None], np.asarray(mass, dtype=float)[None]
+    damping = np.broadcast_to(np.asarray(damping, dtype=float), mass.shape)
+    basis, mobility, cartesian_damping = handle_range(jacobian, mass, damping)
+    along = np.einsum("ik,ck->ci", basis[0], wall_directions(mobility, cartesian_damping)[0])
+    count = len(along)
+    limits = handle_limits(np.repeat(jacobian, count, 0), np.repeat(mass, count, 0), np.repeat(damping, count, 0),
+                           along @ jacobian[0], loop)
+    best = int(np.argmin(limits))
+    return float(limits[best]), along[best]
 
 
 KMAX_OPTIONS = {"period": 0.001, "delay": 1, "damping": 0.0, "direction": None, "velocity": "difference",

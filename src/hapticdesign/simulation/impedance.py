@@ -28,13 +28,16 @@ from functools import cached_property
 
 import numpy as np
 
+from hapticdesign.analysis.configuration import configuration_of, handle_pose
 from hapticdesign.analysis.dynamics.device import mass_matrix
+from hapticdesign.analysis.sampled_loop import SampledLoop, handle_limits
 from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation.analytic import GROWS, AnalyticProblem, linear_loop
 from hapticdesign.simulation.boundary import envelope_grows
 from hapticdesign.simulation.config import (
-    LoopConfig, Wall, compensator_device, normal_jacobian, require_device, require_options, rest_pose, unit_direction,
+    LoopConfig, Wall, compensator_device, handle_jacobian, normal_jacobian, require_device, require_options, rest_pose,
+    unit_direction,
 )
 from hapticdesign.simulation.loop import simulate, tables_of
 from hapticdesign.simulation.criteria import Criteria, Verdict, WallProblem, require_closed, type_paths
@@ -114,6 +117,51 @@ class ImpedanceProblem(WallProblem):
 
 
 @dataclass(frozen=True)
+class StabilityLimit:
+    """The exact stability limit of a wall (N/m along a Cartesian wall, N m/rad or N/m on a joint) under the loop
+    settings ``loop``, linearized at ``pose``, the pose the wall holds (actuated coordinates)."""
+
+    stiffness: float
+    pose: np.ndarray
+    loop: SampledLoop
+
+
+def wall_pose(device: Device, wall_joint: int = 0, equilibrium: float = 0.01, direction=None) -> np.ndarray:
+    """The pose the wall holds, from the rest pose (:func:`~.config.rest_pose`): the wall joint moved by
+    ``equilibrium`` for a joint wall; for a Cartesian wall the handle moved ``equilibrium`` metres along the
+    direction, by inverse kinematics from the rest pose (closed loops closed; to first order in the equilibrium the
+    pose a free handle comes to rest at)."""
+    rest = rest_pose(device)
+    if direction is None:
+        pose = rest.copy()
+        pose[wall_joint] += equilibrium
+        return pose
+    start = configuration_of(device).pose(rest)[:3, 3]
+    return handle_pose(device, start + equilibrium * unit_direction(direction), start=rest).q
+
+
+def stability_limit(device: Device, loop: SampledLoop | None = None, wall_joint: int = 0, equilibrium: float = 0.01,
+                    direction=None, k_max: float = 1e9) -> StabilityLimit:
+    """The exact stability limit of a wall on ``wall_joint`` (or along the Cartesian ``direction`` at the handle)
+    with every actuated joint free but ``loop.held``, linearized where the wall holds the device (:func:`wall_pose`;
+    :func:`hapticdesign.analysis.sampled_loop.handle_limits`). Coulomb friction and quantization are left out: this
+    is the limit of the loop's linear part."""
+    require_device(device)
+    loop = loop or SampledLoop()
+    pose = wall_pose(device, wall_joint, equilibrium, direction)
+    jv = handle_jacobian(device, pose)[:3]
+    if direction is None:
+        spring = np.eye(device.n_dof)[wall_joint]
+    else:
+        spring = unit_direction(direction) @ jv
+        if not np.linalg.norm(spring) > 1e-12 * max(np.linalg.norm(jv), 1e-300):
+            raise UserError("the handle does not move along the wall's direction at the pose the wall holds")
+    limit = handle_limits(jv[None], mass_matrix(device, pose)[None], device.damping_matrix, spring[None], loop,
+                          k_max=k_max)
+    return StabilityLimit(float(limit[0]), pose, loop)
+
+
+@dataclass(frozen=True)
 class RangeResult:
     """The maximum stable impedance (0 when no grid value passes) and the first failing verdict.
 
@@ -132,11 +180,24 @@ class RangeResult:
     """For the analytic method: whether the linearized loop is exact for this device and type."""
     k_true_boundary: float | None = None
     """The oscillation-growth boundary (:func:`growth_boundary`), when asked for."""
+    limit: StabilityLimit | None = None
+    """For the ``limit`` method: the stability limit itself (off the grid) and where it was taken."""
+
+    @property
+    def verdict(self) -> str:
+        """What decided ``k_max``: the stability limit of the sampled loop, or the seed's performance criteria."""
+        if self.method == "limit":
+            return "stability limit (spectral radius of the sampled loop at the wall's equilibrium)"
+        return "seed performance criteria (overshoot, settling, safety switch; seed 000 §4.1.2)"
 
     def as_dict(self) -> dict:
         first = self.first_unstable
         extra = {} if self.exact is None else {"analytic_exact": self.exact}
+        if self.limit is not None:
+            extra = {"k_limit_exact": self.limit.stiffness, "pose": self.limit.pose.tolist(),
+                     "settings": self.limit.loop.as_dict()}
         return {
+            "verdict": self.verdict,
             **extra,
             "k_max": float(self.k_max),
             "k_min": self.k_min,
@@ -322,11 +383,35 @@ def growth_boundary(problem: ImpedanceProblem, rel_tol: float = 1e-4, margin: fl
     return 0.5 * (lo + hi)
 
 
+UNSTABLE = "unstable (spectral radius of the sampled loop above 1)"
+"""The verdict of the first grid stiffness above the stability limit (method ``limit``)."""
+
+
+def limit_range(device: Device, loop: SampledLoop | None = None, k_limit: float = 200.0, wall_joint: int = 0,
+                equilibrium: float = 0.01, resolution: float | None = None, wall_direction=None) -> RangeResult:
+    """The stable range on the grid ``R, 2R, 3R ...`` (``R`` = ``resolution``, default 1) from the exact stability
+    limit of the sampled loop at the wall's equilibrium (:func:`stability_limit`): every grid stiffness up to the
+    limit is stable, the first one above it is not; no simulation, no performance criteria."""
+    grid = 1.0 if resolution is None else float(resolution)
+    limit = stability_limit(device, loop, wall_joint, equilibrium, wall_direction, k_max=2.0 * k_limit)
+    top = int(math.floor(k_limit / grid + 1e-9))
+    count = min(int(math.floor(limit.stiffness / grid)) if math.isfinite(limit.stiffness) else top, top)
+    above = Verdict((count + 1) * grid, False, UNSTABLE, math.nan, math.nan) if count < top else None
+    return RangeResult(count * grid, above.criterion if above else "none", 0, above, "limit",
+                       grid if count >= 1 else None, grid, limit=limit)
+
+
 def impedance_range(device: Device, sim_type: int = 1, method: str = "fast", k_limit: int = 200,
                     criteria: Criteria | None = None, config: LoopConfig | None = None,
                     wall_joint: int = 0, equilibrium: float = 0.01,
-                    resolution: float | None = None, wall_direction=None, true_boundary: bool = False) -> RangeResult:
+                    resolution: float | None = None, wall_direction=None, true_boundary: bool = False,
+                    loop: SampledLoop | None = None) -> RangeResult:
     """Maximum stable impedance of ``wall_joint`` for simulation type 1 or 2 (seed §4.1.2).
+
+    ``method="limit"`` answers from the stability limit of the sampled loop under the settings ``loop`` at the wall's
+    equilibrium, every joint free (:func:`limit_range`; ``sim_type``, ``criteria`` and ``config`` do not enter);
+    the other methods judge the seed's performance criteria on simulated (or exact linear) runs of type 1 or 2
+    under ``config``.
 
     With ``wall_direction`` (x, y, z) the wall is Cartesian: K in N/m along that direction at the
     handle, ``equilibrium`` in metres from the handle's start, the criteria on the handle's
@@ -347,8 +432,9 @@ def impedance_range(device: Device, sim_type: int = 1, method: str = "fast", k_l
     require_options(sim_type, config, LoopConfig)
     if criteria is not None and not isinstance(criteria, Criteria):
         raise UserError(f"criteria must be a Criteria, got {type(criteria).__name__}")
-    if method not in ("fast", "linear", "analytic"):
-        raise InputError(f"method (of the search) must be 'fast', 'linear' or 'analytic', got {method!r}", "method")
+    if method not in ("fast", "linear", "analytic", "limit"):
+        raise InputError(f"method (of the search) must be 'limit', 'fast', 'linear' or 'analytic', got {method!r}",
+                         "method")
     if isinstance(k_limit, bool) or not isinstance(k_limit, (int, float)) or not math.isfinite(k_limit):
         raise UserError(f"the stiffness limit must be a number, got {k_limit!r}")
     if k_limit < 1:
@@ -358,6 +444,11 @@ def impedance_range(device: Device, sim_type: int = 1, method: str = "fast", k_l
     if resolution is not None and resolution > k_limit:
         raise InputError(f"the stiffness resolution {resolution:g} is above the stiffness limit {k_limit:g}",
                          "resolution", "k_limit")
+    if method == "limit":
+        if true_boundary:
+            raise InputError("the growth boundary is a simulated check of the seed's searches; the limit method is "
+                             "the boundary itself", "true_boundary", "method")
+        return limit_range(device, loop, k_limit, wall_joint, equilibrium, resolution, wall_direction)
     config = config or LoopConfig(wall=Wall())
     if wall_direction is not None:
         config = replace(config, wall=replace(config.wall, direction=tuple(unit_direction(wall_direction).tolist())))
