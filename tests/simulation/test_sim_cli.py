@@ -23,7 +23,7 @@ def _closed_form(j: float, b: float, t: float, c: float) -> float:
 
 def test_resolution_gives_a_real_value_below_one():
     result = runner.invoke(app, ["impedance-range", "--device", "examples/devices/pantograph-2dof.yaml",
-                                 "--resolution", "0.02", "--json"])
+                                 "--settings", "seed", "--resolution", "0.02", "--json"])
     assert result.exit_code == 0, result.output
     out = json.loads(result.stdout)
     assert 0 < out["k_max"] < 1 and out["resolution"] == 0.02 and 0 < out["k_min"] <= out["k_max"]

@@ -36,11 +36,12 @@ from hapticdesign.model.device import Device
 from hapticdesign.simulation.analytic import GROWS, AnalyticProblem, linear_loop
 from hapticdesign.simulation.boundary import envelope_grows
 from hapticdesign.simulation.config import (
-    LoopConfig, Wall, compensator_device, handle_jacobian, normal_jacobian, require_device, require_options, rest_pose,
+    LoopConfig, Wall, compensator_device, handle_jacobian, loop_config, normal_jacobian, require_device, require_options, rest_pose,
     unit_direction,
 )
 from hapticdesign.simulation.loop import simulate, tables_of
 from hapticdesign.simulation.criteria import Criteria, Verdict, WallProblem, require_closed, type_paths
+from hapticdesign.simulation.paths import Held
 from hapticdesign.workload import require_plant_steps
 
 
@@ -159,6 +160,63 @@ def stability_limit(device: Device, loop: SampledLoop | None = None, wall_joint:
     limit = handle_limits(jv[None], mass_matrix(device, pose)[None], device.damping_matrix, spring[None], loop,
                           k_max=k_max)
     return StabilityLimit(float(limit[0]), pose, loop)
+
+
+def device_counts(device: Device) -> int | None:
+    """The encoder counts per joint revolution the simulation quantizes with: the coarsest of the device's motors
+    (``cpr`` x quadrature x gear ratio), None when a motor states no encoder."""
+    counts = [a.counts_per_radian for a in device.actuators]
+    if not counts or any(c is None for c in counts):
+        return None
+    return max(1, int(round(2.0 * math.pi * min(counts))))
+
+
+def simulated_limit(device: Device, loop: SampledLoop | None = None, wall_joint: int = 0, equilibrium: float = 0.01,
+                    direction=None, counts: int | None = None, duration: float = 2.0, rel_tol: float = 1e-2,
+                    start: float | None = None, k_limit: float = 1e7, friction: bool = True) -> float:
+    """The simulated growth boundary of the wall, every joint free but ``loop.held``: the device's Coulomb friction
+    (smoothed, :data:`~.config.FRICTION_VELOCITY`) and ``counts`` (encoder quantization) in the loop, the spring
+    bisected (to ``rel_tol``) on the growth of the wall coordinate's oscillation about its rest over ``duration``
+    (the last quarter's envelope against the second's); ``friction`` False leaves the device's friction out. Where the
+    loop is linear it converges to
+    :func:`stability_limit` (the tests check it). ``start``: the first stiffness tried (default: the exact limit of
+    the linear part); inf when nothing up to ``k_limit`` grows."""
+    loop = loop or SampledLoop()
+    rest = rest_pose(device)
+    paths = {j: Held(float(rest[j])) for j in loop.held}
+    if direction is not None:
+        direction = tuple(unit_direction(direction).tolist())
+    base = loop_config(loop, Wall(wall_joint, 1.0, 0.0, equilibrium + (0.0 if direction else float(rest[wall_joint])),
+                                  direction), counts, duration=duration, safety_limit=None, stop_excursion=1.0,
+                       coulomb=None if friction else (0.0,) * device.n_dof)
+    plant, model = tables_of(device), tables_of(compensator_device(device, base.compensator))
+
+    def grows(k: float) -> bool:
+        cfg = replace(base, wall=replace(base.wall, stiffness=k))
+        trace = simulate(device, cfg, paths, plant=plant, model=model)
+        if trace.status != 0:  # diverged, or a closed-loop device's growing motion left the assembly branch
+            return True
+        return envelope_grows(trace.wall_position - wall_rest(trace, cfg.wall))
+
+    k = start if start is not None else stability_limit(device, loop, wall_joint, equilibrium, direction).stiffness
+    k = min(max(k, 1e-6), k_limit) if math.isfinite(k) else k_limit
+    if grows(k):
+        lo, hi = 0.0, k
+        while lo == 0.0 and hi > 1e-6:
+            if grows(hi / 2.0):
+                hi /= 2.0
+            else:
+                lo = hi / 2.0
+    else:
+        lo, hi = k, 2.0 * k
+        while not grows(hi):
+            lo, hi = hi, 2.0 * hi
+            if hi > k_limit:
+                return math.inf
+    while hi - lo > rel_tol * hi:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (lo, mid) if grows(mid) else (mid, hi)
+    return 0.5 * (lo + hi)
 
 
 @dataclass(frozen=True)
@@ -393,7 +451,7 @@ def limit_range(device: Device, loop: SampledLoop | None = None, k_limit: float 
     limit of the sampled loop at the wall's equilibrium (:func:`stability_limit`): every grid stiffness up to the
     limit is stable, the first one above it is not; no simulation, no performance criteria."""
     grid = 1.0 if resolution is None else float(resolution)
-    limit = stability_limit(device, loop, wall_joint, equilibrium, wall_direction, k_max=2.0 * k_limit)
+    limit = stability_limit(device, loop, wall_joint, equilibrium, wall_direction)
     top = int(math.floor(k_limit / grid + 1e-9))
     count = min(int(math.floor(limit.stiffness / grid)) if math.isfinite(limit.stiffness) else top, top)
     above = Verdict((count + 1) * grid, False, UNSTABLE, math.nan, math.nan) if count < top else None
