@@ -171,13 +171,18 @@ def device_counts(device: Device) -> int | None:
     return max(1, int(round(2.0 * math.pi * min(counts))))
 
 
+ESCAPE = 10.0
+"""A simulated wall whose coordinate leaves its start by this many times the spring's rest has grown."""
+
+
 def simulated_limit(device: Device, loop: SampledLoop | None = None, wall_joint: int = 0, equilibrium: float = 0.01,
                     direction=None, counts: int | None = None, duration: float = 2.0, rel_tol: float = 1e-2,
                     start: float | None = None, k_limit: float = 1e7, friction: bool = True) -> float:
     """The simulated growth boundary of the wall, every joint free but ``loop.held``: the device's Coulomb friction
     (smoothed, :data:`~.config.FRICTION_VELOCITY`) and ``counts`` (encoder quantization) in the loop, the spring
     bisected (to ``rel_tol``) on the growth of the wall coordinate's oscillation about its rest over ``duration``
-    (the last quarter's envelope against the second's); ``friction`` False leaves the device's friction out. Where the
+    (the last quarter's envelope against the second's; a run leaving the start by :data:`ESCAPE` times the rest's
+    distance grows, whatever pose it wanders to and settles at); ``friction`` False leaves the device's friction out. Where the
     loop is linear it converges to
     :func:`stability_limit` (the tests check it). ``start``: the first stiffness tried (default: the exact limit of
     the linear part); inf when nothing up to ``k_limit`` grows."""
@@ -187,7 +192,8 @@ def simulated_limit(device: Device, loop: SampledLoop | None = None, wall_joint:
     if direction is not None:
         direction = tuple(unit_direction(direction).tolist())
     base = loop_config(loop, Wall(wall_joint, 1.0, 0.0, equilibrium + (0.0 if direction else float(rest[wall_joint])),
-                                  direction), counts, duration=duration, safety_limit=None, stop_excursion=1.0,
+                                  direction), counts, duration=duration, safety_limit=None,
+                       stop_excursion=ESCAPE * abs(equilibrium) if equilibrium else 1e-3,
                        coulomb=None if friction else (0.0,) * device.n_dof)
     plant, model = tables_of(device), tables_of(compensator_device(device, base.compensator))
 
@@ -262,7 +268,7 @@ class RangeResult:
             "resolution": self.resolution,
             "criterion": first.criterion if first else "none (limit reached)",
             "first_unstable_k": None if first is None else float(first.stiffness),
-            "peak_at_first_unstable": None if first is None else first.peak,
+            "peak_at_first_unstable": None if first is None or math.isnan(first.peak) else first.peak,
             "stopped_at_first_unstable": None if first is None else first.stopped_at,
             "simulations": self.simulations,
             "method": self.method,

@@ -92,8 +92,10 @@ def impedance_range_command(
     sim_type: int = typer.Option(1, "--type", help="Seed's criteria: 1 other joints held at 0; 2 driven at "
                                                    "0.52 sin(3 pi t)."),
     joint: str = typer.Option("1", help="Joint carrying the virtual wall (1-based or coordinate name)."),
-    equilibrium: float = typer.Option(0.01, help="Wall equilibrium [rad]; the joints start at 0. With "
-                                                  "--wall-direction: metres along it from the handle's start."),
+    equilibrium: Optional[float] = typer.Option(
+        None, help="Wall equilibrium from the start [rad, or m along --wall-direction]: where the wall holds the "
+                   "device and the limit is taken. Default: 0 (the home pose, as spec) for the limit method, the "
+                   "seed's 0.01 step for the seed's criteria."),
     wall_direction: Optional[str] = WALL_DIRECTION,
     settings: Optional[str] = SETTINGS,
     method: Optional[str] = typer.Option(
@@ -137,6 +139,8 @@ def impedance_range_command(
         dev = resolve_device(preset, device, params, strict=strict)
         seed = seed_settings(preset, device, settings)
         method = method or ("fast" if seed else "limit")
+        if equilibrium is None:
+            equilibrium = 0.0 if method == "limit" else 0.01
         held = () if hold is None else tuple(joint_index(dev, j) for j in hold.replace(" ", "").split(",") if j)
         loop = sampled_loop(seed, period, delay, velocity, compensation, error_percent, wall_damping, hand_mass,
                             hand_damping, hand_stiffness, held)
