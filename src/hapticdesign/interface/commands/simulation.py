@@ -332,6 +332,9 @@ def stability_boundary_command(
                "relative_difference": (simulated - exact) / exact
                if np.isfinite(exact) and np.isfinite(simulated) and exact != 0 else None,
                "two_b_over_t": 2 * damping / period, "error_percent": error_percent,
+               "settings": {"period": period, "delay_samples": delay, "velocity": "sampled",
+                            "compensation": "inertial" if compensate_inertia else "none",
+                            "model_error_percent": error_percent, "virtual_damping": wall_damping},
                "units": {"k_max_exact": "N m/rad", "k_max_closed_form": "N m/rad", "k_max_simulated": "N m/rad",
                          "relative_difference": "dimensionless", "two_b_over_t": "N m/rad", "error_percent": "%"}}
         if unbounded:
@@ -343,6 +346,8 @@ def stability_boundary_command(
         form = "" if limit is None else f", closed form {_stiffness_text(closed)} ({limit.bound})"
         typer.echo(f"exact {_stiffness_text(exact)}{form}, simulated {_stiffness_text(simulated)} "
                    f"(2b/T = {2 * damping / period:.6g})")
+        typer.echo(f"settings: T = {period:g} s, delay {delay} samples, sampled velocity, "
+                   f"{'inertial' if compensate_inertia else 'no'} compensation, wall damper {wall_damping:g}")
 
 
 def _stiffness_text(value: float) -> str:

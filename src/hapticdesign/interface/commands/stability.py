@@ -118,6 +118,9 @@ def zwidth_command(
         payload = {**result.as_dict(), "loop": {"inertia": loop.inertia, "damping": loop.damping, "period": period,
                                                  "delay": delay, "velocity": velocity, "fraction": fraction},
                    "figures": figures, **({"index": index} if index else {})}
+        if from_device:  # the 1-DOF display of one joint: a named option, the others held
+            payload["loop"]["held_joints"] = "every joint but --joint (a 1-DOF display; impedance-range's limit " \
+                                             "method frees them)"
         if reach is not None:
             payload["units"] = {"B": units[1], "K": units[2]}
             payload["loop"]["wall_reach"] = reach
