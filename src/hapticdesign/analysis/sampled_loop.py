@@ -501,8 +501,8 @@ class SampledLoop:
         if isinstance(self.period, bool) or not (isinstance(self.period, (int, float)) and math.isfinite(self.period)
                                                  and self.period > 0):
             raise InputError(f"the sample period must be a positive number of seconds, got {self.period!r}", "period")
-        if isinstance(self.delay, bool) or not isinstance(self.delay, (int, np.integer)) or not 0 <= self.delay <= 100:
-            raise InputError(f"the delay must be a whole number of samples from 0 to 100, got {self.delay!r}", "delay")
+        if isinstance(self.delay, bool) or not isinstance(self.delay, (int, np.integer)) or self.delay < 0:
+            raise InputError(f"the sensor delay must be a non-negative number of samples, got {self.delay!r}", "delay")
         if self.velocity not in VELOCITIES:
             raise InputError(f"unknown velocity estimate {str(self.velocity)[:40]!r}; choose one of "
                              f"{', '.join(VELOCITIES)}", "velocity")
@@ -510,8 +510,8 @@ class SampledLoop:
             raise InputError(f"unknown compensation {str(self.compensation)[:40]!r}; choose one of "
                              f"{', '.join(COMPENSATIONS)}", "compensation")
         if not (math.isfinite(self.model_error) and -100 < self.model_error < 100):
-            raise InputError(f"the modelling error must be a percentage between -100 and 100, got {self.model_error}",
-                             "error_percent")
+            raise InputError(f"the error percentage must be a finite number between -100 and 100 (exclusive), got "
+                             f"{self.model_error}", "error_percent")
         if not (math.isfinite(self.virtual_damping) and self.virtual_damping >= 0):
             raise InputError(f"the wall damping must be a finite number >= 0, got {self.virtual_damping}",
                              "wall_damping")
