@@ -141,7 +141,7 @@ def test_cli_cartesian_wall(tmp_path):
     runner = CliRunner()
     path = SLIDER
     zw = runner.invoke(app, ["zwidth", "--device", str(path), "--wall-direction", "1,0,1", "--compensate-inertia",
-                             "--b-values", "0", "--json"])
+                             "--delay", "0", "--b-values", "0", "--json"])
     assert zw.exit_code == 0, zw.output
     out = json.loads(zw.stdout)
     assert out["units"] == {"B": "N s/m", "K": "N/m"}

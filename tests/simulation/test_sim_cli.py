@@ -107,8 +107,8 @@ def test_a_prismatic_wall_is_labelled_in_newtons(tmp_path):
     assert out["units"]["k_max"] == "N/m"
     dyn = json.loads(runner.invoke(app, ["dynamics", "--device", str(path), "--q", "0.1", "--json"]).stdout)
     assert dyn["units"]["joints"][0]["effort"] == "N" and dyn["H"] == [[0.5]]
-    zw = json.loads(runner.invoke(app, ["zwidth", "--device", str(path), "--compensate-inertia", "--b-values", "0",
-                                        "--json"]).stdout)
+    zw = json.loads(runner.invoke(app, ["zwidth", "--device", str(path), "--compensate-inertia", "--delay", "0",
+                                        "--b-values", "0", "--json"]).stdout)
     assert zw["K"][0] == pytest.approx(2.0 ** 2 / 0.5, rel=1e-8)
 
 

@@ -8,6 +8,7 @@ from typing import Optional
 
 import typer
 
+from hapticdesign.analysis.sampled_loop import SampledLoop
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import note, parse_vector, print_json, user_errors
 from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, SEED, STRICT
@@ -53,9 +54,12 @@ def zwidth_command(
                    "K in N/m, B in N s/m."),
     strict: bool = STRICT,
     period: float = typer.Option(1e-3, help="Sample period T [s]."),
-    delay: int = typer.Option(0, help="Computation delay N [samples]: the torque of interval k uses the samples of k - N."),
-    velocity: str = typer.Option("sampled", help="The damper's velocity: sampled (the seed's perfect sensor) or "
-                                                 "difference (backward difference of sampled positions)."),
+    delay: Optional[int] = typer.Option(None, help="Computation delay N [samples]: the torque of interval k uses the "
+                                                   "samples of k - N. Default: practice's one sample, the seed's 0 on "
+                                                   "its Phantom presets."),
+    velocity: Optional[str] = typer.Option(None, help="The damper's velocity: difference (backward difference of "
+                                                      "sampled positions; practice's default) or sampled (the seed's "
+                                                      "perfect sensor, its Phantom presets' default)."),
     compensate_inertia: bool = typer.Option(False, help="Feed the sampled acceleration forward (c J a)."),
     error_percent: float = typer.Option(0.0, help="Compensator modelling error E [%]: c = 1 - E/100 "
                                                   "(needs --compensate-inertia)."),
@@ -79,6 +83,11 @@ def zwidth_command(
     from hapticdesign.simulation.zwidth import DisplayLoop, along_wall, zwidth
 
     with user_errors(quiet=quiet):
+        from hapticdesign.interface.commands.simulation import seed_settings
+
+        defaults = SampledLoop.seed() if seed_settings(preset, device, None) and inertia is None else SampledLoop()
+        delay = defaults.delay if delay is None else delay
+        velocity = defaults.velocity if velocity is None else velocity
         if not (math.isfinite(error_percent) and 0.0 <= error_percent < 100.0):
             raise UserError(f"--error-percent must lie in [0, 100), got {error_percent}")
         if error_percent and not compensate_inertia:
