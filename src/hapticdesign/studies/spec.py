@@ -166,7 +166,7 @@ def renderable(device: Device, h: Handle, loop: SampledLoop, simulate: bool = Tr
         "simulated": simulated, "simulated_counts": device_counts(device), "simulated_touch": TOUCH,
         "passivity_viscous": 2.0 * float(np.linalg.eigvalsh(damping).min()) * loop.rate,
         "passivity_coulomb": None if friction is None or res is None else 2.0 * friction[0] / res,
-        "settings": loop.as_dict(), "rate": loop.rate, "delay_samples": loop.delay,
+        "settings": replace(loop, hand=None).as_dict(), "rate": loop.rate, "delay_samples": loop.delay,
     }
 
 

@@ -8,7 +8,6 @@ from typing import Optional
 
 import typer
 
-from hapticdesign.analysis.sampled_loop import SampledLoop
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import note, parse_vector, print_json, user_errors
 from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, SEED, STRICT
@@ -83,6 +82,7 @@ def zwidth_command(
     from hapticdesign.simulation.zwidth import DisplayLoop, along_wall, zwidth
 
     with user_errors(quiet=quiet):
+        from hapticdesign.analysis.sampled_loop import SampledLoop
         from hapticdesign.interface.commands.simulation import seed_settings
 
         defaults = SampledLoop.seed() if seed_settings(preset, device, None) and inertia is None else SampledLoop()
