@@ -272,7 +272,8 @@ class RangeResult:
             "stopped_at_first_unstable": None if first is None else first.stopped_at,
             "simulations": self.simulations,
             "method": self.method,
-            **({} if self.k_true_boundary is None else {"k_true_boundary": self.k_true_boundary}),
+            **({} if self.k_true_boundary is None else {"k_true_boundary": self.k_true_boundary
+                                                        if math.isfinite(self.k_true_boundary) else None}),
         }
 
 
@@ -451,29 +452,42 @@ UNSTABLE = "unstable (spectral radius of the sampled loop above 1)"
 """The verdict of the first grid stiffness above the stability limit (method ``limit``)."""
 
 
+TOUCH = 0.001
+"""The wall's rest from the start (m, or rad on a joint) of a simulated limit asked at the start pose: a touch."""
+
+
 def limit_range(device: Device, loop: SampledLoop | None = None, k_limit: float = 200.0, wall_joint: int = 0,
-                equilibrium: float = 0.01, resolution: float | None = None, wall_direction=None) -> RangeResult:
+                equilibrium: float = 0.01, resolution: float | None = None, wall_direction=None,
+                counts: int | None = None, simulate: bool = False) -> RangeResult:
     """The stable range on the grid ``R, 2R, 3R ...`` (``R`` = ``resolution``, default 1) from the exact stability
     limit of the sampled loop at the wall's equilibrium (:func:`stability_limit`): every grid stiffness up to the
-    limit is stable, the first one above it is not; no simulation, no performance criteria."""
+    limit is stable, the first one above it is not; no performance criteria. With ``simulate`` the simulated limit
+    with the device's dry friction and quantization (``counts``, default the device's encoders) is added beside it
+    (:func:`simulated_limit`, the wall resting ``equilibrium`` or :data:`TOUCH` from the start)."""
     grid = 1.0 if resolution is None else float(resolution)
     limit = stability_limit(device, loop, wall_joint, equilibrium, wall_direction)
     top = int(math.floor(k_limit / grid + 1e-9))
     count = min(int(math.floor(limit.stiffness / grid)) if math.isfinite(limit.stiffness) else top, top)
     above = Verdict((count + 1) * grid, False, UNSTABLE, math.nan, math.nan) if count < top else None
+    simulated = None
+    if simulate:
+        simulated = simulated_limit(device, loop, wall_joint, equilibrium or TOUCH, wall_direction,
+                                    device_counts(device) if counts is None else counts,
+                                    start=max(limit.stiffness, 1e-3) if math.isfinite(limit.stiffness) else None)
     return RangeResult(count * grid, above.criterion if above else "none", 0, above, "limit",
-                       grid if count >= 1 else None, grid, limit=limit)
+                       grid if count >= 1 else None, grid, k_true_boundary=simulated, limit=limit)
 
 
 def impedance_range(device: Device, sim_type: int = 1, method: str = "fast", k_limit: int = 200,
                     criteria: Criteria | None = None, config: LoopConfig | None = None,
                     wall_joint: int = 0, equilibrium: float = 0.01,
                     resolution: float | None = None, wall_direction=None, true_boundary: bool = False,
-                    loop: SampledLoop | None = None) -> RangeResult:
+                    loop: SampledLoop | None = None, counts: int | None = None, simulate: bool = False) -> RangeResult:
     """Maximum stable impedance of ``wall_joint`` for simulation type 1 or 2 (seed §4.1.2).
 
     ``method="limit"`` answers from the stability limit of the sampled loop under the settings ``loop`` at the wall's
-    equilibrium, every joint free (:func:`limit_range`; ``sim_type``, ``criteria`` and ``config`` do not enter);
+    equilibrium, every joint free (:func:`limit_range`, with ``simulate`` its simulated limit with dry friction and
+    ``counts`` beside it; ``sim_type``, ``criteria`` and ``config`` do not enter);
     the other methods judge the seed's performance criteria on simulated (or exact linear) runs of type 1 or 2
     under ``config``.
 
@@ -512,7 +526,8 @@ def impedance_range(device: Device, sim_type: int = 1, method: str = "fast", k_l
         if true_boundary:
             raise InputError("the growth boundary is a simulated check of the seed's searches; the limit method is "
                              "the boundary itself", "true_boundary", "method")
-        return limit_range(device, loop, k_limit, wall_joint, equilibrium, resolution, wall_direction)
+        return limit_range(device, loop, k_limit, wall_joint, equilibrium, resolution, wall_direction, counts,
+                           simulate)
     config = config or LoopConfig(wall=Wall())
     if wall_direction is not None:
         config = replace(config, wall=replace(config.wall, direction=tuple(unit_direction(wall_direction).tolist())))

@@ -113,7 +113,8 @@ def impedance_range_command(
                                                        "the seed's 0.01 step [rad]."),
     settle_window: float = typer.Option(0.5, help="Final window checked for settling [s]."),
     safety: float = typer.Option(0.06, help="Safety switch excursion for the seed's 0.01 step [rad] (Figure 4.7)."),
-    true_boundary: bool = typer.Option(False, "--true-boundary", help="Also bisect the oscillation-growth boundary."),
+    true_boundary: bool = typer.Option(False, "--true-boundary", help="Also bisect the oscillation-growth boundary "
+                                       "(the limit method: simulated with the file's dry friction and quantization)."),
     duration: float = typer.Option(5.0, help="Simulated time per stiffness [s]."),
     period: float = PERIOD, step: float = STEP, step_control: str = STEP_CONTROL, counts: Optional[int] = COUNTS,
     delay: Optional[int] = typer.Option(None, help="Sensor delay in samples (default: the --settings' own)."),
@@ -146,14 +147,13 @@ def impedance_range_command(
                             hand_damping, hand_stiffness, held)
         config = None if method == "limit" else loop_config(loop, Wall(), counts, duration=duration, step=step,
                                                             step_control=step_control)
-        if method == "limit" and counts is not None:
-            raise UserError("the limit method is the loop's linear part: encoder quantization needs a simulated "
-                            "method (--method fast)")
         direction = None if wall_direction is None else parse_vector(wall_direction, 3, "wall-direction")
         wall_joint = joint_index(dev, joint)
+        limit = method == "limit"
         result = impedance_range(dev, _sim_type(sim_type), method, k_limit,
                                  Criteria(overshoot, settle_tolerance, settle_window, safety), config, wall_joint,
-                                 equilibrium, resolution, direction, true_boundary, loop)
+                                 equilibrium, resolution, direction, true_boundary and not limit, loop, counts,
+                                 true_boundary and limit)
         out = {"device": dev.name, "type": sim_type, "joint": wall_joint + 1,
                **({} if direction is None else {"wall_direction": unit_direction(direction).tolist()}),
                "settings": loop.as_dict(), **result.as_dict()}
@@ -176,7 +176,10 @@ def impedance_range_command(
         typer.echo(f"verdict: {out['verdict']}")
         typer.echo(f"settings: {loop.describe()}")
         if true_boundary:
-            typer.echo(f"oscillation-growth boundary: {out['k_true_boundary']:.4g} {unit['stiffness']}")
+            what = "simulated with dry friction and quantization" if method == "limit" else "oscillation-growth"
+            found = out["k_true_boundary"]
+            typer.echo(f"{what} boundary: " + ("none found (unbounded)" if found is None else
+                                                 f"{found:.4g} {unit['stiffness']}"))
 
 
 def transparency_command(
