@@ -10,7 +10,9 @@ other joints move: when the wall joint's row of H, C, G does not depend on them 
 the same 1-DOF loop is exact; otherwise the loop is linear time-varying along the motion and
 :mod:`.analytic_driven` answers with the product of its one-sample transition matrices (exact for a
 cyclic wall joint such as the Phantom's joint 1, linearized in the wall joint otherwise). A Cartesian
-wall, a hand or a closed-loop device in type 2 keeps the start-pose loop (``exact`` false).
+wall, a hand or a closed-loop device in type 2 keeps the start-pose loop (``exact`` false). The growth check
+(:meth:`AnalyticProblem.grows`) takes the loop where the wall holds the joint (:func:`equilibrium_pose`): the free
+joint travels to the spring's rest and oscillates there, so stability is decided there, not at the start.
 
 The seed's criteria are then evaluated on the exact linear response: the closed loop of
 :mod:`.zwidth` (plant discretized exactly, digital side as a discrete state-space system) gives

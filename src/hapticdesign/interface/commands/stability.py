@@ -136,6 +136,9 @@ def zwidth_command(
         if json_out:
             print_json(payload)
             return
+        typer.echo(f"settings: T = {period:g} s, delay {delay} samples, {velocity} velocity, "
+                   + (f"compensator c = {fraction:g}" if compensate_inertia else "no inertial compensation")
+                   + (", the other joints held (a 1-DOF display)" if from_device else ""))
         typer.echo(f"B [{units[1]}]   K_max [{units[2]}]   passivity K   linear approximation K")
         for i, (b, k) in enumerate(zip(result.B, result.K)):
             p = "-" if result.passivity is None else f"{result.passivity[i]:.6g}"
