@@ -22,9 +22,8 @@ from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.analysis.metrics.dynamic import modes
 from hapticdesign.devices.device_file import device_from_mapping, load_device_file
 from hapticdesign.devices.registry import preset
-from hapticdesign.analysis.sampled_loop import MassDamper, exact_boundary
 from hapticdesign.simulation.design_indices import Request, evaluate
-from tests.helpers.handle_energy import cartesian_damping, cartesian_mass
+from tests.helpers.handle_energy import cartesian_mass
 from tests.helpers.planar_arm import planar_arm
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "devices"
