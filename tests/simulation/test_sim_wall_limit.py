@@ -91,3 +91,20 @@ def test_the_delta_wall_of_issue_35_is_at_or_below_its_boundary_at_the_equilibri
     found = impedance_range(device, 1, "analytic", 20, wall_joint=2, equilibrium=step, resolution=0.27434824,
                             wall_direction=n)
     assert math.isfinite(boundary) and found.k_max <= boundary < found.k_max + 0.27434824
+
+
+def test_each_output_states_its_settings_and_verdict():
+    """The seed's Phantom preset keeps the seed's settings and criteria by default (its number unchanged: 6 N m/rad
+    of the analytic method, Table 4.4's scale); a device file gets practice's settings and the stability limit;
+    each says so."""
+    runner = CliRunner()
+    seed = json.loads(runner.invoke(app, ["impedance-range", "--method", "analytic", "--json"]).stdout)
+    assert seed["settings"]["compensation"] == "full" and seed["settings"]["delay_samples"] == 0
+    assert seed["verdict"].startswith("seed performance criteria") and seed["k_max"] == 6.0
+    path = str(EXAMPLES / "five-bar.yaml")
+    practice = json.loads(runner.invoke(app, ["impedance-range", "--device", path, "--json"]).stdout)
+    assert practice["settings"] == SampledLoop().as_dict() and practice["method"] == "limit"
+    assert practice["verdict"].startswith("stability limit")
+    asked = json.loads(runner.invoke(app, ["impedance-range", "--device", path, "--settings", "seed", "--method",
+                                           "analytic", "--json"]).stdout)
+    assert asked["settings"] == SampledLoop.seed().as_dict()
