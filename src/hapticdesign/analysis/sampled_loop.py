@@ -569,6 +569,9 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
     handle along the wall, not an instability; they are deflated (the map restricted to the complement of that
     invariant subspace, where the spring still enters as a rank-one term).
     """
+    if any(not 0 <= j < jacobian.shape[-1] for j in loop.held):
+        raise UserError(f"the held joints {[j + 1 for j in loop.held]} are not all joints of the device (1 to "
+                        f"{jacobian.shape[-1]})")
     free = [j for j in range(jacobian.shape[-1]) if j not in set(loop.held)]
     if not free:
         raise UserError("every joint is held: nothing moves under the wall")
