@@ -3,7 +3,7 @@
 For the five-bar and the delta of examples/devices: the joint walls' k_max (type 1, seed criteria, full
 compensation) and the Cartesian walls along the direction in which the free joint moves the handle (rest
 0.01 J_n,w m from the start, criteria scaled with the step), each beside the exact growth boundary of the
-loop linearized at home (spectral radius 1) and the 1-DOF closed form b^2 / (H_ww J_n,w^2); and the joint
+loop linearized where the wall holds the free joint (spectral radius 1) and the 1-DOF closed form b^2 / (H_ww J_n,w^2); and the joint
 damping that a 1000-N/m Cartesian wall needs by that closed form, ``b = J_n,w sqrt(1000 H_ww)``.
 
 Run: ``.venv/bin/python docs/scripts/closed_loop_walls.py`` (a few minutes: the simulated searches).

@@ -28,9 +28,11 @@ def main() -> None:
          "under 75 g"),
         ("backdrive friction", f"{s['backdrive_friction']['min']:.3f}-{s['backdrive_friction']['max']:.3f} N", ""),
         ("workspace cube around home", f"{s['workspace']['cube']:.0f} mm", ""),
-        ("renderable stiffness", f"{walls['exact']:.1f} N/m exact (1 kHz, one sample late); passivity "
-         f"2b/T = {walls['passivity_viscous']:.1f}, 2 f_c/Delta = {walls['passivity_coulomb']:.0f} N/m",
-         "800 N/m (CHAI3D)"),
+        ("renderable stiffness", f"{walls['exact']:.1f} N/m exact (1 kHz, one sample late, gravity compensation, "
+         f"every joint free); {walls['exact_with_hand']:.0f} N/m with a light grasp ({walls['hand']['mass']:g} kg, "
+         f"{walls['hand']['damping']:g} N s/m, {walls['hand']['stiffness']:g} N/m); {walls['simulated']:.0f} N/m "
+         f"simulated with dry friction and quantization; passivity 2b/T = {walls['passivity_viscous']:.1f}, "
+         f"2 f_c/Delta = {walls['passivity_coulomb']:.0f} N/m", "800 N/m (CHAI3D)"),
     ]
     print("| | hapticdesign, at home (q = 0) | vendor |")
     print("| --- | --- | --- |")

@@ -86,3 +86,20 @@ def test_a_five_bar_whose_loops_cannot_close_at_home_is_refused():
     space = design_space(EXAMPLES / "five-bar.yaml", ["l1", "l2"])
     with pytest.raises(UserError, match="cannot close"):
         space.device({"l1": 0.02, "l2": 0.03})
+
+
+def test_a_home_given_as_a_handle_position_follows_the_geometry(tmp_path):
+    """``home: {position: ...}``: a design whose loops do not close at the file's joint home keeps its handle at
+    the position (issue 35), where the file's joint home would refuse it."""
+    text = (EXAMPLES / "five-bar.yaml").read_text().replace(
+        "home: {q1: 2.0, q2: 1.1}", "home: {position: [0.003, 0.0, 0.202]}")
+    path = tmp_path / "five-bar-position.yaml"
+    path.write_text(text)
+    space = design_space(path, ["l1", "l2"])
+    values = {"l1": 0.12, "l2": 0.2}
+    device = space.device(values)
+    handle = configuration_of(device).pose(configuration_of(device).home)[:3, 3]
+    assert handle == pytest.approx([0.003, 0.0, 0.202], abs=1e-9)
+    fixed = design_space(EXAMPLES / "five-bar.yaml", ["l1", "l2"]).device(values)
+    moved = configuration_of(fixed).pose(configuration_of(fixed).home)[:3, 3]
+    assert np.linalg.norm(moved - [0.003, 0.0, 0.202]) > 1e-3

@@ -22,9 +22,8 @@ from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.analysis.metrics.dynamic import modes
 from hapticdesign.devices.device_file import device_from_mapping, load_device_file
 from hapticdesign.devices.registry import preset
-from hapticdesign.analysis.sampled_loop import MassDamper, exact_boundary
 from hapticdesign.analysis.metrics.indices import Request, evaluate
-from tests.helpers.handle_energy import cartesian_damping, cartesian_mass
+from tests.helpers.handle_energy import cartesian_mass
 from tests.helpers.planar_arm import planar_arm
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "devices"
@@ -111,23 +110,17 @@ def test_stiffness_and_frequency_of_a_two_link_arm_of_elastic_links():
         assert result.values["frequency"][k] == pytest.approx(modes(lam, held).frequencies[0], rel=1e-6)
 
 
-def test_kmax_is_the_sampled_limit_of_the_handles_mass_and_damping():
+def test_kmax_worst_direction_is_below_every_direction():
+    """The worst direction's limit is at or below the limit along x, z and the diagonal (each the n-joint loop,
+    checked against python-control's closed loop in tests/simulation/test_sim_handle_loop.py)."""
     device = load_device_file(EXAMPLES / "five-bar.yaml")
     point = np.array([0.01, 0.0, 0.19])
-    mass, damping = cartesian_mass(device, point, PLANE), cartesian_damping(device, point, PLANE)
-    options = {"period": 0.0005, "delay": 2, "damping": 0.5}
-    along = {}
-    for name, u in (("x", np.array([1.0, 0.0])), ("z", np.array([0.0, 1.0])),
-                    ("diagonal", np.array([1.0, 1.0]) / math.sqrt(2))):
-        m_u = 1.0 / (u @ np.linalg.solve(mass, u))  # the mass the handle shows along u (other directions free)
-        along[name] = exact_boundary(MassDamper(m_u, float(u @ damping @ u), 0.0005, 2, 0.5))
+    options = {"period": 0.0005, "delay": 2, "damping": 0.5, "velocity": "sampled"}
     requests = [Request("kmax", {**options, "direction": PLANE @ u}, name) for name, u in
                 (("x", [1, 0]), ("z", [0, 1]), ("diagonal", [1, 1]))] + [Request("kmax", options)]
     result = evaluate(device, point[None], requests)
     assert result.reason is None
-    for name, value in along.items():
-        assert result.values[name][0] == pytest.approx(value, rel=1e-6)
-    assert result.values["kmax"][0] <= min(along.values())
+    assert result.values["kmax"][0] <= min(result.values[k][0] for k in ("x", "z", "diagonal")) * (1 + 1e-9)
 
 
 def test_kmax_refuses_a_direction_off_the_plane():

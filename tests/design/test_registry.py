@@ -221,3 +221,9 @@ def test_the_r_cube_indices_are_an_entry_point_of_the_installed_package():
     """pyproject.toml names the R-CUBE's module in the group (the installed metadata: ``pip install -e .``)."""
     points = {p.name: p.value for p in importlib.metadata.entry_points(group=ENTRY_POINTS)}
     assert points.get("rcube") == "hapticdesign.optimization.rcube.parameter_indices"
+
+
+def test_the_kmax_index_takes_the_sampled_loops_options_and_defaults():
+    from hapticdesign.analysis.wall_stiffness import KMAX_OPTIONS
+
+    assert dict(INDICES["kmax"].options) == KMAX_OPTIONS

@@ -141,14 +141,14 @@ def test_cli_cartesian_wall(tmp_path):
     runner = CliRunner()
     path = SLIDER
     zw = runner.invoke(app, ["zwidth", "--device", str(path), "--wall-direction", "1,0,1", "--compensate-inertia",
-                             "--b-values", "0", "--json"])
+                             "--delay", "0", "--b-values", "0", "--json"])
     assert zw.exit_code == 0, zw.output
     out = json.loads(zw.stdout)
     assert out["units"] == {"B": "N s/m", "K": "N/m"}
     assert out["K"][0] == pytest.approx(compensated_boundary(0.5 * 2, 2.0 * 2, 1e-3), rel=1e-8)
     assert out["K"][0] == pytest.approx(16.0, rel=1e-8)
-    result = runner.invoke(app, ["impedance-range", "--device", str(path), "--method", "analytic", "--resolution",
-                                 "0.25", "--wall-direction", "1,0,1", "--json"])
+    result = runner.invoke(app, ["impedance-range", "--device", str(path), "--settings", "seed", "--method", "analytic",
+                                 "--resolution", "0.25", "--wall-direction", "1,0,1", "--json"])
     assert result.exit_code == 0, result.output
     out = json.loads(result.stdout)
     assert out["units"]["k_max"] == "N/m" and out["wall_direction"] == pytest.approx([2 ** -0.5, 0, 2 ** -0.5])

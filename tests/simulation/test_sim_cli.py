@@ -23,7 +23,7 @@ def _closed_form(j: float, b: float, t: float, c: float) -> float:
 
 def test_resolution_gives_a_real_value_below_one():
     result = runner.invoke(app, ["impedance-range", "--device", "examples/devices/pantograph-2dof.yaml",
-                                 "--resolution", "0.02", "--json"])
+                                 "--settings", "seed", "--resolution", "0.02", "--json"])
     assert result.exit_code == 0, result.output
     out = json.loads(result.stdout)
     assert 0 < out["k_max"] < 1 and out["resolution"] == 0.02 and 0 < out["k_min"] <= out["k_max"]
@@ -107,8 +107,8 @@ def test_a_prismatic_wall_is_labelled_in_newtons(tmp_path):
     assert out["units"]["k_max"] == "N/m"
     dyn = json.loads(runner.invoke(app, ["dynamics", "--device", str(path), "--q", "0.1", "--json"]).stdout)
     assert dyn["units"]["joints"][0]["effort"] == "N" and dyn["H"] == [[0.5]]
-    zw = json.loads(runner.invoke(app, ["zwidth", "--device", str(path), "--compensate-inertia", "--b-values", "0",
-                                        "--json"]).stdout)
+    zw = json.loads(runner.invoke(app, ["zwidth", "--device", str(path), "--compensate-inertia", "--delay", "0",
+                                        "--b-values", "0", "--json"]).stdout)
     assert zw["K"][0] == pytest.approx(2.0 ** 2 / 0.5, rel=1e-8)
 
 

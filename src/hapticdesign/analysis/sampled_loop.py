@@ -252,11 +252,17 @@ def compensated_boundary(inertia: float, damping: float, period: float, fraction
 
 
 class ClosedLoops:
-    """The one-sample maps of S sampled loops, state ``[q, qd, u_prev, s_(k-1), ..., s_(k-d)]`` with ``s = (q, qd,
-    a)``: ``m(K) = m(0) - K g e_c^T`` (the spring enters one column ``c``, that of ``q`` in the law, through
-    ``g = (Gamma, 1)``), so a search builds the spring-free maps once."""
+    """The one-sample maps of S sampled loops in which the wall's spring ``K`` enters as a rank-one term,
+    ``m(K) = m(0) - K g h^T`` (``base`` (S, N, N), ``g`` and ``h`` (S, N)), so a search builds the spring-free maps
+    once: the 1-DOF loops of :meth:`of` and the n-joint handle loops of :func:`handle_loops`."""
 
-    def __init__(self, systems: MassDampers):
+    def __init__(self, base: np.ndarray, g: np.ndarray, h: np.ndarray):
+        self.base, self.g, self.h = base, g, h
+
+    @classmethod
+    def of(cls, systems: MassDampers) -> "ClosedLoops":
+        """The loops of 1-DOF mass-dampers, state ``[q, qd, u_prev, s_(k-1), ..., s_(k-d)]`` with ``s = (q, qd,
+        a)``: the spring enters one column ``c``, that of ``q`` in the law, through ``g = (Gamma, 1)``."""
         j, b, d = systems.inertia, systems.damping, systems.delay_samples
         phi, gamma = _discretize(j, b, systems.period, systems.plant_stiffness)
         count, size = len(j), 3 + 3 * d
@@ -277,14 +283,19 @@ class ClosedLoops:
         if d > 0:
             m[:, 3:6, :3] = sense
             m[:, 6:, 3:size - 3] = np.eye(size)[3:size - 3, 3:size - 3]
-        self.base, self.column = m, 0 if d == 0 else size - 3
-        self.spring = np.concatenate([gamma, np.ones((count, 1))], axis=1)
+        g = np.zeros((count, size))
+        g[:, :3] = np.concatenate([gamma, np.ones((count, 1))], axis=1)
+        h = np.zeros((count, size))
+        h[:, 0 if d == 0 else size - 3] = 1.0
+        return cls(m, g, h)
+
+    def __len__(self) -> int:
+        return len(self.base)
 
     def matrices(self, stiffness: np.ndarray, index: np.ndarray | slice = slice(None)) -> np.ndarray:
-        """The maps (S', n, n) of the systems ``index`` under the springs ``stiffness`` (S',)."""
-        m = self.base[index].copy()
-        m[:, :3, self.column] -= np.asarray(stiffness, dtype=float)[:, None] * self.spring[index]
-        return m
+        """The maps (S', N, N) of the systems ``index`` under the springs ``stiffness`` (S',)."""
+        k = np.asarray(stiffness, dtype=float)[:, None, None]
+        return self.base[index] - k * self.g[index][:, :, None] * self.h[index][:, None, :]
 
     def radii(self, stiffness: np.ndarray, index: np.ndarray | slice = slice(None)) -> np.ndarray:
         """Spectral radii (S',) of :meth:`matrices` (the loop is stable below 1)."""
@@ -293,11 +304,11 @@ class ClosedLoops:
 
 def closed_loop_matrix(system: MassDamper, stiffness: float) -> np.ndarray:
     """One-sample map of ``[q, qd, u_prev, s_(k-1), ..., s_(k-d)]`` with ``s = (q, qd, a)`` (:class:`ClosedLoops`)."""
-    return ClosedLoops(MassDampers.of([system])).matrices(np.array([stiffness]))[0]
+    return ClosedLoops.of(MassDampers.of([system])).matrices(np.array([stiffness]))[0]
 
 
 def spectral_radius(system: MassDamper, stiffness: float) -> float:
-    return float(ClosedLoops(MassDampers.of([system])).radii(np.array([stiffness]))[0])
+    return float(ClosedLoops.of(MassDampers.of([system])).radii(np.array([stiffness]))[0])
 
 
 FLOOR = 1e-9
@@ -312,28 +323,35 @@ def exact_boundary(system: MassDamper, k_max: float = 1e9) -> float:
 
 
 def exact_boundaries(systems: MassDampers, groups: np.ndarray | None = None, k_max: float = 1e9) -> np.ndarray:
-    """The exact limit of each system (S,), or the smallest in each group (``groups``: S labels 0 ... G - 1; (G,)).
-
-    A system unstable at :data:`FLOOR` has the limit 0; otherwise a stable ``lo`` and an unstable ``hi`` are
-    bracketed by halving or doubling from the passivity scale ``2 (b + B) / (T (1 + 2 d))`` (Colgate's bound with a
-    delay of ``d`` samples; ``hi > k_max``: stable up to ``k_max``, the limit is inf), and the crossing of the
-    spectral radius through 1 is found by the Illinois variant of regula falsi (a bisection after two steps that
-    did not halve the bracket) to ``XTOL + RTOL K``; the limit is the bracket's middle. All systems move at once
-    (one batched eigenvalue call per step). In a group, a system whose stable ``lo`` reaches the smallest unstable
-    ``hi`` of another cannot hold the group's smallest limit and leaves the search.
-    """
+    """The exact limit of each 1-DOF system (S,), or the smallest in each group (``groups``: S labels 0 ... G - 1;
+    (G,)), by :func:`loop_limits` from the passivity scale ``2 (b + B) / (T (1 + 2 d))`` (Colgate's bound with a
+    delay of ``d`` samples)."""
     order = 3 + 3 * systems.delay_samples
     what = f"the closed-loop matrices of {len(systems):,} loops with a {systems.delay_samples:,}-sample delay"
     require_memory(what, 8.0 * order * order * len(systems))
     require_within(what, order, EIGEN_ORDER_LIMIT, "rows")
-    count = len(systems)
+    guess = 2.0 * (systems.damping + systems.virtual_damping) / (systems.period * (1 + 2 * systems.delay_samples))
+    return loop_limits(ClosedLoops.of(systems), guess, groups, k_max)
+
+
+def loop_limits(loops: ClosedLoops, guess: np.ndarray, groups: np.ndarray | None = None,
+                k_max: float = 1e9) -> np.ndarray:
+    """The smallest spring at which each loop (S,) loses stability, or the smallest in each group (``groups``: S
+    labels 0 ... G - 1; (G,)).
+
+    A loop unstable at :data:`FLOOR` has the limit 0; otherwise a stable ``lo`` and an unstable ``hi`` are
+    bracketed by halving or doubling from ``guess`` (``hi > k_max``: stable up to ``k_max``, the limit is inf), and
+    the crossing of the spectral radius through 1 is found by the Illinois variant of regula falsi (a bisection
+    after two steps that did not halve the bracket) to ``XTOL + RTOL K``; the limit is the bracket's middle. All
+    loops move at once (one batched eigenvalue call per step). In a group, a loop whose stable ``lo`` reaches the
+    smallest unstable ``hi`` of another cannot hold the group's smallest limit and leaves the search.
+    """
+    count = len(loops)
     group = np.arange(count) if groups is None else np.asarray(groups, dtype=np.int64)
     n_group = int(group.max()) + 1 if count else 0
-    loops = ClosedLoops(systems)
     f_floor = loops.radii(np.full(count, FLOOR)) - 1.0
     limit = np.full(count, np.nan)
     limit[f_floor >= 0.0] = 0.0
-    guess = 2.0 * (systems.damping + systems.virtual_damping) / (systems.period * (1 + 2 * systems.delay_samples))
     lo = np.minimum(np.maximum(guess, FLOOR), k_max)
     hi, f_lo, f_hi = 2.0 * lo, np.where(lo == FLOOR, f_floor, np.nan), np.full(count, np.nan)
     search = _Search(group, n_group, limit)
@@ -413,3 +431,228 @@ class _Search:
         np.minimum.at(out, self.group[~self.out & ~self.settled], limit[~self.out & ~self.settled])
         out[self.zero] = 0.0
         return out
+
+
+@dataclass(frozen=True)
+class Hand:
+    """A linear hand at the handle: mass (kg), damping (N s/m) and stiffness (N/m) to ground, the same in every
+    direction; mapped to the joints as ``x J_v^T J_v`` (a linearized grasp)."""
+
+    mass: float = 0.0
+    damping: float = 0.0
+    stiffness: float = 0.0
+
+    def __post_init__(self) -> None:
+        values = (self.mass, self.damping, self.stiffness)
+        if not all(math.isfinite(v) and v >= 0 for v in values):
+            raise InputError(f"the hand's mass, damping and stiffness must be finite and non-negative, got "
+                             f"{', '.join(f'{v:g}' for v in values)}", "hand_mass", "hand_damping", "hand_stiffness")
+
+    @staticmethod
+    def optional(mass: float = 0.0, damping: float = 0.0, stiffness: float = 0.0) -> "Hand | None":
+        """A hand when any of its values is non-zero, else None (no hand)."""
+        return Hand(mass, damping, stiffness) if (mass or damping or stiffness) else None
+
+    def as_dict(self) -> dict:
+        return {"mass": self.mass, "damping": self.damping, "stiffness": self.stiffness}
+
+
+GRASP = Hand(mass=0.1, damping=2.0, stiffness=200.0)
+"""The default grasp of the "with the hand" limit: a light fingertip or pen grasp, 0.1 kg, 2 N s/m, 200 N/m, at the
+low (least stabilizing) end of the hand and fingertip impedances measured by Tsuji, Morasso, Goto & Ito (1995,
+"Human hand impedance characteristics during maintained posture", Biol. Cybern. 72) and Hajian & Howe (1997,
+"Identification of the mechanical impedance at the human finger tip", J. Biomech. Eng. 119). Colgate & Brown (1994,
+"Factors affecting the Z-width of a haptic display", ICRA) and Hulin, Preusche & Hirzinger (2008, "Stability boundary
+for haptic rendering: influence of human operator", IROS) show how the operator's impedance enlarges the stable
+region; a firmer grasp renders stiffer walls. A user changes it (``hand_mass``, ``hand_damping``,
+``hand_stiffness``)."""
+
+VELOCITIES = ("difference", "sampled")
+"""How the virtual damper's velocity is formed: the backward difference of the sampled positions (practice), or the
+sampled velocity itself (the seed's perfect sensor, seed 000 §4.1.3 ix)."""
+COMPENSATIONS = ("none", "gravity", "full")
+"""What the controller feeds forward: nothing, the gravity torque (practice), or the full inverse dynamics with the
+sampled acceleration (the seed's, seed 000 §4.1.1.2)."""
+
+
+@dataclass(frozen=True)
+class SampledLoop:
+    """The settings of a sampled haptic loop, one record for every command and index.
+
+    ``period`` (s) the servo period, ``delay`` whole samples between reading the sensors and applying the torque,
+    ``velocity`` of :data:`VELOCITIES`, ``compensation`` of :data:`COMPENSATIONS` with ``model_error`` (percent
+    E: the full compensator's inertia is ``(1 - E/100)`` times the device's), ``virtual_damping`` the wall's damper
+    (N s/m, or N m s/rad on a joint), ``hand`` a :class:`Hand` at the handle (None: none), ``held`` the joints held
+    fixed (none by default: a Cartesian wall acts with every actuated joint free, as under a user's hand).
+    The defaults are what practice uses: 1 kHz, one sample of delay, backward-difference velocity, gravity
+    compensation only; :meth:`seed` gives the seed's settings (full compensation, no delay, sampled velocity).
+    Gravity compensation is taken as exact, so about a pose the linearized plant has no gravity term."""
+
+    period: float = 1e-3
+    delay: int = 1
+    velocity: str = "difference"
+    compensation: str = "gravity"
+    model_error: float = 0.0
+    virtual_damping: float = 0.0
+    hand: Hand | None = None
+    held: tuple[int, ...] = ()
+
+    def __post_init__(self) -> None:
+        if isinstance(self.period, bool) or not (isinstance(self.period, (int, float)) and math.isfinite(self.period)
+                                                 and self.period > 0):
+            raise InputError(f"the sample period must be a positive number of seconds, got {self.period!r}", "period")
+        if isinstance(self.delay, bool) or not isinstance(self.delay, (int, np.integer)) or self.delay < 0:
+            raise InputError(f"the sensor delay must be a non-negative number of samples, got {self.delay!r}", "delay")
+        if self.velocity not in VELOCITIES:
+            raise InputError(f"unknown velocity estimate {str(self.velocity)[:40]!r}; choose one of "
+                             f"{', '.join(VELOCITIES)}", "velocity")
+        if self.compensation not in COMPENSATIONS:
+            raise InputError(f"unknown compensation {str(self.compensation)[:40]!r}; choose one of "
+                             f"{', '.join(COMPENSATIONS)}", "compensation")
+        if not (math.isfinite(self.model_error) and -100 < self.model_error < 100):
+            raise InputError(f"the error percentage must be a finite number between -100 and 100 (exclusive), got "
+                             f"{self.model_error}", "error_percent")
+        if not (math.isfinite(self.virtual_damping) and self.virtual_damping >= 0):
+            raise InputError(f"the wall damping must be a finite number >= 0, got {self.virtual_damping}",
+                             "wall_damping")
+        if self.hand is not None and not isinstance(self.hand, Hand):
+            raise UserError(f"the hand must be a Hand, got {type(self.hand).__name__}")
+
+    @classmethod
+    def seed(cls, **changes) -> "SampledLoop":
+        """The seed's settings (seed 000 §4.1.1): full inverse-dynamics compensation, no delay, sampled velocity."""
+        return cls(**{"delay": 0, "velocity": "sampled", "compensation": "full", **changes})
+
+    @property
+    def rate(self) -> float:
+        return 1.0 / self.period
+
+    @property
+    def fraction(self) -> float:
+        """The compensator's share ``c`` of the inertia it feeds forward: ``1 - E/100`` with full compensation, else
+        0."""
+        return 1.0 - self.model_error / 100.0 if self.compensation == "full" else 0.0
+
+    def as_dict(self) -> dict:
+        """The settings as an output states them."""
+        return {"rate": self.rate, "period": self.period, "delay_samples": self.delay, "velocity": self.velocity,
+                "compensation": self.compensation, "model_error_percent": self.model_error,
+                "virtual_damping": self.virtual_damping, "hand": None if self.hand is None else self.hand.as_dict(),
+                "held_joints": [j + 1 for j in self.held]}
+
+    def describe(self) -> str:
+        """One line for a text output."""
+        hand = "no hand" if self.hand is None else (f"hand {self.hand.mass:g} kg, {self.hand.damping:g} N s/m, "
+                                                     f"{self.hand.stiffness:g} N/m")
+        held = f", joints {', '.join(str(j + 1) for j in self.held)} held" if self.held else ", every joint free"
+        comp = self.compensation + (f" (model error {self.model_error:g} %)" if self.compensation == "full"
+                                    and self.model_error else "")
+        return (f"{self.rate:g} Hz, delay {self.delay} sample{'s' if self.delay != 1 else ''}, {self.velocity} "
+                f"velocity, {comp} compensation, wall damper {self.virtual_damping:g}, {hand}{held}")
+
+
+def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, spring: np.ndarray,
+                 loop: SampledLoop) -> tuple[ClosedLoops, np.ndarray]:
+    """The sampled loops of S handles under a wall whose spring acts on the joints as ``K w w^T`` (``spring``: the
+    rows ``w`` (S, n); ``J_v^T u`` for a Cartesian wall along a unit ``u``, ``e_j`` for a wall on joint j), every
+    joint free but ``loop.held``, and a starting guess of their limits (S,).
+
+    ``jacobian`` ``J_v`` (S, 3, n), ``mass`` ``H`` (S, n, n) and ``damping`` ``B`` (n, n) or (S, n, n) of the
+    actuated coordinates at the pose the wall holds. The plant ``H_h qdd + B_h qd + K_h q = u`` (the hand's mass,
+    damping and stiffness added as ``x J_v^T J_v``) is discretized exactly under a zero-order hold
+    (``scipy.linalg.expm`` of the augmented matrix). Every period the controller holds, ``d`` samples late,
+    ``u_k = c H a_(k-d) - K w w^T q_(k-d) - B_w w w^T v^_(k-d)``, ``a`` the acceleration sampled
+    under the previous torque, ``v^`` the sampled velocity or the backward difference of positions. The state is
+    ``[x_k, ..., x_(k-L), u_(k-1), ..., u_(k-d-1)]`` (``x = (q, qd)``; the torques only with the compensator), and
+    ``K`` enters as the rank-one term of :class:`ClosedLoops`. Without a hand's stiffness the displacements along
+    the wall (``w^T q = 0``) are free: each is a fixed point (eigenvalue 1) whatever ``K``, a neutral drift of the
+    handle along the wall, not an instability; they are deflated (the map restricted to the complement of that
+    invariant subspace, where the spring still enters as a rank-one term).
+    """
+    if any(not 0 <= j < jacobian.shape[-1] for j in loop.held):
+        raise UserError(f"the held joints {[j + 1 for j in loop.held]} are not all joints of the device (1 to "
+                        f"{jacobian.shape[-1]})")
+    free = [j for j in range(jacobian.shape[-1]) if j not in set(loop.held)]
+    if not free:
+        raise UserError("every joint is held: nothing moves under the wall")
+    jv = np.asarray(jacobian, dtype=float)[:, :, free]
+    h = np.asarray(mass, dtype=float)[:, free][:, :, free]
+    b = np.broadcast_to(np.asarray(damping, dtype=float)[..., free, :][..., free], h.shape)
+    count, n = h.shape[0], len(free)
+    jtj = np.swapaxes(jv, 1, 2) @ jv
+    hand = loop.hand or Hand()
+    hh, bh, kp = h + hand.mass * jtj, b + hand.damping * jtj, hand.stiffness * jtj
+    w = np.asarray(spring, dtype=float)[:, free]
+    aug = np.zeros((count, 3 * n, 3 * n))
+    aug[:, :n, n:2 * n] = np.eye(n)
+    aug[:, n:2 * n, :n] = -np.linalg.solve(hh, kp)
+    aug[:, n:2 * n, n:2 * n] = -np.linalg.solve(hh, bh)
+    aug[:, n:2 * n, 2 * n:] = np.linalg.inv(hh)
+    e = expm(aug * loop.period)
+    phi, gamma = e[:, :2 * n, :2 * n], e[:, :2 * n, 2 * n:]
+    d, c = loop.delay, loop.fraction
+    differenced = loop.velocity == "difference" and loop.virtual_damping > 0
+    depth = d + int(differenced)
+    compensated = c != 0.0
+    nx, size = 2 * n, 2 * n * (depth + 1) + (n * (d + 1) if compensated else 0)
+    u0 = 2 * n * (depth + 1)  # first column of the torque buffer
+    law = np.zeros((count, n, size))  # u_k from the state, spring left out
+    ww = w[:, :, None] * w[:, None, :]
+    if compensated:
+        feed = c * h @ np.linalg.inv(hh)  # c H a, a = H_h^-1 (u_prev - B_h v - K_h q)
+        law[:, :, u0 + n * d:u0 + n * (d + 1)] += feed
+        law[:, :, nx * d:nx * d + n] -= feed @ kp
+        law[:, :, nx * d + n:nx * (d + 1)] -= feed @ bh
+    if differenced:
+        law[:, :, nx * d:nx * d + n] -= loop.virtual_damping / loop.period * ww
+        law[:, :, nx * (d + 1):nx * (d + 1) + n] += loop.virtual_damping / loop.period * ww
+    else:
+        law[:, :, nx * d + n:nx * (d + 1)] -= loop.virtual_damping * ww
+    m = np.zeros((count, size, size))
+    m[:, :nx, :nx] = phi
+    m[:, :nx] += gamma @ law
+    for k in range(1, depth + 1):
+        m[:, nx * k:nx * (k + 1), nx * (k - 1):nx * k] = np.eye(nx)
+    if compensated:
+        m[:, u0:u0 + n] = law
+        for k in range(1, d + 1):
+            m[:, u0 + n * k:u0 + n * (k + 1), u0 + n * (k - 1):u0 + n * k] = np.eye(n)
+    g = np.zeros((count, size))
+    g[:, :nx] = np.einsum("sij,sj->si", gamma, w)
+    if compensated:
+        g[:, u0:u0 + n] = w
+    hvec = np.zeros((count, size))
+    hvec[:, nx * d:nx * d + n] = w
+    if hand.stiffness == 0.0 and n > 1:
+        m, g, hvec = _deflated(m, g, hvec, w, n, depth)
+    reach = np.einsum("sn,sn->s", w, w)
+    viscous = np.einsum("sn,snm,sm->s", w, bh, w) / np.maximum(reach, 1e-300) ** 2 + loop.virtual_damping
+    guess = np.maximum(2.0 * viscous / (loop.period * (1 + 2 * d)), FLOOR)
+    return ClosedLoops(m, g, hvec), guess
+
+
+def _deflated(m: np.ndarray, g: np.ndarray, h: np.ndarray, w: np.ndarray, n: int,
+              depth: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The maps restricted to the complement of the fixed points ``[q*, 0, q*, 0, ..., 0]`` (``w^T q* = 0``): in an
+    orthonormal basis ``[Q1 Q2]`` with ``Q1`` spanning them the map is block triangular, so the other eigenvalues
+    are those of ``Q2^T m Q2`` (and the spring's term stays rank one, ``(Q2^T g)(Q2^T h)^T``)."""
+    count, size = m.shape[0], m.shape[1]
+    null = np.linalg.svd(w[:, None, :])[2][:, 1:, :]  # (S, n - 1, n): rows orthogonal to w
+    fixed = np.zeros((count, size, n - 1))
+    for k in range(depth + 1):
+        fixed[:, 2 * n * k:2 * n * k + n] = np.swapaxes(null, 1, 2)
+    q = np.linalg.qr(fixed, mode="complete")[0][:, :, n - 1:]
+    qt = np.swapaxes(q, 1, 2)
+    return qt @ m @ q, np.einsum("sji,sj->si", q, g), np.einsum("sji,sj->si", q, h)
+
+
+def handle_limits(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, spring: np.ndarray,
+                  loop: SampledLoop, groups: np.ndarray | None = None, k_max: float = 1e9) -> np.ndarray:
+    """The exact stable wall stiffness (N/m) of each handle loop of :func:`handle_loops` (S,), or the smallest in
+    each group (:func:`loop_limits`)."""
+    loops, guess = handle_loops(jacobian, mass, damping, spring, loop)
+    order = loops.base.shape[-1]
+    what = f"the closed-loop matrices of {len(loops):,} handle loops of order {order}"
+    require_memory(what, 8.0 * order * order * len(loops))
+    require_within(what, order, EIGEN_ORDER_LIMIT, "rows")
+    return loop_limits(loops, guess, groups, k_max)

@@ -1,33 +1,34 @@
 """The stiffest stable virtual wall at a handle: the sampled loop's exact limit along a direction, or the worst one.
 
-Along a unit direction ``u`` of the directions the handle moves (basis ``U``), the handle is the 1-DOF mass-damper
-of mass ``1 / (u^T M u)`` (``M = U^T J_v H^-1 J_v^T U``, the mobility: the inverse of the Cartesian mass) and
-damping ``u^T D u`` (``D = U^T J_v^+T B J_v^+ U``, ``B`` the joints' and motors' viscous damping). A virtual spring
-``K`` (and damper) sampled every ``T`` with a delay of ``d`` samples is stable below the exact limit of that loop
-(:func:`hapticdesign.analysis.sampled_loop.exact_boundary`: the plant discretized exactly, the closed loop's spectral
-radius reaching 1). The worst direction is searched over the axes, the principal directions of ``M`` and of ``D``
-and :data:`DIRECTIONS` evenly spread directions (a Fibonacci sphere; a half circle for a planar device).
-:func:`wall_limits` takes many points at once: the loops of all their directions are searched together
-(:func:`~hapticdesign.analysis.sampled_loop.exact_boundaries`, one batched eigenvalue call per step), and a
-direction whose stable bracket lies above another's unstable one leaves the search early.
+A wall along a unit direction ``u`` at the handle acts on the joints as the spring ``K J_v^T u u^T J_v``; with every
+actuated joint free (as under a user's hand; :attr:`~hapticdesign.analysis.sampled_loop.SampledLoop.held` names the
+ones held) the n-joint plant ``H``, ``B`` (and the hand of the loop's settings) discretized exactly and the sampled
+controller form one linear map whose spectral radius reaches 1 at the limit
+(:func:`hapticdesign.analysis.sampled_loop.handle_limits`). This is not the 1-DOF model of the handle along ``u``
+(mass ``1 / (u^T J_v H^-1 J_v^T u)``, damping ``u^T J_v^+T B J_v^+ u``): the two agree where ``u`` is a principal
+direction of both the handle's mobility and its damping, and differ elsewhere, where the other directions' motion
+couples into the wall's. The worst direction is searched over the axes of the handle's range, the principal
+directions of its mobility ``U^T J_v H^-1 J_v^T U`` and damping ``U^T J_v^+T B J_v^+ U`` and :data:`DIRECTIONS`
+evenly spread directions (a Fibonacci sphere; a half circle for a planar device). :func:`wall_limits` takes many
+points at once: the loops of all their directions are searched together, and a direction whose stable bracket lies
+above another's unstable one leaves the search early.
+
+:func:`kmax` is the ``kmax`` design index: the options of a study (:data:`KMAX_OPTIONS`) read into a
+:class:`~hapticdesign.analysis.sampled_loop.SampledLoop`.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 
 import numpy as np
 
-from hapticdesign.analysis.sampled_loop import MassDampers, exact_boundaries
+from hapticdesign.analysis.sampled_loop import GRASP, Hand, SampledLoop, handle_limits
 from hapticdesign.errors import UserError
 
 DIRECTIONS = 60
 """Directions spread over the sphere (circle for a planar device) for the worst wall direction."""
-
-
-MAX_PERIOD = 1.0
-"""Longest sample period (s) of ``kmax``'s loop: a haptic loop samples far faster than 1 Hz, and the exact
-discretization of a handle's mass over much longer periods overflows."""
 
 
 def directions(dim: int, count: int = DIRECTIONS) -> np.ndarray:
@@ -54,58 +55,136 @@ def wall_directions(mobility: np.ndarray, damping: np.ndarray) -> np.ndarray:
     return np.concatenate([fixed[0], *principal, fixed[1]], axis=-2)
 
 
+def handle_range(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray) -> tuple[np.ndarray, np.ndarray,
+                                                                                         np.ndarray]:
+    """The basis ``U`` (P, 3, k) of the directions the handle moves, its mobility ``U^T J_v H^-1 J_v^T U`` and
+    damping ``U^T J_v^+T B J_v^+ U`` (P, k, k) in it."""
+    u, s, _ = np.linalg.svd(jacobian)
+    k = s.shape[-1]
+    basis = u[:, :, :k]
+    mobility = np.swapaxes(basis, 1, 2) @ jacobian @ np.linalg.solve(mass, np.swapaxes(jacobian, 1, 2)) @ basis
+    pinv = np.linalg.pinv(jacobian) @ basis
+    return basis, mobility, np.swapaxes(pinv, 1, 2) @ damping @ pinv
+
+
 CHUNK_BYTES = 1 << 24
-"""The closed-loop matrices :func:`wall_limits` searches at once (``8 (3 + 3 d)^2`` bytes a loop), at least one
-point's."""
+"""The closed-loop matrices :func:`wall_limits` searches at once, at least one point's."""
 
 
-def wall_limit(mobility: np.ndarray, damping: np.ndarray, period: float, delay: int, virtual_damping: float = 0.0,
+def wall_limit(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, loop: SampledLoop | None = None,
                direction: np.ndarray | None = None) -> float:
-    """The exact stable wall stiffness (N/m) along ``direction`` (unit, in the basis of ``mobility``), or the smallest
-    over :func:`wall_directions` when it is None (see the module docstring)."""
-    along = None if direction is None else np.atleast_2d(direction)[None]
-    return float(wall_limits(mobility[None], damping[None], period, delay, virtual_damping, along)[0])
+    """The exact stable wall stiffness (N/m) at one pose along ``direction`` (a unit base-frame 3-vector), or the
+    smallest over :func:`wall_directions` when it is None (see the module docstring)."""
+    along = None if direction is None else np.reshape(direction, (1, 1, 3))
+    return float(wall_limits(jacobian[None], mass[None], damping, loop, along)[0])
 
 
-def wall_limits(mobility: np.ndarray, damping: np.ndarray, period: float, delay: int, virtual_damping: float = 0.0,
+def wall_limits(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, loop: SampledLoop | None = None,
                 along: np.ndarray | None = None) -> np.ndarray:
-    """:func:`wall_limit` at P points at once: ``mobility`` and ``damping`` (P, k, k), ``along`` None (the worst
-    of :func:`wall_directions`) or (P, C, k) unit rows (the smallest over them); (P,) in N/m. The loops of all
-    points and directions go through :func:`~hapticdesign.analysis.sampled_loop.exact_boundaries` together, in
-    chunks of about :data:`CHUNK_BYTES` of matrices."""
-    rows = wall_directions(mobility, damping) if along is None else np.asarray(along, dtype=float)
-    mass = 1.0 / np.einsum("pck,pkl,pcl->pc", rows, mobility, rows)
-    damped = np.einsum("pck,pkl,pcl->pc", rows, damping, rows)
-    per = max(1, CHUNK_BYTES // (8 * (3 + 3 * delay) ** 2 * rows.shape[1]))
-    out = np.empty(len(mass))
-    for start in range(0, len(mass), per):
+    """:func:`wall_limit` at P poses at once: ``jacobian`` ``J_v`` (P, 3, n), ``mass`` ``H`` (P, n, n), ``damping``
+    ``B`` (n, n) or (P, n, n); ``along`` None (the worst of :func:`wall_directions`) or (P, C, 3) unit base-frame
+    rows (the smallest over them); (P,) in N/m, the loops searched together in chunks of about
+    :data:`CHUNK_BYTES` of matrices."""
+    loop = loop or SampledLoop()
+    jacobian, mass = np.asarray(jacobian, dtype=float), np.asarray(mass, dtype=float)
+    damping = np.broadcast_to(np.asarray(damping, dtype=float), mass.shape)
+    if along is None:
+        basis, mobility, cartesian_damping = handle_range(jacobian, mass, damping)
+        along = np.einsum("pik,pck->pci", basis, wall_directions(mobility, cartesian_damping))
+    along = np.asarray(along, dtype=float)
+    count, per_point = along.shape[:2]
+    n = jacobian.shape[-1]
+    order = 2 * n * (loop.delay + 2) + n * (loop.delay + 1)
+    per = max(1, CHUNK_BYTES // (8 * order * order * per_point))
+    out = np.empty(count)
+    for start in range(0, count, per):
         part = slice(start, start + per)
-        systems = MassDampers(mass[part].ravel(), damped[part].ravel(), period, delay, virtual_damping)
-        out[part] = exact_boundaries(systems, np.repeat(np.arange(len(mass[part])), rows.shape[1]))
+        size = len(along[part])
+        rows = np.repeat(np.arange(start, start + size), per_point)
+        spring = np.einsum("sk,skn->sn", along[part].reshape(-1, 3), jacobian[rows])
+        out[part] = handle_limits(jacobian[rows], mass[rows], damping[rows], spring, loop,
+                                  np.repeat(np.arange(size), per_point))
     return out
 
 
-def handle_wall_limits(mobility: np.ndarray, damping: np.ndarray, basis: np.ndarray, period: float, delay: int,
-                       virtual_damping: float = 0.0, direction=None) -> np.ndarray:
-    """:func:`wall_limits` at P handle poses (the ``kmax`` design index): ``mobility`` and ``damping`` (P, k, k) on
-    the directions ``basis`` (P, 3, k) the handle moves, along ``direction`` (a base-frame vector, one the handle
-    moves in) or the worst direction when it is None; the settings are checked here (one-line UserError)."""
+def worst_direction(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray,
+                    loop: SampledLoop | None = None) -> tuple[float, np.ndarray]:
+    """The smallest exact wall limit at one pose over :func:`wall_directions` and the direction (unit, base frame)
+    that gives it (every direction searched to the end)."""
+    loop = loop or SampledLoop()
+    jacobian, mass = np.asarray(jacobian, dtype=float)[None], np.asarray(mass, dtype=float)[None]
+    damping = np.broadcast_to(np.asarray(damping, dtype=float), mass.shape)
+    basis, mobility, cartesian_damping = handle_range(jacobian, mass, damping)
+    along = np.einsum("ik,ck->ci", basis[0], wall_directions(mobility, cartesian_damping)[0])
+    count = len(along)
+    limits = handle_limits(np.repeat(jacobian, count, 0), np.repeat(mass, count, 0), np.repeat(damping, count, 0),
+                           along @ jacobian[0], loop)
+    best = int(np.argmin(limits))
+    return float(limits[best]), along[best]
+
+
+MAX_PERIOD = 1.0
+"""Longest sample period (s) of ``kmax``'s loop: a haptic loop samples far faster than 1 Hz, and the exact
+discretization of a handle's mass over much longer periods overflows."""
+
+KMAX_OPTIONS = {"period": 0.001, "delay": 1, "damping": 0.0, "direction": None, "velocity": "difference",
+                "compensation": "gravity", "error_percent": 0.0, "hand": None}
+"""The ``kmax`` index's options and defaults: the settings of :class:`SampledLoop` (``damping`` the wall's damper in
+N s/m), ``direction`` a base-frame vector (default: the worst direction) and ``hand`` None, ``"grasp"`` (the default
+grasp :data:`~hapticdesign.analysis.sampled_loop.GRASP`) or ``{mass, damping, stiffness}``."""
+
+
+def kmax_loop(options: Mapping[str, object]) -> tuple[SampledLoop, np.ndarray | None]:
+    """The loop settings and the unit direction (or None) of the ``kmax`` options; a one-line error for a bad one."""
+    period, delay, damping, direction = (options[k] for k in ("period", "delay", "damping", "direction"))
     if isinstance(period, bool) or not isinstance(period, (int, float)) or not 0 < period <= MAX_PERIOD:
         raise UserError(f"index kmax: the sample period is a positive number of seconds, at most {MAX_PERIOD:g} s, "
                         f"got {period!r}")
     if isinstance(delay, bool) or not isinstance(delay, int) or not 0 <= delay <= 100:
         raise UserError(f"index kmax: the delay is a whole number of samples from 0 to 100, got {delay!r}")
-    if isinstance(virtual_damping, bool) or not isinstance(virtual_damping, (int, float)) or not (
-            math.isfinite(virtual_damping) and virtual_damping >= 0):
-        raise UserError(f"index kmax: the wall's damping is a number >= 0 (N s/m), got {virtual_damping!r}")
+    if isinstance(damping, bool) or not isinstance(damping, (int, float)) or not (math.isfinite(damping)
+                                                                                   and damping >= 0):
+        raise UserError(f"index kmax: the wall's damping is a number >= 0 (N s/m), got {damping!r}")
+    error = options["error_percent"]
+    if isinstance(error, bool) or not isinstance(error, (int, float)):
+        raise UserError(f"index kmax: the modelling error is a percentage, got {error!r}")
+    if direction is not None:
+        try:
+            direction = np.asarray(direction, dtype=float)
+        except (TypeError, ValueError):
+            raise UserError(f"index kmax: the direction is 3 finite numbers, got {options['direction']!r}") from None
+        if direction.shape != (3,) or not np.all(np.isfinite(direction)) or not np.linalg.norm(direction) > 0:
+            raise UserError(f"index kmax: the direction is 3 finite numbers, not all 0, got {options['direction']!r}")
+        direction = direction / np.linalg.norm(direction)
+    try:
+        loop = SampledLoop(float(period), delay, str(options["velocity"]), str(options["compensation"]), float(error),
+                           float(damping), _hand(options["hand"]))
+    except UserError as exc:
+        raise UserError(f"index kmax: {exc}") from None
+    return loop, direction
+
+
+def _hand(value: object) -> Hand | None:
+    if value is None or value is False:
+        return None
+    if value == "grasp" or value is True:
+        return GRASP
+    if isinstance(value, Mapping) and set(value) <= {"mass", "damping", "stiffness"} and all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) for v in value.values()):
+        return Hand(**{k: float(v) for k, v in value.items()})
+    raise UserError(f"the hand is none, 'grasp' or a mapping of mass, damping and stiffness, got {str(value)[:60]!r}")
+
+
+def kmax(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, basis: np.ndarray,
+         options: Mapping[str, object]) -> np.ndarray:
+    """The ``kmax`` index (N/m) at P poses: ``J_v`` (P, 3, n), ``H`` (P, n, n), ``B`` (n, n) or (P, n, n), the range
+    basis ``U`` (P, 3, k) and the options of :data:`KMAX_OPTIONS`."""
+    loop, direction = kmax_loop(options)
     along = None
     if direction is not None:
-        unit = np.asarray(direction, dtype=float)
-        if unit.shape != (3,) or not np.all(np.isfinite(unit)) or not np.linalg.norm(unit) > 0:
-            raise UserError(f"index kmax: the direction is 3 finite numbers, not all 0, got {direction!r}")
-        unit = unit / np.linalg.norm(unit)
-        along = np.swapaxes(basis, 1, 2) @ unit
-        if not np.all(np.abs(np.linalg.norm(along, axis=1) - 1.0) <= 1e-9):
-            raise UserError(f"index kmax: the direction {np.round(unit, 6).tolist()} is not one the handle moves in")
-        along = along[:, None, :]
-    return wall_limits(mobility, damping, float(period), delay, float(virtual_damping), along)
+        inside = np.linalg.norm(np.swapaxes(basis, 1, 2) @ direction, axis=1)
+        if not np.all(np.abs(inside - 1.0) <= 1e-9):
+            raise UserError(f"index kmax: the direction {np.round(direction, 6).tolist()} is not one the handle "
+                            "moves in")
+        along = np.broadcast_to(direction, (len(jacobian), 1, 3))
+    return wall_limits(jacobian, mass, damping, loop, along)

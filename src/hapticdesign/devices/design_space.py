@@ -39,12 +39,14 @@ from hapticdesign.analysis.stiffness.sections import Tube
 from hapticdesign.devices.device_file import (
     actuated_index,
     actuator_from_spec,
+    chain_builder,
     describe_validation_error,
     device_from_spec,
+    home_at,
     link_body_inertias,
     spec_from_mapping,
 )
-from hapticdesign.devices.schema import ActuatorSpec, DeviceFileSpec
+from hapticdesign.devices.schema import HOME_POSITION, ActuatorSpec, DeviceFileSpec
 from hapticdesign.errors import UserError
 from hapticdesign.files import quote
 from hapticdesign.model.actuators import damping_matrix
@@ -200,12 +202,23 @@ class DesignSpace:
         if changes["actuator"]:
             device = self._with_actuators(device, changes["actuator"])
         if changes["parameter"]:
+            device = self._home_follows(device)
             self._check_geometry(device)
         if self.link_bodies and (changes["parameter"] or changes["section"]):
             inertias = link_body_inertias(self.spec, device.mechanism, tubes)
             device = device.with_params({seed_parameter_name(f, body): float(getattr(inertia, f))
                                          for body, inertia in inertias.items() for f in SEED_FIELDS})
         return device
+
+    def _home_follows(self, device: Device) -> Device:
+        """A device whose file gives its home as a handle position (``home: {position: ...}``) keeps the handle
+        there: the home joint values move with the geometry (the inverse kinematics from the file's home, as the
+        file's own loading does), so a design whose loops do not close at the file's joint home is not refused
+        for it."""
+        position = self.spec.home.get(HOME_POSITION)
+        if not isinstance(position, list) or device.mechanism.loops is None:
+            return device
+        return replace(device, builder=chain_builder(self.spec, home_at(device, position)))
 
     def _sections(self, sections: dict[int, dict[str, float]]) -> dict[str, Tube]:
         """The links' sections with ``sections`` (link index to changed sizes) applied, by link name."""

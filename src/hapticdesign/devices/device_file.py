@@ -36,11 +36,11 @@ def device_from_spec(spec: DeviceFileSpec) -> Device:
     device = _device(spec, _closed_loops(spec))
     position = spec.home.get(HOME_POSITION)
     if isinstance(position, list):
-        device = _device(spec, _home_at(device, position))
+        device = _device(spec, home_at(device, position))
     return device
 
 
-def _home_at(device: Device, position: list[float]) -> ClosedLoops:
+def home_at(device: Device, position: list[float]) -> ClosedLoops:
     """The device's loops with their home (and assembly guess) moved to the pose that puts the handle at
     ``position``: the configuration space's inverse kinematics, continued from the home of the joint values."""
     from hapticdesign.analysis.configuration import configuration_of  # the loop solver, for such files only

@@ -10,7 +10,9 @@ other joints move: when the wall joint's row of H, C, G does not depend on them 
 the same 1-DOF loop is exact; otherwise the loop is linear time-varying along the motion and
 :mod:`.analytic_driven` answers with the product of its one-sample transition matrices (exact for a
 cyclic wall joint such as the Phantom's joint 1, linearized in the wall joint otherwise). A Cartesian
-wall, a hand or a closed-loop device in type 2 keeps the start-pose loop (``exact`` false).
+wall, a hand or a closed-loop device in type 2 keeps the start-pose loop (``exact`` false). The growth check
+(:meth:`AnalyticProblem.grows`) takes the loop where the wall holds the joint (:func:`equilibrium_pose`): the free
+joint travels to the spring's rest and oscillates there, so stability is decided there, not at the start.
 
 The seed's criteria are then evaluated on the exact linear response: the closed loop of
 :mod:`.zwidth` (plant discretized exactly, digital side as a discrete state-space system) gives
@@ -80,17 +82,54 @@ def linear_loop(device: Device, config: LoopConfig) -> bool:
     return config.sensors.counts_per_revolution is None and not np.any(plant_friction(device, config)[1] > 0)
 
 
-def linearize(device: Device, sim_type: int, wall_joint: int, config: LoopConfig) -> WallJoint:
-    """The 1-DOF sampled loop of the wall joint at the start pose (see the module docstring)."""
-    if config.sensors.counts_per_revolution is not None:
-        raise UserError("the analytic method has no encoder quantization (not linear): use the simulation")
-    if np.any(plant_friction(device, config)[1] > 0):
-        raise UserError("the analytic method has no Coulomb friction (not linear): use the simulation")
+def start_pose(device: Device, sim_type: int, wall_joint: int) -> tuple[np.ndarray, np.ndarray, dict]:
+    """The rest pose, the pose a run starts at (the other joints at their paths' start) and the paths."""
     rest = rest_pose(device)
     paths = type_paths(sim_type, device.n_dof, wall_joint, rest)
     q0 = rest.copy()
     for j, path in paths.items():
         q0[j] = float(path.sample(np.zeros(1))[0][0])
+    return rest, q0, paths
+
+
+def equilibrium_pose(device: Device, sim_type: int, wall_joint: int, config: LoopConfig,
+                     equilibrium: float) -> np.ndarray:
+    """The pose the wall holds: the start pose with the free joint where the spring rests, ``q_w0 + equilibrium``
+    for a joint wall, and for a Cartesian wall where the handle has moved ``equilibrium`` metres along the wall's
+    direction from its start, ``n^T (x(q) - x(q_0)) = equilibrium``, solved for ``q_w`` by Newton's method on
+    ``J_n,w`` (closed loops closed at every iterate by :func:`~.config.handle_jacobian`'s configuration)."""
+    from hapticdesign.analysis.configuration import configuration_of
+
+    _, q0, _ = start_pose(device, sim_type, wall_joint)
+    q = q0.copy()
+    if not config.wall.cartesian:
+        q[wall_joint] += equilibrium
+        return q
+    space = configuration_of(device)
+    n = np.asarray(config.wall.direction, dtype=float)
+    x0 = float(n @ space.pose(q0)[:3, 3])
+    for _ in range(50):
+        miss = equilibrium - (float(n @ space.pose(q)[:3, 3]) - x0)
+        if abs(miss) <= 1e-13 * max(1.0, abs(equilibrium)):
+            return q
+        reach = float(normal_jacobian(device, config.wall, q)[wall_joint])
+        if abs(reach) < 1e-12:
+            break
+        q[wall_joint] += miss / reach
+    raise UserError(f"the wall's rest {equilibrium:g} m along its direction is not reached by joint {wall_joint + 1} "
+                    "from the start pose")
+
+
+def linearize(device: Device, sim_type: int, wall_joint: int, config: LoopConfig,
+              pose: np.ndarray | None = None) -> WallJoint:
+    """The 1-DOF sampled loop of the wall joint at ``pose`` (default: the start pose; see the module docstring)."""
+    if config.sensors.counts_per_revolution is not None:
+        raise UserError("the analytic method has no encoder quantization (not linear): use the simulation")
+    if np.any(plant_friction(device, config)[1] > 0):
+        raise UserError("the analytic method has no Coulomb friction (not linear): use the simulation")
+    rest, q0, paths = start_pose(device, sim_type, wall_joint)
+    if pose is not None:
+        q0 = np.asarray(pose, dtype=float)
     w = wall_joint
     damping = np.asarray(config.damping if config.damping is not None else device.damping, dtype=float)
     h, g = mass_matrix(device, q0), gravity(device, q0)
@@ -184,6 +223,7 @@ class AnalyticProblem(WallProblem):
     def __post_init__(self) -> None:
         super().__post_init__()
         self.wall = linearize(self.device, self.sim_type, self.wall_joint, self.config)
+        self.held = self._held()
         self.rest = self.equilibrium / self.wall.scale  # the spring's rest in joint units
         self.sub = self.config.steps_per_sample()
         self.samples = int(round(self.config.duration / self.config.sensors.period))
@@ -191,9 +231,16 @@ class AnalyticProblem(WallProblem):
         self.driven = None
         with one_blas_thread():
             self._plant = plant(loop)
+            self._held_plant = plant(self.held.loop)
             self._steps = _sub_steps(loop, self.config.step, self.sub)
             if self._time_varying():
                 self.driven = self._driven_loop()
+
+    def _held(self) -> WallJoint:
+        """The loop linearized where the wall holds the joint (:func:`equilibrium_pose`): its growth decides
+        stability, the start pose's need not (the free joint travels to the rest before it oscillates there)."""
+        pose = equilibrium_pose(self.device, self.sim_type, self.wall_joint, self.config, self.equilibrium)
+        return linearize(self.device, self.sim_type, self.wall_joint, self.config, pose)
 
     def _time_varying(self) -> bool:
         """Type 2 with the wall joint coupled to the motion, on a joint wall of an open chain without a hand."""
@@ -230,12 +277,15 @@ class AnalyticProblem(WallProblem):
         joint = loop.damping ** 2 / loop.inertia if loop.fraction > 0 else 2.0 * loop.damping / loop.period
         return joint / self.wall.scale ** 2
 
-    def _augmented(self, stiffness: float) -> tuple[np.ndarray, np.ndarray, int]:
-        """One-sample map of ``s = [q - q_eq, qd, controller state, 1]`` and the row giving ``u``."""
-        loop, d = self.wall.loop, self.wall.torque
-        s2 = self.wall.scale ** 2
+    def _augmented(self, stiffness: float, wall: WallJoint | None = None) -> tuple[np.ndarray, np.ndarray, int]:
+        """One-sample map of ``s = [q - q_eq, qd, controller state, 1]`` and the row giving ``u`` (of the loop
+        ``wall``, default the start pose's)."""
+        wall = wall or self.wall
+        loop, d = wall.loop, wall.torque
+        s2 = wall.scale ** 2
         ctrl = controller(loop, stiffness * s2, self.config.wall.damping * s2)
-        phi, gamma = np.asarray(self._plant.A), np.asarray(self._plant.B)[:, 0]
+        sampled = self._plant if wall is self.wall else self._held_plant
+        phi, gamma = np.asarray(sampled.A), np.asarray(sampled.B)[:, 0]
         ac, bc, cc, dc = (np.asarray(m) for m in (ctrl.A, ctrl.B, ctrl.C, ctrl.D))
         nc = ac.shape[0]
         n = loop.delay
@@ -285,11 +335,12 @@ class AnalyticProblem(WallProblem):
         one-sample map (the constant state of the affine part left out) exceeds 1, or along a driven motion
         (:mod:`.analytic_driven`) its largest Floquet multiplier over the motion's period (not decided, so
         False, when the run is shorter than a period). For type 1 this is the exact local growth boundary
-        of the wall (Lyapunov's indirect method for the sampled system)."""
+        of the wall (Lyapunov's indirect method for the sampled system), linearized where the wall holds the
+        joint (:func:`equilibrium_pose`)."""
         if self.driven is not None:
             with one_blas_thread():
                 return bool(self.driven.floquet_radius(stiffness) > 1.0)
-        m, _, _ = self._augmented(stiffness)
+        m, _, _ = self._augmented(stiffness, self.held)
         with one_blas_thread():
             radius = float(np.max(np.abs(np.linalg.eigvals(m[:-1, :-1]))))
         return not radius < 1.0

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from hapticdesign.analysis.configuration import configuration_of
+from hapticdesign.analysis.sampled_loop import Hand, SampledLoop
 from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.device import Device
 from hapticdesign.model.inertia import SEED_FIELDS
@@ -72,6 +73,23 @@ class Wall:
         return {"K": "N m/rad", "B": "N m s/rad"}
 
 
+def loop_config(loop: SampledLoop, wall: Wall | None = None, counts_per_revolution: int | None = None,
+                **simulation) -> LoopConfig:
+    """The simulation's configuration of the loop settings ``loop`` (one record for every command): its period,
+    delay, compensation (``gravity``: the gravity term only; ``full``: inertial, Coriolis and gravity terms with the
+    modelling error), wall damper and hand; ``simulation`` the run's own fields (duration, step, ...). The simulated
+    damper uses the sampled velocity: a backward difference with a damper is refused."""
+    if loop.velocity == "difference" and loop.virtual_damping > 0:
+        raise InputError("the simulated wall's damper uses the sampled velocity; a backward-difference damper is "
+                         "analysed exactly only", "velocity")
+    full = loop.compensation == "full"
+    wall = wall or Wall()
+    return LoopConfig(sensors=Sensors(loop.period, counts_per_revolution, loop.delay),
+                      compensator=Compensator(full, full, loop.compensation != "none", loop.model_error),
+                      wall=Wall(wall.joint, wall.stiffness, loop.virtual_damping, wall.equilibrium, wall.direction),
+                      hand=loop.hand, **simulation)
+
+
 def unit_direction(direction) -> np.ndarray:
     """A wall direction as a unit 3-vector; anything else is a :class:`UserError`."""
     try:
@@ -125,29 +143,6 @@ class Sensors:
             raise InputError(f"the sensor delay must be a non-negative number of samples, got {self.delay_samples}", "delay")
         if self.counts_per_revolution is not None and not self.counts_per_revolution >= 1:
             raise InputError(f"the encoder counts per revolution must be at least 1, got {self.counts_per_revolution}", "counts")
-
-
-@dataclass(frozen=True)
-class Hand:
-    """Linear hand at the handle: mass (kg), damping (N s/m), stiffness (N/m), off by default.
-
-    Mapped to the joints through the translational Jacobian at the start pose (a linearized grasp).
-    """
-
-    mass: float = 0.0
-    damping: float = 0.0
-    stiffness: float = 0.0
-
-    def __post_init__(self) -> None:
-        values = (self.mass, self.damping, self.stiffness)
-        if not all(math.isfinite(v) and v >= 0 for v in values):
-            raise InputError(f"the hand's mass, damping and stiffness must be finite and non-negative, got "
-                             f"{', '.join(f'{v:g}' for v in values)}", "hand_mass", "hand_damping", "hand_stiffness")
-
-    @staticmethod
-    def optional(mass: float = 0.0, damping: float = 0.0, stiffness: float = 0.0) -> "Hand | None":
-        """A hand when any of its values is non-zero, else None (no hand)."""
-        return Hand(mass, damping, stiffness) if (mass or damping or stiffness) else None
 
 
 @dataclass(frozen=True)

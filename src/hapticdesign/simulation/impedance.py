@@ -28,16 +28,20 @@ from functools import cached_property
 
 import numpy as np
 
+from hapticdesign.analysis.configuration import configuration_of, handle_pose
 from hapticdesign.analysis.dynamics.device import mass_matrix
+from hapticdesign.analysis.sampled_loop import SampledLoop, handle_limits
 from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation.analytic import GROWS, AnalyticProblem, linear_loop
 from hapticdesign.simulation.boundary import envelope_grows
 from hapticdesign.simulation.config import (
-    LoopConfig, Wall, compensator_device, normal_jacobian, require_device, require_options, rest_pose, unit_direction,
+    LoopConfig, Wall, compensator_device, handle_jacobian, loop_config, normal_jacobian, require_device, require_options, rest_pose,
+    unit_direction,
 )
 from hapticdesign.simulation.loop import simulate, tables_of
 from hapticdesign.simulation.criteria import Criteria, Verdict, WallProblem, require_closed, type_paths
+from hapticdesign.simulation.paths import Held
 from hapticdesign.workload import require_plant_steps
 
 
@@ -114,6 +118,114 @@ class ImpedanceProblem(WallProblem):
 
 
 @dataclass(frozen=True)
+class StabilityLimit:
+    """The exact stability limit of a wall (N/m along a Cartesian wall, N m/rad or N/m on a joint) under the loop
+    settings ``loop``, linearized at ``pose``, the pose the wall holds (actuated coordinates)."""
+
+    stiffness: float
+    pose: np.ndarray
+    loop: SampledLoop
+
+
+def wall_pose(device: Device, wall_joint: int = 0, equilibrium: float = 0.01, direction=None) -> np.ndarray:
+    """The pose the wall holds, from the rest pose (:func:`~.config.rest_pose`): the wall joint moved by
+    ``equilibrium`` for a joint wall; for a Cartesian wall the handle moved ``equilibrium`` metres along the
+    direction, by inverse kinematics from the rest pose (closed loops closed; to first order in the equilibrium the
+    pose a free handle comes to rest at)."""
+    rest = rest_pose(device)
+    if direction is None:
+        pose = rest.copy()
+        pose[wall_joint] += equilibrium
+        return pose
+    start = configuration_of(device).pose(rest)[:3, 3]
+    return handle_pose(device, start + equilibrium * unit_direction(direction), start=rest).q
+
+
+def stability_limit(device: Device, loop: SampledLoop | None = None, wall_joint: int = 0, equilibrium: float = 0.01,
+                    direction=None, k_max: float = 1e9) -> StabilityLimit:
+    """The exact stability limit of a wall on ``wall_joint`` (or along the Cartesian ``direction`` at the handle)
+    with every actuated joint free but ``loop.held``, linearized where the wall holds the device (:func:`wall_pose`;
+    :func:`hapticdesign.analysis.sampled_loop.handle_limits`). Coulomb friction and quantization are left out: this
+    is the limit of the loop's linear part."""
+    require_device(device)
+    loop = loop or SampledLoop()
+    pose = wall_pose(device, wall_joint, equilibrium, direction)
+    jv = handle_jacobian(device, pose)[:3]
+    if direction is None:
+        spring = np.eye(device.n_dof)[wall_joint]
+    else:
+        spring = unit_direction(direction) @ jv
+        if not np.linalg.norm(spring) > 1e-12 * max(np.linalg.norm(jv), 1e-300):
+            raise UserError("the handle does not move along the wall's direction at the pose the wall holds")
+    limit = handle_limits(jv[None], mass_matrix(device, pose)[None], device.damping_matrix, spring[None], loop,
+                          k_max=k_max)
+    return StabilityLimit(float(limit[0]), pose, loop)
+
+
+def device_counts(device: Device) -> int | None:
+    """The encoder counts per joint revolution the simulation quantizes with: the coarsest of the device's motors
+    (``cpr`` x quadrature x gear ratio), None when a motor states no encoder."""
+    counts = [a.counts_per_radian for a in device.actuators]
+    if not counts or any(c is None for c in counts):
+        return None
+    return max(1, int(round(2.0 * math.pi * min(counts))))
+
+
+ESCAPE = 10.0
+"""A simulated wall whose coordinate leaves its start by this many times the spring's rest has grown."""
+
+
+def simulated_limit(device: Device, loop: SampledLoop | None = None, wall_joint: int = 0, equilibrium: float = 0.01,
+                    direction=None, counts: int | None = None, duration: float = 2.0, rel_tol: float = 1e-2,
+                    start: float | None = None, k_limit: float = 1e7, friction: bool = True) -> float:
+    """The simulated growth boundary of the wall, every joint free but ``loop.held``: the device's Coulomb friction
+    (smoothed, :data:`~.config.FRICTION_VELOCITY`) and ``counts`` (encoder quantization) in the loop, the spring
+    bisected (to ``rel_tol``) on the growth of the wall coordinate's oscillation about its rest over ``duration``
+    (the last quarter's envelope against the second's; a run leaving the start by :data:`ESCAPE` times the rest's
+    distance grows, whatever pose it wanders to and settles at); ``friction`` False leaves the device's friction out. Where the
+    loop is linear it converges to
+    :func:`stability_limit` (the tests check it). ``start``: the first stiffness tried (default: the exact limit of
+    the linear part); inf when nothing up to ``k_limit`` grows."""
+    loop = loop or SampledLoop()
+    rest = rest_pose(device)
+    paths = {j: Held(float(rest[j])) for j in loop.held}
+    if direction is not None:
+        direction = tuple(unit_direction(direction).tolist())
+    base = loop_config(loop, Wall(wall_joint, 1.0, 0.0, equilibrium + (0.0 if direction else float(rest[wall_joint])),
+                                  direction), counts, duration=duration, safety_limit=None,
+                       stop_excursion=ESCAPE * abs(equilibrium) if equilibrium else 1e-3,
+                       coulomb=None if friction else (0.0,) * device.n_dof)
+    plant, model = tables_of(device), tables_of(compensator_device(device, base.compensator))
+
+    def grows(k: float) -> bool:
+        cfg = replace(base, wall=replace(base.wall, stiffness=k))
+        trace = simulate(device, cfg, paths, plant=plant, model=model)
+        if trace.status != 0:  # diverged, or a closed-loop device's growing motion left the assembly branch
+            return True
+        return envelope_grows(trace.wall_position - wall_rest(trace, cfg.wall))
+
+    k = start if start is not None else stability_limit(device, loop, wall_joint, equilibrium, direction).stiffness
+    k = min(max(k, 1e-6), k_limit) if math.isfinite(k) else k_limit
+    if grows(k):
+        lo, hi = 0.0, k
+        while lo == 0.0 and hi > 1e-6:
+            if grows(hi / 2.0):
+                hi /= 2.0
+            else:
+                lo = hi / 2.0
+    else:
+        lo, hi = k, 2.0 * k
+        while not grows(hi):
+            lo, hi = hi, 2.0 * hi
+            if hi > k_limit:
+                return math.inf
+    while hi - lo > rel_tol * hi:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (lo, mid) if grows(mid) else (mid, hi)
+    return 0.5 * (lo + hi)
+
+
+@dataclass(frozen=True)
 class RangeResult:
     """The maximum stable impedance (0 when no grid value passes) and the first failing verdict.
 
@@ -132,22 +244,36 @@ class RangeResult:
     """For the analytic method: whether the linearized loop is exact for this device and type."""
     k_true_boundary: float | None = None
     """The oscillation-growth boundary (:func:`growth_boundary`), when asked for."""
+    limit: StabilityLimit | None = None
+    """For the ``limit`` method: the stability limit itself (off the grid) and where it was taken."""
+
+    @property
+    def verdict(self) -> str:
+        """What decided ``k_max``: the stability limit of the sampled loop, or the seed's performance criteria."""
+        if self.method == "limit":
+            return "stability limit (spectral radius of the sampled loop at the wall's equilibrium)"
+        return "seed performance criteria (overshoot, settling, safety switch; seed 000 §4.1.2)"
 
     def as_dict(self) -> dict:
         first = self.first_unstable
         extra = {} if self.exact is None else {"analytic_exact": self.exact}
+        if self.limit is not None:
+            extra = {"k_limit_exact": self.limit.stiffness, "pose": self.limit.pose.tolist(),
+                     "settings": self.limit.loop.as_dict()}
         return {
+            "verdict": self.verdict,
             **extra,
             "k_max": float(self.k_max),
             "k_min": self.k_min,
             "resolution": self.resolution,
             "criterion": first.criterion if first else "none (limit reached)",
             "first_unstable_k": None if first is None else float(first.stiffness),
-            "peak_at_first_unstable": None if first is None else first.peak,
+            "peak_at_first_unstable": None if first is None or math.isnan(first.peak) else first.peak,
             "stopped_at_first_unstable": None if first is None else first.stopped_at,
             "simulations": self.simulations,
             "method": self.method,
-            **({} if self.k_true_boundary is None else {"k_true_boundary": self.k_true_boundary}),
+            **({} if self.k_true_boundary is None else {"k_true_boundary": self.k_true_boundary
+                                                        if math.isfinite(self.k_true_boundary) else None}),
         }
 
 
@@ -322,11 +448,48 @@ def growth_boundary(problem: ImpedanceProblem, rel_tol: float = 1e-4, margin: fl
     return 0.5 * (lo + hi)
 
 
+UNSTABLE = "unstable (spectral radius of the sampled loop above 1)"
+"""The verdict of the first grid stiffness above the stability limit (method ``limit``)."""
+
+
+TOUCH = 0.001
+"""The wall's rest from the start (m, or rad on a joint) of a simulated limit asked at the start pose: a touch."""
+
+
+def limit_range(device: Device, loop: SampledLoop | None = None, k_limit: float = 200.0, wall_joint: int = 0,
+                equilibrium: float = 0.01, resolution: float | None = None, wall_direction=None,
+                counts: int | None = None, simulate: bool = False) -> RangeResult:
+    """The stable range on the grid ``R, 2R, 3R ...`` (``R`` = ``resolution``, default 1) from the exact stability
+    limit of the sampled loop at the wall's equilibrium (:func:`stability_limit`): every grid stiffness up to the
+    limit is stable, the first one above it is not; no performance criteria. With ``simulate`` the simulated limit
+    with the device's dry friction and quantization (``counts``, default the device's encoders) is added beside it
+    (:func:`simulated_limit`, the wall resting ``equilibrium`` or :data:`TOUCH` from the start)."""
+    grid = 1.0 if resolution is None else float(resolution)
+    limit = stability_limit(device, loop, wall_joint, equilibrium, wall_direction)
+    top = int(math.floor(k_limit / grid + 1e-9))
+    count = min(int(math.floor(limit.stiffness / grid)) if math.isfinite(limit.stiffness) else top, top)
+    above = Verdict((count + 1) * grid, False, UNSTABLE, math.nan, math.nan) if count < top else None
+    simulated = None
+    if simulate:
+        simulated = simulated_limit(device, loop, wall_joint, equilibrium or TOUCH, wall_direction,
+                                    device_counts(device) if counts is None else counts,
+                                    start=max(limit.stiffness, 1e-3) if math.isfinite(limit.stiffness) else None)
+    return RangeResult(count * grid, above.criterion if above else "none", 0, above, "limit",
+                       grid if count >= 1 else None, grid, k_true_boundary=simulated, limit=limit)
+
+
 def impedance_range(device: Device, sim_type: int = 1, method: str = "fast", k_limit: int = 200,
                     criteria: Criteria | None = None, config: LoopConfig | None = None,
                     wall_joint: int = 0, equilibrium: float = 0.01,
-                    resolution: float | None = None, wall_direction=None, true_boundary: bool = False) -> RangeResult:
+                    resolution: float | None = None, wall_direction=None, true_boundary: bool = False,
+                    loop: SampledLoop | None = None, counts: int | None = None, simulate: bool = False) -> RangeResult:
     """Maximum stable impedance of ``wall_joint`` for simulation type 1 or 2 (seed §4.1.2).
+
+    ``method="limit"`` answers from the stability limit of the sampled loop under the settings ``loop`` at the wall's
+    equilibrium, every joint free (:func:`limit_range`, with ``simulate`` its simulated limit with dry friction and
+    ``counts`` beside it; ``sim_type``, ``criteria`` and ``config`` do not enter);
+    the other methods judge the seed's performance criteria on simulated (or exact linear) runs of type 1 or 2
+    under ``config``.
 
     With ``wall_direction`` (x, y, z) the wall is Cartesian: K in N/m along that direction at the
     handle, ``equilibrium`` in metres from the handle's start, the criteria on the handle's
@@ -347,8 +510,9 @@ def impedance_range(device: Device, sim_type: int = 1, method: str = "fast", k_l
     require_options(sim_type, config, LoopConfig)
     if criteria is not None and not isinstance(criteria, Criteria):
         raise UserError(f"criteria must be a Criteria, got {type(criteria).__name__}")
-    if method not in ("fast", "linear", "analytic"):
-        raise InputError(f"method (of the search) must be 'fast', 'linear' or 'analytic', got {method!r}", "method")
+    if method not in ("fast", "linear", "analytic", "limit"):
+        raise InputError(f"method (of the search) must be 'limit', 'fast', 'linear' or 'analytic', got {method!r}",
+                         "method")
     if isinstance(k_limit, bool) or not isinstance(k_limit, (int, float)) or not math.isfinite(k_limit):
         raise UserError(f"the stiffness limit must be a number, got {k_limit!r}")
     if k_limit < 1:
@@ -358,6 +522,12 @@ def impedance_range(device: Device, sim_type: int = 1, method: str = "fast", k_l
     if resolution is not None and resolution > k_limit:
         raise InputError(f"the stiffness resolution {resolution:g} is above the stiffness limit {k_limit:g}",
                          "resolution", "k_limit")
+    if method == "limit":
+        if true_boundary:
+            raise InputError("the growth boundary is a simulated check of the seed's searches; the limit method is "
+                             "the boundary itself", "true_boundary", "method")
+        return limit_range(device, loop, k_limit, wall_joint, equilibrium, resolution, wall_direction, counts,
+                           simulate)
     config = config or LoopConfig(wall=Wall())
     if wall_direction is not None:
         config = replace(config, wall=replace(config.wall, direction=tuple(unit_direction(wall_direction).tolist())))

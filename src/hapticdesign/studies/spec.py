@@ -24,19 +24,32 @@ friction reach the handle as follows:
   position whose corners, edge midpoints and face centres the handle reaches from home by inverse
   kinematics (:func:`hapticdesign.analysis.configuration.handle_pose`) within the joint limits and without a
   singularity, found by bisection.
-- ``renderable_stiffness`` (N/m): the exact stability limit of a virtual spring sampled every T with a
-  delay of one sample (:func:`hapticdesign.analysis.sampled_loop.exact_boundary`) on the 1-DOF model of the
-  handle along a direction u: mass ``1 / (u^T J_v H^-1 J_v^T u)`` and damping ``u^T J_v^+T B J_v^+ u`` (B the
-  joint and motor viscous damping); the smallest over the axes, the principal directions and 60 evenly
-  spread directions: the ``kmax`` design index (:mod:`hapticdesign.analysis.wall_stiffness`). A pure
-  spring uses the position only, so the velocity estimate does not enter. Beside it the passivity bounds of Abbott & Okamura (2005):
-  ``2 b / T`` (viscous) and ``2 f_c / Delta`` (Coulomb friction against encoder quantization), with the
-  smallest damping (eigenvalue) and friction over directions and the resolution ``Delta``.
+- ``renderable_stiffness`` (N/m), side by side, under one set of loop settings
+  (:class:`~hapticdesign.analysis.sampled_loop.SampledLoop`, stated in the output; practice's by default: 1 kHz,
+  one sample of delay, backward-difference velocity, gravity compensation):
+
+  - ``exact``: the exact stability limit of the n-joint sampled loop, every joint free, H and B (the joint and
+    motor viscous damping) at the pose, the smallest over the axes, the principal directions and 60 evenly spread
+    directions (:mod:`hapticdesign.analysis.wall_stiffness`, the ``kmax`` design index's too), and ``direction``,
+    the worst one. A pure spring uses the position only, so the velocity estimate does not enter;
+  - ``exact_with_hand``: the same with the hand (``hand``: the default grasp,
+    :data:`~hapticdesign.analysis.sampled_loop.GRASP`, unless the settings hold one) as a linear
+    mass-spring-damper at the handle;
+  - ``simulated``: the simulated growth boundary along the worst direction with the device's dry friction and
+    its coarsest encoder's quantization (``simulated_counts`` per joint revolution), the wall's rest
+    ``simulated_touch`` from the handle's start (:func:`hapticdesign.simulation.impedance.simulated_limit`);
+  - the passivity bounds of Abbott & Okamura (2005) and Diolaiti et al. (2006): ``2 b / T`` (viscous) and
+    ``2 f_c / Delta`` (Coulomb friction against encoder quantization), with the smallest damping (eigenvalue) and
+    friction over directions and the resolution ``Delta``.
+
+  The model's viscous damping alone is small on most devices, so ``exact`` is far below the walls vendors and
+  CHAI3D render (Phantom Premium 1.5 800 N/m, Falcon 3000 N/m, Touch 400 N/m): the hand and the drives' dry
+  friction dissipate the energy the sampled spring creates, which ``exact_with_hand`` and ``simulated`` show.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -46,9 +59,9 @@ from hapticdesign.analysis.metrics.indices import INDICES, HandleStates
 from hapticdesign.errors import UserError
 from hapticdesign.model.actuators import transmission
 from hapticdesign.model.device import Device
+from hapticdesign.analysis.sampled_loop import GRASP, SampledLoop
+from hapticdesign.analysis.wall_stiffness import wall_limit, worst_direction
 
-SERVO_RATE = 1000.0
-"""Hz, the default sampling rate of the renderable-stiffness limit."""
 CUBE_SEARCH = (0.0, 0.4, 12)
 """Bisection of the workspace cube's half edge: lower and upper bound (m) and number of halvings."""
 
@@ -118,9 +131,41 @@ def backdrive_friction(device: Device, h: Handle) -> tuple[float, float] | None:
     return float(1.0 / np.linalg.norm(inv, axis=0).max()), float(np.linalg.norm(signs @ c, axis=1).max())
 
 
-def renderable_stiffness(device: Device, h: Handle, rate: float = SERVO_RATE, delay: int = 1) -> float:
-    """The smallest exact wall limit over directions: the ``kmax`` index sampled at ``rate``."""
-    return _index("kmax", h, period=1.0 / rate, delay=delay)
+def renderable_stiffness(device: Device, h: Handle, loop: SampledLoop | None = None) -> float:
+    """The smallest exact wall limit over directions, every joint free
+    (:func:`hapticdesign.analysis.wall_stiffness.wall_limit`)."""
+    return wall_limit(h.jacobian, h.states.H[0], device.damping_matrix, loop or SampledLoop())
+
+
+TOUCH = 0.001
+"""m: the wall's rest from the handle's start in the simulated limit, a touch (small enough that the free handle's
+drift along the wall stays small, large against one encoder count)."""
+SIMULATED_CAP = 1e5
+"""N/m: the simulated limit's search stops here (reported as inf above it)."""
+
+
+def renderable(device: Device, h: Handle, loop: SampledLoop, simulate: bool = True) -> dict:
+    """The renderable-stiffness rows: the exact limit without the hand (worst direction) and with the hand, the
+    simulated limit along that direction with the device's dry friction and encoder quantization, and the passivity
+    bounds (see the module docstring)."""
+    from hapticdesign.simulation.impedance import device_counts, simulated_limit
+
+    exact, direction = worst_direction(h.jacobian, h.states.H[0], device.damping_matrix, replace(loop, hand=None))
+    hand = loop.hand or GRASP
+    res = resolution(device, h)
+    friction = backdrive_friction(device, h)
+    simulated = None
+    if simulate:
+        simulated = simulated_limit(device, replace(loop, hand=None), direction=direction, equilibrium=TOUCH,
+                                    counts=device_counts(device), start=max(exact, 1.0), k_limit=SIMULATED_CAP)
+    return {
+        "exact": exact, "direction": direction,
+        "exact_with_hand": renderable_stiffness(device, h, replace(loop, hand=hand)), "hand": hand.as_dict(),
+        "simulated": simulated, "simulated_counts": device_counts(device), "simulated_touch": TOUCH,
+        "passivity_viscous": 2.0 * float(np.linalg.eigvalsh(h.states.cartesian_damping[0]).min()) * loop.rate,
+        "passivity_coulomb": None if friction is None or res is None else 2.0 * friction[0] / res,
+        "settings": replace(loop, hand=None).as_dict(), "rate": loop.rate, "delay_samples": loop.delay,
+    }
 
 
 def workspace_cube(device: Device, h: Handle) -> float:
@@ -146,13 +191,16 @@ def workspace_cube(device: Device, h: Handle) -> float:
     return 2 * lo
 
 
-def spec_sheet(device: Device, q=None, rate: float = SERVO_RATE, workspace: bool = True) -> dict:
-    """Every quantity of the module docstring at pose ``q`` (default: home), as a JSON-ready dict."""
+def spec_sheet(device: Device, q=None, loop: SampledLoop | None = None, workspace: bool = True,
+               simulate: bool = True) -> dict:
+    """Every quantity of the module docstring at pose ``q`` (default: home), as a JSON-ready dict; the renderable
+    stiffness under the loop settings ``loop`` (default: practice's, :class:`SampledLoop`), its simulated limit
+    only with ``simulate``."""
+    loop = loop or SampledLoop()
     q = configuration_of(device).home.copy() if q is None else np.asarray(q, dtype=float)
     h = handle_at(device, q)
     res = resolution(device, h)
     friction = backdrive_friction(device, h)
-    smallest_damping = float(np.linalg.eigvalsh(h.states.cartesian_damping[0]).min())
     mass = apparent_mass(device, h)
     sheet = {
         "device": device.name, "q": q, "handle": h.position, "dimensions": h.basis.shape[1],
@@ -163,11 +211,7 @@ def spec_sheet(device: Device, q=None, rate: float = SERVO_RATE, workspace: bool
         "backdrive_friction": None if friction is None else {"min": friction[0], "max": friction[1]},
         "stiffness": _stiffness(device, h),
         "workspace": {"cube": 1000.0 * workspace_cube(device, h)} if workspace else None,
-        "renderable_stiffness": {
-            "exact": renderable_stiffness(device, h, rate), "rate": rate, "delay_samples": 1,
-            "passivity_viscous": 2.0 * smallest_damping * rate,
-            "passivity_coulomb": None if friction is None or res is None else 2.0 * friction[0] / res,
-        },
+        "renderable_stiffness": renderable(device, h, loop, simulate),
         "units": {"resolution": "m", "force_continuous": "N", "force_peak": "N", "apparent_mass": "kg",
                   "backdrive_friction": "N", "stiffness": "N/m", "workspace": "mm", "renderable_stiffness": "N/m",
                   "rate": "Hz", "handle": "m", "q": "rad or m"},

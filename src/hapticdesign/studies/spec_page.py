@@ -26,7 +26,9 @@ VENDOR = {
                                  "the model alone (its only damping is 0.0005 N m s/rad per joint, which bounds "
                                  "2b/T) but below the Coulomb passivity bound 2 f_c / Delta: the devices' dry "
                                  "friction and the user's hand dissipate the energy the sampled spring creates "
-                                 "(Abbott & Okamura 2005; Diolaiti et al. 2006)."),
+                                 "(Abbott & Okamura 2005; Diolaiti et al. 2006), as the limits with the hand and "
+                                 "with friction and quantization show; a firmer grasp than the default raises the "
+                                 "former."),
     },
     "falcon": {
         "renderable_stiffness": (3000.0, "N/m", "the file has no damping or friction data (libnifalcon gives "
@@ -39,7 +41,7 @@ VENDOR = {
 ROWS = [("resolution", "resolution", "mm"), ("force_continuous", "continuous force", "N"),
         ("force_peak", "peak force", "N"), ("apparent_mass", "apparent mass (min - max)", "kg"),
         ("backdrive_friction", "backdrive friction (min - max)", "N"), ("stiffness", "stiffness (VJM)", "N/m"),
-        ("workspace", "workspace cube edge", "mm"), ("renderable_stiffness", "renderable stiffness (exact)", "N/m")]
+        ("workspace", "workspace cube edge", "mm"), ("renderable_stiffness", "renderable stiffness", "N/m")]
 
 
 def value_text(sheet: dict, key: str) -> str:
@@ -56,11 +58,15 @@ def value_text(sheet: dict, key: str) -> str:
     if key == "workspace":
         return f"{value['cube']:.4g}"
     if key == "renderable_stiffness":
-        if value["passivity_viscous"] == 0.0 and not value["passivity_coulomb"]:
-            return "not stated: the file has no damping or friction, which bound it"
-        return (f"{value['exact']:.4g} (at {value['rate']:g} Hz, one sample of delay); passivity: 2b/T = "
-                f"{value['passivity_viscous']:.4g}, 2 f_c / Delta = "
-                + ("n/a" if value["passivity_coulomb"] is None else f"{value['passivity_coulomb']:.4g}"))
+        hand = value["hand"]
+        simulated = "not run" if value["simulated"] is None else f"{value['simulated']:.4g}"
+        exact = ("not stated (the file has no damping or friction, which bound it)"
+                 if value["passivity_viscous"] == 0.0 and not value["passivity_coulomb"] else f"{value['exact']:.4g}")
+        return (f"exact {exact}; with the hand ({hand['mass']:g} kg, {hand['damping']:g} N s/m, "
+                f"{hand['stiffness']:g} N/m) {value['exact_with_hand']:.4g}; simulated with dry friction and "
+                f"quantization {simulated}; passivity: 2b/T = {value['passivity_viscous']:.4g}, 2 f_c / Delta = "
+                + ("n/a" if value["passivity_coulomb"] is None else f"{value['passivity_coulomb']:.4g}")
+                + f" (at {value['rate']:g} Hz, delay {value['delay_samples']}, every joint free)")
     return f"{value:.4g}"
 
 

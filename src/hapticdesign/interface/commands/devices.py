@@ -89,6 +89,14 @@ def spec(
     out: Optional[Path] = typer.Option(None, "--out", help="Folder for spec.html (beside the vendor's numbers where "
                                        "known) and spec.json."),
     rate: float = typer.Option(1000.0, "--rate", min=1.0, max=1e6, help="Servo rate of the renderable stiffness [Hz]."),
+    delay: int = typer.Option(1, "--delay", min=0, max=100, help="Delay of the renderable stiffness's loop [samples]."),
+    compensation: str = typer.Option("gravity", "--compensation", help="none, gravity or full (inverse dynamics)."),
+    hand_mass: Optional[float] = typer.Option(None, "--hand-mass", help="The hand of the 'with the hand' limit [kg]; "
+                                              "default: a light grasp (docs/simulation.md)."),
+    hand_damping: Optional[float] = typer.Option(None, "--hand-damping", help="Its damping [N s/m]."),
+    hand_stiffness: Optional[float] = typer.Option(None, "--hand-stiffness", help="Its stiffness [N/m]."),
+    simulate: bool = typer.Option(True, "--simulate/--no-simulate", help="Simulate the renderable stiffness with "
+                                  "the file's dry friction and encoder quantization (a few seconds)."),
     workspace: bool = typer.Option(True, "--workspace/--no-workspace", help="Search the workspace cube (inverse "
                                    "kinematics to 26 points per bisection step; the slow part)."),
     strict: bool = STRICT,
@@ -99,6 +107,7 @@ def spec(
     force, apparent mass, backdrive friction, VJM stiffness (seed 001 §5.2), workspace cube and renderable
     stiffness beside the passivity bounds."""
     from hapticdesign.files import dumps_json, write_atomically
+    from hapticdesign.analysis.sampled_loop import GRASP, Hand, SampledLoop
     from hapticdesign.studies.spec import spec_sheet
     from hapticdesign.interface.report.spec_page import spec_page
     from hapticdesign.interface.round_off import without_round_off
@@ -108,7 +117,11 @@ def spec(
 
         dev = resolve_device(preset, device, params, strict=strict)
         pose = None if q is None else parse_vector(q, dev.n_dof, "q")
-        sheet = spec_sheet(dev, pose, rate=rate, workspace=workspace)
+        loop = SampledLoop(period=1.0 / rate, delay=delay, compensation=compensation,
+                           hand=Hand(*(GRASP.mass if hand_mass is None else hand_mass,
+                                       GRASP.damping if hand_damping is None else hand_damping,
+                                       GRASP.stiffness if hand_stiffness is None else hand_stiffness)))
+        sheet = spec_sheet(dev, pose, loop, workspace=workspace, simulate=simulate)
         sheet["handle"] = without_round_off(sheet["handle"])  # a position's 1e-18 m residue is 0
         if out is not None:
             figures = []

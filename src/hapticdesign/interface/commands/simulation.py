@@ -50,42 +50,87 @@ HAND_DAMPING = typer.Option(0.0, help="Hand damping at the handle [N s/m].")
 HAND_STIFFNESS = typer.Option(0.0, help="Hand stiffness at the handle [N/m].")
 
 
+SEED_PRESETS = ("phantom-3dof", "phantom-6dof")
+"""The seed's devices: their searches keep the seed's settings and performance criteria by default."""
+SETTINGS = typer.Option(
+    None, help="Loop settings: practice (1 kHz, one sample of delay, backward-difference velocity, gravity "
+               "compensation; every other device's default) or seed (full inverse-dynamics compensation, no delay, "
+               "sampled velocity; the default of the seed's Phantom presets). The options below change single ones.")
+COMPENSATION = typer.Option(None, help="none, gravity or full (inverse dynamics with the sampled acceleration); "
+                                       "default: the --settings' own.")
+VELOCITY = typer.Option(None, help="The wall damper's velocity: difference (backward difference of positions) or "
+                                   "sampled; default: the --settings' own.")
+HOLD = typer.Option(None, help="Joints held fixed under the limit method (e.g. 2,3); default: every joint free.")
+
+
+def seed_settings(preset: Optional[str], device: Optional[Path], settings: Optional[str]) -> bool:
+    """Whether a command uses the seed's settings: asked for, or by default on the seed's Phantom presets."""
+    if settings not in (None, "practice", "seed"):
+        raise UserError(f"--settings must be practice or seed, got {settings!r}")
+    if settings is not None:
+        return settings == "seed"
+    return device is None and (preset is None or preset in SEED_PRESETS)
+
+
+def sampled_loop(seed: bool, period: float, delay: Optional[int], velocity: Optional[str],
+                 compensation: Optional[str], error_percent: float, wall_damping: float, hand_mass: float = 0.0,
+                 hand_damping: float = 0.0, hand_stiffness: float = 0.0, held: tuple[int, ...] = ()):
+    """The one loop record of a command's options: the seed's or practice's settings with the options given."""
+    from hapticdesign.analysis.sampled_loop import Hand, SampledLoop
+
+    changes = {"period": period, "model_error": error_percent, "virtual_damping": wall_damping,
+               "hand": Hand.optional(hand_mass, hand_damping, hand_stiffness), "held": held,
+               **{k: v for k, v in (("delay", delay), ("velocity", velocity), ("compensation", compensation))
+                  if v is not None}}
+    return SampledLoop.seed(**changes) if seed else SampledLoop(**changes)
+
+
 def impedance_range_command(
     preset: Optional[str] = PRESET,
     device: Optional[Path] = DEVICE,
     params: Optional[Path] = PARAMS,
-    sim_type: int = typer.Option(1, "--type", help="1: other joints held at 0; 2: driven at 0.52 sin(3 pi t)."),
+    sim_type: int = typer.Option(1, "--type", help="Seed's criteria: 1 other joints held at 0; 2 driven at "
+                                                   "0.52 sin(3 pi t)."),
     joint: str = typer.Option("1", help="Joint carrying the virtual wall (1-based or coordinate name)."),
-    equilibrium: float = typer.Option(0.01, help="Wall equilibrium [rad]; the joints start at 0. With "
-                                                  "--wall-direction: metres along it from the handle's start."),
+    equilibrium: Optional[float] = typer.Option(
+        None, help="Wall equilibrium from the start [rad, or m along --wall-direction]: where the wall holds the "
+                   "device and the limit is taken. Default: 0 (the home pose, as spec) for the limit method, the "
+                   "seed's 0.01 step for the seed's criteria."),
     wall_direction: Optional[str] = WALL_DIRECTION,
-    method: str = typer.Option("fast", help="fast (doubling + bisection), linear (K = 1, 2, 3, ...) or analytic "
-                                            "(the exact linear response of the sampled loop at the start pose, "
-                                            "no ODE integration; exact for type 1 and LN = 0 designs)."),
+    settings: Optional[str] = SETTINGS,
+    method: Optional[str] = typer.Option(
+        None, help="limit (the stability limit of the sampled loop at the wall's equilibrium, every joint free: "
+                   "practice's default), or the seed's performance criteria (overshoot, settling) on runs: fast "
+                   "(doubling + bisection; the seed presets' default), linear (K = 1, 2, 3, ...) or analytic (the "
+                   "exact linear response, no ODE integration)."),
     resolution: Optional[float] = typer.Option(
-        None, help="Stiffness grid R, 2R, 3R ... [N m/rad, or N/m for a prismatic joint]; reports k_min and k_max "
-                   "on it. Default: the seed's integer scan."),
-    k_limit: int = typer.Option(200, help="Largest stiffness tried [N m/rad]."),
+        None, help="Stiffness grid R, 2R, 3R ... [N m/rad, N/m for a prismatic joint or a Cartesian wall]; "
+                   "reports k_min and k_max on it. Default: the integer grid 1, 2, 3 ..."),
+    k_limit: int = typer.Option(200, help="Largest stiffness tried [N m/rad, or N/m]."),
     overshoot: float = typer.Option(0.012, help="Overshoot limit, peak excursion from the start, for the seed's "
                                                 "0.01 step [rad]; the limits scale with --equilibrium."),
     settle_tolerance: float = typer.Option(0.002, help="Settled: within this of the equilibrium at the end, for "
                                                        "the seed's 0.01 step [rad]."),
     settle_window: float = typer.Option(0.5, help="Final window checked for settling [s]."),
     safety: float = typer.Option(0.06, help="Safety switch excursion for the seed's 0.01 step [rad] (Figure 4.7)."),
-    true_boundary: bool = typer.Option(False, "--true-boundary", help="Also bisect the oscillation-growth boundary."),
+    true_boundary: bool = typer.Option(False, "--true-boundary", help="Also bisect the oscillation-growth boundary "
+                                       "(the limit method: simulated with the file's dry friction and quantization)."),
     duration: float = typer.Option(5.0, help="Simulated time per stiffness [s]."),
     period: float = PERIOD, step: float = STEP, step_control: str = STEP_CONTROL, counts: Optional[int] = COUNTS,
-    delay: int = DELAY,
-    error_percent: float = ERROR, inertial: bool = INERTIAL, coriolis: bool = CORIOLIS, gravity: bool = GRAVITY,
+    delay: Optional[int] = typer.Option(None, help="Sensor delay in samples (default: the --settings' own)."),
+    velocity: Optional[str] = VELOCITY, compensation: Optional[str] = COMPENSATION, error_percent: float = ERROR,
     wall_damping: float = WALL_DAMPING, hand_mass: float = HAND_MASS, hand_damping: float = HAND_DAMPING,
-    hand_stiffness: float = HAND_STIFFNESS,
+    hand_stiffness: float = HAND_STIFFNESS, hold: Optional[str] = HOLD,
     strict: bool = STRICT,
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
     force: bool = FORCE,
 ) -> None:
-    """Maximum stable impedance of one joint under a virtual spring (seed 000 §4.1.2-4.1.3)."""
-    from hapticdesign.simulation.config import Compensator, Hand, LoopConfig, Sensors, Wall, unit_direction
+    """Maximum stable impedance of a virtual wall on a joint or at the handle (seed 000 §4.1.2-4.1.3).
+
+    Practice's default is the stability limit of the sampled loop; the seed's Phantom presets keep the seed's
+    settings and performance criteria. The output states the settings and the verdict used."""
+    from hapticdesign.simulation.config import Wall, loop_config, unit_direction
     from hapticdesign.simulation.impedance import Criteria, impedance_range
     from hapticdesign.simulation.loop import joint_index
 
@@ -93,18 +138,25 @@ def impedance_range_command(
         from hapticdesign.devices.loading import resolve_device
 
         dev = resolve_device(preset, device, params, strict=strict)
-        config = LoopConfig(duration=duration, step=step, step_control=step_control,
-                            sensors=Sensors(period, counts, delay),
-                            compensator=Compensator(inertial, coriolis, gravity, error_percent),
-                            wall=Wall(damping=wall_damping), hand=Hand.optional(hand_mass, hand_damping, hand_stiffness))
+        seed = seed_settings(preset, device, settings)
+        method = method or ("fast" if seed else "limit")
+        if equilibrium is None:
+            equilibrium = 0.0 if method == "limit" else 0.01
+        held = () if hold is None else tuple(joint_index(dev, j) for j in hold.replace(" ", "").split(",") if j)
+        loop = sampled_loop(seed, period, delay, velocity, compensation, error_percent, wall_damping, hand_mass,
+                            hand_damping, hand_stiffness, held)
+        config = None if method == "limit" else loop_config(loop, Wall(), counts, duration=duration, step=step,
+                                                            step_control=step_control)
         direction = None if wall_direction is None else parse_vector(wall_direction, 3, "wall-direction")
         wall_joint = joint_index(dev, joint)
+        limit = method == "limit"
         result = impedance_range(dev, _sim_type(sim_type), method, k_limit,
                                  Criteria(overshoot, settle_tolerance, settle_window, safety), config, wall_joint,
-                                 equilibrium, resolution, direction, true_boundary)
+                                 equilibrium, resolution, direction, true_boundary and not limit, loop, counts,
+                                 true_boundary and limit)
         out = {"device": dev.name, "type": sim_type, "joint": wall_joint + 1,
                **({} if direction is None else {"wall_direction": unit_direction(direction).tolist()}),
-               **result.as_dict()}
+               "settings": loop.as_dict(), **result.as_dict()}
         unit = {"stiffness": "N/m", "position": "m"} if direction is not None else joint_units(dev)[wall_joint]
         out["units"] = {"k_max": unit["stiffness"], "k_min": unit["stiffness"], "peak_at_first_unstable": unit["position"],
                         "stopped_at_first_unstable": "s"}
@@ -112,11 +164,22 @@ def impedance_range_command(
             print_json(out)
             return
         lowest = "" if out["k_min"] is None else f", lowest passing {out['k_min']:g}"
-        typer.echo(f"{dev.name}, type {sim_type}, joint {out['joint']}: maximum stable impedance "
-                   f"{out['k_max']:g} {unit['stiffness']}{lowest} (first failure: {out['criterion']}; "
-                   f"{out['simulations']} simulations)")
+        where = "the handle" if direction is not None else f"joint {out['joint']}"
+        if method == "limit":
+            typer.echo(f"{dev.name}, wall at {where}: maximum stable impedance {out['k_max']:g} {unit['stiffness']} "
+                       f"on the grid{lowest} (stability limit {out['k_limit_exact']:.6g} {unit['stiffness']} at "
+                       "the wall's equilibrium)")
+        else:
+            typer.echo(f"{dev.name}, type {sim_type}, {where}: maximum stable impedance "
+                       f"{out['k_max']:g} {unit['stiffness']}{lowest} (first failure: {out['criterion']}; "
+                       f"{out['simulations']} simulations)")
+        typer.echo(f"verdict: {out['verdict']}")
+        typer.echo(f"settings: {loop.describe()}")
         if true_boundary:
-            typer.echo(f"oscillation-growth boundary: {out['k_true_boundary']:.4g} {unit['stiffness']}")
+            what = "simulated with dry friction and quantization" if method == "limit" else "oscillation-growth"
+            found = out["k_true_boundary"]
+            typer.echo(f"{what} boundary: " + ("none found (unbounded)" if found is None else
+                                                 f"{found:.4g} {unit['stiffness']}"))
 
 
 def transparency_command(
@@ -272,6 +335,9 @@ def stability_boundary_command(
                "relative_difference": (simulated - exact) / exact
                if np.isfinite(exact) and np.isfinite(simulated) and exact != 0 else None,
                "two_b_over_t": 2 * damping / period, "error_percent": error_percent,
+               "settings": {"period": period, "delay_samples": delay, "velocity": "sampled",
+                            "compensation": "inertial" if compensate_inertia else "none",
+                            "model_error_percent": error_percent, "virtual_damping": wall_damping},
                "units": {"k_max_exact": "N m/rad", "k_max_closed_form": "N m/rad", "k_max_simulated": "N m/rad",
                          "relative_difference": "dimensionless", "two_b_over_t": "N m/rad", "error_percent": "%"}}
         if unbounded:
@@ -283,6 +349,8 @@ def stability_boundary_command(
         form = "" if limit is None else f", closed form {_stiffness_text(closed)} ({limit.bound})"
         typer.echo(f"exact {_stiffness_text(exact)}{form}, simulated {_stiffness_text(simulated)} "
                    f"(2b/T = {2 * damping / period:.6g})")
+        typer.echo(f"settings: T = {period:g} s, delay {delay} samples, sampled velocity, "
+                   f"{'inertial' if compensate_inertia else 'no'} compensation, wall damper {wall_damping:g}")
 
 
 def _stiffness_text(value: float) -> str:

@@ -53,9 +53,12 @@ def zwidth_command(
                    "K in N/m, B in N s/m."),
     strict: bool = STRICT,
     period: float = typer.Option(1e-3, help="Sample period T [s]."),
-    delay: int = typer.Option(0, help="Computation delay N [samples]: the torque of interval k uses the samples of k - N."),
-    velocity: str = typer.Option("sampled", help="The damper's velocity: sampled (the seed's perfect sensor) or "
-                                                 "difference (backward difference of sampled positions)."),
+    delay: Optional[int] = typer.Option(None, help="Computation delay N [samples]: the torque of interval k uses the "
+                                                   "samples of k - N. Default: practice's one sample, the seed's 0 on "
+                                                   "its Phantom presets."),
+    velocity: Optional[str] = typer.Option(None, help="The damper's velocity: difference (backward difference of "
+                                                      "sampled positions; practice's default) or sampled (the seed's "
+                                                      "perfect sensor, its Phantom presets' default)."),
     compensate_inertia: bool = typer.Option(False, help="Feed the sampled acceleration forward (c J a)."),
     error_percent: float = typer.Option(0.0, help="Compensator modelling error E [%]: c = 1 - E/100 "
                                                   "(needs --compensate-inertia)."),
@@ -79,6 +82,12 @@ def zwidth_command(
     from hapticdesign.simulation.zwidth import DisplayLoop, along_wall, zwidth
 
     with user_errors(quiet=quiet):
+        from hapticdesign.analysis.sampled_loop import SampledLoop
+        from hapticdesign.interface.commands.simulation import seed_settings
+
+        defaults = SampledLoop.seed() if seed_settings(preset, device, None) and inertia is None else SampledLoop()
+        delay = defaults.delay if delay is None else delay
+        velocity = defaults.velocity if velocity is None else velocity
         if not (math.isfinite(error_percent) and 0.0 <= error_percent < 100.0):
             raise UserError(f"--error-percent must lie in [0, 100), got {error_percent}")
         if error_percent and not compensate_inertia:
@@ -118,12 +127,18 @@ def zwidth_command(
         payload = {**result.as_dict(), "loop": {"inertia": loop.inertia, "damping": loop.damping, "period": period,
                                                  "delay": delay, "velocity": velocity, "fraction": fraction},
                    "figures": figures, **({"index": index} if index else {})}
+        if from_device:  # the 1-DOF display of one joint: a named option, the others held
+            payload["loop"]["held_joints"] = "every joint but --joint (a 1-DOF display; impedance-range's limit " \
+                                             "method frees them)"
         if reach is not None:
             payload["units"] = {"B": units[1], "K": units[2]}
             payload["loop"]["wall_reach"] = reach
         if json_out:
             print_json(payload)
             return
+        typer.echo(f"settings: T = {period:g} s, delay {delay} samples, {velocity} velocity, "
+                   + (f"compensator c = {fraction:g}" if compensate_inertia else "no inertial compensation")
+                   + (", the other joints held (a 1-DOF display)" if from_device else ""))
         typer.echo(f"B [{units[1]}]   K_max [{units[2]}]   passivity K   linear approximation K")
         for i, (b, k) in enumerate(zip(result.B, result.K)):
             p = "-" if result.passivity is None else f"{result.passivity[i]:.6g}"

@@ -21,9 +21,10 @@ index                   formula                                             unit
 ``force`` takes ``torque`` (``continuous``, default, or ``peak``): the motors' torque limits, one motor per actuated
 coordinate. ``stiffness`` and ``frequency`` need links with sections (``K_C`` of the virtual joint method at the
 handle, :func:`~hapticdesign.analysis.stiffness.device.cartesian_stiffness_at`; ``K_C[:3, :3]`` holds the
-rotations, seed 001's ``K_CA``). ``kmax`` is :func:`hapticdesign.analysis.wall_stiffness.handle_wall_limits` of the
-handle's mobility and damping (options ``period``, ``delay``, ``damping``, ``direction``). ``ln`` and ``mass`` are one
-value per design (the same at every point); ``ln`` takes the region of the joint limits (full turns where none) and
+rotations, seed 001's ``K_CA``). ``kmax`` is :func:`hapticdesign.analysis.wall_stiffness.kmax`: the n-joint sampled
+loop about the pose, every joint free, discretized exactly (its options: the loop's settings of
+:data:`~hapticdesign.analysis.wall_stiffness.KMAX_OPTIONS`, practice's by default, ``direction`` and ``hand``).
+``ln`` and ``mass`` are one value per design (the same at every point); ``ln`` takes the region of the joint limits (full turns where none) and
 unit weights (:func:`~hapticdesign.analysis.linearity.form.device_form`). ``m^k/rad^k``: metres per radian for
 revolute coordinates (m/m for prismatic ones).
 """
@@ -38,7 +39,7 @@ from hapticdesign.analysis.metrics import kinematic
 from hapticdesign.analysis.metrics.dynamic import modes
 from hapticdesign.analysis.metrics.indices.registry import index
 from hapticdesign.analysis.metrics.indices.states import HandleStates
-from hapticdesign.analysis.wall_stiffness import handle_wall_limits
+from hapticdesign.analysis.wall_stiffness import kmax as wall_kmax
 from hapticdesign.errors import UserError
 
 
@@ -96,11 +97,14 @@ def frequency(pose: HandleStates) -> np.ndarray:
 
 
 @index(unit="N/m", formula="exact stable wall stiffness of the sampled loop along a direction (or the worst)",
-       source="seed 000 ch. 4-5; hapticdesign.analysis.sampled_loop.exact_boundary",
+       source="seed 000 ch. 4-5; hapticdesign.analysis.sampled_loop.handle_limits",
        needs=("kinematics", "dynamics", "damping"))
 def kmax(pose: HandleStates, period: float = 0.001, delay: int = 1, damping: float = 0.0,
-         direction: list[float] | None = None) -> np.ndarray:
-    return handle_wall_limits(pose.mobility, pose.cartesian_damping, pose.svd[0], period, delay, damping, direction)
+         direction: list[float] | None = None, velocity: str = "difference", compensation: str = "gravity",
+         error_percent: float = 0.0, hand: object = None) -> np.ndarray:
+    options = dict(period=period, delay=delay, damping=damping, direction=direction, velocity=velocity,
+                   compensation=compensation, error_percent=error_percent, hand=hand)
+    return wall_kmax(pose.J_v, pose.H, pose.B, pose.svd[0], options)
 
 
 @index(unit="LN", formula="Linearity Number over the joint region (limits, else full turns)",

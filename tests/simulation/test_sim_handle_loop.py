@@ -1,0 +1,106 @@
+"""The exact wall limit of the n-joint sampled loop at a handle against an independent construction.
+
+python-control builds the loop from scratch: the continuous plant ``H_h qdd + B_h qd + K_h q = tau`` (the hand's mass,
+damping and stiffness added as ``x J_v^T J_v``), ``control.c2d`` with a zero-order hold, the delay as ``z^-d``, and
+``control.feedback`` with the wall's spring ``K J_v^T u u^T J_v``; the limit is the spring at which the closed loop's
+largest pole modulus reaches 1, bisected here. Without a hand the loop seen by the spring is single-input
+single-output (force along u, displacement along u); the displacements along the wall are neither driven nor seen by
+it: each is a pole at z = 1 over a zero at z = 1 of the transfer function, divided out. The inputs J_v, H, B are the five-bar's at a pose of its workspace.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import control
+import numpy as np
+import pytest
+
+from hapticdesign.analysis.configuration import configuration_of, handle_pose
+from hapticdesign.analysis.dynamics.device import mass_matrix
+from hapticdesign.analysis.sampled_loop import GRASP, Hand, MassDamper, SampledLoop, exact_boundary
+from hapticdesign.analysis.wall_stiffness import wall_limit
+from hapticdesign.devices.device_file import load_device_file
+from hapticdesign.analysis.metrics.indices import Request, evaluate
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "devices"
+PERIOD = 1e-3
+
+
+@pytest.fixture(scope="module")
+def five_bar():
+    device = load_device_file(EXAMPLES / "five-bar.yaml")
+    point = np.array([0.01, 0.0, 0.19])
+    q = handle_pose(device, point).q
+    return device, point, configuration_of(device).jacobian(q)[:3], mass_matrix(device, q), device.damping_matrix
+
+
+def _loop_gain(jv, h, b, u, hand: Hand | None, delay: int):
+    """The discrete loop the spring closes, ``w^T P(z) w z^-d`` (SISO, w = J_v^T u) or, with a hand, the MIMO
+    ``P(z) z^-d`` and the spring's direction ``w w^T``."""
+    n = h.shape[0]
+    jtj = jv.T @ jv
+    hand = hand or Hand()
+    hh, bh, kh = h + hand.mass * jtj, b + hand.damping * jtj, hand.stiffness * jtj
+    a = np.block([[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(hh, kh), -np.linalg.solve(hh, bh)]])
+    bu = np.vstack([np.zeros((n, n)), np.linalg.inv(hh)])
+    w = jv.T @ u
+    lag = control.tf([1.0], [1.0] + [0.0] * delay, PERIOD)
+    if hand.stiffness == 0:
+        siso = control.ss(a, bu @ w[:, None], w[None, :] @ np.hstack([np.eye(n), np.zeros((n, n))]), 0)
+        tf = control.tf(control.c2d(siso, PERIOD, "zoh"))
+        num, den = np.asarray(tf.num[0][0]), np.asarray(tf.den[0][0])
+        for _ in range(n - 1):  # each displacement along the wall: a pole at z = 1 over a zero at z = 1
+            (num, r_num), (den, r_den) = np.polydiv(num, [1.0, -1.0]), np.polydiv(den, [1.0, -1.0])
+            assert np.abs(r_num).max() <= 1e-9 * np.abs(num).max() and np.abs(r_den).max() <= 1e-9
+        return control.tf(num, den, PERIOD) * lag, np.ones((1, 1))
+    plant = control.c2d(control.ss(a, bu, np.hstack([np.eye(n), np.zeros((n, n))]), np.zeros((n, n))), PERIOD, "zoh")
+    shift = np.eye(n * delay, k=-n)  # z^-d on n channels: a line of d held vectors
+    line = control.ss(shift, np.eye(n * delay, n), np.eye(n, n * delay, k=n * (delay - 1)), np.zeros((n, n)), PERIOD)
+    return plant * line, np.outer(w, w)
+
+
+def _independent_limit(gain, spring) -> float:
+    def radius(k):
+        return np.abs(control.poles(control.feedback(gain, k * spring))).max()
+
+    lo, hi = 1e-6, 1.0
+    while radius(hi) < 1.0:
+        lo, hi = hi, 2.0 * hi
+    while hi - lo > 1e-9 * hi:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if radius(mid) < 1.0 else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
+@pytest.mark.parametrize("hand", [None, GRASP, Hand(0.5, 8.0, 600.0)])
+@pytest.mark.parametrize("u", [np.array([1.0, 0.0, 0.0]), np.array([0.6, 0.0, 0.8])])
+def test_the_wall_limit_is_python_controls_closed_loop(five_bar, hand, u):
+    _, _, jv, h, b = five_bar
+    for delay in (1, 2):
+        loop = SampledLoop(period=PERIOD, delay=delay, hand=hand)
+        gain, spring = _loop_gain(jv, h, b, u, hand, delay)
+        assert wall_limit(jv, h, b, loop, u) == pytest.approx(_independent_limit(gain, spring), rel=1e-6)
+
+
+def test_one_joint_loop_is_the_mass_damper_of_the_seed_limits():
+    """A 1-joint handle is the 1-DOF mass-damper: the same limit under each setting (the seed's compensator too)."""
+    jv, h, b = np.array([[1.0], [0.0], [0.0]]), np.array([[0.004]]), np.array([[0.0005]])
+    cases = [(SampledLoop(), MassDamper(0.004, 0.0005, PERIOD, 1)),
+             (SampledLoop.seed(), MassDamper(0.004, 0.0005, PERIOD, 0, 0.0, True)),
+             (SampledLoop(delay=2, velocity="sampled", virtual_damping=0.01), MassDamper(0.004, 0.0005, PERIOD, 2, 0.01)),
+             (SampledLoop.seed(delay=1, model_error=5.0, virtual_damping=0.003),
+              MassDamper(0.004, 0.0005, PERIOD, 1, 0.003, True, 0.95 * 0.004))]
+    for loop, system in cases:
+        assert wall_limit(jv, h, b, loop, np.array([1.0, 0.0, 0.0])) == pytest.approx(exact_boundary(system), rel=1e-8)
+
+
+def test_kmax_index_is_the_wall_limit_with_its_options(five_bar):
+    device, point, jv, h, b = five_bar
+    options = {"period": 0.0005, "delay": 2, "damping": 0.5, "hand": "grasp"}
+    u = np.array([0.6, 0.0, 0.8])
+    result = evaluate(device, point[None], [Request("kmax", {**options, "direction": u}, "along"),
+                                            Request("kmax", options, "worst")])
+    loop = SampledLoop(period=0.0005, delay=2, virtual_damping=0.5, hand=GRASP)
+    assert result.values["along"][0] == pytest.approx(wall_limit(jv, h, b, loop, u), rel=1e-9)
+    assert result.values["worst"][0] <= result.values["along"][0]
