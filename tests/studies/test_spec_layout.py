@@ -15,7 +15,9 @@ from hapticdesign.studies.spec_maps import Section, planes, section_figure  # no
 SHEET = {"device": "five-bar", "q": [0.1, 0.2], "handle": [0.01, 0.0, 0.12], "resolution": 2e-5,
          "force_continuous": None, "force_peak": None, "apparent_mass": {"min": 0.05, "max": 0.2},
          "backdrive_friction": None, "stiffness": None, "workspace": {"cube": 60.0},
-         "renderable_stiffness": {"exact": 0.0, "rate": 1000.0, "passivity_viscous": 0.0, "passivity_coulomb": None}}
+         "renderable_stiffness": {"exact": 0.0, "rate": 1000.0, "delay_samples": 1, "passivity_viscous": 0.0,
+                                  "passivity_coulomb": None, "exact_with_hand": 1345.0, "simulated": None,
+                                  "hand": {"mass": 0.1, "damping": 2.0, "stiffness": 200.0}}}
 
 
 def test_a_planar_device_moving_in_z_then_x_draws_an_x_z_plane():
@@ -41,8 +43,8 @@ def test_the_page_uses_the_reports_style_and_states_what_the_file_does_not():
     assert STYLE in page and 'class="table-wrap"' in page
     heads = re.findall(r"<th>(.*?)</th>", page)
     assert heads == ["quantity", "hapticdesign", "unit"]  # no vendor data for this device: no empty columns
-    row = re.search(r"<td class=\"text\">renderable stiffness \(exact\)</td><td class=\"text\">(.*?)</td>", page)
-    assert row.group(1).startswith("not stated") and "0 N/m" not in page
+    row = re.search(r"<td class=\"text\">renderable stiffness</td><td class=\"text\">(.*?)</td>", page)
+    assert row.group(1).startswith("exact not stated") and not re.search(r"(?<![\d.])0 N/m", page)
     assert "0.02</td>" in page  # resolution in mm
     falcon = spec_page({**SHEET, "device": "falcon"})
     assert re.findall(r"<th>(.*?)</th>", falcon)[-2:] == ["vendor", "why they differ"] and "3000 N/m" in falcon
