@@ -115,6 +115,24 @@ def shown_designs(front: list[dict], selected: int) -> list[int]:
     return sorted(picks)
 
 
+def front_ranges(front: list[dict]) -> str:
+    mass = [1000 * d["objectives"]["mass"] for d in front]
+    wall = [d["objectives"]["wall"] for d in front]
+    return (f"heaviest apparent mass {min(mass):.1f} to {max(mass):.1f} g, weakest wall {min(wall):.3f} to "
+            f"{max(wall):.3f} N/m")
+
+
+def at_bounds(study, front: list[dict]) -> str:
+    """How many front designs hold each variable within 1 % of its range from a bound."""
+    said = []
+    for name, (low, high) in study.spec.variables.items():
+        values = np.array([d["variables"][name] for d in front])
+        near = [(np.sum(values <= low + 0.01 * (high - low)), "lower", low),
+                (np.sum(values >= high - 0.01 * (high - low)), "upper", high)]
+        said += [f"`{name}` at its {side} bound {bound:g} in {count}" for count, side, bound in near if count]
+    return ("variables within 1 % of a bound: " + ", ".join(said)) if said else "no variable at a bound"
+
+
 def figure(rows: dict, feasible: list[tuple[float, float]], front: list[dict]) -> Path:
     fig, ax = plt.subplots(figsize=(6.4, 4.2), dpi=120)
     ax.scatter([1000 * m for m, _ in feasible], [w for _, w in feasible], s=8, color="0.75",
@@ -128,7 +146,7 @@ def figure(rows: dict, feasible: list[tuple[float, float]], front: list[dict]) -
     ax.set_xlabel("heaviest apparent mass over the workspace (g, log scale)")
     ax.set_ylabel("weakest renderable wall kmax (N/m)")
     ax.set_title("Phantom Premium redesign: the front beside the published design", fontsize=10)
-    ax.legend(fontsize=8, loc="lower right")
+    ax.legend(fontsize=8, loc="lower left")
     ax.grid(True, which="both", alpha=0.3)
     fig.tight_layout()
     path = TARGET / "front_vs_published.png"
@@ -174,6 +192,7 @@ def main() -> None:
         print(f"| {label} | {1000 * r['l1']:.1f}, {1000 * r['l2']:.1f}, {1000 * r['l3']:.1f} "
               f"| {r['ratio1']:.2f}, {r['ratio2']:.2f}, {r['ratio3']:.2f} | {1000 * r['mass']:.1f} | {r['wall']:.3f} "
               f"| {r['force']:.3f} | {r['peak']:.2f} | {1000 * r['lightest']:.1f} | {100 * r['scale']:.1f} % |")
+    print(f"\nThe whole front ({len(front)} designs): {front_ranges(front)}; {at_bounds(study, front)}.")
     base, best = rows["published"], rows[selected]
     print(f"\nSelected design {selected} against the published one: heaviest apparent mass "
           f"{base['mass'] / best['mass']:.2f}x lower, weakest wall {best['wall'] / base['wall']:.2f}x higher, worst "
