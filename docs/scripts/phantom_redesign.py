@@ -6,7 +6,8 @@ evaluates the published Phantom Premium 1.5 (examples/devices/phantom-premium.ya
 index registry at the study's workspace points. It prints the Markdown of the section: the run, a table of the
 published design beside front designs (the study's objectives, then what they cost: the worst continuous and peak
 force, the lightest point, the largest box of the study's proportions and centre each design reaches on the study's
-grid, as a fraction of the data sheet's) and draws front_vs_published.png (the front, every feasible design evaluated, the published design).
+grid, as a fraction of the data sheet's) and draws front_vs_published.png (the front, every feasible design evaluated,
+the published design).
 
 Run: ``PYTHONPATH=src .venv/bin/python docs/scripts/phantom_redesign.py`` (a few minutes on a shared 2-core
 machine).
@@ -109,6 +110,28 @@ def largest_scale(device, box) -> float:
     return low * box.size[1] / DATA_SHEET_BOX[1]
 
 
+def data_sheet_box(device, box) -> str:
+    """Whether the published design reaches the data sheet's whole box at the study's centre, and why not."""
+    points = Workspace(box.center, DATA_SHEET_BOX, 3).points()
+    farthest = max(float(np.linalg.norm(p)) for p in points)
+    try:
+        reach_workspace(device, points)
+        missed = "reaches it"
+    except UserError as exc:
+        missed = f"does not: {exc}"
+    return (f"The data sheet's whole box at the study's centre (its farthest corner {1000 * farthest:.1f} mm from the "
+            f"shoulder, l1 + l2 = {1000 * (device.params['l1'] + device.params['l2']):.1f} mm): the published "
+            f"design {missed}.")
+
+
+def finer_grid(device, box) -> str:
+    """The published design's reduced indices on grid 5 (125 points) of the study's box."""
+    got = indices(device, Workspace(box.center, box.size, 5).points())
+    return (f"On grid 5 (125 points) of the study's box the published design gives heaviest apparent mass "
+            f"{1000 * got['mass']:.1f} g, weakest wall {got['wall']:.3f} N/m, worst continuous force "
+            f"{got['force']:.3f} N.")
+
+
 def shown_designs(front: list[dict], selected: int) -> list[int]:
     """Front numbers (from 1) of the table: evenly spaced over the front, its ends and the selected design."""
     picks = {int(round(k)) for k in np.linspace(1, len(front), min(SHOWN, len(front)))} | {selected}
@@ -134,23 +157,31 @@ def at_bounds(study, front: list[dict]) -> str:
 
 
 def figure(rows: dict, feasible: list[tuple[float, float]], front: list[dict]) -> Path:
-    fig, ax = plt.subplots(figsize=(6.4, 4.2), dpi=120)
-    ax.scatter([1000 * m for m, _ in feasible], [w for _, w in feasible], s=8, color="0.75",
-               label="feasible designs evaluated")
-    ax.scatter([1000 * d["objectives"]["mass"] for d in front], [d["objectives"]["wall"] for d in front], s=18,
-               color="tab:blue", label="front")
+    """Left: every feasible design, the front and the published design (mass on a log scale); right: the front."""
+    fig, (whole, near) = plt.subplots(1, 2, figsize=(10, 4.4), dpi=110)
+    mass = [1000 * d["objectives"]["mass"] for d in front]
+    wall = [d["objectives"]["wall"] for d in front]
     published = rows["published"]
-    ax.scatter([1000 * published["mass"]], [published["wall"]], marker="*", s=220, color="tab:red",
-               label=f"published Phantom Premium 1.5 (worst force {published['force']:.2f} N < 1.4 N)")
-    ax.set_xscale("log")
-    ax.set_xlabel("heaviest apparent mass over the workspace (g, log scale)")
-    ax.set_ylabel("weakest renderable wall kmax (N/m)")
-    ax.set_title("Phantom Premium redesign: the front beside the published design", fontsize=10)
-    ax.legend(fontsize=8, loc="lower left")
-    ax.grid(True, which="both", alpha=0.3)
+    whole.scatter([1000 * m for m, _ in feasible], [w for _, w in feasible], s=8, color="0.75",
+                  label="feasible designs evaluated")
+    whole.scatter(mass, wall, s=18, color="tab:blue", label="front")
+    whole.scatter([1000 * published["mass"]], [published["wall"]], marker="*", s=220, color="tab:red",
+                  label=f"published Phantom Premium 1.5\n(worst continuous force {published['force']:.2f} N < 1.4 N)")
+    whole.set_xscale("log")
+    whole.set_xlabel("heaviest apparent mass over the workspace (g, log scale)")
+    whole.set_ylabel("weakest renderable wall kmax (N/m)")
+    whole.set_title("every feasible design and the published one", fontsize=10)
+    whole.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2)
+    whole.grid(True, which="both", alpha=0.3)
+    near.plot(mass, wall, "o-", color="tab:blue", markersize=4)
+    near.set_xlabel("heaviest apparent mass over the workspace (g)")
+    near.set_ylabel("weakest renderable wall kmax (N/m)")
+    near.set_title(f"the front ({len(front)} designs; the published design: {1000 * published['mass']:.0f} g, "
+                   f"{published['wall']:.2f} N/m)", fontsize=10)
+    near.grid(True, alpha=0.3)
     fig.tight_layout()
     path = TARGET / "front_vs_published.png"
-    fig.savefig(path, metadata={"Software": None})
+    fig.savefig(path, metadata={"Software": None}, bbox_inches="tight")
     plt.close(fig)
     return path
 
@@ -184,8 +215,10 @@ def main() -> None:
           f"gives "
           + ", ".join(f"{n} = {a:.6g} (the unmodified device file: {b:.6g})" for n, (a, b) in same.items())
           + ".\n")
+    print(data_sheet_box(unmodified, box), finer_grid(unmodified, box), "\n")
     print("| design | l1, l2, l3 (mm) | ratios q1, q2, q3 | heaviest apparent mass (g) | weakest wall kmax (N/m) "
-          "| worst continuous force (N) | worst peak force (N) | lightest apparent mass (g) | largest box reached (of 381 x 267 x 191 mm) |")
+          "| worst continuous force (N) | worst peak force (N) | lightest apparent mass (g) "
+          "| largest box reached (of 381 x 267 x 191 mm) |")
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for name, r in rows.items():
         label = "published" if name == "published" else f"front {name}" + (" (selected)" if name == selected else "")
