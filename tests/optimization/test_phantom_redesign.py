@@ -27,6 +27,7 @@ from hapticdesign.interface.cli import app
 from hapticdesign.optimization.study_evaluation import bind_study
 from hapticdesign.optimization.study_file import load_study
 from hapticdesign.simulation.design_indices import evaluate
+from tests.helpers.phantom_premium_ik import reachable
 
 ROOT = Path(__file__).resolve().parents[2]
 STUDY = ROOT / "examples" / "studies" / "phantom-premium-redesign.yaml"
@@ -74,23 +75,10 @@ def test_the_study_binds_and_its_formulas_give_back_the_published_device(bound):
         assert value == pytest.approx(expected[name], rel=1e-12, abs=1e-15), name
 
 
-def closed_form(p, l1: float, l2: float) -> np.ndarray:
-    """(q1, q2, q3) putting the handle at p on home's branch (x = cos q1 (l1 cos q2 + l2 sin q3), ...)."""
-    x, y, z = p
-    rho, h = math.hypot(x, y), math.hypot(math.hypot(x, y), z)
-    shoulder = (l1**2 + h**2 - l2**2) / (2 * l1 * h)
-    elbow = (l1**2 + l2**2 - h**2) / (2 * l1 * l2)
-    assert abs(shoulder) < 1 and abs(elbow) < 1 and rho > 0, p
-    q2 = math.atan2(z, rho) + math.acos(shoulder)
-    return np.array([math.atan2(y, x), q2, q2 - math.pi / 2 + math.acos(elbow)])
-
-
 def test_the_published_design_reaches_the_study_workspace(bound):
     values = published()
-    limits = np.radians([(-90, 90), (-124, 119), (-29, 214)])  # the device file's joint limits
     for p in bound.points:
-        q = closed_form(p, values["l1"], values["l2"])
-        assert np.all((limits[:, 0] < q) & (q < limits[:, 1])), (p, np.degrees(q))
+        assert reachable(p, values["l1"], values["l2"]), p
     answer = bound.evaluate([values])[0]
     assert answer.reason == ""
     assert all(math.isfinite(v) for v in answer.reduced)
