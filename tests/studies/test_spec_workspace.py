@@ -15,29 +15,10 @@ import pytest
 
 from hapticdesign.devices.device_file import load_device_file
 from hapticdesign.studies.spec import CUBE_SEARCH, spec_sheet
+from tests.helpers.phantom_premium_ik import L1, L2, reachable
 
-L1, L2 = 0.215, 0.170
-LIMITS = np.radians([(-90, 90), (-124, 119), (-29, 214)])
 HOME = np.array([L1, 0.0, -L2])  # q = 0: x = l1 cos q2 + l2 sin q3, z = l1 sin q2 - l2 cos q3
 STENCIL = [np.array(s) - 1.0 for s in itertools.product(range(3), repeat=3) if s != (1, 1, 1)]
-
-
-def closed_form(p) -> np.ndarray | None:
-    """(q1, q2, q3) putting the handle at p on home's branch, or None out of the arm's reach."""
-    x, y, z = p
-    rho = math.hypot(x, y)
-    h = math.hypot(rho, z)
-    shoulder = (L1**2 + h**2 - L2**2) / (2 * L1 * h)
-    elbow = (L1**2 + L2**2 - h**2) / (2 * L1 * L2)
-    if abs(shoulder) >= 1 or abs(elbow) >= 1 or rho == 0.0:
-        return None
-    q2 = math.atan2(z, rho) + math.acos(shoulder)
-    return np.array([math.atan2(y, x), q2, q2 - math.pi / 2 + math.acos(elbow)])
-
-
-def reachable(p) -> bool:
-    q = closed_form(p)
-    return q is not None and bool(np.all((LIMITS[:, 0] <= q) & (q <= LIMITS[:, 1])))
 
 
 def oracle_edge() -> float:
