@@ -167,6 +167,20 @@ def test_a_study_of_a_study_local_index_and_the_cli_flag_that_runs_a_file(tmp_pa
     assert result.output.strip().count("\n") == 0 and "RuntimeError: no such thing" in result.output
 
 
+def test_the_python_door_runs_a_study_with_your_own_index(tmp_path):
+    """``hapticdesign.optimize(study, indices=[...])`` (issue 36's example): an index outside the one registry
+    serves the run; the front's objectives are the built-in's squares; a scheduler with your own indices is refused
+    (its workers would not have them)."""
+    local = hd.index(unit="1", name="isotropy_door", registry=Registry(INDICES))(isotropy_squared.function)
+    path = _five_bar_study(tmp_path, [{**SQUARED, "index": "isotropy_door"}, BUILT_IN])
+    result = hd.optimize(path, seed=3, indices=[local])
+    assert result.front and result.files == []
+    for design in result.front:
+        assert design["objectives"]["squared"] == pytest.approx(design["objectives"]["iso"] ** 2, rel=1e-12)
+    with pytest.raises(UserError, match="scheduler"):
+        hd.optimize(path, seed=3, indices=[local], scheduler="tcp://127.0.0.1:1")
+
+
 def test_registering_a_name_twice_or_a_bad_index_is_one_line():
     local = Registry(INDICES)
     with pytest.raises(UserError, match="'isotropy' is registered already"):
