@@ -1,7 +1,7 @@
 """What ``transparency`` says about its stiffness: the wall joint's stable limit and why a bandwidth is null.
 
-The limit is the stiffness at which the wall joint's sampled loop, linearized at the start pose, starts to
-grow (:meth:`~hapticdesign.simulation.analytic.AnalyticProblem.grows`: its one-sample map's spectral radius
+The limit is the stiffness at which the wall joint's sampled loop, linearized where the wall holds the joint (the
+spring's rest, :data:`STEP` from the start pose), starts to grow (:meth:`~hapticdesign.simulation.analytic.AnalyticProblem.grows`: its one-sample map's spectral radius
 reaches 1; with full inertial compensation and no delay the seed's 1-DOF closed form ``b^2 / H_ww``,
 seed 000 §4.1.2). Imported when the command runs, so ``hapticdesign --help`` loads no engine.
 """
@@ -15,7 +15,7 @@ from hapticdesign.simulation.criteria import Criteria
 
 REL_TOL = 1e-9
 DOUBLINGS = 60
-STEP = 0.01  # the spring's rest from the start (Table 4.2); the growth does not depend on it
+STEP = 0.01  # the spring's rest from the start (Table 4.2), where the loop is linearized
 
 
 def stable_limit(device, sim_type: int, wall_joint: int, config) -> float | None:
