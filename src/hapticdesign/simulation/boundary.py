@@ -7,6 +7,7 @@ against the second quarter). The exact limit of the same loop, its oracle, is
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
@@ -59,15 +60,21 @@ def simulated_boundary(system: MassDamper, rel_tol: float = 1e-3, samples: int =
         raise UserError("the growth test needs at least 40 samples and 1 plant step per sample")
     runs = BOUNDARY_RUNS + math.ceil(math.log2(1.0 / rel_tol))
     require_plant_steps(f"{runs} simulations of {samples:,} samples x {substeps:,} plant steps", runs * samples * substeps)
-    lo, hi = 0.0, system.damping / system.period + 1e-9
-    while not grows(system, hi, samples, substeps):
-        lo, hi = hi, 2.0 * hi
-        if hi > 1e12:
-            return math.inf
+    return growth_onset(lambda k: grows(system, k, samples, substeps), 0.0, system.damping / system.period + 1e-9,
+                        rel_tol, 1e12)
+
+
+def growth_onset(grows: Callable[[float], bool], lo: float, hi: float, rel_tol: float, k_limit: float,
+                 hi_grows: bool = False) -> float:
+    """The stiffness at which ``grows(k)`` turns true, the growth boundary of every simulated search (seed 000 §5):
+    from ``lo`` (not growing), ``hi`` is doubled until the loop grows (inf once past ``k_limit``; skipped when
+    ``hi_grows`` says it is known to grow), then the bracket is bisected to ``rel_tol`` of ``hi``; the midpoint."""
+    if not hi_grows:
+        while not grows(hi):
+            lo, hi = hi, 2.0 * hi
+            if hi > k_limit:
+                return math.inf
     while hi - lo > rel_tol * hi:
         mid = 0.5 * (lo + hi)
-        if grows(system, mid, samples, substeps):
-            hi = mid
-        else:
-            lo = mid
+        lo, hi = (lo, mid) if grows(mid) else (mid, hi)
     return 0.5 * (lo + hi)

@@ -34,7 +34,7 @@ from hapticdesign.analysis.sampled_loop import SampledLoop, handle_limits
 from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation.analytic import GROWS, AnalyticProblem, linear_loop
-from hapticdesign.simulation.boundary import envelope_grows
+from hapticdesign.simulation.boundary import envelope_grows, growth_onset
 from hapticdesign.simulation.config import (
     LoopConfig, Wall, compensator_device, handle_jacobian, loop_config, normal_jacobian, require_device, require_options, rest_pose,
     unit_direction,
@@ -206,23 +206,15 @@ def simulated_limit(device: Device, loop: SampledLoop | None = None, wall_joint:
 
     k = start if start is not None else stability_limit(device, loop, wall_joint, equilibrium, direction).stiffness
     k = min(max(k, 1e-6), k_limit) if math.isfinite(k) else k_limit
-    if grows(k):
-        lo, hi = 0.0, k
-        while lo == 0.0 and hi > 1e-6:
-            if grows(hi / 2.0):
-                hi /= 2.0
-            else:
-                lo = hi / 2.0
-    else:
-        lo, hi = k, 2.0 * k
-        while not grows(hi):
-            lo, hi = hi, 2.0 * hi
-            if hi > k_limit:
-                return math.inf
-    while hi - lo > rel_tol * hi:
-        mid = 0.5 * (lo + hi)
-        lo, hi = (lo, mid) if grows(mid) else (mid, hi)
-    return 0.5 * (lo + hi)
+    if not grows(k):
+        return growth_onset(grows, k, 2.0 * k, rel_tol, k_limit)
+    lo, hi = 0.0, k
+    while lo == 0.0 and hi > 1e-6:
+        if grows(hi / 2.0):
+            hi /= 2.0
+        else:
+            lo = hi / 2.0
+    return growth_onset(grows, lo, hi, rel_tol, k_limit, hi_grows=True)
 
 
 @dataclass(frozen=True)
@@ -434,18 +426,7 @@ def growth_boundary(problem: ImpedanceProblem, rel_tol: float = 1e-4, margin: fl
             return True
         return envelope_grows(trace.wall_position - wall_rest(trace, wall), margin)
 
-    lo, hi = 0.0, 1.0
-    while not grows(hi):
-        lo, hi = hi, 2.0 * hi
-        if hi > k_limit:
-            return math.inf
-    while hi - lo > rel_tol * hi:
-        mid = 0.5 * (lo + hi)
-        if grows(mid):
-            hi = mid
-        else:
-            lo = mid
-    return 0.5 * (lo + hi)
+    return growth_onset(grows, 0.0, 1.0, rel_tol, k_limit)
 
 
 UNSTABLE = "unstable (spectral radius of the sampled loop above 1)"

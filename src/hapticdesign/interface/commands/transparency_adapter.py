@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 
 from hapticdesign.simulation.analytic import AnalyticProblem, linear_loop
+from hapticdesign.simulation.boundary import growth_onset
 from hapticdesign.simulation.criteria import Criteria
 
 REL_TOL = 1e-9
@@ -27,17 +28,8 @@ def stable_limit(device, sim_type: int, wall_joint: int, config) -> float | None
     problem = AnalyticProblem(device, sim_type, wall_joint, STEP, Criteria(), config)
     if not problem.growth_is_exact:
         return None
-    lo, hi = 0.0, problem.estimate()
-    for _ in range(DOUBLINGS):
-        if problem.grows(hi):
-            break
-        lo, hi = hi, 2.0 * hi
-    else:
-        return math.inf
-    while hi - lo > REL_TOL * hi:
-        mid = 0.5 * (lo + hi)
-        lo, hi = (lo, mid) if problem.grows(mid) else (mid, hi)
-    return hi
+    first = problem.estimate()
+    return growth_onset(problem.grows, 0.0, first, REL_TOL, first * 2.0 ** DOUBLINGS)
 
 
 def finite_or_none(limit: float | None) -> float | None:
