@@ -11,7 +11,7 @@ from hapticdesign.model.rcube import RCubeGeometry
 from hapticdesign.optimization.rcube.constraints import (
     ERGONOMIC_POINTS,
     PASSIVE_POINTS,
-    Workspace,
+    CubeWorkspace,
     constraint_values,
     critical_points,
     elbow_cosine,
@@ -81,6 +81,6 @@ def test_workspace_validation():
     from hapticdesign.errors import UserError
 
     with pytest.raises(UserError):
-        Workspace(side=-0.1)
+        CubeWorkspace(side=-0.1)
     with pytest.raises(UserError):
-        Workspace(side=0.12, virtual_side=0.1)
+        CubeWorkspace(side=0.12, virtual_side=0.1)

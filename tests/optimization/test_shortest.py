@@ -8,7 +8,7 @@ import pytest
 from scipy.optimize import brentq
 
 from hapticdesign.errors import UserError
-from hapticdesign.optimization.rcube.constraints import Q_MAX_RANGE, Workspace, constraint_values
+from hapticdesign.optimization.rcube.constraints import Q_MAX_RANGE, CubeWorkspace, constraint_values
 from hapticdesign.optimization.local_search import FEASIBILITY_MARGIN
 from hapticdesign.optimization.rcube.shortest import constrained_minimum
 from hapticdesign.optimization.rcube.synthesis import BOUND_SETS, synthesize
@@ -105,7 +105,7 @@ def test_seed_solutions_1_and_2_break_constraint_5_at_65_mm():
     l1, l2, l3 = t[:, 1], t[:, 2], t[:, 3]
     for v, expected in ((0.065, [0.0105, 0.0074]), (0.064, None)):
         cos_q13 = ((l1 - v * 1e3) ** 2 - l2**2 - l3**2) / (2 * l2 * l3)  # eq. 6.47 at C5 = (l1 - v, 0)
-        G = constraint_values(table_7_2_designs()[:2], Workspace(0.120, 2 * v))[:, 2]
+        G = constraint_values(table_7_2_designs()[:2], CubeWorkspace(0.120, 2 * v))[:, 2]
         assert G == pytest.approx(cos_q13**2 - 1.0, abs=1e-12)
         if expected is not None:  # 1.05 % and 0.74 % above cos^2 q_13 = 1 (issue 10's re-derivation)
             assert np.round(G, 4).tolist() == expected

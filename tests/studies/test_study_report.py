@@ -17,7 +17,7 @@ from hapticdesign.studies.steps import (
     Table,
     figure_from_matplotlib,
 )
-from hapticdesign.studies.study import run_study
+from hapticdesign.studies.study import run_pipeline
 
 
 def _done(ctx):
@@ -37,7 +37,7 @@ def _broken(ctx):
 
 def test_report_shows_each_state_honestly(tmp_path):
     steps = [Step("a", "Done step", _done), Step("b", "Missing step", _missing), Step("c", "Broken step", _broken)]
-    result = run_study("demo", "A study", "intro", steps, {"scale": "smoke"}, tmp_path / "work")
+    result = run_pipeline("demo", "A study", "intro", steps, {"scale": "smoke"}, tmp_path / "work")
     assert result.statuses() == {"a": STATUS_DONE, "b": STATUS_MISSING, "c": STATUS_FAILED}
     assert "ZeroDivisionError: boom" in result.step("c").reason
     report = write_report(result, tmp_path)

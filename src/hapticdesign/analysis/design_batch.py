@@ -50,7 +50,7 @@ from hapticdesign.analysis.dynamics.actuated_kernel import (
 from hapticdesign.analysis.loops import closure_kernel as ck
 from hapticdesign.analysis.loops.solver import settings_of
 from hapticdesign.analysis.loops.records import (
-    BRANCH_CHANGE, NO_HOME, OK, OUT_OF_REACH, SINGULAR, Closures, workspace,
+    BRANCH_CHANGE, NO_HOME, OK, OUT_OF_REACH, SINGULAR, Closures, closure_scratch,
 )
 from hapticdesign.analysis.stiffness import vjm
 from hapticdesign.analysis.stiffness.device import end_compliance
@@ -254,7 +254,7 @@ def mass_designs(offsets, full, status, shape, plan, bodies, loops, params, out)
     body_node = bodies.body_node
     n_body = body_node.shape[0]
     n_node = shape.parent.shape[0]
-    ws = workspace(n_node, n, na, loops.passive, n_body)
+    ws = closure_scratch(n_node, n, na, loops.passive, n_body)
     pw = np.zeros((1, n_body, 10))
     h = np.zeros((na, na))
     g = np.zeros(na)

@@ -251,7 +251,7 @@ def compensated_boundary(inertia: float, damping: float, period: float, fraction
     return compensated_limit(inertia, damping, period, fraction).stiffness
 
 
-class ClosedLoops:
+class SpringLoops:
     """The one-sample maps of S sampled loops in which the wall's spring ``K`` enters as a rank-one term,
     ``m(K) = m(0) - K g h^T`` (``base`` (S, N, N), ``g`` and ``h`` (S, N)), so a search builds the spring-free maps
     once: the 1-DOF loops of :meth:`of` and the n-joint handle loops of :func:`handle_loops`."""
@@ -260,7 +260,7 @@ class ClosedLoops:
         self.base, self.g, self.h = base, g, h
 
     @classmethod
-    def of(cls, systems: MassDampers) -> "ClosedLoops":
+    def of(cls, systems: MassDampers) -> "SpringLoops":
         """The loops of 1-DOF mass-dampers, state ``[q, qd, u_prev, s_(k-1), ..., s_(k-d)]`` with ``s = (q, qd,
         a)``: the spring enters one column ``c``, that of ``q`` in the law, through ``g = (Gamma, 1)``."""
         j, b, d = systems.inertia, systems.damping, systems.delay_samples
@@ -303,12 +303,12 @@ class ClosedLoops:
 
 
 def closed_loop_matrix(system: MassDamper, stiffness: float) -> np.ndarray:
-    """One-sample map of ``[q, qd, u_prev, s_(k-1), ..., s_(k-d)]`` with ``s = (q, qd, a)`` (:class:`ClosedLoops`)."""
-    return ClosedLoops.of(MassDampers.of([system])).matrices(np.array([stiffness]))[0]
+    """One-sample map of ``[q, qd, u_prev, s_(k-1), ..., s_(k-d)]`` with ``s = (q, qd, a)`` (:class:`SpringLoops`)."""
+    return SpringLoops.of(MassDampers.of([system])).matrices(np.array([stiffness]))[0]
 
 
 def spectral_radius(system: MassDamper, stiffness: float) -> float:
-    return float(ClosedLoops.of(MassDampers.of([system])).radii(np.array([stiffness]))[0])
+    return float(SpringLoops.of(MassDampers.of([system])).radii(np.array([stiffness]))[0])
 
 
 FLOOR = 1e-9
@@ -331,10 +331,10 @@ def exact_boundaries(systems: MassDampers, groups: np.ndarray | None = None, k_m
     require_memory(what, 8.0 * order * order * len(systems))
     require_within(what, order, EIGEN_ORDER_LIMIT, "rows")
     guess = 2.0 * (systems.damping + systems.virtual_damping) / (systems.period * (1 + 2 * systems.delay_samples))
-    return loop_limits(ClosedLoops.of(systems), guess, groups, k_max)
+    return loop_limits(SpringLoops.of(systems), guess, groups, k_max)
 
 
-def loop_limits(loops: ClosedLoops, guess: np.ndarray, groups: np.ndarray | None = None,
+def loop_limits(loops: SpringLoops, guess: np.ndarray, groups: np.ndarray | None = None,
                 k_max: float = 1e9) -> np.ndarray:
     """The smallest spring at which each loop (S,) loses stability, or the smallest in each group (``groups``: S
     labels 0 ... G - 1; (G,)).
@@ -552,7 +552,7 @@ class SampledLoop:
 
 
 def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, spring: np.ndarray,
-                 loop: SampledLoop) -> tuple[ClosedLoops, np.ndarray]:
+                 loop: SampledLoop) -> tuple[SpringLoops, np.ndarray]:
     """The sampled loops of S handles under a wall whose spring acts on the joints as ``K w w^T`` (``spring``: the
     rows ``w`` (S, n); ``J_v^T u`` for a Cartesian wall along a unit ``u``, ``e_j`` for a wall on joint j), every
     joint free but ``loop.held``, and a starting guess of their limits (S,).
@@ -564,7 +564,7 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
     ``u_k = c H a_(k-d) - K w w^T q_(k-d) - B_w w w^T v^_(k-d)``, ``a`` the acceleration sampled
     under the previous torque, ``v^`` the sampled velocity or the backward difference of positions. The state is
     ``[x_k, ..., x_(k-L), u_(k-1), ..., u_(k-d-1)]`` (``x = (q, qd)``; the torques only with the compensator), and
-    ``K`` enters as the rank-one term of :class:`ClosedLoops`. Without a hand's stiffness the displacements along
+    ``K`` enters as the rank-one term of :class:`SpringLoops`. Without a hand's stiffness the displacements along
     the wall (``w^T q = 0``) are free: each is a fixed point (eigenvalue 1) whatever ``K``, a neutral drift of the
     handle along the wall, not an instability; they are deflated (the map restricted to the complement of that
     invariant subspace, where the spring still enters as a rank-one term).
@@ -628,7 +628,7 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
     reach = np.einsum("sn,sn->s", w, w)
     viscous = np.einsum("sn,snm,sm->s", w, bh, w) / np.maximum(reach, 1e-300) ** 2 + loop.virtual_damping
     guess = np.maximum(2.0 * viscous / (loop.period * (1 + 2 * d)), FLOOR)
-    return ClosedLoops(m, g, hvec), guess
+    return SpringLoops(m, g, hvec), guess
 
 
 def _deflated(m: np.ndarray, g: np.ndarray, h: np.ndarray, w: np.ndarray, n: int,

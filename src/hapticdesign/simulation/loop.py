@@ -45,10 +45,10 @@ def joint_index(device: Device, joint: int | str) -> int:
     return j - 1
 
 
-def _workspace(dynamics: Dynamics) -> records.Workspace:
+def _scratch(dynamics: Dynamics) -> records.DynamicsScratch:
     if isinstance(dynamics, ClosedLoopPlant):
-        return records.loop_workspace(dynamics.n_dof)
-    return records.workspace(dynamics.n_dof, workspace_size(dynamics), dynamics.index.shape[0], dynamics.n_entries)
+        return records.loop_dynamics_scratch(dynamics.n_dof)
+    return records.dynamics_scratch(dynamics.n_dof, workspace_size(dynamics), dynamics.index.shape[0], dynamics.n_entries)
 
 
 def tables_of(device: Device) -> DynamicsTables | None:
@@ -224,16 +224,16 @@ def step_spans(sub: int, stride: int) -> np.ndarray:
 def _plant_record(plant: Dynamics, damping, friction, friction_map, hand_mass, hand_stiffness, hand_rest):
     """The kernel's plant: :class:`~.records.Plant` of tables or :class:`~.records.LoopPlant`."""
     if isinstance(plant, ClosedLoopPlant):
-        return records.LoopPlant(plant.structure, plant.workspace, _workspace(plant), np.zeros(plant.n_dof),
+        return records.LoopPlant(plant.structure, plant.workspace, _scratch(plant), np.zeros(plant.n_dof),
                                  np.zeros(1, dtype=np.int64), damping, friction, friction_map, hand_mass,
                                  hand_stiffness, hand_rest)
-    return records.Plant(records.table(plant), _workspace(plant), damping, friction, friction_map, hand_mass,
+    return records.Plant(records.table(plant), _scratch(plant), damping, friction, friction_map, hand_mass,
                          hand_stiffness, hand_rest)
 
 
 def _controller_record(model: Dynamics, switches: np.ndarray, quant: float, delay: int):
     """The kernel's compensator: :class:`~.records.Controller` of tables or :class:`~.records.LoopController`."""
     if isinstance(model, ClosedLoopPlant):
-        return records.LoopController(model.structure, model.workspace, _workspace(model), np.zeros(model.n_dof),
+        return records.LoopController(model.structure, model.workspace, _scratch(model), np.zeros(model.n_dof),
                                       np.zeros(1, dtype=np.int64), switches, quant, delay)
-    return records.Controller(records.table(model), _workspace(model), switches, quant, delay)
+    return records.Controller(records.table(model), _scratch(model), switches, quant, delay)

@@ -24,7 +24,7 @@ class Table(NamedTuple):
     degrees: np.ndarray
 
 
-class Workspace(NamedTuple):
+class DynamicsScratch(NamedTuple):
     """Scratch arrays of one set of dynamics tables (basis values, entries, H, C, G, linear solve)."""
 
     values: np.ndarray
@@ -50,7 +50,7 @@ class Plant(NamedTuple):
     ``a_k`` (a unit row for friction on one joint; :func:`~.config.plant_friction`)."""
 
     table: Table
-    ws: Workspace
+    ws: DynamicsScratch
     damping: np.ndarray
     coulomb: np.ndarray
     friction_map: np.ndarray
@@ -67,7 +67,7 @@ class LoopPlant(NamedTuple):
 
     structure: tuple
     loop_ws: tuple
-    ws: Workspace
+    ws: DynamicsScratch
     cqd: np.ndarray
     status: np.ndarray
     damping: np.ndarray
@@ -82,7 +82,7 @@ class Controller(NamedTuple):
     """The digital side: the compensator's tables and switches ``(s_H, s_C, s_G)``, encoder step, delay."""
 
     table: Table
-    ws: Workspace
+    ws: DynamicsScratch
     switches: np.ndarray
     quant: float
     delay: int
@@ -94,7 +94,7 @@ class LoopController(NamedTuple):
 
     structure: tuple
     loop_ws: tuple
-    ws: Workspace
+    ws: DynamicsScratch
     cqd: np.ndarray
     status: np.ndarray
     switches: np.ndarray
@@ -211,20 +211,20 @@ def table(tables) -> Table:
     return Table(*tables.sparse, tables.index, tables.kinds, tables.degrees)
 
 
-def workspace(n: int, n_values: int, n_basis: int, n_entries: int) -> Workspace:
+def dynamics_scratch(n: int, n_values: int, n_basis: int, n_entries: int) -> DynamicsScratch:
     """Scratch arrays for one set of tables of ``n`` joints."""
     m = n * (n + 1) // 2
-    return Workspace(
+    return DynamicsScratch(
         np.zeros((n, n_values)), np.zeros(n_basis), np.zeros(n_entries), np.zeros(n), np.zeros(n),
         np.zeros(1, dtype=np.int64), np.zeros((n, n)), np.zeros((n, m)), np.zeros(n), np.zeros(m), np.zeros((n, n)),
         np.zeros(n), np.zeros(n, dtype=np.int64),
     )
 
 
-def loop_workspace(n: int) -> Workspace:
+def loop_dynamics_scratch(n: int) -> DynamicsScratch:
     """Scratch for a closed-loop plant of ``n`` actuated joints: no basis tables; ``C qd^2`` is the one
     column of ``c`` and its velocity product ``qd2`` the constant 1, so the loop reads it as ``c @ qd2``."""
-    return Workspace(
+    return DynamicsScratch(
         np.zeros((n, 1)), np.zeros(1), np.zeros(1), np.zeros(n), np.zeros(n), np.zeros(1, dtype=np.int64),
         np.zeros((n, n)), np.zeros((n, 1)), np.zeros(n), np.ones(1), np.zeros((n, n)), np.zeros(n),
         np.zeros(n, dtype=np.int64),

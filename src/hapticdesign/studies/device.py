@@ -66,6 +66,6 @@ INTRO = ("Seed 000's analyses (Kizilbey 2019) on the given device: exact equatio
 
 
 def run(settings: DeviceSettings, work_dir, progress=None):
-    from hapticdesign.studies.study import run_study
+    from hapticdesign.studies.study import run_pipeline
 
-    return run_study("device", f"{TITLE} ({settings.device().name})", INTRO, steps(), settings, work_dir, progress)
+    return run_pipeline("device", f"{TITLE} ({settings.device().name})", INTRO, steps(), settings, work_dir, progress)

@@ -290,8 +290,8 @@ INTRO = ("Kizilbey (2019), end to end on the built-in 3-DOF Phantom: equations o
 
 def run(settings: PhantomSettings, work_dir, progress=None):
     """Run the study (see :mod:`hapticdesign.studies.study`)."""
-    from hapticdesign.studies.study import run_study
+    from hapticdesign.studies.study import run_pipeline
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PhysicalConsistencyWarning)
-        return run_study("phantom", TITLE, INTRO, steps(), settings, work_dir, progress)
+        return run_pipeline("phantom", TITLE, INTRO, steps(), settings, work_dir, progress)

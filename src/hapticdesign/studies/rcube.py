@@ -28,7 +28,7 @@ from hapticdesign.optimization.rcube.chain import (
     run_chain,
     write_chain,
 )
-from hapticdesign.optimization.rcube.constraints import Workspace, constraint_values
+from hapticdesign.optimization.rcube.constraints import CubeWorkspace, constraint_values
 from hapticdesign.optimization.rcube.plies import ply_design
 from hapticdesign.optimization.rcube.selection import METRIC_NAMES as TABLE_7_3_METRICS
 from hapticdesign.studies.plots import plt
@@ -374,7 +374,7 @@ def _seed_shortest(workspace) -> list[list]:
 def _shortest_table(found: dict) -> tuple[Table, str]:
     """The seed's shortest designs, the front's shortest and the certified minimum, with the
     constraints they sit on; and a paragraph on the seed's Constraint 5 at 65 and 64 mm."""
-    printed, shifted = Workspace(), Workspace(0.120, 0.128)
+    printed, shifted = CubeWorkspace(), CubeWorkspace(0.120, 0.128)
     rows = _seed_shortest(printed)
     ours = [("front's shortest (NSGA-II)", found["shortest"])]
     if found.get("constrained_minimum"):
@@ -478,7 +478,7 @@ def steps() -> list[Step]:
         Step("device", "The device (§5.1, Table 7.8)", device_step),
         Step("kinematics", "Kinematics and workspace (§5.1, Tables 7.2-7.3)", kinematics_step),
         Step("final_design", "Final design: stiffness, inertia, modes (Tables 7.8-7.9, eq. 7.6-7.13)", final_design_step),
-        Step("maps", "Workspace maps of the metrics (§7.5, Figures 7.5-7.19)", maps_step),
+        Step("maps", "CubeWorkspace maps of the metrics (§7.5, Figures 7.5-7.19)", maps_step),
         Step("optimization", "Optimization chain (ch. 6-7, Tables 7.1-7.9)", optimization_step),
     ]
 
@@ -490,6 +490,6 @@ INTRO = ("Gorgulu (2018), end to end: kinematics and workspace, virtual-joint-me
 
 
 def run(settings: RCubeSettings, work_dir, progress=None):
-    from hapticdesign.studies.study import run_study
+    from hapticdesign.studies.study import run_pipeline
 
-    return run_study("rcube", TITLE, INTRO, steps(), settings, work_dir, progress)
+    return run_pipeline("rcube", TITLE, INTRO, steps(), settings, work_dir, progress)

@@ -36,7 +36,7 @@ class StudyResult:
         return {s.key: s.status for s in self.steps}
 
 
-def run_study(name: str, title: str, intro: str, steps: Sequence[Step], settings: Any, work_dir: Path,
+def run_pipeline(name: str, title: str, intro: str, steps: Sequence[Step], settings: Any, work_dir: Path,
               progress: Progress | None = None) -> StudyResult:
     """Run ``steps`` in order with a shared context; scratch files go to ``work_dir``."""
     work_dir = output_folder(work_dir)

@@ -28,7 +28,7 @@ directly (:func:`pose_entries`), in world axes (each body's ``h`` and ``J`` rota
 skips bodies whose parameters are all zero; :func:`motion_entries` does the same along a motion, each
 pose continued from the last inside the kernel. They share :func:`factor_pose` (poses and ``Phi_p^-1``)
 and :func:`reduce_pose` (``T`` and the reduced Jacobians at one closed pose), which allocate nothing:
-their scratch arrays come from a :class:`~hapticdesign.analysis.loops.records.Workspace`. The closed-loop
+their scratch arrays come from a :class:`~hapticdesign.analysis.loops.records.ClosureScratch`. The closed-loop
 plant of the simulation (:mod:`.closed_loop_plant`) calls them too.
 
 Besides the loop records (``tree``, ``plan``, ``loops``, ``settings``, ``ws``:
@@ -54,7 +54,7 @@ from hapticdesign.analysis.loops.closure_kernel import (
     rotation_entry,
     tangent_into,
 )
-from hapticdesign.analysis.loops.records import Workspace, workspace
+from hapticdesign.analysis.loops.records import ClosureScratch, closure_scratch
 from hapticdesign.model.dense import lu_in_place
 from hapticdesign.model.walk import MotionPlan, add_joint_accelerations, node_motion, planned_poses, unit_twist
 
@@ -80,12 +80,12 @@ class MotionWork(NamedTuple):
     ``s``, ``start`` and ``trial``."""
 
     active: np.ndarray
-    ws: Workspace
+    ws: ClosureScratch
     scratch: "EntriesScratch"
     q_last: np.ndarray
     bias: np.ndarray
     half_gamma: np.ndarray
-    fallback: Workspace
+    fallback: ClosureScratch
     s: np.ndarray
     start: np.ndarray
     trial: np.ndarray
@@ -514,7 +514,7 @@ def actuated_entries(qs, tree, plan, bodies, loops, params):
     m = na * (na + 1) // 2
     out = np.zeros((n_pose, n_sets, m + na * m + na))
     ratios = np.zeros(n_pose)
-    ws = workspace(tree.parent.shape[0], n_dof, na, passive, n_body)
+    ws = closure_scratch(tree.parent.shape[0], n_dof, na, passive, n_body)
     scratch = entries_scratch(n_sets, na, passive.shape[0], n_body)
     entries_into(qs, tree, plan, bodies, loops, params, active_bodies(params), ws, scratch, out, ratios)
     return out, ratios
@@ -550,7 +550,7 @@ def motion_entries(path, q_start, branch, tree, plan, bodies, loops, settings, p
 
     A Python function: it only allocates the scratch and calls the compiled pose loop
     (:func:`motion_entries_into`), whose pieces (:func:`active_bodies`, :func:`entries_scratch`,
-    :func:`~hapticdesign.analysis.loops.records.workspace`) the closed-loop plant compiles too; compiled, this
+    :func:`~hapticdesign.analysis.loops.records.closure_scratch`) the closed-loop plant compiles too; compiled, this
     wrapper alone took about 4 CPU-s of a fresh install's first closed-loop run (``benchmarks/bench_cold.py``).
     """
     passive = loops.passive
@@ -564,9 +564,9 @@ def motion_entries(path, q_start, branch, tree, plan, bodies, loops, settings, p
     out = np.zeros((n_pose, n_sets, m + na * m + na))
     status = np.zeros(n_pose, dtype=np.int64)
     n_node = tree.parent.shape[0]
-    work = MotionWork(active_bodies(params), workspace(n_node, n_dof, na, passive, n_body),
+    work = MotionWork(active_bodies(params), closure_scratch(n_node, n_dof, na, passive, n_body),
                       entries_scratch(n_sets, na, npas, n_body), np.empty(n_dof), np.empty(npas), np.empty(npas),
-                      workspace(n_node, n_dof, na, passive, 0),
+                      closure_scratch(n_node, n_dof, na, passive, 0),
                       np.empty((npas, na)), np.empty(na), np.empty(n_dof))
     q = q_start.copy()
     first = motion_entries_into(path, q, branch, tree, plan, bodies, loops, settings, params, work, out, status)
@@ -669,7 +669,7 @@ def actuated_regressor(qs, tree, plan, bodies, loops):
     n_entries = m + na * m + na
     out = np.zeros((n_pose, n_entries, 10 * n_body))
     ratios = np.zeros(n_pose)
-    ws = workspace(tree.parent.shape[0], n_dof, na, loops.passive, n_body)
+    ws = closure_scratch(tree.parent.shape[0], n_dof, na, loops.passive, n_body)
     rot, w, al, ac, ja = ws.rot, ws.w, ws.al, ws.ac, ws.ja
     jab = np.zeros((n_body, 6, na))
     rb = np.zeros((n_body, 3, 3))

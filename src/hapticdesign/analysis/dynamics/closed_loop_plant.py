@@ -37,7 +37,7 @@ from hapticdesign.analysis.dynamics.actuated_kernel import (
 )
 from hapticdesign.analysis.dynamics.closed_loop import ClosedLoopModel
 from hapticdesign.analysis.loops import closure_kernel as ck
-from hapticdesign.analysis.loops.records import Closures, Settings, Workspace, workspace
+from hapticdesign.analysis.loops.records import ClosureScratch, Closures, Settings, closure_scratch
 from hapticdesign.analysis.loops.solver import MESSAGES
 from hapticdesign.errors import UserError
 from hapticdesign.model.walk import CONSTANT, Tree, WalkPlan, planned_poses, unit_twist
@@ -62,11 +62,11 @@ class PlantStructure(NamedTuple):
 
 
 class PlantWorkspace(NamedTuple):
-    """Scratch of :func:`closed_loop_terms`: the kernels' :class:`~hapticdesign.analysis.loops.records.Workspace`,
+    """Scratch of :func:`closed_loop_terms`: the kernels' :class:`~hapticdesign.analysis.loops.records.ClosureScratch`,
     the warm start ``q`` (full coordinates of the last closed pose), ``q_last`` a copy to fall back to and the
     world parameters ``pw`` (1, B, 10)."""
 
-    kernel: Workspace
+    kernel: ClosureScratch
     q: np.ndarray
     q_last: np.ndarray
     pw: np.ndarray
@@ -74,7 +74,7 @@ class PlantWorkspace(NamedTuple):
 
 def plant_workspace(n_node: int, n_dof: int, na: int, passive: np.ndarray, n_body: int) -> PlantWorkspace:
     """A zeroed :class:`PlantWorkspace`."""
-    return PlantWorkspace(workspace(n_node, n_dof, na, passive, n_body), np.zeros(n_dof), np.zeros(n_dof),
+    return PlantWorkspace(closure_scratch(n_node, n_dof, na, passive, n_body), np.zeros(n_dof), np.zeros(n_dof),
                           np.zeros((1, n_body, 10)))
 
 

@@ -23,7 +23,7 @@ a predicted pose and the rule that accepts its result.
 The kernels take the records of :mod:`.records` and :mod:`hapticdesign.model.walk`: ``tree``
 (:class:`~hapticdesign.model.walk.Tree`), ``plan`` (:class:`~hapticdesign.model.walk.WalkPlan`, the
 closures' nodes first), ``loops`` (:class:`~.records.Closures`), ``settings``
-(:class:`~.records.Settings`) and ``ws`` (:class:`~.records.Workspace`).
+(:class:`~.records.Settings`) and ``ws`` (:class:`~.records.ClosureScratch`).
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from hapticdesign.analysis.loops.records import BRANCH_CHANGE, ILL_CONDITIONED, NO_CLOSURE, OK, SINGULAR, workspace
+from hapticdesign.analysis.loops.records import BRANCH_CHANGE, ILL_CONDITIONED, NO_CLOSURE, OK, SINGULAR, closure_scratch
 from hapticdesign.model.dense import lu_in_place
 from hapticdesign.model.walk import planned_poses, unit_twist
 
@@ -146,7 +146,7 @@ def velocity_map_into(phi, actuated, passive, pp, s):
 @njit(cache=True)
 def newton(q, tree, plan, loops, settings):
     """:func:`newton_into` on a workspace of its own."""
-    ws = workspace(tree.parent.shape[0], q.shape[0], loops.actuated.shape[0], loops.passive, np.int64(0))
+    ws = closure_scratch(tree.parent.shape[0], q.shape[0], loops.actuated.shape[0], loops.passive, np.int64(0))
     return newton_into(q, tree, plan, loops, settings, ws)
 
 
@@ -311,7 +311,7 @@ def solve_path(qa_path, q_start, branch, tree, plan, loops, settings):
     n_dof = q_start.shape[0]
     m = loops.passive.shape[0]
     na = loops.actuated.shape[0]
-    ws = workspace(tree.parent.shape[0], n_dof, na, loops.passive, np.int64(0))
+    ws = closure_scratch(tree.parent.shape[0], n_dof, na, loops.passive, np.int64(0))
     s = np.empty((m, na))
     start = np.empty(na)
     out = np.empty((n_pose, n_dof))

@@ -4,7 +4,7 @@ Pinocchio's Model/Data split in numba form: what a closed-loop mechanism *is* co
 records built once per geometry (the folded tree :class:`~hapticdesign.model.walk.Tree`, its
 :class:`~hapticdesign.model.walk.WalkPlan` and :class:`~hapticdesign.model.walk.MotionPlan`, the
 :class:`Closures` and the solver's :class:`Settings`); what a kernel writes comes in a
-:class:`Workspace` built once per caller, so that the kernels allocate nothing in their loops and read
+:class:`ClosureScratch` built once per caller, so that the kernels allocate nothing in their loops and read
 ``ws.pinv`` by name rather than a slot number.
 """
 
@@ -70,7 +70,7 @@ class Settings(NamedTuple):
     floor: float
 
 
-class Workspace(NamedTuple):
+class ClosureScratch(NamedTuple):
     """Scratch of the closed-loop kernels (one per caller; nothing is allocated in their loops).
 
     Node poses ``rot``, ``pos`` and the walk plan's cosines and sines ``trig``; the closure residual
@@ -106,15 +106,15 @@ class Workspace(NamedTuple):
 
 
 @njit(cache=True)
-def workspace(n_node, n_dof, na, passive, n_body):
-    """A zeroed :class:`Workspace` for a tree of ``n_node`` nodes, ``n_dof`` coordinates, ``na`` actuated and
+def closure_scratch(n_node, n_dof, na, passive, n_body):
+    """A zeroed :class:`ClosureScratch` for a tree of ``n_node`` nodes, ``n_dof`` coordinates, ``na`` actuated and
     the ``passive`` ones, and ``n_body`` bodies."""
     n_node = max(n_node, 1)
     npas = passive.shape[0]
     slot = np.full(n_dof, -1, dtype=np.int64)
     for r in range(npas):
         slot[passive[r]] = r
-    return Workspace(
+    return ClosureScratch(
         np.zeros((n_node, 3, 3)), np.zeros((n_node, 3)), trig_workspace(n_node),
         np.zeros(npas), np.zeros((npas, n_dof)), np.zeros((npas, 1)), np.zeros((npas, npas)), np.zeros((npas, npas)),
         np.zeros((n_node, 3)), np.zeros((n_node, 3)), np.zeros((n_node, 3)),

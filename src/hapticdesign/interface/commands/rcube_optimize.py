@@ -20,7 +20,7 @@ POPULATION = typer.Option(None, "--population", help="Population size (default 1
 GENERATIONS = typer.Option(None, "--generations", help="Generations (default 150 synthesis, 100 cross-section, 200 plies).")
 WEIGHT = typer.Option(0.0, "--weight", help="Weight on mu_vn* of the selection (Table 7.5; the seed picks 0).")
 BOUNDS = typer.Option(None, "--bounds", help="One bound set 'qlo,qhi;l2lo,l2hi;l3lo,l3hi' (rad; m) instead of Table 7.1's three.")
-SIDE = typer.Option(0.120, "--side", help="Workspace cube edge (m), 120 mm in the seed.")
+SIDE = typer.Option(0.120, "--side", help="CubeWorkspace cube edge (m), 120 mm in the seed.")
 VIRTUAL = typer.Option(0.130, "--virtual-side", help="Virtual cube edge for the passive constraints (m), 130 mm.")
 
 
@@ -88,12 +88,12 @@ def register(app: typer.Typer) -> None:
                  json_out: bool = JSON_OUT, quiet: bool = QUIET, force: bool = FORCE) -> None:
         """The whole chain: synthesis, selection, swarm, cross-section and plies (seed 001 ch. 7)."""
         from hapticdesign.optimization.rcube.chain import chain_summary, run_chain, write_chain
-        from hapticdesign.optimization.rcube.constraints import Workspace
+        from hapticdesign.optimization.rcube.constraints import CubeWorkspace
 
         with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
             settings = _settings(quick, population, generations)
             with progress_bar(not (quiet or json_out)) as report:
-                result = run_chain(seed, settings, weight, _bound_sets(bounds), Workspace(side, virtual_side),
+                result = run_chain(seed, settings, weight, _bound_sets(bounds), CubeWorkspace(side, virtual_side),
                                    max_deflection=max_deflection, progress=report)
             summary = chain_summary(result)
             if out is not None:
@@ -118,12 +118,12 @@ def register(app: typer.Typer) -> None:
                    force: bool = FORCE) -> None:
         """Kinematic synthesis by NSGA-II over Table 7.1's bounds, post-evaluation and selection (§7.1-7.2)."""
         from hapticdesign.optimization.rcube import chain
-        from hapticdesign.optimization.rcube.constraints import Workspace
+        from hapticdesign.optimization.rcube.constraints import CubeWorkspace
         from hapticdesign.optimization.rcube.synthesis import synthesize as run
 
         with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
             s = _settings(quick, population, generations)
-            workspace = Workspace(side, virtual_side)
+            workspace = CubeWorkspace(side, virtual_side)
             sets = _bound_sets(bounds)
             with progress_bar(not (quiet or json_out)) as report:
                 callback = (lambda k, gen: report("synthesis", k * s.generations + gen, len(sets) * s.generations)) if report else None

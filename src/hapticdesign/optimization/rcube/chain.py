@@ -19,7 +19,7 @@ from hapticdesign.analysis.rcube.kinematics import dexterous_cube
 from hapticdesign.analysis.rcube.stiffness import cartesian_stiffness
 from hapticdesign.files import csv_rows, output_folder, to_jsonable, write_atomically
 from hapticdesign.optimization.rcube import figures
-from hapticdesign.optimization.rcube.constraints import Workspace
+from hapticdesign.optimization.rcube.constraints import CubeWorkspace
 from hapticdesign.optimization.rcube.cross_section import RATIO_BOUNDS, CrossSectionResult, optimize_ratio
 from hapticdesign.optimization.rcube.objectives import EvaluationLinks, geometry_of
 from hapticdesign.optimization.rcube.plies import PlyResult, choose, optimize_plies, ply_design
@@ -83,7 +83,7 @@ class Selection:
     """The post-evaluation tube (material, D, d, density) the metrics of Table 7.3 were computed with."""
 
 
-def select_solution(synthesis: SynthesisResult, weight: float = 0.0, workspace: Workspace = Workspace(),
+def select_solution(synthesis: SynthesisResult, weight: float = 0.0, workspace: CubeWorkspace = CubeWorkspace(),
                     links: EvaluationLinks = EvaluationLinks()) -> Selection:
     """Post-evaluate the front (Table 7.3), normalize (Table 7.4, eq. 7.1-7.4) and pick the minimum
     weighted RMS with ``weight`` on ``mu_vn*`` (the seed picks weight 0, Sol. 1, §7.2)."""
@@ -115,7 +115,7 @@ def ply_limit(result: PlyResult, max_deflection: float | None = None, relative: 
     return max_deflection if max_deflection is not None else relative * float(result.F[:, 0].min())
 
 
-def specifications(design: RCubeDesign, workspace: Workspace = Workspace()) -> dict[str, float | bool]:
+def specifications(design: RCubeDesign, workspace: CubeWorkspace = CubeWorkspace()) -> dict[str, float | bool]:
     """Table 7.9's computable rows: dexterous workspace, link mass, maximum deflection under 5 N per
     axis at the fully extended pose (``K_C`` with passive joints eliminated and ``K_C*``), and ``M_C``
     at home."""
@@ -151,7 +151,7 @@ class ChainResult:
 
 
 def run_chain(seed: int = 1, settings: Settings = Settings(), weight: float = 0.0, bound_sets=BOUND_SETS,
-              workspace: Workspace = Workspace(), ratio_bounds=RATIO_BOUNDS, max_deflection: float | None = None,
+              workspace: CubeWorkspace = CubeWorkspace(), ratio_bounds=RATIO_BOUNDS, max_deflection: float | None = None,
               progress: Callable[[str, int, int], None] | None = None, client=None) -> ChainResult:
     """Synthesis, selection, swarm, cross-section and plies, all seeded from ``seed``.
 

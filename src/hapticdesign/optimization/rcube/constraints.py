@@ -41,7 +41,7 @@ CONSTRAINT_NAMES = tuple(f"constraint {k} ({p})" for k, p in zip(range(3, 8), PA
 
 
 @dataclass(frozen=True)
-class Workspace:
+class CubeWorkspace:
     """Cube edge ``side`` (m, 120 mm in §6.1.3) and the virtual cube's edge ``virtual_side``
     (130 mm) on which the passive constraints are placed."""
 
@@ -65,12 +65,12 @@ class Workspace:
         return self.virtual_side / 2.0
 
 
-def link1_length(q_max, workspace: Workspace = Workspace()) -> np.ndarray:
+def link1_length(q_max, workspace: CubeWorkspace = CubeWorkspace()) -> np.ndarray:
     """Constraint 1: ``l1 = h / sin q_max`` (eq. 6.24)."""
     return workspace.half / np.sin(np.asarray(q_max, dtype=float))
 
 
-def critical_points(q_max, workspace: Workspace = Workspace()) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+def critical_points(q_max, workspace: CubeWorkspace = CubeWorkspace()) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """``(r_x, r_y)`` of the critical points (eq. 6.40-6.44 and C1, B1), broadcast over ``q_max``."""
     q = np.asarray(q_max, dtype=float)
     l1 = link1_length(q, workspace)
@@ -99,7 +99,7 @@ def distal_sine(r_x, r_y, l2, l3, sigma: int = -1) -> np.ndarray:
     return np.sin(q2 + q3)
 
 
-def constraint_values(X, workspace: Workspace = Workspace()) -> np.ndarray:
+def constraint_values(X, workspace: CubeWorkspace = CubeWorkspace()) -> np.ndarray:
     """Constraints 3-8 as ``g <= 0`` (pymoo's convention), shape ``(n, 7)``, for designs ``X (n, 3)``.
 
     Constraints 3-7: ``cos^2 q_i3 - 1 < 0`` at C2, C3, C5, B3, B5 (eq. 6.45-6.49);
@@ -113,14 +113,14 @@ def constraint_values(X, workspace: Workspace = Workspace()) -> np.ndarray:
     return np.stack(passive + ergonomic, axis=1)
 
 
-def is_feasible(X, workspace: Workspace = Workspace(), tolerance: float = 0.0) -> np.ndarray:
+def is_feasible(X, workspace: CubeWorkspace = CubeWorkspace(), tolerance: float = 0.0) -> np.ndarray:
     """Designs meeting Constraints 2-8 (``g <= tolerance``)."""
     X = np.atleast_2d(np.asarray(X, dtype=float))
     in_range = (X[:, 0] > Q_MAX_RANGE[0]) & (X[:, 0] < Q_MAX_RANGE[1])
     return in_range & np.all(constraint_values(X, workspace) <= tolerance, axis=1)
 
 
-def world_point(name: str, q_max: float, l1: float, workspace: Workspace = Workspace()) -> np.ndarray:
+def world_point(name: str, q_max: float, l1: float, workspace: CubeWorkspace = CubeWorkspace()) -> np.ndarray:
     """The platform position (chain 1, ``S = l1``) at which chain 1's passive arm reaches point ``name``:
     ``r_a = S + l1 sin q_a1`` with ``q_a1 = 0`` (C points) or ``q_max`` (B points), ``r_b = r_x``,
     ``r_c = r_y + l1 cos q_a1`` (eq. 6.33-6.34)."""

@@ -22,7 +22,7 @@ from hapticdesign.analysis.rcube.dynamics import cartesian_mass_matrix
 from hapticdesign.analysis.rcube.stiffness import cartesian_stiffness
 from hapticdesign.analysis.stiffness.materials import STRUCTURAL_STEEL, LinkModuli, laminate
 from hapticdesign.errors import UserError
-from hapticdesign.optimization.rcube.constraints import Workspace, link1_length
+from hapticdesign.optimization.rcube.constraints import CubeWorkspace, link1_length
 
 OBJECTIVE_NAMES = ("O1", "O2", "O3")
 
@@ -66,7 +66,7 @@ class EvaluationLinks:
         return uniform_design(geometry, self.D, self.d, self.moduli, density=self.density)
 
 
-def geometry_of(x, workspace: Workspace = Workspace()) -> RCubeGeometry:
+def geometry_of(x, workspace: CubeWorkspace = CubeWorkspace()) -> RCubeGeometry:
     """The geometry of a design vector ``(q_max, l2, l3)``: ``l1`` from Constraint 1, ``S = l1`` (eq. 6.39)."""
     q, l2, l3 = (float(v) for v in x)
     return RCubeGeometry(float(link1_length(q, workspace)), l2, l3)
@@ -98,7 +98,7 @@ def o3(design: RCubeDesign, half: float, passive_eliminated: bool = True) -> flo
     return float(1.0 / np.linalg.det(K[:3, :3]))
 
 
-def objectives(x, workspace: Workspace = Workspace(), links: EvaluationLinks = EvaluationLinks()) -> np.ndarray:
+def objectives(x, workspace: CubeWorkspace = CubeWorkspace(), links: EvaluationLinks = EvaluationLinks()) -> np.ndarray:
     """``(O1, O2, O3)`` of one feasible design vector."""
     design = links.design(geometry_of(x, workspace))
     return np.array([float(o1(x[0])), o2(design, workspace.half), o3(design, workspace.half, links.passive_eliminated)])

@@ -26,7 +26,7 @@ import numpy as np
 from hapticdesign.analysis.metrics.indices import ParameterStates, index
 from hapticdesign.errors import UserError
 from hapticdesign.model.rcube import RCubeGeometry
-from hapticdesign.optimization.rcube.constraints import ERGONOMIC_POINTS, PASSIVE_POINTS, Workspace, constraint_values
+from hapticdesign.optimization.rcube.constraints import ERGONOMIC_POINTS, PASSIVE_POINTS, CubeWorkspace, constraint_values
 from hapticdesign.optimization.rcube.objectives import EvaluationLinks, o1, o2, o3
 
 POINTS = (*PASSIVE_POINTS, *ERGONOMIC_POINTS)
@@ -36,14 +36,14 @@ SIDE, VIRTUAL_SIDE = 0.120, 0.130
 PARAMETERS = ("parameters",)
 
 
-def _workspace(side: object, virtual_side: object) -> Workspace:
+def _workspace(side: object, virtual_side: object) -> CubeWorkspace:
     for name, value in (("side", side), ("virtual_side", virtual_side)):
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise UserError(f"R-CUBE index option {name} is a length in m, got {value!r}")
-    return Workspace(float(side), float(virtual_side))
+    return CubeWorkspace(float(side), float(virtual_side))
 
 
-def design_vectors(params, workspace: Workspace) -> np.ndarray:
+def design_vectors(params, workspace: CubeWorkspace) -> np.ndarray:
     """``(q_max, l2, l3)`` per design (n, 3) from the parameters, ``q_max = asin(h / l1)`` (eq. 6.24 read backward);
     a design with ``S != l1`` is refused (the closed forms hold for ``S = l1``, eq. 6.39)."""
     missing = [n for n in ("l1", "l2", "l3", "S") if n not in params]

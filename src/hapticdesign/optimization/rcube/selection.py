@@ -21,7 +21,7 @@ from hapticdesign.analysis.rcube.dynamics import chain_cartesian_mass
 from hapticdesign.analysis.rcube.kinematics import critical_condition_number, critical_manipulability, inverse_kinematics
 from hapticdesign.analysis.rcube.stiffness import chain_stiffness_matrices
 from hapticdesign.optimization.front_selection import normalize, weighted_rms
-from hapticdesign.optimization.rcube.constraints import Workspace
+from hapticdesign.optimization.rcube.constraints import CubeWorkspace
 from hapticdesign.optimization.rcube.objectives import EvaluationLinks, geometry_of
 
 METRIC_NAMES = (names.INERTIA_FROBENIUS, names.STIFFNESS_FROBENIUS, names.FREQUENCY_INDEX,
@@ -31,7 +31,7 @@ LARGER_IS_BETTER = (names.STIFFNESS_FROBENIUS, names.FREQUENCY_INDEX, names.CRIT
 """Indices flipped by eq. 7.2-7.4 so that 0 is the best value of every normalized index."""
 
 
-def post_evaluate(X, workspace: Workspace = Workspace(), links: EvaluationLinks = EvaluationLinks()) -> dict[str, np.ndarray]:
+def post_evaluate(X, workspace: CubeWorkspace = CubeWorkspace(), links: EvaluationLinks = EvaluationLinks()) -> dict[str, np.ndarray]:
     """Table 7.3's five indices for each design vector ``(q_max, l2, l3)`` of ``X (n, 3)``."""
     X = np.atleast_2d(np.asarray(X, dtype=float))
     out = {name: np.empty(len(X)) for name in METRIC_NAMES}

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hapticdesign.optimization.rcube.constraints import CONSTRAINT_NAMES, Workspace, constraint_values, is_feasible, link1_length
+from hapticdesign.optimization.rcube.constraints import CONSTRAINT_NAMES, CubeWorkspace, constraint_values, is_feasible, link1_length
 from hapticdesign.optimization.local_search import minimize_in_boxes
 
 ACTIVE_TOLERANCE = 1e-7
@@ -28,7 +28,7 @@ GRADIENT_STEP = 1e-7
 """Central-difference step (rad, m) of the KKT check."""
 
 
-def total_length(x, workspace: Workspace = Workspace()) -> np.ndarray:
+def total_length(x, workspace: CubeWorkspace = CubeWorkspace()) -> np.ndarray:
     """``l1 + l2 + l3`` of design vectors ``(q_max, l2, l3)`` with ``l1 = h / sin q_max`` (eq. 6.24)."""
     X = np.atleast_2d(np.asarray(x, dtype=float))
     return link1_length(X[:, 0], workspace) + X[:, 1] + X[:, 2]
@@ -62,7 +62,7 @@ class Certificate:
         return self.rank == 3 and bool(np.all(self.multipliers > 0.0)) and self.stationarity < 1e-5
 
 
-def certify(x, workspace: Workspace = Workspace(), tolerance: float = ACTIVE_TOLERANCE) -> Certificate:
+def certify(x, workspace: CubeWorkspace = CubeWorkspace(), tolerance: float = ACTIVE_TOLERANCE) -> Certificate:
     """KKT check of a feasible design ``x`` for the minimum total length (eq. 6.24, 6.45-6.52)."""
     x = np.asarray(x, dtype=float)
     g = constraint_values(x[None], workspace)[0]
@@ -85,7 +85,7 @@ class ConstrainedMinimum:
     certificate: Certificate
     converged: int
     starts: int
-    workspace: Workspace = Workspace()
+    workspace: CubeWorkspace = CubeWorkspace()
 
     @property
     def l1(self) -> float:
@@ -100,7 +100,7 @@ class ConstrainedMinimum:
         return design_summary(self.x, self.workspace)
 
 
-def design_summary(x, workspace: Workspace = Workspace()) -> dict[str, float]:
+def design_summary(x, workspace: CubeWorkspace = CubeWorkspace()) -> dict[str, float]:
     """``{"l1", "l2", "l3", "q_max", "total_length"}`` of a design vector (m, rad; eq. 6.24)."""
     q, l2, l3 = (float(v) for v in x)
     l1 = float(link1_length(q, workspace))
@@ -112,7 +112,7 @@ def inside(x, bounds) -> bool:
     return bool(np.all(np.asarray(bounds.lower) <= x) and np.all(x <= np.asarray(bounds.upper)))
 
 
-def constrained_minimum(bound_sets: Sequence, workspace: Workspace = Workspace(), starts: int = 32,
+def constrained_minimum(bound_sets: Sequence, workspace: CubeWorkspace = CubeWorkspace(), starts: int = 32,
                         seed: int = 1) -> ConstrainedMinimum | None:
     """The minimum of ``l1 + l2 + l3`` (eq. 6.24) under Constraints 2-8 (eq. 6.28, 6.45-6.52) over
     the union of ``bound_sets`` (:func:`~hapticdesign.optimization.local_search.minimize_in_boxes`); None when no start reaches a feasible design."""

@@ -14,7 +14,7 @@ import numpy as np
 from pymoo.core.problem import Problem
 
 from hapticdesign.errors import UserError
-from hapticdesign.optimization.rcube.constraints import Workspace, constraint_values
+from hapticdesign.optimization.rcube.constraints import CubeWorkspace, constraint_values
 from hapticdesign.optimization.rcube.objectives import EvaluationLinks, objectives
 from hapticdesign.optimization.pymoo_run import AlgorithmSpec, RowObjective, run
 from hapticdesign.optimization.rcube.synthesis import BOUND_SETS, Bounds, Front
@@ -26,7 +26,7 @@ class WeightedSumProblem(Problem):
     """The scaled weighted sum of ``O1, O2, O3``; constraints are evaluated for the whole population
     at once, the objectives row by row (a loop, or the Dask ``client``'s workers) on feasible rows."""
 
-    def __init__(self, bounds: Bounds, weights, low, high, workspace: Workspace, links: EvaluationLinks, client=None):
+    def __init__(self, bounds: Bounds, weights, low, high, workspace: CubeWorkspace, links: EvaluationLinks, client=None):
         super().__init__(n_var=3, n_obj=1, xl=np.array(bounds.lower), xu=np.array(bounds.upper))
         self.weights, self.low, self.span = np.asarray(weights, float), low, np.where(high > low, high - low, 1.0)
         self.workspace = workspace
@@ -59,7 +59,7 @@ class SwarmResult:
 
 def weighted_sum_swarm(front: Front, weights=(1 / 3, 1 / 3, 1 / 3), bounds: Bounds = BOUND_SETS[2],
                        population: int = 40, generations: int = 60, seed: int = 1,
-                       workspace: Workspace = Workspace(), links: EvaluationLinks = EvaluationLinks(),
+                       workspace: CubeWorkspace = CubeWorkspace(), links: EvaluationLinks = EvaluationLinks(),
                        client=None) -> SwarmResult:
     """Minimize the weighted sum by PSO and compare with the front's own weighted-sum optimum;
     ``client``: a ``dask.distributed.Client`` whose workers evaluate the objectives."""

@@ -23,7 +23,7 @@ from pymoo.core.problem import Problem
 from pymoo.indicators.hv import HV
 
 from hapticdesign.errors import UserError
-from hapticdesign.optimization.rcube.constraints import Q_MAX_RANGE, Workspace, constraint_values, link1_length
+from hapticdesign.optimization.rcube.constraints import Q_MAX_RANGE, CubeWorkspace, constraint_values, link1_length
 from hapticdesign.optimization.rcube.objectives import EvaluationLinks, objectives
 from hapticdesign.optimization.pymoo_run import AlgorithmSpec, RowObjective, initial_population, pareto_filter, run
 from hapticdesign.optimization.rcube.shortest import ConstrainedMinimum, constrained_minimum, design_summary, inside
@@ -68,7 +68,7 @@ class SynthesisProblem(Problem):
     population at once; the objectives, row by row (a loop, or the Dask ``client``'s workers), on
     feasible rows only."""
 
-    def __init__(self, bounds: Bounds, workspace: Workspace, links: EvaluationLinks, client=None):
+    def __init__(self, bounds: Bounds, workspace: CubeWorkspace, links: EvaluationLinks, client=None):
         super().__init__(n_var=3, n_obj=3, n_ieq_constr=7, xl=np.array(bounds.lower), xu=np.array(bounds.upper))
         self.workspace = workspace
         self.objective = RowObjective(partial(objectives, workspace=workspace, links=links), 3, 3, client)
@@ -88,7 +88,7 @@ class Front:
 
     X: np.ndarray
     F: np.ndarray
-    workspace: Workspace = Workspace()
+    workspace: CubeWorkspace = CubeWorkspace()
 
     @property
     def l1(self) -> np.ndarray:
@@ -107,7 +107,7 @@ class Front:
         return design_summary(self.X[k], self.workspace)
 
 
-def run_nsga2(bounds: Bounds, population: int, generations: int, seed: int, workspace: Workspace = Workspace(),
+def run_nsga2(bounds: Bounds, population: int, generations: int, seed: int, workspace: CubeWorkspace = CubeWorkspace(),
               links: EvaluationLinks = EvaluationLinks(), progress: Callable[[int], None] | None = None,
               initial: np.ndarray | None = None, client=None) -> tuple[Front, int]:
     """One NSGA-II run (pymoo) over one bound set; returns its feasible final population and the
@@ -162,7 +162,7 @@ MINIMIZATION_STARTS = 32
 
 
 def synthesize(bound_sets=BOUND_SETS, population: int = 100, generations: int = 150, seed: int = 1,
-               workspace: Workspace = Workspace(), links: EvaluationLinks = EvaluationLinks(),
+               workspace: CubeWorkspace = CubeWorkspace(), links: EvaluationLinks = EvaluationLinks(),
                length_limit: float = TOTAL_LENGTH_LIMIT, progress: Callable[[int, int], None] | None = None,
                starts: int = MINIMIZATION_STARTS, client=None) -> SynthesisResult:
     """NSGA-II over each bound set (seed ``seed + k`` for set ``k``), merged as in §7.1.
