@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 
 from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.analysis.metrics.indices import Request
@@ -173,3 +174,26 @@ def test_an_index_the_device_cannot_give_fails_each_design_as_design_by_design()
         assert [f.reason for f in fast] == [s.reason for s in slow]
         assert all(s.reason for s in slow)
     assert evaluate_designs(space, [], points, ["isotropy"]) == []
+
+
+def test_a_home_given_as_a_handle_position_follows_each_design_batched_as_one_at_a_time():
+    """Issue 35: a device file whose home is a handle position (``home: {position}``) puts each design's home there
+    (design by design: ``DesignSpace.device``, the file's own inverse kinematics). The batch reaches it first: a
+    design that cannot reach the home position fails batched too (it reaches the workspace points, so reaching
+    them from the file's home joint values would pass it), and the others give the same values."""
+    data = yaml.safe_load((EXAMPLES / "five-bar.yaml").read_text())
+    data["home"] = {"position": [0.0, 0.0, 0.22]}
+    space = design_space(data, ["l1", "l2", "d"])
+    short = {"l1": 0.09, "l2": 0.10, "d": 0.08}  # |A1 - home| = 0.2236 m > l1 + l2 = 0.19 m
+    designs = [short, {"l1": 0.11, "l2": 0.15, "d": 0.07}, {"l1": 0.10, "l2": 0.16, "d": 0.05}]
+    points = np.array([[0.0, 0.0, 0.15], [0.02, 0.0, 0.16], [-0.015, 0.0, 0.17]])  # within 0.19 m of both motors
+    batched = evaluate_designs(space, designs, points, ["isotropy", "apparent_mass", "kmax"])
+    assert space.cache.get("batch")
+    with pytest.raises(UserError, match="home.position"):
+        space.device(short)
+    assert batched[0].reason.startswith("the handle cannot reach its home position (0, 0, 0.22) m")
+    for values, fast in zip(designs[1:], batched[1:]):
+        slow = evaluate(space.device(values), points, ["isotropy", "apparent_mass", "kmax"])
+        assert fast.reason is None and slow.reason is None
+        for key in slow.values:
+            np.testing.assert_allclose(fast.values[key], slow.values[key], rtol=1e-9, err_msg=key)

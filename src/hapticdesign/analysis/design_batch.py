@@ -545,19 +545,27 @@ class DesignBatch:
             return vjm.chain_stiffness(j_theta, c_theta, j_p)[..., :6, :6]
         return vjm.locked_stiffness(j_theta, c_theta)[..., :6, :6]
 
-    def evaluate(self, values: DesignValues, points: np.ndarray, stiffness: bool = False) -> Evaluated:
+    def evaluate(self, values: DesignValues, points: np.ndarray, stiffness: bool = False,
+                 home: np.ndarray | None = None) -> Evaluated:
         """Every design of ``values`` at the workspace ``points`` (P, 3), reached in order from home: ``J_v``, ``H``
         (the design's inertial parameters and motors), ``K_C`` when ``stiffness`` (the design's sections), the
         moving mass, and the reason of each design that fails (refused by the device file, a point not reached or
-        outside the joint limits, a pose where the handle is rigid in some direction)."""
+        outside the joint limits, a pose where the handle is rigid in some direction). ``home``: the handle's home
+        position of a device file that gives one (``home: {position}``); each design's home is then where its
+        handle reaches that position from the file's home joint values (as the design's own device file puts it,
+        :func:`~hapticdesign.devices.device_file.home_at`), so the home follows the design's geometry."""
         points = np.asarray(points, dtype=float)
         offsets = self.offsets(values.kinematic)
-        reached = self.reach_points(offsets, points)
+        if home is None:
+            reached = self.reach_points(offsets, points)
+        else:
+            first = self.reach_points(offsets, np.vstack([np.asarray(home, dtype=float)[None], points]))
+            reached = Reached(first.full[:, 1:], first.jvt[:, 1:], first.status, first.point - 1)
         reasons = list(values.refused)
         limited = any(span is not None for span in self.device.joint_limits())
         for d in range(len(reasons)):
             if reasons[d] is None and reached.status[d] != OK:
-                reasons[d] = self.reason(reached, d, points)
+                reasons[d] = self.reason(reached, d, points, home)
             elif reasons[d] is None and limited:
                 try:
                     check_limits(self.device, reached.full[d][:, self.closures.actuated], points)
@@ -577,14 +585,18 @@ class DesignBatch:
             ok &= defined
         return Evaluated(reached.jvt, mass, reached.full[..., self.closures.actuated], k_c, moving, ok, reasons, values)
 
-    def reason(self, reached: Reached, design: int, points: np.ndarray) -> str | None:
-        """One line on why ``design`` failed (naming the point), or None."""
+    def reason(self, reached: Reached, design: int, points: np.ndarray, home: np.ndarray | None = None) -> str | None:
+        """One line on why ``design`` failed (naming the point, or the ``home`` position), or None."""
         code = int(reached.status[design])
         if code == OK:
             return None
         if code == NO_HOME:
             return MESSAGES[NO_HOME]
         index = int(reached.point[design])
-        where = "home" if index < 0 else "(" + ", ".join(f"{v:.6g}" for v in points[index]) + ") m"
+        if index < 0 and home is None:
+            where = "home"
+        else:
+            named = "(" + ", ".join(f"{v:.6g}" for v in (home if index < 0 else points[index])) + ") m"
+            where = named if index >= 0 else f"its home position {named}"
         return f"the handle cannot reach {where}: {MESSAGES[code]}"
 

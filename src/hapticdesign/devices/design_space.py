@@ -102,6 +102,11 @@ class DesignSpace:
         """Whether bodies are links (``bodies: - {link: ...}``), whose masses follow lengths and sections."""
         self.cache: dict[str, object] = {}
         """What a caller builds once per space (the batched kernels' structure, ...)."""
+        position = self.spec.home.get(HOME_POSITION)
+        self.home_position = (np.array(position, dtype=float)
+                              if isinstance(position, list) and self.base.mechanism.loops is not None else None)
+        """The handle's home position of a closed-loop device whose file gives one: each design's home follows it
+        (:meth:`_home_follows`; the batched kernels reach it first)."""
 
     # -- names --------------------------------------------------------------------------------
     def _variable(self, name: str) -> Variable:

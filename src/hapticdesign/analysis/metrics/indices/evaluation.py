@@ -49,6 +49,7 @@ class DesignFamily(Protocol):
 
     base: Device
     cache: dict
+    home_position: np.ndarray | None
 
     def batch_values(self, designs: Sequence[Mapping[str, float]], batch: DesignBatch): ...
 
@@ -104,7 +105,7 @@ def evaluate_designs(space: DesignFamily, designs: Sequence[Mapping[str, float]]
     if batch is None:
         return [_one(space, values, points, checked, registry) for values in designs]
     sections = any("sections" in registry[r.index].needs for r in checked)
-    got = batch.evaluate(space.batch_values(designs, batch), points, sections)
+    got = batch.evaluate(space.batch_values(designs, batch), points, sections, space.home_position)
     ok, v = got.ok, got.values
     per_pose = np.repeat(np.flatnonzero(ok), len(points))
     n_a = got.jacobian.shape[-1]
