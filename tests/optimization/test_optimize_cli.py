@@ -156,3 +156,28 @@ def test_another_study_in_the_same_folder_is_refused(tmp_path):
     study = small_study(tmp_path)
     assert optimize(study, "--seed", 1, "--out", tmp_path / "out").exit_code == 0
     _error([study, "--seed", 2, "--out", tmp_path / "out"], "holds a run of another study or seed")
+
+
+def test_the_selected_designs_sheet_is_taken_where_the_study_evaluated_it(tmp_path):
+    """Issue 35: selected.yaml names the point where the selected design has its weakest wall over the study's
+    points, and ``spec`` at that pose (one design, one pose, every direction searched) gives the study's batched
+    ``kmax`` objective there; a sheet at home, outside the study's box, would read another pose's wall."""
+    wall = {"name": "wall", "index": "kmax", "reduce": "min", "sense": "max"}
+    study = write_study(tmp_path, {"l2": [0.09, 0.3], "actuators.q2.gear_ratio": {"values": [4.0, 8.0, 16.0]}},
+                        [ISOTROPY, wall], population=8, generations=3, center=point(0.15), size=(0.03, 0.0, 0.03),
+                        grid=3)
+    arm = yaml.safe_load((tmp_path / "arm.yaml").read_text())
+    arm["joints"] = [{"name": "q1", "damping": 0.002}, {"name": "q2", "damping": 0.003}]  # a wall needs damping
+    (tmp_path / "arm.yaml").write_text(yaml.safe_dump(arm))
+    res = optimize(study, "--seed", 2, "--out", tmp_path / "out", "--json")
+    assert res.exit_code == 0, res.output
+    weakest = json.loads(res.stdout)["selected"]["objectives"]["wall"]
+    assert weakest > 1.0
+    selected = tmp_path / "out" / "selected.yaml"
+    line, = [t for t in selected.read_text().splitlines() if t.startswith("# min kmax over the study's points")]
+    assert float(line.split(" = ")[1].split()[0]) == pytest.approx(weakest, rel=1e-5)
+    q = line.rsplit("--q ", 1)[1]
+    sheet = runner.invoke(app, ["spec", "--device", str(selected), "--q", q, "--json", "--no-simulate",
+                                "--no-workspace"])
+    assert sheet.exit_code == 0, sheet.output
+    assert json.loads(sheet.stdout)["renderable_stiffness"]["exact"] == pytest.approx(weakest, rel=1e-6)

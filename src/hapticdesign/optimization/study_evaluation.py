@@ -254,11 +254,40 @@ class BoundStudy:
         return data
 
     def device_file_text(self, values: dict[str, float]) -> str:
-        """:meth:`device_mapping` as YAML, headed by where it comes from."""
+        """:meth:`device_mapping` as YAML, headed by where it comes from and where the study evaluated it
+        (:meth:`where_evaluated`)."""
         shown = ", ".join(f"{k} = {v!r}" for k, v in values.items())
         names = (json.dumps(self.study.path.name), json.dumps(self.study.device_path.name))  # no line break in them
         header = f"# The design selected by study {names[0]} from device file {names[1]}:\n# {shown}\n"
-        return header + yaml.safe_dump(self.device_mapping(values), sort_keys=False, allow_unicode=False)
+        return (header + self.where_evaluated(values)
+                + yaml.safe_dump(self.device_mapping(values), sort_keys=False, allow_unicode=False))
+
+    def where_evaluated(self, values: dict[str, float]) -> str:
+        """Comment lines naming, for each index the study reduced over its workspace points by ``min`` or ``max``,
+        the point where the design takes that value and its actuated coordinates there, with the ``spec`` command
+        that gives the sheet at that pose (issue 35: a sheet at home, outside the study's box, reads another pose's
+        numbers; at this pose its renderable stiffness is the study's ``kmax`` with the same loop settings)."""
+        if not len(self.points) or not self.requests:
+            return ""
+        device = self.space.device(self.device_values(values))
+        try:
+            poses = reach_workspace(device, self.points)
+            result = evaluate_at(device, poses.full, self.requests, None, self.registry)
+        except UserError:
+            return ""
+        lines = []
+        for index, options, how in self.keys:
+            label = self.labels.get((index, options))
+            if how not in ("min", "max") or label not in result.values:
+                continue
+            got = result.values[label]
+            k = int(np.argmin(got) if how == "min" else np.argmax(got))
+            named = index + (json.dumps(dict(options), sort_keys=True) if options else "")
+            point = ", ".join(f"{x:.6g}" for x in self.points[k])
+            q = ",".join(repr(float(x)) for x in poses.q[k])
+            lines.append(f"# {how} {named} over the study's points = {got[k]:.6g} {self.registry[index].unit} at "
+                         f"({point}) m; the sheet there: hapticdesign spec --device THIS_FILE --q {q}\n")
+        return "".join(lines)
 
     def pictures(self, values: dict[str, float]) -> list[tuple[bytes, str]]:
         """The selected design's picture at the workspace centre (at home when the centre is out of reach) and
