@@ -72,6 +72,28 @@ class Variable:
     target: str | int
     field: str = ""
 
+    def file_value(self, spec: DeviceFileSpec, params: Mapping[str, float]) -> float:
+        """Its value in the device file ``spec`` whose parameters are ``params`` (NaN for an actuator field the file
+        leaves unset)."""
+        if self.kind in ("parameter", "inertial"):
+            return float(params[self.name])
+        if self.kind == "section":
+            return float(getattr(spec.links[self.target].section, self.field))
+        value = getattr(spec.actuators[self.target], self.field)
+        return math.nan if value is None else float(value)
+
+    def write(self, data: dict, value: float) -> None:
+        """Write ``value`` where the variable sits in the device file's mapping ``data`` (a design written back)."""
+        if self.kind == "parameter":
+            data["parameters"][self.name] = value
+        elif self.kind == "inertial":
+            body = next(b for b in data["bodies"] if str(b["name"]) == self.target)
+            body[next(f for f in SEED_FIELDS if seed_parameter_name(f, self.target) == self.name)] = value
+        elif self.kind == "section":
+            data["links"][self.target]["section"][self.field] = value
+        else:
+            data["actuators"][self.target][self.field] = value
+
 
 class DesignSpace:
     """The design variables ``names`` of the device file ``source`` (a path or its parsed mapping)."""
@@ -158,16 +180,7 @@ class DesignSpace:
 
     def defaults(self) -> dict[str, float]:
         """Each variable's value in the file (NaN for an actuator field the file leaves unset)."""
-        out = {}
-        for v in self.variables:
-            if v.kind in ("parameter", "inertial"):
-                out[v.name] = float(self.base.params[v.name])
-            elif v.kind == "section":
-                out[v.name] = float(getattr(self.spec.links[v.target].section, v.field))
-            else:
-                value = getattr(self.spec.actuators[v.target], v.field)
-                out[v.name] = math.nan if value is None else float(value)
-        return out
+        return {v.name: v.file_value(self.spec, self.base.params) for v in self.variables}
 
     # -- designs ------------------------------------------------------------------------------
     def checked_values(self, values: Mapping[str, float]) -> dict[str, float]:

@@ -31,7 +31,6 @@ from hapticdesign.analysis.workspace import Workspace, reach_workspace
 from hapticdesign.devices.design_space import DesignSpace
 from hapticdesign.errors import UserError
 from hapticdesign.files import parse_structured, quote
-from hapticdesign.model.inertia import SEED_FIELDS, seed_parameter_name
 from hapticdesign.optimization.study_file import Choice, IndexConstraint, Study
 from hapticdesign.optimization.study_outputs import index_maps
 from hapticdesign.optimization.study_polish import most_designs
@@ -240,17 +239,7 @@ class BoundStudy:
         data = copy.deepcopy(self.mapping)
         values = self.device_values(values)
         for v in self.space.variables:
-            value = float(values[v.name])
-            if v.kind == "parameter":
-                data["parameters"][v.name] = value
-            elif v.kind == "inertial":
-                body = next(b for b in data["bodies"] if str(b["name"]) == v.target)
-                field = next(f for f in SEED_FIELDS if seed_parameter_name(f, v.target) == v.name)
-                body[field] = value
-            elif v.kind == "section":
-                data["links"][v.target]["section"][v.field] = value
-            else:
-                data["actuators"][v.target][v.field] = value
+            v.write(data, float(values[v.name]))
         return data
 
     def device_file_text(self, values: dict[str, float]) -> str:
