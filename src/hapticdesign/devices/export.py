@@ -28,8 +28,8 @@ It also refuses inertias that break the triangle inequality (a file may still ho
 
 Constraint stiffness. MuJoCo's equality constraints are soft: a violation decays with the time constant
 ``solref[0]`` (default 0.02 s), which MuJoCo clamps to at least twice the timestep. The MJCF states the
-timestep (1 ms, the haptic loop's 1 kHz) and ``solref = "2 timestep 1"`` (critically damped) on every
-equality, the stiffest setting MuJoCo keeps: a file comment says so, and to scale ``solref`` with the timestep.
+timestep (1 ms, the haptic loop's 1 kHz) and on every equality ``solref`` with twice that time constant and
+damping ratio 1, the stiffest setting MuJoCo keeps: a file comment says so, and to scale it with the timestep.
 """
 
 from __future__ import annotations
