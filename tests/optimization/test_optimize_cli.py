@@ -181,3 +181,42 @@ def test_the_selected_designs_sheet_is_taken_where_the_study_evaluated_it(tmp_pa
                                 "--no-workspace"])
     assert sheet.exit_code == 0, sheet.output
     assert json.loads(sheet.stdout)["renderable_stiffness"]["exact"] == pytest.approx(weakest, rel=1e-6)
+
+
+def _wall_study(tmp_path: Path, variables: dict, wall: float, damping: float) -> Path:
+    """The planar arm with ``damping`` (N m s/rad) on both joints, a study of ``variables`` for the least apparent
+    mass under ``min_kmax >= wall`` (1 kHz, one sample of delay), at one point."""
+    path = write_study(tmp_path, variables, [MASS], population=4, generations=2,
+                       constraints=[{"index": "kmax", "reduce": "min", ">=": wall}])
+    arm = yaml.safe_load((tmp_path / "arm.yaml").read_text())
+    for joint in arm["joints"]:
+        joint["damping"] = damping
+    (tmp_path / "arm.yaml").write_text(yaml.safe_dump(arm))
+    return path
+
+
+MOTOR_TORQUE = {"actuators.q1.torque_continuous": [0.02, 0.05]}
+
+
+@pytest.mark.parametrize("damping, wall", [(0.0, 1.0), (0.01, 1e6)])
+def test_a_wall_no_design_can_render_is_a_warning_before_the_run(tmp_path, damping, wall):
+    """A variable kmax does not read (a motor's continuous torque) leaves every design with the device file's wall
+    limit: without damping no sampled spring is stable (the passivity bound 2b/T is 0), and with 0.01 N m s/rad
+    per joint 1e6 N/m is thousands of times the handle's damping scale b / (l^2 T) = 0.01 / (0.2^2 1e-3) =
+    250 N/m. The
+    warning comes before the run, whose empty front then names the constraint."""
+    res = optimize(_wall_study(tmp_path, MOTOR_TORQUE, wall, damping), "--seed", 1)
+    assert res.exit_code == 2, res.output
+    lines = [line for line in res.stderr.strip().splitlines() if not line.startswith("generations: ")]  # progress
+    assert len(lines) == 2 and "Traceback" not in res.output, res.stderr
+    assert res.stderr.startswith(f"warning: study.yaml: no design can meet min_kmax >= {wall:g} N/m: every design's")
+    assert lines[1].startswith("error: no design of 8 meets the constraints") and "min_kmax" in lines[1]
+
+
+def test_a_wall_within_reach_or_a_study_of_the_geometry_has_no_warning(tmp_path):
+    """Below the device's wall limit nothing is said; nor when a variable changes the geometry (the handle's
+    damping and mass follow it, so no bound holds for every design before the run)."""
+    low = optimize(_wall_study(tmp_path, MOTOR_TORQUE, 1.0, 0.01), "--seed", 1)
+    assert low.exit_code == 0 and "warning" not in low.stderr, low.output
+    geometry = optimize(_wall_study(tmp_path, {"l2": [0.1, 0.3]}, 1e6, 0.01), "--seed", 1)
+    assert geometry.exit_code == 2 and "warning" not in geometry.stderr and "meets the constraints" in geometry.stderr

@@ -25,6 +25,11 @@ no speed limit). URDF cannot state a motor on a combination of coordinates: its 
 MuJoCo refuses moving bodies without mass, and most frames between two joints carry none: the MJCF sets
 ``<compiler boundmass="1e-9" boundinertia="1e-12">`` (kg, kg m^2), a change far below any device's own.
 It also refuses inertias that break the triangle inequality (a file may still hold them, with a warning).
+
+Constraint stiffness. MuJoCo's equality constraints are soft: a violation decays with the time constant
+``solref[0]`` (default 0.02 s), which MuJoCo clamps to at least twice the timestep. The MJCF states the
+timestep (1 ms, the haptic loop's 1 kHz) and on every equality ``solref`` with twice that time constant and
+damping ratio 1, the stiffest setting MuJoCo keeps: a file comment says so, and to scale it with the timestep.
 """
 
 from __future__ import annotations
@@ -45,6 +50,10 @@ BOUND_INERTIA = 1e-12
 EQUALITY_IMPEDANCE = "0.9999 0.9999 0.001 0.5 2"
 """MuJoCo's stiffest constraint impedance (its ceiling is 0.9999): a constraint force within about 1e-4 of
 the ideal one."""
+TIMESTEP = 1e-3
+"""The exported timestep (s): the haptic loop's 1 kHz."""
+EQUALITY_REFERENCE = f"{2 * TIMESTEP:g} 1"
+"""``solref``: time constant twice the timestep (MuJoCo clamps anything shorter), damping ratio 1."""
 
 
 @dataclass(frozen=True)
@@ -126,7 +135,7 @@ def to_mjcf(device: Device) -> Export:
     tree = _Tree(mech)
     root = ET.Element("mujoco", model=device.name)
     ET.SubElement(root, "compiler", angle="radian", boundmass=f"{BOUND_MASS:g}", boundinertia=f"{BOUND_INERTIA:g}")
-    ET.SubElement(root, "option", gravity=_fmt(mech.gravity))
+    ET.SubElement(root, "option", timestep=f"{TIMESTEP:g}", gravity=_fmt(mech.gravity))
     world = ET.SubElement(root, "worldbody")
     element = {"base": world}
     joints: list[JointRow] = []
@@ -201,6 +210,9 @@ def _home(mech: Mechanism) -> np.ndarray:
     return LoopSolver(mech).home
 
 
+_STIFFEST = {"solref": EQUALITY_REFERENCE, "solimp": EQUALITY_IMPEDANCE}
+
+
 def _loops(mech: Mechanism, element: dict, root: ET.Element, couplings) -> None:
     """Couplings as fixed tendons held at zero, loop closures as ``connect`` (or ``weld``) between two sites."""
     tendons = ET.Element("tendon")
@@ -211,7 +223,7 @@ def _loops(mech: Mechanism, element: dict, root: ET.Element, couplings) -> None:
         for k, c in enumerate(row):
             if c and not (mech.coordinates[k] == name):
                 ET.SubElement(fixed, "joint", joint=mech.coordinates[k], coef=f"{-c:.17g}")
-        ET.SubElement(equality, "tendon", tendon1=f"coupling_{name}", solimp=EQUALITY_IMPEDANCE)
+        ET.SubElement(equality, "tendon", tendon1=f"coupling_{name}", **_STIFFEST)
     if mech.loops is not None:
         for i, closure in enumerate(mech.loops.closures):
             kind = {(0, 1, 2): "connect", (0, 1, 2, 3, 4, 5): "weld"}.get(tuple(closure.components))
@@ -223,7 +235,11 @@ def _loops(mech: Mechanism, element: dict, root: ET.Element, couplings) -> None:
                 site = f"loop{i + 1}_{side}"
                 ET.SubElement(element[frame], "site", name=site)
                 sites.append(site)
-            ET.SubElement(equality, kind or "connect", site1=sites[0], site2=sites[1], solimp=EQUALITY_IMPEDANCE)
+            ET.SubElement(equality, kind or "connect", site1=sites[0], site2=sites[1], **_STIFFEST)
+    if len(equality):
+        equality.insert(0, ET.Comment(
+            f" solref {EQUALITY_REFERENCE}: time constant 2 x timestep ({TIMESTEP:g} s), the stiffest MuJoCo keeps "
+            "(it clamps shorter ones); with another timestep, set it to 2 x that timestep "))
     for part in (tendons, equality):
         if len(part):
             root.append(part)

@@ -24,20 +24,22 @@ from hapticdesign.files import dumps_json, to_jsonable, write_atomically
 
 @contextmanager
 def user_errors(strict: bool = False, quiet: bool = False) -> Iterator[None]:
-    """Turn user mistakes into ``error: ...`` on stderr and exit 2; consistency warnings into one line."""
-    with warnings.catch_warnings(record=True) as caught:
+    """Turn user mistakes into ``error: ...`` on stderr and exit 2; consistency and run warnings into one line each,
+    as they are raised (a warning before a long run shows before it); other warnings are not shown."""
+
+    def show(message, category, *args, **kwargs) -> None:
+        if not quiet and issubclass(category, (PhysicalConsistencyWarning, RunWarning)):
+            typer.echo(f"warning: {message}", err=True)
+
+    with warnings.catch_warnings():
         warnings.simplefilter("always", PhysicalConsistencyWarning)
         warnings.simplefilter("always", RunWarning)
+        warnings.showwarning = show
         try:
             yield
         except UserError as exc:
             typer.echo(f"error: {shortened(flagged(exc))}", err=True)
             raise typer.Exit(2) from None
-        finally:
-            if not quiet:
-                for w in caught:
-                    if issubclass(w.category, (PhysicalConsistencyWarning, RunWarning)):
-                        typer.echo(f"warning: {w.message}", err=True)
 
 
 LONGEST_WORD = 200

@@ -42,6 +42,15 @@ STUDY_LIMIT = 1e5
 points (each one a design's pose reached and its indices computed; docs/limits.md)."""
 
 
+KMAX_UNREAD = ("coulomb", "torque_continuous", "torque_peak")
+"""The motor fields (``actuators.<joint>.<field>``) the ``kmax`` index does not read: its loop is linear in the
+handle's J_v, H and B."""
+
+
+def _unread_by_kmax(name: str) -> bool:
+    return name.startswith("actuators.") and name.rsplit(".", 1)[-1] in KMAX_UNREAD
+
+
 def require_study_workload(study: Study) -> None:
     """Refuse a study whose designs (population x generations x runs of a population search and at most as many as
     its polishing may ask, :func:`~.study_polish.most_designs`; one for method convex, whose program the number of
@@ -111,13 +120,17 @@ class BoundStudy:
         self.points = np.zeros((0, 3)) if workspace is None else workspace.points()
         self.title = f"{self.space.base.name} ({study.path.name})"
 
+    def _middle(self) -> dict[str, float]:
+        """The design in the middle of the variables' bounds (a choice's first value)."""
+        return {name: v.values[0] if isinstance(v, Choice) else (v[0] + v[1]) / 2
+                for name, v in self.study.spec.variables.items()}
+
     def _check_options(self) -> None:
         """Every index with its options once at the device file's home pose (the parameter indices at the design in
         the middle of the variables' bounds), so that an option's bad value is refused before the run (not found in every design)."""
         device = self.space.base
         evaluate_at(device, configuration_of(device).full(home_pose(device)), self.requests, None, self.registry)
-        middle = {name: v.values[0] if isinstance(v, Choice) else (v[0] + v[1]) / 2
-                  for name, v in self.study.spec.variables.items()}
+        middle = self._middle()
         full = self.study.spec.with_parameters(middle)
         for name, f in self.study.spec.parameters.items():  # the formula that fails, not an index reading its value
             if not math.isfinite(float(full[name])):
@@ -126,6 +139,34 @@ class BoundStudy:
         params = {name: np.array([float(value)]) for name, value in
                   {**device.params, **self.device_values(middle)}.items()}
         evaluate_parameters(params, self.parameter_requests, self.registry)
+
+    def unmeetable_walls(self) -> list[str]:
+        """The ``kmax`` constraints that no design of the study can meet, in words, known before the run where that is
+        rigorous: ``kmax`` is the sampled wall's exact limit from the handle's ``J_v``, ``H`` and ``B`` at each
+        workspace point (:func:`~hapticdesign.analysis.wall_stiffness.kmax`), so when every device variable of the
+        study is a motor field it does not read (:data:`KMAX_UNREAD`), every design has the device file's value,
+        computed once here. Where a variable changes the geometry, an inertia, a damping or a gear ratio, no bound
+        holds for every design (the handle's damping and mass follow them), and nothing is said before the run."""
+        walls = [c for c in self.study.spec.constraints if isinstance(c, IndexConstraint) and c.index == "kmax"]
+        if not walls or not all(_unread_by_kmax(name) for name in self.space.names):
+            return []
+        answer = self.evaluate([self._middle()], objectives=False)[0]
+        if answer.reason:
+            return []
+        reduced = dict(zip(self.keys, answer.reduced))
+        out = []
+        for c in walls:
+            value = reduced[c.key]
+            if c.at_least is not None and value < c.at_least:
+                word, bound = ">=", c.at_least
+            elif c.at_most is not None and value > c.at_most:
+                word, bound = "<=", c.at_most
+            else:
+                continue
+            out.append(f"{self.study.path.name}: no design can meet {c.label} {word} {bound:g} N/m: every design's "
+                       f"{c.label} is the device file's {value:.6g} N/m (no variable of the study changes the "
+                       "geometry, inertias, damping or gear ratios it depends on)")
+        return out
 
     def device_values(self, values: dict[str, float]) -> dict[str, float]:
         """The device design variables' values of a design: its variables' and the ``parameters`` formulas'."""

@@ -10,13 +10,14 @@ failed or interrupted run leaves complete checkpoint files and nothing half-writ
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable, Sequence
 from contextlib import ExitStack
 from dataclasses import dataclass
 from pathlib import Path
 
 from hapticdesign.analysis.metrics.indices import Index
-from hapticdesign.errors import UserError
+from hapticdesign.errors import RunWarning, UserError
 from hapticdesign.files import write_atomically
 from hapticdesign.interface.report.optimization_page import Picture, render
 from hapticdesign.optimization.study_evaluation import BoundStudy, bind_study, require_study_workload
@@ -184,7 +185,9 @@ def optimize(study: Path | str, seed: int = 1, out: Path | str | None = None, *,
     ``progress(generation, generations)``; ``quiet``: Dask's own logging silenced; ``indices``: your own design
     indices (functions decorated with :func:`hapticdesign.index`, or a Python file defining them, run in this
     process), which the study may name beside the registered ones. Nothing is printed; a bad study, seed or
-    selection raises :class:`~hapticdesign.errors.UserError`."""
+    selection raises :class:`~hapticdesign.errors.UserError`; a ``kmax`` constraint that no design can meet, known
+    before the run (:meth:`~hapticdesign.optimization.study_evaluation.BoundStudy.unmeetable_walls`), is a
+    :class:`~hapticdesign.errors.RunWarning` before the run starts."""
     if isinstance(indices, (str, Path)):
         indices = index_module(Path(indices))
     own = list(indices)
@@ -193,6 +196,8 @@ def optimize(study: Path | str, seed: int = 1, out: Path | str | None = None, *,
     study = load_study(study)
     bound = bind_study(study, indices=own)
     require_study_workload(study)
+    for message in bound.unmeetable_walls():
+        warnings.warn(message, RunWarning, stacklevel=2)
     out = None if out is None else Path(out)
     if out is not None:
         _check_out(out)
