@@ -33,12 +33,11 @@ import tempfile  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-import numpy as np  # noqa: E402
 import yaml  # noqa: E402
 
 from hapticdesign.optimization.study_evaluation import bind_study  # noqa: E402
 from hapticdesign.optimization.study_file import load_study  # noqa: E402
-from hapticdesign.optimization.study_run import Encoding  # noqa: E402
+from bench_study import random_designs  # noqa: E402  (benchmarks/ is the script's folder)
 
 ROOT = Path(__file__).resolve().parents[1]
 STUDIES = ROOT / "examples" / "studies"
@@ -69,11 +68,7 @@ def _evaluation(study_path: Path, designs: int = 40, seed: int = 0) -> float:
     """CPU seconds of one generation of random designs through ``BoundStudy.evaluate`` (the best of three)."""
     study = load_study(study_path)
     bound = bind_study(study)
-    encoding = Encoding.of(study.spec)
-    rng = np.random.default_rng(seed)
-    x = rng.uniform(encoding.xl, encoding.xu, size=(designs, len(encoding.names)))
-    x[:, list(encoding.discrete)] = np.round(x[:, list(encoding.discrete)])
-    batch = [encoding.decode(row) for row in x]
+    batch = random_designs(study, designs, seed)
     bound.evaluate(batch[:2])  # the first call builds the caches
     best = float("inf")
     for _ in range(3):

@@ -33,14 +33,19 @@ def geometry_only(study: Study) -> Study:
     return Study(study_from_mapping(data), study.path, device, yaml.safe_dump(data), device.read_text())
 
 
-def rate(study: Study, designs: int = 60, seed: int = 0) -> tuple[float, float, int]:
-    """Designs per second, milliseconds per workspace point and the designs that reached the workspace."""
-    bound = bind_study(study)
+def random_designs(study: Study, designs: int, seed: int = 0) -> list[dict[str, float]]:
+    """``designs`` designs drawn uniformly (with ``seed``) within the study's bounds, choices rounded to one."""
     encoding = Encoding.of(study.spec)
     rng = np.random.default_rng(seed)
     X = rng.uniform(encoding.xl, encoding.xu, size=(designs, len(encoding.names)))
     X[:, list(encoding.discrete)] = np.round(X[:, list(encoding.discrete)])
-    batch = [encoding.decode(x) for x in X]
+    return [encoding.decode(x) for x in X]
+
+
+def rate(study: Study, designs: int = 60, seed: int = 0) -> tuple[float, float, int]:
+    """Designs per second, milliseconds per workspace point and the designs that reached the workspace."""
+    bound = bind_study(study)
+    batch = random_designs(study, designs, seed)
     bound.evaluate(batch[:2])  # first calls build the caches
     start = time.perf_counter()
     answers = bound.evaluate(batch)
