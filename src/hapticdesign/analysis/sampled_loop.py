@@ -552,13 +552,14 @@ class SampledLoop:
 
 
 def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, spring: np.ndarray,
-                 loop: SampledLoop) -> tuple[SpringLoops, np.ndarray]:
+                 loop: SampledLoop, poses: np.ndarray | None = None) -> tuple[SpringLoops, np.ndarray]:
     """The sampled loops of S handles under a wall whose spring acts on the joints as ``K w w^T`` (``spring``: the
     rows ``w`` (S, n); ``J_v^T u`` for a Cartesian wall along a unit ``u``, ``e_j`` for a wall on joint j), every
     joint free but ``loop.held``, and a starting guess of their limits (S,).
 
-    ``jacobian`` ``J_v`` (S, 3, n), ``mass`` ``H`` (S, n, n) and ``damping`` ``B`` (n, n) or (S, n, n) of the
-    actuated coordinates at the pose the wall holds. The plant ``H_h qdd + B_h qd + K_h q = u`` (the hand's mass,
+    ``jacobian`` ``J_v`` (P, 3, n), ``mass`` ``H`` (P, n, n) and ``damping`` ``B`` (n, n) or (P, n, n) of the
+    actuated coordinates at the P poses the walls hold, ``poses`` (S,) the pose of each loop (default: loop s at
+    pose s, P = S), so that the plant of a pose walled along many directions is discretized once. The plant ``H_h qdd + B_h qd + K_h q = u`` (the hand's mass,
     damping and stiffness added as ``x J_v^T J_v``) is discretized exactly under a zero-order hold
     (``scipy.linalg.expm`` of the augmented matrix). Every period the controller holds, ``d`` samples late,
     ``u_k = c H a_(k-d) - K w w^T q_(k-d) - B_w w w^T v^_(k-d)``, ``a`` the acceleration sampled
@@ -578,17 +579,20 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
     jv = np.asarray(jacobian, dtype=float)[:, :, free]
     h = np.asarray(mass, dtype=float)[:, free][:, :, free]
     b = np.broadcast_to(np.asarray(damping, dtype=float)[..., free, :][..., free], h.shape)
-    count, n = h.shape[0], len(free)
+    n = len(free)
     jtj = np.swapaxes(jv, 1, 2) @ jv
     hand = loop.hand or Hand()
     hh, bh, kp = h + hand.mass * jtj, b + hand.damping * jtj, hand.stiffness * jtj
-    w = np.asarray(spring, dtype=float)[:, free]
-    aug = np.zeros((count, 3 * n, 3 * n))
+    aug = np.zeros((len(h), 3 * n, 3 * n))
     aug[:, :n, n:2 * n] = np.eye(n)
     aug[:, n:2 * n, :n] = -np.linalg.solve(hh, kp)
     aug[:, n:2 * n, n:2 * n] = -np.linalg.solve(hh, bh)
     aug[:, n:2 * n, 2 * n:] = np.linalg.inv(hh)
     e = expm(aug * loop.period)
+    if poses is not None:  # each loop takes its pose's plant
+        e, h, hh, bh, kp = (x[np.asarray(poses, dtype=np.int64)] for x in (e, h, hh, bh, kp))
+    w = np.asarray(spring, dtype=float)[:, free]
+    count = len(w)
     phi, gamma = e[:, :2 * n, :2 * n], e[:, :2 * n, 2 * n:]
     d, c = loop.delay, loop.fraction
     differenced = loop.velocity == "difference" and loop.virtual_damping > 0
@@ -647,10 +651,11 @@ def _deflated(m: np.ndarray, g: np.ndarray, h: np.ndarray, w: np.ndarray, n: int
 
 
 def handle_limits(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, spring: np.ndarray,
-                  loop: SampledLoop, groups: np.ndarray | None = None, k_max: float = 1e9) -> np.ndarray:
+                  loop: SampledLoop, groups: np.ndarray | None = None, k_max: float = 1e9,
+                  poses: np.ndarray | None = None) -> np.ndarray:
     """The exact stable wall stiffness (N/m) of each handle loop of :func:`handle_loops` (S,), or the smallest in
     each group (:func:`loop_limits`)."""
-    loops, guess = handle_loops(jacobian, mass, damping, spring, loop)
+    loops, guess = handle_loops(jacobian, mass, damping, spring, loop, poses)
     order = loops.base.shape[-1]
     what = f"the closed-loop matrices of {len(loops):,} handle loops of order {order}"
     require_memory(what, 8.0 * order * order * len(loops))

@@ -102,8 +102,8 @@ def wall_limits(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, loo
         size = len(along[part])
         rows = np.repeat(np.arange(start, start + size), per_point)
         spring = np.einsum("sk,skn->sn", along[part].reshape(-1, 3), jacobian[rows])
-        out[part] = handle_limits(jacobian[rows], mass[rows], damping[rows], spring, loop,
-                                  np.repeat(np.arange(size), per_point))
+        out[part] = handle_limits(jacobian[part], mass[part], damping[part], spring, loop,
+                                  np.repeat(np.arange(size), per_point), poses=rows - start)
     return out
 
 
@@ -117,8 +117,7 @@ def worst_direction(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray,
     basis, mobility, cartesian_damping = handle_range(jacobian, mass, damping)
     along = np.einsum("ik,ck->ci", basis[0], wall_directions(mobility, cartesian_damping)[0])
     count = len(along)
-    limits = handle_limits(np.repeat(jacobian, count, 0), np.repeat(mass, count, 0), np.repeat(damping, count, 0),
-                           along @ jacobian[0], loop)
+    limits = handle_limits(jacobian, mass, damping, along @ jacobian[0], loop, poses=np.zeros(count, dtype=np.int64))
     best = int(np.argmin(limits))
     return float(limits[best]), along[best]
 
