@@ -236,3 +236,18 @@ def test_falcons_coast_in_mujoco_follows_ours_with_the_exported_constraint_stiff
     default, _ = _coast_error(device, text.replace(f'solref="{2 * model.opt.timestep:g} 1" ', ""), velocity)
     assert exported < 1e-3
     assert default > 10 * exported
+
+
+@pytest.mark.parametrize("name", ["a\x01b", "a\ufffeb", "a\ud800b"])
+def test_a_python_built_device_whose_name_xml_forbids_is_refused_in_one_line(name):
+    """Issue 33: no device file can hold such a name (the reader refuses it), but a Device built in Python can; the
+    export refuses it instead of writing a malformed MJCF or URDF (ElementTree writes control characters as they
+    are, and a lone surrogate cannot be encoded)."""
+    from dataclasses import replace
+
+    from hapticdesign.errors import UserError
+
+    device = replace(load_device_file(EXAMPLES / "arm-3r.toml"), name=name)
+    for export in (to_mjcf, to_urdf):
+        with pytest.raises(UserError, match=f"U\\+{ord(name[1]):04X}, which XML forbids"):
+            export(device)

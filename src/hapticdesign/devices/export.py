@@ -41,6 +41,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from hapticdesign.errors import UserError
+from hapticdesign.files import NOT_TEXT, quote
 from hapticdesign.model.device import Device
 from hapticdesign.model.mechanism import Mechanism
 from hapticdesign.model.transforms import elementary_matrix
@@ -186,7 +187,7 @@ def to_mjcf(device: Device) -> Export:
     keyframe = ET.SubElement(root, "keyframe")
     ET.SubElement(keyframe, "key", name="home", qpos=_fmt(np.array([j.row for j in ordered]) @ _home(mech)))
     ET.indent(root)
-    return Export(ET.tostring(root, encoding="unicode") + "\n", ordered)
+    return Export(_xml_text(root, device), ordered)
 
 
 def _output_torque(actuator) -> float | None:
@@ -323,7 +324,7 @@ def to_urdf(device: Device) -> Export:
         ET.SubElement(fixed, "parent", link=link_of[attachment.frame])
         ET.SubElement(fixed, "child", link=name)
     ET.indent(robot)
-    return Export(ET.tostring(robot, encoding="unicode") + "\n", tuple(joints))
+    return Export(_xml_text(robot, device), tuple(joints))
 
 
 def _urdf_joint(mech: Mechanism, element: ET.Element, joint, bounds: tuple[dict, dict],
@@ -353,6 +354,18 @@ def _urdf_joint(mech: Mechanism, element: ET.Element, joint, bounds: tuple[dict,
         if kind == "hinge" and span is None:
             element.set("type", "continuous")
     joints.append(JointRow(name, tuple(float(c) for c in (row if k is None else np.eye(mech.n_dof)[k]))))
+
+
+def _xml_text(root: ET.Element, device: Device) -> str:
+    """The XML document of ``root``; a name holding a character XML 1.0 forbids (:data:`~hapticdesign.files.NOT_TEXT`:
+    control characters, lone surrogates, U+FFFE/U+FFFF), which a device built in Python may carry although no device
+    file can, is refused in one line instead of making a malformed file."""
+    text = ET.tostring(root, encoding="unicode") + "\n"
+    found = NOT_TEXT.search(text)
+    if found:
+        raise UserError(f"cannot export {quote(device.name)}: a name holds the character U+{ord(found.group()):04X}, "
+                        "which XML forbids")
+    return text
 
 
 FORMATS = {"mjcf": to_mjcf, "urdf": to_urdf}
