@@ -21,16 +21,17 @@ import numpy as np
 import yaml
 
 from hapticdesign.analysis.metrics.indices import (
-    INDICES, Evaluation, Index, Registry, Request, evaluate, evaluate_at, evaluate_designs, evaluate_parameters, reduce,
+    INDICES, Evaluation, Index, Registry, Request, evaluate_at, evaluate_designs, evaluate_parameters, reduce,
     requests_of,
 )
 from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.analysis.view.figure import render_png
 from hapticdesign.analysis.view.skeleton import home_pose
-from hapticdesign.analysis.workspace import Workspace, reach_workspace
+from hapticdesign.analysis.workspace import Workspace, WorkspacePoses, reach_workspace
 from hapticdesign.devices.design_space import DesignSpace
 from hapticdesign.errors import UserError
 from hapticdesign.files import parse_structured, quote
+from hapticdesign.model.device import Device
 from hapticdesign.optimization.study_file import Choice, IndexConstraint, Study
 from hapticdesign.optimization.study_outputs import index_maps
 from hapticdesign.optimization.study_polish import most_designs
@@ -119,6 +120,7 @@ class BoundStudy:
         workspace = workspace_of(study)
         self.points = np.zeros((0, 3)) if workspace is None else workspace.points()
         self.title = f"{self.space.base.name} ({study.path.name})"
+        self._evaluated: dict[tuple, tuple] = {}
 
     def _middle(self) -> dict[str, float]:
         """The design in the middle of the variables' bounds (a choice's first value)."""
@@ -292,37 +294,48 @@ class BoundStudy:
         return (header + self.where_evaluated(values)
                 + yaml.safe_dump(self.device_mapping(values), sort_keys=False, allow_unicode=False))
 
+    def _at_points(self, values: dict[str, float]) -> tuple[Device, WorkspacePoses | None, dict | None]:
+        """A design's device, its poses at the workspace points and its indices there per request key (None, None
+        without points, indices or a reached workspace): computed once per design for selected.yaml and the
+        report's pictures."""
+        key = tuple(sorted(values.items()))
+        if key not in self._evaluated:
+            device = self.space.device(self.device_values(values))
+            poses = got = None
+            if len(self.points) and self.requests:
+                try:
+                    poses = reach_workspace(device, self.points)
+                    got = evaluate_at(device, poses.full, self.requests, None, self.registry).values
+                except UserError:
+                    poses = got = None
+            self._evaluated = {key: (device, poses, got)}
+        return self._evaluated[key]
+
     def where_evaluated(self, values: dict[str, float]) -> str:
         """Comment lines naming, for each index the study reduced over its workspace points by ``min`` or ``max``,
         the point where the design takes that value and its actuated coordinates there, with the ``spec`` command
         that gives the sheet at that pose (issue 35: a sheet at home, outside the study's box, reads another pose's
         numbers; at this pose its renderable stiffness is the study's ``kmax`` with the same loop settings)."""
-        if not len(self.points) or not self.requests:
-            return ""
-        device = self.space.device(self.device_values(values))
-        try:
-            poses = reach_workspace(device, self.points)
-            result = evaluate_at(device, poses.full, self.requests, None, self.registry)
-        except UserError:
+        device, poses, got = self._at_points(values)
+        if got is None:
             return ""
         lines = []
         for index, options, how in self.keys:
             label = self.labels.get((index, options))
-            if how not in ("min", "max") or label not in result.values:
+            if how not in ("min", "max") or label not in got:
                 continue
-            got = result.values[label]
-            k = int(np.argmin(got) if how == "min" else np.argmax(got))
+            k = int(np.argmin(got[label]) if how == "min" else np.argmax(got[label]))
             named = index + (json.dumps(dict(options), sort_keys=True) if options else "")
             point = ", ".join(f"{x:.6g}" for x in self.points[k])
             q = ",".join(repr(float(x)) for x in poses.q[k])
-            lines.append(f"# {how} {named} over the study's points = {got[k]:.6g} {self.registry[index].unit} at "
+            lines.append(f"# {how} {named} over the study's points = {got[label][k]:.6g} {self.registry[index].unit} at "
                          f"({point}) m; the sheet there: hapticdesign spec --device THIS_FILE --q {q}\n")
         return "".join(lines)
 
     def pictures(self, values: dict[str, float]) -> list[tuple[bytes, str]]:
         """The selected design's picture at the workspace centre (at home when the centre is out of reach) and
         maps of its indices over the workspace points."""
-        device = self.space.device(self.device_values(values))
+        device, _, got = self._at_points(values)
         workspace = workspace_of(self.study)
         if workspace is None:
             return [(render_png(device, home_pose(device), dpi=100), "The selected design at home")]
@@ -333,10 +346,9 @@ class BoundStudy:
             q = home_pose(device)
             where = "at home"
         out = [(render_png(device, q, dpi=100), f"The selected design {where}")]
-        result = evaluate(device, self.points, self.requests, registry=self.registry)
-        if self.requests and result.reason is None:
+        if got is not None:
             names = {r.key: f"{r.index} ({self.registry[r.index].unit})" for r in self.requests}
-            maps = {names[key]: result.values[key] for key in names}
+            maps = {names[key]: got[key] for key in names}
             out.append((index_maps(self.points, maps, "The selected design's indices over the workspace"),
                         "The selected design's indices at the workspace points"))
         return out
