@@ -18,7 +18,7 @@ from pathlib import Path
 
 from hapticdesign.analysis.metrics.indices import Index
 from hapticdesign.errors import RunWarning, UserError
-from hapticdesign.files import write_atomically
+from hapticdesign.files import quote, write_atomically
 from hapticdesign.interface.report.optimization_page import Picture, render
 from hapticdesign.optimization.study_evaluation import BoundStudy, bind_study, require_study_workload
 from hapticdesign.optimization.study_file import Study, load_study
@@ -159,18 +159,18 @@ def index_module(path: Path) -> list[Index]:
 
     path = Path(path)
     if path.suffix != ".py" or not path.is_file():
-        raise UserError(f"--indices: {path} is not a Python file (.py) of design indices")
+        raise UserError(f"indices file {quote(str(path))}: not a Python file (.py) of design indices")
     spec = importlib.util.spec_from_file_location(f"hapticdesign_user_indices_{path.stem}", path)
     module = importlib.util.module_from_spec(spec)
     try:
         spec.loader.exec_module(module)
     except UserError as exc:
-        raise UserError(f"--indices {path}: {exc}") from None
+        raise UserError(f"indices file {quote(str(path))}: {exc}") from None
     except Exception as exc:  # the user's code: one line saying where it failed
-        raise UserError(f"--indices {path}: running it failed: {type(exc).__name__}: {exc}") from None
+        raise UserError(f"indices file {quote(str(path))}: running it failed: {type(exc).__name__}: {exc}") from None
     found = [value for value in vars(module).values() if isinstance(value, Index)]
     if not found:
-        raise UserError(f"--indices {path}: it defines no index (decorate a function with @hapticdesign.index)")
+        raise UserError(f"indices file {quote(str(path))}: it defines no index (decorate a function with @hapticdesign.index)")
     return found
 
 
