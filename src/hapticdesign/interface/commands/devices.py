@@ -107,7 +107,9 @@ def spec(
     force, apparent mass, backdrive friction, VJM stiffness (seed 001 §5.2), workspace cube and renderable
     stiffness beside the passivity bounds."""
     from hapticdesign.files import dumps_json, write_atomically
-    from hapticdesign.analysis.sampled_loop import GRASP, Hand, SampledLoop
+    from dataclasses import replace
+
+    from hapticdesign.analysis.sampled_loop import GRASP, SampledLoop
     from hapticdesign.studies.spec import spec_sheet
     from hapticdesign.interface.report.spec_page import spec_page
     from hapticdesign.interface.round_off import without_round_off
@@ -117,10 +119,9 @@ def spec(
 
         dev = resolve_device(preset, device, params, strict=strict)
         pose = None if q is None else parse_vector(q, dev.n_dof, "q")
+        given = {"mass": hand_mass, "damping": hand_damping, "stiffness": hand_stiffness}
         loop = SampledLoop(period=1.0 / rate, delay=delay, compensation=compensation,
-                           hand=Hand(*(GRASP.mass if hand_mass is None else hand_mass,
-                                       GRASP.damping if hand_damping is None else hand_damping,
-                                       GRASP.stiffness if hand_stiffness is None else hand_stiffness)))
+                           hand=replace(GRASP, **{k: v for k, v in given.items() if v is not None}))
         sheet = spec_sheet(dev, pose, loop, workspace=workspace, simulate=simulate)
         sheet["handle"] = without_round_off(sheet["handle"])  # a position's 1e-18 m residue is 0
         if out is not None:
