@@ -144,24 +144,24 @@ SIMULATED_CAP = 1e5
 """N/m: the simulated limit's search stops here (reported as inf above it)."""
 
 
-def renderable(device: Device, h: Handle, loop: SampledLoop, simulate: bool = True) -> dict:
+def renderable(device: Device, h: Handle, loop: SampledLoop, res: float | None,
+               friction: tuple[float, float] | None, simulate: bool = True) -> dict:
     """The renderable-stiffness rows: the exact limit without the hand (worst direction) and with the hand, the
     simulated limit along that direction with the device's dry friction and encoder quantization, and the passivity
-    bounds (see the module docstring)."""
+    bounds from the sheet's resolution ``res`` and backdrive ``friction`` (see the module docstring)."""
     from hapticdesign.simulation.impedance import device_counts, simulated_limit
 
     exact, direction = worst_direction(h.jacobian, h.states.H[0], device.damping_matrix, replace(loop, hand=None))
     hand = loop.hand or GRASP
-    res = resolution(device, h)
-    friction = backdrive_friction(device, h)
+    counts = device_counts(device)
     simulated = None
     if simulate:
         simulated = simulated_limit(device, replace(loop, hand=None), direction=direction, equilibrium=TOUCH,
-                                    counts=device_counts(device), start=max(exact, 1.0), k_limit=SIMULATED_CAP)
+                                    counts=counts, start=max(exact, 1.0), k_limit=SIMULATED_CAP)
     return {
         "exact": exact, "direction": direction,
         "exact_with_hand": renderable_stiffness(device, h, replace(loop, hand=hand)), "hand": hand.as_dict(),
-        "simulated": simulated, "simulated_counts": device_counts(device), "simulated_touch": TOUCH,
+        "simulated": simulated, "simulated_counts": counts, "simulated_touch": TOUCH,
         "passivity_viscous": 2.0 * float(np.linalg.eigvalsh(h.states.cartesian_damping[0]).min()) * loop.rate,
         "passivity_coulomb": None if friction is None or res is None else 2.0 * friction[0] / res,
         "settings": replace(loop, hand=None).as_dict(), "rate": loop.rate, "delay_samples": loop.delay,
@@ -211,7 +211,7 @@ def spec_sheet(device: Device, q=None, loop: SampledLoop | None = None, workspac
         "backdrive_friction": None if friction is None else {"min": friction[0], "max": friction[1]},
         "stiffness": _stiffness(device, h),
         "workspace": {"cube": 1000.0 * workspace_cube(device, h)} if workspace else None,
-        "renderable_stiffness": renderable(device, h, loop, simulate),
+        "renderable_stiffness": renderable(device, h, loop, res, friction, simulate),
         "units": {"resolution": "m", "force_continuous": "N", "force_peak": "N", "apparent_mass": "kg",
                   "backdrive_friction": "N", "stiffness": "N/m", "workspace": "mm", "renderable_stiffness": "N/m",
                   "rate": "Hz", "handle": "m", "q": "rad or m"},
