@@ -14,7 +14,8 @@ Every analysis that needs "the device at actuated coordinates ``q_a``" asks :fun
 - :meth:`Configuration.reach` (and :meth:`Configuration.inverse_kinematics` for one point, :func:`handle_pose`
   with the device's joint limits): the one inverse kinematics of the project, the actuated coordinates that put
   a frame's origin (default: the handle) at positions, continued from home (or a given pose) on its branch in
-  small Cartesian steps, point after point.
+  small Cartesian steps, point after point, by the compiled kernel the design batch runs over many designs
+  (:func:`~.reach_kernel.reach_designs`, here a batch of one).
 
 A closed-loop device's configuration (:class:`LoopConfiguration`) owns the loop solver; its dynamics model
 (:class:`~.dynamics.closed_loop.ClosedLoopModel`) takes it, so one solver serves every caller.
@@ -28,25 +29,24 @@ from functools import lru_cache
 import numpy as np
 
 from hapticdesign.analysis import kinematics
-from hapticdesign.analysis.loops.solver import LoopSolver
+from hapticdesign.analysis.loops.records import BRANCH_CHANGE, OK, OUT_OF_REACH, SINGULAR
+from hapticdesign.analysis.loops.solver import LoopSolver, settings_of
+from hapticdesign.analysis.reach_kernel import MESSAGES, Reach, Reached, Structure, reach_designs, structure_of
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device, MechanismBuilder, build_mechanism
 from hapticdesign.model.mechanism import Mechanism
+from hapticdesign.model.walk import WalkPlan
 
 IK_STEP = 0.01
 """m: largest Cartesian step of :meth:`Configuration.reach` along a straight segment."""
-IK_WAY = 1e-3
-"""Position tolerance on the way between two points, as a fraction of :data:`IK_STEP` (at the points themselves it
-is 1e-12 of the device's size). A safeguard rather than a working part: with it 1000 times looser (every step on
-the way accepted as it starts), 1200 random reaches from home of the five-bar, delta, Phantom and Falcon gave the same
-answers and the same refusals, because Newton's steps clamped to :data:`IK_JOINT_STEP` follow the branch by
-themselves (issue 36's mutation audit; no test distinguishes it yet)."""
-IK_ITER = 30
+IK_ITER = 60
 """Newton iterations per Cartesian step."""
 IK_JOINT_STEP = 0.2
-"""rad or m: largest change of an actuated coordinate in one Newton iteration."""
+"""rad or m: largest change of a coordinate in one Newton iteration."""
 IK_SINGULAR = 1e-7
-"""Smallest over largest singular value of the position Jacobian below which a pose is singular."""
+"""Smallest over largest singular value of the position Jacobian below which a start pose is singular."""
+IK_PIVOTS = 1e-9
+"""Pivot ratio of the inverse kinematics' system ``[Phi; U^T J_v]`` below which a pose counts as singular."""
 
 
 class Configuration:
@@ -60,6 +60,9 @@ class Configuration:
         self.n_actuated = len(self.names)
         self.home = self._home()
         """Actuated coordinates of the home pose."""
+        self.settings = settings_of(mechanism)
+        """The loop solver's settings (:func:`~.loops.solver.settings_of`), whose tolerance the reach closes to."""
+        self._walks: dict[str | None, tuple[Structure, WalkPlan]] = {}
 
     def _home(self) -> np.ndarray:
         return np.zeros(self.mechanism.n_dof)
@@ -102,6 +105,17 @@ class Configuration:
         (:meth:`reach` of one point)."""
         return self.reach(np.reshape(np.asarray(position, dtype=float), (1, -1)), frame, start)[0][0]
 
+    def walk(self, frame: str | None = None) -> tuple[Structure, WalkPlan]:
+        """The records :func:`~.reach_kernel.reach_designs` takes for ``frame`` as the handle (built once per frame):
+        the device's :class:`~.reach_kernel.Structure` and the walk of its tree, the closures' and the handle's
+        nodes first."""
+        if frame not in self._walks:
+            structure = structure_of(self.mechanism, frame)
+            closures = structure.closures
+            plan = structure.raw.plan([*closures.frame_a, *closures.frame_b, structure.handle], list(closures.passive))
+            self._walks[frame] = (structure, plan)
+        return self._walks[frame]
+
     def reach(self, positions, frame: str | None = None,
               start: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Actuated (P, n_a) and full (P, N) coordinates that put the origin of ``frame`` (default: the handle)
@@ -109,93 +123,59 @@ class Configuration:
 
         Continuation from ``start`` (a closed full pose; default: home, on the loops' assembly branch) to the
         first point, then from each point to the next, along straight Cartesian segments in steps of at most
-        :data:`IK_STEP` (met within :data:`IK_WAY` of the step on the way, within 1e-12 of the device's size at the
-        points), each closed by Newton on the actuated coordinates (least squares on ``J_v T``, at most
-        :data:`IK_JOINT_STEP` per iteration, the loops closed from the last pose), so every answer stays on the
-        branch of the start. The working mode is the sign of ``det(B^T J_v T)`` (``B`` the directions the handle
-        moves at the start, when there are as many as actuated coordinates); a change of that sign between two
-        steps, like a change of the loops' assembly branch, means the way crossed a singularity. A point the
-        handle cannot reach, or one behind a singularity, raises a one-line UserError naming the point.
+        :data:`IK_STEP`, each closed by Newton on all coordinates (the closures and the handle's position on the
+        directions ``U`` it moves at the start, at most :data:`IK_JOINT_STEP` per iteration), so every answer
+        stays on the branch of the start: the compiled :func:`~.reach_kernel.reach_designs`, the design batch's
+        own, for this one device. The working mode is the sign of ``det(U^T J_v T)`` (with the loops' assembly
+        branch, the sign of the system's determinant); a change of that sign, or of the assembly branch, means
+        the way crossed a singularity. A point the handle cannot reach, or one behind a singularity, raises a
+        one-line UserError naming the point.
         """
         targets = np.asarray(positions, dtype=float)
         if targets.ndim != 2 or targets.shape[1] != 3 or not np.all(np.isfinite(targets)):
             raise UserError(f"a handle position is 3 finite numbers, got {np.ravel(positions).tolist()[:6]}")
         q = self.full(self.home) if start is None else np.array(start, dtype=float)
-        q_a = q[self.actuated_index()]
-        p, jac = self.position_and_jacobian(q, frame)
-        walk = _Walk(self, frame, _moving_directions(jac), q_a, q, p)
-        out_a = np.empty((len(targets), self.n_actuated))
-        out = np.empty((len(targets), len(q)))
-        for i, target in enumerate(targets):
-            walk.go_to(target)
-            out_a[i], out[i] = walk.q_a, walk.q
-        return out_a, out
+        jac = self.position_and_jacobian(q, frame)[1]
+        structure, plan = self.walk(frame)
+        n = len(q)
+        out = Reached(np.zeros((1, len(targets), n)), np.zeros((1, len(targets), 3, self.n_actuated)),
+                      np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64), np.zeros((1, 3)))
+        reach_designs(structure.offset[None], np.ascontiguousarray(targets), structure.shape, plan,
+                      structure.closures, self.settings, reach_settings(structure.handle, jac, q, self.settings), out)
+        code = int(out.status[0])
+        if code != OK:
+            raise UserError(reach_failure(code, targets[max(int(out.point[0]), 0)], out.near[0]))
+        full = out.full[0]
+        return full[:, self.actuated_index()], full
 
     def actuated_index(self) -> np.ndarray:
         """The places of the actuated coordinates among the full ones."""
         return np.arange(self.n_actuated)
 
 
-def _moving_directions(jac: np.ndarray) -> np.ndarray | None:
-    """Orthonormal directions (3 x n_a) the handle moves in at a pose, when ``J_v T`` has full column rank
-    n_a <= 3 (the working mode's frame); None for a redundant device."""
-    if jac.shape[1] > 3:
-        return None
-    u, s, _ = np.linalg.svd(jac)
-    if s[-1] <= IK_SINGULAR * s[0]:
-        return None
-    return u[:, :jac.shape[1]]
+def reach_settings(handle: int, jac: np.ndarray, start: np.ndarray, settings) -> Reach:
+    """The :class:`~.reach_kernel.Reach` record of a walk from ``start`` (full coordinates) whose handle is node
+    ``handle`` with ``J_v T`` = ``jac`` (3 x n_a) there: the directions ``U`` the handle moves (the left singular
+    vectors of ``jac``; all three for a redundant device), closed to the loop solver's tolerance."""
+    n_a = jac.shape[1]
+    basis = np.linalg.svd(jac)[0][:, :n_a] if n_a <= 3 else np.eye(3)
+    return Reach(IK_STEP, settings.tol, IK_ITER, IK_JOINT_STEP, IK_PIVOTS, int(handle), np.ascontiguousarray(basis),
+                 np.ascontiguousarray(start, dtype=float))
+
+
+def reach_failure(code: int, target: np.ndarray, near: np.ndarray) -> str:
+    """One line on why the handle does not reach ``target``, from the reach kernel's status and the handle's
+    position ``near`` where the walk stopped."""
+    head = f"the handle cannot reach ({_text(target)}) m: {MESSAGES[code]}"
+    if code == SINGULAR:
+        return f"{head} (the handle's Jacobian loses rank near ({_text(near)}) m on the way)"
+    if code == OUT_OF_REACH:
+        return f"{head} (the last point reached on the way is ({_text(near)}) m)"
+    return f"{head} (near ({_text(near)}) m)" if code == BRANCH_CHANGE else head
 
 
 def _text(v) -> str:
     return ", ".join(f"{x:.6g}" for x in v)
-
-
-class _Walk:
-    """The continuation state of :meth:`Configuration.reach`: the pose, the handle position and the working mode."""
-
-    def __init__(self, space: Configuration, frame: str | None, basis: np.ndarray | None, q_a: np.ndarray,
-                 q: np.ndarray, p: np.ndarray):
-        self.space, self.frame, self.basis = space, frame, basis
-        self.q_a, self.q, self.p = q_a, q, p
-        self.mode = self._mode(space.position_and_jacobian(q, frame)[1])
-        scale = max(float(np.abs(space.mechanism.compiled.node_offset).max(initial=0.0)), 1e-3)
-        self.tol = 1e-12 * max(scale, float(np.linalg.norm(p)))
-
-    def _mode(self, jac: np.ndarray) -> float:
-        if self.basis is None:
-            return 0.0
-        return float(np.sign(np.linalg.det(self.basis.T @ jac)))
-
-    def go_to(self, target: np.ndarray) -> None:
-        begin = self.p.copy()
-        n_steps = max(1, int(np.ceil(np.linalg.norm(target - begin) / IK_STEP)))
-        for k in range(1, n_steps + 1):
-            self._newton(begin + (target - begin) * (k / n_steps), target,
-                         self.tol if k == n_steps else IK_WAY * IK_STEP)
-
-    def _newton(self, goal: np.ndarray, target: np.ndarray, tol: float) -> None:
-        space, q_a, q = self.space, self.q_a, self.q
-        for _ in range(IK_ITER):
-            p, jac = space.position_and_jacobian(q, self.frame)
-            error = goal - p
-            s = np.linalg.svd(jac, compute_uv=False)
-            if s[-1] <= IK_SINGULAR * s[0] or (self.mode and self._mode(jac) != self.mode):
-                raise UserError(f"the handle cannot reach ({_text(target)}) m: it is out of reach or behind a singularity (the "
-                                f"handle's Jacobian loses rank near ({_text(p)}) m on the way)")
-            if np.linalg.norm(error) <= tol:
-                self.q_a, self.q, self.p = q_a, q, p
-                return
-            dq = np.linalg.lstsq(jac, error, rcond=None)[0]
-            dq *= min(1.0, IK_JOINT_STEP / max(float(np.abs(dq).max()), 1e-300))
-            try:
-                q = space.full(q_a + dq, start=q)
-            except UserError:
-                raise UserError(f"the handle cannot reach ({_text(target)}) m: it is out of reach (the loops cannot "
-                                f"close on the way, near ({_text(p)}) m)") from None
-            q_a = q_a + dq
-        raise UserError(f"the handle cannot reach ({_text(target)}) m: it is out of reach (the last point reached "
-                        f"on the way is ({_text(p)}) m)")
 
 
 @dataclass(frozen=True)
