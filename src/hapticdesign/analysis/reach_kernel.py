@@ -31,7 +31,9 @@ import numpy as np
 from numba import njit
 
 from hapticdesign.analysis.loops import closure_kernel as ck
-from hapticdesign.analysis.loops.records import BRANCH_CHANGE, NO_HOME, OK, OUT_OF_REACH, SINGULAR, Closures
+from hapticdesign.analysis.loops.records import (
+    BRANCH_CHANGE, NO_HOME, OK, OUT_OF_REACH, SINGULAR, Closures, closure_scratch,
+)
 from hapticdesign.model.dense import lu_in_place
 from hapticdesign.model.mechanism import Mechanism
 from hapticdesign.model.walk import KinematicTree, Tree, frame_jacobian, planned_poses, trig_workspace
@@ -126,20 +128,26 @@ class Scratch(NamedTuple):
 
 
 @njit(cache=True, _nrt=False)
-def _walk_and_system(q, tree, plan, loops, reach, goal, ws):
-    """Node poses, the system ``[Phi; U^T J_v]`` into ``ws.a`` and ``[-phi; U^T (goal - p)]`` into ``ws.rhs``;
-    returns the largest closure residual and the 3-D distance of the handle from ``goal``."""
-    rot, pos, trig, jac, a, rhs, res = ws.rot, ws.pos, ws.trig, ws.jac, ws.a, ws.rhs, ws.res
-    m = loops.row_loop.shape[0]
-    n = q.shape[0]
-    planned_poses(q, tree, plan, np.int64(0), plan.n_first, rot, pos, trig)  # a literal would compile its own copy
-    ck.closure_residual(loops, rot, pos, res)
-    ck.closure_jacobian(loops, tree, plan, rot, pos, a[:m])
-    frame_jacobian(reach.handle, tree.parent, tree.axis, tree.coef, rot, pos, np.bool_(False), jac)
+def _walk(q, tree, plan, loops, reach, ws):
+    """Node poses, the closure residual, ``Phi`` and the handle's Jacobian at ``q`` into ``ws``."""
+    planned_poses(q, tree, plan, np.int64(0), plan.n_first, ws.rot, ws.pos, ws.trig)  # a literal: its own copy
+    ck.closure_residual(loops, ws.rot, ws.pos, ws.res)
+    ck.closure_jacobian(loops, tree, plan, ws.rot, ws.pos, ws.phi)
+    frame_jacobian(reach.handle, tree.parent, tree.axis, tree.coef, ws.rot, ws.pos, np.bool_(False), ws.jac)
+
+
+@njit(cache=True, _nrt=False)
+def _system(reach, goal, ws):
+    """The system ``[Phi; U^T J_v]`` into ``ws.a`` and ``[-phi; U^T (goal - p)]`` into ``ws.rhs`` from the walk in
+    ``ws``; returns the largest closure residual and the 3-D distance of the handle from ``goal``."""
+    pos, jac, a, rhs, res, phi = ws.pos, ws.jac, ws.a, ws.rhs, ws.res, ws.phi
+    m, n = phi.shape
     big = 0.0
     for i in range(m):
         rhs[i, 0] = -res[i]
         big = max(big, abs(res[i]))
+        for j in range(n):
+            a[i, j] = phi[i, j]
     e0, e1, e2 = goal[0] - pos[reach.handle, 0], goal[1] - pos[reach.handle, 1], goal[2] - pos[reach.handle, 2]
     k = reach.basis.shape[1]
     for r in range(k):
@@ -178,13 +186,16 @@ def _solve(ws, singular):
 
 
 @njit(cache=True, _nrt=False)
-def _newton(q, tree, plan, loops, settings, reach, goal, mode, final, ws):
+def _newton(q, tree, plan, loops, settings, reach, goal, mode, final, walked, ws):
     """Newton on all coordinates to put the handle at ``goal`` with the loops closed (to the tolerance when
     ``final``, else one corrector near the segment); returns (status, sign of the system's determinant). ``mode``
-    0: no sign to keep (the start)."""
+    0: no sign to keep (the start). ``walked``: ``ws`` holds the walk at ``q`` already (a point just reached, whose
+    last walk is the next step's first)."""
     rhs = ws.rhs
-    for _ in range(reach.max_iter):
-        big, dist = _walk_and_system(q, tree, plan, loops, reach, goal, ws)
+    for it in range(reach.max_iter):
+        if it > 0 or not walked:
+            _walk(q, tree, plan, loops, reach, ws)
+        big, dist = _system(reach, goal, ws)
         ratio, sign = _solve(ws, reach.singular)
         if not ratio > reach.singular:
             return SINGULAR, sign
@@ -204,11 +215,10 @@ def _newton(q, tree, plan, loops, settings, reach, goal, mode, final, ws):
 
 
 @njit(cache=True, _nrt=False)
-def _branch(q, tree, plan, loops, ws):
-    """Sign of ``det Phi_p`` at the closed pose ``q`` (its poses in ``ws``) and ``S`` into ``ws.t`` (1 for a tree)."""
+def _branch(loops, ws):
+    """Sign of ``det Phi_p`` at the closed pose walked in ``ws`` and ``S`` into ``ws.t`` (1 for a tree)."""
     if loops.passive.shape[0] == 0:
         return 1.0
-    ck.closure_jacobian(loops, tree, plan, ws.rot, ws.pos, ws.phi)
     ratio, sign = ck.velocity_map_into(ws.phi, loops.actuated, loops.passive, ws.pp, ws.t)
     return sign if ratio > 0.0 else 0.0
 
@@ -225,6 +235,7 @@ def reach_designs(offsets, targets, shape, plan, loops, settings, reach, out):
     ws = Scratch(np.zeros((n_node, 3, 3)), np.zeros((n_node, 3)), trig_workspace(n_node), np.zeros((6, n)),
                  np.zeros((rows, n)), np.zeros((max(rows, n), 1)), np.zeros(m), np.zeros((m, n)), np.zeros((m, m)),
                  np.zeros((m, na)), np.zeros((rows, rows)), np.zeros((rows, 1)))
+    closing = closure_scratch(n_node, n, na, loops.passive, np.int64(0))
     here = np.zeros(3)
     goal = np.zeros(3)
     for d in range(offsets.shape[0]):
@@ -233,15 +244,15 @@ def reach_designs(offsets, targets, shape, plan, loops, settings, reach, out):
         out.status[d] = OK
         out.point[d] = -1
         if m > 0:
-            code, _, _ = ck.newton(q, tree, plan, loops, settings)
+            code, _, _ = ck.newton_into(q, tree, plan, loops, settings, closing)
             if code != OK:
                 out.status[d] = NO_HOME
                 continue
-        planned_poses(q, tree, plan, np.int64(0), plan.n_first, ws.rot, ws.pos, ws.trig)
-        branch = _branch(q, tree, plan, loops, ws)
+        _walk(q, tree, plan, loops, reach, ws)
+        branch = _branch(loops, ws)
         for c in range(3):
             here[c] = ws.pos[reach.handle, c]
-        code, mode = _newton(q, tree, plan, loops, settings, reach, here, 0.0, True, ws)
+        code, mode = _newton(q, tree, plan, loops, settings, reach, here, 0.0, True, True, ws)
         for p in range(targets.shape[0]):
             if code != OK:
                 break
@@ -251,10 +262,10 @@ def reach_designs(offsets, targets, shape, plan, loops, settings, reach, out):
             for s in range(1, steps + 1):
                 for c in range(3):
                     goal[c] = here[c] + (targets[p, c] - here[c]) * (s / steps)
-                code, _ = _newton(q, tree, plan, loops, settings, reach, goal, mode, s == steps, ws)
+                code, _ = _newton(q, tree, plan, loops, settings, reach, goal, mode, s == steps, s == 1, ws)
                 if code != OK:
                     break
-            if code == OK and _branch(q, tree, plan, loops, ws) != branch:
+            if code == OK and _branch(loops, ws) != branch:
                 code = BRANCH_CHANGE
             if code != OK:
                 out.point[d] = p
