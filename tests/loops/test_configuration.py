@@ -63,3 +63,23 @@ def test_inverse_kinematics_refuses_a_target_out_of_reach(device):
     space = configuration_of(device)
     with pytest.raises(UserError, match="cannot reach"):
         space.inverse_kinematics(space.pose(space.home)[:3, 3] + np.array([5.0, 5.0, 5.0]))
+
+
+def test_a_redundant_arm_moves_by_the_least_norm_joint_motion():
+    """The Phantom with its gimbal (6 joints, a 3-D handle position) is redundant: the one IK takes least-norm steps,
+    so a small move ``dp`` from home moves the joints by ``pinv(J_v) dp`` to first order (``J_v`` by central
+    differences of the forward kinematics, the pseudo-inverse NumPy's): the relative difference shrinks with the move
+    (a second-order term), where another choice among the joint motions would leave it of order one."""
+    space = configuration_of(preset("phantom-6dof"))
+    start = space.pose(space.home)[:3, 3]
+    eps = 1e-6
+    jac = np.column_stack([(space.pose(space.home + eps * e)[:3, 3] - space.pose(space.home - eps * e)[:3, 3]) / (2 * eps)
+                           for e in np.eye(6)])
+    errors = []
+    for size in (1e-5, 1e-6):
+        move = size * np.array([2.0, -1.0, 1.5])
+        q = space.inverse_kinematics(start + move)
+        np.testing.assert_allclose(space.pose(q)[:3, 3], start + move, rtol=0, atol=1e-12)
+        expected = np.linalg.pinv(jac) @ move
+        errors.append(np.abs(q - space.home - expected).max() / np.abs(expected).max())
+    assert errors[1] < 0.2 * errors[0] and errors[1] < 1e-3
