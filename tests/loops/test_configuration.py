@@ -69,7 +69,7 @@ def test_a_redundant_arm_moves_by_the_least_norm_joint_motion():
     """The Phantom with its gimbal (6 joints, a 3-D handle position) is redundant: the one IK takes least-norm steps,
     so a small move ``dp`` from home moves the joints by ``pinv(J_v) dp`` to first order (``J_v`` by central
     differences of the forward kinematics, the pseudo-inverse NumPy's): the relative difference shrinks with the move
-    (a second-order term), where another choice among the joint motions would leave it of order one."""
+    (a second-order term), where another choice among the joint motions (the gimbal held, say: 1e-2) would not."""
     space = configuration_of(preset("phantom-6dof"))
     start = space.pose(space.home)[:3, 3]
     eps = 1e-6
