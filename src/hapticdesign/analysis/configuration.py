@@ -29,7 +29,7 @@ from functools import lru_cache
 import numpy as np
 
 from hapticdesign.analysis import kinematics
-from hapticdesign.analysis.loops.records import BRANCH_CHANGE, OK, OUT_OF_REACH, SINGULAR
+from hapticdesign.analysis.loops.records import BRANCH_CHANGE, OK, OUT_OF_REACH, SINGULAR, Settings
 from hapticdesign.analysis.loops.solver import LoopSolver, settings_of
 from hapticdesign.analysis.reach_kernel import MESSAGES, Reach, Reached, Structure, reach_designs, structure_of
 from hapticdesign.errors import UserError
@@ -153,7 +153,7 @@ class Configuration:
         return np.arange(self.n_actuated)
 
 
-def reach_settings(handle: int, jac: np.ndarray, start: np.ndarray, settings) -> Reach:
+def reach_settings(handle: int, jac: np.ndarray, start: np.ndarray, settings: Settings) -> Reach:
     """The :class:`~.reach_kernel.Reach` record of a walk from ``start`` (full coordinates) whose handle is node
     ``handle`` with ``J_v T`` = ``jac`` (3 x n_a) there: the directions ``U`` the handle moves (the left singular
     vectors of ``jac``; all three for a redundant device), closed to the loop solver's tolerance."""
