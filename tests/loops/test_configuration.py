@@ -73,8 +73,8 @@ def test_a_redundant_arm_moves_by_the_least_norm_joint_motion():
     space = configuration_of(preset("phantom-6dof"))
     start = space.pose(space.home)[:3, 3]
     eps = 1e-6
-    jac = np.column_stack([(space.pose(space.home + eps * e)[:3, 3] - space.pose(space.home - eps * e)[:3, 3]) / (2 * eps)
-                           for e in np.eye(6)])
+    jac = np.column_stack([(space.pose(space.home + eps * e)[:3, 3] - space.pose(space.home - eps * e)[:3, 3])
+                           / (2 * eps) for e in np.eye(6)])
     errors = []
     for size in (1e-5, 1e-6):
         move = size * np.array([2.0, -1.0, 1.5])
