@@ -28,6 +28,7 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 from pydantic import ValidationError
@@ -127,6 +128,19 @@ class Applied:
     def motor_key(self) -> tuple:
         """The motors' changes as a key (actuator index and its changed fields, sorted)."""
         return tuple(sorted((k, tuple(sorted(f.items()))) for k, f in self.motors.items()))
+
+
+class Motors(NamedTuple):
+    """A design's motors (:meth:`DesignSpace._motors`): the actuators and the joints' damping of its device, and
+    what the batched kernels take of them: the reflected inertia, the damping matrix ``B``, ``A^-1`` (None unless
+    one motor per coordinate) and ``n_k tau_k`` per torque kind (None where a motor lacks it)."""
+
+    actuators: tuple
+    damping: tuple
+    reflected: np.ndarray
+    damping_matrix: np.ndarray
+    motor_map: np.ndarray | None
+    torques: dict
 
 
 class DesignSpace:
@@ -258,7 +272,8 @@ class DesignSpace:
         if design.sections:
             device = replace(device, elasticity=self._elasticity(tubes))
         if design.motors:
-            device = self._with_actuators(device, design.motors)
+            motors = self._motors(design.motor_key)
+            device = replace(device, actuators=motors.actuators, damping=motors.damping)
         if design.geometry:
             device = self._home_follows(device)
             self._check_geometry(device)
@@ -298,7 +313,10 @@ class DesignSpace:
         joints = self.base.elasticity.joints if self.base.elasticity is not None else ()
         return Elasticity(links, joints)
 
-    def _with_actuators(self, device: Device, fields: dict[int, dict[str, float]]) -> Device:
+    def _with_actuators(self, fields: dict[int, dict[str, float]]) -> Device:
+        """The file's device with the motors' ``fields`` (actuator index to changed fields), validated as the file's
+        own loading validates them."""
+        device = self.base
         actuators = list(device.actuators)
         for k, change in fields.items():
             spec = self.spec.actuators[k]
@@ -369,22 +387,24 @@ class DesignSpace:
             if refused[d] is None:
                 refused[d] = f"the inertial parameters of {base.name} overflow (m r or m r^2 is not a finite number)"
         built = [self._motors(key) for key in motors]
-        torques = {which: None if any(b[3][which] is None for b in built) else np.array([b[3][which] for b in built])
-                   for which in ("continuous", "peak")}
-        inverse = None if any(b[2] is None for b in built) else np.array([b[2] for b in built])
-        return DesignValues(kinematic, standard, np.array([b[0] for b in built]), np.array([b[1] for b in built]),
+        torques = {which: None if any(b.torques[which] is None for b in built)
+                   else np.array([b.torques[which] for b in built]) for which in ("continuous", "peak")}
+        inverse = None if any(b.motor_map is None for b in built) else np.array([b.motor_map for b in built])
+        return DesignValues(kinematic, standard, np.array([b.reflected for b in built]),
+                            np.array([b.damping_matrix for b in built]),
                             inverse, torques, rigidity, refused)
 
-    def _motors(self, key: tuple) -> tuple:
-        """The reflected inertia, damping matrix, ``A^-1`` and torque limits of the motors with the changes ``key``
-        (actuator index and its changed fields), built once per distinct set."""
+    def _motors(self, key: tuple) -> "Motors":
+        """The motors with the changes ``key`` (:attr:`Applied.motor_key`), built and validated once per distinct
+        set."""
         motors = self.cache.setdefault("motors", {})
         if key not in motors:
             if len(motors) >= MOTOR_SETS:
                 motors.clear()
-            device = self._with_actuators(self.base, {k: dict(f) for k, f in key}) if key else self.base
-            motors[key] = (device.reflected_inertia, device.damping_matrix, force.motor_map(device),
-                           {which: force.torque_limits(device, which) for which in ("continuous", "peak")})
+            device = self._with_actuators({k: dict(f) for k, f in key}) if key else self.base
+            motors[key] = Motors(device.actuators, device.damping, device.reflected_inertia, device.damping_matrix,
+                                 force.motor_map(device),
+                                 {which: force.torque_limits(device, which) for which in ("continuous", "peak")})
         return motors[key]
 
     @staticmethod
