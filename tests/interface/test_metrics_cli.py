@@ -98,3 +98,16 @@ def test_an_unknown_index_is_one_line_exit_2():
     result = runner.invoke(app, ["metrics", "--q", "0.1,0.5,0.3", "--index", "nope"])
     assert result.exit_code == 2
     assert result.stderr.startswith("error: unknown index 'nope'") and result.stderr.count("\n") == 1
+
+
+def test_your_own_index_from_a_file(tmp_path, phantom3):
+    """An index of an --indices file, named by --index: the squared isotropy of a 3-joint device, 1 / cond(J)^2."""
+    (tmp_path / "mine.py").write_text(
+        "import numpy as np, hapticdesign as hd\n\n"
+        "@hd.index(unit='1', name='isotropy_squared_metrics', needs=('kinematics',))\n"
+        "def isotropy_squared_metrics(pose):\n"
+        "    s = np.linalg.svd(pose.J_v, compute_uv=False)\n"
+        "    return (s[..., -1] / s[..., 0]) ** 2\n")
+    out = _run(["--q", "0.2,0.4,-0.3", "--indices", str(tmp_path / "mine.py"), "--index", "isotropy_squared_metrics"])
+    s = np.linalg.svd(_fd_jacobian(phantom3, np.array([0.2, 0.4, -0.3])), compute_uv=False)
+    assert out["indices"]["isotropy_squared_metrics"] == pytest.approx((s[-1] / s[0]) ** 2, rel=1e-6)

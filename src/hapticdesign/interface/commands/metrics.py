@@ -3,7 +3,7 @@
 The metrics of seed 001 chapter 4 are general: they are indices of the one registry
 (:mod:`hapticdesign.analysis.metrics.indices`) on the task Jacobian of the handle (translational rows for devices of up
 to 3 joints, all six rows for 6 joints) and the mass matrix H over the actuated coordinates. ``--index`` adds any
-index of the registry by name (built-in, or a package's through its entry point).
+index of the registry by name (built-in, a package's through its entry point, or your own of an ``--indices`` file).
 """
 
 from __future__ import annotations
@@ -22,6 +22,7 @@ from hapticdesign.interface.options import DEVICE, FORCE, FORCE_HINT, JSON_OUT, 
 from hapticdesign.workload import allow_large
 
 if TYPE_CHECKING:
+    from hapticdesign.analysis.metrics.indices import Registry
     from hapticdesign.model.device import Device
 
 SINGULAR_CONDITION = 1e10
@@ -36,11 +37,12 @@ ORDER = (names.MANIPULABILITY, names.CONDITION_NUMBER, "velocity_ellipsoid_radii
          names.ACCELERATION_RADIUS)
 
 
-def device_metrics(device: Device, q: np.ndarray, extra: Sequence[str] = ()) -> dict:
+def device_metrics(device: Device, q: np.ndarray, extra: Sequence[str] = (), registry: Registry | None = None) -> dict:
     """Kinematic (eq. 4.24-4.38) and dynamic (eq. 4.90-4.99) metrics at pose ``q``, keyed as in
     :mod:`hapticdesign.analysis.metrics.names`: the indices of the one registry on the task Jacobian
     (:attr:`~hapticdesign.analysis.metrics.indices.states.HandleStates.task`: translational rows for devices of up
-    to 3 joints, all six rows for 6 joints), and under ``indices`` the registry's indices ``extra`` by name."""
+    to 3 joints, all six rows for 6 joints), and under ``indices`` the indices ``extra`` of ``registry`` (default:
+    the one registry) by name."""
     from hapticdesign.analysis.configuration import configuration_of
     from hapticdesign.analysis.metrics.indices import INDICES, evaluate_at, requests_of
     from hapticdesign.analysis.metrics.indices.states import HandleStates
@@ -48,7 +50,8 @@ def device_metrics(device: Device, q: np.ndarray, extra: Sequence[str] = ()) -> 
     n = device.n_dof
     if n > 3 and n != 6:
         raise UserError(f"metrics need 1-3 or 6 joints (a square task Jacobian); {device.name} has {n}")
-    extra = requests_of(extra)
+    registry = INDICES if registry is None else registry
+    extra = requests_of(extra, registry)
     pose = HandleStates(device, configuration_of(device).full(q)[None])
     values = {}
     for key, name, options in METRIC_INDICES:
@@ -59,7 +62,7 @@ def device_metrics(device: Device, q: np.ndarray, extra: Sequence[str] = ()) -> 
     values.update(velocity_ellipsoid_radii=kinematic.velocity_ellipsoid(J)[0], cartesian_inertia=M_C)
     out = {"device": device.name, "q": q, "jacobian": J, **{key: values[key] for key in ORDER}}
     if extra:
-        found = evaluate_at(device, pose.full, extra)
+        found = evaluate_at(device, pose.full, extra, registry=registry)
         out["indices"] = {key: float(value[0]) for key, value in found.values.items()}
     return out
 
@@ -85,7 +88,10 @@ def metrics(
     params: Optional[Path] = PARAMS,
     q: str = typer.Option(..., help="Joint coordinates, comma-separated (rad or m)."),
     index: str = typer.Option("", "--index", help="Comma-separated design indices to add at the pose "
-                              "(docs/indices.md): built-in, or a package's through its entry point."),
+                              "(docs/indices.md): built-in, a package's through its entry point, or one of --indices."),
+    indices: Optional[Path] = typer.Option(None, "--indices", help="A Python file of your own design indices "
+                                           "(decorated with @hapticdesign.index) that --index may name. Its code "
+                                           "RUNS, as 'python FILE' would."),
     strict: bool = STRICT,
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
@@ -94,6 +100,7 @@ def metrics(
     """Kinematic and dynamic metrics of any device at one pose (seed 001 eq. 4.24-4.38, 4.90-4.99)."""
     from hapticdesign.analysis.metrics.indices import INDICES
     from hapticdesign.devices.loading import resolve_device
+    from hapticdesign.interface.commands.optimize_adapter import index_module
     from hapticdesign.interface.commands.pose_adapter import handle, handle_line
 
     with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
@@ -101,11 +108,12 @@ def metrics(
         qv = parse_vector(q, dev.n_dof, "q")
         for message in dev.limit_warnings(qv):
             note(f"warning: {message}", quiet)
-        result = device_metrics(dev, qv, [name.strip() for name in index.split(",") if name.strip()])
+        registry = INDICES.with_indices(index_module(indices)) if indices is not None else INDICES
+        result = device_metrics(dev, qv, [name.strip() for name in index.split(",") if name.strip()], registry)
         found = handle(dev, qv)
         result["units"] = metric_units(dev)
         if "indices" in result:
-            result["units"]["indices"] = {key: INDICES[key].unit for key in result["indices"]}
+            result["units"]["indices"] = {key: registry[key].unit for key in result["indices"]}
         if json_out:
             print_json({**result, **({"handle": found} if found is not None else {})})
             return
@@ -113,7 +121,7 @@ def metrics(
         for key, value in result.items():
             if key == "indices":
                 for name, number in value.items():
-                    unit = INDICES[name].unit
+                    unit = registry[name].unit
                     typer.echo(f"{name}: {number:.6g}" + ("" if unit == "1" else f" {unit}"))
             elif key in ("jacobian", "cartesian_inertia"):
                 typer.echo(f"{key}:")
