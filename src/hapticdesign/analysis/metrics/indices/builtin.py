@@ -26,9 +26,10 @@ index                   formula                                             unit
 ``condition`` and ``manipulability`` take ``jacobian``: ``handle`` (default, ``J_v``) or ``task``, the square task
 Jacobian ``J_m`` of seed 001 ch. 4 (:attr:`.states.HandleStates.task`: the handle's twist for six coordinates), on
 which ``I_m`` ... ``acceleration_radius`` are, with ``M_C = J_m^-T H J_m^-1``. ``force`` takes ``torque``
-(``continuous``, default, or ``peak``): the motors' torque limits, one motor per actuated coordinate. ``stiffness`` and ``frequency`` need links with sections (``K_C`` of the virtual joint method at the
-handle, :func:`~hapticdesign.analysis.stiffness.device.cartesian_stiffness_at`; ``K_C[:3, :3]`` holds the
-rotations, seed 001's ``K_CA``). ``kmax`` is :func:`hapticdesign.analysis.wall_stiffness.kmax`: the n-joint sampled
+(``continuous``, default, or ``peak``): the motors' torque limits, one motor per actuated coordinate. ``stiffness``
+and ``frequency`` need links with sections (``K_C`` of the virtual joint method at the handle,
+:func:`~hapticdesign.analysis.stiffness.device.cartesian_stiffness_at`; ``K_C[:3, :3]`` holds the rotations,
+seed 001's ``K_CA``). ``kmax`` is :func:`hapticdesign.analysis.wall_stiffness.kmax`: the n-joint sampled
 loop about the pose, every joint free, discretized exactly (its options: the loop's settings of
 :data:`~hapticdesign.analysis.wall_stiffness.KMAX_OPTIONS`, practice's by default, ``direction`` and ``hand``).
 ``ln`` and ``mass`` are one value per design (the same at every point); ``ln`` takes the region of the joint limits (full turns where none) and
