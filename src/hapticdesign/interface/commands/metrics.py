@@ -47,15 +47,12 @@ def device_metrics(device: Device, q: np.ndarray, extra: Sequence[str] = (), reg
     from hapticdesign.analysis.metrics.indices import INDICES, evaluate_at, requests_of
     from hapticdesign.analysis.metrics.indices.states import HandleStates
 
-    n = device.n_dof
-    if n > 3 and n != 6:
-        raise UserError(f"metrics need 1-3 or 6 joints (a square task Jacobian); {device.name} has {n}")
     registry = INDICES if registry is None else registry
     extra = requests_of(extra, registry)
     pose = HandleStates(device, configuration_of(device).full(q)[None])
     values = {}
     for key, name, options in METRIC_INDICES:
-        values[key] = float(INDICES[name].values(pose, options)[0])
+        values[key] = float(registry[name].values(pose, options)[0])
         if key == names.CONDITION_NUMBER and not values[key] <= SINGULAR_CONDITION:
             raise UserError(f"singular configuration at q = {np.round(q, 6).tolist()}: the Jacobian loses rank")
     J, M_C = pose.task[0], pose.task_inertia[0]
