@@ -74,3 +74,40 @@ def test_singular_pose_is_one_line_exit_2():
     result = runner.invoke(app, ["metrics", "--q", "0,0,1.5707963267948966"])
     assert result.exit_code == 2
     assert result.stderr.startswith("error: singular configuration") and result.stderr.count("\n") == 1
+
+
+def test_registry_metrics_against_a_finite_difference_jacobian(phantom3):
+    """I_d, I_f, I_e and the acceleration radius (seed 001 eq. 4.96-4.99) by NumPy from a finite-difference J_m, and
+    an index of the registry asked by --index (the handle's isotropy of a 3-joint device: 1 / cond J)."""
+    q = np.array([0.2, 0.4, -0.3])
+    out = _run(["--q", "0.2,0.4,-0.3", "--index", "isotropy,mass"])
+    J, H = _fd_jacobian(phantom3, q), mass_matrix(phantom3, q)
+    M_C = np.linalg.inv(J).T @ H @ np.linalg.inv(J)
+    assert out["I_d"] == pytest.approx(abs(np.linalg.det(J)) / np.linalg.det(H), rel=1e-6)
+    assert out["I_f"] == pytest.approx(np.sqrt(np.trace(M_C @ M_C.T)), rel=1e-6)
+    assert out["I_e"] == pytest.approx(np.linalg.cond(M_C), rel=1e-6)
+    assert out["acceleration_radius"] == pytest.approx(np.linalg.svd(J @ np.linalg.inv(H), compute_uv=False)[-1],
+                                                       rel=1e-6)
+    s = np.linalg.svd(J, compute_uv=False)
+    assert out["indices"]["isotropy"] == pytest.approx(s[-1] / s[0], rel=1e-6)
+    assert out["indices"]["mass"] == pytest.approx(sum(phantom3.body(b).m for b in phantom3.body_names), rel=1e-12)
+    assert out["units"]["indices"] == {"isotropy": "1", "mass": "kg"}
+
+
+def test_an_unknown_index_is_one_line_exit_2():
+    result = runner.invoke(app, ["metrics", "--q", "0.1,0.5,0.3", "--index", "nope"])
+    assert result.exit_code == 2
+    assert result.stderr.startswith("error: unknown index 'nope'") and result.stderr.count("\n") == 1
+
+
+def test_your_own_index_from_a_file(tmp_path, phantom3):
+    """An index of an --indices file, named by --index: the squared isotropy of a 3-joint device, 1 / cond(J)^2."""
+    (tmp_path / "mine.py").write_text(
+        "import numpy as np, hapticdesign as hd\n\n"
+        "@hd.index(unit='1', name='isotropy_squared_metrics', needs=('kinematics',))\n"
+        "def isotropy_squared_metrics(pose):\n"
+        "    s = np.linalg.svd(pose.J_v, compute_uv=False)\n"
+        "    return (s[..., -1] / s[..., 0]) ** 2\n")
+    out = _run(["--q", "0.2,0.4,-0.3", "--indices", str(tmp_path / "mine.py"), "--index", "isotropy_squared_metrics"])
+    s = np.linalg.svd(_fd_jacobian(phantom3, np.array([0.2, 0.4, -0.3])), compute_uv=False)
+    assert out["indices"]["isotropy_squared_metrics"] == pytest.approx((s[-1] / s[0]) ** 2, rel=1e-6)

@@ -10,10 +10,12 @@ A design variable is named as in a study file (issue 23):
 - ``actuators.<joint>.<field>`` (or ``actuators.<k>.<field>``, ``k`` the 0-based place of the actuator in the
   file, for a motor that ``drives`` a combination): a numeric field of a motor, one of :data:`ACTUATOR_FIELDS`.
 
-:class:`DesignSpace` reads and validates the file once and builds its device once; :meth:`DesignSpace.device`
-applies values to that device (no file is read again and no schema is run again): each value is checked as the
-file's own validation checks it (a finite number, ``D > d >= 0``, ``gear_ratio > 0``, a body's physical
-consistency, the loops closing at home, ...), and an invalid design raises a one-line :class:`UserError`. Bodies
+:class:`DesignSpace` reads and validates the file once and builds its device once. Each variable applies its value
+by the one rule of its kind (:meth:`Variable.apply`, into an :class:`Applied` design); :meth:`DesignSpace.device`
+builds the device of an applied design from the file's (no file is read again and no schema is run again) and
+:meth:`DesignSpace.batch_values` the arrays of many. Each value is checked as the file's own validation checks it
+(a finite number, ``D > d >= 0``, ``gear_ratio > 0``, a body's physical consistency, the loops closing at home,
+...), and an invalid design raises a one-line :class:`UserError`. Bodies
 that are links (``bodies: - {name: b, link: l}``) follow the lengths and sections: their mass and inertia are
 computed again (:func:`~hapticdesign.devices.device_file.link_body_inertias`) whenever a parameter or a section
 changes. :meth:`DesignSpace.batch_values` gives the same numbers and refusals for a whole generation of designs at
@@ -24,8 +26,9 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 from pydantic import ValidationError
@@ -93,6 +96,51 @@ class Variable:
             data["links"][self.target]["section"][self.field] = value
         else:
             data["actuators"][self.target][self.field] = value
+
+    def apply(self, design: "Applied", value: float) -> None:
+        """Apply ``value`` to one ``design``: the one rule of this variable's kind, which both the device of
+        :meth:`DesignSpace.device` and the arrays of :meth:`DesignSpace.batch_values` are built from."""
+        if self.kind in ("parameter", "inertial"):
+            design.params[self.name] = value
+            if self.kind == "inertial":
+                design.bodies.add(self.target)
+            else:
+                design.geometry.add(self.name)
+        elif self.kind == "section":
+            design.sections.setdefault(self.target, {})[self.field] = value
+        else:
+            design.motors.setdefault(self.target, {})[self.field] = value
+
+
+@dataclass
+class Applied:
+    """One design's values (:meth:`DesignSpace.applied`), by what they change: parameters (geometry) and inertial
+    parameters by name, the names of the changed geometry parameters and bodies, the sections' diameters and the
+    motors' fields by link and actuator index."""
+
+    params: dict[str, float] = field(default_factory=dict)
+    geometry: set[str] = field(default_factory=set)
+    bodies: set[str] = field(default_factory=set)
+    sections: dict[int, dict[str, float]] = field(default_factory=dict)
+    motors: dict[int, dict[str, float]] = field(default_factory=dict)
+
+    @property
+    def motor_key(self) -> tuple:
+        """The motors' changes as a key (actuator index and its changed fields, sorted)."""
+        return tuple(sorted((k, tuple(sorted(f.items()))) for k, f in self.motors.items()))
+
+
+class Motors(NamedTuple):
+    """A design's motors (:meth:`DesignSpace._motors`): the actuators and the joints' damping of its device, and
+    what the batched kernels take of them: the reflected inertia, the damping matrix ``B``, ``A^-1`` (None unless
+    one motor per coordinate) and ``n_k tau_k`` per torque kind (None where a motor lacks it)."""
+
+    actuators: tuple
+    damping: tuple
+    reflected: np.ndarray
+    damping_matrix: np.ndarray
+    motor_map: np.ndarray | None
+    torques: dict
 
 
 class DesignSpace:
@@ -192,37 +240,44 @@ class DesignSpace:
             out[name] = _number(name, raw)
         return out
 
+    def applied(self, values: Mapping[str, float]) -> Applied:
+        """``values`` (variable name to number) applied, each by its variable's rule (:meth:`Variable.apply`), and
+        checked as the device file's validation checks them: a known name and a finite number, each changed body's
+        physical consistency, each changed section (``D > d >= 0``) and motor (its fields, ``torque_peak`` not below
+        ``torque_continuous``). Raises a one-line UserError for a design the device file refuses."""
+        by_name = {v.name: v for v in self.variables}
+        design = Applied()
+        for name, value in self.checked_values(values).items():
+            by_name[name].apply(design, value)
+        if design.bodies:
+            device = self.base.with_params({name: design.params[name] for name in design.params
+                                            if name not in design.geometry})
+            for body in sorted(design.bodies):
+                report = check_body(body, device.body(body))
+                if report.error:
+                    raise UserError(report.error)
+        self._sections(design.sections)
+        self._motors(design.motor_key)
+        return design
+
     def device(self, values: Mapping[str, float]) -> Device:
-        """The device with ``values`` (variable name to number) applied; the others keep the file's values.
+        """The device with ``values`` (variable name to number) applied (:meth:`applied`); the others keep the
+        file's values.
 
         Raises a one-line UserError for an unknown name, a value that is not a finite number, and a design the
         device file's validation refuses."""
-        by_name = {v.name: v for v in self.variables}
-        changes: dict[str, dict] = {"parameter": {}, "inertial": {}, "section": {}, "actuator": {}}
-        for name, value in self.checked_values(values).items():
-            v = by_name[name]
-            key = v.name if v.kind in ("parameter", "inertial") else v.target
-            if v.kind in ("section", "actuator"):
-                changes[v.kind].setdefault(key, {})[v.field] = value
-            else:
-                changes[v.kind][key] = value
-        device = self.base
-        overrides = {**changes["parameter"], **changes["inertial"]}
-        if overrides:
-            device = device.with_params(overrides)
-        for body in sorted({by_name[n].target for n in changes["inertial"]}):
-            report = check_body(body, device.body(body))
-            if report.error:
-                raise UserError(report.error)
-        tubes = self._sections(changes["section"])
-        if changes["section"]:
+        design = self.applied(values)
+        device = self.base.with_params(design.params) if design.params else self.base
+        tubes = self._sections(design.sections)
+        if design.sections:
             device = replace(device, elasticity=self._elasticity(tubes))
-        if changes["actuator"]:
-            device = self._with_actuators(device, changes["actuator"])
-        if changes["parameter"]:
+        if design.motors:
+            motors = self._motors(design.motor_key)
+            device = replace(device, actuators=motors.actuators, damping=motors.damping)
+        if design.geometry:
             device = self._home_follows(device)
             self._check_geometry(device)
-        if self.link_bodies and (changes["parameter"] or changes["section"]):
+        if self.link_bodies and (design.geometry or design.sections):
             inertias = link_body_inertias(self.spec, device.mechanism, tubes)
             device = device.with_params({seed_parameter_name(f, body): float(getattr(inertia, f))
                                          for body, inertia in inertias.items() for f in SEED_FIELDS})
@@ -258,7 +313,10 @@ class DesignSpace:
         joints = self.base.elasticity.joints if self.base.elasticity is not None else ()
         return Elasticity(links, joints)
 
-    def _with_actuators(self, device: Device, fields: dict[int, dict[str, float]]) -> Device:
+    def _with_actuators(self, fields: dict[int, dict[str, float]]) -> Device:
+        """The file's device with the motors' ``fields`` (actuator index to changed fields), validated as the file's
+        own loading validates them."""
+        device = self.base
         actuators = list(device.actuators)
         for k, change in fields.items():
             spec = self.spec.actuators[k]
@@ -287,38 +345,23 @@ class DesignSpace:
         seed, diameters = np.tile(seed_file, (count, 1, 1)), np.tile(diameters_file, (count, 1, 1))
         refused: list[str | None] = [None] * count
         motors: list[tuple] = [()] * count
-        by_name = {v.name: v for v in self.variables}
-        inertial = [v for v in self.variables if v.kind == "inertial"]
+        seed_place = {seed_parameter_name(f, body): (b, k) for b, body in enumerate(base.body_names)
+                      for k, f in enumerate(SEED_FIELDS)}
         for d, values in enumerate(designs):
             try:
-                checked = self.checked_values(values)
-                changed: dict[int, dict[str, float]] = {}
-                for name, value in checked.items():
-                    v = by_name[name]
-                    if v.kind == "parameter":
-                        kinematic[d, column[name]] = value
-                    elif v.kind == "section":
-                        diameters[d, v.target, ("D", "d").index(v.field)] = value
-                    elif v.kind == "actuator":
-                        changed.setdefault(v.target, {})[v.field] = value
-                if inertial:
-                    overrides = {name: value for name, value in checked.items() if by_name[name].kind == "inertial"}
-                    device = base.with_params(overrides)
-                    for body in sorted({by_name[name].target for name in overrides}):
-                        report = check_body(body, device.body(body))
-                        if report.error:
-                            raise UserError(report.error)
-                    seed[d] = device.seed_parameters()
-                for k in sorted({by_name[name].target for name in checked if by_name[name].kind == "section"}):
-                    try:
-                        Tube(*(float(v) for v in diameters[d, k]))
-                    except UserError as exc:
-                        raise UserError(f"link {self.spec.links[k].name}: {exc}") from None
-                motors[d] = tuple(sorted((k, tuple(sorted(f.items()))) for k, f in changed.items()))
-                self._motors(motors[d])
+                design = self.applied(values)
             except UserError as exc:
                 refused[d] = str(exc)
-                kinematic[d], seed[d], diameters[d], motors[d] = batch.p0, seed_file, diameters_file, ()
+                continue
+            for name, value in design.params.items():
+                if name in design.geometry:
+                    kinematic[d, column[name]] = value
+                else:
+                    seed[(d, *seed_place[name])] = value
+            for k, sizes in design.sections.items():
+                for name, value in sizes.items():
+                    diameters[d, k, ("D", "d").index(name)] = value
+            motors[d] = design.motor_key
         pairs = [(link.start, link.end) for link in self.spec.links]
         vectors = batch.frame_vectors(batch.offsets(kinematic), pairs)
         lengths = np.linalg.norm(vectors[:, :, 0], axis=-1)
@@ -344,22 +387,24 @@ class DesignSpace:
             if refused[d] is None:
                 refused[d] = f"the inertial parameters of {base.name} overflow (m r or m r^2 is not a finite number)"
         built = [self._motors(key) for key in motors]
-        torques = {which: None if any(b[3][which] is None for b in built) else np.array([b[3][which] for b in built])
-                   for which in ("continuous", "peak")}
-        inverse = None if any(b[2] is None for b in built) else np.array([b[2] for b in built])
-        return DesignValues(kinematic, standard, np.array([b[0] for b in built]), np.array([b[1] for b in built]),
+        torques = {which: None if any(b.torques[which] is None for b in built)
+                   else np.array([b.torques[which] for b in built]) for which in ("continuous", "peak")}
+        inverse = None if any(b.motor_map is None for b in built) else np.array([b.motor_map for b in built])
+        return DesignValues(kinematic, standard, np.array([b.reflected for b in built]),
+                            np.array([b.damping_matrix for b in built]),
                             inverse, torques, rigidity, refused)
 
-    def _motors(self, key: tuple) -> tuple:
-        """The reflected inertia, damping matrix, ``A^-1`` and torque limits of the motors with the changes ``key``
-        (actuator index and its changed fields), built once per distinct set."""
+    def _motors(self, key: tuple) -> "Motors":
+        """The motors with the changes ``key`` (:attr:`Applied.motor_key`), built and validated once per distinct
+        set."""
         motors = self.cache.setdefault("motors", {})
         if key not in motors:
             if len(motors) >= MOTOR_SETS:
                 motors.clear()
-            device = self._with_actuators(self.base, {k: dict(f) for k, f in key}) if key else self.base
-            motors[key] = (device.reflected_inertia, device.damping_matrix, force.motor_map(device),
-                           {which: force.torque_limits(device, which) for which in ("continuous", "peak")})
+            device = self._with_actuators({k: dict(f) for k, f in key}) if key else self.base
+            motors[key] = Motors(device.actuators, device.damping, device.reflected_inertia, device.damping_matrix,
+                                 force.motor_map(device),
+                                 {which: force.torque_limits(device, which) for which in ("continuous", "peak")})
         return motors[key]
 
     @staticmethod

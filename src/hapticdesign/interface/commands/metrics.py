@@ -1,78 +1,67 @@
 """Command ``metrics``: kinematic and dynamic performance metrics of any device at one pose.
 
-The metrics of seed 001 chapter 4 are general: here they take the end-effector Jacobian of the
-kinematic core (translational rows for devices of up to 3 joints, all six rows for 6 joints)
-and the joint-space mass matrix H of the equations of motion.
+The metrics of seed 001 chapter 4 are general: they are indices of the one registry
+(:mod:`hapticdesign.analysis.metrics.indices`) on the task Jacobian of the handle (translational rows for devices of up
+to 3 joints, all six rows for 6 joints) and the mass matrix H over the actuated coordinates. ``--index`` adds any
+index of the registry by name (built-in, a package's through its entry point, or your own of an ``--indices`` file).
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Optional
 
 import numpy as np
 import typer
 
+from hapticdesign.analysis.metrics import kinematic, names
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import note, parse_vector, print_json, user_errors
 from hapticdesign.interface.options import DEVICE, FORCE, FORCE_HINT, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
 from hapticdesign.workload import allow_large
 
 if TYPE_CHECKING:
+    from hapticdesign.analysis.metrics.indices import Registry
     from hapticdesign.model.device import Device
 
 SINGULAR_CONDITION = 1e10
+METRIC_INDICES = ((names.CONDITION_NUMBER, "condition", {"jacobian": "task"}),
+                  (names.MANIPULABILITY, "manipulability", {"jacobian": "task"}),
+                  ("I_m", "I_m", {}), ("I_d", "I_d", {}), ("I_f", "I_f", {}), ("I_e", "I_e", {}),
+                  ("acceleration_radius", "acceleration_radius", {}))
+"""The metrics of seed 001 ch. 4 the command gives, as indices of the one registry on the task Jacobian (key, index,
+options)."""
+ORDER = (names.MANIPULABILITY, names.CONDITION_NUMBER, "velocity_ellipsoid_radii", "cartesian_inertia",
+         names.INERTIA_VOLUME, names.DYNAMIC_MANIPULABILITY, names.INERTIA_FROBENIUS, names.INERTIA_UNIFORMITY,
+         names.ACCELERATION_RADIUS)
 
 
-def task_jacobian(device: Device, q: np.ndarray) -> np.ndarray:
-    """End-effector Jacobian with as many task rows as joints.
-
-    3 joints: the translational rows in base coordinates; 6 joints: all six rows; 1-2 joints
-    (planar devices): the translational rows projected on the plane (or line) of motion, i.e. on
-    the leading left singular vectors, which leaves every metric unchanged by the choice of axes.
-    """
-    from hapticdesign.analysis.configuration import configuration_of
-
-    full = configuration_of(device).jacobian(q)
-    n = device.n_dof
-    if n == 3:
-        return full[:3]
-    if n == 6:
-        return full
-    if n < 3:
-        u, _, _ = np.linalg.svd(full[:3])
-        return u[:, :n].T @ full[:3]
-    raise UserError(f"metrics need 1-3 or 6 joints (a square task Jacobian); {device.name} has {n}")
-
-
-def device_metrics(device: Device, q: np.ndarray) -> dict:
+def device_metrics(device: Device, q: np.ndarray, extra: Sequence[str] = (), registry: Registry | None = None) -> dict:
     """Kinematic (eq. 4.24-4.38) and dynamic (eq. 4.90-4.99) metrics at pose ``q``, keyed as in
-    :mod:`hapticdesign.analysis.metrics.names`."""
-    from hapticdesign.analysis.dynamics.cartesian import cartesian_inertia
-    from hapticdesign.analysis.dynamics.device import mass_matrix
-    from hapticdesign.analysis.metrics import dynamic, kinematic, names
+    :mod:`hapticdesign.analysis.metrics.names`: the indices of the one registry on the task Jacobian
+    (:attr:`~hapticdesign.analysis.metrics.indices.states.HandleStates.task`: translational rows for devices of up
+    to 3 joints, all six rows for 6 joints), and under ``indices`` the indices ``extra`` of ``registry`` (default:
+    the one registry) by name."""
+    from hapticdesign.analysis.configuration import configuration_of
+    from hapticdesign.analysis.metrics.indices import INDICES, evaluate_at, requests_of
+    from hapticdesign.analysis.metrics.indices.states import HandleStates
 
-    J = task_jacobian(device, q)
-    cond = float(kinematic.condition_number(J))
-    if not np.isfinite(cond) or cond > SINGULAR_CONDITION:
-        raise UserError(f"singular configuration at q = {np.round(q, 6).tolist()}: the Jacobian loses rank")
-    H = mass_matrix(device, q)
-    M_C = cartesian_inertia(H, J)
-    radii, _ = kinematic.velocity_ellipsoid(J)
-    return {
-        "device": device.name,
-        "q": q,
-        "jacobian": J,
-        names.MANIPULABILITY: kinematic.manipulability(J),
-        names.CONDITION_NUMBER: cond,
-        "velocity_ellipsoid_radii": radii,
-        "cartesian_inertia": M_C,
-        names.INERTIA_VOLUME: dynamic.inertia_volume(M_C),
-        names.DYNAMIC_MANIPULABILITY: dynamic.dynamic_manipulability(H, J),
-        names.INERTIA_FROBENIUS: dynamic.inertia_frobenius(M_C),
-        names.INERTIA_UNIFORMITY: dynamic.inertia_uniformity(M_C),
-        names.ACCELERATION_RADIUS: dynamic.acceleration_radius(H, J),
-    }
+    registry = INDICES if registry is None else registry
+    extra = requests_of(extra, registry)
+    pose = HandleStates(device, configuration_of(device).full(q)[None])
+    values = {}
+    for key, name, options in METRIC_INDICES:
+        values[key] = float(registry[name].values(pose, options)[0])
+        if key == names.CONDITION_NUMBER and not values[key] <= SINGULAR_CONDITION:
+            raise UserError(f"singular configuration at q = {np.round(q, 6).tolist()}: the Jacobian loses rank")
+    J, M_C = pose.task[0], pose.task_inertia[0]
+    values.update(velocity_ellipsoid_radii=kinematic.velocity_ellipsoid(J)[0], cartesian_inertia=M_C)
+    out = {"device": device.name, "q": q, "jacobian": J, **{key: values[key] for key in ORDER}}
+    if extra:
+        found = evaluate_at(device, pose.full, extra, registry=registry)
+        out["indices"] = {key: float(value[0]) for key, value in found.values.items()}
+    return out
 
 
 def metric_units(device: Device) -> dict:
@@ -95,13 +84,20 @@ def metrics(
     device: Optional[Path] = DEVICE,
     params: Optional[Path] = PARAMS,
     q: str = typer.Option(..., help="Joint coordinates, comma-separated (rad or m)."),
+    index: str = typer.Option("", "--index", help="Comma-separated design indices to add at the pose "
+                              "(docs/indices.md): built-in, a package's through its entry point, or one of --indices."),
+    indices: Optional[Path] = typer.Option(None, "--indices", help="A Python file of your own design indices "
+                                           "(decorated with @hapticdesign.index) that --index may name. Its code "
+                                           "RUNS, as 'python FILE' would."),
     strict: bool = STRICT,
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
     force: bool = FORCE,
 ) -> None:
     """Kinematic and dynamic metrics of any device at one pose (seed 001 eq. 4.24-4.38, 4.90-4.99)."""
+    from hapticdesign.analysis.metrics.indices import INDICES
     from hapticdesign.devices.loading import resolve_device
+    from hapticdesign.interface.commands.optimize_adapter import index_module
     from hapticdesign.interface.commands.pose_adapter import handle, handle_line
 
     with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
@@ -109,15 +105,22 @@ def metrics(
         qv = parse_vector(q, dev.n_dof, "q")
         for message in dev.limit_warnings(qv):
             note(f"warning: {message}", quiet)
-        result = device_metrics(dev, qv)
+        registry = INDICES.with_indices(index_module(indices)) if indices is not None else INDICES
+        result = device_metrics(dev, qv, [name.strip() for name in index.split(",") if name.strip()], registry)
         found = handle(dev, qv)
         result["units"] = metric_units(dev)
+        if "indices" in result:
+            result["units"]["indices"] = {key: registry[key].unit for key in result["indices"]}
         if json_out:
             print_json({**result, **({"handle": found} if found is not None else {})})
             return
         del result["units"]
         for key, value in result.items():
-            if key in ("jacobian", "cartesian_inertia"):
+            if key == "indices":
+                for name, number in value.items():
+                    unit = registry[name].unit
+                    typer.echo(f"{name}: {number:.6g}" + ("" if unit == "1" else f" {unit}"))
+            elif key in ("jacobian", "cartesian_inertia"):
                 typer.echo(f"{key}:")
                 for row in value:
                     typer.echo("  " + " ".join(f"{v: .6e}" for v in row))

@@ -23,7 +23,7 @@ import numpy as np
 
 from hapticdesign.analysis import kinematics
 from hapticdesign.analysis.configuration import configuration_of
-from hapticdesign.analysis.dynamics.cartesian import mobility
+from hapticdesign.analysis.dynamics.cartesian import cartesian_inertia, mobility
 from hapticdesign.analysis.dynamics.device import mass_matrix_at
 from hapticdesign.analysis.metrics import force
 from hapticdesign.analysis.stiffness.device import cartesian_stiffness_at
@@ -65,6 +65,26 @@ class HandleStates:
         u, s, _ = np.linalg.svd(self.J_v)
         k = s.shape[-1]
         return u[:, :, :k], s
+
+    @cached_property
+    def task(self) -> np.ndarray:
+        """The task Jacobian ``J_m`` (P, n_a, n_a) of seed 001 ch. 4, square, as many rows as actuated coordinates:
+        ``J_v`` (base axes) for 3, ``U^T J_v`` (the plane or line the handle moves in, which leaves every metric
+        unchanged by the choice of axes) for 1 or 2, and the handle's twist (``J_v`` over the angular rows) for 6."""
+        n_a = self.J_v.shape[-1]
+        if n_a == 3:
+            return self.J_v
+        if n_a < 3:
+            return np.swapaxes(self.svd[0], 1, 2) @ self.J_v
+        if n_a == 6:
+            return np.concatenate([self.J_v, handle_jacobians(self._device, self.full, self.frame, rows=(3, 6))], 1)
+        raise UserError(f"the task Jacobian is square for 1-3 or 6 actuated coordinates; {self.name} has {n_a}")
+
+    @cached_property
+    def task_inertia(self) -> np.ndarray:
+        """``M_C = J_m^-T H J_m^-1`` (P, n_a, n_a) of the :attr:`task` Jacobian (seed 001 eq. 4.90), kg for
+        translational rows."""
+        return cartesian_inertia(self.H, self.task)
 
     @cached_property
     def H(self) -> np.ndarray:
@@ -175,10 +195,11 @@ def moving_mass(device: Device) -> float:
     return float(sum(device.body(name).m for name, moves in zip(device.body_names, moving) if moves))
 
 
-def handle_jacobians(device: Device, full: np.ndarray, frame: str | None = None) -> np.ndarray:
+def handle_jacobians(device: Device, full: np.ndarray, frame: str | None = None,
+                     rows: tuple[int, int] = (0, 3)) -> np.ndarray:
     """``J_v T`` (P, 3, n_a): the handle's (or ``frame``'s) translational Jacobian over the actuated coordinates at
-    closed full poses (P, N)."""
+    closed full poses (P, N); ``rows`` (3, 6) gives the angular rows, (0, 6) the twist's."""
     space = configuration_of(device)
     full = np.atleast_2d(np.asarray(full, dtype=float))
     _, jac = kinematics.poses_and_jacobians(space.mechanism, full, frame)
-    return jac[:, :3] @ space.velocity_transform(full)
+    return jac[:, rows[0]:rows[1]] @ space.velocity_transform(full)
