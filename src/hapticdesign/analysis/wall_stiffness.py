@@ -24,6 +24,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from hapticdesign.analysis.metrics.kinematic import handle_range_basis
 from hapticdesign.analysis.sampled_loop import GRASP, Hand, SampledLoop, handle_limits
 from hapticdesign.errors import UserError
 
@@ -59,9 +60,7 @@ def handle_range(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray) ->
                                                                                          np.ndarray]:
     """The basis ``U`` (P, 3, k) of the directions the handle moves, its mobility ``U^T J_v H^-1 J_v^T U`` and
     damping ``U^T J_v^+T B J_v^+ U`` (P, k, k) in it."""
-    u, s, _ = np.linalg.svd(jacobian)
-    k = s.shape[-1]
-    basis = u[:, :, :k]
+    basis, _ = handle_range_basis(jacobian)
     mobility = np.swapaxes(basis, 1, 2) @ jacobian @ np.linalg.solve(mass, np.swapaxes(jacobian, 1, 2)) @ basis
     pinv = np.linalg.pinv(jacobian) @ basis
     return basis, mobility, np.swapaxes(pinv, 1, 2) @ damping @ pinv

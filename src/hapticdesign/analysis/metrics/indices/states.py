@@ -26,6 +26,7 @@ from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.analysis.dynamics.cartesian import mobility
 from hapticdesign.analysis.dynamics.device import mass_matrix_at
 from hapticdesign.analysis.metrics import force
+from hapticdesign.analysis.metrics.kinematic import handle_range_basis
 from hapticdesign.analysis.stiffness.device import cartesian_stiffness_at
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
@@ -61,10 +62,9 @@ class HandleStates:
 
     @cached_property
     def svd(self) -> tuple[np.ndarray, np.ndarray]:
-        """``U`` (P, 3, k) and the singular values (P, k) of ``J_v``, largest first."""
-        u, s, _ = np.linalg.svd(self.J_v)
-        k = s.shape[-1]
-        return u[:, :, :k], s
+        """``U`` (P, 3, k) and the singular values (P, k) of ``J_v``, largest first
+        (:func:`~hapticdesign.analysis.metrics.kinematic.handle_range_basis`)."""
+        return handle_range_basis(self.J_v)
 
     @cached_property
     def H(self) -> np.ndarray:
