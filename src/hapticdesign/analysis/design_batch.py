@@ -251,8 +251,7 @@ def mass_designs(offsets, full, status, shape, plan, bodies, loops, params, out)
     ``sum_b (J_b T)^T M_b (J_b T)`` (eq. 2.44) with the closed-loop dynamics' own pose kernels."""
     n_design, n_pose, n = full.shape
     na = loops.actuated.shape[0]
-    body_node = bodies.body_node
-    n_body = body_node.shape[0]
+    n_body = bodies.body_node.shape[0]
     n_node = shape.parent.shape[0]
     ws = closure_scratch(n_node, n, na, loops.passive, n_body)
     pw = np.zeros((1, n_body, 10))
@@ -260,22 +259,33 @@ def mass_designs(offsets, full, status, shape, plan, bodies, loops, params, out)
     g = np.zeros(na)
     mj = np.zeros((6, na))
     for d in range(n_design):
-        if status[d] != OK:
-            continue
-        tree = Tree(shape.parent, shape.axis, shape.coef, offsets[d], shape.const_rot, shape.const_pos)
-        sets = params[d:d + 1]
-        for p in range(n_pose):
-            if loops.passive.shape[0] > 0:
-                factor_pose(full[d, p], tree, plan, loops, ws)
-            else:
-                planned_poses(full[d, p], tree, plan, np.int64(0), n_node, ws.rot, ws.pos, ws.trig)
-            reduce_pose(tree, plan, body_node, loops, ws)
-            world_parameters(ws.rot, body_node, sets, np.int64(0), pw)
-            h[:] = 0.0
-            for b in range(n_body):
-                if body_node[b] >= 0:
-                    mass_and_gravity(ws.ja, b, bodies.gravity, pw, 0, h, g, mj, False)
-            out[d, p] = h
+        if status[d] == OK:
+            tree = Tree(shape.parent, shape.axis, shape.coef, offsets[d], shape.const_rot, shape.const_pos)
+            _design_masses(full[d], tree, plan, bodies, loops, params[d:d + 1], ws, pw, h, g, mj, out[d])
+
+
+@njit(cache=True, _nrt=False)
+def _design_masses(full, tree, plan, bodies, loops, sets, ws, pw, h, g, mj, out):
+    """:func:`mass_designs` of one design at its poses ``full`` (P, N) into ``out`` (P, n_a, n_a); allocates nothing
+    (no reference counts on the records' arrays per pose)."""
+    body_node = bodies.body_node
+    n_node = tree.parent.shape[0]
+    for p in range(full.shape[0]):
+        if loops.passive.shape[0] > 0:
+            factor_pose(full[p], tree, plan, loops, ws)
+        else:
+            planned_poses(full[p], tree, plan, np.int64(0), n_node, ws.rot, ws.pos, ws.trig)
+        reduce_pose(tree, plan, body_node, loops, ws)
+        world_parameters(ws.rot, body_node, sets, np.int64(0), pw)
+        for i in range(h.shape[0]):
+            for j in range(h.shape[1]):
+                h[i, j] = 0.0
+        for b in range(body_node.shape[0]):
+            if body_node[b] >= 0:
+                mass_and_gravity(ws.ja, b, bodies.gravity, pw, 0, h, g, mj, False)
+        for i in range(h.shape[0]):
+            for j in range(h.shape[1]):
+                out[p, i, j] = h[i, j]
 
 
 @njit(cache=True)

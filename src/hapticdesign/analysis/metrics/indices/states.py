@@ -29,6 +29,7 @@ from hapticdesign.analysis.metrics import force
 from hapticdesign.analysis.metrics.kinematic import handle_range_basis
 from hapticdesign.analysis.stiffness.device import cartesian_stiffness_at
 from hapticdesign.errors import UserError
+from hapticdesign.model.dense import symmetric_eigenvalues
 from hapticdesign.model.device import Device
 
 BATCH_NEEDS = frozenset({"kinematics", "dynamics", "damping", "sections", "motors", "bodies"})
@@ -107,7 +108,7 @@ class HandleStates:
     @cached_property
     def cartesian_mass(self) -> np.ndarray:
         """Eigenvalues (P, k) of ``Lambda`` (kg), ascending."""
-        return 1.0 / np.linalg.eigvalsh(self.mobility)[:, ::-1]
+        return 1.0 / symmetric_eigenvalues(self.mobility)[:, ::-1]
 
     @cached_property
     def cartesian_mass_matrix(self) -> np.ndarray:
