@@ -104,7 +104,7 @@ def kmax(pose: HandleStates, period: float = 0.001, delay: int = 1, damping: flo
          error_percent: float = 0.0, hand: object = None) -> np.ndarray:
     options = dict(period=period, delay=delay, damping=damping, direction=direction, velocity=velocity,
                    compensation=compensation, error_percent=error_percent, hand=hand)
-    return wall_kmax(pose.J_v, pose.H, pose.B, pose.svd[0], options)
+    return wall_kmax(pose.J_v, pose.H, pose.B, (pose.svd[0], pose.mobility, pose.cartesian_damping), options)
 
 
 @index(unit="LN", formula="Linearity Number over the joint region (limits, else full turns)",
