@@ -67,25 +67,26 @@ def condition_of_singular_values(s: np.ndarray) -> np.ndarray:
         return s[..., 0] / s[..., -1]
 
 
-def handle_range_basis(J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def handle_range_basis(J: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The left singular vectors ``U`` (P, 3, k) and singular values (P, k), largest first, of translational Jacobians
-    ``J`` (P, 3, n) with ``k = min(3, n)``: the directions the handle moves and its speeds along them.
+    ``J`` (P, 3, n) with ``k = min(3, n)``: the directions the handle moves and its speeds along them; and ``U^T J``
+    (P, k, n), the Jacobian on those directions.
 
     One-sided Jacobi (Hestenes): plane rotations of the rows of ``J`` until they are mutually orthogonal,
     ``V^T J = W``; then ``J = V W``, the singular values are the rows' norms and ``U`` the columns of ``V`` in their
-    order. A row below ``eps ||J||_F`` is left as it is (rank < 3: its direction is rounding). ``U`` is orthonormal
+    order (``W``'s rows are ``U^T J``). A row below ``eps ||J||_F`` is left as it is (rank < 3: its direction is rounding). ``U`` is orthonormal
     by construction (a product of rotations) and the singular values are as accurate as LAPACK's (within a few ulps
     of ``sigma_1``), without LAPACK's per-matrix cost on thousands of 3 x n matrices."""
     J = np.ascontiguousarray(J, dtype=float)
     k = min(3, J.shape[-1])
-    u, s = np.empty((len(J), 3, k)), np.empty((len(J), k))
-    _range_bases(J, u, s)
-    return u, s
+    u, s, along = np.empty((len(J), 3, k)), np.empty((len(J), k)), np.empty((len(J), k, J.shape[-1]))
+    _range_bases(J, u, s, along)
+    return u, s, along
 
 
 @njit(cache=True)
-def _range_bases(jac, u, s):
-    """:func:`handle_range_basis` of ``jac`` (P, 3, n) into ``u`` (P, 3, k) and ``s`` (P, k)."""
+def _range_bases(jac, u, s, along):
+    """:func:`handle_range_basis` of ``jac`` (P, 3, n) into ``u`` (P, 3, k), ``s`` (P, k) and ``along`` (P, k, n)."""
     n = jac.shape[2]
     k = s.shape[1]
     eps = np.finfo(np.float64).eps
@@ -144,6 +145,8 @@ def _range_bases(jac, u, s):
             s[p, r] = norm[order[r]]
             for i in range(3):
                 u[p, i, r] = v[i, order[r]]
+            for j in range(n):
+                along[p, r, j] = w[order[r], j]
 
 
 def characteristic_length(desired_reach: float, actual_reach: float) -> float:

@@ -57,7 +57,7 @@ def condition(pose: HandleStates) -> np.ndarray:
 @index(unit="m^k/rad^k", formula="sqrt(det(U^T J_v J_v^T U))", source="seed 001 eq. 4.36 (Yoshikawa 1985)",
        needs=("kinematics",))
 def manipulability(pose: HandleStates) -> np.ndarray:
-    return kinematic.manipulability(np.swapaxes(pose.svd[0], 1, 2) @ pose.J_v)
+    return kinematic.manipulability(pose.J_u)
 
 
 @index(unit="kg", formula="largest eigenvalue of Lambda = (J_v H^-1 J_v^T)^+", source="Khatib (1987); seed 001 §4.3")

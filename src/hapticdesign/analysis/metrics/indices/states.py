@@ -65,6 +65,15 @@ class HandleStates:
     def svd(self) -> tuple[np.ndarray, np.ndarray]:
         """``U`` (P, 3, k) and the singular values (P, k) of ``J_v``, largest first
         (:func:`~hapticdesign.analysis.metrics.kinematic.handle_range_basis`)."""
+        return self._range[:2]
+
+    @cached_property
+    def J_u(self) -> np.ndarray:
+        """``U^T J_v`` (P, k, n_a): the Jacobian on the directions the handle moves."""
+        return self._range[2]
+
+    @cached_property
+    def _range(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         return handle_range_basis(self.J_v)
 
     @cached_property
@@ -103,7 +112,7 @@ class HandleStates:
     @cached_property
     def mobility(self) -> np.ndarray:
         """``U^T J_v H^-1 J_v^T U`` (P, k, k), the inverse of ``Lambda`` (1/kg)."""
-        return mobility(self.H, np.swapaxes(self.svd[0], 1, 2) @ self.J_v)
+        return mobility(self.H, self.J_u)
 
     @cached_property
     def cartesian_mass(self) -> np.ndarray:
