@@ -41,6 +41,7 @@ from hapticdesign.analysis.metrics.indices.registry import index
 from hapticdesign.analysis.metrics.indices.states import HandleStates
 from hapticdesign.analysis.wall_stiffness import kmax as wall_kmax
 from hapticdesign.errors import UserError
+from hapticdesign.model.dense import symmetric_eigenvalues
 
 
 @index(unit="1", formula="sigma_min(J_v) / sigma_max(J_v)",
@@ -87,7 +88,7 @@ def force(pose: HandleStates, torque: str = "continuous") -> np.ndarray:
 @index(unit="N/m", formula="smallest eigenvalue of U^T K_C[:3, :3] U (VJM)", source="seed 001 eq. 5.117-5.123 (K_CA)",
        needs=("kinematics", "sections"))
 def stiffness(pose: HandleStates) -> np.ndarray:
-    return np.linalg.eigvalsh(pose.stiffness)[:, 0]
+    return symmetric_eigenvalues(pose.stiffness)[:, 0]
 
 
 @index(unit="rad/s", formula="sqrt of the smallest eigenvalue of K v = w^2 Lambda v (U^T K_C[:3, :3] U, Lambda)",
