@@ -32,6 +32,7 @@ def task_jacobian(device: Device, q: np.ndarray) -> np.ndarray:
     the leading left singular vectors, which leaves every metric unchanged by the choice of axes.
     """
     from hapticdesign.analysis.configuration import configuration_of
+    from hapticdesign.analysis.metrics.kinematic import handle_range_basis
 
     full = configuration_of(device).jacobian(q)
     n = device.n_dof
@@ -40,8 +41,7 @@ def task_jacobian(device: Device, q: np.ndarray) -> np.ndarray:
     if n == 6:
         return full
     if n < 3:
-        u, _, _ = np.linalg.svd(full[:3])
-        return u[:, :n].T @ full[:3]
+        return handle_range_basis(full[None, :3])[2][0]
     raise UserError(f"metrics need 1-3 or 6 joints (a square task Jacobian); {device.name} has {n}")
 
 
