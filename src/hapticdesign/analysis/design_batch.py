@@ -522,30 +522,32 @@ class DesignBatch:
         links' rigidities (D, L, 3) (:func:`~hapticdesign.analysis.stiffness.device.cartesian_stiffness_at`), and
         per design whether it is defined at every point (False: the handle is rigid in some direction there)."""
         d, p, n = reached.full.shape
+        defined = reached.status == OK
+        chosen = np.flatnonzero(defined)  # only these designs' rows are built (no copies of the others' zeros)
+        offsets = np.ascontiguousarray(offsets[chosen], dtype=float)
         m, links = len(self.closures.row_loop), len(self.elastic_links)
-        rows, virtual = np.zeros((d, p, 6 + m, n)), np.zeros((d, p, 6 + m, 6 * links))
-        vjm_designs(np.ascontiguousarray(offsets, dtype=float), reached.full, reached.status, self.shape, self.plan,
-                    self.closures, self.handle, self.ends, rows, virtual)
+        rows, virtual = np.zeros((len(chosen), p, 6 + m, n)), np.zeros((len(chosen), p, 6 + m, 6 * links))
+        vjm_designs(offsets, reached.full[chosen], reached.status[chosen], self.shape, self.plan, self.closures,
+                    self.handle, self.ends, rows, virtual)
         axis = self.frame_vectors(offsets, [(link.start, link.end) for link in self.elastic_links])[:, :, 1]
-        compliance = end_compliance(axis, *np.moveaxis(rigidity, -1, 0))
+        compliance = end_compliance(axis, *np.moveaxis(rigidity[chosen], -1, 0))
         index = {name: k for k, name in enumerate(self.device.mechanism.coordinates)}
         spring_columns = [index[name] for name, _ in self.springs]
         size = 6 * links + len(self.springs)
-        c_theta = np.zeros((d, size, size))
+        c_theta = np.zeros((len(chosen), size, size))
         for k in range(links):
             c_theta[:, 6 * k:6 * k + 6, 6 * k:6 * k + 6] = compliance[:, k]
         for k, (_, value) in enumerate(self.springs):
             c_theta[:, 6 * links + k, 6 * links + k] = 1.0 / value
-        j_theta = np.concatenate([virtual, rows[..., spring_columns]], axis=-1)
+        j_theta = np.concatenate([virtual, rows[..., spring_columns]], axis=-1) if spring_columns else virtual
         j_p = rows[..., self.closures.passive]
-        out, defined = np.zeros((d, p, 6, 6)), reached.status == OK
-        chosen = np.flatnonzero(defined)
+        out = np.zeros((d, p, 6, 6))
         try:
-            out[chosen] = self._cartesian(j_theta[chosen], c_theta[chosen, None], j_p[chosen])
+            out[chosen] = self._cartesian(j_theta, c_theta[:, None], j_p)
         except UserError:  # some pose is singular: design by design, to tell which
-            for k in chosen:
+            for row, k in enumerate(chosen):
                 try:
-                    out[k] = self._cartesian(j_theta[k], c_theta[k], j_p[k])
+                    out[k] = self._cartesian(j_theta[row], c_theta[row], j_p[row])
                 except UserError:
                     defined[k] = False
         return out, defined
