@@ -123,8 +123,9 @@ def test_every_metric_key_is_in_the_one_vocabulary(phantom3):
 def test_handle_range_basis_agrees_with_lapack_svd_near_singular_poses_too(n):
     """The one-sided Jacobi range of 3 x n Jacobians against NumPy's (LAPACK's) SVD: singular values within a few
     ulps of sigma_1 (the backward error both have), ``U`` orthonormal and spanning the same range (``U^T J`` keeps
-    J's norm along each direction, and is the returned Jacobian on the range), on random matrices and ones whose smallest singular value is 1e-4 .. 1e-12 of
-    the largest (isotropy near 0) or exactly 0 (a zero row: a planar device)."""
+    J's norm along each direction, and is the returned Jacobian on the range), on random matrices and ones whose
+    smallest singular value is 1e-4 .. 1e-12 of the largest (isotropy near 0) or exactly 0 (a zero row: a planar
+    device)."""
     rng = np.random.default_rng(7)
     J = rng.normal(size=(400, 3, n)) * rng.uniform(1e-3, 1e3, size=(400, 1, 1))
     u0, s0, vt0 = np.linalg.svd(J, full_matrices=False)

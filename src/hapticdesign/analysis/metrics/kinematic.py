@@ -74,9 +74,10 @@ def handle_range_basis(J: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarra
 
     One-sided Jacobi (Hestenes): plane rotations of the rows of ``J`` until they are mutually orthogonal,
     ``V^T J = W``; then ``J = V W``, the singular values are the rows' norms and ``U`` the columns of ``V`` in their
-    order (``W``'s rows are ``U^T J``). A row below ``eps ||J||_F`` is left as it is (rank < 3: its direction is rounding). ``U`` is orthonormal
-    by construction (a product of rotations) and the singular values are as accurate as LAPACK's (within a few ulps
-    of ``sigma_1``), without LAPACK's per-matrix cost on thousands of 3 x n matrices."""
+    order (``W``'s rows are ``U^T J``). A row below ``eps ||J||_F`` is left as it is (rank < 3: its direction is
+    rounding). ``U`` is orthonormal by construction (a product of rotations) and the singular values are as accurate
+    as LAPACK's (within a few ulps of ``sigma_1``), without LAPACK's per-matrix cost on thousands of 3 x n
+    matrices."""
     J = np.ascontiguousarray(J, dtype=float)
     k = min(3, J.shape[-1])
     u, s, along = np.empty((len(J), 3, k)), np.empty((len(J), k)), np.empty((len(J), k, J.shape[-1]))
