@@ -117,3 +117,49 @@ def test_every_metric_key_is_in_the_one_vocabulary(phantom3):
     assert set(selection.METRIC_NAMES) <= set(METRICS)
     shared = set(device_metrics(phantom3, np.array([0.2, 0.5, -0.4]))) & set(METRICS)
     assert shared == {"manipulability", "condition_number", "I_m", "I_f", "I_e", "I_d", "acceleration_radius"}
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 4, 6])
+def test_handle_range_basis_agrees_with_lapack_svd_near_singular_poses_too(n):
+    """The one-sided Jacobi range of 3 x n Jacobians against NumPy's (LAPACK's) SVD: singular values within a few
+    ulps of sigma_1 (the backward error both have), ``U`` orthonormal and spanning the same range (``U^T J`` keeps
+    J's norm along each direction, and is the returned Jacobian on the range), on random matrices and ones whose
+    smallest singular value is 1e-4 .. 1e-12 of the largest (isotropy near 0) or exactly 0 (a zero row: a planar
+    device)."""
+    rng = np.random.default_rng(7)
+    J = rng.normal(size=(400, 3, n)) * rng.uniform(1e-3, 1e3, size=(400, 1, 1))
+    u0, s0, vt0 = np.linalg.svd(J, full_matrices=False)
+    s0[:100, -1] *= 1e-4
+    s0[100:200, -1] *= 1e-8
+    s0[200:300, -1] *= 1e-12
+    J = (u0 * s0[:, None, :]) @ vt0
+    J[300:, 2] = 0.0
+    u, s, along = kinematic.handle_range_basis(J)
+    k = min(3, n)
+    lapack = np.linalg.svd(J, compute_uv=False)
+    eps = np.finfo(float).eps
+    assert u.shape == (400, 3, k) and s.shape == (400, k)
+    assert np.all(np.abs(s - lapack) <= 20 * eps * lapack[:, :1])
+    assert np.all(s[:, :-1] >= s[:, 1:])
+    assert np.abs(np.swapaxes(u, 1, 2) @ u - np.eye(k)).max() <= 20 * eps
+    assert np.all(np.abs(along - np.swapaxes(u, 1, 2) @ J) <= 20 * eps * lapack[:, :1, None])
+    assert np.all(np.abs(np.linalg.norm(np.swapaxes(u, 1, 2) @ J, axis=2) - s) <= 20 * eps * lapack[:, :1])
+    # isotropy sigma_k / sigma_1 then within 40 eps of LAPACK's, near 0 too
+    assert np.all(np.abs(s[:, -1] / s[:, 0] - lapack[:, k - 1] / lapack[:, 0]) <= 41 * eps)
+    if n >= 3:  # the zero row leaves rank 2
+        assert np.all(s[300:, 2] <= 20 * eps * lapack[300:, 0])
+
+
+def test_handle_range_basis_of_a_planar_two_r_near_its_singularity():
+    """The 2R arm's Jacobian on the x-y rows of a 3-row one (z row 0): sigma_1 sigma_2 = |det J| = l1 l2 |sin t2|
+    and sigma_1^2 + sigma_2^2 = ||J||_F^2, to the rounding of J's entries, down to t2 = 1e-9 (isotropy ~1e-9);
+    ``U`` spans the x-y plane."""
+    eps = np.finfo(float).eps
+    for t2 in (1.1, 1e-3, 1e-6, 1e-9):
+        J = np.zeros((1, 3, 2))
+        J[0, :2] = two_r_jacobian(0.3, 0.2, 0.4, t2)
+        u, s, _ = kinematic.handle_range_basis(J)
+        s1, s2 = s[0]
+        assert s1 * s1 + s2 * s2 == pytest.approx(np.sum(J ** 2), rel=1e-14)
+        assert abs(s2 - 0.3 * 0.2 * abs(np.sin(t2)) / s1) <= 10 * eps * s1
+        assert np.abs(u[0, 2]).max() == 0.0

@@ -54,8 +54,7 @@ def mass_designs(offsets, full, status, shape, plan, bodies, loops, params, out)
     ``sum_b (J_b T)^T M_b (J_b T)`` (eq. 2.44) with the closed-loop dynamics' own pose kernels."""
     n_design, n_pose, n = full.shape
     na = loops.actuated.shape[0]
-    body_node = bodies.body_node
-    n_body = body_node.shape[0]
+    n_body = bodies.body_node.shape[0]
     n_node = shape.parent.shape[0]
     ws = closure_scratch(n_node, n, na, loops.passive, n_body)
     pw = np.zeros((1, n_body, 10))
@@ -63,22 +62,33 @@ def mass_designs(offsets, full, status, shape, plan, bodies, loops, params, out)
     g = np.zeros(na)
     mj = np.zeros((6, na))
     for d in range(n_design):
-        if status[d] != OK:
-            continue
-        tree = Tree(shape.parent, shape.axis, shape.coef, offsets[d], shape.const_rot, shape.const_pos)
-        sets = params[d:d + 1]
-        for p in range(n_pose):
-            if loops.passive.shape[0] > 0:
-                factor_pose(full[d, p], tree, plan, loops, ws)
-            else:
-                planned_poses(full[d, p], tree, plan, np.int64(0), n_node, ws.rot, ws.pos, ws.trig)
-            reduce_pose(tree, plan, body_node, loops, ws)
-            world_parameters(ws.rot, body_node, sets, np.int64(0), pw)
-            h[:] = 0.0
-            for b in range(n_body):
-                if body_node[b] >= 0:
-                    mass_and_gravity(ws.ja, b, bodies.gravity, pw, 0, h, g, mj, False)
-            out[d, p] = h
+        if status[d] == OK:
+            tree = Tree(shape.parent, shape.axis, shape.coef, offsets[d], shape.const_rot, shape.const_pos)
+            _design_masses(full[d], tree, plan, bodies, loops, params[d:d + 1], ws, pw, h, g, mj, out[d])
+
+
+@njit(cache=True, _nrt=False)
+def _design_masses(full, tree, plan, bodies, loops, sets, ws, pw, h, g, mj, out):
+    """:func:`mass_designs` of one design at its poses ``full`` (P, N) into ``out`` (P, n_a, n_a); allocates nothing
+    (no reference counts on the records' arrays per pose)."""
+    body_node = bodies.body_node
+    n_node = tree.parent.shape[0]
+    for p in range(full.shape[0]):
+        if loops.passive.shape[0] > 0:
+            factor_pose(full[p], tree, plan, loops, ws)
+        else:
+            planned_poses(full[p], tree, plan, np.int64(0), n_node, ws.rot, ws.pos, ws.trig)
+        reduce_pose(tree, plan, body_node, loops, ws)
+        world_parameters(ws.rot, body_node, sets, np.int64(0), pw)
+        for i in range(h.shape[0]):
+            for j in range(h.shape[1]):
+                h[i, j] = 0.0
+        for b in range(body_node.shape[0]):
+            if body_node[b] >= 0:
+                mass_and_gravity(ws.ja, b, bodies.gravity, pw, 0, h, g, mj, False)
+        for i in range(h.shape[0]):
+            for j in range(h.shape[1]):
+                out[p, i, j] = h[i, j]
 
 
 @njit(cache=True)
@@ -309,30 +319,32 @@ class DesignBatch:
         links' rigidities (D, L, 3) (:func:`~hapticdesign.analysis.stiffness.device.cartesian_stiffness_at`), and
         per design whether it is defined at every point (False: the handle is rigid in some direction there)."""
         d, p, n = reached.full.shape
+        defined = reached.status == OK
+        chosen = np.flatnonzero(defined)  # only these designs' rows are built (no copies of the others' zeros)
+        offsets = np.ascontiguousarray(offsets[chosen], dtype=float)
         m, links = len(self.closures.row_loop), len(self.elastic_links)
-        rows, virtual = np.zeros((d, p, 6 + m, n)), np.zeros((d, p, 6 + m, 6 * links))
-        vjm_designs(np.ascontiguousarray(offsets, dtype=float), reached.full, reached.status, self.shape, self.plan,
-                    self.closures, self.handle, self.ends, rows, virtual)
+        rows, virtual = np.zeros((len(chosen), p, 6 + m, n)), np.zeros((len(chosen), p, 6 + m, 6 * links))
+        vjm_designs(offsets, reached.full[chosen], reached.status[chosen], self.shape, self.plan, self.closures,
+                    self.handle, self.ends, rows, virtual)
         axis = self.frame_vectors(offsets, [(link.start, link.end) for link in self.elastic_links])[:, :, 1]
-        compliance = end_compliance(axis, *np.moveaxis(rigidity, -1, 0))
+        compliance = end_compliance(axis, *np.moveaxis(rigidity[chosen], -1, 0))
         index = {name: k for k, name in enumerate(self.device.mechanism.coordinates)}
         spring_columns = [index[name] for name, _ in self.springs]
         size = 6 * links + len(self.springs)
-        c_theta = np.zeros((d, size, size))
+        c_theta = np.zeros((len(chosen), size, size))
         for k in range(links):
             c_theta[:, 6 * k:6 * k + 6, 6 * k:6 * k + 6] = compliance[:, k]
         for k, (_, value) in enumerate(self.springs):
             c_theta[:, 6 * links + k, 6 * links + k] = 1.0 / value
-        j_theta = np.concatenate([virtual, rows[..., spring_columns]], axis=-1)
+        j_theta = np.concatenate([virtual, rows[..., spring_columns]], axis=-1) if spring_columns else virtual
         j_p = rows[..., self.closures.passive]
-        out, defined = np.zeros((d, p, 6, 6)), reached.status == OK
-        chosen = np.flatnonzero(defined)
+        out = np.zeros((d, p, 6, 6))
         try:
-            out[chosen] = self._cartesian(j_theta[chosen], c_theta[chosen, None], j_p[chosen])
+            out[chosen] = self._cartesian(j_theta, c_theta[:, None], j_p)
         except UserError:  # some pose is singular: design by design, to tell which
-            for k in chosen:
+            for row, k in enumerate(chosen):
                 try:
-                    out[k] = self._cartesian(j_theta[k], c_theta[k], j_p[k])
+                    out[k] = self._cartesian(j_theta[row], c_theta[row], j_p[row])
                 except UserError:
                     defined[k] = False
         return out, defined

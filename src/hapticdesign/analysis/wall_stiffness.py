@@ -24,6 +24,8 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from hapticdesign.analysis.dynamics import cartesian
+from hapticdesign.analysis.metrics.kinematic import handle_range_basis
 from hapticdesign.analysis.sampled_loop import GRASP, Hand, SampledLoop, handle_limits
 from hapticdesign.errors import UserError
 
@@ -59,12 +61,9 @@ def handle_range(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray) ->
                                                                                          np.ndarray]:
     """The basis ``U`` (P, 3, k) of the directions the handle moves, its mobility ``U^T J_v H^-1 J_v^T U`` and
     damping ``U^T J_v^+T B J_v^+ U`` (P, k, k) in it."""
-    u, s, _ = np.linalg.svd(jacobian)
-    k = s.shape[-1]
-    basis = u[:, :, :k]
-    mobility = np.swapaxes(basis, 1, 2) @ jacobian @ np.linalg.solve(mass, np.swapaxes(jacobian, 1, 2)) @ basis
+    basis, _, along = handle_range_basis(jacobian)
     pinv = np.linalg.pinv(jacobian) @ basis
-    return basis, mobility, np.swapaxes(pinv, 1, 2) @ damping @ pinv
+    return basis, cartesian.mobility(mass, along), np.swapaxes(pinv, 1, 2) @ damping @ pinv
 
 
 CHUNK_BYTES = 1 << 24
@@ -174,13 +173,16 @@ def _hand(value: object) -> Hand | None:
     raise UserError(f"the hand is none, 'grasp' or a mapping of mass, damping and stiffness, got {str(value)[:60]!r}")
 
 
-def kmax(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, basis: np.ndarray,
-         options: Mapping[str, object]) -> np.ndarray:
-    """The ``kmax`` index (N/m) at P poses: ``J_v`` (P, 3, n), ``H`` (P, n, n), ``B`` (n, n) or (P, n, n), the range
-    basis ``U`` (P, 3, k) and the options of :data:`KMAX_OPTIONS`."""
+def kmax(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray,
+         ranges: tuple[np.ndarray, np.ndarray, np.ndarray], options: Mapping[str, object]) -> np.ndarray:
+    """The ``kmax`` index (N/m) at P poses: ``J_v`` (P, 3, n), ``H`` (P, n, n), ``B`` (n, n) or (P, n, n), the
+    handle's range as :func:`handle_range` gives it (the basis ``U``, mobility and damping in it, already known to
+    the caller) and the options of :data:`KMAX_OPTIONS`."""
     loop, direction = kmax_loop(options)
-    along = None
-    if direction is not None:
+    basis, mobility, cartesian_damping = ranges
+    if direction is None:
+        along = np.einsum("pik,pck->pci", basis, wall_directions(mobility, cartesian_damping))
+    else:
         inside = np.linalg.norm(np.swapaxes(basis, 1, 2) @ direction, axis=1)
         if not np.all(np.abs(inside - 1.0) <= 1e-9):
             raise UserError(f"index kmax: the direction {np.round(direction, 6).tolist()} is not one the handle "

@@ -15,6 +15,7 @@ Expressions use the device files' grammar (:func:`hapticdesign.devices.schema.pa
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import math
 from pathlib import Path
@@ -160,6 +161,12 @@ class IndexConstraint(_Bounded, _IndexUse):
         return f"{self.reduce}_{self.index}" + (f"[{shown}]" if shown else "")
 
 
+@functools.lru_cache(maxsize=256)
+def _parsed(text: str) -> LinearExpr:
+    """The expression ``text`` parsed once (a study's constraints are read at every design)."""
+    return parse_expression(text)
+
+
 class ExpressionConstraint(_Bounded):
     """An affine expression of the variables (the device files' grammar), bounded."""
 
@@ -173,7 +180,7 @@ class ExpressionConstraint(_Bounded):
 
     @property
     def parsed(self) -> LinearExpr:
-        return parse_expression(self.expression)
+        return _parsed(self.expression)
 
     @property
     def label(self) -> str:

@@ -11,8 +11,10 @@ and the two agree for a square ``J``.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 from hapticdesign.errors import UserError
+from hapticdesign.model.dense import lu_in_place
 
 SINGULAR_CONDITION = 1.0 / np.finfo(float).eps
 """Condition estimate ``max|A_ij| max|(A^-1)_ij|`` (within a factor ``n^2`` of the infinity-norm
@@ -56,6 +58,40 @@ def cartesian_inertia(mass_matrix, jacobian) -> np.ndarray:
 
 def mobility(mass_matrix: np.ndarray, jacobian: np.ndarray) -> np.ndarray:
     """``J H^-1 J^T`` (..., m, m): the inverse of the Cartesian inertia of a full-row-rank ``J`` (1/kg for a
-    translational task), batched over the leading axes."""
+    translational task), batched over the leading axes (a compiled solve per matrix, :func:`_mobilities`); a
+    singular ``H`` raises :class:`numpy.linalg.LinAlgError`."""
+    H = np.asarray(mass_matrix, dtype=float)
     J = np.asarray(jacobian, dtype=float)
-    return J @ np.linalg.solve(np.asarray(mass_matrix, dtype=float), np.swapaxes(J, -1, -2))
+    stack = np.broadcast_shapes(H.shape[:-2], J.shape[:-2])
+    m, n = J.shape[-2:]
+    hs = np.ascontiguousarray(np.broadcast_to(H, (*stack, n, n))).reshape(-1, n, n)
+    js = np.ascontiguousarray(np.broadcast_to(J, (*stack, m, n))).reshape(-1, m, n)
+    out = np.empty((len(js), m, m))
+    if not _mobilities(hs, js, out):
+        raise np.linalg.LinAlgError("Singular matrix")
+    return out.reshape(*stack, m, m)
+
+
+@njit(cache=True)
+def _mobilities(H, J, out):
+    """``J_i H_i^-1 J_i^T`` into ``out[i]`` (H (P, n, n), J (P, m, n)) by Gaussian elimination with partial pivoting
+    (:func:`~hapticdesign.model.dense.lu_in_place`); False when some ``H_i`` is singular."""
+    n, m = H.shape[1], J.shape[1]
+    lu, x = np.empty((n, n)), np.empty((n, m))
+    for p in range(H.shape[0]):
+        for i in range(n):
+            for j in range(n):
+                lu[i, j] = H[p, i, j]
+            for j in range(m):
+                x[i, j] = J[p, j, i]
+        ratio, _ = lu_in_place(lu, x)
+        if ratio == 0.0:
+            return False
+        for i in range(m):
+            for j in range(i + 1):
+                acc = 0.0
+                for c in range(n):
+                    acc += J[p, i, c] * x[c, j]
+                out[p, i, j] = acc
+                out[p, j, i] = acc
+    return True

@@ -1,4 +1,5 @@
-"""Kinematic metrics (seed 001 §4.1): ellipsoids, manipulability, condition number, normalization.
+"""Kinematic metrics (seed 001 §4.1): ellipsoids, manipulability, condition number, normalization, and the range of
+the handle's translational Jacobians (:func:`handle_range_basis`).
 
 Every function takes Jacobians ``(..., m, n)`` and broadcasts over leading pose axes; the
 Euclidean norm ``||.||`` is the largest singular value.
@@ -7,8 +8,13 @@ Euclidean norm ``||.||`` is the largest singular value.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 from hapticdesign.errors import UserError
+
+JACOBI_SWEEPS = 40
+"""Most sweeps of the one-sided Jacobi iteration of :func:`handle_range_basis` (3 rows converge quadratically, in a
+handful)."""
 
 
 def _square(J: np.ndarray) -> np.ndarray:
@@ -59,6 +65,89 @@ def condition_of_singular_values(s: np.ndarray) -> np.ndarray:
     """The condition number ``sigma_max / sigma_min`` of singular values (..., k), largest first (eq. 4.33)."""
     with np.errstate(divide="ignore"):
         return s[..., 0] / s[..., -1]
+
+
+def handle_range_basis(J: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The left singular vectors ``U`` (P, 3, k) and singular values (P, k), largest first, of translational Jacobians
+    ``J`` (P, 3, n) with ``k = min(3, n)``: the directions the handle moves and its speeds along them; and ``U^T J``
+    (P, k, n), the Jacobian on those directions.
+
+    One-sided Jacobi (Hestenes): plane rotations of the rows of ``J`` until they are mutually orthogonal,
+    ``V^T J = W``; then ``J = V W``, the singular values are the rows' norms and ``U`` the columns of ``V`` in their
+    order (``W``'s rows are ``U^T J``). A row below ``eps ||J||_F`` is left as it is (rank < 3: its direction is
+    rounding). ``U`` is orthonormal by construction (a product of rotations) and the singular values are as accurate
+    as LAPACK's (within a few ulps of ``sigma_1``), without LAPACK's per-matrix cost on thousands of 3 x n
+    matrices."""
+    J = np.ascontiguousarray(J, dtype=float)
+    k = min(3, J.shape[-1])
+    u, s, along = np.empty((len(J), 3, k)), np.empty((len(J), k)), np.empty((len(J), k, J.shape[-1]))
+    _range_bases(J, u, s, along)
+    return u, s, along
+
+
+@njit(cache=True)
+def _range_bases(jac, u, s, along):
+    """:func:`handle_range_basis` of ``jac`` (P, 3, n) into ``u`` (P, 3, k), ``s`` (P, k) and ``along`` (P, k, n)."""
+    n = jac.shape[2]
+    k = s.shape[1]
+    eps = np.finfo(np.float64).eps
+    w = np.empty((3, n))
+    v = np.empty((3, 3))
+    norm = np.empty(3)
+    order = np.empty(3, dtype=np.int64)
+    for p in range(jac.shape[0]):
+        total = 0.0
+        for i in range(3):
+            for j in range(n):
+                w[i, j] = jac[p, i, j]
+                total += w[i, j] * w[i, j]
+            for j in range(3):
+                v[i, j] = 1.0 if i == j else 0.0
+        negligible = eps * eps * total
+        for _ in range(JACOBI_SWEEPS):
+            rotated = False
+            for a in range(2):
+                for b in range(a + 1, 3):
+                    alpha, beta, gamma = 0.0, 0.0, 0.0
+                    for j in range(n):
+                        alpha += w[a, j] * w[a, j]
+                        beta += w[b, j] * w[b, j]
+                        gamma += w[a, j] * w[b, j]
+                    if abs(gamma) <= eps * np.sqrt(alpha * beta) or min(alpha, beta) <= negligible:
+                        continue  # orthogonal, or a row below the rounding of J (rank < 3)
+                    rotated = True
+                    zeta = (beta - alpha) / (2.0 * gamma)
+                    t = (1.0 if zeta >= 0.0 else -1.0) / (abs(zeta) + np.sqrt(1.0 + zeta * zeta))
+                    c = 1.0 / np.sqrt(1.0 + t * t)
+                    sn = c * t
+                    for j in range(n):
+                        wa, wb = w[a, j], w[b, j]
+                        w[a, j] = c * wa - sn * wb
+                        w[b, j] = sn * wa + c * wb
+                    for i in range(3):
+                        va, vb = v[i, a], v[i, b]
+                        v[i, a] = c * va - sn * vb
+                        v[i, b] = sn * va + c * vb
+            if not rotated:
+                break
+        for i in range(3):
+            acc = 0.0
+            for j in range(n):
+                acc += w[i, j] * w[i, j]
+            norm[i] = np.sqrt(acc)
+        for r in range(3):
+            order[r] = r
+        for r in range(1, 3):  # insertion sort, largest first
+            at = r
+            while at > 0 and norm[order[at]] > norm[order[at - 1]]:
+                order[at], order[at - 1] = order[at - 1], order[at]
+                at -= 1
+        for r in range(k):
+            s[p, r] = norm[order[r]]
+            for i in range(3):
+                u[p, i, r] = v[i, order[r]]
+            for j in range(n):
+                along[p, r, j] = w[order[r], j]
 
 
 def characteristic_length(desired_reach: float, actual_reach: float) -> float:

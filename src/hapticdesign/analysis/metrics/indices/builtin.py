@@ -49,6 +49,7 @@ from hapticdesign.analysis.metrics.indices.registry import index
 from hapticdesign.analysis.metrics.indices.states import HandleStates
 from hapticdesign.analysis.wall_stiffness import kmax as wall_kmax
 from hapticdesign.errors import UserError
+from hapticdesign.model.dense import symmetric_eigenvalues
 
 
 @index(unit="1", formula="sigma_min(J_v) / sigma_max(J_v)",
@@ -69,7 +70,7 @@ def condition(pose: HandleStates, jacobian: str = "handle") -> np.ndarray:
 def manipulability(pose: HandleStates, jacobian: str = "handle") -> np.ndarray:
     if _jacobian(jacobian) == "task":
         return kinematic.manipulability(pose.task)
-    return kinematic.manipulability(np.swapaxes(pose.svd[0], 1, 2) @ pose.J_v)
+    return kinematic.manipulability(pose.J_u)
 
 
 def _jacobian(which: str) -> str:
@@ -131,7 +132,7 @@ def force(pose: HandleStates, torque: str = "continuous") -> np.ndarray:
 @index(unit="N/m", formula="smallest eigenvalue of U^T K_C[:3, :3] U (VJM)", source="seed 001 eq. 5.117-5.123 (K_CA)",
        needs=("kinematics", "sections"))
 def stiffness(pose: HandleStates) -> np.ndarray:
-    return np.linalg.eigvalsh(pose.stiffness)[:, 0]
+    return symmetric_eigenvalues(pose.stiffness)[:, 0]
 
 
 @index(unit="rad/s", formula="sqrt of the smallest eigenvalue of K v = w^2 Lambda v (U^T K_C[:3, :3] U, Lambda)",
@@ -148,7 +149,7 @@ def kmax(pose: HandleStates, period: float = 0.001, delay: int = 1, damping: flo
          error_percent: float = 0.0, hand: object = None) -> np.ndarray:
     options = dict(period=period, delay=delay, damping=damping, direction=direction, velocity=velocity,
                    compensation=compensation, error_percent=error_percent, hand=hand)
-    return wall_kmax(pose.J_v, pose.H, pose.B, pose.svd[0], options)
+    return wall_kmax(pose.J_v, pose.H, pose.B, (pose.svd[0], pose.mobility, pose.cartesian_damping), options)
 
 
 @index(unit="LN", formula="Linearity Number over the joint region (limits, else full turns)",

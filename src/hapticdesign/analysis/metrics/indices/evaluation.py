@@ -123,15 +123,15 @@ def evaluate_designs(space: DesignFamily, designs: Sequence[Mapping[str, float]]
             values[r.key] = np.asarray(registry[r.index].values(states, r.options), dtype=float).reshape(-1, len(points))
     except UserError as exc:  # an index no design of the space can give (the same for each, as design by design)
         failed = str(exc)
-    out, row = [], 0
-    for d in range(len(designs)):
-        if not ok[d]:
+    rows = (dict(zip(values, row)) for row in zip(*values.values()))  # the designs that reached, in order
+    out = []
+    for d, reached in enumerate(ok.tolist()):
+        if not reached:
             out.append(Evaluation({}, got.reasons[d]))
         elif failed is not None:
             out.append(Evaluation({}, failed))
         else:
-            out.append(Evaluation({key: value[row] for key, value in values.items()}))
-        row += int(ok[d])
+            out.append(Evaluation(next(rows, {})))
     return out
 
 

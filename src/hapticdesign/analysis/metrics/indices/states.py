@@ -26,8 +26,10 @@ from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.analysis.dynamics.cartesian import cartesian_inertia, mobility
 from hapticdesign.analysis.dynamics.device import mass_matrix_at
 from hapticdesign.analysis.metrics import force
+from hapticdesign.analysis.metrics.kinematic import handle_range_basis
 from hapticdesign.analysis.stiffness.device import cartesian_stiffness_at
 from hapticdesign.errors import UserError
+from hapticdesign.model.dense import symmetric_eigenvalues
 from hapticdesign.model.device import Device
 
 BATCH_NEEDS = frozenset({"kinematics", "dynamics", "damping", "sections", "motors", "bodies"})
@@ -61,10 +63,18 @@ class HandleStates:
 
     @cached_property
     def svd(self) -> tuple[np.ndarray, np.ndarray]:
-        """``U`` (P, 3, k) and the singular values (P, k) of ``J_v``, largest first."""
-        u, s, _ = np.linalg.svd(self.J_v)
-        k = s.shape[-1]
-        return u[:, :, :k], s
+        """``U`` (P, 3, k) and the singular values (P, k) of ``J_v``, largest first
+        (:func:`~hapticdesign.analysis.metrics.kinematic.handle_range_basis`)."""
+        return self._range[:2]
+
+    @cached_property
+    def J_u(self) -> np.ndarray:
+        """``U^T J_v`` (P, k, n_a): the Jacobian on the directions the handle moves."""
+        return self._range[2]
+
+    @cached_property
+    def _range(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        return handle_range_basis(self.J_v)
 
     @cached_property
     def task(self) -> np.ndarray:
@@ -75,7 +85,7 @@ class HandleStates:
         if n_a == 3:
             return self.J_v
         if n_a < 3:
-            return np.swapaxes(self.svd[0], 1, 2) @ self.J_v
+            return self.J_u
         if n_a == 6:
             return np.concatenate([self.J_v, handle_jacobians(self._device, self.full, self.frame, rows=(3, 6))], 1)
         raise UserError(f"the task Jacobian is square for 1-3 or 6 actuated coordinates; {self.name} has {n_a}")
@@ -122,12 +132,12 @@ class HandleStates:
     @cached_property
     def mobility(self) -> np.ndarray:
         """``U^T J_v H^-1 J_v^T U`` (P, k, k), the inverse of ``Lambda`` (1/kg)."""
-        return mobility(self.H, np.swapaxes(self.svd[0], 1, 2) @ self.J_v)
+        return mobility(self.H, self.J_u)
 
     @cached_property
     def cartesian_mass(self) -> np.ndarray:
         """Eigenvalues (P, k) of ``Lambda`` (kg), ascending."""
-        return 1.0 / np.linalg.eigvalsh(self.mobility)[:, ::-1]
+        return 1.0 / symmetric_eigenvalues(self.mobility)[:, ::-1]
 
     @cached_property
     def cartesian_mass_matrix(self) -> np.ndarray:
