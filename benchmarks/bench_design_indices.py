@@ -27,6 +27,7 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
+from hapticdesign.analysis.design_batch import DesignBatch  # noqa: E402
 from hapticdesign.analysis.workspace import Workspace  # noqa: E402
 from hapticdesign.devices.design_space import design_space  # noqa: E402
 from hapticdesign.analysis.metrics.indices import evaluate, evaluate_designs  # noqa: E402
@@ -45,6 +46,20 @@ def _best(run, repeat: int = 3) -> float:
     return out
 
 
+def _stages(space, designs, points, total: float) -> dict[str, float]:
+    """Shares of the batched time: the variables' arrays, the continuation to every point (the one inverse
+    kinematics), ``H`` at every pose, and the rest (the range of ``J_v``, the indices, the per-design results)."""
+    batch = DesignBatch(space.base)
+    values = space.batch_values(designs, batch)
+    offsets = batch.offsets(values.kinematic)
+    reached = batch.reach_points(offsets, points)
+    times = {"design variables to arrays": _best(lambda: space.batch_values(designs, batch)),
+             "continuation (inverse kinematics)": _best(lambda: batch.reach_points(offsets, points)),
+             "H at every pose": _best(lambda: batch.mass_matrices(offsets, reached, values.standard, values.reflected))}
+    times["indices and the rest"] = max(total - sum(times.values()), 0.0)
+    return {name: t / total for name, t in times.items()}
+
+
 START, END = "<!-- design-indices-speed:start -->", "<!-- design-indices-speed:end -->"
 
 
@@ -56,13 +71,17 @@ def main(count: int = 2000, write: Path | None = None) -> None:
     evaluate_designs(space, designs[:5], points, INDICES)  # compile
     batched = _best(lambda: evaluate_designs(space, designs, points, INDICES))
     feasible = sum(e.reason is None for e in evaluate_designs(space, designs, points, INDICES))
+    stages = _stages(space, designs, points, batched)
     few = designs[:20]
     for values in few[:2]:
         evaluate(space.device(values), points, INDICES)
     single = _best(lambda: [evaluate(space.device(values), points, INDICES) for values in few], repeat=1)
-    table = "\n".join(["| path | designs/s (one core, CPU time) |", "|---|---|",
+    table = "\n".join([f"Load average {os.getloadavg()[0]:.1f} during this run.", "",
+                       "| path | designs/s (one core, CPU time) |", "|---|---|",
                        f"| batched (compiled kernels) | {count / batched:.0f} |",
-                       f"| one design at a time | {len(few) / single:.1f} |"])
+                       f"| one design at a time | {len(few) / single:.1f} |", "",
+                       "| batched stage | share of the time |", "|---|---|",
+                       *(f"| {name} | {share:.0%} |" for name, share in stages.items())])
     print(f"five-bar, {len(points)} points, {', '.join(INDICES)}; {count} designs, {feasible} reach the workspace")
     print(table)
     if write is not None:
