@@ -486,7 +486,8 @@ class SampledLoop:
     fixed (none by default: a Cartesian wall acts with every actuated joint free, as under a user's hand).
     The defaults are what practice uses: 1 kHz, one sample of delay, backward-difference velocity, gravity
     compensation only; :meth:`seed` gives the seed's settings (full compensation, no delay, sampled velocity).
-    Gravity compensation is taken as exact, so about a pose the linearized plant has no gravity term."""
+    About a pose, gravity enters the linearized loop through its gradient: the plant's ``K_G = dG/dq`` and the
+    compensator's ``s K_G`` on the sensed pose (:attr:`gravity_share`)."""
 
     period: float = 1e-3
     delay: int = 1
@@ -533,6 +534,12 @@ class SampledLoop:
         0."""
         return 1.0 - self.model_error / 100.0 if self.compensation == "full" else 0.0
 
+    @property
+    def gravity_share(self) -> float:
+        """The share ``s`` of the gravity torque the compensator feeds forward: ``1 - E/100`` (its model's masses
+        carry the modelling error, and gravity is linear in them) unless the compensation is none, 0 then."""
+        return 0.0 if self.compensation == "none" else 1.0 - self.model_error / 100.0
+
     def as_dict(self) -> dict:
         """The settings as an output states them."""
         return {"rate": self.rate, "period": self.period, "delay_samples": self.delay, "velocity": self.velocity,
@@ -552,23 +559,25 @@ class SampledLoop:
 
 
 def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, spring: np.ndarray,
-                 loop: SampledLoop, poses: np.ndarray | None = None) -> tuple[SpringLoops, np.ndarray]:
+                 loop: SampledLoop, poses: np.ndarray | None = None,
+                 gravity: np.ndarray | None = None) -> tuple[SpringLoops, np.ndarray]:
     """The sampled loops of S handles under a wall whose spring acts on the joints as ``K w w^T`` (``spring``: the
     rows ``w`` (S, n); ``J_v^T u`` for a Cartesian wall along a unit ``u``, ``e_j`` for a wall on joint j), every
     joint free but ``loop.held``, and a starting guess of their limits (S,).
 
     ``jacobian`` ``J_v`` (P, 3, n), ``mass`` ``H`` (P, n, n) and ``damping`` ``B`` (n, n) or (P, n, n) of the
     actuated coordinates at the P poses the walls hold, ``poses`` (S,) the pose of each loop (default: loop s at
-    pose s, P = S), so that the plant of a pose walled along many directions is discretized once. The plant ``H_h qdd + B_h qd + K_h q = u`` (the hand's mass,
-    damping and stiffness added as ``x J_v^T J_v``) is discretized exactly under a zero-order hold
-    (``scipy.linalg.expm`` of the augmented matrix). Every period the controller holds, ``d`` samples late,
-    ``u_k = c H a_(k-d) - K w w^T q_(k-d) - B_w w w^T v^_(k-d)``, ``a`` the acceleration sampled
-    under the previous torque, ``v^`` the sampled velocity or the backward difference of positions. The state is
-    ``[x_k, ..., x_(k-L), u_(k-1), ..., u_(k-d-1)]`` (``x = (q, qd)``; the torques only with the compensator), and
-    ``K`` enters as the rank-one term of :class:`SpringLoops`. Without a hand's stiffness the displacements along
-    the wall (``w^T q = 0``) are free: each is a fixed point (eigenvalue 1) whatever ``K``, a neutral drift of the
-    handle along the wall, not an instability; they are deflated (the map restricted to the complement of that
-    invariant subspace, where the spring still enters as a rank-one term).
+    pose s, P = S), so that the plant of a pose walled along many directions is discretized once; ``gravity``
+    ``K_G = dG/dq`` (n, n) or (P, n, n) at those poses (None: 0). The plant ``H_h qdd + B_h qd + (K_h + K_G) q =
+    u`` (the hand's mass, damping and stiffness added as ``x J_v^T J_v``) is discretized exactly under a zero-order
+    hold (``scipy.linalg.expm`` of the augmented matrix). Every period the controller holds, ``d`` samples late,
+    ``u_k = c H a_(k-d) + s K_G q_(k-d) - K w w^T q_(k-d) - B_w w w^T v^_(k-d)``, ``a`` the acceleration sampled
+    under the previous torque, ``s K_G q`` the linearized gravity compensation
+    (:attr:`SampledLoop.gravity_share`), ``v^`` the sampled velocity or the backward difference of positions. The
+    state is ``[x_k, ..., x_(k-L), u_(k-1), ..., u_(k-d-1)]`` (``x = (q, qd)``; the torques only with the
+    compensator), and ``K`` enters as the rank-one term of :class:`SpringLoops`. The pose changes along the wall
+    (``w^T q = 0``) that no static stiffness resists are fixed points (eigenvalue 1) whatever ``K``, a neutral
+    drift of the handle along the wall, not an instability; they are deflated (:func:`_deflated`).
     """
     if any(not 0 <= j < jacobian.shape[-1] for j in loop.held):
         raise UserError(f"the held joints {[j + 1 for j in loop.held]} are not all joints of the device (1 to "
@@ -583,6 +592,10 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
     jtj = np.swapaxes(jv, 1, 2) @ jv
     hand = loop.hand or Hand()
     hh, bh, kp = h + hand.mass * jtj, b + hand.damping * jtj, hand.stiffness * jtj
+    held = np.zeros_like(kp)  # the compensator's gravity gradient, on the sensed pose
+    if gravity is not None:
+        grad = np.broadcast_to(np.asarray(gravity, dtype=float)[..., free, :][..., free], h.shape)
+        kp, held = kp + grad, loop.gravity_share * grad
     aug = np.zeros((len(h), 3 * n, 3 * n))
     aug[:, :n, n:2 * n] = np.eye(n)
     aug[:, n:2 * n, :n] = -np.linalg.solve(hh, kp)
@@ -590,7 +603,7 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
     aug[:, n:2 * n, 2 * n:] = np.linalg.inv(hh)
     e = expm(aug * loop.period)
     if poses is not None:  # each loop takes its pose's plant
-        e, h, hh, bh, kp = (x[np.asarray(poses, dtype=np.int64)] for x in (e, h, hh, bh, kp))
+        e, h, hh, bh, kp, held = (x[np.asarray(poses, dtype=np.int64)] for x in (e, h, hh, bh, kp, held))
     w = np.asarray(spring, dtype=float)[:, free]
     count = len(w)
     phi, gamma = e[:, :2 * n, :2 * n], e[:, :2 * n, 2 * n:]
@@ -607,6 +620,7 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
         law[:, :, u0 + n * d:u0 + n * (d + 1)] += feed
         law[:, :, nx * d:nx * d + n] -= feed @ kp
         law[:, :, nx * d + n:nx * (d + 1)] -= feed @ bh
+    law[:, :, nx * d:nx * d + n] += held
     if differenced:
         law[:, :, nx * d:nx * d + n] -= loop.virtual_damping / loop.period * ww
         law[:, :, nx * (d + 1):nx * (d + 1) + n] += loop.virtual_damping / loop.period * ww
@@ -627,35 +641,52 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
         g[:, u0:u0 + n] = w
     hvec = np.zeros((count, size))
     hvec[:, nx * d:nx * d + n] = w
-    if hand.stiffness == 0.0 and n > 1:
-        m, g, hvec = _deflated(m, g, hvec, w, n, depth)
+    if n > 1:
+        net = (kp - held) * loop.period ** 2 / np.linalg.norm(hh, axis=(1, 2))[:, None, None]
+        m, g, hvec = _deflated(m, g, hvec, w, net, held, depth, u0 if compensated else None)
     reach = np.einsum("sn,sn->s", w, w)
     viscous = np.einsum("sn,snm,sm->s", w, bh, w) / np.maximum(reach, 1e-300) ** 2 + loop.virtual_damping
     guess = np.maximum(2.0 * viscous / (loop.period * (1 + 2 * d)), FLOOR)
     return SpringLoops(m, g, hvec), guess
 
 
-def _deflated(m: np.ndarray, g: np.ndarray, h: np.ndarray, w: np.ndarray, n: int,
-              depth: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The maps restricted to the complement of the fixed points ``[q*, 0, q*, 0, ..., 0]`` (``w^T q* = 0``): in an
-    orthonormal basis ``[Q1 Q2]`` with ``Q1`` spanning them the map is block triangular, so the other eigenvalues
-    are those of ``Q2^T m Q2`` (and the spring's term stays rank one, ``(Q2^T g)(Q2^T h)^T``)."""
+def _deflated(m: np.ndarray, g: np.ndarray, h: np.ndarray, w: np.ndarray, net: np.ndarray, held: np.ndarray,
+              depth: int, u0: int | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The maps with their spring-independent fixed points removed: a pose change ``q*`` along the wall (``w^T q* =
+    0``) that no static stiffness resists (``(K_h + (1 - s) K_G) q* = 0``; ``net`` that stiffness times ``T^2 /
+    |H_h|``, the share of the inertia's scale it reaches over a period) is held still whatever ``K`` (the state
+    ``[q*, 0, q*, 0, ..., 0]``, the torque buffer ``s K_G q*``; ``held`` ``s K_G``): eigenvalue 1, a
+    neutral drift of the handle along the wall, not an instability. With ``P`` the orthogonal projector on them
+    (``m P = P``) the map is block triangular in ``[P, I - P]``, so ``(I - P) m (I - P)`` has the other eigenvalues
+    (and zeros), and the spring's term stays rank one, ``((I - P) g)((I - P) h)^T``."""
     count, size = m.shape[0], m.shape[1]
-    null = np.linalg.svd(w[:, None, :])[2][:, 1:, :]  # (S, n - 1, n): rows orthogonal to w
-    fixed = np.zeros((count, size, n - 1))
+    n = w.shape[1]
+    rows = np.concatenate([(w / np.linalg.norm(w, axis=1, keepdims=True))[:, None, :], net], axis=1)
+    _, sv, vt = np.linalg.svd(rows)
+    null = vt * (sv <= NULL_TOL)[:, :, None]  # (S, n, n): rows spanning each loop's fixed pose changes, else 0
+    fixed = np.zeros((count, size, n))
     for k in range(depth + 1):
         fixed[:, 2 * n * k:2 * n * k + n] = np.swapaxes(null, 1, 2)
-    q = np.linalg.qr(fixed, mode="complete")[0][:, :, n - 1:]
-    qt = np.swapaxes(q, 1, 2)
-    return qt @ m @ q, np.einsum("sji,sj->si", q, g), np.einsum("sji,sj->si", q, h)
+    if u0 is not None:
+        torque = held @ np.swapaxes(null, 1, 2)
+        for k in range((size - u0) // n):
+            fixed[:, u0 + n * k:u0 + n * (k + 1)] = torque
+    keep = np.eye(size) - fixed @ np.linalg.pinv(fixed)
+    return keep @ m @ keep, np.einsum("sij,sj->si", keep, g), np.einsum("sij,sj->si", keep, h)
+
+
+NULL_TOL = 1e-9
+"""A pose change along the wall is free when the static stiffness resists it by less than this (singular values of
+the wall's unit row stacked on the stiffness in units of ``|H_h| / T^2``): a balanced device's rounding-level
+gravity gradient leaves the drift free."""
 
 
 def handle_limits(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, spring: np.ndarray,
                   loop: SampledLoop, groups: np.ndarray | None = None, k_max: float = 1e9,
-                  poses: np.ndarray | None = None) -> np.ndarray:
+                  poses: np.ndarray | None = None, gravity: np.ndarray | None = None) -> np.ndarray:
     """The exact stable wall stiffness (N/m) of each handle loop of :func:`handle_loops` (S,), or the smallest in
     each group (:func:`loop_limits`)."""
-    loops, guess = handle_loops(jacobian, mass, damping, spring, loop, poses)
+    loops, guess = handle_loops(jacobian, mass, damping, spring, loop, poses, gravity)
     order = loops.base.shape[-1]
     what = f"the closed-loop matrices of {len(loops):,} handle loops of order {order}"
     require_memory(what, 8.0 * order * order * len(loops))

@@ -86,6 +86,20 @@ def gravity(device: Device, q: np.ndarray) -> np.ndarray:
     return dynamics_of(device).G(q, device.standard_parameters())
 
 
+GRADIENT_STEP = 1e-6
+"""The step (rad or m) of :func:`gravity_gradient`'s central differences: G is smooth (trigonometric in the angles),
+so their truncation error, about ``step^2 |G'''| / 6``, is far below their rounding error (about 1e-10 of G)."""
+
+
+def gravity_gradient(device: Device, q: np.ndarray) -> np.ndarray:
+    """``K_G = dG/dq`` (N, N), the stiffness gravity adds to the linearized plant at the pose ``q`` (``K_G[i, j] =
+    dG_i / dq_j``), by central differences of :func:`gravity`."""
+    q = np.asarray(q, dtype=float)
+    steps = GRADIENT_STEP * np.eye(len(q))
+    torques = gravity(device, np.concatenate([q + steps, q - steps]))
+    return ((torques[:len(q)] - torques[len(q):]) / (2.0 * GRADIENT_STEP)).T
+
+
 def inverse_dynamics(device: Device, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
     """``tau = H qdd + C qd^2 + G`` (eq. 2.50)."""
     return dynamics_of(device).inverse(q, qd, qdd, device.standard_parameters())
