@@ -1,18 +1,20 @@
-"""Stability boundary of a 1-DOF mass-damper under a sampled virtual spring (seed 000 ch. 4, §5).
+"""The sampled haptic loop: one record of its settings, one construction of its exact limit (seed 000 ch. 4, §5).
 
-Plant ``J qdd + b qd + k_p q = u`` (``k_p``: a physical spring such as a hand's, 0 by default);
-every ``T`` the digital side reads ``q, qd`` (and the acceleration under the previous held
-torque), optionally ``delay`` samples late, and holds ``u = J_m a - K q - B qd`` with the
-inertial compensator (model inertia ``J_m``, ``J_m = c J`` for a modelling error of
-``E = 100 (1 - c)`` percent), ``u = - K q - B qd`` without it.
+- :class:`SampledLoop`: the settings of every command and index (rate, delay, velocity estimate, compensation and
+  its modelling error, the wall's damper, the hand, the joints held); practice's by default, the seed's one call
+  away (:meth:`SampledLoop.seed`).
+- :func:`handle_loops` / :func:`handle_limits`: the loop of an n-joint plant ``H``, ``B`` (with the hand and
+  gravity's gradient) under a wall ``K w w^T``, discretized exactly under a zero-order hold, as one linear map of the
+  sampled state; the limit is the smallest ``K`` at which its spectral radius reaches 1 (:func:`loop_limits`).
+  :func:`joint_limits` is its one-joint case, the 1-DOF mass-damper ``J qdd + b qd = u`` of ``stability-boundary``
+  and ``zwidth`` (about ``2 b / T`` without compensation, ``b^2 / J`` with the seed's).
+- :func:`compensated_boundary`: the closed form of the 1-DOF limit with the seed's inertial compensator, no delay
+  and no virtual damper (derived below), the oracle of the simulation tests.
+- :func:`hapticdesign.simulation.boundary.simulated_boundary` (the simulation layer): the numba loop itself, ``K``
+  bisected on the growth of the oscillation.
 
-- :func:`exact_boundary`: the plant discretized exactly (``scipy.linalg.expm`` of the augmented
-  matrix), the closed loop written as one linear map of the sampled state, and the smallest
-  ``K`` at which its spectral radius reaches 1 (about ``2 b / T`` without compensation).
-- :func:`compensated_boundary`: the closed form of that limit with the inertial compensator,
-  no delay and no virtual damper (derived below), the oracle of the simulation tests.
-- :func:`hapticdesign.simulation.boundary.simulated_boundary` (the simulation layer): the numba
-  loop itself, ``K`` bisected on the growth of the oscillation.
+The 1-DOF law with the compensator (model inertia ``J_m = c J``, ``c = 1 - E/100`` for a modelling error of E
+percent) is ``u = J_m a - K q - B qd``, ``a`` the acceleration sampled under the previous held torque.
 
 The closed form. Over one period the held torque moves the plant (``k_p = 0``) by
 ``v+ = a v + (1 - a) u / b`` and ``q+ = q + J (1 - a) v / b + (T/b - J (1 - a)/b^2) u`` with
@@ -51,7 +53,6 @@ against the spectral radius of the exactly discretized loop and the simulated lo
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -61,141 +62,12 @@ from hapticdesign.errors import InputError, UserError
 from hapticdesign.workload import EIGEN_ORDER_LIMIT, require_memory, require_within
 
 
-@dataclass(frozen=True)
-class MassDamper:
-    """A 1-DOF inertia ``J`` (kg m^2) with viscous damping ``b`` (N m s/rad), sampled every ``T``."""
-
-    inertia: float
-    damping: float
-    period: float
-    delay_samples: int = 0
-    virtual_damping: float = 0.0
-    compensate_inertia: bool = False
-    model_inertia: float | None = None
-    plant_stiffness: float = 0.0
-
-    def __post_init__(self) -> None:
-        _check(self)
-
-    @property
-    def j_model(self) -> float:
-        return self.inertia if self.model_inertia is None else self.model_inertia
-
-
-@dataclass(frozen=True)
-class MassDampers:
-    """Many :class:`MassDamper` s at once (each numeric field a number or an array of S values) that share the delay
-    and the use of the compensator: the systems of one batched boundary search."""
-
-    inertia: np.ndarray
-    damping: np.ndarray
-    period: np.ndarray | float
-    delay_samples: int = 0
-    virtual_damping: np.ndarray | float = 0.0
-    compensate_inertia: bool = False
-    model_inertia: np.ndarray | None = None
-    plant_stiffness: np.ndarray | float = 0.0
-
-    def __post_init__(self) -> None:
-        size = np.broadcast_shapes(*(np.shape(getattr(self, name)) for name in _NUMERIC
-                                     if getattr(self, name) is not None))
-        for name in _NUMERIC:
-            value = getattr(self, name)
-            if value is not None:
-                object.__setattr__(self, name, np.broadcast_to(np.asarray(value, dtype=float), size).ravel())
-        _check(self)
-
-    @classmethod
-    def of(cls, systems: Sequence[MassDamper]) -> "MassDampers":
-        """The systems ``systems`` (one delay, compensated all or none) as one batch."""
-        if len({(s.delay_samples, s.compensate_inertia) for s in systems}) > 1:
-            raise UserError("a batch of mass-dampers shares the delay and the use of the compensator")
-        first = systems[0]
-        return cls(*(np.array([getattr(s, name) for s in systems], dtype=float) for name in _NUMERIC[:3]),
-                   first.delay_samples, np.array([s.virtual_damping for s in systems], dtype=float),
-                   first.compensate_inertia, np.array([s.j_model for s in systems], dtype=float),
-                   np.array([s.plant_stiffness for s in systems], dtype=float))
-
-    def __len__(self) -> int:
-        return len(self.inertia)
-
-    @property
-    def j_model(self) -> np.ndarray:
-        return self.inertia if self.model_inertia is None else self.model_inertia
-
-
-_NUMERIC = ("inertia", "damping", "period", "virtual_damping", "model_inertia", "plant_stiffness")
-
-
-def _check(system: MassDamper | MassDampers) -> None:
-    """The one-line refusals of a mass-damper's (or a batch's) values."""
-    for name in ("inertia", "period"):
-        value = getattr(system, name)
-        if not np.all((np.asarray(value) > 0) & np.isfinite(value)):
-            raise UserError(f"the {name} must be positive, got {_worst(value)}")
-    if not np.all((np.asarray(system.damping) >= 0) & np.isfinite(system.damping)):
-        raise UserError(f"the damping must be non-negative, got {_worst(system.damping)}")
-    if system.delay_samples < 0:
-        raise InputError(f"the sensor delay must be a non-negative number of samples, got {system.delay_samples}",
-                         "delay")
-    if not np.all((np.asarray(system.virtual_damping) >= 0) & np.isfinite(system.virtual_damping)):
-        raise InputError(f"the wall damping must be a finite number >= 0, got {_worst(system.virtual_damping)}",
-                         "wall_damping")
-    if not np.all((np.asarray(system.plant_stiffness) >= 0) & np.isfinite(system.plant_stiffness)):
-        raise UserError(f"the plant stiffness must be non-negative, got {_worst(system.plant_stiffness)}")
-    if system.model_inertia is not None and not np.all((np.asarray(system.model_inertia) >= 0)
-                                                       & np.isfinite(system.model_inertia)):
-        raise UserError(f"the model inertia must be non-negative, got {_worst(system.model_inertia)}")
-
-
-def _worst(value) -> float:
-    """The value a refusal names: the number itself, or a batch's smallest (or first non-finite) value."""
-    values = np.ravel(np.asarray(value, dtype=float))
-    bad = values[~np.isfinite(values)]
-    return float(bad[0] if bad.size else values.min())
-
-
-def _discretize(j: np.ndarray, b: np.ndarray, t: np.ndarray, k_p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Exact zero-order-hold discretization of ``J qdd + b qd + k_p q = u`` over one period, for S systems at once
-    (arrays of S values): ``Phi`` (S, 2, 2) and ``Gamma`` (S, 2).
-
-    Without a plant spring, in closed form (``x = b T / J``, ``a = e^-x``)::
-
-        Phi = [[1, T h1], [0, a]],   Gamma = [T^2 h2 / J, T h1 / J],
-        h1 = (1 - e^-x) / x,   h2 = (x - 1 + e^-x) / x^2
-
-    (series below x = 1, 1 and 1/2 at x = 0); with one, ``scipy.linalg.expm`` of the augmented matrix.
-    """
-    x = b * t / j
-    small = x < 1.0
-    xs, xl = np.where(small, x, 0.0), np.where(small, 1.0, x)
-    h1 = np.where(small, _series(xs, _H1), -np.expm1(-xl) / xl)
-    h2 = np.where(small, _series(xs, _H2), (xl + np.expm1(-xl)) / xl ** 2)
-    phi = np.zeros((len(x), 2, 2))
-    phi[:, 0, 0] = 1.0
-    phi[:, 0, 1] = t * h1
-    phi[:, 1, 1] = np.exp(-x)
-    gamma = np.stack([t * t * h2 / j, t * h1 / j], axis=1)
-    spring = np.flatnonzero(k_p != 0.0)
-    if spring.size:
-        aug = np.zeros((spring.size, 3, 3))
-        aug[:, 0, 1] = 1.0
-        aug[:, 1, 0] = -k_p[spring] / j[spring]
-        aug[:, 1, 1] = -b[spring] / j[spring]
-        aug[:, 1, 2] = 1.0 / j[spring]
-        e = expm(aug * t[spring, None, None])
-        phi[spring], gamma[spring] = e[:, :2, :2], e[:, :2, 2]
-    return phi, gamma
-
-
 def _taylor(first: int, term) -> np.ndarray:
     """The coefficients of ``sum_(n >= first) term(n) x^n / n!`` up to ``x^(first + 39)`` (zeros below ``first``):
     double precision for ``0 <= x < 1``."""
     return np.array([term(n) / math.factorial(n) if n >= first else 0.0 for n in range(first + 40)])
 
 
-_H1 = _taylor(0, lambda n: (-1) ** n / (n + 1))
-_H2 = _taylor(0, lambda n: (-1) ** n / ((n + 1) * (n + 2)))
 _G = _taylor(2, lambda n: (-1) ** n * (n - 1))
 _F = _taylor(3, lambda n: (-1) ** (n - 1) * (n - 2))
 
@@ -254,40 +126,10 @@ def compensated_boundary(inertia: float, damping: float, period: float, fraction
 class SpringLoops:
     """The one-sample maps of S sampled loops in which the wall's spring ``K`` enters as a rank-one term,
     ``m(K) = m(0) - K g h^T`` (``base`` (S, N, N), ``g`` and ``h`` (S, N)), so a search builds the spring-free maps
-    once: the 1-DOF loops of :meth:`of` and the n-joint handle loops of :func:`handle_loops`."""
+    once (the loops of :func:`handle_loops`)."""
 
     def __init__(self, base: np.ndarray, g: np.ndarray, h: np.ndarray):
         self.base, self.g, self.h = base, g, h
-
-    @classmethod
-    def of(cls, systems: MassDampers) -> "SpringLoops":
-        """The loops of 1-DOF mass-dampers, state ``[q, qd, u_prev, s_(k-1), ..., s_(k-d)]`` with ``s = (q, qd,
-        a)``: the spring enters one column ``c``, that of ``q`` in the law, through ``g = (Gamma, 1)``."""
-        j, b, d = systems.inertia, systems.damping, systems.delay_samples
-        phi, gamma = _discretize(j, b, systems.period, systems.plant_stiffness)
-        count, size = len(j), 3 + 3 * d
-        sense = np.zeros((count, 3, 3))  # s_k from z_k
-        sense[:, 0, 0] = 1.0
-        sense[:, 1, 1] = 1.0
-        sense[:, 2, 0] = -systems.plant_stiffness / j
-        sense[:, 2, 1] = -b / j
-        sense[:, 2, 2] = 1.0 / j
-        gains = np.stack([np.zeros(count), -systems.virtual_damping,
-                          float(systems.compensate_inertia) * systems.j_model], axis=1)
-        law = np.einsum("si,sij->sj", gains, sense) if d == 0 else np.concatenate(
-            [np.zeros((count, 3 + 3 * (d - 1))), gains], axis=1)
-        m = np.zeros((count, size, size))
-        m[:, :2, :2] = phi
-        m[:, :2] += gamma[:, :, None] * law[:, None, :]
-        m[:, 2] = law
-        if d > 0:
-            m[:, 3:6, :3] = sense
-            m[:, 6:, 3:size - 3] = np.eye(size)[3:size - 3, 3:size - 3]
-        g = np.zeros((count, size))
-        g[:, :3] = np.concatenate([gamma, np.ones((count, 1))], axis=1)
-        h = np.zeros((count, size))
-        h[:, 0 if d == 0 else size - 3] = 1.0
-        return cls(m, g, h)
 
     def __len__(self) -> int:
         return len(self.base)
@@ -302,36 +144,10 @@ class SpringLoops:
         return np.abs(np.linalg.eigvals(self.matrices(stiffness, index))).max(axis=-1)
 
 
-def closed_loop_matrix(system: MassDamper, stiffness: float) -> np.ndarray:
-    """One-sample map of ``[q, qd, u_prev, s_(k-1), ..., s_(k-d)]`` with ``s = (q, qd, a)`` (:class:`SpringLoops`)."""
-    return SpringLoops.of(MassDampers.of([system])).matrices(np.array([stiffness]))[0]
-
-
-def spectral_radius(system: MassDamper, stiffness: float) -> float:
-    return float(SpringLoops.of(MassDampers.of([system])).radii(np.array([stiffness]))[0])
-
-
 FLOOR = 1e-9
 """The smallest spring of the search: a loop unstable already there has the limit 0."""
 RTOL, XTOL = 1e-10, 1e-12
 """The search stops when the stable and unstable springs are within ``XTOL + RTOL K`` of each other."""
-
-
-def exact_boundary(system: MassDamper, k_max: float = 1e9) -> float:
-    """Smallest spring stiffness at which the exactly discretized loop loses stability (:func:`exact_boundaries`)."""
-    return float(exact_boundaries(MassDampers.of([system]), k_max=k_max)[0])
-
-
-def exact_boundaries(systems: MassDampers, groups: np.ndarray | None = None, k_max: float = 1e9) -> np.ndarray:
-    """The exact limit of each 1-DOF system (S,), or the smallest in each group (``groups``: S labels 0 ... G - 1;
-    (G,)), by :func:`loop_limits` from the passivity scale ``2 (b + B) / (T (1 + 2 d))`` (Colgate's bound with a
-    delay of ``d`` samples)."""
-    order = 3 + 3 * systems.delay_samples
-    what = f"the closed-loop matrices of {len(systems):,} loops with a {systems.delay_samples:,}-sample delay"
-    require_memory(what, 8.0 * order * order * len(systems))
-    require_within(what, order, EIGEN_ORDER_LIMIT, "rows")
-    guess = 2.0 * (systems.damping + systems.virtual_damping) / (systems.period * (1 + 2 * systems.delay_samples))
-    return loop_limits(SpringLoops.of(systems), guess, groups, k_max)
 
 
 def loop_limits(loops: SpringLoops, guess: np.ndarray, groups: np.ndarray | None = None,
@@ -405,7 +221,7 @@ def loop_limits(loops: SpringLoops, guess: np.ndarray, groups: np.ndarray | None
 
 
 class _Search:
-    """Which systems of :func:`exact_boundaries` still search: not done (``limit`` NaN, 0 for those unstable at the
+    """Which systems of :func:`loop_limits` still search: not done (``limit`` NaN, 0 for those unstable at the
     floor, set before), their group not settled at 0, and not left behind by another system of their group."""
 
     def __init__(self, group: np.ndarray, n_group: int, limit: np.ndarray):
@@ -692,3 +508,40 @@ def handle_limits(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, s
     require_memory(what, 8.0 * order * order * len(loops))
     require_within(what, order, EIGEN_ORDER_LIMIT, "rows")
     return loop_limits(loops, guess, groups, k_max)
+
+
+def _joint(inertia, damping) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The handle arrays of S one-joint plants (``J_v`` the unit x axis, ``H = J``, ``B = b``, the wall's row 1)."""
+    j, b = np.broadcast_arrays(np.asarray(inertia, dtype=float), np.asarray(damping, dtype=float))
+    j, b = j.ravel(), b.ravel()
+    if not np.all((j > 0) & np.isfinite(j)):
+        raise UserError(f"the inertia must be positive, got {_worst(j)}")
+    if not np.all((b >= 0) & np.isfinite(b)):
+        raise UserError(f"the damping must be non-negative, got {_worst(b)}")
+    axis = np.broadcast_to(np.array([[1.0], [0.0], [0.0]]), (len(j), 3, 1))
+    return axis, j[:, None, None], b[:, None, None], np.ones((len(j), 1))
+
+
+def joint_loops(inertia, damping, loop: SampledLoop) -> SpringLoops:
+    """The sampled loops of 1-DOF plants, a joint of inertia ``J`` (kg m^2, or kg) and damping ``b`` (N m s/rad, or
+    N s/m) each (numbers or S values) under the wall on it and the settings ``loop`` (a hand adds its mass, damping
+    and stiffness to the joint's): the one-joint case of :func:`handle_loops`."""
+    return handle_loops(*_joint(inertia, damping), loop)[0]
+
+
+def joint_limits(inertia, damping, loop: SampledLoop, groups: np.ndarray | None = None,
+                 k_max: float = 1e9) -> np.ndarray:
+    """The exact limits (S,) of the loops of :func:`joint_loops`, or the smallest in each group
+    (:func:`handle_limits`)."""
+    return handle_limits(*_joint(inertia, damping), loop, groups, k_max)
+
+
+def joint_limit(inertia: float, damping: float, loop: SampledLoop, k_max: float = 1e9) -> float:
+    """:func:`joint_limits` of one joint."""
+    return float(joint_limits(inertia, damping, loop, k_max=k_max)[0])
+
+
+def _worst(values: np.ndarray) -> float:
+    """The value a refusal names: the first non-finite value, else the smallest."""
+    bad = values[~np.isfinite(values)]
+    return float(bad[0] if bad.size else values.min())
