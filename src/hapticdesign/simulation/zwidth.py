@@ -111,7 +111,7 @@ def zwidth(inertia: float, damping: float, loop: SampledLoop, dampers: list[floa
     the largest usable one)."""
     if dampers is not None and not 1 <= len(dampers) <= MAX_DAMPERS:
         raise InputError(f"give 1 to {MAX_DAMPERS} virtual dampers, got {len(dampers):,}", "b_values")
-    joint_limit(inertia, damping, loop)  # the plant's values checked before any grid search
+    _check_resolvable(inertia, damping, loop)
     values = damping_grid(inertia, damping, loop, points) if dampers is None else [float(b) for b in dampers]
     if any(not (math.isfinite(b) and b >= 0.0) for b in values):
         raise InputError(f"the virtual dampers must be finite and >= 0, got "
@@ -120,6 +120,17 @@ def zwidth(inertia: float, damping: float, loop: SampledLoop, dampers: list[floa
     return ZWidth(values, [max_stiffness(inertia, damping, loop, b) for b in values],
                   [passivity_stiffness(damping, loop, b) for b in values] if bounds else None,
                   [linear_approximation(damping, loop, b) for b in values] if bounds else None)
+
+
+def _check_resolvable(inertia: float, damping: float, loop: SampledLoop) -> None:
+    """Refuse a joint whose values' ratios overflow double precision (before any grid search)."""
+    t = loop.period
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        scales = (inertia / t, damping / inertia * t, t / inertia * t, 4.0 * inertia / t + 4.0 * damping)
+        plant = joint_loops(inertia, damping, loop).base if all(math.isfinite(v) for v in scales) else None
+    if plant is None or not np.all(np.isfinite(plant)):
+        raise UserError(f"the inertia {inertia:g}, damping {damping:g} and period {t:g} are outside the range this "
+                        "computation can resolve (their ratios overflow)")
 
 
 @dataclass(frozen=True)
