@@ -62,7 +62,7 @@ def test_closed_form_discretization_matches_scipy_cont2discrete_at_every_damping
     phi, gamma, *_ = cont2discrete((np.array([[0, 1], [0, -b / j]]), np.array([[0], [1 / j]]), np.eye(2),
                                     np.zeros((2, 1))), t)
     loops = joint_loops(j, b, SampledLoop(period=t, delay=0, compensation="none"))  # state (q, qd)
-    m0, m1 = loops.matrices(np.array([0.0]))[0], loops.matrices(np.array([1e6]))[0]  # m1[:, 0] = phi[:, 0] - 1e6 gamma
+    m0, m1 = loops.matrices(np.array([0.0]))[0], loops.matrices(np.array([1e6]))[0]  # m1[:, 0]: phi[:, 0] - 1e6 gamma
     np.testing.assert_allclose(m0[:2, :2], phi, rtol=1e-13, atol=1e-300)
     np.testing.assert_allclose((m0[:2, 0] - m1[:2, 0]) / 1e6, gamma[:, 0], rtol=1e-12)
 

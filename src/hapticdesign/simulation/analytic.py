@@ -15,8 +15,9 @@ wall, a hand or a closed-loop device in type 2 keeps the start-pose loop (``exac
 joint travels to the spring's rest and oscillates there, so stability is decided there, not at the start.
 
 The seed's criteria are then evaluated on the exact linear response: the closed loop (plant discretized exactly,
-:func:`_plant`; the digital side a discrete state-space system, :func:`_controller`) gives the state at every sample, and the exact sub-sample transition of the plant under the held torque
-gives the excursion at every plant step (as the simulation checks it). No ODE is integrated.
+:func:`_plant`; the digital side a discrete state-space system, :func:`_controller`) gives the state at every
+sample, and the exact sub-sample transition of the plant under the held torque gives the excursion at every plant
+step (as the simulation checks it). No ODE is integrated.
 Quantized encoders and Coulomb friction are not linear: the analytic method refuses them.
 
 A Cartesian wall (spring K in N/m, damper B in N s/m along n at the handle) acts on the free joint w

@@ -22,8 +22,9 @@ index                   formula                                             unit
 coordinate. ``stiffness`` and ``frequency`` need links with sections (``K_C`` of the virtual joint method at the
 handle, :func:`~hapticdesign.analysis.stiffness.device.cartesian_stiffness_at`; ``K_C[:3, :3]`` holds the
 rotations, seed 001's ``K_CA``). ``kmax`` is :func:`hapticdesign.analysis.wall_stiffness.kmax`: the n-joint sampled
-loop about the pose, every joint free, gravity's gradient in it, discretized exactly (its options: the loop's settings of
-:data:`~hapticdesign.analysis.wall_stiffness.KMAX_OPTIONS`, practice's by default, ``direction`` and ``hand``).
+loop about the pose, every joint free, gravity's gradient in it, discretized exactly (its options: the loop's
+settings of :data:`~hapticdesign.analysis.wall_stiffness.KMAX_OPTIONS`, practice's by default, ``direction`` and
+``hand``).
 ``ln`` and ``mass`` are one value per design (the same at every point); ``ln`` takes the region of the joint limits (full turns where none) and
 unit weights (:func:`~hapticdesign.analysis.linearity.form.device_form`). ``m^k/rad^k``: metres per radian for
 revolute coordinates (m/m for prismatic ones).
