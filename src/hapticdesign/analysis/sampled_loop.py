@@ -472,21 +472,32 @@ def _deflated(m: np.ndarray, g: np.ndarray, h: np.ndarray, w: np.ndarray, net: n
     0``) that no static stiffness resists (``(K_h + (1 - s) K_G) q* = 0``; ``net`` that stiffness times ``T^2 /
     |H_h|``, the share of the inertia's scale it reaches over a period) is held still whatever ``K`` (the state
     ``[q*, 0, q*, 0, ..., 0]``, the torque buffer ``s K_G q*``; ``held`` ``s K_G``): eigenvalue 1, a
-    neutral drift of the handle along the wall, not an instability. With ``P`` the orthogonal projector on them
-    (``m P = P``) the map is block triangular in ``[P, I - P]``, so ``(I - P) m (I - P)`` has the other eigenvalues
-    (and zeros), and the spring's term stays rank one, ``((I - P) g)((I - P) h)^T``."""
+    neutral drift of the handle along the wall, not an instability. In an orthonormal basis ``[Q1 Q2]`` with ``Q1``
+    spanning them the map is block triangular, so the other eigenvalues are those of ``Q2^T m Q2`` (and the spring's
+    term stays rank one, ``(Q2^T g)(Q2^T h)^T``); when the loops have different numbers of them, ``(I - P) m (I -
+    P)`` with ``P`` the orthogonal projector on them has the same eigenvalues and zeros, at one size for all."""
     count, size = m.shape[0], m.shape[1]
     n = w.shape[1]
     rows = np.concatenate([(w / np.linalg.norm(w, axis=1, keepdims=True))[:, None, :], net], axis=1)
     _, sv, vt = np.linalg.svd(rows)
-    null = vt * (sv <= NULL_TOL)[:, :, None]  # (S, n, n): rows spanning each loop's fixed pose changes, else 0
-    fixed = np.zeros((count, size, n))
+    free = sv <= NULL_TOL  # the last rows of vt (singular values descending)
+    ranks = free.sum(axis=1)
+    uniform = bool(np.all(ranks == ranks[0]))
+    null = vt[:, n - ranks[0]:, :] if uniform else vt * free[:, :, None]  # rows spanning the fixed pose changes
+    r = null.shape[1]
+    if r == 0:
+        return m, g, h
+    fixed = np.zeros((count, size, r))
     for k in range(depth + 1):
         fixed[:, 2 * n * k:2 * n * k + n] = np.swapaxes(null, 1, 2)
     if u0 is not None:
         torque = held @ np.swapaxes(null, 1, 2)
         for k in range((size - u0) // n):
             fixed[:, u0 + n * k:u0 + n * (k + 1)] = torque
+    if uniform:
+        q = np.linalg.qr(fixed, mode="complete")[0][:, :, r:]
+        qt = np.swapaxes(q, 1, 2)
+        return qt @ m @ q, np.einsum("sji,sj->si", q, g), np.einsum("sji,sj->si", q, h)
     keep = np.eye(size) - fixed @ np.linalg.pinv(fixed)
     return keep @ m @ keep, np.einsum("sij,sj->si", keep, g), np.einsum("sij,sj->si", keep, h)
 

@@ -24,7 +24,7 @@ import numpy as np
 from hapticdesign.analysis import kinematics
 from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.analysis.dynamics.cartesian import mobility
-from hapticdesign.analysis.dynamics.device import gravity_gradient, mass_matrix_at
+from hapticdesign.analysis.dynamics.device import gravity_gradient_at, mass_matrix_at
 from hapticdesign.analysis.metrics import force
 from hapticdesign.analysis.stiffness.device import cartesian_stiffness_at
 from hapticdesign.errors import UserError
@@ -80,8 +80,8 @@ class HandleStates:
     @cached_property
     def gravity(self) -> np.ndarray:
         """``dG/dq`` (P, n_a, n_a): the stiffness gravity adds to the linearized plant at each pose
-        (:func:`~hapticdesign.analysis.dynamics.device.gravity_gradient`)."""
-        return np.array([gravity_gradient(self._device, q) for q in self.q])
+        (:func:`~hapticdesign.analysis.dynamics.device.gravity_gradient_at`)."""
+        return gravity_gradient_at(self._device, self.full)
 
     @cached_property
     def name(self) -> str:
