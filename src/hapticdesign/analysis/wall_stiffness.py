@@ -2,8 +2,8 @@
 
 A wall along a unit direction ``u`` at the handle acts on the joints as the spring ``K J_v^T u u^T J_v``; with every
 actuated joint free (as under a user's hand; :attr:`~hapticdesign.analysis.sampled_loop.SampledLoop.held` names the
-ones held) the n-joint plant ``H``, ``B`` (and the hand of the loop's settings) discretized exactly and the sampled
-controller form one linear map whose spectral radius reaches 1 at the limit
+ones held) the n-joint plant ``H``, ``B`` (the hand of the loop's settings and gravity's gradient at the pose in it)
+discretized exactly and the sampled controller form one linear map whose spectral radius reaches 1 at the limit
 (:func:`hapticdesign.analysis.sampled_loop.handle_limits`). This is not the 1-DOF model of the handle along ``u``
 (mass ``1 / (u^T J_v H^-1 J_v^T u)``, damping ``u^T J_v^+T B J_v^+ u``): the two agree where ``u`` is a principal
 direction of both the handle's mobility and its damping, and differ elsewhere, where the other directions' motion
