@@ -123,7 +123,12 @@ def zwidth(inertia: float, damping: float, loop: SampledLoop, dampers: list[floa
 
 
 def _check_resolvable(inertia: float, damping: float, loop: SampledLoop) -> None:
-    """Refuse a joint whose values' ratios overflow double precision (before any grid search)."""
+    """Refuse a joint whose values are not a plant's or whose ratios overflow double precision (before any grid
+    search)."""
+    if not (math.isfinite(inertia) and inertia > 0):
+        raise UserError(f"the inertia must be positive, got {inertia:g}")
+    if not (math.isfinite(damping) and damping >= 0):
+        raise UserError(f"the damping must be non-negative, got {damping:g}")
     t = loop.period
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         scales = (inertia / t, damping / inertia * t, t / inertia * t, 4.0 * inertia / t + 4.0 * damping)
