@@ -17,9 +17,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from hapticdesign.analysis.sampled_loop import compensated_limit
-from hapticdesign.simulation.zwidth import (DisplayLoop, damping_grid, linear_approximation, max_stiffness,
-                                            passivity_stiffness)
+from hapticdesign.analysis.sampled_loop import SampledLoop, compensated_limit
+from hapticdesign.simulation import zwidth
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCS, README = ROOT / "docs" / "simulation.md", ROOT / "README.md"
@@ -27,11 +26,36 @@ J, B_JOINT, T = 0.039, 0.5, 1e-3  # the Phantom's joint 1 (H11 of the default de
 DAMPERS = (0.0, 0.1, 0.25, 0.5, 1.0, 2.0, 5.0, 10.0)
 
 
-def _loop(inertia: float, delay: int, velocity: str) -> DisplayLoop:
-    return DisplayLoop(inertia, B_JOINT, T, delay, velocity)
+class _Joint:
+    """The Phantom's joint (damping ``B_JOINT``) of one inertia under the settings the table names: no
+    compensation, a delay of ``delay`` samples, the damper on the ``velocity`` estimate (stated in the table)."""
+
+    def __init__(self, inertia: float, delay: int, velocity: str):
+        self.inertia = inertia
+        self.loop = SampledLoop(period=T, delay=delay, velocity=velocity, compensation="none")
 
 
-def _gap(loop: DisplayLoop, damper: float, bound) -> float:
+def _loop(inertia: float, delay: int, velocity: str) -> _Joint:
+    return _Joint(inertia, delay, velocity)
+
+
+def max_stiffness(joint: _Joint, damper: float) -> float:
+    return zwidth.max_stiffness(joint.inertia, B_JOINT, joint.loop, damper)
+
+
+def passivity_stiffness(joint: _Joint, damper: float) -> float:
+    return zwidth.passivity_stiffness(B_JOINT, joint.loop, damper)
+
+
+def linear_approximation(joint: _Joint, damper: float) -> float:
+    return zwidth.linear_approximation(B_JOINT, joint.loop, damper)
+
+
+def damping_grid(joint: _Joint, points: int) -> list[float]:
+    return zwidth.damping_grid(joint.inertia, B_JOINT, joint.loop, points)
+
+
+def _gap(loop: _Joint, damper: float, bound) -> float:
     """``bound / exact - 1`` in percent."""
     return 100.0 * (bound(loop, damper) / max_stiffness(loop, damper) - 1.0)
 

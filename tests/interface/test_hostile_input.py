@@ -132,7 +132,7 @@ NONSENSE = [
     (["transparency", "--amplitude", "nan"], "--amplitude must be a finite, non-zero angle"),
     (["transparency", "--wall-damping", "-0.5"], "wall damping must be a finite number >= 0, got -0.5 (--wall-damping)"),
     ([*BOUNDARY, "--wall-damping", "-1"], "wall damping must be a finite number >= 0, got -1.0 (--wall-damping)"),
-    ([*BOUNDARY, "--compensate-inertia", "--error-percent", "150"], "between -100 and 100"),
+    ([*BOUNDARY, "--compensation", "full", "--error-percent", "150"], "between -100 and 100"),
     ([*BOUNDARY, "--delay", "2000", "--samples", "4000"], "shorter than a quarter of --samples"),
     (["designs", "--seed", "-1"], "--seed"),
     (["linearize", "--seed", "-1", "--find", "2"], "--seed"),
@@ -303,10 +303,11 @@ def test_zwidth_refuses_loops_it_cannot_resolve_and_negative_dampers(args, fragm
 
 def test_zwidth_api_caps_the_dampers_before_any_work():
     from hapticdesign.errors import InputError
-    from hapticdesign.simulation.zwidth import DisplayLoop, zwidth
+    from hapticdesign.analysis.sampled_loop import SampledLoop
+    from hapticdesign.simulation.zwidth import zwidth
 
     with pytest.raises(InputError, match="give 1 to 1000 virtual dampers, got 10,000,000"):
-        zwidth(DisplayLoop(0.04, 0.5, 1e-3), [0.1] * 10**7)
+        zwidth(0.04, 0.5, SampledLoop(), [0.1] * 10**7)
 
 
 def test_eom_of_a_closed_loop_device_is_refused_not_the_opened_tree():

@@ -1,4 +1,5 @@
-"""1-DOF mass-damper: exact boundary (spectral radius of the exact discretization) vs the simulated loop."""
+"""1-DOF mass-damper: the exact limit of the one-joint sampled loop (spectral radius of the exact discretization)
+against the closed form, SciPy's discretization and the simulated loop, under the settings of a ``SampledLoop``."""
 
 from pathlib import Path
 
@@ -15,13 +16,11 @@ from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import UserError
 from hapticdesign.analysis.sampled_loop import (
-    MassDamper, MassDampers, closed_loop_matrix, compensated_boundary, compensated_limit, exact_boundaries,
-    exact_boundary,
+    SampledLoop, compensated_boundary, compensated_limit, joint_limit, joint_limits, joint_loops,
 )
 from hapticdesign.simulation.boundary import simulated_boundary
 from hapticdesign.simulation.config import Compensator, Hand, LoopConfig
 from hapticdesign.simulation.impedance import ImpedanceProblem, growth_boundary
-from hapticdesign.simulation.zwidth import DisplayLoop, max_stiffness
 
 CASES = [
     (0.01, 0.5, 1e-3, 0, False),
@@ -34,16 +33,16 @@ CASES = [
 
 @pytest.mark.parametrize("inertia, damping, period, delay, compensate", CASES)
 def test_simulated_boundary_agrees_with_exact_within_one_percent(inertia, damping, period, delay, compensate):
-    system = MassDamper(inertia, damping, period, delay, compensate_inertia=compensate)
-    exact = exact_boundary(system)
-    simulated = simulated_boundary(system, rel_tol=2e-3, samples=3000)
+    loop = SampledLoop(period=period, delay=delay, velocity="sampled", compensation="full" if compensate else "none")
+    exact = joint_limit(inertia, damping, loop)
+    simulated = simulated_boundary(inertia, damping, loop, rel_tol=2e-3, samples=3000)
     assert abs(simulated - exact) / exact < 0.01
 
 
 def test_exact_boundary_is_slightly_above_two_b_over_t():
     """Without compensation the limit is about 2b/T, slightly above."""
     for inertia, damping, period in [(0.01, 0.5, 1e-3), (0.1, 0.2, 1e-3), (0.005, 0.1, 2e-4)]:
-        k = exact_boundary(MassDamper(inertia, damping, period))
+        k = joint_limit(inertia, damping, SampledLoop(period=period, delay=0, compensation="none"))
         assert 2 * damping / period < k < 1.02 * 2 * damping / period
 
 
@@ -51,7 +50,7 @@ def test_full_inertia_compensation_limit_is_b_squared_over_j():
     """Feeding the sampled acceleration forward turns u into a sum: u_k = u_(k-1) - b v_k - K q_k,
     whose exact discrete limit is K = b^2 / J (the scale of the seed's Table 4.4)."""
     for inertia, damping, period in [(0.039, 0.5, 1e-3), (0.01, 0.3, 5e-4), (0.02, 0.5, 2e-3)]:
-        k = exact_boundary(MassDamper(inertia, damping, period, compensate_inertia=True))
+        k = joint_limit(inertia, damping, SampledLoop.seed(period=period))
         assert k == pytest.approx(damping**2 / inertia, rel=1e-8)
 
 
@@ -62,7 +61,8 @@ def test_closed_form_discretization_matches_scipy_cont2discrete_at_every_damping
     b = x * j / t
     phi, gamma, *_ = cont2discrete((np.array([[0, 1], [0, -b / j]]), np.array([[0], [1 / j]]), np.eye(2),
                                     np.zeros((2, 1))), t)
-    m0, m1 = (closed_loop_matrix(MassDamper(j, b, t), k) for k in (0.0, 1e6))  # m1[:2, 0] = phi[:, 0] - 1e6 gamma
+    loops = joint_loops(j, b, SampledLoop(period=t, delay=0, compensation="none"))  # state (q, qd)
+    m0, m1 = loops.matrices(np.array([0.0]))[0], loops.matrices(np.array([1e6]))[0]  # m1[:, 0]: phi[:, 0] - 1e6 gamma
     np.testing.assert_allclose(m0[:2, :2], phi, rtol=1e-13, atol=1e-300)
     np.testing.assert_allclose((m0[:2, 0] - m1[:2, 0]) / 1e6, gamma[:, 0], rtol=1e-12)
 
@@ -70,9 +70,9 @@ def test_closed_form_discretization_matches_scipy_cont2discrete_at_every_damping
 def test_discretization_matches_scipy_cont2discrete():
     j, b, t = 0.01, 0.5, 1e-3
     phi, gamma, *_ = cont2discrete((np.array([[0, 1], [0, -b / j]]), np.array([[0], [1 / j]]), np.eye(2), np.zeros((2, 1))), t)
-    m = closed_loop_matrix(MassDamper(j, b, t), 0.0)
+    loops = joint_loops(j, b, SampledLoop(period=t, delay=0, compensation="none"))
+    m, m1 = loops.matrices(np.array([0.0]))[0], loops.matrices(np.array([1.0]))[0]
     assert np.allclose(m[:2, :2], phi, rtol=1e-12, atol=1e-15)
-    m1 = closed_loop_matrix(MassDamper(j, b, t), 1.0)
     assert np.allclose(m1[:2, 0] - m[:2, 0], -gamma[:, 0], rtol=1e-12, atol=1e-15)
 
 
@@ -80,15 +80,17 @@ def test_discretization_matches_scipy_cont2discrete():
                                     dict(inertia=0.01, damping=-0.1, period=1e-3)])
 def test_bad_mass_damper_raises(kwargs):
     with pytest.raises(UserError):
-        MassDamper(**kwargs)
+        joint_limit(kwargs["inertia"], kwargs["damping"], SampledLoop(period=kwargs["period"]))
 
 
 @pytest.mark.parametrize("inertia, damping, period", [(0.04, 0.5, 1e-3), (0.01, 0.2, 5e-4), (0.2, 0.05, 1e-3)])
 @pytest.mark.parametrize("fraction", [1.0, 0.99, 0.9, 0.5, 0.0])
 def test_closed_form_with_compensator_error_is_the_spectral_radius_boundary(inertia, damping, period, fraction):
     """K* = b^2 (1-a)(1-ac) / [J (1-a)(1-ac) - T a b (1-c)], a = exp(-bT/J), against eigenvalues."""
-    system = MassDamper(inertia, damping, period, compensate_inertia=True, model_inertia=fraction * inertia)
-    assert compensated_boundary(inertia, damping, period, fraction) == pytest.approx(exact_boundary(system), rel=1e-8)
+    loop = (SampledLoop.seed(period=period, model_error=100.0 * (1.0 - fraction)) if fraction else
+            SampledLoop.seed(period=period, compensation="none"))
+    assert compensated_boundary(inertia, damping, period, fraction) == pytest.approx(joint_limit(inertia, damping, loop),
+                                                                                     rel=1e-8)
 
 
 def _own_spectral_limit(j: float, b: float, t: float, c: float) -> float:
@@ -181,8 +183,8 @@ def test_closed_form_limits():
 def test_simulated_loop_with_compensator_error_meets_the_closed_form(error_percent):
     j, b, t = 0.039, 0.5, 1e-3
     c = 1 - error_percent / 100
-    system = MassDamper(j, b, t, compensate_inertia=True, model_inertia=c * j)
-    simulated = simulated_boundary(system, rel_tol=1e-4, samples=4000)
+    simulated = simulated_boundary(j, b, SampledLoop.seed(period=t, model_error=error_percent), rel_tol=1e-4,
+                                   samples=4000)
     assert simulated == pytest.approx(compensated_boundary(j, b, t, c), rel=2e-3)
 
 
@@ -197,52 +199,43 @@ def test_hand_on_a_one_dof_device_meets_the_exact_discrete_analysis():
     hand = Hand(mass=0.4, damping=2.0, stiffness=40.0)
     config = LoopConfig(hand=hand, compensator=Compensator(coriolis=False, gravity=False))
     simulated = growth_boundary(ImpedanceProblem(device, 1, config=config))
-    system = MassDamper(j + hand.mass * r2, 0.3 + hand.damping * r2, 1e-3, compensate_inertia=True,
-                        model_inertia=j, plant_stiffness=hand.stiffness * r2)
-    exact = exact_boundary(system)
+    at_joint = Hand(hand.mass * r2, hand.damping * r2, hand.stiffness * r2)  # the hand seen at the joint
+    exact = joint_limit(j, 0.3, SampledLoop.seed(hand=at_joint))
     assert simulated == pytest.approx(exact, rel=2e-3)
-    without_mass = exact_boundary(MassDamper(j, 0.3 + hand.damping * r2, 1e-3, compensate_inertia=True,
-                                             plant_stiffness=hand.stiffness * r2))
+    without_mass = joint_limit(j, 0.3, SampledLoop.seed(hand=Hand(0.0, at_joint.damping, at_joint.stiffness)))
     assert abs(without_mass - exact) > 0.2 * exact
 
 
-def _random_systems(rng, count: int, delay: int, compensate: bool) -> list[MassDamper]:
-    """Mass-dampers over three decades of inertia, damping and period, with a virtual damper half the time and,
-    compensated, a model inertia 90-100 % of the plant's."""
-    out = []
-    for _ in range(count):
-        j, b, t = 10 ** rng.uniform(-3, -1), 10 ** rng.uniform(-2, 0), 10 ** rng.uniform(-4, -3)
-        out.append(MassDamper(j, b, t, delay, float(rng.choice([0.0, rng.uniform(0.0, b)])), compensate,
-                              rng.uniform(0.9, 1.0) * j if compensate else None))
-    return out
+def _random_joints(rng, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """Inertias and dampings over two decades each."""
+    return 10 ** rng.uniform(-3, -1, count), 10 ** rng.uniform(-2, 0, count)
 
 
 @pytest.mark.parametrize("delay", [0, 1, 2, 3])
 @pytest.mark.parametrize("compensate", [False, True])
-def test_batched_limits_are_each_systems_limit_and_python_controls(delay, compensate):
-    """One batched search over random loops gives each loop's own limit (searched alone) and the limit of the loop
-    built independently by python-control (zwidth: c2d of the plant, feedback of the delayed law), to 1e-8."""
-    systems = _random_systems(np.random.default_rng(10 * delay + compensate), 4, delay, compensate)
-    batched = exact_boundaries(MassDampers.of(systems))
-    for system, limit in zip(systems, batched):
-        assert limit == pytest.approx(exact_boundary(system), rel=1e-9)
-        fraction = system.j_model / system.inertia if compensate else 0.0
-        loop = DisplayLoop(system.inertia, system.damping, system.period, delay, "sampled", fraction)
-        assert limit == pytest.approx(max_stiffness(loop, system.virtual_damping), rel=1e-8)
+def test_batched_limits_are_each_joints_limit(delay, compensate):
+    """One batched search over random joints gives each joint's own limit, searched alone, to 1e-9 (a virtual damper
+    and a 5 % model error in the compensated case)."""
+    j, b = _random_joints(np.random.default_rng(10 * delay + compensate), 4)
+    loop = SampledLoop(period=5e-4, delay=delay, velocity="sampled", compensation="full" if compensate else "none",
+                       model_error=5.0 if compensate else 0.0, virtual_damping=0.005)
+    batched = joint_limits(j, b, loop)
+    for inertia, damping, limit in zip(j, b, batched):
+        assert limit == pytest.approx(joint_limit(inertia, damping, loop), rel=1e-9)
 
 
 def test_grouped_search_gives_each_groups_smallest_limit():
-    """The smallest limit per group (loops leave the search once another loop of their group is unstable below their
-    stable spring) equals the smallest of the loops searched alone; a loop with no stable spring (a compensator
-    over-estimating the inertia by 5 % at x = 0.0128: 0) settles its group at 0, and loops stable up to ``k_max``
-    give inf."""
+    """The smallest limit per group (joints leave the search once another joint of their group is unstable below
+    their stable spring) equals the smallest of the joints searched alone; under a compensator over-estimating the
+    inertia by 5 %, a joint at x = bT/J below ln 1.05 has no stable spring (0) and settles its group at 0, and joints
+    stable up to ``k_max`` give inf."""
     rng = np.random.default_rng(3)
-    systems = _random_systems(rng, 11, 1, True)
-    systems.append(MassDamper(0.039, 0.5, 1e-3, 1, 0.0, True, 1.05 * 0.039))
-    systems += [MassDamper(1e-3, 50.0, 1e-4, 1, 0.0, True, 1e-3)] * 2  # about 4.8e5 N m/rad
+    j = np.concatenate([10 ** rng.uniform(-3, -2.7, 11), [0.039, 1e-3, 1e-3]])
+    b = np.concatenate([10 ** rng.uniform(0.3, 0.7, 11), [0.5, 50.0, 50.0]])
+    loop = SampledLoop.seed(period=1e-4, delay=1, model_error=-5.0)
     groups = np.array([0] * 5 + [1] * 6 + [1] + [2] * 2)
-    alone = np.array([exact_boundary(s, k_max=1e5) for s in systems])
-    smallest = exact_boundaries(MassDampers.of(systems), groups, k_max=1e5)
+    alone = np.array([joint_limit(i, d, loop, k_max=1e5) for i, d in zip(j, b)])
+    smallest = joint_limits(j, b, loop, groups, k_max=1e5)
     expected = [alone[groups == g].min() for g in range(3)]
     np.testing.assert_allclose(smallest, expected, rtol=1e-12)
     assert 0.0 < smallest[0] < math.inf and smallest[1] == 0.0 and smallest[2] == math.inf

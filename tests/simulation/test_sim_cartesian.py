@@ -140,7 +140,7 @@ def test_cli_cartesian_wall(tmp_path):
 
     runner = CliRunner()
     path = SLIDER
-    zw = runner.invoke(app, ["zwidth", "--device", str(path), "--wall-direction", "1,0,1", "--compensate-inertia",
+    zw = runner.invoke(app, ["zwidth", "--device", str(path), "--wall-direction", "1,0,1", "--compensation", "full",
                              "--delay", "0", "--b-values", "0", "--json"])
     assert zw.exit_code == 0, zw.output
     out = json.loads(zw.stdout)

@@ -33,7 +33,7 @@ def test_resolution_gives_a_real_value_below_one():
 
 def test_error_percent_reports_the_closed_form():
     result = runner.invoke(app, ["stability-boundary", "--inertia", "0.04", "--damping", "0.5", "--period", "0.001",
-                                 "--compensate-inertia", "--error-percent", "1", "--samples", "2000", "--json"])
+                                 "--settings", "seed", "--error-percent", "1", "--samples", "2000", "--json"])
     assert result.exit_code == 0, result.output
     out = json.loads(result.stdout)
     expected = _closed_form(0.04, 0.5, 1e-3, 0.99)
@@ -48,7 +48,7 @@ def test_over_estimated_inertia_reports_zero_not_a_negative_closed_form():
     written-out K* is negative there); the exact limit and the closed form are both 0."""
     assert _closed_form(0.039, 0.5, 1e-3, 1.05) < 0
     result = runner.invoke(app, ["stability-boundary", "--inertia", "0.039", "--damping", "0.5", "--period", "0.001",
-                                 "--compensate-inertia", "--error-percent", "-5", "--samples", "400", "--json"])
+                                 "--settings", "seed", "--error-percent", "-5", "--samples", "400", "--json"])
     assert result.exit_code == 0, result.output
     out = json.loads(result.stdout)
     assert out["k_max_exact"] == 0.0 and out["k_max_closed_form"] == 0.0
@@ -57,7 +57,7 @@ def test_over_estimated_inertia_reports_zero_not_a_negative_closed_form():
 
 @pytest.mark.parametrize("args, message", [
     (["stability-boundary", "--inertia", "0.04", "--damping", "0.5", "--period", "0.001", "--error-percent", "1"],
-     "needs --compensate-inertia"),
+     "needs --compensation full"),
     (["impedance-range", "--resolution", "-1"], "resolution must be a positive number, got -1.0 (--resolution)"),
     (["impedance-range", "--resolution", "500"], "above the stiffness limit 200 (--resolution, --k-limit)"),
 ])
@@ -74,7 +74,7 @@ def test_zwidth_of_a_device_joint_at_a_pose():
     from hapticdesign.devices.registry import preset
 
     device = preset("phantom-3dof")
-    result = runner.invoke(app, ["zwidth", "--preset", "phantom-3dof", "--q", "0,0.5,0.3", "--compensate-inertia",
+    result = runner.invoke(app, ["zwidth", "--preset", "phantom-3dof", "--q", "0,0.5,0.3", "--compensation", "full",
                                  "--b-values", "0", "--json"])
     assert result.exit_code == 0, result.output
     out = json.loads(result.stdout)
@@ -107,7 +107,7 @@ def test_a_prismatic_wall_is_labelled_in_newtons(tmp_path):
     assert out["units"]["k_max"] == "N/m"
     dyn = json.loads(runner.invoke(app, ["dynamics", "--device", str(path), "--q", "0.1", "--json"]).stdout)
     assert dyn["units"]["joints"][0]["effort"] == "N" and dyn["H"] == [[0.5]]
-    zw = json.loads(runner.invoke(app, ["zwidth", "--device", str(path), "--compensate-inertia", "--delay", "0",
+    zw = json.loads(runner.invoke(app, ["zwidth", "--device", str(path), "--compensation", "full", "--delay", "0",
                                         "--b-values", "0", "--json"]).stdout)
     assert zw["K"][0] == pytest.approx(2.0 ** 2 / 0.5, rel=1e-8)
 

@@ -21,7 +21,7 @@ import pytest
 from scipy.optimize import linprog
 
 from hapticdesign.devices.device_file import load_device_file
-from hapticdesign.analysis.sampled_loop import MassDamper, exact_boundary
+from hapticdesign.analysis.sampled_loop import SampledLoop, joint_limit
 from hapticdesign.studies.spec import handle_at, inscribed_force, spec_sheet
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "devices"
@@ -60,7 +60,7 @@ def test_phantom_apparent_mass_friction_and_passivity_by_hand(sheet):
     walls = sheet["renderable_stiffness"]
     assert walls["passivity_viscous"] == pytest.approx(2 * damping.min() * 1000, rel=1e-9)
     assert walls["passivity_coulomb"] == pytest.approx(2 * friction.min() / sheet["resolution"], rel=1e-9)
-    axes = [exact_boundary(MassDamper(m, b, 1e-3, 1)) for m, b in zip(mass, damping)]
+    axes = [joint_limit(m, b, SampledLoop()) for m, b in zip(mass, damping)]
     assert walls["exact"] == pytest.approx(min(axes), rel=1e-4)
 
 

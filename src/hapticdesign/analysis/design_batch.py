@@ -38,6 +38,7 @@ from hapticdesign.analysis.configuration import IK_SINGULAR, check_limits, confi
 from hapticdesign.analysis.dynamics.actuated_kernel import (
     Bodies, factor_pose, mass_and_gravity, passive_paths, reduce_pose, world_parameters,
 )
+from hapticdesign.analysis.dynamics.device import GRADIENT_STEP
 from hapticdesign.analysis.loops import closure_kernel as ck
 from hapticdesign.analysis.loops.records import NO_HOME, OK, closure_scratch
 from hapticdesign.analysis.reach_kernel import MESSAGES, Reached, reach_designs, structure_of
@@ -89,6 +90,58 @@ def _design_masses(full, tree, plan, bodies, loops, sets, ws, pw, h, g, mj, out)
         for i in range(h.shape[0]):
             for j in range(h.shape[1]):
                 out[p, i, j] = h[i, j]
+
+
+@njit(cache=True)
+def _pose_gravity(q, tree, plan, bodies, loops, sets, ws, pw, h, g, mj):
+    """``G`` in the actuated coordinates at the full pose ``q`` into ``g`` (``T`` of the pose left in ``ws.t``)."""
+    body_node = bodies.body_node
+    if loops.passive.shape[0] > 0:
+        factor_pose(q, tree, plan, loops, ws)
+    else:
+        planned_poses(q, tree, plan, np.int64(0), tree.parent.shape[0], ws.rot, ws.pos, ws.trig)
+    reduce_pose(tree, plan, body_node, loops, ws)
+    world_parameters(ws.rot, body_node, sets, np.int64(0), pw)
+    h[:] = 0.0
+    g[:] = 0.0
+    for b in range(body_node.shape[0]):
+        if body_node[b] >= 0:
+            mass_and_gravity(ws.ja, b, bodies.gravity, pw, 0, h, g, mj, False)
+
+
+@njit(cache=True)
+def gravity_designs(offsets, full, status, shape, plan, bodies, loops, params, step, out):
+    """``K_G = dG/dq_a`` (actuated coordinates) at the poses ``full`` (D, P, N) of the designs whose status is OK into
+    ``out`` (D, P, n_a, n_a), by central differences of ``G`` over ``+-step`` along each actuated coordinate's
+    motion ``T e_j`` (the passive coordinates follow to first order; the second-order miss of the closure is even in
+    the step and cancels in the difference)."""
+    n_design, n_pose, n = full.shape
+    na = loops.actuated.shape[0]
+    n_body = bodies.body_node.shape[0]
+    ws = closure_scratch(shape.parent.shape[0], n, na, loops.passive, n_body)
+    pw = np.zeros((1, n_body, 10))
+    h = np.zeros((na, na))
+    g_up, g_down = np.zeros(na), np.zeros(na)
+    mj = np.zeros((6, na))
+    t = np.zeros((n, na))
+    q = np.zeros(n)
+    for d in range(n_design):
+        if status[d] != OK:
+            continue
+        tree = Tree(shape.parent, shape.axis, shape.coef, offsets[d], shape.const_rot, shape.const_pos)
+        sets = params[d:d + 1]
+        for p in range(n_pose):
+            _pose_gravity(full[d, p], tree, plan, bodies, loops, sets, ws, pw, h, g_up, mj)
+            t[:] = ws.t
+            for j in range(na):
+                for i in range(n):
+                    q[i] = full[d, p, i] + step * t[i, j]
+                _pose_gravity(q, tree, plan, bodies, loops, sets, ws, pw, h, g_up, mj)
+                for i in range(n):
+                    q[i] = full[d, p, i] - step * t[i, j]
+                _pose_gravity(q, tree, plan, bodies, loops, sets, ws, pw, h, g_down, mj)
+                for i in range(na):
+                    out[d, p, i, j] = (g_up[i] - g_down[i]) / (2.0 * step)
 
 
 @njit(cache=True)
@@ -203,7 +256,7 @@ class DesignValues(NamedTuple):
 class Evaluated(NamedTuple):
     """Many designs at the workspace points (:meth:`DesignBatch.evaluate`): ``J_v`` (D, P, 3, n_a), ``H`` with the
     reflected rotor inertia (D, P, n_a, n_a), the actuated coordinates ``q`` (D, P, n_a), the VJM's ``K_C``
-    (D, P, 6, 6; None unless asked), the mass the
+    (D, P, 6, 6; None unless asked), the gravity gradient (None unless asked), the mass the
     coordinates move (D,), whether each design reached every point (D,) and else why not (one line), and the
     design values it was given (``B``, the motors)."""
 
@@ -215,6 +268,8 @@ class Evaluated(NamedTuple):
     ok: np.ndarray
     reasons: list
     values: DesignValues
+    gravity: np.ndarray | None = None
+    """``dG/dq`` (D, P, n_a, n_a) when asked."""
 
 
 class DesignBatch:
@@ -314,6 +369,17 @@ class DesignBatch:
                      self.bodies, self.closures, params, h)
         return h + (reflected[:, None] if np.ndim(reflected) == 3 else reflected)
 
+    def gravity_gradients(self, offsets: np.ndarray, reached: Reached, params: np.ndarray) -> np.ndarray:
+        """``dG/dq`` (D, P, n_a, n_a) at the reached poses, standard parameters ``params`` (D, 10 B)
+        (:func:`gravity_designs`; the step of :func:`~hapticdesign.analysis.dynamics.device.gravity_gradient`)."""
+        d, p = reached.status.shape[0], reached.full.shape[1]
+        na = len(self.closures.actuated)
+        out = np.zeros((d, p, na, na))
+        params = np.ascontiguousarray(np.broadcast_to(np.atleast_2d(params), (d, np.shape(params)[-1])), dtype=float)
+        gravity_designs(np.ascontiguousarray(offsets, dtype=float), reached.full, reached.status, self.shape,
+                        self.plan, self.bodies, self.closures, params, GRADIENT_STEP, out)
+        return out
+
     def stiffness(self, offsets: np.ndarray, reached: Reached, rigidity: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The VJM's ``K_C`` (D, P, 6, 6) at the reached poses of the designs whose status is OK, for the elastic
         links' rigidities (D, L, 3) (:func:`~hapticdesign.analysis.stiffness.device.cartesian_stiffness_at`), and
@@ -355,11 +421,12 @@ class DesignBatch:
         return vjm.locked_stiffness(j_theta, c_theta)[..., :6, :6]
 
     def evaluate(self, values: DesignValues, points: np.ndarray, stiffness: bool = False,
-                 home: np.ndarray | None = None) -> Evaluated:
+                 home: np.ndarray | None = None, gravity: bool = False) -> Evaluated:
         """Every design of ``values`` at the workspace ``points`` (P, 3), reached in order from home: ``J_v``, ``H``
         (the design's inertial parameters and motors), ``K_C`` when ``stiffness`` (the design's sections), the
         moving mass, and the reason of each design that fails (refused by the device file, a point not reached or
-        outside the joint limits, a pose where the handle is rigid in some direction). ``home``: the handle's home
+        outside the joint limits, a pose where the handle is rigid in some direction), and ``dG/dq`` when
+        ``gravity`` (:meth:`gravity_gradients`). ``home``: the handle's home
         position of a device file that gives one (``home: {position}``); each design's home is then where its
         handle reaches that position from the file's home joint values (as the design's own device file puts it,
         :func:`~hapticdesign.devices.device_file.home_at`), so the home follows the design's geometry."""
@@ -392,7 +459,9 @@ class DesignBatch:
                 reasons[d] = (f"the end effector {self.frame!r} is rigid in some direction at this pose: the elastic "
                               "links and joint springs do not reach it, or the pose is singular")
             ok &= defined
-        return Evaluated(reached.jvt, mass, reached.full[..., self.closures.actuated], k_c, moving, ok, reasons, values)
+        grad = self.gravity_gradients(offsets, reached, values.standard) if gravity else None
+        return Evaluated(reached.jvt, mass, reached.full[..., self.closures.actuated], k_c, moving, ok, reasons, values,
+                         grad)
 
     def reason(self, reached: Reached, design: int, points: np.ndarray, home: np.ndarray | None = None) -> str | None:
         """One line on why ``design`` failed (naming the point, or the ``home`` position), or None."""

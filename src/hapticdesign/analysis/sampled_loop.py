@@ -1,18 +1,20 @@
-"""Stability boundary of a 1-DOF mass-damper under a sampled virtual spring (seed 000 ch. 4, §5).
+"""The sampled haptic loop: one record of its settings, one construction of its exact limit (seed 000 ch. 4, §5).
 
-Plant ``J qdd + b qd + k_p q = u`` (``k_p``: a physical spring such as a hand's, 0 by default);
-every ``T`` the digital side reads ``q, qd`` (and the acceleration under the previous held
-torque), optionally ``delay`` samples late, and holds ``u = J_m a - K q - B qd`` with the
-inertial compensator (model inertia ``J_m``, ``J_m = c J`` for a modelling error of
-``E = 100 (1 - c)`` percent), ``u = - K q - B qd`` without it.
+- :class:`SampledLoop`: the settings of every command and index (rate, delay, velocity estimate, compensation and
+  its modelling error, the wall's damper, the hand, the joints held); practice's by default, the seed's one call
+  away (:meth:`SampledLoop.seed`).
+- :func:`handle_loops` / :func:`handle_limits`: the loop of an n-joint plant ``H``, ``B`` (with the hand and
+  gravity's gradient) under a wall ``K w w^T``, discretized exactly under a zero-order hold, as one linear map of the
+  sampled state; the limit is the smallest ``K`` at which its spectral radius reaches 1 (:func:`loop_limits`).
+  :func:`joint_limits` is its one-joint case, the 1-DOF mass-damper ``J qdd + b qd = u`` of ``stability-boundary``
+  and ``zwidth`` (about ``2 b / T`` without compensation, ``b^2 / J`` with the seed's).
+- :func:`compensated_boundary`: the closed form of the 1-DOF limit with the seed's inertial compensator, no delay
+  and no virtual damper (derived below), the oracle of the simulation tests.
+- :func:`hapticdesign.simulation.boundary.simulated_boundary` (the simulation layer): the numba loop itself, ``K``
+  bisected on the growth of the oscillation.
 
-- :func:`exact_boundary`: the plant discretized exactly (``scipy.linalg.expm`` of the augmented
-  matrix), the closed loop written as one linear map of the sampled state, and the smallest
-  ``K`` at which its spectral radius reaches 1 (about ``2 b / T`` without compensation).
-- :func:`compensated_boundary`: the closed form of that limit with the inertial compensator,
-  no delay and no virtual damper (derived below), the oracle of the simulation tests.
-- :func:`hapticdesign.simulation.boundary.simulated_boundary` (the simulation layer): the numba
-  loop itself, ``K`` bisected on the growth of the oscillation.
+The 1-DOF law with the compensator (model inertia ``J_m = c J``, ``c = 1 - E/100`` for a modelling error of E
+percent) is ``u = J_m a - K q - B qd``, ``a`` the acceleration sampled under the previous held torque.
 
 The closed form. Over one period the held torque moves the plant (``k_p = 0``) by
 ``v+ = a v + (1 - a) u / b`` and ``q+ = q + J (1 - a) v / b + (T/b - J (1 - a)/b^2) u`` with
@@ -51,7 +53,6 @@ against the spectral radius of the exactly discretized loop and the simulated lo
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -61,141 +62,12 @@ from hapticdesign.errors import InputError, UserError
 from hapticdesign.workload import EIGEN_ORDER_LIMIT, require_memory, require_within
 
 
-@dataclass(frozen=True)
-class MassDamper:
-    """A 1-DOF inertia ``J`` (kg m^2) with viscous damping ``b`` (N m s/rad), sampled every ``T``."""
-
-    inertia: float
-    damping: float
-    period: float
-    delay_samples: int = 0
-    virtual_damping: float = 0.0
-    compensate_inertia: bool = False
-    model_inertia: float | None = None
-    plant_stiffness: float = 0.0
-
-    def __post_init__(self) -> None:
-        _check(self)
-
-    @property
-    def j_model(self) -> float:
-        return self.inertia if self.model_inertia is None else self.model_inertia
-
-
-@dataclass(frozen=True)
-class MassDampers:
-    """Many :class:`MassDamper` s at once (each numeric field a number or an array of S values) that share the delay
-    and the use of the compensator: the systems of one batched boundary search."""
-
-    inertia: np.ndarray
-    damping: np.ndarray
-    period: np.ndarray | float
-    delay_samples: int = 0
-    virtual_damping: np.ndarray | float = 0.0
-    compensate_inertia: bool = False
-    model_inertia: np.ndarray | None = None
-    plant_stiffness: np.ndarray | float = 0.0
-
-    def __post_init__(self) -> None:
-        size = np.broadcast_shapes(*(np.shape(getattr(self, name)) for name in _NUMERIC
-                                     if getattr(self, name) is not None))
-        for name in _NUMERIC:
-            value = getattr(self, name)
-            if value is not None:
-                object.__setattr__(self, name, np.broadcast_to(np.asarray(value, dtype=float), size).ravel())
-        _check(self)
-
-    @classmethod
-    def of(cls, systems: Sequence[MassDamper]) -> "MassDampers":
-        """The systems ``systems`` (one delay, compensated all or none) as one batch."""
-        if len({(s.delay_samples, s.compensate_inertia) for s in systems}) > 1:
-            raise UserError("a batch of mass-dampers shares the delay and the use of the compensator")
-        first = systems[0]
-        return cls(*(np.array([getattr(s, name) for s in systems], dtype=float) for name in _NUMERIC[:3]),
-                   first.delay_samples, np.array([s.virtual_damping for s in systems], dtype=float),
-                   first.compensate_inertia, np.array([s.j_model for s in systems], dtype=float),
-                   np.array([s.plant_stiffness for s in systems], dtype=float))
-
-    def __len__(self) -> int:
-        return len(self.inertia)
-
-    @property
-    def j_model(self) -> np.ndarray:
-        return self.inertia if self.model_inertia is None else self.model_inertia
-
-
-_NUMERIC = ("inertia", "damping", "period", "virtual_damping", "model_inertia", "plant_stiffness")
-
-
-def _check(system: MassDamper | MassDampers) -> None:
-    """The one-line refusals of a mass-damper's (or a batch's) values."""
-    for name in ("inertia", "period"):
-        value = getattr(system, name)
-        if not np.all((np.asarray(value) > 0) & np.isfinite(value)):
-            raise UserError(f"the {name} must be positive, got {_worst(value)}")
-    if not np.all((np.asarray(system.damping) >= 0) & np.isfinite(system.damping)):
-        raise UserError(f"the damping must be non-negative, got {_worst(system.damping)}")
-    if system.delay_samples < 0:
-        raise InputError(f"the sensor delay must be a non-negative number of samples, got {system.delay_samples}",
-                         "delay")
-    if not np.all((np.asarray(system.virtual_damping) >= 0) & np.isfinite(system.virtual_damping)):
-        raise InputError(f"the wall damping must be a finite number >= 0, got {_worst(system.virtual_damping)}",
-                         "wall_damping")
-    if not np.all((np.asarray(system.plant_stiffness) >= 0) & np.isfinite(system.plant_stiffness)):
-        raise UserError(f"the plant stiffness must be non-negative, got {_worst(system.plant_stiffness)}")
-    if system.model_inertia is not None and not np.all((np.asarray(system.model_inertia) >= 0)
-                                                       & np.isfinite(system.model_inertia)):
-        raise UserError(f"the model inertia must be non-negative, got {_worst(system.model_inertia)}")
-
-
-def _worst(value) -> float:
-    """The value a refusal names: the number itself, or a batch's smallest (or first non-finite) value."""
-    values = np.ravel(np.asarray(value, dtype=float))
-    bad = values[~np.isfinite(values)]
-    return float(bad[0] if bad.size else values.min())
-
-
-def _discretize(j: np.ndarray, b: np.ndarray, t: np.ndarray, k_p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Exact zero-order-hold discretization of ``J qdd + b qd + k_p q = u`` over one period, for S systems at once
-    (arrays of S values): ``Phi`` (S, 2, 2) and ``Gamma`` (S, 2).
-
-    Without a plant spring, in closed form (``x = b T / J``, ``a = e^-x``)::
-
-        Phi = [[1, T h1], [0, a]],   Gamma = [T^2 h2 / J, T h1 / J],
-        h1 = (1 - e^-x) / x,   h2 = (x - 1 + e^-x) / x^2
-
-    (series below x = 1, 1 and 1/2 at x = 0); with one, ``scipy.linalg.expm`` of the augmented matrix.
-    """
-    x = b * t / j
-    small = x < 1.0
-    xs, xl = np.where(small, x, 0.0), np.where(small, 1.0, x)
-    h1 = np.where(small, _series(xs, _H1), -np.expm1(-xl) / xl)
-    h2 = np.where(small, _series(xs, _H2), (xl + np.expm1(-xl)) / xl ** 2)
-    phi = np.zeros((len(x), 2, 2))
-    phi[:, 0, 0] = 1.0
-    phi[:, 0, 1] = t * h1
-    phi[:, 1, 1] = np.exp(-x)
-    gamma = np.stack([t * t * h2 / j, t * h1 / j], axis=1)
-    spring = np.flatnonzero(k_p != 0.0)
-    if spring.size:
-        aug = np.zeros((spring.size, 3, 3))
-        aug[:, 0, 1] = 1.0
-        aug[:, 1, 0] = -k_p[spring] / j[spring]
-        aug[:, 1, 1] = -b[spring] / j[spring]
-        aug[:, 1, 2] = 1.0 / j[spring]
-        e = expm(aug * t[spring, None, None])
-        phi[spring], gamma[spring] = e[:, :2, :2], e[:, :2, 2]
-    return phi, gamma
-
-
 def _taylor(first: int, term) -> np.ndarray:
     """The coefficients of ``sum_(n >= first) term(n) x^n / n!`` up to ``x^(first + 39)`` (zeros below ``first``):
     double precision for ``0 <= x < 1``."""
     return np.array([term(n) / math.factorial(n) if n >= first else 0.0 for n in range(first + 40)])
 
 
-_H1 = _taylor(0, lambda n: (-1) ** n / (n + 1))
-_H2 = _taylor(0, lambda n: (-1) ** n / ((n + 1) * (n + 2)))
 _G = _taylor(2, lambda n: (-1) ** n * (n - 1))
 _F = _taylor(3, lambda n: (-1) ** (n - 1) * (n - 2))
 
@@ -254,40 +126,10 @@ def compensated_boundary(inertia: float, damping: float, period: float, fraction
 class SpringLoops:
     """The one-sample maps of S sampled loops in which the wall's spring ``K`` enters as a rank-one term,
     ``m(K) = m(0) - K g h^T`` (``base`` (S, N, N), ``g`` and ``h`` (S, N)), so a search builds the spring-free maps
-    once: the 1-DOF loops of :meth:`of` and the n-joint handle loops of :func:`handle_loops`."""
+    once (the loops of :func:`handle_loops`)."""
 
     def __init__(self, base: np.ndarray, g: np.ndarray, h: np.ndarray):
         self.base, self.g, self.h = base, g, h
-
-    @classmethod
-    def of(cls, systems: MassDampers) -> "SpringLoops":
-        """The loops of 1-DOF mass-dampers, state ``[q, qd, u_prev, s_(k-1), ..., s_(k-d)]`` with ``s = (q, qd,
-        a)``: the spring enters one column ``c``, that of ``q`` in the law, through ``g = (Gamma, 1)``."""
-        j, b, d = systems.inertia, systems.damping, systems.delay_samples
-        phi, gamma = _discretize(j, b, systems.period, systems.plant_stiffness)
-        count, size = len(j), 3 + 3 * d
-        sense = np.zeros((count, 3, 3))  # s_k from z_k
-        sense[:, 0, 0] = 1.0
-        sense[:, 1, 1] = 1.0
-        sense[:, 2, 0] = -systems.plant_stiffness / j
-        sense[:, 2, 1] = -b / j
-        sense[:, 2, 2] = 1.0 / j
-        gains = np.stack([np.zeros(count), -systems.virtual_damping,
-                          float(systems.compensate_inertia) * systems.j_model], axis=1)
-        law = np.einsum("si,sij->sj", gains, sense) if d == 0 else np.concatenate(
-            [np.zeros((count, 3 + 3 * (d - 1))), gains], axis=1)
-        m = np.zeros((count, size, size))
-        m[:, :2, :2] = phi
-        m[:, :2] += gamma[:, :, None] * law[:, None, :]
-        m[:, 2] = law
-        if d > 0:
-            m[:, 3:6, :3] = sense
-            m[:, 6:, 3:size - 3] = np.eye(size)[3:size - 3, 3:size - 3]
-        g = np.zeros((count, size))
-        g[:, :3] = np.concatenate([gamma, np.ones((count, 1))], axis=1)
-        h = np.zeros((count, size))
-        h[:, 0 if d == 0 else size - 3] = 1.0
-        return cls(m, g, h)
 
     def __len__(self) -> int:
         return len(self.base)
@@ -302,36 +144,10 @@ class SpringLoops:
         return np.abs(np.linalg.eigvals(self.matrices(stiffness, index))).max(axis=-1)
 
 
-def closed_loop_matrix(system: MassDamper, stiffness: float) -> np.ndarray:
-    """One-sample map of ``[q, qd, u_prev, s_(k-1), ..., s_(k-d)]`` with ``s = (q, qd, a)`` (:class:`SpringLoops`)."""
-    return SpringLoops.of(MassDampers.of([system])).matrices(np.array([stiffness]))[0]
-
-
-def spectral_radius(system: MassDamper, stiffness: float) -> float:
-    return float(SpringLoops.of(MassDampers.of([system])).radii(np.array([stiffness]))[0])
-
-
 FLOOR = 1e-9
 """The smallest spring of the search: a loop unstable already there has the limit 0."""
 RTOL, XTOL = 1e-10, 1e-12
 """The search stops when the stable and unstable springs are within ``XTOL + RTOL K`` of each other."""
-
-
-def exact_boundary(system: MassDamper, k_max: float = 1e9) -> float:
-    """Smallest spring stiffness at which the exactly discretized loop loses stability (:func:`exact_boundaries`)."""
-    return float(exact_boundaries(MassDampers.of([system]), k_max=k_max)[0])
-
-
-def exact_boundaries(systems: MassDampers, groups: np.ndarray | None = None, k_max: float = 1e9) -> np.ndarray:
-    """The exact limit of each 1-DOF system (S,), or the smallest in each group (``groups``: S labels 0 ... G - 1;
-    (G,)), by :func:`loop_limits` from the passivity scale ``2 (b + B) / (T (1 + 2 d))`` (Colgate's bound with a
-    delay of ``d`` samples)."""
-    order = 3 + 3 * systems.delay_samples
-    what = f"the closed-loop matrices of {len(systems):,} loops with a {systems.delay_samples:,}-sample delay"
-    require_memory(what, 8.0 * order * order * len(systems))
-    require_within(what, order, EIGEN_ORDER_LIMIT, "rows")
-    guess = 2.0 * (systems.damping + systems.virtual_damping) / (systems.period * (1 + 2 * systems.delay_samples))
-    return loop_limits(SpringLoops.of(systems), guess, groups, k_max)
 
 
 def loop_limits(loops: SpringLoops, guess: np.ndarray, groups: np.ndarray | None = None,
@@ -405,7 +221,7 @@ def loop_limits(loops: SpringLoops, guess: np.ndarray, groups: np.ndarray | None
 
 
 class _Search:
-    """Which systems of :func:`exact_boundaries` still search: not done (``limit`` NaN, 0 for those unstable at the
+    """Which systems of :func:`loop_limits` still search: not done (``limit`` NaN, 0 for those unstable at the
     floor, set before), their group not settled at 0, and not left behind by another system of their group."""
 
     def __init__(self, group: np.ndarray, n_group: int, limit: np.ndarray):
@@ -486,7 +302,8 @@ class SampledLoop:
     fixed (none by default: a Cartesian wall acts with every actuated joint free, as under a user's hand).
     The defaults are what practice uses: 1 kHz, one sample of delay, backward-difference velocity, gravity
     compensation only; :meth:`seed` gives the seed's settings (full compensation, no delay, sampled velocity).
-    Gravity compensation is taken as exact, so about a pose the linearized plant has no gravity term."""
+    About a pose, gravity enters the linearized loop through its gradient: the plant's ``K_G = dG/dq`` and the
+    compensator's ``s K_G`` on the sensed pose (:attr:`gravity_share`)."""
 
     period: float = 1e-3
     delay: int = 1
@@ -533,6 +350,12 @@ class SampledLoop:
         0."""
         return 1.0 - self.model_error / 100.0 if self.compensation == "full" else 0.0
 
+    @property
+    def gravity_share(self) -> float:
+        """The share ``s`` of the gravity torque the compensator feeds forward: ``1 - E/100`` (its model's masses
+        carry the modelling error, and gravity is linear in them) unless the compensation is none, 0 then."""
+        return 0.0 if self.compensation == "none" else 1.0 - self.model_error / 100.0
+
     def as_dict(self) -> dict:
         """The settings as an output states them."""
         return {"rate": self.rate, "period": self.period, "delay_samples": self.delay, "velocity": self.velocity,
@@ -552,23 +375,25 @@ class SampledLoop:
 
 
 def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, spring: np.ndarray,
-                 loop: SampledLoop, poses: np.ndarray | None = None) -> tuple[SpringLoops, np.ndarray]:
+                 loop: SampledLoop, poses: np.ndarray | None = None,
+                 gravity: np.ndarray | None = None) -> tuple[SpringLoops, np.ndarray]:
     """The sampled loops of S handles under a wall whose spring acts on the joints as ``K w w^T`` (``spring``: the
     rows ``w`` (S, n); ``J_v^T u`` for a Cartesian wall along a unit ``u``, ``e_j`` for a wall on joint j), every
     joint free but ``loop.held``, and a starting guess of their limits (S,).
 
     ``jacobian`` ``J_v`` (P, 3, n), ``mass`` ``H`` (P, n, n) and ``damping`` ``B`` (n, n) or (P, n, n) of the
     actuated coordinates at the P poses the walls hold, ``poses`` (S,) the pose of each loop (default: loop s at
-    pose s, P = S), so that the plant of a pose walled along many directions is discretized once. The plant ``H_h qdd + B_h qd + K_h q = u`` (the hand's mass,
-    damping and stiffness added as ``x J_v^T J_v``) is discretized exactly under a zero-order hold
-    (``scipy.linalg.expm`` of the augmented matrix). Every period the controller holds, ``d`` samples late,
-    ``u_k = c H a_(k-d) - K w w^T q_(k-d) - B_w w w^T v^_(k-d)``, ``a`` the acceleration sampled
-    under the previous torque, ``v^`` the sampled velocity or the backward difference of positions. The state is
-    ``[x_k, ..., x_(k-L), u_(k-1), ..., u_(k-d-1)]`` (``x = (q, qd)``; the torques only with the compensator), and
-    ``K`` enters as the rank-one term of :class:`SpringLoops`. Without a hand's stiffness the displacements along
-    the wall (``w^T q = 0``) are free: each is a fixed point (eigenvalue 1) whatever ``K``, a neutral drift of the
-    handle along the wall, not an instability; they are deflated (the map restricted to the complement of that
-    invariant subspace, where the spring still enters as a rank-one term).
+    pose s, P = S), so that the plant of a pose walled along many directions is discretized once; ``gravity``
+    ``K_G = dG/dq`` (n, n) or (P, n, n) at those poses (None: 0). The plant ``H_h qdd + B_h qd + (K_h + K_G) q =
+    u`` (the hand's mass, damping and stiffness added as ``x J_v^T J_v``) is discretized exactly under a zero-order
+    hold (``scipy.linalg.expm`` of the augmented matrix). Every period the controller holds, ``d`` samples late,
+    ``u_k = c H a_(k-d) + s K_G q_(k-d) - K w w^T q_(k-d) - B_w w w^T v^_(k-d)``, ``a`` the acceleration sampled
+    under the previous torque, ``s K_G q`` the linearized gravity compensation
+    (:attr:`SampledLoop.gravity_share`), ``v^`` the sampled velocity or the backward difference of positions. The
+    state is ``[x_k, ..., x_(k-L), u_(k-1), ..., u_(k-d-1)]`` (``x = (q, qd)``; the torques only with the
+    compensator), and ``K`` enters as the rank-one term of :class:`SpringLoops`. The pose changes along the wall
+    (``w^T q = 0``) that no static stiffness resists are fixed points (eigenvalue 1) whatever ``K``, a neutral
+    drift of the handle along the wall, not an instability; they are deflated (:func:`_deflated`).
     """
     if any(not 0 <= j < jacobian.shape[-1] for j in loop.held):
         raise UserError(f"the held joints {[j + 1 for j in loop.held]} are not all joints of the device (1 to "
@@ -583,6 +408,10 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
     jtj = np.swapaxes(jv, 1, 2) @ jv
     hand = loop.hand or Hand()
     hh, bh, kp = h + hand.mass * jtj, b + hand.damping * jtj, hand.stiffness * jtj
+    held = np.zeros_like(kp)  # the compensator's gravity gradient, on the sensed pose
+    if gravity is not None:
+        grad = np.broadcast_to(np.asarray(gravity, dtype=float)[..., free, :][..., free], h.shape)
+        kp, held = kp + grad, loop.gravity_share * grad
     aug = np.zeros((len(h), 3 * n, 3 * n))
     aug[:, :n, n:2 * n] = np.eye(n)
     aug[:, n:2 * n, :n] = -np.linalg.solve(hh, kp)
@@ -590,7 +419,7 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
     aug[:, n:2 * n, 2 * n:] = np.linalg.inv(hh)
     e = expm(aug * loop.period)
     if poses is not None:  # each loop takes its pose's plant
-        e, h, hh, bh, kp = (x[np.asarray(poses, dtype=np.int64)] for x in (e, h, hh, bh, kp))
+        e, h, hh, bh, kp, held = (x[np.asarray(poses, dtype=np.int64)] for x in (e, h, hh, bh, kp, held))
     w = np.asarray(spring, dtype=float)[:, free]
     count = len(w)
     phi, gamma = e[:, :2 * n, :2 * n], e[:, :2 * n, 2 * n:]
@@ -607,6 +436,7 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
         law[:, :, u0 + n * d:u0 + n * (d + 1)] += feed
         law[:, :, nx * d:nx * d + n] -= feed @ kp
         law[:, :, nx * d + n:nx * (d + 1)] -= feed @ bh
+    law[:, :, nx * d:nx * d + n] += held
     if differenced:
         law[:, :, nx * d:nx * d + n] -= loop.virtual_damping / loop.period * ww
         law[:, :, nx * (d + 1):nx * (d + 1) + n] += loop.virtual_damping / loop.period * ww
@@ -627,37 +457,102 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
         g[:, u0:u0 + n] = w
     hvec = np.zeros((count, size))
     hvec[:, nx * d:nx * d + n] = w
-    if hand.stiffness == 0.0 and n > 1:
-        m, g, hvec = _deflated(m, g, hvec, w, n, depth)
+    if n > 1:
+        net = (kp - held) * loop.period ** 2 / np.linalg.norm(hh, axis=(1, 2))[:, None, None]
+        m, g, hvec = _deflated(m, g, hvec, w, net, held, depth, u0 if compensated else None)
     reach = np.einsum("sn,sn->s", w, w)
     viscous = np.einsum("sn,snm,sm->s", w, bh, w) / np.maximum(reach, 1e-300) ** 2 + loop.virtual_damping
     guess = np.maximum(2.0 * viscous / (loop.period * (1 + 2 * d)), FLOOR)
     return SpringLoops(m, g, hvec), guess
 
 
-def _deflated(m: np.ndarray, g: np.ndarray, h: np.ndarray, w: np.ndarray, n: int,
-              depth: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The maps restricted to the complement of the fixed points ``[q*, 0, q*, 0, ..., 0]`` (``w^T q* = 0``): in an
-    orthonormal basis ``[Q1 Q2]`` with ``Q1`` spanning them the map is block triangular, so the other eigenvalues
-    are those of ``Q2^T m Q2`` (and the spring's term stays rank one, ``(Q2^T g)(Q2^T h)^T``)."""
+def _deflated(m: np.ndarray, g: np.ndarray, h: np.ndarray, w: np.ndarray, net: np.ndarray, held: np.ndarray,
+              depth: int, u0: int | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The maps with their spring-independent fixed points removed: a pose change ``q*`` along the wall (``w^T q* =
+    0``) that no static stiffness resists (``(K_h + (1 - s) K_G) q* = 0``; ``net`` that stiffness times ``T^2 /
+    |H_h|``, the share of the inertia's scale it reaches over a period) is held still whatever ``K`` (the state
+    ``[q*, 0, q*, 0, ..., 0]``, the torque buffer ``s K_G q*``; ``held`` ``s K_G``): eigenvalue 1, a
+    neutral drift of the handle along the wall, not an instability. In an orthonormal basis ``[Q1 Q2]`` with ``Q1``
+    spanning them the map is block triangular, so the other eigenvalues are those of ``Q2^T m Q2`` (and the spring's
+    term stays rank one, ``(Q2^T g)(Q2^T h)^T``); when the loops have different numbers of them, ``(I - P) m (I -
+    P)`` with ``P`` the orthogonal projector on them has the same eigenvalues and zeros, at one size for all."""
     count, size = m.shape[0], m.shape[1]
-    null = np.linalg.svd(w[:, None, :])[2][:, 1:, :]  # (S, n - 1, n): rows orthogonal to w
-    fixed = np.zeros((count, size, n - 1))
+    n = w.shape[1]
+    rows = np.concatenate([(w / np.linalg.norm(w, axis=1, keepdims=True))[:, None, :], net], axis=1)
+    _, sv, vt = np.linalg.svd(rows)
+    free = sv <= NULL_TOL  # the last rows of vt (singular values descending)
+    ranks = free.sum(axis=1)
+    uniform = bool(np.all(ranks == ranks[0]))
+    null = vt[:, n - ranks[0]:, :] if uniform else vt * free[:, :, None]  # rows spanning the fixed pose changes
+    r = null.shape[1]
+    if r == 0:
+        return m, g, h
+    fixed = np.zeros((count, size, r))
     for k in range(depth + 1):
         fixed[:, 2 * n * k:2 * n * k + n] = np.swapaxes(null, 1, 2)
-    q = np.linalg.qr(fixed, mode="complete")[0][:, :, n - 1:]
-    qt = np.swapaxes(q, 1, 2)
-    return qt @ m @ q, np.einsum("sji,sj->si", q, g), np.einsum("sji,sj->si", q, h)
+    if u0 is not None:
+        torque = held @ np.swapaxes(null, 1, 2)
+        for k in range((size - u0) // n):
+            fixed[:, u0 + n * k:u0 + n * (k + 1)] = torque
+    if uniform:
+        q = np.linalg.qr(fixed, mode="complete")[0][:, :, r:]
+        qt = np.swapaxes(q, 1, 2)
+        return qt @ m @ q, np.einsum("sji,sj->si", q, g), np.einsum("sji,sj->si", q, h)
+    keep = np.eye(size) - fixed @ np.linalg.pinv(fixed)
+    return keep @ m @ keep, np.einsum("sij,sj->si", keep, g), np.einsum("sij,sj->si", keep, h)
+
+
+NULL_TOL = 1e-9
+"""A pose change along the wall is free when the static stiffness resists it by less than this (singular values of
+the wall's unit row stacked on the stiffness in units of ``|H_h| / T^2``): a balanced device's rounding-level
+gravity gradient leaves the drift free."""
 
 
 def handle_limits(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, spring: np.ndarray,
                   loop: SampledLoop, groups: np.ndarray | None = None, k_max: float = 1e9,
-                  poses: np.ndarray | None = None) -> np.ndarray:
+                  poses: np.ndarray | None = None, gravity: np.ndarray | None = None) -> np.ndarray:
     """The exact stable wall stiffness (N/m) of each handle loop of :func:`handle_loops` (S,), or the smallest in
     each group (:func:`loop_limits`)."""
-    loops, guess = handle_loops(jacobian, mass, damping, spring, loop, poses)
+    loops, guess = handle_loops(jacobian, mass, damping, spring, loop, poses, gravity)
     order = loops.base.shape[-1]
     what = f"the closed-loop matrices of {len(loops):,} handle loops of order {order}"
     require_memory(what, 8.0 * order * order * len(loops))
     require_within(what, order, EIGEN_ORDER_LIMIT, "rows")
     return loop_limits(loops, guess, groups, k_max)
+
+
+def _joint(inertia, damping) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The handle arrays of S one-joint plants (``J_v`` the unit x axis, ``H = J``, ``B = b``, the wall's row 1)."""
+    j, b = np.broadcast_arrays(np.asarray(inertia, dtype=float), np.asarray(damping, dtype=float))
+    j, b = j.ravel(), b.ravel()
+    if not np.all((j > 0) & np.isfinite(j)):
+        raise UserError(f"the inertia must be positive, got {_worst(j)}")
+    if not np.all((b >= 0) & np.isfinite(b)):
+        raise UserError(f"the damping must be non-negative, got {_worst(b)}")
+    axis = np.broadcast_to(np.array([[1.0], [0.0], [0.0]]), (len(j), 3, 1))
+    return axis, j[:, None, None], b[:, None, None], np.ones((len(j), 1))
+
+
+def joint_loops(inertia, damping, loop: SampledLoop) -> SpringLoops:
+    """The sampled loops of 1-DOF plants, a joint of inertia ``J`` (kg m^2, or kg) and damping ``b`` (N m s/rad, or
+    N s/m) each (numbers or S values) under the wall on it and the settings ``loop`` (a hand adds its mass, damping
+    and stiffness to the joint's): the one-joint case of :func:`handle_loops`."""
+    return handle_loops(*_joint(inertia, damping), loop)[0]
+
+
+def joint_limits(inertia, damping, loop: SampledLoop, groups: np.ndarray | None = None,
+                 k_max: float = 1e9) -> np.ndarray:
+    """The exact limits (S,) of the loops of :func:`joint_loops`, or the smallest in each group
+    (:func:`handle_limits`)."""
+    return handle_limits(*_joint(inertia, damping), loop, groups, k_max)
+
+
+def joint_limit(inertia: float, damping: float, loop: SampledLoop, k_max: float = 1e9) -> float:
+    """:func:`joint_limits` of one joint."""
+    return float(joint_limits(inertia, damping, loop, k_max=k_max)[0])
+
+
+def _worst(values: np.ndarray) -> float:
+    """The value a refusal names: the first non-finite value, else the smallest."""
+    bad = values[~np.isfinite(values)]
+    return float(bad[0] if bad.size else values.min())

@@ -2,8 +2,8 @@
 
 A wall along a unit direction ``u`` at the handle acts on the joints as the spring ``K J_v^T u u^T J_v``; with every
 actuated joint free (as under a user's hand; :attr:`~hapticdesign.analysis.sampled_loop.SampledLoop.held` names the
-ones held) the n-joint plant ``H``, ``B`` (and the hand of the loop's settings) discretized exactly and the sampled
-controller form one linear map whose spectral radius reaches 1 at the limit
+ones held) the n-joint plant ``H``, ``B`` (the hand of the loop's settings and gravity's gradient at the pose in it)
+discretized exactly and the sampled controller form one linear map whose spectral radius reaches 1 at the limit
 (:func:`hapticdesign.analysis.sampled_loop.handle_limits`). This is not the 1-DOF model of the handle along ``u``
 (mass ``1 / (u^T J_v H^-1 J_v^T u)``, damping ``u^T J_v^+T B J_v^+ u``): the two agree where ``u`` is a principal
 direction of both the handle's mobility and its damping, and differ elsewhere, where the other directions' motion
@@ -71,22 +71,25 @@ CHUNK_BYTES = 1 << 24
 
 
 def wall_limit(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, loop: SampledLoop | None = None,
-               direction: np.ndarray | None = None) -> float:
+               direction: np.ndarray | None = None, gravity: np.ndarray | None = None) -> float:
     """The exact stable wall stiffness (N/m) at one pose along ``direction`` (a unit base-frame 3-vector), or the
-    smallest over :func:`wall_directions` when it is None (see the module docstring)."""
+    smallest over :func:`wall_directions` when it is None (see the module docstring); ``gravity`` the gradient
+    ``dG/dq`` (n, n) at the pose (None: 0)."""
     along = None if direction is None else np.reshape(direction, (1, 1, 3))
-    return float(wall_limits(jacobian[None], mass[None], damping, loop, along)[0])
+    return float(wall_limits(jacobian[None], mass[None], damping, loop, along,
+                             None if gravity is None else np.asarray(gravity)[None])[0])
 
 
 def wall_limits(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, loop: SampledLoop | None = None,
-                along: np.ndarray | None = None) -> np.ndarray:
+                along: np.ndarray | None = None, gravity: np.ndarray | None = None) -> np.ndarray:
     """:func:`wall_limit` at P poses at once: ``jacobian`` ``J_v`` (P, 3, n), ``mass`` ``H`` (P, n, n), ``damping``
-    ``B`` (n, n) or (P, n, n); ``along`` None (the worst of :func:`wall_directions`) or (P, C, 3) unit base-frame
-    rows (the smallest over them); (P,) in N/m, the loops searched together in chunks of about
-    :data:`CHUNK_BYTES` of matrices."""
+    ``B`` (n, n) or (P, n, n), ``gravity`` ``dG/dq`` (P, n, n) or None; ``along`` None (the worst of
+    :func:`wall_directions`) or (P, C, 3) unit base-frame rows (the smallest over them); (P,) in N/m, the loops
+    searched together in chunks of about :data:`CHUNK_BYTES` of matrices."""
     loop = loop or SampledLoop()
     jacobian, mass = np.asarray(jacobian, dtype=float), np.asarray(mass, dtype=float)
     damping = np.broadcast_to(np.asarray(damping, dtype=float), mass.shape)
+    gravity = np.zeros_like(mass) if gravity is None else np.broadcast_to(np.asarray(gravity, dtype=float), mass.shape)
     if along is None:
         basis, mobility, cartesian_damping = handle_range(jacobian, mass, damping)
         along = np.einsum("pik,pck->pci", basis, wall_directions(mobility, cartesian_damping))
@@ -102,21 +105,22 @@ def wall_limits(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, loo
         rows = np.repeat(np.arange(start, start + size), per_point)
         spring = np.einsum("sk,skn->sn", along[part].reshape(-1, 3), jacobian[rows])
         out[part] = handle_limits(jacobian[part], mass[part], damping[part], spring, loop,
-                                  np.repeat(np.arange(size), per_point), poses=rows - start)
+                                  np.repeat(np.arange(size), per_point), poses=rows - start, gravity=gravity[part])
     return out
 
 
-def worst_direction(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray,
-                    loop: SampledLoop | None = None) -> tuple[float, np.ndarray]:
+def worst_direction(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, loop: SampledLoop | None = None,
+                    gravity: np.ndarray | None = None) -> tuple[float, np.ndarray]:
     """The smallest exact wall limit at one pose over :func:`wall_directions` and the direction (unit, base frame)
-    that gives it (every direction searched to the end)."""
+    that gives it (every direction searched to the end); ``gravity`` ``dG/dq`` (n, n) at the pose or None."""
     loop = loop or SampledLoop()
     jacobian, mass = np.asarray(jacobian, dtype=float)[None], np.asarray(mass, dtype=float)[None]
     damping = np.broadcast_to(np.asarray(damping, dtype=float), mass.shape)
     basis, mobility, cartesian_damping = handle_range(jacobian, mass, damping)
     along = np.einsum("ik,ck->ci", basis[0], wall_directions(mobility, cartesian_damping)[0])
     count = len(along)
-    limits = handle_limits(jacobian, mass, damping, along @ jacobian[0], loop, poses=np.zeros(count, dtype=np.int64))
+    limits = handle_limits(jacobian, mass, damping, along @ jacobian[0], loop, poses=np.zeros(count, dtype=np.int64),
+                           gravity=None if gravity is None else np.asarray(gravity, dtype=float)[None])
     best = int(np.argmin(limits))
     return float(limits[best]), along[best]
 
@@ -174,10 +178,11 @@ def _hand(value: object) -> Hand | None:
 
 
 def kmax(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray,
-         ranges: tuple[np.ndarray, np.ndarray, np.ndarray], options: Mapping[str, object]) -> np.ndarray:
+         ranges: tuple[np.ndarray, np.ndarray, np.ndarray], options: Mapping[str, object],
+         gravity: np.ndarray | None = None) -> np.ndarray:
     """The ``kmax`` index (N/m) at P poses: ``J_v`` (P, 3, n), ``H`` (P, n, n), ``B`` (n, n) or (P, n, n), the
     handle's range as :func:`handle_range` gives it (the basis ``U``, mobility and damping in it, already known to
-    the caller) and the options of :data:`KMAX_OPTIONS`."""
+    the caller), the options of :data:`KMAX_OPTIONS` and gravity's gradient ``dG/dq`` (P, n, n) or None."""
     loop, direction = kmax_loop(options)
     basis, mobility, cartesian_damping = ranges
     if direction is None:
@@ -188,4 +193,4 @@ def kmax(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray,
             raise UserError(f"index kmax: the direction {np.round(direction, 6).tolist()} is not one the handle "
                             "moves in")
         along = np.broadcast_to(direction, (len(jacobian), 1, 3))
-    return wall_limits(jacobian, mass, damping, loop, along)
+    return wall_limits(jacobian, mass, damping, loop, along, gravity)

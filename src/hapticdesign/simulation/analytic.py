@@ -14,10 +14,10 @@ wall, a hand or a closed-loop device in type 2 keeps the start-pose loop (``exac
 (:meth:`AnalyticProblem.grows`) takes the loop where the wall holds the joint (:func:`equilibrium_pose`): the free
 joint travels to the spring's rest and oscillates there, so stability is decided there, not at the start.
 
-The seed's criteria are then evaluated on the exact linear response: the closed loop of
-:mod:`.zwidth` (plant discretized exactly, digital side as a discrete state-space system) gives
-the state at every sample, and the exact sub-sample transition of the plant under the held torque
-gives the excursion at every plant step (as the simulation checks it). No ODE is integrated.
+The seed's criteria are then evaluated on the exact linear response: the closed loop (plant discretized exactly,
+:func:`_plant`; the digital side a discrete state-space system, :func:`_controller`) gives the state at every
+sample, and the exact sub-sample transition of the plant under the held torque gives the excursion at every plant
+step (as the simulation checks it). No ODE is integrated.
 Quantized encoders and Coulomb friction are not linear: the analytic method refuses them.
 
 A Cartesian wall (spring K in N/m, damper B in N s/m along n at the handle) acts on the free joint w
@@ -46,7 +46,6 @@ from hapticdesign.simulation.config import (
     LoopConfig, compensator_device, handle_jacobian, normal_jacobian, plant_friction, rest_pose,
 )
 from hapticdesign.simulation.criteria import Verdict, WallProblem, type_paths
-from hapticdesign.simulation.zwidth import DisplayLoop, controller, plant
 
 
 GROWS = "oscillation grows"
@@ -67,14 +66,62 @@ def one_blas_thread():
 
 @dataclass(frozen=True)
 class WallJoint:
-    """The wall joint linearized at the start pose: the 1-DOF loop, the constant torque on it, and
-    ``scale``, the wall coordinate per unit of the joint (1 for a joint wall, ``J_n,w`` for a
-    Cartesian wall: its spring and damper act on the joint as ``K J_n,w^2`` and ``B J_n,w^2``)."""
+    """The wall joint linearized at the start pose: its inertia ``J``, damping ``b`` and physical spring ``k_p`` (a
+    hand's), the compensator's share ``c`` of ``J a``, the constant torque on it, and ``scale``, the wall coordinate
+    per unit of the joint (1 for a joint wall, ``J_n,w`` for a Cartesian wall: its spring and damper act on the joint
+    as ``K J_n,w^2`` and ``B J_n,w^2``)."""
 
-    loop: DisplayLoop
+    inertia: float
+    damping: float
+    stiffness: float
+    fraction: float
     torque: float
     exact: bool
     scale: float = 1.0
+
+
+def _plant(wall: WallJoint, step: float) -> tuple[np.ndarray, np.ndarray]:
+    """``J qdd + b qd + k_p q = u`` over ``step`` under a held ``u``, exactly (``scipy.linalg.expm`` of the augmented
+    matrix): ``Phi`` (2, 2) and ``Gamma`` (2,) of ``(q, qd)``."""
+    a = np.zeros((3, 3))
+    a[0, 1] = 1.0
+    a[1, 0] = -wall.stiffness / wall.inertia
+    a[1, 1] = -wall.damping / wall.inertia
+    a[1, 2] = 1.0 / wall.inertia
+    e = expm(a * step)
+    return e[:2, :2], e[:2, 2]
+
+
+def _controller(wall: WallJoint, delay: int, stiffness: float,
+                virtual_damping: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The digital side ``(A, B, C, D)`` from ``(q_k, v_k)`` to ``u_k = -K q_(k-N) - B v_(k-N) + c (u_(k-N-1) -
+    b v_(k-N) - k_p q_(k-N))`` (the sampled velocity, the seed's), state ``q_(k-1..k-N-1)``, ``v_(k-1..k-N)``,
+    ``u_(k-1..k-N-1)``."""
+    n = delay
+    nq, nv, nu = n + 1, n, n + 1
+    size = nq + nv + nu
+    c, d = np.zeros(size), np.zeros(2)
+
+    def add(signal: str, lag: int, gain: float) -> None:
+        """Add ``gain * signal_(k - lag)`` to the output."""
+        if lag == 0:
+            d["qv".index(signal)] += gain
+        else:
+            c[{"q": 0, "v": nq, "u": nq + nv}[signal] + lag - 1] += gain
+
+    add("q", n, -stiffness - wall.fraction * wall.stiffness)
+    add("v", n, -virtual_damping - wall.fraction * wall.damping)
+    add("u", n + 1, wall.fraction)
+    a, b = np.zeros((size, size)), np.zeros((size, 2))
+    b[0, 0] = 1.0  # q_k enters the position line
+    a[1:nq, 0:nq - 1] = np.eye(nq - 1)
+    if nv:
+        b[nq, 1] = 1.0
+        a[nq + 1:nq + nv, nq:nq + nv - 1] = np.eye(nv - 1)
+    a[nq + nv] = c  # u_k enters the torque line
+    b[nq + nv] = d
+    a[nq + nv + 1:, nq + nv:size - 1] = np.eye(nu - 1)
+    return a, b, c[None, :], d[None, :]
 
 
 def linear_loop(device: Device, config: LoopConfig) -> bool:
@@ -145,14 +192,13 @@ def linearize(device: Device, sim_type: int, wall_joint: int, config: LoopConfig
     comp = config.compensator
     fraction = float(mass_matrix(model, q0)[w, w]) / j_device if comp.inertial else 0.0
     torque = -(float(g[w]) - comp.gravity * float(gravity(model, q0)[w]))
-    loop = DisplayLoop(j, b, config.sensors.period, config.sensors.delay_samples, "sampled", fraction, spring)
     exact = sim_type == 1 or _decoupled(device, w, paths, rest)
     if not config.wall.cartesian:
-        return WallJoint(loop, torque, exact)
+        return WallJoint(j, b, spring, fraction, torque, exact)
     scale = float(normal_jacobian(device, config.wall, q0)[w])
     if abs(scale) < 1e-12:
         raise UserError(f"joint {w + 1} does not move the handle along the wall direction at the start pose")
-    return WallJoint(loop, torque, exact and _linear_along_wall(device, config, w, q0, paths), scale)
+    return WallJoint(j, b, spring, fraction, torque, exact and _linear_along_wall(device, config, w, q0, paths), scale)
 
 
 def _linear_along_wall(device: Device, config: LoopConfig, w: int, q0: np.ndarray, paths: dict) -> bool:
@@ -178,17 +224,11 @@ def _decoupled(device: Device, w: int, paths: dict, rest: np.ndarray) -> bool:
     return all(np.abs(r - rows[0]).max() <= 1e-9 * scale for r in rows)
 
 
-def _sub_steps(loop: DisplayLoop, step: float, count: int) -> list[tuple[np.ndarray, np.ndarray]]:
+def _sub_steps(wall: WallJoint, step: float, count: int) -> list[tuple[np.ndarray, np.ndarray]]:
     """Exact transitions of ``(q, qd)`` over ``0, h, ..., (count - 1) h`` under a held torque:
     ``(Phi_j, Gamma_j)`` from one matrix exponential, ``Phi_(j+1) = Phi_h Phi_j``,
     ``Gamma_(j+1) = Phi_h Gamma_j + Gamma_h``."""
-    a = np.zeros((3, 3))
-    a[0, 1] = 1.0
-    a[1, 0] = -loop.plant_stiffness / loop.inertia
-    a[1, 1] = -loop.damping / loop.inertia
-    a[1, 2] = 1.0 / loop.inertia
-    e = expm(a * step)
-    phi_h, gamma_h = e[:2, :2], e[:2, 2]
+    phi_h, gamma_h = _plant(wall, step)
     steps = [(np.eye(2), np.zeros(2))]
     for _ in range(count - 1):
         phi, gamma = steps[-1]
@@ -227,12 +267,11 @@ class AnalyticProblem(WallProblem):
         self.rest = self.equilibrium / self.wall.scale  # the spring's rest in joint units
         self.sub = self.config.steps_per_sample()
         self.samples = int(round(self.config.duration / self.config.sensors.period))
-        loop = self.wall.loop
         self.driven = None
         with one_blas_thread():
-            self._plant = plant(loop)
-            self._held_plant = plant(self.held.loop)
-            self._steps = _sub_steps(loop, self.config.step, self.sub)
+            self._plant = _plant(self.wall, self.config.sensors.period)
+            self._held_plant = _plant(self.held, self.config.sensors.period)
+            self._steps = _sub_steps(self.wall, self.config.step, self.sub)
             if self._time_varying():
                 self.driven = self._driven_loop()
 
@@ -273,26 +312,24 @@ class AnalyticProblem(WallProblem):
         return self.sim_type == 1 or self.exact
 
     def estimate(self) -> float:
-        loop = self.wall.loop
-        joint = loop.damping ** 2 / loop.inertia if loop.fraction > 0 else 2.0 * loop.damping / loop.period
+        wall, period = self.wall, self.config.sensors.period
+        joint = wall.damping ** 2 / wall.inertia if wall.fraction > 0 else 2.0 * wall.damping / period
         return joint / self.wall.scale ** 2
 
     def _augmented(self, stiffness: float, wall: WallJoint | None = None) -> tuple[np.ndarray, np.ndarray, int]:
         """One-sample map of ``s = [q - q_eq, qd, controller state, 1]`` and the row giving ``u`` (of the loop
         ``wall``, default the start pose's)."""
         wall = wall or self.wall
-        loop, d = wall.loop, wall.torque
+        d = wall.torque
         s2 = wall.scale ** 2
-        ctrl = controller(loop, stiffness * s2, self.config.wall.damping * s2)
-        sampled = self._plant if wall is self.wall else self._held_plant
-        phi, gamma = np.asarray(sampled.A), np.asarray(sampled.B)[:, 0]
-        ac, bc, cc, dc = (np.asarray(m) for m in (ctrl.A, ctrl.B, ctrl.C, ctrl.D))
+        n = self.config.sensors.delay_samples
+        ac, bc, cc, dc = _controller(wall, n, stiffness * s2, self.config.wall.damping * s2)
+        phi, gamma = self._plant if wall is self.wall else self._held_plant
         nc = ac.shape[0]
-        n = loop.delay
         u_line = (n + 1) + n
         # the spring acts on q - q_eq; the rest of the hand's spring and the constant torque act on the plant
-        const = d - loop.plant_stiffness * self.rest
-        comp = loop.fraction * const
+        const = d - wall.stiffness * self.rest
+        comp = wall.fraction * const
         size = 2 + nc + 1
         m = np.zeros((size, size))
         u_row = np.concatenate([dc[0], cc[0], [comp]])
@@ -307,15 +344,14 @@ class AnalyticProblem(WallProblem):
 
     def _initial(self, u_line: int) -> np.ndarray:
         """The kernel's start: q = 0, qd = 0, the delay line holding the first sample, no acceleration."""
-        loop = self.wall.loop
-        n = loop.delay
+        n = self.config.sensors.delay_samples
         nc = (n + 1) + n + (n + 1)
         s = np.zeros(2 + nc + 1)
         e0 = -self.rest
         s[0] = e0
         s[2:2 + n + 1] = e0
-        const = self.wall.torque - loop.plant_stiffness * self.rest
-        s[2 + u_line:2 + nc] = loop.plant_stiffness * e0 - const  # the compensator sees a = 0 until samples arrive
+        const = self.wall.torque - self.wall.stiffness * self.rest
+        s[2 + u_line:2 + nc] = self.wall.stiffness * e0 - const  # the compensator sees a = 0 until samples arrive
         s[-1] = 1.0
         return s
 
@@ -325,7 +361,7 @@ class AnalyticProblem(WallProblem):
         m, u_row, u_line = self._augmented(stiffness)
         states = _powers(m, self._initial(u_line), self.samples)
         u = states @ u_row
-        const = self.wall.torque - self.wall.loop.plant_stiffness * self.rest
+        const = self.wall.torque - self.wall.stiffness * self.rest
         cols = [phi[0, 0] * states[:, 0] + phi[0, 1] * states[:, 1] + gamma[0] * (u + const)
                 for phi, gamma in self._steps]
         return (np.stack(cols, axis=1) + self.rest) * self.wall.scale

@@ -1,7 +1,7 @@
 """The simulated stability boundary of a 1-DOF mass-damper under a sampled virtual spring (seed 000 ch. 4, §5):
-the numba loop itself, ``K`` bisected on the growth of the oscillation (the envelope of the last quarter of the run
-against the second quarter). The exact limit of the same loop, its oracle, is
-:mod:`hapticdesign.analysis.sampled_loop`.
+the numba loop itself under the settings of a :class:`~hapticdesign.analysis.sampled_loop.SampledLoop`, ``K``
+bisected on the growth of the oscillation (the envelope of the last quarter of the run against the second quarter).
+The exact limit of the same loop, its oracle, is :func:`hapticdesign.analysis.sampled_loop.joint_limits`.
 """
 
 from __future__ import annotations
@@ -11,9 +11,9 @@ from collections.abc import Callable
 
 import numpy as np
 
-from hapticdesign.analysis.sampled_loop import MassDamper
+from hapticdesign.analysis.sampled_loop import SampledLoop
 from hapticdesign.errors import UserError
-from hapticdesign.simulation.config import Compensator, LoopConfig, Sensors, Wall
+from hapticdesign.simulation.config import Wall, loop_config
 from hapticdesign.simulation.loop import simulate_tables
 from hapticdesign.simulation.tables import DynamicsTables
 from hapticdesign.workload import require_plant_steps
@@ -21,29 +21,22 @@ from hapticdesign.workload import require_plant_steps
 BOUNDARY_RUNS = 42  # doublings from b / T to the 1e12 cap of :func:`simulated_boundary`
 
 
-def _config(system: MassDamper, stiffness: float, duration: float, step: float) -> LoopConfig:
-    return LoopConfig(
-        duration=duration,
-        step=step,
-        sensors=Sensors(period=system.period, delay_samples=system.delay_samples),
-        compensator=Compensator(inertial=system.compensate_inertia, coriolis=False, gravity=False),
-        wall=Wall(0, stiffness, system.virtual_damping, 0.01),
-        damping=(system.damping,),
-        safety_limit=None,
-        stop_excursion=1e6,
-    )
-
-
-def grows(system: MassDamper, stiffness: float, samples: int = 4000, substeps: int = 10) -> bool:
-    """True when the simulated oscillation about the equilibrium grows (last vs second quarter)."""
-    plant = DynamicsTables.constant_inertia(system.inertia)
-    model = DynamicsTables.constant_inertia(system.j_model)
-    cfg = _config(system, stiffness, samples * system.period, system.period / substeps)
-    spring = np.array([[system.plant_stiffness]])
-    trace = simulate_tables(plant, model, cfg, (system.damping,), hand=(np.zeros((1, 1)), np.zeros((1, 1)), spring))
+def grows(inertia: float, damping: float, loop: SampledLoop, stiffness: float, samples: int = 4000,
+          substeps: int = 10) -> bool:
+    """True when the simulated oscillation of the 1-DOF loop (inertia, damping, the settings ``loop``; a hand adds
+    its mass, damping and stiffness to the joint's) about the wall's rest grows (last vs second quarter)."""
+    cfg = loop_config(loop, Wall(0, stiffness, 0.0, 0.01), duration=samples * loop.period, step=loop.period / substeps,
+                      damping=(damping,), safety_limit=None, stop_excursion=1e6)
+    model = inertia * (1.0 - loop.model_error / 100.0)
+    plant = DynamicsTables.constant_inertia(inertia)
+    hand = loop.hand
+    spring = 0.0 if hand is None else hand.stiffness
+    trace = simulate_tables(plant, DynamicsTables.constant_inertia(model), cfg, (damping,),
+                            hand=None if hand is None else (np.array([[hand.mass]]), np.array([[hand.damping]]),
+                                                            np.array([[spring]])))
     if trace.diverged or len(trace.t) < samples + 1:
         return True
-    rest = stiffness * cfg.wall.equilibrium / (stiffness + system.plant_stiffness)
+    rest = stiffness * cfg.wall.equilibrium / (stiffness + spring)
     return envelope_grows(trace.q[:, 0] - rest)
 
 
@@ -54,14 +47,15 @@ def envelope_grows(error: np.ndarray, margin: float = 0.0) -> bool:
     return bool(err[3 * quarter:].max() > (1.0 + margin) * err[quarter:2 * quarter].max())
 
 
-def simulated_boundary(system: MassDamper, rel_tol: float = 1e-3, samples: int = 4000, substeps: int = 10) -> float:
-    """Bisect the simulated loop for the stiffness at which oscillations start to grow."""
+def simulated_boundary(inertia: float, damping: float, loop: SampledLoop, rel_tol: float = 1e-3, samples: int = 4000,
+                       substeps: int = 10) -> float:
+    """Bisect the simulated 1-DOF loop (:func:`grows`) for the stiffness at which oscillations start to grow."""
     if samples < 40 or substeps < 1:
         raise UserError("the growth test needs at least 40 samples and 1 plant step per sample")
     runs = BOUNDARY_RUNS + math.ceil(math.log2(1.0 / rel_tol))
     require_plant_steps(f"{runs} simulations of {samples:,} samples x {substeps:,} plant steps", runs * samples * substeps)
-    return growth_onset(lambda k: grows(system, k, samples, substeps), 0.0, system.damping / system.period + 1e-9,
-                        rel_tol, 1e12)
+    return growth_onset(lambda k: grows(inertia, damping, loop, k, samples, substeps), 0.0,
+                        damping / loop.period + 1e-9, rel_tol, 1e12)
 
 
 def growth_onset(grows: Callable[[float], bool], lo: float, hi: float, rel_tol: float, k_limit: float,

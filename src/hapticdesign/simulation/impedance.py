@@ -29,7 +29,7 @@ from functools import cached_property
 import numpy as np
 
 from hapticdesign.analysis.configuration import configuration_of, handle_pose
-from hapticdesign.analysis.dynamics.device import mass_matrix
+from hapticdesign.analysis.dynamics.device import gravity_gradient, mass_matrix
 from hapticdesign.analysis.sampled_loop import SampledLoop, handle_limits
 from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.device import Device
@@ -145,8 +145,9 @@ def stability_limit(device: Device, loop: SampledLoop | None = None, wall_joint:
                     direction=None, k_max: float = 1e9) -> StabilityLimit:
     """The exact stability limit of a wall on ``wall_joint`` (or along the Cartesian ``direction`` at the handle)
     with every actuated joint free but ``loop.held``, linearized where the wall holds the device (:func:`wall_pose`;
-    :func:`hapticdesign.analysis.sampled_loop.handle_limits`). Coulomb friction and quantization are left out: this
-    is the limit of the loop's linear part."""
+    :func:`hapticdesign.analysis.sampled_loop.handle_limits`; gravity through its gradient there, the share the
+    compensator leaves and the one it feeds back late). Coulomb friction and quantization are left out: this is the
+    limit of the loop's linear part."""
     require_device(device)
     loop = loop or SampledLoop()
     pose = wall_pose(device, wall_joint, equilibrium, direction)
@@ -158,7 +159,7 @@ def stability_limit(device: Device, loop: SampledLoop | None = None, wall_joint:
         if not np.linalg.norm(spring) > 1e-12 * max(np.linalg.norm(jv), 1e-300):
             raise UserError("the handle does not move along the wall's direction at the pose the wall holds")
     limit = handle_limits(jv[None], mass_matrix(device, pose)[None], device.damping_matrix, spring[None], loop,
-                          k_max=k_max)
+                          k_max=k_max, gravity=gravity_gradient(device, pose)[None])
     return StabilityLimit(float(limit[0]), pose, loop)
 
 

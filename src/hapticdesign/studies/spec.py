@@ -54,6 +54,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from hapticdesign.analysis.configuration import configuration_of, handle_pose
+from hapticdesign.analysis.dynamics.device import gravity_gradient
 from hapticdesign.analysis.metrics import force as polytope
 from hapticdesign.analysis.metrics.indices import INDICES, HandleStates
 from hapticdesign.errors import UserError
@@ -133,8 +134,9 @@ def backdrive_friction(device: Device, h: Handle) -> tuple[float, float] | None:
 
 def renderable_stiffness(device: Device, h: Handle, loop: SampledLoop | None = None) -> float:
     """The smallest exact wall limit over directions, every joint free
-    (:func:`hapticdesign.analysis.wall_stiffness.wall_limit`)."""
-    return wall_limit(h.jacobian, h.states.H[0], device.damping_matrix, loop or SampledLoop())
+    (:func:`hapticdesign.analysis.wall_stiffness.wall_limit`), gravity's gradient at the pose in the loop."""
+    return wall_limit(h.jacobian, h.states.H[0], device.damping_matrix, loop or SampledLoop(),
+                      gravity=gravity_gradient(device, h.q))
 
 
 TOUCH = 0.001
@@ -151,7 +153,8 @@ def renderable(device: Device, h: Handle, loop: SampledLoop, res: float | None,
     bounds from the sheet's resolution ``res`` and backdrive ``friction`` (see the module docstring)."""
     from hapticdesign.simulation.impedance import device_counts, simulated_limit
 
-    exact, direction = worst_direction(h.jacobian, h.states.H[0], device.damping_matrix, replace(loop, hand=None))
+    exact, direction = worst_direction(h.jacobian, h.states.H[0], device.damping_matrix, replace(loop, hand=None),
+                                       gravity_gradient(device, h.q))
     hand = loop.hand or GRASP
     counts = device_counts(device)
     simulated = None

@@ -86,6 +86,42 @@ def gravity(device: Device, q: np.ndarray) -> np.ndarray:
     return dynamics_of(device).G(q, device.standard_parameters())
 
 
+GRADIENT_STEP = 1e-6
+"""The step (rad or m) of :func:`gravity_gradient`'s central differences: G is smooth (trigonometric in the angles),
+so their truncation error, about ``step^2 |G'''| / 6``, is far below their rounding error (about 1e-10 of G)."""
+
+
+def gravity_gradient(device: Device, q: np.ndarray) -> np.ndarray:
+    """``K_G = dG/dq`` (n_a, n_a), the stiffness gravity adds to the linearized plant at the actuated pose ``q``
+    (``K_G[i, j] = dG_i / dq_j``; :func:`gravity_gradient_at` of the closed pose)."""
+    space = configuration_for(device.builder, device.kinematic_values())
+    return gravity_gradient_at(device, space.full(np.atleast_2d(np.asarray(q, dtype=float))))[0]
+
+
+def gravity_gradient_at(device: Device, q_full: np.ndarray) -> np.ndarray:
+    """``dG/dq_a`` (P, n_a, n_a) at closed full poses (P, N), by central differences of G over ``+-``
+    :data:`GRADIENT_STEP` along each actuated coordinate's motion ``T e_j`` (the passive coordinates follow to first
+    order; the second-order miss of the closure is even in the step and cancels in the difference): a tree's G from
+    the compiled regressor kernel, a closed-loop device's from its model's entries at those poses (as
+    :func:`mass_matrix_at`)."""
+    space = configuration_for(device.builder, device.kinematic_values())
+    q_full = np.atleast_2d(np.asarray(q_full, dtype=float))
+    steps = GRADIENT_STEP * np.swapaxes(space.velocity_transform(q_full), 1, 2)  # (P, n_a, N)
+    poses = np.concatenate([q_full[:, None, :] + steps, q_full[:, None, :] - steps], axis=1)
+    poses = poses.reshape(-1, q_full.shape[1])
+    params = device.standard_parameters()
+    if space.is_tree:
+        c = space.mechanism.compiled
+        _, yg = regressor_kernel(np.ascontiguousarray(poses), *c.tree.arrays, c.tree.body_node, c.gravity)
+        torques = yg @ params
+    else:
+        model = _model(device.builder, device.kinematic_values())
+        torques = model.entries_at(poses, params)[:, model.slice_g]
+    n = steps.shape[1]
+    torques = torques.reshape(len(q_full), 2, n, -1)  # (P, +-, j, i)
+    return np.swapaxes((torques[:, 0] - torques[:, 1]) / (2.0 * GRADIENT_STEP), 1, 2)
+
+
 def inverse_dynamics(device: Device, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
     """``tau = H qdd + C qd^2 + G`` (eq. 2.50)."""
     return dynamics_of(device).inverse(q, qd, qdd, device.standard_parameters())

@@ -283,20 +283,27 @@ def _finite_or_none(value: float | None) -> float | None:
 def stability_boundary_command(
     inertia: float = typer.Option(..., help="Inertia J [kg m^2]."),
     damping: float = typer.Option(..., help="Viscous damping b [N m s/rad]."),
-    period: float = typer.Option(..., help="Sample period T [s]."),
-    delay: int = typer.Option(0, help="Sensor delay in samples."),
-    wall_damping: float = typer.Option(0.0, help="Virtual damper B [N m s/rad]."),
-    compensate_inertia: bool = typer.Option(False, help="Feed the sampled acceleration forward (J qdd)."),
+    period: float = PERIOD,
+    settings: Optional[str] = typer.Option(
+        None, help="Loop settings: practice (1 kHz, one sample of delay, backward-difference velocity, gravity "
+                   "compensation, which a 1-DOF mass-damper has no gravity for; the default) or seed (full "
+                   "inverse-dynamics compensation, no delay, sampled velocity). The options below change single ones."),
+    delay: Optional[int] = typer.Option(None, help="Sensor delay in samples (default: the --settings' own)."),
+    velocity: Optional[str] = VELOCITY, compensation: Optional[str] = COMPENSATION,
     error_percent: float = typer.Option(
-        0.0, help="Compensator modelling error E [%]: it feeds (1 - E/100) J qdd forward (needs --compensate-inertia)."),
+        0.0, help="Compensator modelling error E [%]: it feeds (1 - E/100) J qdd forward (needs --compensation full)."),
+    wall_damping: float = typer.Option(0.0, help="Virtual damper B [N m s/rad]."),
     substeps: int = typer.Option(10, help="Plant steps per sample in the simulation."),
     samples: int = typer.Option(4000, help="Samples per simulation of the growth test."),
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
     force: bool = FORCE,
 ) -> None:
-    """Exact vs simulated stiffness limit of a 1-DOF mass-damper under a sampled spring (check of seed 000 ch. 4)."""
-    from hapticdesign.analysis.sampled_loop import MassDamper, compensated_limit, exact_boundary
+    """Exact vs simulated stiffness limit of a 1-DOF mass-damper under a sampled spring (check of seed 000 ch. 4).
+
+    The loop settings are every command's (practice's by default, --settings seed for the seed's); the output
+    states them."""
+    from hapticdesign.analysis.sampled_loop import compensated_limit, joint_limit
     from hapticdesign.simulation.boundary import simulated_boundary
 
     with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
@@ -305,28 +312,24 @@ def stability_boundary_command(
         if not (np.isfinite(inertia) and inertia > 0 and np.isfinite(period) and period > 0):
             raise UserError(f"--inertia and --period must be positive numbers, got {inertia:g} and {period:g}")
         _check_scale(inertia=inertia, damping=damping, period=period, wall_damping=wall_damping)
-        if not (np.isfinite(error_percent) and -100 < error_percent < 100):
-            raise UserError(f"--error-percent must be a finite number between -100 and 100 (exclusive), got "
-                            f"{error_percent}")
+        loop = sampled_loop(seed_settings(None, None, settings or "practice"), period, delay, velocity, compensation,
+                            error_percent, wall_damping)
+        if error_percent and loop.compensation != "full":
+            raise UserError("--error-percent needs --compensation full (it scales the compensator's inertia)")
         if damping * period / substeps > inertia:
             raise UserError(f"the plant step --period / --substeps = {period / substeps:.3g} s is longer than the "
                             f"plant's time constant J/b = {inertia / damping:.3g} s; raise --substeps")
         if 0 < damping * period / inertia < 1e-9:
             raise UserError(f"the damping over one sample, b T / J = {damping * period / inertia:.3g}, is too small to "
                             "resolve in double precision (below 1e-9); give --damping 0 for an undamped plant")
-        if delay >= samples // 4:
-            raise UserError(f"--delay ({delay} samples) must be shorter than a quarter of --samples ({samples}) "
+        if loop.delay >= samples // 4:
+            raise UserError(f"--delay ({loop.delay} samples) must be shorter than a quarter of --samples ({samples}) "
                             "for the growth test to see the loop respond")
-        if error_percent and not compensate_inertia:
-            raise UserError("--error-percent needs --compensate-inertia (it scales the compensator's inertia)")
-        fraction = 1.0 - error_percent / 100.0
-        system = MassDamper(inertia, damping, period, delay, wall_damping, compensate_inertia,
-                            model_inertia=fraction * inertia)
-        exact = exact_boundary(system)
-        limit = (compensated_limit(inertia, damping, period, fraction)
-                 if compensate_inertia and delay == 0 and wall_damping == 0 else None)
+        exact = joint_limit(inertia, damping, loop)
+        limit = (compensated_limit(inertia, damping, period, loop.fraction)
+                 if loop.compensation == "full" and loop.delay == 0 and wall_damping == 0 else None)
         closed = None if limit is None else limit.stiffness
-        simulated = simulated_boundary(system, samples=samples, substeps=substeps)
+        simulated = simulated_boundary(inertia, damping, loop, samples=samples, substeps=substeps)
         unbounded = [name for name, v in (("exact", exact), ("closed_form", closed), ("simulated", simulated))
                      if v is not None and not np.isfinite(v)]
         out = {"k_max_exact": _finite_or_none(exact), "k_max_closed_form": _finite_or_none(closed),
@@ -334,10 +337,7 @@ def stability_boundary_command(
                "k_max_simulated": _finite_or_none(simulated),
                "relative_difference": (simulated - exact) / exact
                if np.isfinite(exact) and np.isfinite(simulated) and exact != 0 else None,
-               "two_b_over_t": 2 * damping / period, "error_percent": error_percent,
-               "settings": {"period": period, "delay_samples": delay, "velocity": "sampled",
-                            "compensation": "inertial" if compensate_inertia else "none",
-                            "model_error_percent": error_percent, "virtual_damping": wall_damping},
+               "two_b_over_t": 2 * damping / period, "error_percent": error_percent, "settings": loop.as_dict(),
                "units": {"k_max_exact": "N m/rad", "k_max_closed_form": "N m/rad", "k_max_simulated": "N m/rad",
                          "relative_difference": "dimensionless", "two_b_over_t": "N m/rad", "error_percent": "%"}}
         if unbounded:
@@ -349,8 +349,7 @@ def stability_boundary_command(
         form = "" if limit is None else f", closed form {_stiffness_text(closed)} ({limit.bound})"
         typer.echo(f"exact {_stiffness_text(exact)}{form}, simulated {_stiffness_text(simulated)} "
                    f"(2b/T = {2 * damping / period:.6g})")
-        typer.echo(f"settings: T = {period:g} s, delay {delay} samples, sampled velocity, "
-                   f"{'inertial' if compensate_inertia else 'no'} compensation, wall damper {wall_damping:g}")
+        typer.echo(f"settings: {loop.describe()}")
 
 
 def _stiffness_text(value: float) -> str:

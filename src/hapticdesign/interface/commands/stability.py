@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Optional
 
@@ -10,6 +9,7 @@ import typer
 
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import note, parse_vector, print_json, user_errors
+from hapticdesign.interface.commands.simulation import COMPENSATION, PERIOD, SETTINGS, VELOCITY
 from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, SEED, STRICT
 
 
@@ -17,27 +17,26 @@ def _dampers(text: Optional[str]) -> Optional[list[float]]:
     return None if text is None else [float(v) for v in parse_vector(text, None, "b-values")]
 
 
-def _device_joint(preset, device, params, strict, q, joint, error_percent, compensate,
-                  direction=None) -> tuple[float, float, float, float | None]:
-    """J = H_jj(q), b_j, the compensator fraction H_model,jj / H_jj of a device at a pose, and
-    ``J_n = n^T J_v`` of the joint along a Cartesian wall's ``direction`` (None without one)."""
+def _device_joint(preset, device, params, strict, q, joint, direction=None) -> tuple[float, float, int, int,
+                                                                                   float | None]:
+    """J = H_jj(q), b_j, the joint's index, the device's joint count, and ``J_n = n^T J_v`` of the joint along a
+    Cartesian wall's ``direction`` (None without one)."""
     from hapticdesign.analysis.dynamics.device import mass_matrix
     from hapticdesign.devices.loading import resolve_device
-    from hapticdesign.simulation.config import Wall, model_device, normal_jacobian
+    from hapticdesign.simulation.config import Wall, normal_jacobian
     from hapticdesign.simulation.loop import joint_index
 
     dev = resolve_device(preset, device, params, strict=strict)
     pose = parse_vector(q, dev.n_dof, "q")
     j = joint_index(dev, joint)
     inertia = float(mass_matrix(dev, pose)[j, j])
-    fraction = float(mass_matrix(model_device(dev, error_percent), pose)[j, j]) / inertia if compensate else 0.0
     reach = None
     if direction is not None:
         vector = parse_vector(direction, 3, "wall-direction")
         if not vector.any():
             raise UserError("--wall-direction must not be the zero vector")
         reach = float(normal_jacobian(dev, Wall(direction=tuple(vector.tolist())), pose)[j])
-    return inertia, float(dev.damping[j]), fraction, reach
+    return inertia, float(dev.damping[j]), j, dev.n_dof, reach
 
 
 def zwidth_command(
@@ -52,16 +51,14 @@ def zwidth_command(
         None, help="Device mode: a Cartesian wall along x,y,z at the handle, moved by --joint (the others held); "
                    "K in N/m, B in N s/m."),
     strict: bool = STRICT,
-    period: float = typer.Option(1e-3, help="Sample period T [s]."),
+    period: float = PERIOD,
+    settings: Optional[str] = SETTINGS,
     delay: Optional[int] = typer.Option(None, help="Computation delay N [samples]: the torque of interval k uses the "
-                                                   "samples of k - N. Default: practice's one sample, the seed's 0 on "
-                                                   "its Phantom presets."),
-    velocity: Optional[str] = typer.Option(None, help="The damper's velocity: difference (backward difference of "
-                                                      "sampled positions; practice's default) or sampled (the seed's "
-                                                      "perfect sensor, its Phantom presets' default)."),
-    compensate_inertia: bool = typer.Option(False, help="Feed the sampled acceleration forward (c J a)."),
+                                                   "samples of k - N. Default: the --settings' own."),
+    velocity: Optional[str] = VELOCITY,
+    compensation: Optional[str] = COMPENSATION,
     error_percent: float = typer.Option(0.0, help="Compensator modelling error E [%]: c = 1 - E/100 "
-                                                  "(needs --compensate-inertia)."),
+                                                  "(needs --compensation full)."),
     b_values: Optional[str] = typer.Option(None, help="Virtual dampers B1,B2,... [N m s/rad]; default: a grid up "
                                                       "to the largest usable damper."),
     points: int = typer.Option(25, help="Points of the default damper grid."),
@@ -74,71 +71,64 @@ def zwidth_command(
 ) -> None:
     """Exact Z-width of a 1-DOF haptic display, K_max for each virtual damper B (seed 000 ch. 5 future work).
 
-    Exact for the sampled-data loop (zero-order hold, delay, compensator), with the passivity bound of
-    Colgate & Schenkel beside it (Colgate & Brown 1994). J and b come from the options or from one
-    joint of a device at a pose (the other joints held)."""
+    Exact for the sampled-data loop (zero-order hold, delay, compensator) under every command's loop settings
+    (practice's by default, the seed's on its Phantom presets), with the passivity bound of Colgate & Schenkel beside
+    it (Colgate & Brown 1994). J and b come from the options or from one joint of a device at a pose (the other
+    joints held). The output states the settings."""
+    from dataclasses import replace
+
     from hapticdesign.interface.report.index import write_folder_index
     from hapticdesign.simulation.figures import zwidth_chart
-    from hapticdesign.simulation.zwidth import DisplayLoop, along_wall, zwidth
+    from hapticdesign.simulation.zwidth import along_wall, zwidth
 
     with user_errors(quiet=quiet):
-        from hapticdesign.analysis.sampled_loop import SampledLoop
-        from hapticdesign.interface.commands.simulation import seed_settings
+        from hapticdesign.interface.commands.simulation import sampled_loop, seed_settings
 
-        defaults = SampledLoop.seed() if seed_settings(preset, device, None) and inertia is None else SampledLoop()
-        delay = defaults.delay if delay is None else delay
-        velocity = defaults.velocity if velocity is None else velocity
-        if not (math.isfinite(error_percent) and 0.0 <= error_percent < 100.0):
-            raise UserError(f"--error-percent must lie in [0, 100), got {error_percent}")
-        if error_percent and not compensate_inertia:
-            raise UserError("--error-percent needs --compensate-inertia (it scales the compensator's inertia)")
-        fraction = (1.0 - error_percent / 100.0) if compensate_inertia else 0.0
         from_device = preset is not None or device is not None
+        seed = seed_settings(preset, device, settings) if from_device or settings is not None else False
+        loop = sampled_loop(seed, period, delay, velocity, compensation, error_percent, 0.0)
+        if error_percent and loop.compensation != "full":
+            raise UserError("--error-percent needs --compensation full (it scales the compensator's inertia)")
         if from_device == (inertia is not None or damping is not None):
             raise UserError("give either --inertia and --damping, or a device (--preset or --device) with --q and --joint")
         if wall_direction is not None and not from_device:
             raise UserError("--wall-direction needs a device (--preset or --device)")
         if wall_direction is not None and map_joints is not None:
             raise UserError("--map-joints charts a joint wall; leave out --wall-direction")
-        reach = None
-        if from_device:
-            inertia, damping, fraction, reach = _device_joint(preset, device, params, strict, q, joint, error_percent,
-                                                              compensate_inertia, wall_direction)
+        reach, shown = None, loop
+        if from_device:  # a 1-DOF display of the joint: the others held, a named option the settings state
+            inertia, damping, wall, count, reach = _device_joint(preset, device, params, strict, q, joint,
+                                                                 wall_direction)
+            shown = replace(loop, held=tuple(j for j in range(count) if j != wall))
         if map_joints is not None and not (from_device and out is not None):
             raise UserError("--map-joints needs a device (--preset or --device) and --out")
         elif inertia is None or damping is None:
             raise UserError("--inertia and --damping go together")
-        loop = DisplayLoop(inertia, damping, period, delay, velocity, fraction)
         if reach is not None:
-            loop = along_wall(loop, reach)
-        result = zwidth(loop, _dampers(b_values), points)
+            inertia, damping = along_wall(inertia, damping, reach)
+        result = zwidth(inertia, damping, loop, _dampers(b_values), points)
         units = ("kg", "N s/m", "N/m") if reach is not None else ("kg m^2", "N m s/rad", "N m/rad")
         figures, index = [], None
         if out is not None:
-            title = (f"J = {loop.inertia:g} {units[0]}, b = {loop.damping:g} {units[1]}, T = {period:g} s, N = {delay}, "
-                     f"{velocity} velocity" + (f", compensator c = {fraction:g}" if compensate_inertia else "")
+            title = (f"J = {inertia:g} {units[0]}, b = {damping:g} {units[1]}, T = {period:g} s, N = {loop.delay}, "
+                     f"{loop.velocity} velocity, {loop.compensation} compensation"
+                     + (f" (c = {loop.fraction:g})" if loop.compensation == "full" else "")
                      + (" (Cartesian wall)" if reach is not None else ""))
             figures = [str(p) for p in zwidth_chart(result, title, Path(out) / "zwidth", units[1:])]
             if map_joints is not None:
-                figures += _map(preset, device, params, strict, joint, map_joints, map_points, loop, result.B[0],
-                                Path(out))
+                figures += _map(preset, device, params, strict, joint, map_joints, map_points,
+                                replace(loop, virtual_damping=result.B[0]), Path(out))
             index = str(write_folder_index(Path(out), "Z-width", "Exact Z-width of a 1-DOF haptic display (seed 000 "
                                            f"ch. 5 future work): {title}.", figures))
-        payload = {**result.as_dict(), "loop": {"inertia": loop.inertia, "damping": loop.damping, "period": period,
-                                                 "delay": delay, "velocity": velocity, "fraction": fraction},
+        payload = {**result.as_dict(), "settings": shown.as_dict(), "loop": {"inertia": inertia, "damping": damping},
                    "figures": figures, **({"index": index} if index else {})}
-        if from_device:  # the 1-DOF display of one joint: a named option, the others held
-            payload["loop"]["held_joints"] = "every joint but --joint (a 1-DOF display; impedance-range's limit " \
-                                             "method frees them)"
         if reach is not None:
             payload["units"] = {"B": units[1], "K": units[2]}
             payload["loop"]["wall_reach"] = reach
         if json_out:
             print_json(payload)
             return
-        typer.echo(f"settings: T = {period:g} s, delay {delay} samples, {velocity} velocity, "
-                   + (f"compensator c = {fraction:g}" if compensate_inertia else "no inertial compensation")
-                   + (", the other joints held (a 1-DOF display)" if from_device else ""))
+        typer.echo(f"settings: {shown.describe()}")
         typer.echo(f"B [{units[1]}]   K_max [{units[2]}]   passivity K   linear approximation K")
         for i, (b, k) in enumerate(zip(result.B, result.K)):
             p = "-" if result.passivity is None else f"{result.passivity[i]:.6g}"
@@ -148,7 +138,7 @@ def zwidth_command(
             note(f"wrote {f}", quiet)
 
 
-def _map(preset, device, params, strict, joint, map_joints, points, loop, damper, out: Path) -> list[str]:
+def _map(preset, device, params, strict, joint, map_joints, points, loop, out: Path) -> list[str]:
     from hapticdesign.devices.loading import resolve_device
     from hapticdesign.simulation.figures import stiffness_map_chart
     from hapticdesign.simulation.loop import joint_index
@@ -160,7 +150,7 @@ def _map(preset, device, params, strict, joint, map_joints, points, loop, damper
         raise UserError(f"--map-joints: give two joints, got {map_joints!r}")
     axes = (joint_index(dev, names[0]), joint_index(dev, names[1]))
     wall = joint_index(dev, joint)
-    result = stiffness_map(dev, wall, axes, points, loop.period, loop.delay, loop.velocity, loop.fraction, damper)
+    result = stiffness_map(dev, wall, axes, points, loop)
     coordinates = dev.mechanism.coordinates
     return [str(p) for p in stiffness_map_chart(result, [coordinates[a] for a in axes], coordinates[wall],
                                                 out / "kmax_map")]

@@ -30,7 +30,7 @@ which ``I_m`` ... ``acceleration_radius`` are, with ``M_C = J_m^-T H J_m^-1``. `
 and ``frequency`` need links with sections (``K_C`` of the virtual joint method at the handle,
 :func:`~hapticdesign.analysis.stiffness.device.cartesian_stiffness_at`; ``K_C[:3, :3]`` holds the rotations,
 seed 001's ``K_CA``). ``kmax`` is :func:`hapticdesign.analysis.wall_stiffness.kmax`: the n-joint sampled
-loop about the pose, every joint free, discretized exactly (its options: the loop's settings of
+loop about the pose, every joint free, gravity's gradient in it, discretized exactly (its options: the loop's settings of
 :data:`~hapticdesign.analysis.wall_stiffness.KMAX_OPTIONS`, practice's by default, ``direction`` and ``hand``).
 ``ln`` and ``mass`` are one value per design (the same at every point); ``ln`` takes the region of the joint limits (full turns where none) and
 unit weights (:func:`~hapticdesign.analysis.linearity.form.device_form`). ``m^k/rad^k``: metres per radian for
@@ -143,13 +143,14 @@ def frequency(pose: HandleStates) -> np.ndarray:
 
 @index(unit="N/m", formula="exact stable wall stiffness of the sampled loop along a direction (or the worst)",
        source="seed 000 ch. 4-5; hapticdesign.analysis.sampled_loop.handle_limits",
-       needs=("kinematics", "dynamics", "damping"))
+       needs=("kinematics", "dynamics", "damping", "gravity"))
 def kmax(pose: HandleStates, period: float = 0.001, delay: int = 1, damping: float = 0.0,
          direction: list[float] | None = None, velocity: str = "difference", compensation: str = "gravity",
          error_percent: float = 0.0, hand: object = None) -> np.ndarray:
     options = dict(period=period, delay=delay, damping=damping, direction=direction, velocity=velocity,
                    compensation=compensation, error_percent=error_percent, hand=hand)
-    return wall_kmax(pose.J_v, pose.H, pose.B, (pose.svd[0], pose.mobility, pose.cartesian_damping), options)
+    return wall_kmax(pose.J_v, pose.H, pose.B, (pose.svd[0], pose.mobility, pose.cartesian_damping), options,
+                     pose.gravity)
 
 
 @index(unit="LN", formula="Linearity Number over the joint region (limits, else full turns)",

@@ -105,7 +105,8 @@ def evaluate_designs(space: DesignFamily, designs: Sequence[Mapping[str, float]]
     if batch is None:
         return [_one(space, values, points, checked, registry) for values in designs]
     sections = any("sections" in registry[r.index].needs for r in checked)
-    got = batch.evaluate(space.batch_values(designs, batch), points, sections, space.home_position)
+    gravity = any("gravity" in registry[r.index].needs for r in checked)
+    got = batch.evaluate(space.batch_values(designs, batch), points, sections, space.home_position, gravity)
     ok, v = got.ok, got.values
     per_pose = np.repeat(np.flatnonzero(ok), len(points))
     n_a = got.jacobian.shape[-1]
@@ -113,7 +114,8 @@ def evaluate_designs(space: DesignFamily, designs: Sequence[Mapping[str, float]]
         got.jacobian[ok].reshape(-1, 3, n_a), got.mass[ok].reshape(-1, n_a, n_a), v.damping[per_pose],
         got.q[ok].reshape(-1, n_a), motor_map=None if v.motor_map is None else v.motor_map[per_pose],
         torque_limits={k: None if t is None else t[per_pose] for k, t in v.torques.items()},
-        moving_mass=got.moving_mass[per_pose], name=space.base.name)
+        moving_mass=got.moving_mass[per_pose], name=space.base.name,
+        **({} if got.gravity is None else {"gravity": got.gravity[ok].reshape(-1, n_a, n_a)}))
     if sections:
         u = states.svd[0]
         states.__dict__["stiffness"] = np.swapaxes(u, 1, 2) @ got.stiffness[ok].reshape(-1, 6, 6)[:, :3, :3] @ u

@@ -24,7 +24,7 @@ import numpy as np
 from hapticdesign.analysis import kinematics
 from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.analysis.dynamics.cartesian import cartesian_inertia, mobility
-from hapticdesign.analysis.dynamics.device import mass_matrix_at
+from hapticdesign.analysis.dynamics.device import gravity_gradient_at, mass_matrix_at
 from hapticdesign.analysis.metrics import force
 from hapticdesign.analysis.metrics.kinematic import handle_range_basis
 from hapticdesign.analysis.stiffness.device import cartesian_stiffness_at
@@ -32,10 +32,10 @@ from hapticdesign.errors import UserError
 from hapticdesign.model.dense import symmetric_eigenvalues
 from hapticdesign.model.device import Device
 
-BATCH_NEEDS = frozenset({"kinematics", "dynamics", "damping", "sections", "motors", "bodies"})
+BATCH_NEEDS = frozenset({"kinematics", "dynamics", "damping", "sections", "motors", "bodies", "gravity"})
 """What :meth:`HandleStates.of` gives of many designs' poses: ``J_v`` and ``q`` (kinematics), ``H`` (dynamics),
 ``B`` (damping), the links' sections (``stiffness``, ``U^T K_C[:3, :3] U``), the motors (``motor_map``,
-``torque_limits``) and the bodies (``moving_mass``)."""
+``torque_limits``), the bodies (``moving_mass``) and gravity's gradient (``gravity``)."""
 POSE_NEEDS = BATCH_NEEDS | {"device"}
 """What a device at poses gives an index: all of :data:`BATCH_NEEDS`, and the ``device`` itself (an index of the
 whole device, such as its exact Linearity Number, is evaluated design by design)."""
@@ -108,6 +108,12 @@ class HandleStates:
         return self._device.damping_matrix
 
     @cached_property
+    def gravity(self) -> np.ndarray:
+        """``dG/dq`` (P, n_a, n_a): the stiffness gravity adds to the linearized plant at each pose
+        (:func:`~hapticdesign.analysis.dynamics.device.gravity_gradient_at`)."""
+        return gravity_gradient_at(self._device, self.full)
+
+    @cached_property
     def name(self) -> str:
         """The device's name (for messages)."""
         return self._device.name
@@ -171,9 +177,10 @@ class HandleStates:
         """The states of poses whose ``J_v`` (P, 3, n_a), ``H`` (P, n_a, n_a), ``B`` ((n_a, n_a) or per pose) and
         actuated coordinates ``q`` (P, n_a) are known already (many designs' poses at once,
         :mod:`hapticdesign.analysis.design_batch`), with any other quantity of :data:`BATCH_NEEDS` known per pose by
-        its name (``stiffness`` (P, k, k), ``motor_map``, ``torque_limits``, ``moving_mass``, ``name``): enough for an
+        its name (``stiffness`` (P, k, k), ``motor_map``, ``torque_limits``, ``moving_mass``, ``name``, ``gravity``
+        (P, n_a, n_a)): enough for an
         index that needs at most :data:`BATCH_NEEDS`, of those quantities given."""
-        unknown = set(known) - {"stiffness", "motor_map", "torque_limits", "moving_mass", "name"}
+        unknown = set(known) - {"stiffness", "motor_map", "torque_limits", "moving_mass", "name", "gravity"}
         if unknown:
             raise TypeError(f"HandleStates.of: unknown quantities {sorted(unknown)}")
         states = cls(None, np.zeros((len(J_v), 0)))

@@ -1,0 +1,94 @@
+"""Gravity's gradient in the linearized sampled loop (issue 35): the plant's ``K_G = dG/dq`` and the compensator's
+``s K_G`` on the sensed (delayed) pose, against closed forms, python-control and the simulated loop.
+
+The pendulum: one point mass ``m`` at ``l`` from a horizontal axis, hanging at q = 0, so ``G = m g l sin q`` and its
+linearized stiffness about the pose is ``m g l cos q`` (textbook). Its loop's limit is built here from scratch with
+python-control: the plant ``J qdd + b qd + K_G q = u`` discretized with ``control.c2d`` (zero-order hold), the wall's
+spring ``K`` and the compensator's ``- s K_G`` on the position ``d`` samples late (``z^-d``), closed with
+``control.feedback``, and the spring at which the largest pole modulus reaches 1 bisected.
+"""
+
+from __future__ import annotations
+
+import math
+
+import control
+import numpy as np
+import pytest
+
+from hapticdesign.analysis.dynamics.device import gravity_gradient, mass_matrix
+from hapticdesign.analysis.sampled_loop import SampledLoop
+from hapticdesign.analysis.wall_stiffness import wall_limit
+from hapticdesign.devices.device_file import device_from_mapping
+from hapticdesign.simulation.impedance import simulated_limit, stability_limit
+
+M, L, B, G, PERIOD = 0.5, 0.2, 0.002, 9.81, 1e-3
+
+
+def _pendulum():
+    """A link turning about the base's -y axis, its mass at ``l`` hanging straight down at q = 0."""
+    return device_from_mapping({
+        "name": "pendulum", "parameters": {"l": L},
+        "joints": [{"name": "q1", "damping": B}],
+        "frames": [{"name": "arm", "transforms": [{"Rx": "pi/2"}, {"Rz": "-pi/2"}, {"Rz": "q1"}]},
+                   {"name": "tip", "parent": "arm", "transforms": [{"tx": "l"}]}],
+        "bodies": [{"name": "bob", "frame": "tip", "m": M}],
+        "end_effector": "tip",
+    })
+
+
+def _python_control_limit(j: float, b: float, k_g: float, share: float, delay: int) -> float:
+    plant = control.c2d(control.ss([[0.0, 1.0], [-k_g / j, -b / j]], [[0.0], [1.0 / j]], [[1.0, 0.0]], [[0.0]]),
+                        PERIOD, "zoh")
+    lag = control.tf([1.0], [1.0] + [0.0] * delay, PERIOD)
+
+    def radius(k):
+        return np.abs(control.poles(control.feedback(plant * lag, k - share * k_g))).max()
+
+    lo, hi = 1e-6, 1.0
+    assert radius(lo) < 1.0
+    while radius(hi) < 1.0:
+        lo, hi = hi, 2.0 * hi
+    while hi - lo > 1e-10 * hi:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if radius(mid) < 1.0 else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
+@pytest.mark.parametrize("q", [0.0, 0.4, -1.1])
+def test_the_gradient_is_m_g_l_cos_q(q):
+    device = _pendulum()
+    assert mass_matrix(device, np.array([q]))[0, 0] == pytest.approx(M * L * L, rel=1e-12)
+    assert gravity_gradient(device, np.array([q]))[0, 0] == pytest.approx(M * G * L * math.cos(q), rel=1e-8)
+
+
+@pytest.mark.parametrize("loop", [SampledLoop(compensation="none"), SampledLoop(compensation="none", delay=0),
+                                  SampledLoop(compensation="none", delay=2, velocity="sampled"),
+                                  SampledLoop(model_error=30.0), SampledLoop(model_error=60.0, delay=2)])
+def test_the_pendulums_limit_is_python_controls_loop_with_its_gravity_stiffness(loop):
+    """Without compensation (``s = 0``) or with a wrong model (``s = 1 - E/100``), at the hanging pose and tilted."""
+    device = _pendulum()
+    for q in (0.0, 0.6):
+        k_g = M * G * L * math.cos(q)
+        pose = np.array([q])
+        ours = wall_limit(np.array([[1.0], [0.0], [0.0]]), mass_matrix(device, pose), device.damping_matrix, loop,
+                          np.array([1.0, 0.0, 0.0]), gravity_gradient(device, pose))
+        expected = _python_control_limit(M * L * L, B, k_g, loop.gravity_share, loop.delay)
+        assert ours == pytest.approx(expected, rel=1e-7)
+        without = _python_control_limit(M * L * L, B, 0.0, 0.0, loop.delay)
+        assert abs(expected / without - 1.0) > 1e-6  # 10 times the tolerance: leaving gravity out would fail
+
+
+def test_the_undercompensated_pendulums_simulated_limit_is_the_exact_one():
+    """A gravity compensator whose model is 60 % light (``s = 0.4``), no friction, no quantization: the loop is linear
+    about the hanging pose, so the simulated growth boundary (bisected to 1e-3) is the exact limit with the plant's
+    ``m g l`` and the compensator's late ``0.4 m g l`` in it (a joint wall resting 1 mrad from the start; the
+    compensator's share moves the limit by far more than the tolerance)."""
+    device = _pendulum()
+    loop = SampledLoop(model_error=60.0)
+    exact = stability_limit(device, loop, equilibrium=1e-3).stiffness
+    simulated = simulated_limit(device, loop, equilibrium=1e-3, rel_tol=1e-3, duration=4.0, friction=False)
+    assert simulated == pytest.approx(exact, rel=2e-3)
+    k_g = M * G * L * math.cos(1e-3)
+    assert exact == pytest.approx(_python_control_limit(M * L * L, B, k_g, 0.4, 1), rel=1e-7)
+    assert abs(exact / _python_control_limit(M * L * L, B, 0.0, 0.0, 1) - 1.0) > 0.05
