@@ -114,17 +114,21 @@ class KinematicTree:
 
     def plan(self, needed: list[int], moving: list[int]) -> "WalkPlan":
         """:class:`WalkPlan` whose first part is the nodes ``needed`` (and their ancestors), those that the
-        coordinates ``moving`` do not move first."""
+        coordinates ``moving`` do not move first, and of those first the ones no coordinate moves."""
         first = set()
         for node in needed:
             while node >= 0 and node not in first:
                 first.add(node)
                 node = int(self.parent[node])
         moved: set[int] = set()
+        fixed: set[int] = set()  # the nodes no coordinate moves
         for n in range(len(self.parent)):  # parents come first
             if int(self.parent[n]) in moved or np.any(self.coef[n, list(moving)] != 0.0):
                 moved.add(n)
-        still = sorted(first - moved)
+            if (self.parent[n] < 0 or int(self.parent[n]) in fixed) and not np.any(self.coef[n] != 0.0):
+                fixed.add(n)
+        fixed &= first
+        still = sorted(fixed) + sorted(first - moved - fixed)
         order = still + sorted(first & moved) + [n for n in range(len(self.parent)) if n not in first]
         nonzero = [np.flatnonzero(row) for row in self.coef]
         ptr = np.cumsum([0] + [len(k) for k in nonzero])
@@ -146,7 +150,7 @@ class KinematicTree:
             order=np.array(order, dtype=np.int64), n_first=len(first), ptr=ptr.astype(np.int64),
             index=np.concatenate([np.zeros(0, dtype=np.int64)] + nonzero).astype(np.int64),
             value=np.concatenate([np.zeros(0)] + [row[k] for row, k in zip(self.coef, nonzero)]),
-            trig_source=source.astype(np.int64), trig_sign=sign, n_still=len(still),
+            trig_source=source.astype(np.int64), trig_sign=sign, n_still=len(still), n_fixed=len(fixed),
         )
 
     def workspace(self) -> tuple[np.ndarray, np.ndarray]:
@@ -171,7 +175,8 @@ class WalkPlan(NamedTuple):
 
     ``order`` lists every node after its parent, the ``n_first`` nodes a chosen set needs first, and of
     those the ``n_still`` that chosen coordinates do not move first (a walk after a change of only those
-    coordinates starts after them); the coupling coefficients of node ``n`` are the sparse row ``value[ptr[n]:ptr[n + 1]]`` at the coordinates
+    coordinates starts after them), and of those the ``n_fixed`` that no coordinate moves first (a walk of the
+    same tree at other coordinates starts after them); the coupling coefficients of node ``n`` are the sparse row ``value[ptr[n]:ptr[n + 1]]`` at the coordinates
     ``index[ptr[n]:ptr[n + 1]]`` (in increasing order, so a joint value is the same sum as the dense one's);
     a rotation node whose angle (coefficients and offset) equals, or is the negative of, that of an
     earlier node of ``order``, ``trig_source[n]``, takes its cosine and sine (times ``trig_sign[n]``).
@@ -185,6 +190,7 @@ class WalkPlan(NamedTuple):
     trig_source: np.ndarray
     trig_sign: np.ndarray
     n_still: int
+    n_fixed: int
 
     def workspace(self) -> np.ndarray:
         """The scratch of :func:`planned_poses` (:func:`trig_workspace`)."""
@@ -199,7 +205,7 @@ def trig_workspace(n_node):
     return out
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, inline="always")
 def planned_poses(q, tree, plan, start, stop, rot, pos, trig):
     """:func:`node_poses` of the nodes ``order[start:stop]`` of a :class:`WalkPlan` ``plan`` on the :class:`Tree` ``tree``.
 
@@ -322,14 +328,16 @@ def unit_twist(rot, pos, axis, n, point):
     return u1 * r2 - u2 * r1, u2 * r0 - u0 * r2, u0 * r1 - u1 * r0, u0, u1, u2
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def frame_jacobian(node, parent, axis, coef, rot, pos, body, jac):
-    """Jacobian (6 x N, rows v then w) of the origin of node ``node`` (-1: the base) at the poses ``rot, pos``.
+    """Jacobian (6 x N, rows v then w) of the origin of node ``node`` (-1: the base) at the poses ``rot, pos``;
+    only its rows ``v`` when ``jac`` has 3 rows.
 
     In the base frame, or with ``body`` in the node's own frame (``R^T v``, ``R^T w``).
     """
     n_dof = jac.shape[1]
-    for i in range(6):
+    angular = jac.shape[0] == 6
+    for i in range(jac.shape[0]):
         for k in range(n_dof):
             jac[i, k] = 0.0
     if node < 0:
@@ -337,11 +345,12 @@ def frame_jacobian(node, parent, axis, coef, rot, pos, body, jac):
     n = node
     while n >= 0:
         if axis[n] != CONSTANT:
-            rotation = axis[n] < 3
+            rotation = axis[n] < 3 and angular
             v0, v1, v2, u0, u1, u2 = unit_twist(rot, pos, axis, n, node)
             if body:
                 v0, v1, v2 = _to_node(rot, node, v0, v1, v2)
-                u0, u1, u2 = _to_node(rot, node, u0, u1, u2)
+                if rotation:
+                    u0, u1, u2 = _to_node(rot, node, u0, u1, u2)
             for k in range(n_dof):
                 c = coef[n, k]
                 if c != 0.0:

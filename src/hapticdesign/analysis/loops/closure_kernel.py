@@ -51,7 +51,7 @@ def rotation_entry(rot, node, i, k):
     return 1.0 if i == k else 0.0
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, inline="always")
 def closure_residual(loops, rot, pos, out):
     """``phi`` (m,): origin differences and the skew-part vector of ``R_A R_B^T`` in the base frame."""
     frame_a, frame_b, row_loop, row_comp = loops.frame_a, loops.frame_b, loops.row_loop, loops.row_comp
@@ -74,7 +74,7 @@ def closure_residual(loops, rot, pos, out):
             out[i] = 0.5 * acc
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, inline="always")
 def closure_jacobian(loops, tree, plan, rot, pos, phi):
     """``Phi = select(J_A - J_B)`` (m x N) at the current node poses.
 
