@@ -223,12 +223,11 @@ def planned_poses(q, tree, plan, start, stop, rot, pos, trig):
     for i in range(start, stop):
         n = order[i]
         pn = parent[n]
-        if axis[n] == CONSTANT:
+        ax = axis[n]
+        if ax == CONSTANT:
             _constant_node(n, pn, const_rot, const_pos, rot, pos)
             continue
-        _parent_pose(n, pn, rot, pos)
-        a = axis[n] % 3
-        if axis[n] < 3:
+        if ax < 3:
             s = source[n]
             if s == n:
                 v = offset[n]
@@ -247,19 +246,39 @@ def planned_poses(q, tree, plan, start, stop, rot, pos, trig):
                     trig[n, 2] = v
             cv = trig[s, 0]
             sv = sign[n] * trig[s, 1]
-            b = (a + 1) % 3
-            c = (a + 2) % 3
-            for r in range(3):
-                rb = rot[n, r, b]
-                rc = rot[n, r, c]
-                rot[n, r, b] = rb * cv + rc * sv
-                rot[n, r, c] = -rb * sv + rc * cv
-        else:
+            b = 1 if ax == 0 else (2 if ax == 1 else 0)  # the other two columns, cyclic after ax, turn
+            c = 2 if ax == 0 else (0 if ax == 1 else 1)
+            if pn >= 0:
+                for r in range(3):
+                    rb = rot[pn, r, b]
+                    rc = rot[pn, r, c]
+                    rot[n, r, ax] = rot[pn, r, ax]
+                    rot[n, r, b] = rb * cv + rc * sv
+                    rot[n, r, c] = -rb * sv + rc * cv
+                    pos[n, r] = pos[pn, r]
+            else:
+                for r in range(3):
+                    rb = 1.0 if r == b else 0.0
+                    rc = 1.0 if r == c else 0.0
+                    rot[n, r, ax] = 1.0 if r == ax else 0.0
+                    rot[n, r, b] = rb * cv + rc * sv
+                    rot[n, r, c] = -rb * sv + rc * cv
+                    pos[n, r] = 0.0
+        else:  # the parent's rotation, the origin moved along column a
+            a = ax - 3
             v = offset[n]
             for k in range(ptr[n], ptr[n + 1]):
                 v += value[k] * q[index[k]]
-            for r in range(3):
-                pos[n, r] += rot[n, r, a] * v
+            if pn >= 0:
+                for r in range(3):
+                    for j in range(3):
+                        rot[n, r, j] = rot[pn, r, j]
+                    pos[n, r] = pos[pn, r] + rot[pn, r, a] * v
+            else:
+                for r in range(3):
+                    for j in range(3):
+                        rot[n, r, j] = 1.0 if r == j else 0.0
+                    pos[n, r] = 0.0 + (1.0 if r == a else 0.0) * v
 
 
 @njit(cache=True, inline="always")
