@@ -25,7 +25,8 @@ system's pivot ratio falls below ``IK_PIVOTS`` or the sign of its determinant (`
 Schur's complement: the working mode with the assembly branch) changes from the start's, or when ``det Phi_p``
 (the assembly branch) differs at a point from the start's (behind a singularity). At each point it leaves the full
 pose and ``J_v T`` (3 x n_a). Its inner kernels allocate nothing and are compiled without numba's reference counting
-(``_nrt=False``), so that passing the records costs no atomic counts per array.
+(``_nrt=False``), so that passing the records costs no atomic counts per array; the walk, the system and its solve
+are inlined into Newton's loop (a call copies the records' fields).
 """
 
 from __future__ import annotations
@@ -114,9 +115,9 @@ def structure_of(mech: Mechanism, frame: str | None = None) -> Structure:
 
 
 class Scratch(NamedTuple):
-    """The continuation's scratch: node poses, cosines and sines, the handle's position Jacobian, the system and its right-hand
-    side, the closure residual, ``Phi``, ``Phi_p``, ``S = -Phi_p^-1 Phi_a`` and, for a redundant device, ``A A^T``
-    and its right-hand side."""
+    """The continuation's scratch: node poses, cosines and sines, the handle's position Jacobian, the system and its
+    right-hand side, the closure residual, ``Phi``, ``Phi_p``, ``S = -Phi_p^-1 Phi_a`` and, for a redundant device,
+    ``A A^T`` and its right-hand side."""
 
     rot: np.ndarray
     pos: np.ndarray

@@ -23,7 +23,8 @@ a predicted pose and the rule that accepts its result.
 The kernels take the records of :mod:`.records` and :mod:`hapticdesign.model.walk`: ``tree``
 (:class:`~hapticdesign.model.walk.Tree`), ``plan`` (:class:`~hapticdesign.model.walk.WalkPlan`, the
 closures' nodes first), ``loops`` (:class:`~.records.Closures`), ``settings``
-(:class:`~.records.Settings`) and ``ws`` (:class:`~.records.ClosureScratch`).
+(:class:`~.records.Settings`) and ``ws`` (:class:`~.records.ClosureScratch`). The residual and the constraint
+Jacobian are inlined into their callers (a call copies the records' fields).
 """
 
 from __future__ import annotations
