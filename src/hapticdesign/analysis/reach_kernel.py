@@ -25,7 +25,8 @@ system's pivot ratio falls below ``IK_PIVOTS`` or the sign of its determinant (`
 Schur's complement: the working mode with the assembly branch) changes from the start's, or when ``det Phi_p``
 (the assembly branch) differs at a point from the start's (behind a singularity). At each point it leaves the full
 pose and ``J_v T`` (3 x n_a). Its inner kernels allocate nothing and are compiled without numba's reference counting
-(``_nrt=False``), so that passing the records costs no atomic counts per array.
+(``_nrt=False``), so that passing the records costs no atomic counts per array; the walk, the system and its solve
+are inlined into Newton's loop (a call copies the records' fields).
 """
 
 from __future__ import annotations
@@ -114,9 +115,9 @@ def structure_of(mech: Mechanism, frame: str | None = None) -> Structure:
 
 
 class Scratch(NamedTuple):
-    """The continuation's scratch: node poses, cosines and sines, the handle's Jacobian, the system and its right-hand
-    side, the closure residual, ``Phi``, ``Phi_p``, ``S = -Phi_p^-1 Phi_a`` and, for a redundant device, ``A A^T``
-    and its right-hand side."""
+    """The continuation's scratch: node poses, cosines and sines, the handle's position Jacobian, the system and its
+    right-hand side, the closure residual, ``Phi``, ``Phi_p``, ``S = -Phi_p^-1 Phi_a`` and, for a redundant device,
+    ``A A^T`` and its right-hand side."""
 
     rot: np.ndarray
     pos: np.ndarray
@@ -132,16 +133,17 @@ class Scratch(NamedTuple):
     y: np.ndarray
 
 
-@njit(cache=True, _nrt=False)
-def _walk(q, tree, plan, loops, reach, ws):
-    """Node poses, the closure residual, ``Phi`` and the handle's Jacobian at ``q`` into ``ws``."""
-    planned_poses(q, tree, plan, np.int64(0), plan.n_first, ws.rot, ws.pos, ws.trig)  # a literal: its own copy
+@njit(cache=True, _nrt=False, inline="always")
+def _walk(q, tree, plan, loops, reach, ws, start):
+    """Node poses from the plan's node ``start`` on (0, or the plan's ``n_fixed`` after a walk of the same design),
+    the closure residual, ``Phi`` and the handle's position Jacobian at ``q`` into ``ws``."""
+    planned_poses(q, tree, plan, start, plan.n_first, ws.rot, ws.pos, ws.trig)
     ck.closure_residual(loops, ws.rot, ws.pos, ws.res)
     ck.closure_jacobian(loops, tree, plan, ws.rot, ws.pos, ws.phi)
     frame_jacobian(reach.handle, tree.parent, tree.axis, tree.coef, ws.rot, ws.pos, np.bool_(False), ws.jac)
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, inline="always")
 def _system(reach, goal, ws):
     """The system ``[Phi; U^T J_v]`` into ``ws.a`` and ``[-phi; U^T (goal - p)]`` into ``ws.rhs`` from the walk in
     ``ws``; returns the largest closure residual and the 3-D distance of the handle from ``goal``."""
@@ -165,7 +167,7 @@ def _system(reach, goal, ws):
     return big, np.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, inline="always")
 def _solve(ws, singular):
     """The Newton step into ``ws.rhs`` (its first N rows): the system's solution when it is square, else the
     least-norm ``A^T (A A^T)^-1 r``; returns (pivot ratio, sign of the determinant of ``A`` or ``A A^T``)."""
@@ -199,7 +201,7 @@ def _newton(q, tree, plan, loops, settings, reach, goal, mode, final, walked, ws
     rhs = ws.rhs
     for it in range(reach.max_iter):
         if it > 0 or not walked:
-            _walk(q, tree, plan, loops, reach, ws)
+            _walk(q, tree, plan, loops, reach, ws, plan.n_fixed)
         big, dist = _system(reach, goal, ws)
         ratio, sign = _solve(ws, reach.singular)
         if not ratio > reach.singular:
@@ -237,7 +239,7 @@ def reach_designs(offsets, targets, shape, plan, loops, settings, reach, out):
     na = loops.actuated.shape[0]
     rows = m + reach.basis.shape[1]
     n_node = shape.parent.shape[0]
-    ws = Scratch(np.zeros((n_node, 3, 3)), np.zeros((n_node, 3)), trig_workspace(n_node), np.zeros((6, n)),
+    ws = Scratch(np.zeros((n_node, 3, 3)), np.zeros((n_node, 3)), trig_workspace(n_node), np.zeros((3, n)),
                  np.zeros((rows, n)), np.zeros((max(rows, n), 1)), np.zeros(m), np.zeros((m, n)), np.zeros((m, m)),
                  np.zeros((m, na)), np.zeros((rows, rows)), np.zeros((rows, 1)))
     closing = closure_scratch(n_node, n, na, loops.passive, np.int64(0))
@@ -253,7 +255,7 @@ def reach_designs(offsets, targets, shape, plan, loops, settings, reach, out):
             if code != OK:
                 out.status[d] = NO_HOME
                 continue
-        _walk(q, tree, plan, loops, reach, ws)
+        _walk(q, tree, plan, loops, reach, ws, np.int64(0))  # the design's fixed nodes too
         branch = _branch(loops, ws)
         for c in range(3):
             here[c] = ws.pos[reach.handle, c]

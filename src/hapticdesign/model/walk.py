@@ -26,7 +26,9 @@ transforms keep their :class:`~hapticdesign.model.transforms.Axis` code and affi
 :class:`Tree`, :class:`WalkPlan` and :class:`MotionPlan` are NamedTuples, the records the compiled
 kernels take. The kernels of the hot loops are compiled without numba's reference counting
 (``_nrt=False``): they allocate nothing, and each array a record passes would otherwise cost an atomic
-increment and decrement per call.
+increment and decrement per call. :func:`planned_poses` and :func:`frame_jacobian` are inlined into their callers
+(numba's ``inline="always"``): a call still copies every field of the records it passes, about 35 ns, a fifth of
+a five-bar's walk.
 
 Forward kinematics, the dynamics regressors, the loop-closure kernels and the R-CUBE stiffness model
 all call these.
@@ -114,17 +116,21 @@ class KinematicTree:
 
     def plan(self, needed: list[int], moving: list[int]) -> "WalkPlan":
         """:class:`WalkPlan` whose first part is the nodes ``needed`` (and their ancestors), those that the
-        coordinates ``moving`` do not move first."""
+        coordinates ``moving`` do not move first, and of those first the ones no coordinate moves."""
         first = set()
         for node in needed:
             while node >= 0 and node not in first:
                 first.add(node)
                 node = int(self.parent[node])
         moved: set[int] = set()
+        fixed: set[int] = set()  # the nodes no coordinate moves
         for n in range(len(self.parent)):  # parents come first
             if int(self.parent[n]) in moved or np.any(self.coef[n, list(moving)] != 0.0):
                 moved.add(n)
-        still = sorted(first - moved)
+            if (self.parent[n] < 0 or int(self.parent[n]) in fixed) and not np.any(self.coef[n] != 0.0):
+                fixed.add(n)
+        fixed &= first
+        still = sorted(fixed) + sorted(first - moved - fixed)
         order = still + sorted(first & moved) + [n for n in range(len(self.parent)) if n not in first]
         nonzero = [np.flatnonzero(row) for row in self.coef]
         ptr = np.cumsum([0] + [len(k) for k in nonzero])
@@ -146,7 +152,7 @@ class KinematicTree:
             order=np.array(order, dtype=np.int64), n_first=len(first), ptr=ptr.astype(np.int64),
             index=np.concatenate([np.zeros(0, dtype=np.int64)] + nonzero).astype(np.int64),
             value=np.concatenate([np.zeros(0)] + [row[k] for row, k in zip(self.coef, nonzero)]),
-            trig_source=source.astype(np.int64), trig_sign=sign, n_still=len(still),
+            trig_source=source.astype(np.int64), trig_sign=sign, n_still=len(still), n_fixed=len(fixed),
         )
 
     def workspace(self) -> tuple[np.ndarray, np.ndarray]:
@@ -171,8 +177,10 @@ class WalkPlan(NamedTuple):
 
     ``order`` lists every node after its parent, the ``n_first`` nodes a chosen set needs first, and of
     those the ``n_still`` that chosen coordinates do not move first (a walk after a change of only those
-    coordinates starts after them); the coupling coefficients of node ``n`` are the sparse row ``value[ptr[n]:ptr[n + 1]]`` at the coordinates
-    ``index[ptr[n]:ptr[n + 1]]`` (in increasing order, so a joint value is the same sum as the dense one's);
+    coordinates starts after them), and of those the ``n_fixed`` that no coordinate moves first (a walk of the
+    same tree at other coordinates starts after them); the coupling coefficients of node ``n`` are the sparse row
+    ``value[ptr[n]:ptr[n + 1]]`` at the coordinates ``index[ptr[n]:ptr[n + 1]]`` (in increasing order, so a joint
+    value is the same sum as the dense one's);
     a rotation node whose angle (coefficients and offset) equals, or is the negative of, that of an
     earlier node of ``order``, ``trig_source[n]``, takes its cosine and sine (times ``trig_sign[n]``).
     """
@@ -185,6 +193,7 @@ class WalkPlan(NamedTuple):
     trig_source: np.ndarray
     trig_sign: np.ndarray
     n_still: int
+    n_fixed: int
 
     def workspace(self) -> np.ndarray:
         """The scratch of :func:`planned_poses` (:func:`trig_workspace`)."""
@@ -199,7 +208,7 @@ def trig_workspace(n_node):
     return out
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, inline="always")
 def planned_poses(q, tree, plan, start, stop, rot, pos, trig):
     """:func:`node_poses` of the nodes ``order[start:stop]`` of a :class:`WalkPlan` ``plan`` on the :class:`Tree` ``tree``.
 
@@ -217,12 +226,11 @@ def planned_poses(q, tree, plan, start, stop, rot, pos, trig):
     for i in range(start, stop):
         n = order[i]
         pn = parent[n]
-        if axis[n] == CONSTANT:
+        ax = axis[n]
+        if ax == CONSTANT:
             _constant_node(n, pn, const_rot, const_pos, rot, pos)
             continue
-        _parent_pose(n, pn, rot, pos)
-        a = axis[n] % 3
-        if axis[n] < 3:
+        if ax < 3:
             s = source[n]
             if s == n:
                 v = offset[n]
@@ -241,19 +249,39 @@ def planned_poses(q, tree, plan, start, stop, rot, pos, trig):
                     trig[n, 2] = v
             cv = trig[s, 0]
             sv = sign[n] * trig[s, 1]
-            b = (a + 1) % 3
-            c = (a + 2) % 3
-            for r in range(3):
-                rb = rot[n, r, b]
-                rc = rot[n, r, c]
-                rot[n, r, b] = rb * cv + rc * sv
-                rot[n, r, c] = -rb * sv + rc * cv
-        else:
+            b = 1 if ax == 0 else (2 if ax == 1 else 0)  # the other two columns, cyclic after ax, turn
+            c = 2 if ax == 0 else (0 if ax == 1 else 1)
+            if pn >= 0:
+                for r in range(3):
+                    rb = rot[pn, r, b]
+                    rc = rot[pn, r, c]
+                    rot[n, r, ax] = rot[pn, r, ax]
+                    rot[n, r, b] = rb * cv + rc * sv
+                    rot[n, r, c] = -rb * sv + rc * cv
+                    pos[n, r] = pos[pn, r]
+            else:
+                for r in range(3):
+                    rb = 1.0 if r == b else 0.0
+                    rc = 1.0 if r == c else 0.0
+                    rot[n, r, ax] = 1.0 if r == ax else 0.0
+                    rot[n, r, b] = rb * cv + rc * sv
+                    rot[n, r, c] = -rb * sv + rc * cv
+                    pos[n, r] = 0.0
+        else:  # the parent's rotation, the origin moved along column a
+            a = ax - 3
             v = offset[n]
             for k in range(ptr[n], ptr[n + 1]):
                 v += value[k] * q[index[k]]
-            for r in range(3):
-                pos[n, r] += rot[n, r, a] * v
+            if pn >= 0:
+                for r in range(3):
+                    for j in range(3):
+                        rot[n, r, j] = rot[pn, r, j]
+                    pos[n, r] = pos[pn, r] + rot[pn, r, a] * v
+            else:
+                for r in range(3):
+                    for j in range(3):
+                        rot[n, r, j] = 1.0 if r == j else 0.0
+                    pos[n, r] = 0.0 + (1.0 if r == a else 0.0) * v
 
 
 @njit(cache=True, inline="always")
@@ -322,14 +350,16 @@ def unit_twist(rot, pos, axis, n, point):
     return u1 * r2 - u2 * r1, u2 * r0 - u0 * r2, u0 * r1 - u1 * r0, u0, u1, u2
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def frame_jacobian(node, parent, axis, coef, rot, pos, body, jac):
-    """Jacobian (6 x N, rows v then w) of the origin of node ``node`` (-1: the base) at the poses ``rot, pos``.
+    """Jacobian (6 x N, rows v then w) of the origin of node ``node`` (-1: the base) at the poses ``rot, pos``;
+    only its rows ``v`` when ``jac`` has 3 rows.
 
     In the base frame, or with ``body`` in the node's own frame (``R^T v``, ``R^T w``).
     """
     n_dof = jac.shape[1]
-    for i in range(6):
+    angular = jac.shape[0] == 6
+    for i in range(jac.shape[0]):
         for k in range(n_dof):
             jac[i, k] = 0.0
     if node < 0:
@@ -337,11 +367,12 @@ def frame_jacobian(node, parent, axis, coef, rot, pos, body, jac):
     n = node
     while n >= 0:
         if axis[n] != CONSTANT:
-            rotation = axis[n] < 3
+            rotation = axis[n] < 3 and angular
             v0, v1, v2, u0, u1, u2 = unit_twist(rot, pos, axis, n, node)
             if body:
                 v0, v1, v2 = _to_node(rot, node, v0, v1, v2)
-                u0, u1, u2 = _to_node(rot, node, u0, u1, u2)
+                if rotation:
+                    u0, u1, u2 = _to_node(rot, node, u0, u1, u2)
             for k in range(n_dof):
                 c = coef[n, k]
                 if c != 0.0:
