@@ -15,7 +15,6 @@ from typing import TYPE_CHECKING, Optional
 import numpy as np
 import typer
 
-from hapticdesign.analysis.metrics import kinematic, names
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import note, parse_vector, print_json, user_errors
 from hapticdesign.interface.options import DEVICE, FORCE, FORCE_HINT, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
@@ -26,15 +25,21 @@ if TYPE_CHECKING:
     from hapticdesign.model.device import Device
 
 SINGULAR_CONDITION = 1e10
-METRIC_INDICES = ((names.CONDITION_NUMBER, "condition", {"jacobian": "task"}),
-                  (names.MANIPULABILITY, "manipulability", {"jacobian": "task"}),
-                  ("I_m", "I_m", {}), ("I_d", "I_d", {}), ("I_f", "I_f", {}), ("I_e", "I_e", {}),
-                  ("acceleration_radius", "acceleration_radius", {}))
-"""The metrics of seed 001 ch. 4 the command gives, as indices of the one registry on the task Jacobian (key, index,
-options)."""
-ORDER = (names.MANIPULABILITY, names.CONDITION_NUMBER, "velocity_ellipsoid_radii", "cartesian_inertia",
-         names.INERTIA_VOLUME, names.DYNAMIC_MANIPULABILITY, names.INERTIA_FROBENIUS, names.INERTIA_UNIFORMITY,
-         names.ACCELERATION_RADIUS)
+
+
+def _metric_table() -> tuple[tuple, tuple]:
+    """The metrics of seed 001 ch. 4 the command gives, as indices of the one registry on the task Jacobian (key,
+    index, options), and the order of the output's keys (imported when the command runs, not with the CLI's table)."""
+    from hapticdesign.analysis.metrics import names
+
+    indices = ((names.CONDITION_NUMBER, "condition", {"jacobian": "task"}),
+               (names.MANIPULABILITY, "manipulability", {"jacobian": "task"}),
+               ("I_m", "I_m", {}), ("I_d", "I_d", {}), ("I_f", "I_f", {}), ("I_e", "I_e", {}),
+               ("acceleration_radius", "acceleration_radius", {}))
+    order = (names.MANIPULABILITY, names.CONDITION_NUMBER, "velocity_ellipsoid_radii", "cartesian_inertia",
+             names.INERTIA_VOLUME, names.DYNAMIC_MANIPULABILITY, names.INERTIA_FROBENIUS, names.INERTIA_UNIFORMITY,
+             names.ACCELERATION_RADIUS)
+    return indices, order
 
 
 def device_metrics(device: Device, q: np.ndarray, extra: Sequence[str] = (), registry: Registry | None = None) -> dict:
@@ -45,19 +50,21 @@ def device_metrics(device: Device, q: np.ndarray, extra: Sequence[str] = (), reg
     the one registry) by name."""
     from hapticdesign.analysis.configuration import configuration_of
     from hapticdesign.analysis.metrics.indices import INDICES, evaluate_at, requests_of
+    from hapticdesign.analysis.metrics import kinematic, names
     from hapticdesign.analysis.metrics.indices.states import HandleStates
 
     registry = INDICES if registry is None else registry
     extra = requests_of(extra, registry)
     pose = HandleStates(device, configuration_of(device).full(q)[None])
     values = {}
-    for key, name, options in METRIC_INDICES:
+    metric_indices, order = _metric_table()
+    for key, name, options in metric_indices:
         values[key] = float(registry[name].values(pose, options)[0])
         if key == names.CONDITION_NUMBER and not values[key] <= SINGULAR_CONDITION:
             raise UserError(f"singular configuration at q = {np.round(q, 6).tolist()}: the Jacobian loses rank")
     J, M_C = pose.task[0], pose.task_inertia[0]
     values.update(velocity_ellipsoid_radii=kinematic.velocity_ellipsoid(J)[0], cartesian_inertia=M_C)
-    out = {"device": device.name, "q": q, "jacobian": J, **{key: values[key] for key in ORDER}}
+    out = {"device": device.name, "q": q, "jacobian": J, **{key: values[key] for key in order}}
     if extra:
         found = evaluate_at(device, pose.full, extra, registry=registry)
         out["indices"] = {key: float(value[0]) for key, value in found.values.items()}
