@@ -15,6 +15,7 @@ import math
 import control
 import numpy as np
 import pytest
+from scipy.optimize import brentq
 
 from hapticdesign.analysis.dynamics.device import gravity_gradient, mass_matrix
 from hapticdesign.analysis.sampled_loop import SampledLoop
@@ -45,14 +46,9 @@ def _python_control_limit(j: float, b: float, k_g: float, share: float, delay: i
     def radius(k):
         return np.abs(control.poles(control.feedback(plant * lag, k - share * k_g))).max()
 
-    lo, hi = 1e-6, 1.0
-    assert radius(lo) < 1.0
-    while radius(hi) < 1.0:
-        lo, hi = hi, 2.0 * hi
-    while hi - lo > 1e-10 * hi:
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if radius(mid) < 1.0 else (lo, mid)
-    return 0.5 * (lo + hi)
+    assert radius(1e-6) < 1.0
+    hi = next(2.0 ** e for e in range(60) if radius(2.0 ** e) >= 1.0)
+    return brentq(lambda k: radius(k) - 1.0, 1e-6, hi, xtol=1e-14, rtol=1e-12)
 
 
 @pytest.mark.parametrize("q", [0.0, 0.4, -1.1])
