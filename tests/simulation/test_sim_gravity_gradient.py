@@ -88,3 +88,40 @@ def test_the_undercompensated_pendulums_simulated_limit_is_the_exact_one():
     k_g = M * G * L * math.cos(1e-3)
     assert exact == pytest.approx(_python_control_limit(M * L * L, B, k_g, 0.4, 1), rel=1e-7)
     assert abs(exact / _python_control_limit(M * L * L, B, 0.0, 0.0, 1) - 1.0) > 0.05
+
+
+def _offset_pendulum():
+    """The pendulum with its mass centre given in the arm's frame (``rx = l``), so a modelling error, which scales the
+    mass centres too, gives the compensator ``f^3 m l^2`` and ``f^2 m g l cos q`` (``f = 1 - E/100``), not ``f``
+    times the device's."""
+    return device_from_mapping({
+        "name": "offset pendulum", "joints": [{"name": "q1", "damping": B}],
+        "frames": [{"name": "arm", "transforms": [{"Rx": "pi/2"}, {"Rz": "-pi/2"}, {"Rz": "q1"}]}],
+        "bodies": [{"name": "bob", "frame": "arm", "m": M, "rx": L}],
+        "end_effector": "arm",
+    })
+
+
+def test_a_gravity_compensators_model_error_enters_as_its_model_devices_gradient():
+    """Gravity compensation with a 30 % modelling error: the compensator's late gravity stiffness is its model
+    device's, ``0.7^2 m g l cos q`` (python-control's loop), not ``0.7 m g l cos q`` (whose limit is about 10 % higher)."""
+    device, loop = _offset_pendulum(), SampledLoop(model_error=30.0)
+    for q in (0.0, 0.6):
+        exact = stability_limit(device, loop, equilibrium=q).stiffness
+        k_g = M * G * L * math.cos(q)
+        assert exact == pytest.approx(_python_control_limit(M * L * L, B, k_g, 0.7 ** 2, 1), rel=1e-7)
+        assert abs(exact / _python_control_limit(M * L * L, B, k_g, 0.7, 1) - 1.0) > 0.05
+
+
+def test_a_full_compensators_model_error_is_the_simulated_compensators():
+    """Full compensation with a 20 % modelling error on the offset pendulum, no friction: the simulated growth
+    boundary (whose compensator is the model device, ``H_m = 0.8^3 m l^2``) is the exact limit built with the model
+    device's inertia and gravity gradient; the uniform share ``0.8 H`` gives less than a third of it."""
+    device, loop = _offset_pendulum(), SampledLoop(compensation="full", model_error=20.0)
+    exact = stability_limit(device, loop, equilibrium=1e-3).stiffness
+    simulated = simulated_limit(device, loop, equilibrium=1e-3, rel_tol=1e-3, duration=4.0, friction=False)
+    assert simulated == pytest.approx(exact, rel=2e-3)
+    pose = np.array([1e-3])
+    uniform = wall_limit(np.array([[1.0], [0.0], [0.0]]), mass_matrix(device, pose), device.damping_matrix, loop,
+                         np.array([1.0, 0.0, 0.0]), gravity_gradient(device, pose))
+    assert uniform < 0.5 * exact

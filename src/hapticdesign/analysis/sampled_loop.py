@@ -375,8 +375,8 @@ class SampledLoop:
 
 
 def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, spring: np.ndarray,
-                 loop: SampledLoop, poses: np.ndarray | None = None,
-                 gravity: np.ndarray | None = None) -> tuple[SpringLoops, np.ndarray]:
+                 loop: SampledLoop, poses: np.ndarray | None = None, gravity: np.ndarray | None = None,
+                 model: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[SpringLoops, np.ndarray]:
     """The sampled loops of S handles under a wall whose spring acts on the joints as ``K w w^T`` (``spring``: the
     rows ``w`` (S, n); ``J_v^T u`` for a Cartesian wall along a unit ``u``, ``e_j`` for a wall on joint j), every
     joint free but ``loop.held``, and a starting guess of their limits (S,).
@@ -384,12 +384,15 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
     ``jacobian`` ``J_v`` (P, 3, n), ``mass`` ``H`` (P, n, n) and ``damping`` ``B`` (n, n) or (P, n, n) of the
     actuated coordinates at the P poses the walls hold, ``poses`` (S,) the pose of each loop (default: loop s at
     pose s, P = S), so that the plant of a pose walled along many directions is discretized once; ``gravity``
-    ``K_G = dG/dq`` (n, n) or (P, n, n) at those poses (None: 0). The plant ``H_h qdd + B_h qd + (K_h + K_G) q =
+    ``K_G = dG/dq`` (n, n) or (P, n, n) at those poses (None: 0); ``model`` the compensator's own inertia ``H_m`` and
+    gravity gradient ``K_Gm`` there (each (n, n) or (P, n, n): a device's are its model device's, whose modelling
+    error need not scale ``H`` and ``G`` alike), None for the loop's uniform shares ``H_m = c H`` and ``K_Gm = s
+    K_G`` (:attr:`SampledLoop.fraction`, :attr:`SampledLoop.gravity_share`); the compensation setting switches them
+    (``none``: neither, ``gravity``: ``K_Gm`` only). The plant ``H_h qdd + B_h qd + (K_h + K_G) q =
     u`` (the hand's mass, damping and stiffness added as ``x J_v^T J_v``) is discretized exactly under a zero-order
     hold (``scipy.linalg.expm`` of the augmented matrix). Every period the controller holds, ``d`` samples late,
-    ``u_k = c H a_(k-d) + s K_G q_(k-d) - K w w^T q_(k-d) - B_w w w^T v^_(k-d)``, ``a`` the acceleration sampled
-    under the previous torque, ``s K_G q`` the linearized gravity compensation
-    (:attr:`SampledLoop.gravity_share`), ``v^`` the sampled velocity or the backward difference of positions. The
+    ``u_k = H_m a_(k-d) + K_Gm q_(k-d) - K w w^T q_(k-d) - B_w w w^T v^_(k-d)``, ``a`` the acceleration sampled
+    under the previous torque, ``K_Gm q`` the linearized gravity compensation, ``v^`` the sampled velocity or the backward difference of positions. The
     state is ``[x_k, ..., x_(k-L), u_(k-1), ..., u_(k-d-1)]`` (``x = (q, qd)``; the torques only with the
     compensator), and ``K`` enters as the rank-one term of :class:`SpringLoops`. The pose changes along the wall
     (``w^T q = 0``) that no static stiffness resists are fixed points (eigenvalue 1) whatever ``K``, a neutral
@@ -408,10 +411,17 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
     jtj = np.swapaxes(jv, 1, 2) @ jv
     hand = loop.hand or Hand()
     hh, bh, kp = h + hand.mass * jtj, b + hand.damping * jtj, hand.stiffness * jtj
-    held = np.zeros_like(kp)  # the compensator's gravity gradient, on the sensed pose
-    if gravity is not None:
-        grad = np.broadcast_to(np.asarray(gravity, dtype=float)[..., free, :][..., free], h.shape)
-        kp, held = kp + grad, loop.gravity_share * grad
+    grad = np.zeros_like(kp) if gravity is None else np.broadcast_to(
+        np.asarray(gravity, dtype=float)[..., free, :][..., free], h.shape)
+    kp = kp + grad
+    if model is None:  # held: the compensator's gravity gradient, on the sensed pose
+        h_model, held = loop.fraction * h, loop.gravity_share * grad
+    else:
+        h_model, held = (np.broadcast_to(np.asarray(x, dtype=float)[..., free, :][..., free], h.shape) for x in model)
+    if loop.compensation != "full":
+        h_model = np.zeros_like(h)
+    if loop.compensation == "none":
+        held = np.zeros_like(h)
     aug = np.zeros((len(h), 3 * n, 3 * n))
     aug[:, :n, n:2 * n] = np.eye(n)
     aug[:, n:2 * n, :n] = -np.linalg.solve(hh, kp)
@@ -419,20 +429,20 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
     aug[:, n:2 * n, 2 * n:] = np.linalg.inv(hh)
     e = expm(aug * loop.period)
     if poses is not None:  # each loop takes its pose's plant
-        e, h, hh, bh, kp, held = (x[np.asarray(poses, dtype=np.int64)] for x in (e, h, hh, bh, kp, held))
+        e, h_model, hh, bh, kp, held = (x[np.asarray(poses, dtype=np.int64)] for x in (e, h_model, hh, bh, kp, held))
     w = np.asarray(spring, dtype=float)[:, free]
     count = len(w)
     phi, gamma = e[:, :2 * n, :2 * n], e[:, :2 * n, 2 * n:]
-    d, c = loop.delay, loop.fraction
+    d = loop.delay
     differenced = loop.velocity == "difference" and loop.virtual_damping > 0
     depth = d + int(differenced)
-    compensated = c != 0.0
+    compensated = bool(np.any(h_model))
     nx, size = 2 * n, 2 * n * (depth + 1) + (n * (d + 1) if compensated else 0)
     u0 = 2 * n * (depth + 1)  # first column of the torque buffer
     law = np.zeros((count, n, size))  # u_k from the state, spring left out
     ww = w[:, :, None] * w[:, None, :]
     if compensated:
-        feed = c * h @ np.linalg.inv(hh)  # c H a, a = H_h^-1 (u_prev - B_h v - K_h q)
+        feed = h_model @ np.linalg.inv(hh)  # H_m a, a = H_h^-1 (u_prev - B_h v - K_h q)
         law[:, :, u0 + n * d:u0 + n * (d + 1)] += feed
         law[:, :, nx * d:nx * d + n] -= feed @ kp
         law[:, :, nx * d + n:nx * (d + 1)] -= feed @ bh
@@ -510,10 +520,11 @@ gravity gradient leaves the drift free."""
 
 def handle_limits(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, spring: np.ndarray,
                   loop: SampledLoop, groups: np.ndarray | None = None, k_max: float = 1e9,
-                  poses: np.ndarray | None = None, gravity: np.ndarray | None = None) -> np.ndarray:
+                  poses: np.ndarray | None = None, gravity: np.ndarray | None = None,
+                  model: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """The exact stable wall stiffness (N/m) of each handle loop of :func:`handle_loops` (S,), or the smallest in
     each group (:func:`loop_limits`)."""
-    loops, guess = handle_loops(jacobian, mass, damping, spring, loop, poses, gravity)
+    loops, guess = handle_loops(jacobian, mass, damping, spring, loop, poses, gravity, model)
     order = loops.base.shape[-1]
     what = f"the closed-loop matrices of {len(loops):,} handle loops of order {order}"
     require_memory(what, 8.0 * order * order * len(loops))
@@ -521,35 +532,47 @@ def handle_limits(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, s
     return loop_limits(loops, guess, groups, k_max)
 
 
-def _joint(inertia, damping) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The handle arrays of S one-joint plants (``J_v`` the unit x axis, ``H = J``, ``B = b``, the wall's row 1)."""
+def _joint(inertia, damping, model_inertia=None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+                                                           tuple[np.ndarray, np.ndarray] | None]:
+    """The handle arrays of S one-joint plants (``J_v`` the unit x axis, ``H = J``, ``B = b``, the wall's row 1) and
+    the compensator's model (its inertia ``model_inertia``, no gravity; None: the loop's share of ``J``)."""
     j, b = np.broadcast_arrays(np.asarray(inertia, dtype=float), np.asarray(damping, dtype=float))
     j, b = j.ravel(), b.ravel()
     if not np.all((j > 0) & np.isfinite(j)):
         raise UserError(f"the inertia must be positive, got {_worst(j)}")
     if not np.all((b >= 0) & np.isfinite(b)):
         raise UserError(f"the damping must be non-negative, got {_worst(b)}")
+    model = None
+    if model_inertia is not None:
+        m = np.broadcast_to(np.asarray(model_inertia, dtype=float), j.shape)
+        if not np.all((m >= 0) & np.isfinite(m)):
+            raise UserError(f"the compensator's inertia must be non-negative, got {_worst(m)}")
+        model = (m[:, None, None], np.zeros((len(j), 1, 1)))
     axis = np.broadcast_to(np.array([[1.0], [0.0], [0.0]]), (len(j), 3, 1))
-    return axis, j[:, None, None], b[:, None, None], np.ones((len(j), 1))
+    return axis, j[:, None, None], b[:, None, None], np.ones((len(j), 1)), model
 
 
-def joint_loops(inertia, damping, loop: SampledLoop) -> SpringLoops:
+def joint_loops(inertia, damping, loop: SampledLoop, model_inertia=None) -> SpringLoops:
     """The sampled loops of 1-DOF plants, a joint of inertia ``J`` (kg m^2, or kg) and damping ``b`` (N m s/rad, or
     N s/m) each (numbers or S values) under the wall on it and the settings ``loop`` (a hand adds its mass, damping
-    and stiffness to the joint's): the one-joint case of :func:`handle_loops`."""
-    return handle_loops(*_joint(inertia, damping), loop)[0]
+    and stiffness to the joint's), the full compensator feeding ``model_inertia`` times the acceleration (default
+    ``c J``): the one-joint case of :func:`handle_loops`."""
+    axis, h, b, w, model = _joint(inertia, damping, model_inertia)
+    return handle_loops(axis, h, b, w, loop, model=model)[0]
 
 
 def joint_limits(inertia, damping, loop: SampledLoop, groups: np.ndarray | None = None,
-                 k_max: float = 1e9) -> np.ndarray:
+                 k_max: float = 1e9, model_inertia=None) -> np.ndarray:
     """The exact limits (S,) of the loops of :func:`joint_loops`, or the smallest in each group
     (:func:`handle_limits`)."""
-    return handle_limits(*_joint(inertia, damping), loop, groups, k_max)
+    axis, h, b, w, model = _joint(inertia, damping, model_inertia)
+    return handle_limits(axis, h, b, w, loop, groups, k_max, model=model)
 
 
-def joint_limit(inertia: float, damping: float, loop: SampledLoop, k_max: float = 1e9) -> float:
+def joint_limit(inertia: float, damping: float, loop: SampledLoop, k_max: float = 1e9,
+                model_inertia: float | None = None) -> float:
     """:func:`joint_limits` of one joint."""
-    return float(joint_limits(inertia, damping, loop, k_max=k_max)[0])
+    return float(joint_limits(inertia, damping, loop, k_max=k_max, model_inertia=model_inertia)[0])
 
 
 def _worst(values: np.ndarray) -> float:

@@ -71,20 +71,29 @@ CHUNK_BYTES = 1 << 24
 
 
 def wall_limit(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, loop: SampledLoop | None = None,
-               direction: np.ndarray | None = None, gravity: np.ndarray | None = None) -> float:
+               direction: np.ndarray | None = None, gravity: np.ndarray | None = None,
+               model: tuple[np.ndarray, np.ndarray] | None = None) -> float:
     """The exact stable wall stiffness (N/m) at one pose along ``direction`` (a unit base-frame 3-vector), or the
     smallest over :func:`wall_directions` when it is None (see the module docstring); ``gravity`` the gradient
-    ``dG/dq`` (n, n) at the pose (None: 0)."""
+    ``dG/dq`` (n, n) at the pose (None: 0), ``model`` the compensator's ``H_m`` and ``dG_m/dq`` there (None: the
+    loop's shares, :func:`~hapticdesign.analysis.sampled_loop.handle_loops`)."""
     along = None if direction is None else np.reshape(direction, (1, 1, 3))
     return float(wall_limits(jacobian[None], mass[None], damping, loop, along,
-                             None if gravity is None else np.asarray(gravity)[None])[0])
+                             None if gravity is None else np.asarray(gravity)[None], _one(model))[0])
+
+
+def _one(model: tuple[np.ndarray, np.ndarray] | None) -> tuple[np.ndarray, np.ndarray] | None:
+    """A pose's compensator model as the model of a batch of one."""
+    return None if model is None else tuple(np.asarray(x, dtype=float)[None] for x in model)
 
 
 def wall_limits(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, loop: SampledLoop | None = None,
-                along: np.ndarray | None = None, gravity: np.ndarray | None = None) -> np.ndarray:
+                along: np.ndarray | None = None, gravity: np.ndarray | None = None,
+                model: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """:func:`wall_limit` at P poses at once: ``jacobian`` ``J_v`` (P, 3, n), ``mass`` ``H`` (P, n, n), ``damping``
     ``B`` (n, n) or (P, n, n), ``gravity`` ``dG/dq`` (P, n, n) or None; ``along`` None (the worst of
-    :func:`wall_directions`) or (P, C, 3) unit base-frame rows (the smallest over them); (P,) in N/m, the loops
+    :func:`wall_directions`) or (P, C, 3) unit base-frame rows (the smallest over them), ``model`` the compensator's
+    ``H_m`` and ``dG_m/dq`` (P, n, n) each or None (the loop's shares); (P,) in N/m, the loops
     searched together in chunks of about :data:`CHUNK_BYTES` of matrices."""
     loop = loop or SampledLoop()
     jacobian, mass = np.asarray(jacobian, dtype=float), np.asarray(mass, dtype=float)
@@ -105,14 +114,17 @@ def wall_limits(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, loo
         rows = np.repeat(np.arange(start, start + size), per_point)
         spring = np.einsum("sk,skn->sn", along[part].reshape(-1, 3), jacobian[rows])
         out[part] = handle_limits(jacobian[part], mass[part], damping[part], spring, loop,
-                                  np.repeat(np.arange(size), per_point), poses=rows - start, gravity=gravity[part])
+                                  np.repeat(np.arange(size), per_point), poses=rows - start, gravity=gravity[part],
+                                  model=None if model is None else tuple(x[part] for x in model))
     return out
 
 
 def worst_direction(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, loop: SampledLoop | None = None,
-                    gravity: np.ndarray | None = None) -> tuple[float, np.ndarray]:
+                    gravity: np.ndarray | None = None,
+                    model: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[float, np.ndarray]:
     """The smallest exact wall limit at one pose over :func:`wall_directions` and the direction (unit, base frame)
-    that gives it (every direction searched to the end); ``gravity`` ``dG/dq`` (n, n) at the pose or None."""
+    that gives it (every direction searched to the end); ``gravity`` ``dG/dq`` (n, n) at the pose or None, ``model``
+    as :func:`wall_limit`'s."""
     loop = loop or SampledLoop()
     jacobian, mass = np.asarray(jacobian, dtype=float)[None], np.asarray(mass, dtype=float)[None]
     damping = np.broadcast_to(np.asarray(damping, dtype=float), mass.shape)
@@ -120,7 +132,8 @@ def worst_direction(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray,
     along = np.einsum("ik,ck->ci", basis[0], wall_directions(mobility, cartesian_damping)[0])
     count = len(along)
     limits = handle_limits(jacobian, mass, damping, along @ jacobian[0], loop, poses=np.zeros(count, dtype=np.int64),
-                           gravity=None if gravity is None else np.asarray(gravity, dtype=float)[None])
+                           gravity=None if gravity is None else np.asarray(gravity, dtype=float)[None],
+                           model=_one(model))
     best = int(np.argmin(limits))
     return float(limits[best]), along[best]
 

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from hapticdesign.analysis.configuration import configuration_of
+from hapticdesign.analysis.dynamics.device import gravity_gradient, mass_matrix
 from hapticdesign.analysis.sampled_loop import Hand, SampledLoop
 from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.device import Device
@@ -294,6 +295,18 @@ def model_device(device: Device, error_percent: float, group_errors: tuple[tuple
 def compensator_device(device: Device, compensator: Compensator) -> Device:
     """The device the compensator models, with its errors (:func:`model_device`)."""
     return model_device(device, compensator.error_percent, compensator.group_errors, compensator.error_seed)
+
+
+def loop_model(device: Device, loop: SampledLoop, pose: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """The compensator's own inertia ``H_m`` and gravity gradient ``dG_m/dq`` at the actuated ``pose`` under the
+    settings ``loop``: those of :func:`model_device` with the loop's modelling error (which scales the mass centres
+    too, so ``H_m`` and ``G_m`` are not ``(1 - E/100)`` times the device's, and motors' rotors are not scaled); None
+    without a modelling error (the model is the device). The exact limits take them
+    (:func:`hapticdesign.analysis.sampled_loop.handle_loops`), as the simulation's compensator does."""
+    if loop.model_error == 0:
+        return None
+    model = model_device(device, loop.model_error)
+    return mass_matrix(model, pose), gravity_gradient(model, pose)
 
 
 def rest_pose(device: Device) -> np.ndarray:

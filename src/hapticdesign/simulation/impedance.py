@@ -36,8 +36,8 @@ from hapticdesign.model.device import Device
 from hapticdesign.simulation.analytic import GROWS, AnalyticProblem, linear_loop
 from hapticdesign.simulation.boundary import envelope_grows, growth_onset
 from hapticdesign.simulation.config import (
-    LoopConfig, Wall, compensator_device, handle_jacobian, loop_config, normal_jacobian, require_device, require_options, rest_pose,
-    unit_direction,
+    LoopConfig, Wall, compensator_device, handle_jacobian, loop_config, loop_model, normal_jacobian, require_device,
+    require_options, rest_pose, unit_direction,
 )
 from hapticdesign.simulation.loop import simulate, tables_of
 from hapticdesign.simulation.criteria import Criteria, Verdict, WallProblem, require_closed, type_paths
@@ -159,8 +159,13 @@ def stability_limit(device: Device, loop: SampledLoop | None = None, wall_joint:
         if not np.linalg.norm(spring) > 1e-12 * max(np.linalg.norm(jv), 1e-300):
             raise UserError("the handle does not move along the wall's direction at the pose the wall holds")
     limit = handle_limits(jv[None], mass_matrix(device, pose)[None], device.damping_matrix, spring[None], loop,
-                          k_max=k_max, gravity=gravity_gradient(device, pose)[None])
+                          k_max=k_max, gravity=gravity_gradient(device, pose)[None],
+                          model=_batch_of_one(loop_model(device, loop, pose)))
     return StabilityLimit(float(limit[0]), pose, loop)
+
+
+def _batch_of_one(model: tuple[np.ndarray, np.ndarray] | None) -> tuple[np.ndarray, np.ndarray] | None:
+    return None if model is None else (model[0][None], model[1][None])
 
 
 def device_counts(device: Device) -> int | None:

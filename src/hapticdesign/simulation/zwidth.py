@@ -36,16 +36,18 @@ import numpy as np
 from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.analysis.sampled_loop import FLOOR, SampledLoop, joint_limit, joint_limits, joint_loops
 from hapticdesign.errors import InputError, UserError
+from hapticdesign.simulation.config import model_device
 
 MAX_DAMPERS = 1000
 """Most virtual dampers of one Z-width (each one a search of K_max over about 60 eigenvalue problems)."""
 
 
 def max_stiffness(inertia: float, damping: float, loop: SampledLoop, virtual_damping: float = 0.0,
-                  k_limit: float = 1e9) -> float:
+                  k_limit: float = 1e9, model_inertia: float | None = None) -> float:
     """The largest stable ``K`` of the joint for a virtual damper ``B`` (0 when even a tiny spring is unstable, inf
-    when none up to ``k_limit`` destabilizes it)."""
-    return joint_limit(inertia, damping, replace(loop, virtual_damping=virtual_damping), k_limit)
+    when none up to ``k_limit`` destabilizes it); ``model_inertia`` the full compensator's inertia (default ``c
+    J``)."""
+    return joint_limit(inertia, damping, replace(loop, virtual_damping=virtual_damping), k_limit, model_inertia)
 
 
 def passivity_stiffness(damping: float, loop: SampledLoop, virtual_damping: float) -> float:
@@ -87,13 +89,14 @@ class ZWidth:
                 "units": {"B": "N m s/rad", "K": "N m/rad"}}
 
 
-def damping_grid(inertia: float, damping: float, loop: SampledLoop, points: int = 25) -> list[float]:
+def damping_grid(inertia: float, damping: float, loop: SampledLoop, points: int = 25,
+                 model_inertia: float | None = None) -> list[float]:
     """Virtual dampers from 0 to where a damper alone destabilizes the loop (bisected to 0.1 %)."""
     if not 2 <= points <= 1000:
         raise UserError(f"the damper grid needs 2 to 1000 points, got {points}")
 
     def usable(b: float) -> bool:
-        loops = joint_loops(inertia, damping, replace(loop, virtual_damping=b))
+        loops = joint_loops(inertia, damping, replace(loop, virtual_damping=b), model_inertia)
         return bool(loops.radii(np.array([FLOOR]))[0] < 1.0)
 
     lo, hi = 0.0, 4.0 * inertia / loop.period + 4.0 * damping
@@ -106,18 +109,20 @@ def damping_grid(inertia: float, damping: float, loop: SampledLoop, points: int 
 
 
 def zwidth(inertia: float, damping: float, loop: SampledLoop, dampers: list[float] | None = None,
-           points: int = 25) -> ZWidth:
+           points: int = 25, model_inertia: float | None = None) -> ZWidth:
     """The Z-width of a joint under the settings ``loop``: ``K_max`` for each virtual damper (default: a grid up to
-    the largest usable one)."""
+    the largest usable one); ``model_inertia`` the full compensator's inertia (a device's model's ``H_jj``; default
+    ``c J``, :attr:`~hapticdesign.analysis.sampled_loop.SampledLoop.fraction`)."""
     if dampers is not None and not 1 <= len(dampers) <= MAX_DAMPERS:
         raise InputError(f"give 1 to {MAX_DAMPERS} virtual dampers, got {len(dampers):,}", "b_values")
     _check_resolvable(inertia, damping, loop)
-    values = damping_grid(inertia, damping, loop, points) if dampers is None else [float(b) for b in dampers]
+    values = (damping_grid(inertia, damping, loop, points, model_inertia) if dampers is None
+              else [float(b) for b in dampers])
     if any(not (math.isfinite(b) and b >= 0.0) for b in values):
         raise InputError(f"the virtual dampers must be finite and >= 0, got "
                          f"{min(values, key=lambda b: b if math.isfinite(b) else -math.inf):g}", "b_values")
     bounds = loop.fraction == 0.0 and loop.hand is None
-    return ZWidth(values, [max_stiffness(inertia, damping, loop, b) for b in values],
+    return ZWidth(values, [max_stiffness(inertia, damping, loop, b, model_inertia=model_inertia) for b in values],
                   [passivity_stiffness(damping, loop, b) for b in values] if bounds else None,
                   [linear_approximation(damping, loop, b) for b in values] if bounds else None)
 
@@ -152,7 +157,8 @@ def stiffness_map(device, joint: int, axes: tuple[int, int], n: int, loop: Sampl
                   span: tuple[float, float] = (-math.pi, math.pi)) -> StiffnessMap:
     """The Z-width's K at the loop's virtual damper over the workspace: ``J = H_jj(q)`` on an ``n x n`` grid of
     joints ``axes`` (the others at 0), each cell exact for the sampled loop with the other joints held (the cells
-    searched at once, :func:`~hapticdesign.analysis.sampled_loop.joint_limits`)."""
+    searched at once, :func:`~hapticdesign.analysis.sampled_loop.joint_limits`; the compensator's inertia that of
+    the model device, :func:`~.config.model_device`)."""
     if not 2 <= n <= 101:
         raise UserError(f"the map needs 2 to 101 points per axis, got {n}")
     if len(set(axes)) != 2 or joint in axes or not all(0 <= a < device.n_dof for a in axes):
@@ -161,5 +167,6 @@ def stiffness_map(device, joint: int, axes: tuple[int, int], n: int, loop: Sampl
     poses = np.zeros((n * n, device.n_dof))
     poses[:, axes[0]], poses[:, axes[1]] = np.repeat(grid, n), np.tile(grid, n)
     inertia = mass_matrix(device, poses)[:, joint, joint]
-    values = joint_limits(inertia, float(device.damping[joint]), loop).reshape(n, n)
+    model = mass_matrix(model_device(device, loop.model_error), poses)[:, joint, joint] if loop.model_error else None
+    values = joint_limits(inertia, float(device.damping[joint]), loop, model_inertia=model).reshape(n, n)
     return StiffnessMap(axes, grid.tolist(), grid.tolist(), values.tolist())

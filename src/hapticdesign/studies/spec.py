@@ -62,6 +62,7 @@ from hapticdesign.model.actuators import transmission
 from hapticdesign.model.device import Device
 from hapticdesign.analysis.sampled_loop import GRASP, SampledLoop
 from hapticdesign.analysis.wall_stiffness import wall_limit, worst_direction
+from hapticdesign.simulation.config import loop_model
 
 CUBE_SEARCH = (0.0, 0.4, 12)
 """Bisection of the workspace cube's half edge: lower and upper bound (m) and number of halvings."""
@@ -135,8 +136,9 @@ def backdrive_friction(device: Device, h: Handle) -> tuple[float, float] | None:
 def renderable_stiffness(device: Device, h: Handle, loop: SampledLoop | None = None) -> float:
     """The smallest exact wall limit over directions, every joint free
     (:func:`hapticdesign.analysis.wall_stiffness.wall_limit`), gravity's gradient at the pose in the loop."""
-    return wall_limit(h.jacobian, h.states.H[0], device.damping_matrix, loop or SampledLoop(),
-                      gravity=gravity_gradient(device, h.q))
+    loop = loop or SampledLoop()
+    return wall_limit(h.jacobian, h.states.H[0], device.damping_matrix, loop, gravity=gravity_gradient(device, h.q),
+                      model=loop_model(device, loop, h.q))
 
 
 TOUCH = 0.001
@@ -154,7 +156,7 @@ def renderable(device: Device, h: Handle, loop: SampledLoop, res: float | None,
     from hapticdesign.simulation.impedance import device_counts, simulated_limit
 
     exact, direction = worst_direction(h.jacobian, h.states.H[0], device.damping_matrix, replace(loop, hand=None),
-                                       gravity_gradient(device, h.q))
+                                       gravity_gradient(device, h.q), loop_model(device, loop, h.q))
     hand = loop.hand or GRASP
     counts = device_counts(device)
     simulated = None

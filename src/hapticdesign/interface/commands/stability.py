@@ -17,13 +17,14 @@ def _dampers(text: Optional[str]) -> Optional[list[float]]:
     return None if text is None else [float(v) for v in parse_vector(text, None, "b-values")]
 
 
-def _device_joint(preset, device, params, strict, q, joint, direction=None) -> tuple[float, float, int, int,
-                                                                                   float | None]:
-    """J = H_jj(q), b_j, the joint's index, the device's joint count, and ``J_n = n^T J_v`` of the joint along a
-    Cartesian wall's ``direction`` (None without one)."""
+def _device_joint(preset, device, params, strict, q, joint, direction, loop) -> tuple[float, float, int, int,
+                                                                                     float | None, float | None]:
+    """J = H_jj(q), b_j, the joint's index, the device's joint count, ``J_n = n^T J_v`` of the joint along a
+    Cartesian wall's ``direction`` (None without one) and the compensator's ``H_m,jj`` (its model device's, None
+    without a modelling error)."""
     from hapticdesign.analysis.dynamics.device import mass_matrix
     from hapticdesign.devices.loading import resolve_device
-    from hapticdesign.simulation.config import Wall, normal_jacobian
+    from hapticdesign.simulation.config import Wall, loop_model, normal_jacobian
     from hapticdesign.simulation.loop import joint_index
 
     dev = resolve_device(preset, device, params, strict=strict)
@@ -36,7 +37,8 @@ def _device_joint(preset, device, params, strict, q, joint, direction=None) -> t
         if not vector.any():
             raise UserError("--wall-direction must not be the zero vector")
         reach = float(normal_jacobian(dev, Wall(direction=tuple(vector.tolist())), pose)[j])
-    return inertia, float(dev.damping[j]), j, dev.n_dof, reach
+    model = loop_model(dev, loop, pose)
+    return inertia, float(dev.damping[j]), j, dev.n_dof, reach, None if model is None else float(model[0][j, j])
 
 
 def zwidth_command(
@@ -95,10 +97,10 @@ def zwidth_command(
             raise UserError("--wall-direction needs a device (--preset or --device)")
         if wall_direction is not None and map_joints is not None:
             raise UserError("--map-joints charts a joint wall; leave out --wall-direction")
-        reach, shown = None, loop
+        reach, shown, model = None, loop, None
         if from_device:  # a 1-DOF display of the joint: the others held, a named option the settings state
-            inertia, damping, wall, count, reach = _device_joint(preset, device, params, strict, q, joint,
-                                                                 wall_direction)
+            inertia, damping, wall, count, reach, model = _device_joint(preset, device, params, strict, q, joint,
+                                                                        wall_direction, loop)
             shown = replace(loop, held=tuple(j for j in range(count) if j != wall))
         if map_joints is not None and not (from_device and out is not None):
             raise UserError("--map-joints needs a device (--preset or --device) and --out")
@@ -106,13 +108,15 @@ def zwidth_command(
             raise UserError("--inertia and --damping go together")
         if reach is not None:
             inertia, damping = along_wall(inertia, damping, reach)
-        result = zwidth(inertia, damping, loop, _dampers(b_values), points)
+            model = None if model is None else model / reach ** 2
+        result = zwidth(inertia, damping, loop, _dampers(b_values), points, model)
         units = ("kg", "N s/m", "N/m") if reach is not None else ("kg m^2", "N m s/rad", "N m/rad")
         figures, index = [], None
         if out is not None:
             title = (f"J = {inertia:g} {units[0]}, b = {damping:g} {units[1]}, T = {period:g} s, N = {loop.delay}, "
                      f"{loop.velocity} velocity, {loop.compensation} compensation"
-                     + (f" (c = {loop.fraction:g})" if loop.compensation == "full" else "")
+                     + (f" (c = {loop.fraction if model is None else model / inertia:g})"
+                        if loop.compensation == "full" else "")
                      + (" (Cartesian wall)" if reach is not None else ""))
             figures = [str(p) for p in zwidth_chart(result, title, Path(out) / "zwidth", units[1:])]
             if map_joints is not None:
@@ -120,7 +124,8 @@ def zwidth_command(
                                 replace(loop, virtual_damping=result.B[0]), Path(out))
             index = str(write_folder_index(Path(out), "Z-width", "Exact Z-width of a 1-DOF haptic display (seed 000 "
                                            f"ch. 5 future work): {title}.", figures))
-        payload = {**result.as_dict(), "settings": shown.as_dict(), "loop": {"inertia": inertia, "damping": damping},
+        about = {"inertia": inertia, "damping": damping, **({} if model is None else {"model_inertia": model})}
+        payload = {**result.as_dict(), "settings": shown.as_dict(), "loop": about,
                    "figures": figures, **({"index": index} if index else {})}
         if reach is not None:
             payload["units"] = {"B": units[1], "K": units[2]}
