@@ -11,6 +11,7 @@ from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.simulation.analytic import AnalyticProblem
 from hapticdesign.simulation.analytic_driven import DrivenLoop
 from hapticdesign.simulation.criteria import type_paths
+from hapticdesign.analysis.sampled_loop import Hand
 from hapticdesign.simulation.config import Compensator, LoopConfig, Sensors
 from hapticdesign.simulation.impedance import ImpedanceProblem, fast_search, impedance_range
 
@@ -103,3 +104,14 @@ def test_group_errors_with_random_signs_equal_the_simulation():
     config = LoopConfig(compensator=Compensator(group_errors=(("mass", 5.0), ("inertia", 5.0)), error_seed=11))
     analytic, simulated = AnalyticProblem(device, 1, config=config), ImpedanceProblem(device, 1, config=config)
     assert fast_search(analytic).k_max == fast_search(simulated).k_max
+
+
+@pytest.mark.parametrize("config", [LoopConfig(hand=Hand(0.2, 1.0, 0.0)),
+                                    LoopConfig(hand=Hand(0.2, 1.0, 0.0), compensator=Compensator(error_percent=5),
+                                               sensors=Sensors(delay_samples=1))], ids=["hand", "hand-error5-delay1"])
+def test_a_hand_in_type_one_equals_the_simulation(config):
+    """A hand's mass and damping on the handle (``x J_v^T J_v`` on joint 1): the compensator's model has no hand, so
+    it feeds its own ``H_m,11`` times the sampled acceleration of the joint with the hand; the analytic loop (the
+    one-joint case of the handle loop) equals the RK4 simulation's verdicts, peaks and stop times."""
+    device = preset("phantom-3dof").with_params(NONLINEAR)
+    assert_same_search(AnalyticProblem(device, 1, config=config), ImpedanceProblem(device, 1, config=config))

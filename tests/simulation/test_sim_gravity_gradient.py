@@ -104,7 +104,8 @@ def _offset_pendulum():
 
 def test_a_gravity_compensators_model_error_enters_as_its_model_devices_gradient():
     """Gravity compensation with a 30 % modelling error: the compensator's late gravity stiffness is its model
-    device's, ``0.7^2 m g l cos q`` (python-control's loop), not ``0.7 m g l cos q`` (whose limit is about 10 % higher)."""
+    device's, ``0.7^2 m g l cos q`` (python-control's loop), not ``0.7 m g l cos q`` (whose limit is about 10 %
+    higher)."""
     device, loop = _offset_pendulum(), SampledLoop(model_error=30.0)
     for q in (0.0, 0.6):
         exact = stability_limit(device, loop, equilibrium=q).stiffness

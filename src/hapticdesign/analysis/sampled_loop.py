@@ -126,10 +126,11 @@ def compensated_boundary(inertia: float, damping: float, period: float, fraction
 class SpringLoops:
     """The one-sample maps of S sampled loops in which the wall's spring ``K`` enters as a rank-one term,
     ``m(K) = m(0) - K g h^T`` (``base`` (S, N, N), ``g`` and ``h`` (S, N)), so a search builds the spring-free maps
-    once (the loops of :func:`handle_loops`)."""
+    once (the loops of :func:`handle_loops`); ``law`` (S, n, N) and ``wall`` (S, n) give the torque the controller
+    holds over the next period, ``law s - K wall (h^T s)`` (:meth:`torques`)."""
 
-    def __init__(self, base: np.ndarray, g: np.ndarray, h: np.ndarray):
-        self.base, self.g, self.h = base, g, h
+    def __init__(self, base: np.ndarray, g: np.ndarray, h: np.ndarray, law: np.ndarray, wall: np.ndarray):
+        self.base, self.g, self.h, self.law, self.wall = base, g, h, law, wall
 
     def __len__(self) -> int:
         return len(self.base)
@@ -138,6 +139,11 @@ class SpringLoops:
         """The maps (S', N, N) of the systems ``index`` under the springs ``stiffness`` (S',)."""
         k = np.asarray(stiffness, dtype=float)[:, None, None]
         return self.base[index] - k * self.g[index][:, :, None] * self.h[index][:, None, :]
+
+    def torques(self, stiffness: float, states: np.ndarray, index: int = 0) -> np.ndarray:
+        """The torques (..., n) loop ``index`` holds after the sampled states (..., N) under the spring
+        ``stiffness``."""
+        return states @ self.law[index].T - stiffness * np.multiply.outer(states @ self.h[index], self.wall[index])
 
     def radii(self, stiffness: np.ndarray, index: np.ndarray | slice = slice(None)) -> np.ndarray:
         """Spectral radii (S',) of :meth:`matrices` (the loop is stable below 1)."""
@@ -390,10 +396,10 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
     K_G`` (:attr:`SampledLoop.fraction`, :attr:`SampledLoop.gravity_share`); the compensation setting switches them
     (``none``: neither, ``gravity``: ``K_Gm`` only). The plant ``H_h qdd + B_h qd + (K_h + K_G) q =
     u`` (the hand's mass, damping and stiffness added as ``x J_v^T J_v``) is discretized exactly under a zero-order
-    hold (``scipy.linalg.expm`` of the augmented matrix). Every period the controller holds, ``d`` samples late,
+    hold (:func:`held_plant`). Every period the controller holds, ``d`` samples late,
     ``u_k = H_m a_(k-d) + K_Gm q_(k-d) - K w w^T q_(k-d) - B_w w w^T v^_(k-d)``, ``a`` the acceleration sampled
-    under the previous torque, ``K_Gm q`` the linearized gravity compensation, ``v^`` the sampled velocity or the backward difference of positions. The
-    state is ``[x_k, ..., x_(k-L), u_(k-1), ..., u_(k-d-1)]`` (``x = (q, qd)``; the torques only with the
+    under the previous torque, ``K_Gm q`` the linearized gravity compensation, ``v^`` the sampled velocity or the
+    backward difference of positions. The state is ``[x_k, ..., x_(k-L), u_(k-1), ..., u_(k-d-1)]`` (``x = (q, qd)``; the torques only with the
     compensator), and ``K`` enters as the rank-one term of :class:`SpringLoops`. The pose changes along the wall
     (``w^T q = 0``) that no static stiffness resists are fixed points (eigenvalue 1) whatever ``K``, a neutral
     drift of the handle along the wall, not an instability; they are deflated (:func:`_deflated`).
@@ -422,17 +428,12 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
         h_model = np.zeros_like(h)
     if loop.compensation == "none":
         held = np.zeros_like(h)
-    aug = np.zeros((len(h), 3 * n, 3 * n))
-    aug[:, :n, n:2 * n] = np.eye(n)
-    aug[:, n:2 * n, :n] = -np.linalg.solve(hh, kp)
-    aug[:, n:2 * n, n:2 * n] = -np.linalg.solve(hh, bh)
-    aug[:, n:2 * n, 2 * n:] = np.linalg.inv(hh)
-    e = expm(aug * loop.period)
+    phi, gamma = held_plant(hh, bh, kp, loop.period)
     if poses is not None:  # each loop takes its pose's plant
-        e, h_model, hh, bh, kp, held = (x[np.asarray(poses, dtype=np.int64)] for x in (e, h_model, hh, bh, kp, held))
+        phi, gamma, h_model, hh, bh, kp, held = (x[np.asarray(poses, dtype=np.int64)]
+                                                 for x in (phi, gamma, h_model, hh, bh, kp, held))
     w = np.asarray(spring, dtype=float)[:, free]
     count = len(w)
-    phi, gamma = e[:, :2 * n, :2 * n], e[:, :2 * n, 2 * n:]
     d = loop.delay
     differenced = loop.velocity == "difference" and loop.virtual_damping > 0
     depth = d + int(differenced)
@@ -469,15 +470,31 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
     hvec[:, nx * d:nx * d + n] = w
     if n > 1:
         net = (kp - held) * loop.period ** 2 / np.linalg.norm(hh, axis=(1, 2))[:, None, None]
-        m, g, hvec = _deflated(m, g, hvec, w, net, held, depth, u0 if compensated else None)
+        m, g, hvec, law = _deflated(m, g, hvec, law, w, net, held, depth, u0 if compensated else None)
     reach = np.einsum("sn,sn->s", w, w)
     viscous = np.einsum("sn,snm,sm->s", w, bh, w) / np.maximum(reach, 1e-300) ** 2 + loop.virtual_damping
     guess = np.maximum(2.0 * viscous / (loop.period * (1 + 2 * d)), FLOOR)
-    return SpringLoops(m, g, hvec), guess
+    return SpringLoops(m, g, hvec, law, w), guess
 
 
-def _deflated(m: np.ndarray, g: np.ndarray, h: np.ndarray, w: np.ndarray, net: np.ndarray, held: np.ndarray,
-              depth: int, u0: int | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def held_plant(mass: np.ndarray, damping: np.ndarray, stiffness: np.ndarray,
+               period: float) -> tuple[np.ndarray, np.ndarray]:
+    """The plants ``H qdd + B qd + K q = u`` ((P, n, n) each) over ``period`` under a held ``u``, exactly: ``Phi``
+    (P, 2n, 2n) and ``Gamma`` (P, 2n, n) of ``x = (q, qd)``, ``x+ = Phi x + Gamma u`` (``scipy.linalg.expm`` of the
+    augmented matrix)."""
+    n = mass.shape[-1]
+    aug = np.zeros((len(mass), 3 * n, 3 * n))
+    aug[:, :n, n:2 * n] = np.eye(n)
+    aug[:, n:2 * n, :n] = -np.linalg.solve(mass, stiffness)
+    aug[:, n:2 * n, n:2 * n] = -np.linalg.solve(mass, damping)
+    aug[:, n:2 * n, 2 * n:] = np.linalg.inv(mass)
+    e = expm(aug * period)
+    return e[:, :2 * n, :2 * n], e[:, :2 * n, 2 * n:]
+
+
+def _deflated(m: np.ndarray, g: np.ndarray, h: np.ndarray, law: np.ndarray, w: np.ndarray, net: np.ndarray,
+              held: np.ndarray, depth: int,
+              u0: int | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The maps with their spring-independent fixed points removed: a pose change ``q*`` along the wall (``w^T q* =
     0``) that no static stiffness resists (``(K_h + (1 - s) K_G) q* = 0``; ``net`` that stiffness times ``T^2 /
     |H_h|``, the share of the inertia's scale it reaches over a period) is held still whatever ``K`` (the state
@@ -485,7 +502,8 @@ def _deflated(m: np.ndarray, g: np.ndarray, h: np.ndarray, w: np.ndarray, net: n
     neutral drift of the handle along the wall, not an instability. In an orthonormal basis ``[Q1 Q2]`` with ``Q1``
     spanning them the map is block triangular, so the other eigenvalues are those of ``Q2^T m Q2`` (and the spring's
     term stays rank one, ``(Q2^T g)(Q2^T h)^T``); when the loops have different numbers of them, ``(I - P) m (I -
-    P)`` with ``P`` the orthogonal projector on them has the same eigenvalues and zeros, at one size for all."""
+    P)`` with ``P`` the orthogonal projector on them has the same eigenvalues and zeros, at one size for all. The
+    torque law is taken into the same coordinates."""
     count, size = m.shape[0], m.shape[1]
     n = w.shape[1]
     rows = np.concatenate([(w / np.linalg.norm(w, axis=1, keepdims=True))[:, None, :], net], axis=1)
@@ -496,7 +514,7 @@ def _deflated(m: np.ndarray, g: np.ndarray, h: np.ndarray, w: np.ndarray, net: n
     null = vt[:, n - ranks[0]:, :] if uniform else vt * free[:, :, None]  # rows spanning the fixed pose changes
     r = null.shape[1]
     if r == 0:
-        return m, g, h
+        return m, g, h, law
     fixed = np.zeros((count, size, r))
     for k in range(depth + 1):
         fixed[:, 2 * n * k:2 * n * k + n] = np.swapaxes(null, 1, 2)
@@ -507,9 +525,9 @@ def _deflated(m: np.ndarray, g: np.ndarray, h: np.ndarray, w: np.ndarray, net: n
     if uniform:
         q = np.linalg.qr(fixed, mode="complete")[0][:, :, r:]
         qt = np.swapaxes(q, 1, 2)
-        return qt @ m @ q, np.einsum("sji,sj->si", q, g), np.einsum("sji,sj->si", q, h)
+        return qt @ m @ q, np.einsum("sji,sj->si", q, g), np.einsum("sji,sj->si", q, h), law @ q
     keep = np.eye(size) - fixed @ np.linalg.pinv(fixed)
-    return keep @ m @ keep, np.einsum("sij,sj->si", keep, g), np.einsum("sij,sj->si", keep, h)
+    return keep @ m @ keep, np.einsum("sij,sj->si", keep, g), np.einsum("sij,sj->si", keep, h), law @ keep
 
 
 NULL_TOL = 1e-9

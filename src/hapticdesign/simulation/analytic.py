@@ -1,23 +1,26 @@
 """The stable impedance range without integrating an ODE: the sampled loop linearized about the pose.
 
 With the other joints held (type 1) the wall joint of any device is a 1-DOF system about the start
-pose ``q0``: inertia ``J = H_ww(q0)`` (plus a hand's mass ``m_h J_v^T J_v``), damping ``b_w`` (plus
-the hand's), a physical spring from a hand's stiffness, and a constant torque, the gravity the
-compensator leaves (``G_w - s_G G_model,w``). Coriolis terms vanish at rest. The compensator feeds
-``c J a`` forward with ``c = H_model,ww / J`` (its model has no hand; a modelling error lowers it).
-For joint 1 of the Phantom (vertical axis, cyclic) this is exact for every design. In type 2 the
-other joints move: when the wall joint's row of H, C, G does not depend on them (LN = 0 designs)
-the same 1-DOF loop is exact; otherwise the loop is linear time-varying along the motion and
-:mod:`.analytic_driven` answers with the product of its one-sample transition matrices (exact for a
-cyclic wall joint such as the Phantom's joint 1, linearized in the wall joint otherwise). A Cartesian
-wall, a hand or a closed-loop device in type 2 keeps the start-pose loop (``exact`` false). The growth check
-(:meth:`AnalyticProblem.grows`) takes the loop where the wall holds the joint (:func:`equilibrium_pose`): the free
-joint travels to the spring's rest and oscillates there, so stability is decided there, not at the start.
+pose ``q0`` (eq. 2.50 at rest there): inertia ``J = H_ww(q0)``, damping ``b_w``, gravity's stiffness
+``dG_w/dq_w``, a hand's mass, damping and spring (``x J_v^T J_v``), and a constant torque, the gravity
+the compensator leaves (``G_w - s_G G_model,w``). Coriolis terms vanish at rest. The compensator feeds its
+own model's ``H_model,ww a`` forward (its model has no hand; a modelling error changes it) and its
+gravity stiffness ``s_G dG_model,w/dq_w`` on the sensed pose. That loop is the one-joint case of the one
+sampled loop of every command, :func:`hapticdesign.analysis.sampled_loop.handle_loops` (:func:`wall_loops`),
+under the seed's sampled velocity. For joint 1 of the Phantom (vertical axis, cyclic) this is exact for
+every design. In type 2 the other joints move: when the wall joint's row of H, C, G does not depend on
+them (LN = 0 designs) the same 1-DOF loop is exact; otherwise the loop is linear time-varying along the
+motion and :mod:`.analytic_driven` answers with the product of its one-sample transition matrices (exact
+for a cyclic wall joint such as the Phantom's joint 1, linearized in the wall joint otherwise). A
+Cartesian wall, a hand or a closed-loop device in type 2 keeps the start-pose loop (``exact`` false). The
+growth check (:meth:`AnalyticProblem.grows`) takes the loop where the wall holds the joint
+(:func:`equilibrium_pose`): the free joint travels to the spring's rest and oscillates there, so
+stability is decided there, not at the start.
 
-The seed's criteria are then evaluated on the exact linear response: the closed loop (plant discretized exactly,
-:func:`_plant`; the digital side a discrete state-space system, :func:`_controller`) gives the state at every
-sample, and the exact sub-sample transition of the plant under the held torque gives the excursion at every plant
-step (as the simulation checks it). No ODE is integrated.
+The seed's criteria are then evaluated on the exact linear response: the loop about the start pose is
+affine (the constant torque, the springs' rests), so the deviation from its fixed point follows the
+linear map, sample by sample, and the exact sub-sample transition of the plant under the held torque
+gives the excursion at every plant step (as the simulation checks it). No ODE is integrated.
 Quantized encoders and Coulomb friction are not linear: the analytic method refuses them.
 
 A Cartesian wall (spring K in N/m, damper B in N s/m along n at the handle) acts on the free joint w
@@ -31,14 +34,16 @@ small-displacement approximation, and ``exact`` says so.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 
 import numpy as np
-from scipy.linalg import expm
 from threadpoolctl import ThreadpoolController
 
-from hapticdesign.analysis.dynamics.device import coriolis_centrifugal, dynamics_of, gravity, mass_matrix
+from hapticdesign.analysis.dynamics.device import (
+    coriolis_centrifugal, dynamics_of, gravity, gravity_gradient, mass_matrix,
+)
+from hapticdesign.analysis.sampled_loop import Hand, SampledLoop, SpringLoops, handle_loops, held_plant
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation.analytic_driven import DrivenLoop
@@ -66,62 +71,47 @@ def one_blas_thread():
 
 @dataclass(frozen=True)
 class WallJoint:
-    """The wall joint linearized at the start pose: its inertia ``J``, damping ``b`` and physical spring ``k_p`` (a
-    hand's), the compensator's share ``c`` of ``J a``, the constant torque on it, and ``scale``, the wall coordinate
-    per unit of the joint (1 for a joint wall, ``J_n,w`` for a Cartesian wall: its spring and damper act on the joint
-    as ``K J_n,w^2`` and ``B J_n,w^2``)."""
+    """The wall joint linearized at a pose (eq. 2.50 at rest there): its inertia ``H_ww`` and damping ``b_w`` (a
+    hand's are added by the loop through ``reach``, the joint's column of ``J_v``), gravity's stiffness
+    ``dG_w/dq_w``, the compensator's inertia ``H_m,ww`` and gravity stiffness ``dG_m,w/dq_w`` (0 where its switches
+    leave them out), the constant torque it leaves (``-(G_w - s_G G_m,w)``), whether this 1-DOF loop is exact, and
+    ``scale``, the wall coordinate per unit of the joint (1 for a joint wall, ``J_n,w`` for a Cartesian wall: its
+    spring and damper act on the joint as ``K J_n,w^2`` and ``B J_n,w^2``)."""
 
     inertia: float
     damping: float
-    stiffness: float
-    fraction: float
+    reach: np.ndarray
+    gravity: float
+    model_inertia: float
+    model_gravity: float
     torque: float
     exact: bool
     scale: float = 1.0
 
+    @property
+    def fraction(self) -> float:
+        """The compensator's share ``c = H_m,ww / H_ww`` of the inertia it feeds forward."""
+        return self.model_inertia / self.inertia
 
-def _plant(wall: WallJoint, step: float) -> tuple[np.ndarray, np.ndarray]:
-    """``J qdd + b qd + k_p q = u`` over ``step`` under a held ``u``, exactly (``scipy.linalg.expm`` of the augmented
-    matrix): ``Phi`` (2, 2) and ``Gamma`` (2,) of ``(q, qd)``."""
-    a = np.zeros((3, 3))
-    a[0, 1] = 1.0
-    a[1, 0] = -wall.stiffness / wall.inertia
-    a[1, 1] = -wall.damping / wall.inertia
-    a[1, 2] = 1.0 / wall.inertia
-    e = expm(a * step)
-    return e[:2, :2], e[:2, 2]
+    def plant(self, hand: Hand | None) -> tuple[float, float, float]:
+        """The joint's inertia, damping and stiffness with the hand (``x J_v^T J_v``, its spring resting at the
+        start) and gravity's stiffness."""
+        hand = hand or Hand()
+        r2 = float(self.reach @ self.reach)
+        return self.inertia + hand.mass * r2, self.damping + hand.damping * r2, hand.stiffness * r2 + self.gravity
 
 
-def _controller(wall: WallJoint, delay: int, stiffness: float,
-                virtual_damping: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The digital side ``(A, B, C, D)`` from ``(q_k, v_k)`` to ``u_k = -K q_(k-N) - B v_(k-N) + c (u_(k-N-1) -
-    b v_(k-N) - k_p q_(k-N))`` (the sampled velocity, the seed's), state ``q_(k-1..k-N-1)``, ``v_(k-1..k-N)``,
-    ``u_(k-1..k-N-1)``."""
-    n = delay
-    nq, nv, nu = n + 1, n, n + 1
-    size = nq + nv + nu
-    c, d = np.zeros(size), np.zeros(2)
-
-    def add(signal: str, lag: int, gain: float) -> None:
-        """Add ``gain * signal_(k - lag)`` to the output."""
-        if lag == 0:
-            d["qv".index(signal)] += gain
-        else:
-            c[{"q": 0, "v": nq, "u": nq + nv}[signal] + lag - 1] += gain
-
-    add("q", n, -stiffness - wall.fraction * wall.stiffness)
-    add("v", n, -virtual_damping - wall.fraction * wall.damping)
-    add("u", n + 1, wall.fraction)
-    a, b = np.zeros((size, size)), np.zeros((size, 2))
-    b[0, 0] = 1.0  # q_k enters the position line
-    a[1:nq, 0:nq - 1] = np.eye(nq - 1)
-    if nv:
-        b[nq, 1] = 1.0
-        a[nq + 1:nq + nv, nq:nq + nv - 1] = np.eye(nv - 1)
-    a[nq + nv] = c  # u_k enters the torque line
-    b[nq + nv] = d
-    a[nq + nv + 1:, nq + nv:size - 1] = np.eye(nu - 1)
-    return a, b, c[None, :], d[None, :]
+def wall_loops(walls: list[WallJoint], config: LoopConfig) -> SpringLoops:
+    """The sampled loops of the walls' joints under the settings of ``config`` (its period, delay, wall damper and
+    hand; the sampled velocity, the seed's): the one-joint case of
+    :func:`hapticdesign.analysis.sampled_loop.handle_loops`, with each wall's own compensator model."""
+    loop = SampledLoop(config.sensors.period, config.sensors.delay_samples, "sampled", "full", 0.0,
+                       config.wall.damping, config.hand)
+    column = np.array([[[w.inertia]] for w in walls]), np.array([[[w.damping]] for w in walls])
+    model = np.array([[[w.model_inertia]] for w in walls]), np.array([[[w.model_gravity]] for w in walls])
+    return handle_loops(np.array([w.reach for w in walls])[:, :, None], *column,
+                        np.array([[w.scale] for w in walls]), loop,
+                        gravity=np.array([[[w.gravity]] for w in walls]), model=model)[0]
 
 
 def linear_loop(device: Device, config: LoopConfig) -> bool:
@@ -179,26 +169,22 @@ def linearize(device: Device, sim_type: int, wall_joint: int, config: LoopConfig
         q0 = np.asarray(pose, dtype=float)
     w = wall_joint
     damping = np.asarray(config.damping if config.damping is not None else device.damping, dtype=float)
-    h, g = mass_matrix(device, q0), gravity(device, q0)
     model = compensator_device(device, config.compensator)
-    j_device = float(h[w, w])
-    j, b, spring = j_device, float(damping[w]), 0.0
-    if config.hand is not None:
-        jv = handle_jacobian(device, q0)[:3, w]
-        reach = float(jv @ jv)
-        j += config.hand.mass * reach
-        b += config.hand.damping * reach
-        spring = config.hand.stiffness * reach
     comp = config.compensator
-    fraction = float(mass_matrix(model, q0)[w, w]) / j_device if comp.inertial else 0.0
-    torque = -(float(g[w]) - comp.gravity * float(gravity(model, q0)[w]))
-    exact = sim_type == 1 or _decoupled(device, w, paths, rest)
+    reach = handle_jacobian(device, q0)[:3, w]
+    wall = WallJoint(
+        inertia=float(mass_matrix(device, q0)[w, w]), damping=float(damping[w]), reach=reach,
+        gravity=float(gravity_gradient(device, q0)[w, w]),
+        model_inertia=float(mass_matrix(model, q0)[w, w]) if comp.inertial else 0.0,
+        model_gravity=float(comp.gravity * gravity_gradient(model, q0)[w, w]),
+        torque=-(float(gravity(device, q0)[w]) - comp.gravity * float(gravity(model, q0)[w])),
+        exact=sim_type == 1 or _decoupled(device, w, paths, rest))
     if not config.wall.cartesian:
-        return WallJoint(j, b, spring, fraction, torque, exact)
+        return wall
     scale = float(normal_jacobian(device, config.wall, q0)[w])
     if abs(scale) < 1e-12:
         raise UserError(f"joint {w + 1} does not move the handle along the wall direction at the start pose")
-    return WallJoint(j, b, spring, fraction, torque, exact and _linear_along_wall(device, config, w, q0, paths), scale)
+    return replace(wall, scale=scale, exact=wall.exact and _linear_along_wall(device, config, w, q0, paths))
 
 
 def _linear_along_wall(device: Device, config: LoopConfig, w: int, q0: np.ndarray, paths: dict) -> bool:
@@ -224,11 +210,10 @@ def _decoupled(device: Device, w: int, paths: dict, rest: np.ndarray) -> bool:
     return all(np.abs(r - rows[0]).max() <= 1e-9 * scale for r in rows)
 
 
-def _sub_steps(wall: WallJoint, step: float, count: int) -> list[tuple[np.ndarray, np.ndarray]]:
-    """Exact transitions of ``(q, qd)`` over ``0, h, ..., (count - 1) h`` under a held torque:
-    ``(Phi_j, Gamma_j)`` from one matrix exponential, ``Phi_(j+1) = Phi_h Phi_j``,
-    ``Gamma_(j+1) = Phi_h Gamma_j + Gamma_h``."""
-    phi_h, gamma_h = _plant(wall, step)
+def _sub_steps(plant: tuple[np.ndarray, np.ndarray], count: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Exact transitions of ``(q, qd)`` over ``0, h, ..., (count - 1) h`` under a held torque, from the plant's
+    one-step ``(Phi_h, Gamma_h)``: ``Phi_(j+1) = Phi_h Phi_j``, ``Gamma_(j+1) = Phi_h Gamma_j + Gamma_h``."""
+    phi_h, gamma_h = plant
     steps = [(np.eye(2), np.zeros(2))]
     for _ in range(count - 1):
         phi, gamma = steps[-1]
@@ -269,9 +254,10 @@ class AnalyticProblem(WallProblem):
         self.samples = int(round(self.config.duration / self.config.sensors.period))
         self.driven = None
         with one_blas_thread():
-            self._plant = _plant(self.wall, self.config.sensors.period)
-            self._held_plant = _plant(self.held, self.config.sensors.period)
-            self._steps = _sub_steps(self.wall, self.config.step, self.sub)
+            self.loops = wall_loops([self.wall, self.held], self.config)
+            inertia, damping, stiffness = (np.full((1, 1, 1), v) for v in self.wall.plant(self.config.hand))
+            phi, gamma = held_plant(inertia, damping, stiffness, self.config.step)
+            self._steps = _sub_steps((phi[0], gamma[0, :, 0]), self.sub)
             if self._time_varying():
                 self.driven = self._driven_loop()
 
@@ -312,59 +298,37 @@ class AnalyticProblem(WallProblem):
         return self.sim_type == 1 or self.exact
 
     def estimate(self) -> float:
-        wall, period = self.wall, self.config.sensors.period
-        joint = wall.damping ** 2 / wall.inertia if wall.fraction > 0 else 2.0 * wall.damping / period
+        inertia, damping, _ = self.wall.plant(self.config.hand)
+        joint = damping ** 2 / inertia if self.wall.model_inertia > 0 else 2.0 * damping / self.config.sensors.period
         return joint / self.wall.scale ** 2
 
-    def _augmented(self, stiffness: float, wall: WallJoint | None = None) -> tuple[np.ndarray, np.ndarray, int]:
-        """One-sample map of ``s = [q - q_eq, qd, controller state, 1]`` and the row giving ``u`` (of the loop
-        ``wall``, default the start pose's)."""
-        wall = wall or self.wall
-        d = wall.torque
-        s2 = wall.scale ** 2
-        n = self.config.sensors.delay_samples
-        ac, bc, cc, dc = _controller(wall, n, stiffness * s2, self.config.wall.damping * s2)
-        phi, gamma = self._plant if wall is self.wall else self._held_plant
-        nc = ac.shape[0]
-        u_line = (n + 1) + n
-        # the spring acts on q - q_eq; the rest of the hand's spring and the constant torque act on the plant
-        const = d - wall.stiffness * self.rest
-        comp = wall.fraction * const
-        size = 2 + nc + 1
-        m = np.zeros((size, size))
-        u_row = np.concatenate([dc[0], cc[0], [comp]])
-        m[:2] = np.outer(gamma, u_row)
-        m[:2, :2] += phi
-        m[:2, -1] += gamma * const
-        m[2:2 + nc, :2] = bc
-        m[2:2 + nc, 2:2 + nc] = ac
-        m[2 + u_line, -1] += comp
-        m[-1, -1] = 1.0
-        return m, u_row, u_line
-
-    def _initial(self, u_line: int) -> np.ndarray:
-        """The kernel's start: q = 0, qd = 0, the delay line holding the first sample, no acceleration."""
-        n = self.config.sensors.delay_samples
-        nc = (n + 1) + n + (n + 1)
-        s = np.zeros(2 + nc + 1)
-        e0 = -self.rest
-        s[0] = e0
-        s[2:2 + n + 1] = e0
-        const = self.wall.torque - self.wall.stiffness * self.rest
-        s[2 + u_line:2 + nc] = self.wall.stiffness * e0 - const  # the compensator sees a = 0 until samples arrive
-        s[-1] = 1.0
-        return s
-
     def response(self, stiffness: float) -> np.ndarray:
-        """The wall coordinate from its start (``q - q0``, or ``J_n,w (q - q0)`` along a Cartesian wall) at
-        every plant step (rows: samples, columns: plant steps within the period)."""
-        m, u_row, u_line = self._augmented(stiffness)
-        states = _powers(m, self._initial(u_line), self.samples)
-        u = states @ u_row
-        const = self.wall.torque - self.wall.stiffness * self.rest
-        cols = [phi[0, 0] * states[:, 0] + phi[0, 1] * states[:, 1] + gamma[0] * (u + const)
-                for phi, gamma in self._steps]
-        return (np.stack(cols, axis=1) + self.rest) * self.wall.scale
+        """The wall coordinate from its start (``q - q0``, or ``J_n,w (q - q0)`` along a Cartesian wall) at every
+        plant step (rows: samples, columns: plant steps within the period).
+
+        The loop about the start pose is affine: the constant torque and the springs' rests (the wall's at
+        ``equilibrium``, the hand's at the start) move its fixed point to ``x*`` (the spring, the hand's and
+        gravity's stiffness and the compensator's balance there, at rest, torque ``u*``), and the deviation from it
+        follows the linear map of :func:`wall_loops`: ``e_k = m(K)^k e_0``. The run starts at rest at the start
+        pose with the delay line holding the first sample and the compensator's torque memory such that it reads no
+        acceleration (the seed's initial conditions); between samples the plant moves exactly under the held torque.
+        """
+        wall = self.wall
+        _, _, k = wall.plant(self.config.hand)
+        s2 = wall.scale ** 2
+        push = wall.torque - k * self.rest  # the constant torque in the spring's coordinate p = x - rest
+        with np.errstate(divide="ignore", invalid="ignore"):
+            p_eq = (push + wall.model_gravity * self.rest) / (k - wall.model_gravity + stiffness * s2)
+        u_eq = -stiffness * s2 * p_eq + wall.model_gravity * (p_eq + self.rest)
+        size, lines = self.loops.base.shape[-1], 2 * (self.config.sensors.delay_samples + 1)
+        start, fixed = np.zeros(size), np.zeros(size)
+        start[:lines:2], fixed[:lines:2] = -self.rest, p_eq
+        start[lines:], fixed[lines:] = -k * self.rest - push, u_eq
+        m = self.loops.matrices(np.array([stiffness]), [0])[0]
+        states = _powers(m, start - fixed, self.samples)
+        du = self.loops.torques(stiffness, states, 0)[:, 0]
+        cols = [phi[0, 0] * states[:, 0] + phi[0, 1] * states[:, 1] + gamma[0] * du for phi, gamma in self._steps]
+        return (np.stack(cols, axis=1) + p_eq + self.rest) * wall.scale
 
     def grows(self, stiffness: float) -> bool:
         """Whether the linearized sampled loop is unstable at ``stiffness``: the spectral radius of its
@@ -376,9 +340,8 @@ class AnalyticProblem(WallProblem):
         if self.driven is not None:
             with one_blas_thread():
                 return bool(self.driven.floquet_radius(stiffness) > 1.0)
-        m, _, _ = self._augmented(stiffness, self.held)
         with one_blas_thread():
-            radius = float(np.max(np.abs(np.linalg.eigvals(m[:-1, :-1]))))
+            radius = float(self.loops.radii(np.array([stiffness]), [1])[0])
         return not radius < 1.0
 
     def verdict(self, stiffness: float) -> Verdict:
