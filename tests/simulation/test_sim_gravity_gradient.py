@@ -38,10 +38,10 @@ def _pendulum():
     })
 
 
-def _python_control_limit(j: float, b: float, k_g: float, share: float, delay: int) -> float:
+def _python_control_limit(j: float, b: float, k_g: float, share: float, delay: int, period: float = PERIOD) -> float:
     plant = control.c2d(control.ss([[0.0, 1.0], [-k_g / j, -b / j]], [[0.0], [1.0 / j]], [[1.0, 0.0]], [[0.0]]),
-                        PERIOD, "zoh")
-    lag = control.tf([1.0], [1.0] + [0.0] * delay, PERIOD)
+                        period, "zoh")
+    lag = control.tf([1.0], [1.0] + [0.0] * delay, period)
 
     def radius(k):
         return np.abs(control.poles(control.feedback(plant * lag, k - share * k_g))).max()
@@ -126,3 +126,29 @@ def test_a_full_compensators_model_error_is_the_simulated_compensators():
     uniform = wall_limit(np.array([[1.0], [0.0], [0.0]]), mass_matrix(device, pose), device.damping_matrix, loop,
                          np.array([1.0, 0.0, 0.0]), gravity_gradient(device, pose))
     assert uniform < 0.5 * exact
+
+
+def test_the_analytic_growth_check_holds_the_pendulum_where_gravity_and_the_spring_balance():
+    """No compensation, one sample of delay at 50 Hz (so gravity's stiffness matters), a joint wall resting 1 rad
+    from the hanging pose: gravity holds the pendulum short of the spring's rest, at ``K (x - 1) + m g l sin x = 0``
+    (SciPy's brentq), and its growth boundary is the spring at which python-control's loop linearized there (``m g l
+    cos x``) loses stability (a fixed point in K, brentq again). The analytic method's growth check, bisected,
+    finds that spring; linearized at the spring's rest instead it would be 0.4 % off."""
+    from scipy.optimize import bisect
+
+    from hapticdesign.simulation.analytic import AnalyticProblem
+    from hapticdesign.simulation.config import Compensator, LoopConfig, Sensors
+
+    rest, period = 1.0, 0.02
+    config = LoopConfig(sensors=Sensors(period, delay_samples=1), compensator=Compensator(False, False, False))
+    problem = AnalyticProblem(_pendulum(), 1, 0, rest, config=config)
+
+    def limit_where_held(k: float) -> float:
+        x = brentq(lambda q: k * (q - rest) + M * G * L * math.sin(q), -1.0, rest, xtol=1e-15)
+        return _python_control_limit(M * L * L, B, M * G * L * math.cos(x), 0.0, 1, period)
+
+    expected = brentq(lambda k: limit_where_held(k) - k, 1e-3, 1.0, xtol=1e-14)
+    found = bisect(lambda k: 1.0 if problem.grows(k) else -1.0, 1e-3, 1.0, xtol=1e-13)
+    assert found == pytest.approx(expected, rel=1e-7)
+    at_rest = _python_control_limit(M * L * L, B, M * G * L * math.cos(rest), 0.0, 1, period)
+    assert abs(at_rest / expected - 1.0) > 1e-3

@@ -53,6 +53,11 @@ from hapticdesign.simulation.config import (
 from hapticdesign.simulation.criteria import Verdict, WallProblem, type_paths
 
 
+REST_STEPS = 30
+"""Most Newton steps of the wall's resting pose (:meth:`AnalyticProblem._resting`)."""
+REST_TOL = 1e-12
+"""The resting pose is found when a Newton step moves the joint by less than this (relative, rad or m)."""
+
 GROWS = "oscillation grows"
 """The verdict of a stiffness whose linearized loop is unstable although the run met the criteria."""
 
@@ -262,10 +267,37 @@ class AnalyticProblem(WallProblem):
                 self.driven = self._driven_loop()
 
     def _held(self) -> WallJoint:
-        """The loop linearized where the wall holds the joint (:func:`equilibrium_pose`): its growth decides
+        """The loop linearized where the wall's spring rests (:func:`equilibrium_pose`): its growth decides
         stability, the start pose's need not (the free joint travels to the rest before it oscillates there)."""
-        pose = equilibrium_pose(self.device, self.sim_type, self.wall_joint, self.config, self.equilibrium)
-        return linearize(self.device, self.sim_type, self.wall_joint, self.config, pose)
+        self.held_pose = equilibrium_pose(self.device, self.sim_type, self.wall_joint, self.config, self.equilibrium)
+        return linearize(self.device, self.sim_type, self.wall_joint, self.config, self.held_pose)
+
+    def _resting(self, stiffness: float) -> WallJoint | None:
+        """The wall joint linearized where the wall holds it under the spring ``stiffness``: from the spring's rest,
+        Newton steps on the joint's static balance ``T(y) = -(G_w - s_G G_m,w) - k_hand (y + y_h) - K J_n,w^2 y = 0``
+        (``y`` from the spring's rest, ``y_h`` the rest's distance from the start, where the hand's spring rests; the
+        wall's spring linear about its rest), so a residual gravity torque or a hand's spring moves the pose by
+        about ``T / K``; nothing moves where gravity is compensated exactly and no hand spring pulls. None when no
+        balance is found within :data:`REST_STEPS` steps or the net static stiffness there is not positive (the
+        wall cannot hold the joint: it falls)."""
+        wall, pose, w = self.held, self.held_pose.copy(), self.wall_joint
+        hand = self.config.hand or Hand()
+        y_h = self.rest
+        for _ in range(REST_STEPS):
+            k_hand = hand.stiffness * float(wall.reach @ wall.reach)
+            net = wall.gravity - wall.model_gravity + k_hand + stiffness * wall.scale ** 2
+            y = pose[w] - self.held_pose[w]
+            balance = wall.torque - k_hand * (y + y_h) - stiffness * wall.scale ** 2 * y
+            if balance == 0.0:
+                return wall
+            if not net > 0.0:
+                return None
+            step = balance / net
+            if abs(step) <= REST_TOL * max(1.0, abs(pose[w])):
+                return wall
+            pose[w] += step
+            wall = linearize(self.device, self.sim_type, w, self.config, pose)
+        return None
 
     def _time_varying(self) -> bool:
         """Type 2 with the wall joint coupled to the motion, on a joint wall of an open chain without a hand."""
@@ -336,12 +368,16 @@ class AnalyticProblem(WallProblem):
         (:mod:`.analytic_driven`) its largest Floquet multiplier over the motion's period (not decided, so
         False, when the run is shorter than a period). For type 1 this is the exact local growth boundary
         of the wall (Lyapunov's indirect method for the sampled system), linearized where the wall holds the
-        joint (:func:`equilibrium_pose`)."""
+        joint under the spring (:meth:`_resting`; a spring that cannot hold it grows)."""
         if self.driven is not None:
             with one_blas_thread():
                 return bool(self.driven.floquet_radius(stiffness) > 1.0)
+        wall = self._resting(stiffness)
+        if wall is None:
+            return True
         with one_blas_thread():
-            radius = float(self.loops.radii(np.array([stiffness]), [1])[0])
+            loops, index = (self.loops, 1) if wall is self.held else (wall_loops([wall], self.config), 0)
+            radius = float(loops.radii(np.array([stiffness]), [index])[0])
         return not radius < 1.0
 
     def verdict(self, stiffness: float) -> Verdict:
