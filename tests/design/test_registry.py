@@ -241,3 +241,30 @@ def test_the_kmax_index_takes_the_sampled_loops_options_and_defaults():
     from hapticdesign.analysis.wall_stiffness import KMAX_OPTIONS
 
     assert dict(INDICES["kmax"].options) == KMAX_OPTIONS
+
+
+def test_kmax_with_a_modelling_error_takes_the_compensators_model_batched_and_one_at_a_time():
+    """``kmax`` with full compensation and a 20 % modelling error on the horizontal pantograph: the batched designs
+    take the compensator's ``H`` from the closed form of the scaled masses, mass centres and inertias on standard
+    parameters, one design at a time from the model device the simulation builds (the seed's "error %" on each
+    parameter); the two agree, and the uniform share ``0.8 H`` would give a softer wall (about 18 against 25 N/m)."""
+    from hapticdesign.analysis.metrics.indices import HandleStates
+    from hapticdesign.analysis.sampled_loop import SampledLoop
+    from hapticdesign.analysis.wall_stiffness import wall_limit
+    from hapticdesign.analysis.workspace import reach_workspace
+
+    space = design_space(EXAMPLES / "haply-2diy.yaml", ["l1", "l2", "d"])
+    points = Workspace((0.0, 0.12, 0.0), (0.03, 0.03, 0.0), 2).points()
+    designs = [{"l1": 0.07, "l2": 0.09, "d": 0.038}, {"l1": 0.075, "l2": 0.095, "d": 0.04}]
+    request = Request("kmax", {"compensation": "full", "error_percent": 20.0}, "kmax")
+    batched = evaluate_designs(space, designs, points, [request])
+    assert space.cache.get("batch"), "the compiled kernels served kmax"
+    for values, fast in zip(designs, batched):
+        slow = evaluate(space.device(values), points, [request])
+        assert np.all(slow.values["kmax"] > 0)
+        np.testing.assert_allclose(fast.values["kmax"], slow.values["kmax"], rtol=1e-8)
+    device = space.device(designs[-1])
+    states = HandleStates(device, reach_workspace(device, points[:1]).full)
+    uniform = wall_limit(states.J_v[0], states.H[0], states.B, SampledLoop(compensation="full", model_error=20.0),
+                         gravity=states.gravity[0])
+    assert uniform < 0.9 * slow.values["kmax"][0]

@@ -29,7 +29,7 @@ kind of design variable.
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import Callable, NamedTuple
 
 import numpy as np
 from numba import njit
@@ -45,6 +45,7 @@ from hapticdesign.analysis.reach_kernel import MESSAGES, Reached, reach_designs,
 from hapticdesign.analysis.stiffness import vjm
 from hapticdesign.analysis.stiffness.device import end_compliance
 from hapticdesign.errors import UserError
+from hapticdesign.model.compensator_model import scaled_standard
 from hapticdesign.model.device import Device, build_mechanism
 from hapticdesign.model.walk import MotionPlan, Tree, frame_jacobian, node_poses, planned_poses, trig_workspace
 
@@ -270,6 +271,9 @@ class Evaluated(NamedTuple):
     values: DesignValues
     gravity: np.ndarray | None = None
     """``dG/dq`` (D, P, n_a, n_a) when asked."""
+    model: Callable[[float], tuple[np.ndarray, np.ndarray]] | None = None
+    """The compensator's ``H`` and ``dG/dq`` (D, P, n_a, n_a each) at the same poses for a modelling error in percent
+    (:func:`~hapticdesign.model.compensator_model.scaled_standard` of each design's parameters, the rotors exact)."""
 
 
 class DesignBatch:
@@ -460,8 +464,14 @@ class DesignBatch:
                               "links and joint springs do not reach it, or the pose is singular")
             ok &= defined
         grad = self.gravity_gradients(offsets, reached, values.standard) if gravity else None
+
+        def model(error_percent: float) -> tuple[np.ndarray, np.ndarray]:
+            standard = scaled_standard(values.standard, 1.0 - error_percent / 100.0)
+            return (self.mass_matrices(offsets, reached, standard, values.reflected),
+                    self.gravity_gradients(offsets, reached, standard))
+
         return Evaluated(reached.jvt, mass, reached.full[..., self.closures.actuated], k_c, moving, ok, reasons, values,
-                         grad)
+                         grad, model)
 
     def reason(self, reached: Reached, design: int, points: np.ndarray, home: np.ndarray | None = None) -> str | None:
         """One line on why ``design`` failed (naming the point, or the ``home`` position), or None."""

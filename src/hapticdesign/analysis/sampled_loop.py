@@ -303,7 +303,9 @@ class SampledLoop:
 
     ``period`` (s) the servo period, ``delay`` whole samples between reading the sensors and applying the torque,
     ``velocity`` of :data:`VELOCITIES`, ``compensation`` of :data:`COMPENSATIONS` with ``model_error`` (percent
-    E: the full compensator's inertia is ``(1 - E/100)`` times the device's), ``virtual_damping`` the wall's damper
+    E: a bare joint's compensator feeds ``(1 - E/100)`` times its inertia; a device's is its model device, every
+    mass, mass centre and inertia off by E %, :mod:`hapticdesign.model.compensator_model`, whose ``H`` and ``G``
+    the callers pass to :func:`handle_loops`), ``virtual_damping`` the wall's damper
     (N s/m, or N m s/rad on a joint), ``hand`` a :class:`Hand` at the handle (None: none), ``held`` the joints held
     fixed (none by default: a Cartesian wall acts with every actuated joint free, as under a user's hand).
     The defaults are what practice uses: 1 kHz, one sample of delay, backward-difference velocity, gravity

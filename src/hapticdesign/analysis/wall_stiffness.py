@@ -192,10 +192,11 @@ def _hand(value: object) -> Hand | None:
 
 def kmax(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray,
          ranges: tuple[np.ndarray, np.ndarray, np.ndarray], options: Mapping[str, object],
-         gravity: np.ndarray | None = None) -> np.ndarray:
+         gravity: np.ndarray | None = None, model: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """The ``kmax`` index (N/m) at P poses: ``J_v`` (P, 3, n), ``H`` (P, n, n), ``B`` (n, n) or (P, n, n), the
     handle's range as :func:`handle_range` gives it (the basis ``U``, mobility and damping in it, already known to
-    the caller), the options of :data:`KMAX_OPTIONS` and gravity's gradient ``dG/dq`` (P, n, n) or None."""
+    the caller), the options of :data:`KMAX_OPTIONS`, gravity's gradient ``dG/dq`` (P, n, n) or None and the
+    compensator's ``H_m`` and ``dG_m/dq`` (P, n, n each; None: the loop's uniform shares)."""
     loop, direction = kmax_loop(options)
     basis, mobility, cartesian_damping = ranges
     if direction is None:
@@ -206,4 +207,4 @@ def kmax(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray,
             raise UserError(f"index kmax: the direction {np.round(direction, 6).tolist()} is not one the handle "
                             "moves in")
         along = np.broadcast_to(direction, (len(jacobian), 1, 3))
-    return wall_limits(jacobian, mass, damping, loop, along, gravity)
+    return wall_limits(jacobian, mass, damping, loop, along, gravity, model)

@@ -18,7 +18,7 @@ from hapticdesign.analysis.dynamics.device import gravity_gradient, mass_matrix
 from hapticdesign.analysis.sampled_loop import Hand, SampledLoop
 from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.device import Device
-from hapticdesign.model.inertia import SEED_FIELDS
+from hapticdesign.model.compensator_model import model_device
 
 STATUS_COMPLETED = 0
 STATUS_EXCURSION = 1
@@ -257,39 +257,6 @@ def require_options(sim_type: object, config: object, config_type: type) -> None
         raise UserError(f"simulation type must be 1 or 2, got {sim_type!r}")
     if config is not None and not isinstance(config, config_type):
         raise UserError(f"config must be a {config_type.__name__}, got {type(config).__name__}")
-
-
-ERROR_GROUPS = {"mass": ("m",), "centre": ("rx", "ry", "rz"), "inertia": ("Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz")}
-
-
-def _check_percent(value: float, what: str) -> None:
-    if not (math.isfinite(value) and -100 < value < 100):
-        raise UserError(f"{what} must be a finite number between -100 and 100 (exclusive), got {value}")
-
-
-def model_device(device: Device, error_percent: float, group_errors: tuple[tuple[str, float], ...] = (),
-                 error_seed: int | None = None) -> Device:
-    """The compensator's device: every inertial parameter times ``1 - error_percent / 100``, then each
-    group of :data:`ERROR_GROUPS` times ``1 + s E_group / 100`` (``s = -1``, or a seeded random sign)."""
-    _check_percent(error_percent, "error percentage")
-    groups = dict(group_errors)
-    for name, value in groups.items():
-        if name not in ERROR_GROUPS:
-            raise UserError(f"unknown error group {name!r}; groups: {', '.join(ERROR_GROUPS)}")
-        _check_percent(value, f"the {name} error")
-    if error_percent == 0 and not any(groups.values()):
-        return device
-    factor = 1.0 - error_percent / 100.0
-    names = device.inertial_names()
-    fields = [f for _ in device.body_names for f in SEED_FIELDS]
-    rng = np.random.default_rng(error_seed) if error_seed is not None else None
-    signs = rng.choice([-1.0, 1.0], size=len(names)) if rng is not None else -np.ones(len(names))
-    values = {}
-    for name, kind, sign in zip(names, fields, signs):
-        group = next((g for g, members in ERROR_GROUPS.items() if kind in members), None)
-        scale = factor * (1.0 + sign * groups.get(group, 0.0) / 100.0)
-        values[name] = device.params.get(name, 0.0) * scale
-    return device.with_params(values)
 
 
 def compensator_device(device: Device, compensator: Compensator) -> Device:

@@ -36,7 +36,7 @@ import numpy as np
 from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.analysis.sampled_loop import FLOOR, SampledLoop, joint_limit, joint_limits, joint_loops
 from hapticdesign.errors import InputError, UserError
-from hapticdesign.simulation.config import model_device
+from hapticdesign.model.compensator_model import model_device
 
 MAX_DAMPERS = 1000
 """Most virtual dampers of one Z-width (each one a search of K_max over about 60 eigenvalue problems)."""

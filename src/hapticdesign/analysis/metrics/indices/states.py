@@ -30,6 +30,7 @@ from hapticdesign.analysis.metrics.kinematic import handle_range_basis
 from hapticdesign.analysis.stiffness.device import cartesian_stiffness_at
 from hapticdesign.errors import UserError
 from hapticdesign.model.dense import symmetric_eigenvalues
+from hapticdesign.model.compensator_model import model_device
 from hapticdesign.model.device import Device
 
 BATCH_NEEDS = frozenset({"kinematics", "dynamics", "damping", "sections", "motors", "bodies", "gravity"})
@@ -113,6 +114,20 @@ class HandleStates:
         (:func:`~hapticdesign.analysis.dynamics.device.gravity_gradient_at`)."""
         return gravity_gradient_at(self._device, self.full)
 
+    def compensator(self, error_percent: float) -> tuple[np.ndarray, np.ndarray]:
+        """The compensator's ``H_m`` and ``dG_m/dq`` (P, n_a, n_a each) at the poses, its model carrying a modelling
+        error of ``error_percent`` (:func:`~hapticdesign.model.compensator_model.model_device`: masses, mass centres
+        and inertias alike, the motors' rotors exact)."""
+        key = float(error_percent)
+        models = self.__dict__.setdefault("_models", {})
+        if key not in models:
+            if "model" in self.__dict__:
+                models[key] = self.__dict__["model"](key)
+            else:
+                device = model_device(self._device, key)
+                models[key] = mass_matrix_at(device, self.full), gravity_gradient_at(device, self.full)
+        return models[key]
+
     @cached_property
     def name(self) -> str:
         """The device's name (for messages)."""
@@ -178,9 +193,10 @@ class HandleStates:
         actuated coordinates ``q`` (P, n_a) are known already (many designs' poses at once,
         :mod:`hapticdesign.analysis.design_batch`), with any other quantity of :data:`BATCH_NEEDS` known per pose by
         its name (``stiffness`` (P, k, k), ``motor_map``, ``torque_limits``, ``moving_mass``, ``name``, ``gravity``
-        (P, n_a, n_a)): enough for an
-        index that needs at most :data:`BATCH_NEEDS`, of those quantities given."""
-        unknown = set(known) - {"stiffness", "motor_map", "torque_limits", "moving_mass", "name", "gravity"}
+        (P, n_a, n_a), ``model``: the compensator's ``H_m`` and ``dG_m/dq`` for a modelling error in percent, as
+        :meth:`compensator` gives them): enough for an index that needs at most :data:`BATCH_NEEDS`, of those
+        quantities given."""
+        unknown = set(known) - {"stiffness", "motor_map", "torque_limits", "moving_mass", "name", "gravity", "model"}
         if unknown:
             raise TypeError(f"HandleStates.of: unknown quantities {sorted(unknown)}")
         states = cls(None, np.zeros((len(J_v), 0)))
