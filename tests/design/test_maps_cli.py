@@ -56,3 +56,20 @@ def test_bad_maps_input_is_one_line(tmp_path, extra, message):
     assert result.exit_code == 2
     assert message in result.output and "Traceback" not in result.output
     assert len(result.output.strip().splitlines()) == 1
+
+
+def test_the_kmax_map_states_the_loop_settings_it_used(tmp_path):
+    """``kmax`` runs with the sampled loop's settings: the map says which (the index's defaults, practice's:
+    1 kHz, one sample of delay, backward difference, gravity compensation), as ``spec`` and ``metrics`` do."""
+    from hapticdesign.analysis.wall_stiffness import KMAX_OPTIONS
+
+    args = ["maps", "--device", str(EXAMPLES / "five-bar.yaml"), "--size", "0.02,0,0.02", "--grid", "2", "--index",
+            "kmax,isotropy", "--out", str(tmp_path), "--json"]
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, result.output
+    assert json.loads(result.stdout)["options"] == {"kmax": KMAX_OPTIONS}
+    text = runner.invoke(app, args[:-1])
+    assert "delay=1" in text.stdout and "compensation=gravity" in text.stdout
+    metrics = runner.invoke(app, ["metrics", "--device", str(EXAMPLES / "five-bar.yaml"), "--q", "2.2,0.9", "--index",
+                                  "kmax", "--json"])
+    assert json.loads(metrics.stdout)["options"] == {"kmax": KMAX_OPTIONS}

@@ -39,7 +39,7 @@ def maps(
     from hapticdesign.analysis.configuration import configuration_of
     from hapticdesign.analysis.metrics.maps import device_map
     from hapticdesign.analysis.workspace import Workspace
-    from hapticdesign.analysis.metrics.indices import INDICES
+    from hapticdesign.analysis.metrics.indices import INDICES, options_line, options_used, requests_of
 
     with user_errors(strict=strict, quiet=quiet):
         from hapticdesign.devices.loading import resolve_device
@@ -58,6 +58,7 @@ def maps(
         workspace = Workspace(tuple(middle), tuple(abs(sizes)), grid)
         points = workspace.points()
         found = device_map(dev, points, names)
+        used = options_used(requests_of(names))
         files = _write(out, found, names, plane)
         note(f"wrote {len(files)} files to {out} ({int(found.reached.sum())} of {len(points)} points reached)",
              quiet or json_out)
@@ -65,12 +66,12 @@ def maps(
             print_json({"device": dev.name, "out": str(out), "files": files, "points": len(points),
                         "reached": int(found.reached.sum()),
                         "range": {k: [_finite(v, min), _finite(v, max)] for k, v in found.values.items()},
-                        "units": {k: INDICES[k].unit for k in names}})
+                        "units": {k: INDICES[k].unit for k in names}, "options": used})
             return
         for key, values in found.values.items():
             low, high = _finite(values, min), _finite(values, max)
             span = "no point reached" if low is None else f"{low:.6g} to {high:.6g} {INDICES[key].unit}"
-            typer.echo(f"{key}: {span}")
+            typer.echo(f"{key}: {span}" + (f" ({options_line(used[key])})" if key in used else ""))
 
 
 def _finite(values, how) -> float | None:

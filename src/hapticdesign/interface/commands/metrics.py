@@ -49,7 +49,7 @@ def device_metrics(device: Device, q: np.ndarray, extra: Sequence[str] = (), reg
     to 3 joints, all six rows for 6 joints), and under ``indices`` the indices ``extra`` of ``registry`` (default:
     the one registry) by name."""
     from hapticdesign.analysis.configuration import configuration_of
-    from hapticdesign.analysis.metrics.indices import INDICES, evaluate_at, requests_of
+    from hapticdesign.analysis.metrics.indices import INDICES, evaluate_at, options_used, requests_of
     from hapticdesign.analysis.metrics import kinematic, names
     from hapticdesign.analysis.metrics.indices.states import HandleStates
 
@@ -68,6 +68,9 @@ def device_metrics(device: Device, q: np.ndarray, extra: Sequence[str] = (), reg
     if extra:
         found = evaluate_at(device, pose.full, extra, registry=registry)
         out["indices"] = {key: float(value[0]) for key, value in found.values.items()}
+        used = options_used(extra, registry)
+        if used:
+            out["options"] = used
     return out
 
 
@@ -102,7 +105,7 @@ def metrics(
     force: bool = FORCE,
 ) -> None:
     """Kinematic and dynamic metrics of any device at one pose (seed 001 eq. 4.24-4.38, 4.90-4.99)."""
-    from hapticdesign.analysis.metrics.indices import INDICES
+    from hapticdesign.analysis.metrics.indices import INDICES, options_line
     from hapticdesign.devices.loading import resolve_device
     from hapticdesign.interface.commands.optimize_adapter import index_module
     from hapticdesign.interface.commands.pose_adapter import handle, handle_line
@@ -127,6 +130,9 @@ def metrics(
                 for name, number in value.items():
                     unit = registry[name].unit
                     typer.echo(f"{name}: {number:.6g}" + ("" if unit == "1" else f" {unit}"))
+            elif key == "options":
+                for name, used in value.items():
+                    typer.echo(f"{name} options: {options_line(used)}")
             elif key in ("jacobian", "cartesian_inertia"):
                 typer.echo(f"{key}:")
                 for row in value:

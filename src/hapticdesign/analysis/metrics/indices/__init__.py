@@ -14,9 +14,11 @@ from hapticdesign.analysis.metrics.indices import builtin  # noqa: F401  (regist
 from hapticdesign.analysis.metrics.indices.evaluation import (
     REDUCTIONS, Evaluation, evaluate, evaluate_at, evaluate_designs, evaluate_parameters, reduce,
 )
-from hapticdesign.analysis.metrics.indices.registry import INDICES, Index, Registry, Request, index, register, requests_of
+from hapticdesign.analysis.metrics.indices.registry import (
+    INDICES, Index, Registry, Request, index, options_line, options_used, register, requests_of,
+)
 from hapticdesign.analysis.metrics.indices.states import HandleStates, ParameterStates, handle_jacobians, moving_mass
 
 __all__ = ["INDICES", "REDUCTIONS", "Evaluation", "HandleStates", "Index", "ParameterStates", "Registry", "Request",
            "evaluate", "evaluate_at", "evaluate_designs", "evaluate_parameters", "handle_jacobians", "index",
-           "moving_mass", "register", "reduce", "requests_of"]
+           "moving_mass", "options_line", "options_used", "register", "reduce", "requests_of"]

@@ -209,3 +209,15 @@ def requests_of(requests: Iterable[str | Request], registry: Mapping[str, Index]
     if twice:
         raise UserError(f"index {twice[0]} is asked twice (give each request its own label)")
     return out
+
+
+def options_used(requests: Iterable[Request], registry: Mapping[str, Index] = INDICES) -> dict[str, dict]:
+    """The options each checked request ran with (its own over its index's defaults), by request key, for the
+    requests whose index has options: what an output states beside the values (``kmax``: the loop settings)."""
+    return {r.key: {**registry[r.index].options, **r.options} for r in requests if registry[r.index].options}
+
+
+def options_line(options: Mapping[str, object]) -> str:
+    """``name=value, ...`` of :func:`options_used`'s options of one request, for a text output."""
+    return ", ".join(f"{k}={v}" for k, v in options.items())
+
