@@ -40,7 +40,7 @@ from hapticdesign.analysis.dynamics.actuated_kernel import (
 )
 from hapticdesign.analysis.dynamics.device import GRADIENT_STEP
 from hapticdesign.analysis.loops import closure_kernel as ck
-from hapticdesign.analysis.loops.records import NO_HOME, OK, closure_scratch
+from hapticdesign.analysis.loops.records import NO_HOME, OK, ClosureScratch, closure_scratch
 from hapticdesign.analysis.reach_kernel import MESSAGES, Reached, reach_designs, structure_of
 from hapticdesign.analysis.stiffness import vjm
 from hapticdesign.analysis.stiffness.device import end_compliance
@@ -49,65 +49,69 @@ from hapticdesign.model.compensator_model import scaled_standard
 from hapticdesign.model.device import Device, build_mechanism
 from hapticdesign.model.walk import MotionPlan, Tree, frame_jacobian, node_poses, planned_poses, trig_workspace
 
+class PoseDynamics(NamedTuple):
+    """Scratch of one pose's ``H`` and ``G`` in the actuated coordinates (:func:`_pose_terms`): the closed-loop
+    kernels' ``closure`` scratch, the bodies' parameters in the world frame ``world`` (1, B, 10), ``h`` (n_a, n_a),
+    ``g`` (n_a,) and one body's ``mj`` (6, n_a)."""
+
+    closure: ClosureScratch
+    world: np.ndarray
+    h: np.ndarray
+    g: np.ndarray
+    mj: np.ndarray
+
+
 @njit(cache=True)
-def mass_designs(offsets, full, status, shape, plan, bodies, loops, params, out):
-    """``H`` (actuated coordinates, without the reflected rotor inertia) at the poses ``full`` (D, P, N) of the
-    designs whose status is OK, for their standard parameters ``params`` (D, 10 B), into ``out`` (D, P, n_a, n_a):
-    ``sum_b (J_b T)^T M_b (J_b T)`` (eq. 2.44) with the closed-loop dynamics' own pose kernels."""
-    n_design, n_pose, n = full.shape
+def pose_dynamics(shape, loops, bodies, n: int) -> PoseDynamics:
+    """A zeroed :class:`PoseDynamics` for designs of the tree ``shape`` with ``n`` coordinates."""
     na = loops.actuated.shape[0]
     n_body = bodies.body_node.shape[0]
-    n_node = shape.parent.shape[0]
-    ws = closure_scratch(n_node, n, na, loops.passive, n_body)
-    pw = np.zeros((1, n_body, 10))
-    h = np.zeros((na, na))
-    g = np.zeros(na)
-    mj = np.zeros((6, na))
-    for d in range(n_design):
-        if status[d] == OK:
-            tree = Tree(shape.parent, shape.axis, shape.coef, offsets[d], shape.const_rot, shape.const_pos)
-            _design_masses(full[d], tree, plan, bodies, loops, params[d:d + 1], ws, pw, h, g, mj, out[d])
+    return PoseDynamics(closure_scratch(shape.parent.shape[0], n, na, loops.passive, n_body),
+                        np.zeros((1, n_body, 10)), np.zeros((na, na)), np.zeros(na), np.zeros((6, na)))
 
 
 @njit(cache=True, _nrt=False)
-def _design_masses(full, tree, plan, bodies, loops, sets, ws, pw, h, g, mj, out):
-    """:func:`mass_designs` of one design at its poses ``full`` (P, N) into ``out`` (P, n_a, n_a); allocates nothing
-    (no reference counts on the records' arrays per pose)."""
-    body_node = bodies.body_node
-    n_node = tree.parent.shape[0]
-    for p in range(full.shape[0]):
-        if loops.passive.shape[0] > 0:
-            factor_pose(full[p], tree, plan, loops, ws)
-        else:
-            planned_poses(full[p], tree, plan, np.int64(0), n_node, ws.rot, ws.pos, ws.trig)
-        reduce_pose(tree, plan, body_node, loops, ws)
-        world_parameters(ws.rot, body_node, sets, np.int64(0), pw)
-        for i in range(h.shape[0]):
-            for j in range(h.shape[1]):
-                h[i, j] = 0.0
-        for b in range(body_node.shape[0]):
-            if body_node[b] >= 0:
-                mass_and_gravity(ws.ja, b, bodies.gravity, pw, 0, h, g, mj, False)
-        for i in range(h.shape[0]):
-            for j in range(h.shape[1]):
-                out[p, i, j] = h[i, j]
-
-
-@njit(cache=True)
-def _pose_gravity(q, tree, plan, bodies, loops, sets, ws, pw, h, g, mj):
-    """``G`` in the actuated coordinates at the full pose ``q`` into ``g`` (``T`` of the pose left in ``ws.t``)."""
-    body_node = bodies.body_node
+def _pose_terms(q, tree, plan, bodies, loops, sets, s):
+    """``H`` and ``G`` in the actuated coordinates at the full pose ``q`` into ``s.h`` and ``s.g`` (eq. 2.44: ``sum_b
+    (J_b T)^T M_b (J_b T)`` with the closed-loop dynamics' own pose kernels; ``T`` of the pose left in
+    ``s.closure.t``); allocates nothing."""
+    ws, body_node = s.closure, bodies.body_node
     if loops.passive.shape[0] > 0:
         factor_pose(q, tree, plan, loops, ws)
     else:
         planned_poses(q, tree, plan, np.int64(0), tree.parent.shape[0], ws.rot, ws.pos, ws.trig)
     reduce_pose(tree, plan, body_node, loops, ws)
-    world_parameters(ws.rot, body_node, sets, np.int64(0), pw)
-    h[:] = 0.0
-    g[:] = 0.0
+    world_parameters(ws.rot, body_node, sets, np.int64(0), s.world)
+    for i in range(s.h.shape[0]):
+        s.g[i] = 0.0
+        for j in range(s.h.shape[1]):
+            s.h[i, j] = 0.0
     for b in range(body_node.shape[0]):
         if body_node[b] >= 0:
-            mass_and_gravity(ws.ja, b, bodies.gravity, pw, 0, h, g, mj, False)
+            mass_and_gravity(ws.ja, b, bodies.gravity, s.world, 0, s.h, s.g, s.mj, False)
+
+
+@njit(cache=True)
+def mass_designs(offsets, full, status, shape, plan, bodies, loops, params, out):
+    """``H`` (actuated coordinates, without the reflected rotor inertia) at the poses ``full`` (D, P, N) of the
+    designs whose status is OK, for their standard parameters ``params`` (D, 10 B), into ``out`` (D, P, n_a, n_a)
+    (:func:`_pose_terms`)."""
+    s = pose_dynamics(shape, loops, bodies, full.shape[2])
+    for d in range(full.shape[0]):
+        if status[d] == OK:
+            tree = Tree(shape.parent, shape.axis, shape.coef, offsets[d], shape.const_rot, shape.const_pos)
+            _design_masses(full[d], tree, plan, bodies, loops, params[d:d + 1], s, out[d])
+
+
+@njit(cache=True, _nrt=False)
+def _design_masses(full, tree, plan, bodies, loops, sets, s, out):
+    """:func:`mass_designs` of one design at its poses ``full`` (P, N) into ``out`` (P, n_a, n_a); allocates nothing
+    (no reference counts on the records' arrays per pose)."""
+    for p in range(full.shape[0]):
+        _pose_terms(full[p], tree, plan, bodies, loops, sets, s)
+        for i in range(s.h.shape[0]):
+            for j in range(s.h.shape[1]):
+                out[p, i, j] = s.h[i, j]
 
 
 @njit(cache=True)
@@ -117,13 +121,9 @@ def gravity_designs(offsets, full, status, shape, plan, bodies, loops, params, s
     motion ``T e_j`` (the passive coordinates follow to first order; the second-order miss of the closure is even in
     the step and cancels in the difference)."""
     n_design, n_pose, n = full.shape
-    na = loops.actuated.shape[0]
-    n_body = bodies.body_node.shape[0]
-    ws = closure_scratch(shape.parent.shape[0], n, na, loops.passive, n_body)
-    pw = np.zeros((1, n_body, 10))
-    h = np.zeros((na, na))
-    g_up, g_down = np.zeros(na), np.zeros(na)
-    mj = np.zeros((6, na))
+    s = pose_dynamics(shape, loops, bodies, n)
+    na = s.h.shape[0]
+    g_up = np.zeros(na)
     t = np.zeros((n, na))
     q = np.zeros(n)
     for d in range(n_design):
@@ -132,17 +132,18 @@ def gravity_designs(offsets, full, status, shape, plan, bodies, loops, params, s
         tree = Tree(shape.parent, shape.axis, shape.coef, offsets[d], shape.const_rot, shape.const_pos)
         sets = params[d:d + 1]
         for p in range(n_pose):
-            _pose_gravity(full[d, p], tree, plan, bodies, loops, sets, ws, pw, h, g_up, mj)
-            t[:] = ws.t
+            _pose_terms(full[d, p], tree, plan, bodies, loops, sets, s)
+            t[:] = s.closure.t
             for j in range(na):
                 for i in range(n):
                     q[i] = full[d, p, i] + step * t[i, j]
-                _pose_gravity(q, tree, plan, bodies, loops, sets, ws, pw, h, g_up, mj)
+                _pose_terms(q, tree, plan, bodies, loops, sets, s)
+                g_up[:] = s.g
                 for i in range(n):
                     q[i] = full[d, p, i] - step * t[i, j]
-                _pose_gravity(q, tree, plan, bodies, loops, sets, ws, pw, h, g_down, mj)
+                _pose_terms(q, tree, plan, bodies, loops, sets, s)
                 for i in range(na):
-                    out[d, p, i, j] = (g_up[i] - g_down[i]) / (2.0 * step)
+                    out[d, p, i, j] = (g_up[i] - s.g[i]) / (2.0 * step)
 
 
 @njit(cache=True)
