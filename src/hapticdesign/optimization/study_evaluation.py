@@ -14,7 +14,7 @@ from __future__ import annotations
 import copy
 import json
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 
 import numpy as np
@@ -52,16 +52,22 @@ def _unread_by_kmax(name: str) -> bool:
     return name.startswith("actuators.") and name.rsplit(".", 1)[-1] in KMAX_UNREAD
 
 
-def require_study_workload(study: Study) -> None:
+def require_study_workload(study: Study, registry: Mapping[str, Index] = INDICES) -> None:
     """Refuse a study whose designs (population x generations x runs of a population search and at most as many as
     its polishing may ask, :func:`~.study_polish.most_designs`; one for method convex, whose program the number of
-    variables bounds) x workspace points is above :data:`STUDY_LIMIT`."""
+    variables bounds) x workspace points, each counted as its costliest index (:attr:`Index.cost`), is above
+    :data:`STUDY_LIMIT`."""
     spec = study.spec
     workspace = workspace_of(study) if spec.algorithm.over_poses else None
     points = 1 if workspace is None else len(workspace.points())
     designs = spec.algorithm.designs + most_designs(spec)
+    costliest = max((u.index for u in spec.index_uses if u.index in registry), key=lambda n: registry[n].cost,
+                    default=None)
+    cost = 1.0 if costliest is None else registry[costliest].cost
+    each = "" if cost == 1.0 else f", each costing {cost:g} evaluations (index {costliest})"
     require_within(f"a study of {designs} designs (population x generations x runs, and the polishing's most) x "
-                   f"{points} workspace points", designs * points, STUDY_LIMIT, "design-point evaluations")
+                   f"{points} workspace points{each}", designs * points * cost, STUDY_LIMIT,
+                   "design-point evaluations")
 
 
 def workspace_of(study: Study) -> Workspace | None:

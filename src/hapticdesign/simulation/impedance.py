@@ -183,17 +183,18 @@ ESCAPE = 10.0
 
 def simulated_limit(device: Device, loop: SampledLoop | None = None, wall_joint: int = 0, equilibrium: float = 0.01,
                     direction=None, counts: int | None = None, duration: float = 2.0, rel_tol: float = 1e-2,
-                    start: float | None = None, k_limit: float = 1e7, friction: bool = True) -> float:
+                    start: float | None = None, k_limit: float = 1e7, friction: bool = True,
+                    pose: np.ndarray | None = None) -> float:
     """The simulated growth boundary of the wall, every joint free but ``loop.held``: the device's Coulomb friction
     (smoothed, :data:`~.config.FRICTION_VELOCITY`) and ``counts`` (encoder quantization) in the loop, the spring
     bisected (to ``rel_tol``) on the growth of the wall coordinate's oscillation about its rest over ``duration``
     (the last quarter's envelope against the second's; a run leaving the start by :data:`ESCAPE` times the rest's
-    distance grows, whatever pose it wanders to and settles at); ``friction`` False leaves the device's friction out. Where the
-    loop is linear it converges to
-    :func:`stability_limit` (the tests check it). ``start``: the first stiffness tried (default: the exact limit of
-    the linear part); inf when nothing up to ``k_limit`` grows."""
+    distance grows, whatever pose it wanders to and settles at); ``friction`` False leaves the device's friction out;
+    ``pose`` the actuated pose the runs start at (default: :func:`~.config.rest_pose`). Where the loop is linear it
+    converges to :func:`stability_limit` (the tests check it). ``start``: the first stiffness tried (default: the
+    exact limit of the linear part at the rest pose); inf when nothing up to ``k_limit`` grows."""
     loop = loop or SampledLoop()
-    rest = rest_pose(device)
+    rest = rest_pose(device) if pose is None else np.asarray(pose, dtype=float)
     paths = {j: Held(float(rest[j])) for j in loop.held}
     if direction is not None:
         direction = tuple(unit_direction(direction).tolist())
@@ -205,7 +206,7 @@ def simulated_limit(device: Device, loop: SampledLoop | None = None, wall_joint:
 
     def grows(k: float) -> bool:
         cfg = replace(base, wall=replace(base.wall, stiffness=k))
-        trace = simulate(device, cfg, paths, plant=plant, model=model)
+        trace = simulate(device, cfg, paths, q0=rest, plant=plant, model=model)
         if trace.status != 0:  # diverged, or a closed-loop device's growing motion left the assembly branch
             return True
         return envelope_grows(trace.wall_position - wall_rest(trace, cfg.wall))
@@ -440,7 +441,10 @@ UNSTABLE = "unstable (spectral radius of the sampled loop above 1)"
 
 
 TOUCH = 0.001
-"""The wall's rest from the start (m, or rad on a joint) of a simulated limit asked at the start pose: a touch."""
+"""The wall's rest from the start (m, or rad on a joint) of a simulated limit asked at the start pose: a touch (small
+enough that the free handle's drift along the wall stays small, large against one encoder count)."""
+SIMULATED_CAP = 1e5
+"""N/m: a simulated limit of the spec sheet or a study stops its search here (inf above it)."""
 
 
 def limit_range(device: Device, loop: SampledLoop | None = None, k_limit: float = 200.0, wall_joint: int = 0,

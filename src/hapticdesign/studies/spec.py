@@ -141,19 +141,12 @@ def renderable_stiffness(device: Device, h: Handle, loop: SampledLoop | None = N
                       model=loop_model(device, loop, h.q))
 
 
-TOUCH = 0.001
-"""m: the wall's rest from the handle's start in the simulated limit, a touch (small enough that the free handle's
-drift along the wall stays small, large against one encoder count)."""
-SIMULATED_CAP = 1e5
-"""N/m: the simulated limit's search stops here (reported as inf above it)."""
-
-
 def renderable(device: Device, h: Handle, loop: SampledLoop, res: float | None,
                friction: tuple[float, float] | None, simulate: bool = True) -> dict:
     """The renderable-stiffness rows: the exact limit without the hand (worst direction) and with the hand, the
     simulated limit along that direction with the device's dry friction and encoder quantization, and the passivity
     bounds from the sheet's resolution ``res`` and backdrive ``friction`` (see the module docstring)."""
-    from hapticdesign.simulation.impedance import device_counts, simulated_limit
+    from hapticdesign.simulation.impedance import SIMULATED_CAP, TOUCH, device_counts, simulated_limit
 
     exact, direction = worst_direction(h.jacobian, h.states.H[0], device.damping_matrix, replace(loop, hand=None),
                                        gravity_gradient(device, h.q), loop_model(device, loop, h.q))

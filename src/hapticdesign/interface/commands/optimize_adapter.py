@@ -195,7 +195,7 @@ def optimize(study: Path | str, seed: int = 1, out: Path | str | None = None, *,
         raise UserError("your own indices live in this process; the workers of a scheduler would not have them")
     study = load_study(study)
     bound = bind_study(study, indices=own)
-    require_study_workload(study)
+    require_study_workload(study, bound.registry)
     for message in bound.unmeetable_walls():
         warnings.warn(message, RunWarning, stacklevel=2)
     out = None if out is None else Path(out)

@@ -45,6 +45,9 @@ class Index:
     function: Callable[..., np.ndarray]
     options: Mapping[str, object] = field(default_factory=dict)
     needs: frozenset[str] = frozenset({"kinematics"})
+    cost: float = 1.0
+    """How many ordinary evaluations (a pose's kinematics and dynamics) one evaluation of it costs: a study's
+    workload counts it so (an index that runs the sampled loop costs about a thousand)."""
 
     def values(self, state, options: Mapping[str, object] | None = None) -> np.ndarray:
         """The index of ``state`` with ``options`` over its defaults, as floats."""
@@ -144,7 +147,7 @@ INDICES = Registry()
 
 
 def index(function: Callable | None = None, *, unit: str, formula: str | None = None, source: str | None = None,
-          name: str | None = None, needs: Iterable[str] = ("kinematics", "dynamics"),
+          name: str | None = None, needs: Iterable[str] = ("kinematics", "dynamics"), cost: float = 1.0,
           registry: Registry = INDICES):
     """Register ``function(state, **options)`` as an index (a decorator; the :class:`Index` it returns is callable
     like the function). Its name is the function's (or ``name``), its options its keyword parameters with their
@@ -163,8 +166,10 @@ def index(function: Callable | None = None, *, unit: str, formula: str | None = 
         if not isinstance(unit, str) or not unit:
             raise UserError(f"index {label}: unit is a text such as '1', 'kg' or 'N/m'")
         doc = (inspect.getdoc(f) or "").strip().splitlines()
+        if not (isinstance(cost, (int, float)) and not isinstance(cost, bool) and 1.0 <= cost < float("inf")):
+            raise UserError(f"index {label}: cost is a number of ordinary evaluations, at least 1, got {cost!r}")
         made = Index(label, unit, formula or (doc[0] if doc else label), source or ".".join(_origin(f)), f,
-                     _options(f, label), wanted)
+                     _options(f, label), wanted, float(cost))
         return registry.register(made)
 
     return make if function is None else make(function)
