@@ -1,9 +1,9 @@
 """``transparency`` says when its stiffness is above the wall joint's stable limit, and why a bandwidth is null.
 
-Oracle: seed 000 §4.1.2's 1-DOF limit of a sampled spring with full inertial compensation and no delay,
-``K* = b^2 / H_ww`` (the Jury condition of the three-state loop at c = 1), with b = 0.01 N m s/rad from the
-five-bar file and ``H_ww`` from :func:`hapticdesign.mass_matrix` where the wall holds joint 1 (issue 35: the loop is
-linearized at the wall's equilibrium, the spring's rest 0.01 rad from home (2.0, 1.1), so at (2.01, 1.1)).
+Oracle: the growth boundary of the simulated (nonlinear, RK4) loop of the five-bar's joint 1 under the seed's
+settings (full inertial compensation, no delay), the spring resting 0.01 rad from home (2.0, 1.1)
+(:func:`hapticdesign.simulation.impedance.growth_boundary`, 10-s runs bisected to 1e-4). Seed 000 §4.1.2's 1-DOF
+closed form ``b^2 / H_ww`` at (2.01, 1.1) leaves gravity's stiffness out and is 0.8 % higher.
 """
 
 from __future__ import annotations
@@ -24,9 +24,15 @@ runner = CliRunner()
 
 
 @pytest.fixture(scope="module")
-def closed_form_limit() -> float:
+def simulated_limit() -> float:
+    from hapticdesign.simulation.config import LoopConfig
+    from hapticdesign.simulation.impedance import ImpedanceProblem, growth_boundary
+
     device = load_device_file(FIVE_BAR)
-    return 0.01 ** 2 / mass_matrix(device, np.array([2.0 + 0.01, 1.1]))[0, 0]
+    limit = growth_boundary(ImpedanceProblem(device, 1, 0, config=LoopConfig(duration=10.0)), rel_tol=1e-4)
+    closed_form = 0.01 ** 2 / mass_matrix(device, np.array([2.0 + 0.01, 1.1]))[0, 0]
+    assert abs(closed_form / limit - 1.0) > 5e-3  # gravity's stiffness matters here
+    return limit
 
 
 def _run(stiffness: float):
@@ -34,28 +40,28 @@ def _run(stiffness: float):
                                "--stiffness", repr(float(stiffness)), "--json"])
 
 
-def test_stiffness_above_the_limit_is_said(closed_form_limit):
+def test_stiffness_above_the_limit_is_said(simulated_limit):
     done = _run(4.0)
     assert done.exit_code == 0, done.output
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("warning: K = 4 N m/rad is above joint 1's stable limit")
     out = json.loads(done.stdout)
-    assert out["stable_limit"] == pytest.approx(closed_form_limit, rel=1e-6)
+    assert out["stable_limit"] == pytest.approx(simulated_limit, rel=2e-4)
     assert out["units"]["stable_limit"] == "N m/rad"
     if out["bandwidth_hz"] is None:
         assert "above the wall joint's stable limit" in out["bandwidth_note"]
 
 
-def test_stiffness_below_the_limit_gives_no_warning(closed_form_limit):
-    done = _run(0.5 * closed_form_limit)
+def test_stiffness_below_the_limit_gives_no_warning(simulated_limit):
+    done = _run(0.5 * simulated_limit)
     assert done.exit_code == 0, done.output
     assert done.stderr == ""
     out = json.loads(done.stdout)
-    assert out["stable_limit"] == pytest.approx(closed_form_limit, rel=1e-6)
+    assert out["stable_limit"] == pytest.approx(simulated_limit, rel=2e-4)
     assert (out["bandwidth_hz"] is None) == ("bandwidth_note" in out)
 
 
-def test_the_docs_quote_the_five_bar_limit(closed_form_limit):
-    """docs/simulation.md quotes joint 1's limit of the five-bar; it is the closed form's, to 4 digits."""
+def test_the_docs_quote_the_five_bar_limit(simulated_limit):
+    """docs/simulation.md quotes joint 1's limit of the five-bar; it is the simulated loop's, to 4 digits."""
     docs = (Path(__file__).resolve().parents[2] / "docs" / "simulation.md").read_text()
-    assert f"five-bar's {closed_form_limit:.4g} N m/rad on joint 1" in docs
+    assert f"five-bar's {simulated_limit:.4g} N m/rad on joint 1" in docs
