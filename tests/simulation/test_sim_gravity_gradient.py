@@ -152,3 +152,37 @@ def test_the_analytic_growth_check_holds_the_pendulum_where_gravity_and_the_spri
     assert found == pytest.approx(expected, rel=1e-7)
     at_rest = _python_control_limit(M * L * L, B, M * G * L * math.cos(rest), 0.0, 1, period)
     assert abs(at_rest / expected - 1.0) > 1e-3
+
+
+def _python_control_radius(j: float, b: float, k_g: float, share: float, delay: int, period: float = PERIOD):
+    """The largest pole modulus of python-control's loop of the pendulum under a spring ``K`` (a function of K)."""
+    plant = control.c2d(control.ss([[0.0, 1.0], [-k_g / j, -b / j]], [[0.0], [1.0 / j]], [[1.0, 0.0]], [[0.0]]),
+                        period, "zoh")
+    lag = control.tf([1.0], [1.0] + [0.0] * delay, period)
+    return lambda k: np.abs(control.poles(control.feedback(plant * lag, k - share * k_g))).max()
+
+
+@pytest.mark.parametrize("up, share, delay", [(True, 0.0, 1), (True, 0.0, 0), (False, 1.4, 1)])
+def test_gravity_pulling_off_the_wall_leaves_a_stable_interval(up, share, delay):
+    """The pendulum standing up (``K_G = -m g l``) without compensation, or hanging with a model 40 % too heavy
+    compensating its gravity (net ``-0.4 m g l``): springs softer than gravity's pull are unstable, stiff ones too, so
+    the stable springs are an interval. Both ends are the crossings of python-control's largest pole modulus through
+    1 (sign changes on a grid, each closed by SciPy's brentq); the grouped search (the worst of two walls, the second
+    acting through 0.95, so its interval is the first's over 0.9025) gives their intersection."""
+    from hapticdesign.analysis.sampled_loop import handle_intervals
+
+    k_g = (-1.0 if up else 1.0) * M * G * L
+    radius = _python_control_radius(M * L * L, B, k_g, share, delay)
+    grid = np.geomspace(1e-3, 1e4, 400)
+    sign = np.array([radius(k) >= 1.0 for k in grid])
+    changes = np.flatnonzero(sign[1:] != sign[:-1])
+    assert len(changes) == 2 and sign[0] and sign[-1]
+    low, high = (brentq(lambda k: radius(k) - 1.0, grid[i], grid[i + 1], xtol=1e-13, rtol=1e-12) for i in changes)
+    loop = SampledLoop(compensation="none" if share == 0.0 else "gravity", delay=delay,
+                       model_error=100.0 * (1.0 - share) if share else 0.0, velocity="sampled")
+    axis, mass = np.array([[[1.0], [0.0], [0.0]]]), np.array([[[M * L * L]]])
+    found = handle_intervals(axis, mass, np.array([[B]]), np.array([[1.0]]), loop, gravity=np.array([[[k_g]]]))
+    assert found[0][0] == pytest.approx(low, rel=1e-7) and found[1][0] == pytest.approx(high, rel=1e-7)
+    both = handle_intervals(np.repeat(axis, 2, 0), np.repeat(mass, 2, 0), np.array([[B]]), np.array([[1.0], [0.95]]),
+                            loop, groups=np.array([0, 0]), gravity=np.array([[[k_g]], [[k_g]]]))
+    assert both[0][0] == pytest.approx(low / 0.9025, rel=1e-7) and both[1][0] == pytest.approx(high, rel=1e-7)

@@ -108,3 +108,25 @@ def test_each_output_states_its_settings_and_verdict():
     asked = json.loads(runner.invoke(app, ["impedance-range", "--device", path, "--settings", "seed", "--method",
                                            "analytic", "--json"]).stdout)
     assert asked["settings"] == SampledLoop.seed().as_dict()
+
+
+def test_a_wall_gravity_pulls_away_from_is_stable_only_above_gravitys_pull():
+    """The five-bar stands up, so without compensation gravity pulls joint 1 away from a joint wall (joint 2 held):
+    springs softer than ``-dG_1/dq_1`` cannot hold it. A real pole leaves the unit circle at z = 1 exactly where the
+    static stiffness ``K + dG_1/dq_1`` vanishes, so the interval's lower end is gravity's stiffness at the pose the
+    wall holds (central differences of ``G``), and the command says so; the grid starts above it."""
+    from hapticdesign.analysis.dynamics.device import gravity
+
+    path = str(EXAMPLES / "five-bar.yaml")
+    found = CliRunner().invoke(app, ["impedance-range", "--device", path, "--compensation", "none", "--joint", "1",
+                                     "--hold", "2", "--resolution", "0.01", "--json"])
+    assert found.exit_code == 0, found.output
+    out = json.loads(found.stdout)
+    device, pose = _device("five-bar"), np.array(out["pose"])
+    step = 1e-5
+    k_g = (gravity(device, pose + [step, 0.0])[0] - gravity(device, pose - [step, 0.0])[0]) / (2 * step)
+    assert k_g < 0 and out["k_limit_lower"] == pytest.approx(-k_g, rel=1e-6)
+    assert out["k_min"] == pytest.approx(math.ceil(-k_g / 0.01) * 0.01) and out["k_max"] > out["k_min"]
+    text = CliRunner().invoke(app, ["impedance-range", "--device", path, "--compensation", "none", "--joint", "1",
+                                    "--hold", "2", "--resolution", "0.01"])
+    assert f"springs below {-k_g:.6g} N m/rad are unstable too" in text.stdout

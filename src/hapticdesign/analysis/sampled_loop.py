@@ -160,31 +160,47 @@ RTOL, XTOL = 1e-10, 1e-12
 
 def loop_limits(loops: SpringLoops, guess: np.ndarray, groups: np.ndarray | None = None,
                 k_max: float = 1e9) -> np.ndarray:
-    """The smallest spring at which each loop (S,) loses stability, or the smallest in each group (``groups``: S
-    labels 0 ... G - 1; (G,)).
+    """The upper ends of :func:`loop_intervals`: the spring at which each loop (S,) stops being stable, or the
+    smallest in each group (G,)."""
+    return loop_intervals(loops, guess, groups, k_max)[1]
 
-    A loop unstable at :data:`FLOOR` has the limit 0; otherwise a stable ``lo`` and an unstable ``hi`` are
-    bracketed from ``guess`` by steps down or up that start at :data:`STEP` and square each time (``hi > k_max``:
-    stable up to ``k_max``, the limit is inf), and the crossing of the spectral radius through 1 is found by the
-    Illinois variant of regula falsi (a bisection after two steps that did not halve the bracket; a step that would
-    land within half the tolerance of an end lands that far from it, so an end that has converged closes the
-    bracket at the next step, as in Dekker's method) to ``XTOL + RTOL K``; the limit is the bracket's middle. All loops move at once (one batched eigenvalue call per step). In a
-    group, a loop whose stable ``lo`` reaches the smallest unstable ``hi`` of another cannot hold the group's
-    smallest limit and leaves the search, so a bracket as tight as the guess allows lets most of a group leave after
-    the first step of regula falsi (halving from a guess a few per cent above the limit left ``lo`` far below it and
-    kept them searching: 3.4 times the steps once gravity's gradient put half the limits just below their guess).
+
+def loop_intervals(loops: SpringLoops, guess: np.ndarray, groups: np.ndarray | None = None,
+                   k_max: float = 1e9) -> tuple[np.ndarray, np.ndarray]:
+    """The springs ``[low, high]`` for which each loop (S,) is stable, or each group's (``groups``: S labels 0 ...
+    G - 1; (G,) each: the largest ``low`` and the smallest ``high`` of its loops, the springs all of them hold).
+
+    A loop stable at :data:`FLOOR` has ``low`` 0. One unstable there (gravity pulling the handle away from the wall
+    faster than anything else holds it: over-compensation, an inverted pose) is tried at its guess and then at
+    every decade up to ``k_max``; with no stable spring among them both ends are 0, else ``low`` is the crossing
+    below the first stable spring found (:func:`_crossing`). ``high``: from ``guess`` (or that stable spring) a
+    stable ``lo`` and an unstable ``hi`` are bracketed by steps down or up that start at :data:`STEP` and square
+    each time (``hi > k_max``: stable up to ``k_max``, inf), then the crossing is found to ``XTOL + RTOL K``. All
+    loops move at once (one batched eigenvalue call per step). In a group, a loop whose stable ``lo`` reaches the
+    smallest unstable ``hi`` of another cannot hold the group's smallest ``high`` and leaves the search, so a bracket
+    as tight as the guess allows lets most of a group leave after the first step of regula falsi (halving from a
+    guess a few per cent above the limit left ``lo`` far below it and kept them searching: 3.4 times the steps once
+    gravity's gradient put half the limits just below their guess).
     """
     count = len(loops)
     group = np.arange(count) if groups is None else np.asarray(groups, dtype=np.int64)
     n_group = int(group.max()) + 1 if count else 0
     f_floor = loops.radii(np.full(count, FLOOR)) - 1.0
-    limit = np.full(count, np.nan)
-    limit[f_floor >= 0.0] = 0.0
+    limit, low = np.full(count, np.nan), np.zeros(count)
     lo = np.minimum(np.maximum(guess, FLOOR), k_max)
     hi, f_lo, f_hi = lo * STEP, np.where(lo == FLOOR, f_floor, np.nan), np.full(count, np.nan)
+    floor_unstable = np.flatnonzero(f_floor >= 0.0)
+    if floor_unstable.size:
+        found, f_found, below, f_below = _stable_spring(loops, floor_unstable, lo[floor_unstable], k_max)
+        held = ~np.isnan(found)
+        limit[floor_unstable[~held]] = 0.0
+        kept = floor_unstable[held]
+        low[kept] = _crossing(lambda x, idx: 1.0 - loops.radii(x, kept[idx]), below[held], found[held],
+                              -f_below[held], -f_found[held])
+        lo[kept], f_lo[kept], hi[kept] = found[held], f_found[held], found[held] * STEP
     step = np.full(count, STEP)
     search = _Search(group, n_group, limit)
-    todo = np.flatnonzero(search.open() & (lo > FLOOR))
+    todo = np.flatnonzero(search.open() & (lo > FLOOR) & np.isnan(f_lo))
     while todo.size:  # step lo down until it is stable
         f = loops.radii(lo[todo], todo) - 1.0
         stable, unstable = todo[f < 0.0], todo[f >= 0.0]
@@ -209,22 +225,68 @@ def loop_limits(loops: SpringLoops, guess: np.ndarray, groups: np.ndarray | None
         lo[stable], f_lo[stable], hi[stable] = hi[stable], f[f < 0.0], hi[stable] * step[stable]
         if groups is not None:
             search.prune(lo, hi, f_hi)
-    side, stall = np.zeros(count, dtype=np.int8), np.zeros(count, dtype=np.int8)
-    while True:  # Illinois regula falsi
-        if groups is not None:
-            search.prune(lo, hi, f_hi)
-        todo = np.flatnonzero(search.open())
-        done = todo[hi[todo] - lo[todo] <= XTOL + RTOL * hi[todo]]
-        limit[done] = 0.5 * (lo[done] + hi[done])
-        todo = todo[hi[todo] - lo[todo] > XTOL + RTOL * hi[todo]]
+    todo = np.flatnonzero(search.open())
+    prune = None if groups is None else (lambda idx, a, b: search.left_behind(todo, idx, a, b))
+    limit[todo] = _crossing(lambda x, idx: loops.radii(x, todo[idx]) - 1.0, lo[todo], hi[todo], f_lo[todo],
+                            f_hi[todo], prune)
+    if groups is None:
+        return low, limit
+    low, high = search.largest(low), search.smallest(limit)
+    apart = low > high  # no spring holds every loop of the group
+    low[apart] = high[apart] = 0.0
+    return low, high
+
+
+def _stable_spring(loops: SpringLoops, index: np.ndarray, guess: np.ndarray,
+                   k_max: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """For the loops ``index``, unstable at :data:`FLOOR`: a stable spring (their guess, else the first decade from
+    ``10 FLOOR`` to ``k_max`` that is; NaN where none is), its ``f = radius - 1``, and the unstable spring below it
+    with its ``f`` (the last one tried, or the floor)."""
+    found, f_found = np.full(len(index), np.nan), np.full(len(index), np.nan)
+    below, f_below = np.full(len(index), FLOOR), loops.radii(np.full(len(index), FLOOR), index) - 1.0
+    decades = FLOOR * 10.0 ** np.arange(1, int(np.floor(np.log10(k_max / FLOOR))) + 1)
+    for level in range(len(decades) + 1):
+        todo = np.flatnonzero(np.isnan(found))
         if not todo.size:
             break
+        trial = guess[todo] if level == 0 else np.full(todo.size, decades[level - 1])
+        f = loops.radii(trial, index[todo]) - 1.0
+        stable = f < 0.0
+        found[todo[stable]], f_found[todo[stable]] = trial[stable], f[stable]
+        if level:  # the decades rise: an unstable one is the highest unstable spring below a stable one found later
+            below[todo[~stable]], f_below[todo[~stable]] = trial[~stable], f[~stable]
+    return found, f_found, below, f_below
+
+
+def _crossing(evaluate, lo: np.ndarray, hi: np.ndarray, f_lo: np.ndarray, f_hi: np.ndarray,
+              prune=None) -> np.ndarray:
+    """Where ``evaluate(x, idx)`` (the sign of ``radius - 1`` or its opposite, of the systems ``idx`` of these arrays)
+    crosses 0 between ``lo`` (``f < 0``) and ``hi`` (``f >= 0``), by the Illinois variant of regula falsi (a
+    bisection after two steps that did not halve the bracket; a step that would land within half the tolerance of
+    an end lands that far from it, so an end that has converged closes the bracket at the next step, as in Dekker's
+    method) to ``XTOL + RTOL K``: the bracket's middle. ``prune(idx, lo, hi)`` (a group search) returns a mask of
+    the systems that no longer matter among the open ones ``idx`` (NaN for them)."""
+    lo, hi, f_lo, f_hi = (np.array(v, dtype=float) for v in (lo, hi, f_lo, f_hi))
+    out = np.full(len(lo), np.nan)
+    open_ = np.ones(len(lo), dtype=bool)
+    side, stall = np.zeros(len(lo), dtype=np.int8), np.zeros(len(lo), dtype=np.int8)
+    while True:
+        if prune is not None:
+            open_ &= ~prune(np.flatnonzero(open_), lo, hi)
+        todo = np.flatnonzero(open_)
+        narrow = hi[todo] - lo[todo] <= XTOL + RTOL * hi[todo]
+        done = todo[narrow]
+        out[done] = 0.5 * (lo[done] + hi[done])
+        open_[done] = False
+        todo = todo[~narrow]
+        if not todo.size:
+            return out
         a, b, fa, fb = lo[todo], hi[todo], f_lo[todo], f_hi[todo]
         x = (a * fb - b * fa) / (fb - fa)
         x = np.where((stall[todo] >= 2) | ~(x > a) | ~(x < b), 0.5 * (a + b), x)
         half = 0.5 * (XTOL + RTOL * b)
         x = np.clip(x, a + half, b - half)
-        f = loops.radii(x, todo) - 1.0
+        f = evaluate(x, todo)
         up = f >= 0.0
         stall[todo] = np.where(np.maximum(np.where(up, x, b) - np.where(up, a, x), 0.0) > 0.5 * (b - a),
                                stall[todo] + 1, 0)
@@ -233,12 +295,11 @@ def loop_limits(loops: SpringLoops, guess: np.ndarray, groups: np.ndarray | None
         f_hi[fall[side[fall] == 1]] *= 0.5
         hi[rise], f_hi[rise], side[rise] = x[up], f[up], 2
         lo[fall], f_lo[fall], side[fall] = x[~up], f[~up], 1
-    return limit if groups is None else search.smallest(limit)
 
 
 class _Search:
-    """Which systems of :func:`loop_limits` still search: not done (``limit`` NaN, 0 for those unstable at the
-    floor, set before), their group not settled at 0, and not left behind by another system of their group."""
+    """Which systems of :func:`loop_intervals` still search: not done (``limit`` NaN, 0 for those with no stable
+    spring, set before), their group not settled at 0, and not left behind by another system of their group."""
 
     def __init__(self, group: np.ndarray, n_group: int, limit: np.ndarray):
         self.group, self.n_group, self.limit = group, n_group, limit
@@ -256,6 +317,24 @@ class _Search:
         known = self.open() & ~np.isnan(f_hi)
         np.minimum.at(unstable, self.group[known], hi[known])
         self.out |= self.open() & (lo >= unstable[self.group])
+
+    def left_behind(self, systems: np.ndarray, open_: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        """:meth:`prune` in the regula-falsi phase (every bracket known): of ``systems`` (whose brackets ``lo``,
+        ``hi`` these are), a mask of the open ones ``open_`` left behind, now out."""
+        group = self.group[systems[open_]]
+        unstable = np.full(self.n_group, np.inf)
+        np.minimum.at(unstable, group, hi[open_])
+        drop = np.zeros(len(systems), dtype=bool)
+        drop[open_] = lo[open_] >= unstable[group]
+        self.out[systems[drop]] = True
+        return drop
+
+    def largest(self, low: np.ndarray) -> np.ndarray:
+        """Each group's largest lower end over all its systems (0 for a group settled at 0)."""
+        out = np.zeros(self.n_group)
+        np.maximum.at(out, self.group, low)
+        out[self.zero] = 0.0
+        return out
 
     def smallest(self, limit: np.ndarray) -> np.ndarray:
         """Each group's smallest limit over the systems that finished (the ones left behind hold larger ones)."""
@@ -548,18 +627,27 @@ the wall's unit row stacked on the stiffness in units of ``|H_h| / T^2``): a bal
 gravity gradient leaves the drift free."""
 
 
-def handle_limits(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, spring: np.ndarray,
-                  loop: SampledLoop, groups: np.ndarray | None = None, k_max: float = 1e9,
-                  poses: np.ndarray | None = None, gravity: np.ndarray | None = None,
-                  model: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
-    """The exact stable wall stiffness (N/m) of each handle loop of :func:`handle_loops` (S,), or the smallest in
-    each group (:func:`loop_limits`)."""
+def handle_intervals(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, spring: np.ndarray,
+                     loop: SampledLoop, groups: np.ndarray | None = None, k_max: float = 1e9,
+                     poses: np.ndarray | None = None, gravity: np.ndarray | None = None,
+                     model: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The exact stable wall stiffnesses ``[low, high]`` (N/m) of each handle loop of :func:`handle_loops` (S,
+    each), or of each group (:func:`loop_intervals`; ``low`` 0 unless gravity pulls the handle off the wall)."""
     loops, guess = handle_loops(jacobian, mass, damping, spring, loop, poses, gravity, model)
     order = loops.base.shape[-1]
     what = f"the closed-loop matrices of {len(loops):,} handle loops of order {order}"
     require_memory(what, 8.0 * order * order * len(loops))
     require_within(what, order, EIGEN_ORDER_LIMIT, "rows")
-    return loop_limits(loops, guess, groups, k_max)
+    return loop_intervals(loops, guess, groups, k_max)
+
+
+def handle_limits(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, spring: np.ndarray,
+                  loop: SampledLoop, groups: np.ndarray | None = None, k_max: float = 1e9,
+                  poses: np.ndarray | None = None, gravity: np.ndarray | None = None,
+                  model: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+    """The upper ends of :func:`handle_intervals`: the exact stable wall stiffness (N/m) of each handle loop (S,),
+    or the smallest in each group."""
+    return handle_intervals(jacobian, mass, damping, spring, loop, groups, k_max, poses, gravity, model)[1]
 
 
 def _joint(inertia, damping, model_inertia=None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,

@@ -14,7 +14,10 @@ points at once: the loops of all their directions are searched together, and a d
 above another's unstable one leaves the search early.
 
 :func:`kmax` is the ``kmax`` design index: the options of a study (:data:`KMAX_OPTIONS`) read into a
-:class:`~hapticdesign.analysis.sampled_loop.SampledLoop`.
+:class:`~hapticdesign.analysis.sampled_loop.SampledLoop`. Its value is the upper end of the stable springs; where
+gravity pulls the handle off the wall (a model error over-compensating, an inverted pose), springs below a lower end
+are unstable too (:func:`~hapticdesign.analysis.sampled_loop.handle_intervals`; ``impedance-range`` states it), and
+where no spring holds the handle along a free direction the value is 0.
 """
 
 from __future__ import annotations

@@ -30,7 +30,7 @@ import numpy as np
 
 from hapticdesign.analysis.configuration import configuration_of, handle_pose
 from hapticdesign.analysis.dynamics.device import gravity_gradient, mass_matrix
-from hapticdesign.analysis.sampled_loop import SampledLoop, handle_limits
+from hapticdesign.analysis.sampled_loop import SampledLoop, handle_intervals
 from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation.analytic import GROWS, AnalyticProblem, linear_loop
@@ -120,11 +120,14 @@ class ImpedanceProblem(WallProblem):
 @dataclass(frozen=True)
 class StabilityLimit:
     """The exact stability limit of a wall (N/m along a Cartesian wall, N m/rad or N/m on a joint) under the loop
-    settings ``loop``, linearized at ``pose``, the pose the wall holds (actuated coordinates)."""
+    settings ``loop``, linearized at ``pose``, the pose the wall holds (actuated coordinates), and ``lower``, the
+    softest stable spring: 0, or above it where gravity pulls the handle off the wall faster than the loop holds it
+    (over-compensation, an inverted pose), so that only springs from ``lower`` to ``stiffness`` are stable."""
 
     stiffness: float
     pose: np.ndarray
     loop: SampledLoop
+    lower: float = 0.0
 
 
 def wall_pose(device: Device, wall_joint: int = 0, equilibrium: float = 0.01, direction=None) -> np.ndarray:
@@ -158,10 +161,10 @@ def stability_limit(device: Device, loop: SampledLoop | None = None, wall_joint:
         spring = unit_direction(direction) @ jv
         if not np.linalg.norm(spring) > 1e-12 * max(np.linalg.norm(jv), 1e-300):
             raise UserError("the handle does not move along the wall's direction at the pose the wall holds")
-    limit = handle_limits(jv[None], mass_matrix(device, pose)[None], device.damping_matrix, spring[None], loop,
-                          k_max=k_max, gravity=gravity_gradient(device, pose)[None],
-                          model=_batch_of_one(loop_model(device, loop, pose)))
-    return StabilityLimit(float(limit[0]), pose, loop)
+    low, high = handle_intervals(jv[None], mass_matrix(device, pose)[None], device.damping_matrix, spring[None],
+                                 loop, k_max=k_max, gravity=gravity_gradient(device, pose)[None],
+                                 model=_batch_of_one(loop_model(device, loop, pose)))
+    return StabilityLimit(float(high[0]), pose, loop, float(low[0]))
 
 
 def _batch_of_one(model: tuple[np.ndarray, np.ndarray] | None) -> tuple[np.ndarray, np.ndarray] | None:
@@ -257,8 +260,8 @@ class RangeResult:
         first = self.first_unstable
         extra = {} if self.exact is None else {"analytic_exact": self.exact}
         if self.limit is not None:
-            extra = {"k_limit_exact": self.limit.stiffness, "pose": self.limit.pose.tolist(),
-                     "settings": self.limit.loop.as_dict()}
+            extra = {"k_limit_exact": self.limit.stiffness, "k_limit_lower": self.limit.lower,
+                     "pose": self.limit.pose.tolist(), "settings": self.limit.loop.as_dict()}
         return {
             "verdict": self.verdict,
             **extra,
@@ -451,14 +454,17 @@ def limit_range(device: Device, loop: SampledLoop | None = None, k_limit: float 
                 equilibrium: float = 0.01, resolution: float | None = None, wall_direction=None,
                 counts: int | None = None, simulate: bool = False) -> RangeResult:
     """The stable range on the grid ``R, 2R, 3R ...`` (``R`` = ``resolution``, default 1) from the exact stability
-    limit of the sampled loop at the wall's equilibrium (:func:`stability_limit`): every grid stiffness up to the
-    limit is stable, the first one above it is not; no performance criteria. With ``simulate`` the simulated limit
+    limit of the sampled loop at the wall's equilibrium (:func:`stability_limit`): every grid stiffness from its
+    lower end (0, unless gravity pulls the handle off the wall) up to the limit is stable, the first one above it is
+    not; no performance criteria. With ``simulate`` the simulated limit
     with the device's dry friction and quantization (``counts``, default the device's encoders) is added beside it
     (:func:`simulated_limit`, the wall resting ``equilibrium`` or :data:`TOUCH` from the start)."""
     grid = 1.0 if resolution is None else float(resolution)
     limit = stability_limit(device, loop, wall_joint, equilibrium, wall_direction)
     top = int(math.floor(k_limit / grid + 1e-9))
     count = min(int(math.floor(limit.stiffness / grid)) if math.isfinite(limit.stiffness) else top, top)
+    first = max(1, int(math.ceil(limit.lower / grid - 1e-9)))
+    count = count if count >= first else 0
     above = Verdict((count + 1) * grid, False, UNSTABLE, math.nan, math.nan) if count < top else None
     simulated = None
     if simulate:
@@ -466,7 +472,7 @@ def limit_range(device: Device, loop: SampledLoop | None = None, k_limit: float 
                                     device_counts(device) if counts is None else counts,
                                     start=max(limit.stiffness, 1e-3) if math.isfinite(limit.stiffness) else None)
     return RangeResult(count * grid, above.criterion if above else "none", 0, above, "limit",
-                       grid if count >= 1 else None, grid, k_true_boundary=simulated, limit=limit)
+                       first * grid if count >= 1 else None, grid, k_true_boundary=simulated, limit=limit)
 
 
 def impedance_range(device: Device, sim_type: int = 1, method: str = "fast", k_limit: int = 200,

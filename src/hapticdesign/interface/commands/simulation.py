@@ -166,9 +166,11 @@ def impedance_range_command(
         lowest = "" if out["k_min"] is None else f", lowest passing {out['k_min']:g}"
         where = "the handle" if direction is not None else f"joint {out['joint']}"
         if method == "limit":
+            softest = ("" if not out["k_limit_lower"] else f"; springs below {out['k_limit_lower']:.6g} "
+                       f"{unit['stiffness']} are unstable too: gravity pulls the handle off the wall")
             typer.echo(f"{dev.name}, wall at {where}: maximum stable impedance {out['k_max']:g} {unit['stiffness']} "
                        f"on the grid{lowest} (stability limit {out['k_limit_exact']:.6g} {unit['stiffness']} at "
-                       "the wall's equilibrium)")
+                       f"the wall's equilibrium{softest})")
         else:
             typer.echo(f"{dev.name}, type {sim_type}, {where}: maximum stable impedance "
                        f"{out['k_max']:g} {unit['stiffness']}{lowest} (first failure: {out['criterion']}; "
