@@ -104,10 +104,11 @@ def _offset_pendulum():
 
 def test_a_gravity_compensators_model_error_enters_as_its_model_devices_gradient():
     """Gravity compensation with a 30 % modelling error: the compensator's late gravity stiffness is its model
-    device's, ``0.7^2 m g l cos q`` (python-control's loop), not ``0.7 m g l cos q`` (whose limit is about 10 %
-    higher)."""
+    device's, ``0.7^2 m g l`` at the hanging pose (python-control's loop), not ``0.7 m g l`` (whose limit is about 10 %
+    higher). At the hanging pose the model's leftover gravity torque is 0, so the wall holds the pendulum at its
+    spring's rest."""
     device, loop = _offset_pendulum(), SampledLoop(model_error=30.0)
-    for q in (0.0, 0.6):
+    for q in (0.0,):
         exact = stability_limit(device, loop, equilibrium=q).stiffness
         k_g = M * G * L * math.cos(q)
         assert exact == pytest.approx(_python_control_limit(M * L * L, B, k_g, 0.7 ** 2, 1), rel=1e-7)
@@ -186,3 +187,27 @@ def test_gravity_pulling_off_the_wall_leaves_a_stable_interval(up, share, delay)
     both = handle_intervals(np.repeat(axis, 2, 0), np.repeat(mass, 2, 0), np.array([[B]]), np.array([[1.0], [0.95]]),
                             loop, groups=np.array([0, 0]), gravity=np.array([[[k_g]], [[k_g]]]))
     assert both[0][0] == pytest.approx(low / 0.9025, rel=1e-7) and both[1][0] == pytest.approx(high, rel=1e-7)
+
+
+def test_the_wall_holds_an_uncompensated_pendulum_where_gravity_and_the_spring_balance():
+    """No compensation at 50 Hz, a joint wall resting 1 rad from the hanging pose: gravity holds the pendulum at
+    ``K (x - 1) + m g l sin x = 0`` (SciPy's brentq), so the exact limit is the fixed point of python-control's limit
+    of the loop linearized there (brentq again, 1e-7), not the limit at the spring's rest (0.4 % off); the simulated
+    growth boundary (the nonlinear loop, bisected to 1e-3) agrees."""
+    rest, period = 1.0, 0.02
+    loop = SampledLoop(period=period, compensation="none")
+    found = stability_limit(_pendulum(), loop, equilibrium=rest)
+
+    def held(k: float) -> float:
+        return brentq(lambda q: k * (q - rest) + M * G * L * math.sin(q), -1.0, rest, xtol=1e-15)
+
+    def limit_where_held(k: float) -> float:
+        return _python_control_limit(M * L * L, B, M * G * L * math.cos(held(k)), 0.0, 1, period)
+
+    expected = brentq(lambda k: limit_where_held(k) - k, 1e-3, 1.0, xtol=1e-14)
+    assert found.stiffness == pytest.approx(expected, rel=1e-7)
+    assert found.pose[0] == pytest.approx(held(expected), abs=1e-9)
+    at_rest = _python_control_limit(M * L * L, B, M * G * L * math.cos(rest), 0.0, 1, period)
+    assert abs(at_rest / expected - 1.0) > 3e-3
+    simulated = simulated_limit(_pendulum(), loop, equilibrium=rest, rel_tol=1e-3, duration=20.0, friction=False)
+    assert simulated == pytest.approx(expected, rel=2e-3)

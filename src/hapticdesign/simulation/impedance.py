@@ -29,9 +29,10 @@ from functools import cached_property
 import numpy as np
 
 from hapticdesign.analysis.configuration import configuration_of, handle_pose
-from hapticdesign.analysis.dynamics.device import gravity_gradient, mass_matrix
+from hapticdesign.analysis.dynamics.device import gravity, gravity_gradient, mass_matrix
 from hapticdesign.analysis.sampled_loop import SampledLoop, handle_intervals
 from hapticdesign.errors import InputError, UserError
+from hapticdesign.model.compensator_model import model_device
 from hapticdesign.model.device import Device
 from hapticdesign.simulation.analytic import GROWS, AnalyticProblem, linear_loop
 from hapticdesign.simulation.boundary import envelope_grows, growth_onset
@@ -147,24 +148,79 @@ def wall_pose(device: Device, wall_joint: int = 0, equilibrium: float = 0.01, di
 def stability_limit(device: Device, loop: SampledLoop | None = None, wall_joint: int = 0, equilibrium: float = 0.01,
                     direction=None, k_max: float = 1e9) -> StabilityLimit:
     """The exact stability limit of a wall on ``wall_joint`` (or along the Cartesian ``direction`` at the handle)
-    with every actuated joint free but ``loop.held``, linearized where the wall holds the device (:func:`wall_pose`;
-    :func:`hapticdesign.analysis.sampled_loop.handle_limits`; gravity through its gradient there, the share the
+    with every actuated joint free but ``loop.held``, linearized where the wall holds the device
+    (:func:`hapticdesign.analysis.sampled_loop.handle_intervals`; gravity through its gradient there, the share the
     compensator leaves and the one it feeds back late). Coulomb friction and quantization are left out: this is the
-    limit of the loop's linear part."""
+    limit of the loop's linear part.
+
+    Where the wall holds the device: at its spring's rest (:func:`wall_pose`) when gravity is compensated exactly
+    (the default). Otherwise the gravity the compensator leaves (none, or a model error) presses the handle into the
+    spring, and it rests where the spring balances that torque along the wall (:func:`_resting`); the pose depends
+    on the spring, so the limit is the fixed point ``K = limit(pose(K))``, found by iterating from the spring's rest
+    (at most :data:`REST_STEPS` times, to ``1e-9 K``). Along the wall nothing but gravity's own stiffness resists
+    the leftover torque: there the handle drifts (the neutral motion the loop deflates), as without a hand it
+    would."""
     require_device(device)
     loop = loop or SampledLoop()
-    pose = wall_pose(device, wall_joint, equilibrium, direction)
-    jv = handle_jacobian(device, pose)[:3]
+    rest = wall_pose(device, wall_joint, equilibrium, direction)
+    pose, found = rest, None
+    exact = loop.compensation != "none" and loop.model_error == 0.0
+    for _ in range(1 if exact else REST_STEPS):
+        spring = _wall_row(device, pose, wall_joint, direction)
+        low, high = handle_intervals(handle_jacobian(device, pose)[:3][None], mass_matrix(device, pose)[None],
+                                     device.damping_matrix, spring[None], loop, k_max=k_max,
+                                     gravity=gravity_gradient(device, pose)[None],
+                                     model=_batch_of_one(loop_model(device, loop, pose)))
+        settled = found is not None and abs(high[0] - found.stiffness) <= 1e-9 * found.stiffness
+        found = StabilityLimit(float(high[0]), pose, loop, float(low[0]))
+        if settled or not (0.0 < high[0] < np.inf):
+            break
+        moved = _resting(device, loop, rest, _wall_row(device, rest, wall_joint, direction), float(high[0]))
+        if moved is None:
+            break
+        pose = moved
+    return found
+
+
+REST_STEPS = 20
+"""Most steps of the wall's resting pose under a leftover gravity torque (Newton's, and the fixed point in K)."""
+
+
+def _wall_row(device: Device, pose: np.ndarray, wall_joint: int, direction) -> np.ndarray:
+    """The wall's row ``w`` at ``pose``: ``e_j`` on a joint, ``n^T J_v`` along a Cartesian direction ``n``."""
     if direction is None:
-        spring = np.eye(device.n_dof)[wall_joint]
-    else:
-        spring = unit_direction(direction) @ jv
-        if not np.linalg.norm(spring) > 1e-12 * max(np.linalg.norm(jv), 1e-300):
-            raise UserError("the handle does not move along the wall's direction at the pose the wall holds")
-    low, high = handle_intervals(jv[None], mass_matrix(device, pose)[None], device.damping_matrix, spring[None],
-                                 loop, k_max=k_max, gravity=gravity_gradient(device, pose)[None],
-                                 model=_batch_of_one(loop_model(device, loop, pose)))
-    return StabilityLimit(float(high[0]), pose, loop, float(low[0]))
+        return np.eye(device.n_dof)[wall_joint]
+    jv = handle_jacobian(device, pose)[:3]
+    row = unit_direction(direction) @ jv
+    if not np.linalg.norm(row) > 1e-12 * max(np.linalg.norm(jv), 1e-300):
+        raise UserError("the handle does not move along the wall's direction at the pose the wall holds")
+    return row
+
+
+def _resting(device: Device, loop: SampledLoop, rest: np.ndarray, row: np.ndarray,
+             stiffness: float) -> np.ndarray | None:
+    """Where a wall of ``stiffness`` (row ``row`` at its spring's ``rest``) holds the device against the gravity the
+    compensator leaves, ``tau_r = -(G - G_m)`` (``G_m`` its model's, 0 without compensation): the pose ``rest +
+    delta d`` (``d = w / |w|^2`` over the free joints, the least joint motion that moves the wall coordinate by one)
+    where ``d^T tau_r = K delta``, by Newton's method on ``delta`` (slope ``K + d^T (K_G - K_Gm) d``). None when the
+    spring and gravity's stiffness do not hold it there (a non-positive slope) or no balance is found."""
+    model = None if loop.compensation == "none" else model_device(device, loop.model_error)
+    d = np.zeros(device.n_dof)
+    free = [j for j in range(device.n_dof) if j not in set(loop.held)]
+    d[free] = row[free] / float(row[free] @ row[free])
+    delta = 0.0
+    for _ in range(REST_STEPS):
+        q = rest + delta * d
+        torque = -gravity(device, q) + (0.0 if model is None else gravity(model, q))
+        stiff = gravity_gradient(device, q) - (0.0 if model is None else gravity_gradient(model, q))
+        slope = stiffness + float(d @ stiff @ d)
+        if not slope > 0.0:
+            return None
+        step = (float(d @ torque) - stiffness * delta) / slope
+        delta += step
+        if abs(step) <= 1e-12 * max(1.0, abs(delta)):
+            return rest + delta * d
+    return None
 
 
 def _batch_of_one(model: tuple[np.ndarray, np.ndarray] | None) -> tuple[np.ndarray, np.ndarray] | None:
