@@ -261,15 +261,19 @@ def _stable_spring(loops: SpringLoops, index: np.ndarray, guess: np.ndarray,
 def _crossing(evaluate, lo: np.ndarray, hi: np.ndarray, f_lo: np.ndarray, f_hi: np.ndarray,
               prune=None) -> np.ndarray:
     """Where ``evaluate(x, idx)`` (the sign of ``radius - 1`` or its opposite, of the systems ``idx`` of these arrays)
-    crosses 0 between ``lo`` (``f < 0``) and ``hi`` (``f >= 0``), by the Illinois variant of regula falsi (a
-    bisection after two steps that did not halve the bracket; a step that would land within half the tolerance of
-    an end lands that far from it, so an end that has converged closes the bracket at the next step, as in Dekker's
-    method) to ``XTOL + RTOL K``: the bracket's middle. ``prune(idx, lo, hi)`` (a group search) returns a mask of
+    crosses 0 between ``lo`` (``f < 0``) and ``hi`` (``f >= 0``), by the Illinois variant of regula falsi to
+    ``XTOL + RTOL K``: the bracket's middle. A step that would land within half the tolerance of an end (the secant
+    through an end at f = 0 lands on it) lands that far from it, so an end that has converged closes the bracket at
+    the next step, as in Dekker's method; a bisection follows two stalls, a stall being a step that neither halved
+    the bracket nor moved its end by less than half the move before (Brent's test): a secant converging on the
+    crossing from one side, its moves shrinking fast, is not cut short by a bisection of the far end (which took
+    about 30 steps to reach the tolerance where the radius is nearly linear). ``prune(idx, lo, hi)`` (a group search) returns a mask of
     the systems that no longer matter among the open ones ``idx`` (NaN for them)."""
     lo, hi, f_lo, f_hi = (np.array(v, dtype=float) for v in (lo, hi, f_lo, f_hi))
     out = np.full(len(lo), np.nan)
     open_ = np.ones(len(lo), dtype=bool)
     side, stall = np.zeros(len(lo), dtype=np.int8), np.zeros(len(lo), dtype=np.int8)
+    moved = np.full(len(lo), np.inf)  # how far the end each step replaced moved
     while True:
         if prune is not None:
             open_ &= ~prune(np.flatnonzero(open_), lo, hi)
@@ -283,13 +287,15 @@ def _crossing(evaluate, lo: np.ndarray, hi: np.ndarray, f_lo: np.ndarray, f_hi: 
             return out
         a, b, fa, fb = lo[todo], hi[todo], f_lo[todo], f_hi[todo]
         x = (a * fb - b * fa) / (fb - fa)
-        x = np.where((stall[todo] >= 2) | ~(x > a) | ~(x < b), 0.5 * (a + b), x)
+        x = np.where((stall[todo] >= 2) | ~(x >= a) | ~(x <= b), 0.5 * (a + b), x)
         half = 0.5 * (XTOL + RTOL * b)
         x = np.clip(x, a + half, b - half)
         f = evaluate(x, todo)
         up = f >= 0.0
-        stall[todo] = np.where(np.maximum(np.where(up, x, b) - np.where(up, a, x), 0.0) > 0.5 * (b - a),
-                               stall[todo] + 1, 0)
+        move = np.abs(x - np.where(up, b, a))
+        halved = np.where(up, x - a, b - x) <= 0.5 * (b - a)
+        stall[todo] = np.where(halved | (move < 0.5 * moved[todo]), 0, stall[todo] + 1)
+        moved[todo] = move
         rise, fall = todo[up], todo[~up]
         f_lo[rise[side[rise] == 2]] *= 0.5
         f_hi[fall[side[fall] == 1]] *= 0.5
