@@ -211,3 +211,46 @@ def test_the_wall_holds_an_uncompensated_pendulum_where_gravity_and_the_spring_b
     assert abs(at_rest / expected - 1.0) > 3e-3
     simulated = simulated_limit(_pendulum(), loop, equilibrium=rest, rel_tol=1e-3, duration=20.0, friction=False)
     assert simulated == pytest.approx(expected, rel=2e-3)
+
+
+def test_the_spec_sheet_states_the_upright_pendulums_stable_interval():
+    """The spec sheet of the pendulum standing up (its bob straight above the axis at q = 0, ``K_G = -m g l``),
+    uncompensated: the handle moves along one line, a wall's ``K`` acts on the joint as ``K l^2``, so the exact row's
+    ends are python-control's joint interval (grid sign changes closed by brentq) over ``l^2``, and the page says
+    "stable from ... to ..."."""
+    from hapticdesign.studies.spec import spec_sheet
+    from hapticdesign.studies.spec_page import value_text
+
+    upright = device_from_mapping({
+        "name": "upright pendulum", "parameters": {"l": L},
+        "joints": [{"name": "q1", "damping": B}],
+        "frames": [{"name": "arm", "transforms": [{"Rx": "pi/2"}, {"Rz": "pi/2"}, {"Rz": "q1"}]},
+                   {"name": "tip", "parent": "arm", "transforms": [{"tx": "l"}]}],
+        "bodies": [{"name": "bob", "frame": "tip", "m": M}],
+        "end_effector": "tip",
+    })
+    pose = np.array([0.0])
+    assert gravity_gradient(upright, pose)[0, 0] == pytest.approx(-M * G * L, rel=1e-8)
+    radius = _python_control_radius(M * L * L, B, -M * G * L, 0.0, 1)
+    grid = np.geomspace(1e-3, 1e4, 400)
+    sign = np.array([radius(k) >= 1.0 for k in grid])
+    changes = np.flatnonzero(sign[1:] != sign[:-1])
+    assert len(changes) == 2 and sign[0] and sign[-1]
+    low, high = (brentq(lambda k: radius(k) - 1.0, grid[i], grid[i + 1], xtol=1e-13, rtol=1e-12) for i in changes)
+    sheet = spec_sheet(upright, pose, SampledLoop(compensation="none"), workspace=False, simulate=False)
+    row = sheet["renderable_stiffness"]
+    assert row["exact_lower"] == pytest.approx(low / L ** 2, rel=1e-6)
+    assert row["exact"] == pytest.approx(high / L ** 2, rel=1e-6)
+    text = value_text(sheet, "renderable_stiffness")
+    assert text.startswith(f"exact stable from {low / L ** 2:.4g} to {high / L ** 2:.4g};")
+
+
+def test_the_spec_sheet_of_a_hanging_pendulum_has_no_lower_end():
+    """Hanging (``K_G = m g l``), uncompensated: stable from the smallest spring, ``exact_lower`` 0 and the row's
+    ``exact`` python-control's limit over ``l^2``."""
+    from hapticdesign.studies.spec import spec_sheet
+
+    row = spec_sheet(_pendulum(), np.array([0.0]), SampledLoop(compensation="none"), workspace=False,
+                     simulate=False)["renderable_stiffness"]
+    assert row["exact_lower"] == 0.0
+    assert row["exact"] == pytest.approx(_python_control_limit(M * L * L, B, M * G * L, 0.0, 1) / L ** 2, rel=1e-6)

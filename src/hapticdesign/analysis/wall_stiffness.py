@@ -16,8 +16,9 @@ above another's unstable one leaves the search early.
 :func:`kmax` is the ``kmax`` design index: the options of a study (:data:`KMAX_OPTIONS`) read into a
 :class:`~hapticdesign.analysis.sampled_loop.SampledLoop`. Its value is the upper end of the stable springs; where
 gravity pulls the handle off the wall (a model error over-compensating, an inverted pose), springs below a lower end
-are unstable too (:func:`~hapticdesign.analysis.sampled_loop.handle_intervals`; ``impedance-range`` states it), and
-where no spring holds the handle along a free direction the value is 0.
+are unstable too (:func:`~hapticdesign.analysis.sampled_loop.handle_intervals`; ``impedance-range`` and the spec
+sheet, through :func:`worst_direction`, state it), and where no spring holds the handle along a free direction the
+value is 0.
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ import numpy as np
 
 from hapticdesign.analysis.dynamics import cartesian
 from hapticdesign.analysis.metrics.kinematic import handle_range_basis
-from hapticdesign.analysis.sampled_loop import GRASP, Hand, SampledLoop, handle_limits
+from hapticdesign.analysis.sampled_loop import GRASP, Hand, SampledLoop, handle_intervals, handle_limits
 from hapticdesign.errors import UserError
 
 DIRECTIONS = 60
@@ -124,21 +125,24 @@ def wall_limits(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, loo
 
 def worst_direction(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, loop: SampledLoop | None = None,
                     gravity: np.ndarray | None = None,
-                    model: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[float, np.ndarray]:
-    """The smallest exact wall limit at one pose over :func:`wall_directions` and the direction (unit, base frame)
-    that gives it (every direction searched to the end); ``gravity`` ``dG/dq`` (n, n) at the pose or None, ``model``
-    as :func:`wall_limit`'s."""
+                    model: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[float, np.ndarray, float]:
+    """The smallest exact wall limit at one pose over :func:`wall_directions`, the direction (unit, base frame)
+    that gives it (every direction searched to the end) and the largest lower end over the directions (0 unless
+    gravity pulls the handle off a wall: a wall in any direction is then stable for springs between the two, and
+    for none when it is the larger);
+    ``gravity`` ``dG/dq`` (n, n) at the pose or None, ``model`` as :func:`wall_limit`'s."""
     loop = loop or SampledLoop()
     jacobian, mass = np.asarray(jacobian, dtype=float)[None], np.asarray(mass, dtype=float)[None]
     damping = np.broadcast_to(np.asarray(damping, dtype=float), mass.shape)
     basis, mobility, cartesian_damping = handle_range(jacobian, mass, damping)
     along = np.einsum("ik,ck->ci", basis[0], wall_directions(mobility, cartesian_damping)[0])
     count = len(along)
-    limits = handle_limits(jacobian, mass, damping, along @ jacobian[0], loop, poses=np.zeros(count, dtype=np.int64),
-                           gravity=None if gravity is None else np.asarray(gravity, dtype=float)[None],
-                           model=_one(model))
+    lows, limits = handle_intervals(jacobian, mass, damping, along @ jacobian[0], loop,
+                                    poses=np.zeros(count, dtype=np.int64),
+                                    gravity=None if gravity is None else np.asarray(gravity, dtype=float)[None],
+                                    model=_one(model))
     best = int(np.argmin(limits))
-    return float(limits[best]), along[best]
+    return float(limits[best]), along[best], float(lows.max())
 
 
 MAX_PERIOD = 1.0

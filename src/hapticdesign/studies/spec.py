@@ -31,7 +31,9 @@ friction reach the handle as follows:
   - ``exact``: the exact stability limit of the n-joint sampled loop, every joint free, H and B (the joint and
     motor viscous damping) at the pose, the smallest over the axes, the principal directions and 60 evenly spread
     directions (:mod:`hapticdesign.analysis.wall_stiffness`, the ``kmax`` design index's too), and ``direction``,
-    the worst one. A pure spring uses the position only, so the velocity estimate does not enter;
+    the worst one. A pure spring uses the position only, so the velocity estimate does not enter. ``exact_lower``:
+    the smallest spring stable in every direction, 0 unless gravity pulls the handle off a wall (an over-compensating
+    model, an inverted pose); the sheet then says "stable from exact_lower to exact";
   - ``exact_with_hand``: the same with the hand (``hand``: the default grasp,
     :data:`~hapticdesign.analysis.sampled_loop.GRASP`, unless the settings hold one) as a linear
     mass-spring-damper at the handle;
@@ -148,8 +150,9 @@ def renderable(device: Device, h: Handle, loop: SampledLoop, res: float | None,
     bounds from the sheet's resolution ``res`` and backdrive ``friction`` (see the module docstring)."""
     from hapticdesign.simulation.impedance import SIMULATED_CAP, TOUCH, device_counts, simulated_limit
 
-    exact, direction = worst_direction(h.jacobian, h.states.H[0], device.damping_matrix, replace(loop, hand=None),
-                                       gravity_gradient(device, h.q), loop_model(device, loop, h.q))
+    exact, direction, lower = worst_direction(h.jacobian, h.states.H[0], device.damping_matrix,
+                                              replace(loop, hand=None), gravity_gradient(device, h.q),
+                                              loop_model(device, loop, h.q))
     hand = loop.hand or GRASP
     counts = device_counts(device)
     simulated = None
@@ -157,7 +160,7 @@ def renderable(device: Device, h: Handle, loop: SampledLoop, res: float | None,
         simulated = simulated_limit(device, replace(loop, hand=None), direction=direction, equilibrium=TOUCH,
                                     counts=counts, start=max(exact, 1.0), k_limit=SIMULATED_CAP)
     return {
-        "exact": exact, "direction": direction,
+        "exact": exact, "exact_lower": lower, "direction": direction,
         "exact_with_hand": renderable_stiffness(device, h, replace(loop, hand=hand)), "hand": hand.as_dict(),
         "simulated": simulated, "simulated_counts": counts, "simulated_touch": TOUCH,
         "passivity_viscous": 2.0 * float(np.linalg.eigvalsh(h.states.cartesian_damping[0]).min()) * loop.rate,

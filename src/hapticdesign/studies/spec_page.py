@@ -61,7 +61,9 @@ def value_text(sheet: dict, key: str) -> str:
         hand = value["hand"]
         simulated = "not run" if value["simulated"] is None else f"{value['simulated']:.4g}"
         exact = ("not stated (the file has no damping or friction, which bound it)"
-                 if value["passivity_viscous"] == 0.0 and not value["passivity_coulomb"] else f"{value['exact']:.4g}")
+                 if value["passivity_viscous"] == 0.0 and not value["passivity_coulomb"] else
+                 f"stable from {value['exact_lower']:.4g} to {value['exact']:.4g}" if value.get("exact_lower")
+                 else f"{value['exact']:.4g}")
         return (f"exact {exact}; with the hand ({hand['mass']:g} kg, {hand['damping']:g} N s/m, "
                 f"{hand['stiffness']:g} N/m) {value['exact_with_hand']:.4g}; simulated with dry friction and "
                 f"quantization {simulated}; passivity: 2b/T = {value['passivity_viscous']:.4g}, 2 f_c / Delta = "
