@@ -10,6 +10,7 @@ spring ``K`` and the compensator's ``- s K_G`` on the position ``d`` samples lat
 
 from __future__ import annotations
 
+import json
 import math
 
 import control
@@ -213,6 +214,29 @@ def test_the_wall_holds_an_uncompensated_pendulum_where_gravity_and_the_spring_b
     assert simulated == pytest.approx(expected, rel=2e-3)
 
 
+UPRIGHT = {
+    "name": "upright pendulum", "parameters": {"l": L},
+    "joints": [{"name": "q1", "damping": B}],
+    "frames": [{"name": "arm", "transforms": [{"Rx": "pi/2"}, {"Rz": "pi/2"}, {"Rz": "q1"}]},
+               {"name": "tip", "parent": "arm", "transforms": [{"tx": "l"}]}],
+    "bodies": [{"name": "bob", "frame": "tip", "m": M}],
+    "end_effector": "tip",
+}
+"""The pendulum standing up: its bob straight above the axis at q = 0."""
+
+
+def _upright_interval() -> tuple[float, float]:
+    """python-control's stable joint springs of the uncompensated upright pendulum, one sample late: the sign
+    changes of its largest pole modulus - 1 on a grid, each closed by SciPy's brentq."""
+    radius = _python_control_radius(M * L * L, B, -M * G * L, 0.0, 1)
+    grid = np.geomspace(1e-3, 1e4, 400)
+    sign = np.array([radius(k) >= 1.0 for k in grid])
+    changes = np.flatnonzero(sign[1:] != sign[:-1])
+    assert len(changes) == 2 and sign[0] and sign[-1]
+    low, high = (brentq(lambda k: radius(k) - 1.0, grid[i], grid[i + 1], xtol=1e-13, rtol=1e-12) for i in changes)
+    return low, high
+
+
 def test_the_spec_sheet_states_the_upright_pendulums_stable_interval():
     """The spec sheet of the pendulum standing up (its bob straight above the axis at q = 0, ``K_G = -m g l``),
     uncompensated: the handle moves along one line, a wall's ``K`` acts on the joint as ``K l^2``, so the exact row's
@@ -221,22 +245,10 @@ def test_the_spec_sheet_states_the_upright_pendulums_stable_interval():
     from hapticdesign.studies.spec import spec_sheet
     from hapticdesign.studies.spec_page import value_text
 
-    upright = device_from_mapping({
-        "name": "upright pendulum", "parameters": {"l": L},
-        "joints": [{"name": "q1", "damping": B}],
-        "frames": [{"name": "arm", "transforms": [{"Rx": "pi/2"}, {"Rz": "pi/2"}, {"Rz": "q1"}]},
-                   {"name": "tip", "parent": "arm", "transforms": [{"tx": "l"}]}],
-        "bodies": [{"name": "bob", "frame": "tip", "m": M}],
-        "end_effector": "tip",
-    })
+    upright = device_from_mapping(UPRIGHT)
     pose = np.array([0.0])
     assert gravity_gradient(upright, pose)[0, 0] == pytest.approx(-M * G * L, rel=1e-8)
-    radius = _python_control_radius(M * L * L, B, -M * G * L, 0.0, 1)
-    grid = np.geomspace(1e-3, 1e4, 400)
-    sign = np.array([radius(k) >= 1.0 for k in grid])
-    changes = np.flatnonzero(sign[1:] != sign[:-1])
-    assert len(changes) == 2 and sign[0] and sign[-1]
-    low, high = (brentq(lambda k: radius(k) - 1.0, grid[i], grid[i + 1], xtol=1e-13, rtol=1e-12) for i in changes)
+    low, high = _upright_interval()
     sheet = spec_sheet(upright, pose, SampledLoop(compensation="none"), workspace=False, simulate=False)
     row = sheet["renderable_stiffness"]
     assert row["exact_lower"] == pytest.approx(low / L ** 2, rel=1e-6)
@@ -254,3 +266,21 @@ def test_the_spec_sheet_of_a_hanging_pendulum_has_no_lower_end():
                      simulate=False)["renderable_stiffness"]
     assert row["exact_lower"] == 0.0
     assert row["exact"] == pytest.approx(_python_control_limit(M * L * L, B, M * G * L, 0.0, 1) / L ** 2, rel=1e-6)
+
+
+def test_the_spec_command_states_the_upright_pendulums_lower_end(tmp_path):
+    """``spec --json`` of the upright pendulum's device file, uncompensated: ``exact_lower`` and ``exact`` are
+    python-control's joint interval over ``l^2``."""
+    from typer.testing import CliRunner
+
+    from hapticdesign.interface.cli import app
+
+    path = tmp_path / "upright.json"
+    path.write_text(json.dumps(UPRIGHT))
+    result = CliRunner().invoke(app, ["spec", "--device", str(path), "--compensation", "none", "--no-simulate",
+                                      "--json"])
+    assert result.exit_code == 0, result.output
+    row = json.loads(result.stdout)["renderable_stiffness"]
+    low, high = _upright_interval()
+    assert row["exact_lower"] == pytest.approx(low / L ** 2, rel=1e-6)
+    assert row["exact"] == pytest.approx(high / L ** 2, rel=1e-6)
