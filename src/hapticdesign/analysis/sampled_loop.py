@@ -267,8 +267,8 @@ def _crossing(evaluate, lo: np.ndarray, hi: np.ndarray, f_lo: np.ndarray, f_hi: 
     the next step, as in Dekker's method; a bisection follows two stalls, a stall being a step that neither halved
     the bracket nor moved its end by less than half the move before (Brent's test): a secant converging on the
     crossing from one side, its moves shrinking fast, is not cut short by a bisection of the far end (which took
-    about 30 steps to reach the tolerance where the radius is nearly linear). ``prune(idx, lo, hi)`` (a group search) returns a mask of
-    the systems that no longer matter among the open ones ``idx`` (NaN for them)."""
+    about 30 steps to reach the tolerance where the radius is nearly linear). ``prune(idx, lo, hi)`` (a group
+    search) returns a mask of the systems that no longer matter among the open ones ``idx`` (NaN for them)."""
     lo, hi, f_lo, f_hi = (np.array(v, dtype=float) for v in (lo, hi, f_lo, f_hi))
     out = np.full(len(lo), np.nan)
     open_ = np.ones(len(lo), dtype=bool)
