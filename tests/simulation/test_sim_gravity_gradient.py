@@ -27,16 +27,22 @@ from hapticdesign.simulation.impedance import simulated_limit, stability_limit
 M, L, B, G, PERIOD = 0.5, 0.2, 0.002, 9.81, 1e-3
 
 
-def _pendulum():
-    """A link turning about the base's -y axis, its mass at ``l`` hanging straight down at q = 0."""
-    return device_from_mapping({
-        "name": "pendulum", "parameters": {"l": L},
+def _pendulum_file(name: str, turn: str) -> dict:
+    """A link turning about an axis along the base's y, its mass at ``l``, turned by ``turn`` from the base's x at
+    q = 0 (``-pi/2``: hanging straight down; ``pi/2``: standing straight up)."""
+    return {
+        "name": name, "parameters": {"l": L},
         "joints": [{"name": "q1", "damping": B}],
-        "frames": [{"name": "arm", "transforms": [{"Rx": "pi/2"}, {"Rz": "-pi/2"}, {"Rz": "q1"}]},
+        "frames": [{"name": "arm", "transforms": [{"Rx": "pi/2"}, {"Rz": turn}, {"Rz": "q1"}]},
                    {"name": "tip", "parent": "arm", "transforms": [{"tx": "l"}]}],
         "bodies": [{"name": "bob", "frame": "tip", "m": M}],
         "end_effector": "tip",
-    })
+    }
+
+
+def _pendulum():
+    """The pendulum hanging straight down at q = 0."""
+    return device_from_mapping(_pendulum_file("pendulum", "-pi/2"))
 
 
 def _python_control_limit(j: float, b: float, k_g: float, share: float, delay: int, period: float = PERIOD) -> float:
@@ -174,12 +180,7 @@ def test_gravity_pulling_off_the_wall_leaves_a_stable_interval(up, share, delay)
     from hapticdesign.analysis.sampled_loop import handle_intervals
 
     k_g = (-1.0 if up else 1.0) * M * G * L
-    radius = _python_control_radius(M * L * L, B, k_g, share, delay)
-    grid = np.geomspace(1e-3, 1e4, 400)
-    sign = np.array([radius(k) >= 1.0 for k in grid])
-    changes = np.flatnonzero(sign[1:] != sign[:-1])
-    assert len(changes) == 2 and sign[0] and sign[-1]
-    low, high = (brentq(lambda k: radius(k) - 1.0, grid[i], grid[i + 1], xtol=1e-13, rtol=1e-12) for i in changes)
+    low, high = _python_control_interval(k_g, share, delay)
     loop = SampledLoop(compensation="none" if share == 0.0 else "gravity", delay=delay,
                        model_error=100.0 * (1.0 - share) if share else 0.0, velocity="sampled")
     axis, mass = np.array([[[1.0], [0.0], [0.0]]]), np.array([[[M * L * L]]])
@@ -214,21 +215,19 @@ def test_the_wall_holds_an_uncompensated_pendulum_where_gravity_and_the_spring_b
     assert simulated == pytest.approx(expected, rel=2e-3)
 
 
-UPRIGHT = {
-    "name": "upright pendulum", "parameters": {"l": L},
-    "joints": [{"name": "q1", "damping": B}],
-    "frames": [{"name": "arm", "transforms": [{"Rx": "pi/2"}, {"Rz": "pi/2"}, {"Rz": "q1"}]},
-               {"name": "tip", "parent": "arm", "transforms": [{"tx": "l"}]}],
-    "bodies": [{"name": "bob", "frame": "tip", "m": M}],
-    "end_effector": "tip",
-}
+UPRIGHT = _pendulum_file("upright pendulum", "pi/2")
 """The pendulum standing up: its bob straight above the axis at q = 0."""
 
 
 def _upright_interval() -> tuple[float, float]:
-    """python-control's stable joint springs of the uncompensated upright pendulum, one sample late: the sign
-    changes of its largest pole modulus - 1 on a grid, each closed by SciPy's brentq."""
-    radius = _python_control_radius(M * L * L, B, -M * G * L, 0.0, 1)
+    """python-control's stable joint springs of the uncompensated upright pendulum, one sample late."""
+    return _python_control_interval(-M * G * L, 0.0, 1)
+
+
+def _python_control_interval(k_g: float, share: float, delay: int) -> tuple[float, float]:
+    """The pendulum's stable springs (gravity's stiffness ``k_g``, the compensator's share of it, the delay): the
+    sign changes of python-control's largest pole modulus - 1 on a grid, each closed by SciPy's brentq."""
+    radius = _python_control_radius(M * L * L, B, k_g, share, delay)
     grid = np.geomspace(1e-3, 1e4, 400)
     sign = np.array([radius(k) >= 1.0 for k in grid])
     changes = np.flatnonzero(sign[1:] != sign[:-1])
