@@ -72,3 +72,16 @@ def test_bad_options_are_one_line(options, message):
     device = load_device_file(FIVE_BAR)
     found = evaluate(device, _home_point(device)[None], [Request("kmax_simulated", options)])
     assert found.reason is not None and message in found.reason
+
+
+def test_a_map_of_the_simulated_wall_is_estimated_first(tmp_path):
+    """121 points of ``kmax_simulated`` count as 121,000 evaluations: refused in one line, exit 2, nothing written."""
+    from typer.testing import CliRunner
+
+    from hapticdesign.interface.cli import app
+
+    out = tmp_path / "map"
+    done = CliRunner().invoke(app, ["maps", "--device", str(FIVE_BAR), "--size", "0.02,0,0.02", "--grid", "11",
+                                    "--index", "kmax_simulated", "--out", str(out)])
+    assert done.exit_code == 2 and len(done.output.strip().splitlines()) == 1
+    assert "121,000 design-point evaluations" in done.output and not out.exists()

@@ -83,12 +83,8 @@ def wall_limit(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, loop
     loop's shares, :func:`~hapticdesign.analysis.sampled_loop.handle_loops`)."""
     along = None if direction is None else np.reshape(direction, (1, 1, 3))
     return float(wall_limits(jacobian[None], mass[None], damping, loop, along,
-                             None if gravity is None else np.asarray(gravity)[None], _one(model))[0])
-
-
-def _one(model: tuple[np.ndarray, np.ndarray] | None) -> tuple[np.ndarray, np.ndarray] | None:
-    """A pose's compensator model as the model of a batch of one."""
-    return None if model is None else tuple(np.asarray(x, dtype=float)[None] for x in model)
+                             None if gravity is None else np.asarray(gravity)[None],
+                             None if model is None else tuple(np.asarray(x, dtype=float)[None] for x in model))[0])
 
 
 def wall_limits(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, loop: SampledLoop | None = None,
@@ -140,7 +136,7 @@ def worst_direction(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray,
     lows, limits = handle_intervals(jacobian, mass, damping, along @ jacobian[0], loop,
                                     poses=np.zeros(count, dtype=np.int64),
                                     gravity=None if gravity is None else np.asarray(gravity, dtype=float)[None],
-                                    model=_one(model))
+                                    model=model)
     best = int(np.argmin(limits))
     return float(limits[best]), along[best], float(lows.max())
 

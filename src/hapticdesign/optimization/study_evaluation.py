@@ -24,6 +24,7 @@ from hapticdesign.analysis.metrics.indices import (
     INDICES, Evaluation, Index, Registry, Request, evaluate_at, evaluate_designs, evaluate_parameters, reduce,
     requests_of,
 )
+from hapticdesign.analysis.metrics.indices.registry import EVALUATION_LIMIT, require_evaluations
 from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.analysis.view.figure import render_png
 from hapticdesign.analysis.view.skeleton import home_pose
@@ -36,9 +37,8 @@ from hapticdesign.optimization.study_file import Choice, IndexConstraint, Study
 from hapticdesign.optimization.study_outputs import index_maps
 from hapticdesign.optimization.study_polish import most_designs
 from hapticdesign.optimization.study_run import Answer, reduced_keys, violations
-from hapticdesign.workload import require_within
 
-STUDY_LIMIT = 1e5
+STUDY_LIMIT = EVALUATION_LIMIT
 """Most design-point evaluations of a study without ``--force``: population x generations x workspace
 points (each one a design's pose reached and its indices computed; docs/limits.md)."""
 
@@ -61,13 +61,9 @@ def require_study_workload(study: Study, registry: Mapping[str, Index] = INDICES
     workspace = workspace_of(study) if spec.algorithm.over_poses else None
     points = 1 if workspace is None else len(workspace.points())
     designs = spec.algorithm.designs + most_designs(spec)
-    costliest = max((u.index for u in spec.index_uses if u.index in registry), key=lambda n: registry[n].cost,
-                    default=None)
-    cost = 1.0 if costliest is None else registry[costliest].cost
-    each = "" if cost == 1.0 else f", each costing {cost:g} evaluations (index {costliest})"
-    require_within(f"a study of {designs} designs (population x generations x runs, and the polishing's most) x "
-                   f"{points} workspace points{each}", designs * points * cost, STUDY_LIMIT,
-                   "design-point evaluations")
+    require_evaluations(f"a study of {designs} designs (population x generations x runs, and the polishing's most) "
+                        f"x {points} workspace points", designs * points, [u.index for u in spec.index_uses],
+                        registry)
 
 
 def workspace_of(study: Study) -> Workspace | None:

@@ -11,6 +11,7 @@ import numpy as np
 
 from hapticdesign.analysis.configuration import check_limits, configuration_of
 from hapticdesign.analysis.metrics.indices import INDICES, Index, Request, evaluate_at, requests_of
+from hapticdesign.analysis.metrics.indices.registry import require_evaluations
 from hapticdesign.errors import UserError
 from hapticdesign.files import save_figure
 from hapticdesign.model.device import Device
@@ -129,6 +130,7 @@ def device_map(device: Device, points: np.ndarray, requests: Iterable[str | Requ
     handle does not reach is NaN with its reason, and the map goes on."""
     checked = requests_of(requests, registry)
     points = np.asarray(points, dtype=float)
+    require_evaluations(f"a map of {len(points)} points", len(points), [r.index for r in checked], registry)
     space = configuration_of(device)
     full, reasons, start = [], [], None
     for point in points:

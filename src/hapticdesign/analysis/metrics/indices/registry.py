@@ -26,6 +26,7 @@ import numpy as np
 
 from hapticdesign.analysis.metrics.indices.states import PARAMETER_NEEDS, POSE_NEEDS
 from hapticdesign.errors import UserError
+from hapticdesign.workload import require_within
 
 ENTRY_POINTS = "hapticdesign.indices"
 """The entry-point group of the packages that register indices."""
@@ -225,4 +226,19 @@ def options_used(requests: Iterable[Request], registry: Mapping[str, Index] = IN
 def options_line(options: Mapping[str, object]) -> str:
     """``name=value, ...`` of :func:`options_used`'s options of one request, for a text output."""
     return ", ".join(f"{k}={v}" for k, v in options.items())
+
+
+EVALUATION_LIMIT = 1e5
+"""Most ordinary index evaluations (a pose's kinematics and dynamics) one run asks for without ``--force``: a study's
+designs x points, a map's points, each counted as its costliest index (:attr:`Index.cost`; docs/limits.md)."""
+
+
+def require_evaluations(what: str, count: float, indices: Iterable[str], registry: Mapping[str, Index] = INDICES) -> None:
+    """Refuse ``count`` evaluations (design-points or points) of the named ``indices`` (unknown names cost 1) when,
+    each counted as the costliest index's :attr:`Index.cost`, they are above :data:`EVALUATION_LIMIT`."""
+    known = [name for name in indices if name in registry]
+    costliest = max(known, key=lambda name: registry[name].cost, default=None)
+    cost = 1.0 if costliest is None else registry[costliest].cost
+    each = "" if cost == 1.0 else f", each costing {cost:g} evaluations (index {costliest})"
+    require_within(f"{what}{each}", count * cost, EVALUATION_LIMIT, "design-point evaluations")
 
