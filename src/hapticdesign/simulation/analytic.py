@@ -48,15 +48,10 @@ from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation.analytic_driven import DrivenLoop
 from hapticdesign.simulation.config import (
-    LoopConfig, compensator_device, handle_jacobian, normal_jacobian, plant_friction, rest_pose,
+    LoopConfig, compensator_device, handle_jacobian, normal_jacobian, plant_friction, rest_pose, spring_rest,
 )
 from hapticdesign.simulation.criteria import Verdict, WallProblem, type_paths
 
-
-REST_STEPS = 30
-"""Most Newton steps of the wall's resting pose (:meth:`AnalyticProblem._resting`)."""
-REST_TOL = 1e-12
-"""The resting pose is found when a Newton step moves the joint by less than this (relative, rad or m)."""
 
 GROWS = "oscillation grows"
 """The verdict of a stiffness whose linearized loop is unstable although the run met the criteria."""
@@ -273,31 +268,23 @@ class AnalyticProblem(WallProblem):
         return linearize(self.device, self.sim_type, self.wall_joint, self.config, self.held_pose)
 
     def _resting(self, stiffness: float) -> WallJoint | None:
-        """The wall joint linearized where the wall holds it under the spring ``stiffness``: from the spring's rest,
-        Newton steps on the joint's static balance ``T(y) = -(G_w - s_G G_m,w) - k_hand (y + y_h) - K J_n,w^2 y = 0``
-        (``y`` from the spring's rest, ``y_h`` the rest's distance from the start, where the hand's spring rests; the
-        wall's spring linear about its rest), so a residual gravity torque or a hand's spring moves the pose by
-        about ``T / K``; nothing moves where gravity is compensated exactly and no hand spring pulls. None when no
-        balance is found within :data:`REST_STEPS` steps or the net static stiffness there is not positive (the
-        wall cannot hold the joint: it falls)."""
-        wall, pose, w = self.held, self.held_pose.copy(), self.wall_joint
+        """The wall joint linearized where the wall holds it under the spring ``stiffness``
+        (:func:`~.config.spring_rest` on the wall joint alone: the residual gravity torque ``-(G_w - s_G G_m,w)`` and
+        a hand's spring, resting at the start pose, move the pose by about their torque over ``K``); the loop at the
+        spring's rest when nothing pushes there, None when the wall cannot hold the joint (it falls)."""
+        w, held = self.wall_joint, self.held
         hand = self.config.hand or Hand()
-        y_h = self.rest
-        for _ in range(REST_STEPS):
-            k_hand = hand.stiffness * float(wall.reach @ wall.reach)
-            net = wall.gravity - wall.model_gravity + k_hand + stiffness * wall.scale ** 2
-            y = pose[w] - self.held_pose[w]
-            balance = wall.torque - k_hand * (y + y_h) - stiffness * wall.scale ** 2 * y
-            if balance == 0.0:
-                return wall
-            if not net > 0.0:
-                return None
-            step = balance / net
-            if abs(step) <= REST_TOL * max(1.0, abs(pose[w])):
-                return wall
-            pose[w] += step
-            wall = linearize(self.device, self.sim_type, w, self.config, pose)
-        return None
+        row = np.zeros(self.device.n_dof)
+        row[w] = held.scale
+        hand_spring = np.zeros((self.device.n_dof, self.device.n_dof))
+        hand_spring[w, w] = hand.stiffness * float(held.reach @ held.reach)
+        start = start_pose(self.device, self.sim_type, w)[1]
+        comp = self.config.compensator
+        model = compensator_device(self.device, comp) if comp.gravity else None
+        pose = spring_rest(self.device, model, self.held_pose, row, stiffness, [w], (hand_spring, start))
+        if pose is None:
+            return None
+        return held if pose is self.held_pose else linearize(self.device, self.sim_type, w, self.config, pose)
 
     def _time_varying(self) -> bool:
         """Type 2 with the wall joint coupled to the motion, on a joint wall of an open chain without a hand."""

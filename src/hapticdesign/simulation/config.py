@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from hapticdesign.analysis.configuration import configuration_of
-from hapticdesign.analysis.dynamics.device import gravity_gradient, mass_matrix
+from hapticdesign.analysis.dynamics.device import gravity, gravity_gradient, mass_matrix
 from hapticdesign.analysis.sampled_loop import Hand, SampledLoop
 from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.device import Device
@@ -274,6 +274,42 @@ def loop_model(device: Device, loop: SampledLoop, pose: np.ndarray) -> tuple[np.
         return None
     model = model_device(device, loop.model_error)
     return mass_matrix(model, pose), gravity_gradient(model, pose)
+
+
+REST_STEPS = 30
+"""Most Newton steps of :func:`spring_rest` (and of the fixed points that call it)."""
+
+
+def spring_rest(device: Device, model: Device | None, rest: np.ndarray, row: np.ndarray, stiffness: float,
+                free: list[int], hand: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray | None:
+    """Where a wall's spring ``stiffness`` along the joint row ``row`` (``w``, resting at the actuated pose ``rest``)
+    holds ``device`` against the gravity its compensator leaves, ``tau_r = -(G - G_m)`` (``model`` the compensator's
+    device, None without gravity compensation) and a hand's spring ``hand = (K_h, q_h)`` (``-K_h (q - q_h)``): the
+    pose ``rest + delta d`` (``d = w / |w|^2`` over the ``free`` joints, the least joint motion that moves the wall
+    coordinate by one) where ``d^T tau = K delta``, by Newton's method on ``delta`` (slope ``K + d^T (K_G - K_Gm +
+    K_h) d``). ``rest`` itself (the same array) when nothing pushes there; None when the spring and the static
+    stiffness do not hold the device (a non-positive slope) or no balance is found in :data:`REST_STEPS` steps. Along
+    the wall nothing but gravity's own stiffness resists the leftover torque: the other directions stay (a drift the
+    loop deflates)."""
+    k_h, q_h = (np.zeros((device.n_dof, device.n_dof)), rest) if hand is None else hand
+    d = np.zeros(device.n_dof)
+    d[free] = row[free] / float(row[free] @ row[free])
+    delta = 0.0
+    for _ in range(REST_STEPS):
+        q = rest + delta * d
+        torque = -gravity(device, q) + (0.0 if model is None else gravity(model, q)) - k_h @ (q - q_h)
+        balance = float(d @ torque) - stiffness * delta
+        if delta == 0.0 and balance == 0.0:
+            return rest
+        stiff = gravity_gradient(device, q) - (0.0 if model is None else gravity_gradient(model, q)) + k_h
+        slope = stiffness + float(d @ stiff @ d)
+        if not slope > 0.0:
+            return None
+        step = balance / slope
+        delta += step
+        if abs(step) <= 1e-12 * max(1.0, abs(delta)):
+            return rest + delta * d
+    return None
 
 
 def rest_pose(device: Device) -> np.ndarray:

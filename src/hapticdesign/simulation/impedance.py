@@ -29,7 +29,7 @@ from functools import cached_property
 import numpy as np
 
 from hapticdesign.analysis.configuration import configuration_of, handle_pose
-from hapticdesign.analysis.dynamics.device import gravity, gravity_gradient, mass_matrix
+from hapticdesign.analysis.dynamics.device import gravity_gradient, mass_matrix
 from hapticdesign.analysis.sampled_loop import SampledLoop, handle_intervals
 from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.compensator_model import model_device
@@ -37,8 +37,8 @@ from hapticdesign.model.device import Device
 from hapticdesign.simulation.analytic import GROWS, AnalyticProblem, linear_loop
 from hapticdesign.simulation.boundary import envelope_grows, growth_onset
 from hapticdesign.simulation.config import (
-    LoopConfig, Wall, compensator_device, handle_jacobian, loop_config, loop_model, normal_jacobian, require_device,
-    require_options, rest_pose, unit_direction,
+    REST_STEPS, LoopConfig, Wall, compensator_device, handle_jacobian, loop_config, loop_model, normal_jacobian,
+    require_device, require_options, rest_pose, spring_rest, unit_direction,
 )
 from hapticdesign.simulation.loop import simulate, tables_of
 from hapticdesign.simulation.criteria import Criteria, Verdict, WallProblem, require_closed, type_paths
@@ -155,9 +155,9 @@ def stability_limit(device: Device, loop: SampledLoop | None = None, wall_joint:
 
     Where the wall holds the device: at its spring's rest (:func:`wall_pose`) when gravity is compensated exactly
     (the default). Otherwise the gravity the compensator leaves (none, or a model error) presses the handle into the
-    spring, and it rests where the spring balances that torque along the wall (:func:`_resting`); the pose depends
+    spring, and it rests where the spring balances that torque along the wall (:func:`~.config.spring_rest`); the pose depends
     on the spring, so the limit is the fixed point ``K = limit(pose(K))``, found by iterating from the spring's rest
-    (at most :data:`REST_STEPS` times, to ``1e-9 K``). Along the wall nothing but gravity's own stiffness resists
+    (at most :data:`~.config.REST_STEPS` times, to ``1e-9 K``). Along the wall nothing but gravity's own stiffness resists
     the leftover torque: there the handle drifts (the neutral motion the loop deflates), as without a hand it
     would."""
     require_device(device)
@@ -175,15 +175,13 @@ def stability_limit(device: Device, loop: SampledLoop | None = None, wall_joint:
         found = StabilityLimit(float(high[0]), pose, loop, float(low[0]))
         if settled or not (0.0 < high[0] < np.inf):
             break
-        moved = _resting(device, loop, rest, _wall_row(device, rest, wall_joint, direction), float(high[0]))
+        model = None if loop.compensation == "none" else model_device(device, loop.model_error)
+        moved = spring_rest(device, model, rest, _wall_row(device, rest, wall_joint, direction), float(high[0]),
+                            [j for j in range(device.n_dof) if j not in set(loop.held)])
         if moved is None:
             break
         pose = moved
     return found
-
-
-REST_STEPS = 20
-"""Most steps of the wall's resting pose under a leftover gravity torque (Newton's, and the fixed point in K)."""
 
 
 def _wall_row(device: Device, pose: np.ndarray, wall_joint: int, direction) -> np.ndarray:
@@ -195,32 +193,6 @@ def _wall_row(device: Device, pose: np.ndarray, wall_joint: int, direction) -> n
     if not np.linalg.norm(row) > 1e-12 * max(np.linalg.norm(jv), 1e-300):
         raise UserError("the handle does not move along the wall's direction at the pose the wall holds")
     return row
-
-
-def _resting(device: Device, loop: SampledLoop, rest: np.ndarray, row: np.ndarray,
-             stiffness: float) -> np.ndarray | None:
-    """Where a wall of ``stiffness`` (row ``row`` at its spring's ``rest``) holds the device against the gravity the
-    compensator leaves, ``tau_r = -(G - G_m)`` (``G_m`` its model's, 0 without compensation): the pose ``rest +
-    delta d`` (``d = w / |w|^2`` over the free joints, the least joint motion that moves the wall coordinate by one)
-    where ``d^T tau_r = K delta``, by Newton's method on ``delta`` (slope ``K + d^T (K_G - K_Gm) d``). None when the
-    spring and gravity's stiffness do not hold it there (a non-positive slope) or no balance is found."""
-    model = None if loop.compensation == "none" else model_device(device, loop.model_error)
-    d = np.zeros(device.n_dof)
-    free = [j for j in range(device.n_dof) if j not in set(loop.held)]
-    d[free] = row[free] / float(row[free] @ row[free])
-    delta = 0.0
-    for _ in range(REST_STEPS):
-        q = rest + delta * d
-        torque = -gravity(device, q) + (0.0 if model is None else gravity(model, q))
-        stiff = gravity_gradient(device, q) - (0.0 if model is None else gravity_gradient(model, q))
-        slope = stiffness + float(d @ stiff @ d)
-        if not slope > 0.0:
-            return None
-        step = (float(d @ torque) - stiffness * delta) / slope
-        delta += step
-        if abs(step) <= 1e-12 * max(1.0, abs(delta)):
-            return rest + delta * d
-    return None
 
 
 def device_counts(device: Device) -> int | None:
