@@ -15,7 +15,9 @@ goes through :func:`write_atomically`. The limits are stated here once:
 - a CSV output is written by :func:`csv_rows`: a text cell that a spreadsheet would run as a formula is
   written as text (:func:`csv_cell`);
 - a figure is rendered by :func:`figure_bytes`: the same figure gives the same bytes (SVG ids
-  hashed with a fixed salt, no creation date in SVG or PDF).
+  hashed with a fixed salt, no creation date in SVG or PDF);
+- a signal that ends the process (Ctrl-C, SIGTERM, SIGHUP) while :func:`write_atomically` writes is held until
+  the file is complete and in its place (:func:`signals_held`): an interrupted run leaves only complete files.
 """
 
 from __future__ import annotations
@@ -26,8 +28,12 @@ import json
 import math
 import os
 import re
+import signal
 import stat
+import threading
 import tomllib
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -306,6 +312,30 @@ def _write_new(path: Path, data: bytes) -> None:
         handle.write(data)
 
 
+HELD_SIGNALS = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, name))
+"""The signals :func:`signals_held` holds: Ctrl-C, a ``kill`` and a closed terminal."""
+
+
+@contextmanager
+def signals_held() -> Iterator[None]:
+    """Hold :data:`HELD_SIGNALS` over the block and deliver them after it, to the handlers there were before (a
+    SIGTERM then ends the process as it would have, once the block is done). Off the main thread (where Python
+    cannot set a handler) the block runs as it is."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught: list[int] = []
+    previous = {number: signal.signal(number, lambda signum, frame: caught.append(signum))
+                for number in HELD_SIGNALS}
+    try:
+        yield
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, signal.SIG_DFL if handler is None else handler)
+        for number in dict.fromkeys(caught):
+            signal.raise_signal(number)
+
+
 def write_atomically(path: Path | str, content: str | bytes) -> None:
     """Write a file so that an interruption or a failure never leaves it (or a ``.tmp``) half-written.
 
@@ -313,7 +343,8 @@ def write_atomically(path: Path | str, content: str | bytes) -> None:
     at ``path`` is replaced, not followed; a directory, named pipe, device or socket there is refused
     (:func:`_refuse_in_place`). Any problem with the output place (a read-only folder, a full disk) is a
     one-line :class:`UserError`; text that cannot be UTF-8 (a lone surrogate) is refused before anything is
-    written.
+    written. A signal that would end the process meanwhile (SIGTERM to a run's checkpoints) waits until the file
+    is in its place (:func:`signals_held`).
     """
     path = Path(path)
     _refuse_in_place(path)
@@ -325,9 +356,10 @@ def write_atomically(path: Path | str, content: str | bytes) -> None:
                             "which is not a character (a lone surrogate)") from None
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        _write_new(tmp, content)
-        tmp.replace(path)
+        with signals_held():
+            path.parent.mkdir(parents=True, exist_ok=True)
+            _write_new(tmp, content)
+            tmp.replace(path)
     except OSError as exc:
         try:
             tmp.unlink(missing_ok=True)

@@ -392,6 +392,14 @@ COMPENSATIONS = ("none", "gravity", "full")
 sampled acceleration (the seed's, seed 000 §4.1.1.2)."""
 
 
+MIN_PERIOD = 1e-12
+"""The shortest sample period (s) of a loop: below a picosecond the loop's ratios (``J / T``, the damper grid's
+``4 J / T``) leave double precision (longer periods are checked where a plant meets them, as their ratios)."""
+MAX_VIRTUAL_DAMPING = 1e9
+"""The largest wall damper (N s/m, or N m s/rad on a joint), as the springs searched stop at ``k_max`` = 1e9: its
+gain ``B / T`` must stay a finite entry of the loop's map."""
+
+
 @dataclass(frozen=True)
 class SampledLoop:
     """The settings of a sampled haptic loop, one record for every command and index.
@@ -421,6 +429,8 @@ class SampledLoop:
         if isinstance(self.period, bool) or not (isinstance(self.period, (int, float)) and math.isfinite(self.period)
                                                  and self.period > 0):
             raise InputError(f"the sample period must be a positive number of seconds, got {self.period!r}", "period")
+        if self.period < MIN_PERIOD:
+            raise InputError(f"the sample period must be at least {MIN_PERIOD:g} s, got {self.period:g}", "period")
         if isinstance(self.delay, bool) or not isinstance(self.delay, (int, np.integer)) or self.delay < 0:
             raise InputError(f"the sensor delay must be a non-negative number of samples, got {self.delay!r}", "delay")
         if self.velocity not in VELOCITIES:
@@ -435,8 +445,29 @@ class SampledLoop:
         if not (math.isfinite(self.virtual_damping) and self.virtual_damping >= 0):
             raise InputError(f"the wall damping must be a finite number >= 0, got {self.virtual_damping}",
                              "wall_damping")
+        if self.virtual_damping > MAX_VIRTUAL_DAMPING:
+            raise InputError(f"the wall damping must be at most {MAX_VIRTUAL_DAMPING:g} (N s/m or N m s/rad), got "
+                             f"{self.virtual_damping:g}", "wall_damping")
         if self.hand is not None and not isinstance(self.hand, Hand):
             raise UserError(f"the hand must be a Hand, got {type(self.hand).__name__}")
+
+    def order(self, joints: int = 1) -> int:
+        """The order of the exact loop's one-sample map for ``joints`` free joints (:func:`handle_loops`): position
+        and velocity over the delay (one sample more for a differenced damper), the held torques with full
+        compensation."""
+        differenced = self.velocity == "difference" and self.virtual_damping > 0
+        torques = joints * (self.delay + 1) if self.compensation == "full" else 0
+        return 2 * joints * (self.delay + int(differenced) + 1) + torques
+
+    def require_exact(self, joints: int, count: int) -> None:
+        """Estimate the exact loops of ``count`` systems of ``joints`` free joints before they are built: their
+        order at most :data:`~hapticdesign.workload.EIGEN_ORDER_LIMIT` rows, their matrices within the memory
+        limits (a delay of 10^9 samples is refused here, not when its matrix is allocated)."""
+        order = self.order(joints)
+        what = (f"the closed-loop matrices of {count:,} loop{'s' if count != 1 else ''} of order {order:,} (a delay "
+                f"of {self.delay:,} samples)")
+        require_within(what, order, EIGEN_ORDER_LIMIT, "rows")
+        require_memory(what, 8.0 * order * order * count)
 
     @classmethod
     def seed(cls, **changes) -> "SampledLoop":
@@ -639,11 +670,8 @@ def handle_intervals(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray
                      model: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The exact stable wall stiffnesses ``[low, high]`` (N/m) of each handle loop of :func:`handle_loops` (S,
     each), or of each group (:func:`loop_intervals`; ``low`` 0 unless gravity pulls the handle off the wall)."""
+    loop.require_exact(np.shape(jacobian)[-1] - len(loop.held), len(spring))
     loops, guess = handle_loops(jacobian, mass, damping, spring, loop, poses, gravity, model)
-    order = loops.base.shape[-1]
-    what = f"the closed-loop matrices of {len(loops):,} handle loops of order {order}"
-    require_memory(what, 8.0 * order * order * len(loops))
-    require_within(what, order, EIGEN_ORDER_LIMIT, "rows")
     return loop_intervals(loops, guess, groups, k_max)
 
 
@@ -682,6 +710,7 @@ def joint_loops(inertia, damping, loop: SampledLoop, model_inertia=None) -> Spri
     and stiffness to the joint's), the full compensator feeding ``model_inertia`` times the acceleration (default
     ``c J``): the one-joint case of :func:`handle_loops`."""
     axis, h, b, w, model = _joint(inertia, damping, model_inertia)
+    loop.require_exact(1, len(w))
     return handle_loops(axis, h, b, w, loop, model=model)[0]
 
 

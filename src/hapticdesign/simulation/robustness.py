@@ -56,7 +56,13 @@ def inertia_share(device: Device, compensator: Compensator, joint: int = 0) -> f
 
 
 def case_count(designs: int, errors: list[float], draws: int) -> int:
-    """How many searches :func:`error_cases` runs: each design once at E = 0, ``draws`` times at every other E."""
+    """How many searches :func:`error_cases` runs: each design once at E = 0, ``draws`` times at every other E; a
+    one-line error for error levels outside [0, 100) % or draws outside 1 to :data:`MAX_DRAWS` (checked here, before
+    a command announces the work)."""
+    if not errors or any(not (math.isfinite(e) and 0 <= e < 100) for e in errors):
+        raise UserError(f"error levels must be percentages in [0, 100), got {errors}")
+    if isinstance(draws, bool) or not (isinstance(draws, int) and 1 <= draws <= MAX_DRAWS):
+        raise UserError(f"the number of error draws must be a whole number from 1 to {MAX_DRAWS}, got {draws}")
     return designs * sum(1 if e == 0 else draws for e in errors)
 
 
@@ -69,12 +75,8 @@ def error_cases(devices: list[tuple[str, float, Device]], errors: list[float], s
     Draw d of design i uses the sign seed ``seed + i draws + d`` at every E, so the levels differ
     only in size, not in direction; E = 0 has no error to draw and is searched once per design.
     """
-    if not errors or any(not (math.isfinite(e) and 0 <= e < 100) for e in errors):
-        raise UserError(f"error levels must be percentages in [0, 100), got {errors}")
-    if not (isinstance(draws, int) and 1 <= draws <= MAX_DRAWS):
-        raise UserError(f"the number of error draws must be a whole number from 1 to {MAX_DRAWS}, got {draws}")
-    cases, done = [], 0
     total = case_count(len(devices), errors, draws)
+    cases, done = [], 0
     for i, (name, level, device) in enumerate(devices):
         for error in errors:
             for d in range(1 if error == 0 else draws):

@@ -34,7 +34,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from hapticdesign.analysis.dynamics.device import mass_matrix
-from hapticdesign.analysis.sampled_loop import FLOOR, SampledLoop, joint_limit, joint_limits, joint_loops
+from hapticdesign.analysis.sampled_loop import FLOOR, MAX_VIRTUAL_DAMPING, SampledLoop, joint_limit, joint_limits, joint_loops
 from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.compensator_model import model_device
 
@@ -91,7 +91,8 @@ class ZWidth:
 
 def damping_grid(inertia: float, damping: float, loop: SampledLoop, points: int = 25,
                  model_inertia: float | None = None) -> list[float]:
-    """Virtual dampers from 0 to where a damper alone destabilizes the loop (bisected to 0.1 %)."""
+    """Virtual dampers from 0 to where a damper alone destabilizes the loop (bisected to 0.1 %), at most
+    :data:`~hapticdesign.analysis.sampled_loop.MAX_VIRTUAL_DAMPING`."""
     if not 2 <= points <= 1000:
         raise UserError(f"the damper grid needs 2 to 1000 points, got {points}")
 
@@ -99,9 +100,11 @@ def damping_grid(inertia: float, damping: float, loop: SampledLoop, points: int 
         loops = joint_loops(inertia, damping, replace(loop, virtual_damping=b), model_inertia)
         return bool(loops.radii(np.array([FLOOR]))[0] < 1.0)
 
-    lo, hi = 0.0, 4.0 * inertia / loop.period + 4.0 * damping
+    lo, hi = 0.0, min(4.0 * inertia / loop.period + 4.0 * damping, MAX_VIRTUAL_DAMPING)
     while usable(hi):
-        lo, hi = hi, 2.0 * hi
+        if hi == MAX_VIRTUAL_DAMPING:  # usable up to the largest damper a loop takes
+            return [float(b) for b in np.linspace(0.0, hi, points)]
+        lo, hi = hi, min(2.0 * hi, MAX_VIRTUAL_DAMPING)
     while hi - lo > 1e-3 * hi:
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if usable(mid) else (lo, mid)
@@ -121,6 +124,11 @@ def zwidth(inertia: float, damping: float, loop: SampledLoop, dampers: list[floa
     if any(not (math.isfinite(b) and b >= 0.0) for b in values):
         raise InputError(f"the virtual dampers must be finite and >= 0, got "
                          f"{min(values, key=lambda b: b if math.isfinite(b) else -math.inf):g}", "b_values")
+    try:  # each damper's loop, validated before any search
+        for b in values:
+            replace(loop, virtual_damping=b)
+    except InputError as exc:
+        raise InputError(str(exc), "b_values") from None
     bounds = loop.fraction == 0.0 and loop.hand is None
     return ZWidth(values, [max_stiffness(inertia, damping, loop, b, model_inertia=model_inertia) for b in values],
                   [passivity_stiffness(damping, loop, b) for b in values] if bounds else None,

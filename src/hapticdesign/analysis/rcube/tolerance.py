@@ -59,6 +59,23 @@ class Tolerances:
         if len(self.lengths) != 3 or not all(isfinite(v) and v >= 0.0 for v in values):
             raise UserError(f"tolerances must be non-negative lengths in metres, got {values!r}")
 
+    def check_design(self, design: RCubeDesign) -> None:
+        """A one-line error unless every tolerance is below :data:`LARGEST_SHARE` of the link lengths it perturbs
+        (the joint offset: of the shortest link), checked before a run is announced."""
+        shortest = min(design.lengths)
+        for name, t, length in (*zip(("l1", "l2", "l3"), self.lengths, design.lengths),
+                                ("joint_offset", self.joint_offset, shortest)):
+            if not t < LARGEST_SHARE * length:
+                raise InputError(f"the tolerance of {name} must be below {LARGEST_SHARE:g} of the link length "
+                                 f"{length:g} m (a manufacturing error, not another mechanism), got {t:g} m",
+                                 f"tol_{name.replace('joint_offset', 'joint')}")
+
+
+LARGEST_SHARE = 0.1
+"""The largest tolerance as a share of a link's length: manufacturing tolerances are fractions of a per cent of it
+(ISO 2768-m: 0.3 mm on 120 mm); at a link's own length the drawn mechanism has links of length 0 and no longer reaches
+its home."""
+
 
 TOLERANCE_KEYS = ("l1", "l2", "l3", "joint_offset")
 """Keys of a design file's ``tolerances`` mapping (m)."""
@@ -242,6 +259,7 @@ def monte_carlo(design: RCubeDesign, tolerances: Tolerances, samples: int, seed:
         raise InputError(f"grid must be at least 2, got {grid}", "grid")
     if not (isfinite(side) and side > 0.0):
         raise InputError(f"side must be a positive length, got {side!r}", "side")
+    tolerances.check_design(design)
     errors = draw_errors(tolerances, samples, seed)
     out = []
     for k in range(samples):

@@ -153,6 +153,7 @@ def tolerance(samples: int = typer.Option(200, "--samples", help="Number of Mont
         seconds = tol.check_budget(samples, grid, allow=allow_long)
         dsg = _design(design)
         tolerances = _tolerances(design, dsg, tol_l1, tol_l2, tol_l3, tol_joint)
+        tolerances.check_design(dsg)
         nominal = tol.evaluate_sample(dsg, *tol.nominal_errors(), side, grid)
         if out is not None:  # the output place is checked (and named) before the run is announced
             output_folder(out)

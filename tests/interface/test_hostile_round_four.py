@@ -1,0 +1,145 @@
+"""Hostile and careless input, round four (issue 46): the sampled loop's doors, interrupted polishing, forged
+checkpoints, names on pages, and errors before work. Each case is one ``error:`` line, exit status 2, nothing
+half-written and nothing outside ``--out``."""
+
+from __future__ import annotations
+
+import pytest
+from typer.testing import CliRunner
+
+from hapticdesign.interface.cli import app
+
+from tests.helpers.sim_designs import write_designs
+
+runner = CliRunner()
+ZWIDTH = ["zwidth", "--inertia", "0.039", "--damping", "0.5"]
+
+
+def one_line_error(args: list[str], fragment: str) -> str:
+    """Run the CLI; assert exit 2, exactly one ``error:`` line on stderr (no progress line before it) holding
+    ``fragment``, and nothing on stdout."""
+    result = runner.invoke(app, args)
+    assert result.exit_code == 2, (args, result.output)
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), (args, result.stderr)
+    assert fragment in lines[0], (fragment, lines[0])
+    assert result.stdout == ""
+    return lines[0]
+
+
+# -- the sampled loop's settings: one validation, work estimated before it is built ------------------------------
+@pytest.mark.parametrize("args, fragment", [
+    (["--b-values", "1e308", "--json"], "the wall damping must be at most 1e+09 (N s/m or N m s/rad), got 1e+308 "
+                                        "(--b-values)"),
+    (["--b-values", "0.1,1e12"], "got 1e+12 (--b-values)"),
+    (["--delay", "1000000000"], "a delay of 1,000,000,000 samples) would take 2e+09 rows, above the limit of 600 rows"),
+    (["--period", "1e-300", "--json"], "the sample period must be at least 1e-12 s, got 1e-300 (--period)"),
+])
+def test_zwidth_refuses_loops_out_of_range_before_building_them(args, fragment):
+    one_line_error([*ZWIDTH, *args], fragment)
+
+
+def test_a_delay_of_a_billion_samples_is_refused_even_when_forced(monkeypatch):
+    """Above the soft order limit the memory estimate still holds: the matrix is never allocated."""
+    monkeypatch.setenv("HAPTICDESIGN_FORCE", "1")
+    one_line_error([*ZWIDTH, "--delay", "1000000000"], "of memory; this machine has")
+
+
+def test_the_loop_record_owns_the_ranges_and_the_estimate():
+    from hapticdesign.analysis.sampled_loop import SampledLoop, joint_limits
+    from hapticdesign.errors import InputError
+    from hapticdesign.workload import WorkloadTooLarge
+
+    with pytest.raises(InputError, match="at least 1e-12 s"):
+        SampledLoop(period=1e-300)
+    with pytest.raises(InputError, match="at most 1e\\+09"):
+        SampledLoop(virtual_damping=1e308)
+    assert SampledLoop(delay=300, compensation="full").order() == 2 * 301 + 301
+    with pytest.raises(WorkloadTooLarge, match="above the limit of 600 rows"):
+        joint_limits(0.039, 0.5, SampledLoop(delay=10**9))
+
+
+def test_the_default_damper_grid_stops_at_the_largest_damper():
+    """A heavy joint at a short period reaches the damper cap: the grid ends there instead of overflowing."""
+    from hapticdesign.analysis.sampled_loop import MAX_VIRTUAL_DAMPING, SampledLoop
+    from hapticdesign.simulation.zwidth import damping_grid
+
+    grid = damping_grid(1e4, 0.5, SampledLoop(period=1e-6, delay=0, velocity="sampled"), points=3)
+    assert grid[-1] <= MAX_VIRTUAL_DAMPING
+
+
+# -- options checked before the work is announced ---------------------------------------------------------------
+@pytest.mark.parametrize("errors", ["100", "-5", "1e9"])
+def test_robustness_checks_its_error_levels_before_announcing_the_work(tmp_path, errors):
+    designs = write_designs(tmp_path / "designs.csv")
+    one_line_error(["robustness", "--designs", str(designs), "--errors", errors, "--out", str(tmp_path / "o")],
+                   "error levels must be percentages in [0, 100)")
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("flag", ["--tol-l1", "--tol-joint"])
+def test_rcube_tolerance_checks_the_tolerances_before_announcing_the_run(tmp_path, flag):
+    one_line_error(["rcube", "tolerance", flag, "10", "--out", str(tmp_path / "o")],
+                   f"must be below 0.1 of the link length")
+    assert not (tmp_path / "o").exists()
+
+
+# -- an interrupted run leaves only complete files ---------------------------------------------------------------
+SIGNALLED_WRITE = """
+import os, signal, sys
+from pathlib import Path
+
+import hapticdesign.files as files
+
+written = files._write_new
+
+
+def signalled(path, data):  # the signal arrives between writing the temporary file and renaming it
+    written(path, data)
+    os.kill(os.getpid(), signal.{name})
+
+
+files._write_new = signalled
+files.write_atomically(Path(sys.argv[1]) / "polish-generation-0001.json", '{{"X": []}}')
+print("after")
+"""
+
+
+@pytest.mark.parametrize("name", ["SIGTERM", "SIGHUP"])
+def test_a_signal_during_a_checkpoint_write_leaves_the_complete_file_only(tmp_path, name):
+    """SIGTERM while ``optimize`` polishes (or runs its generations): every checkpoint goes through
+    ``write_atomically``, which holds the signal until the file is in its place, then ends the process as the
+    signal would have."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    src = str(Path(__file__).resolve().parents[2] / "src")
+    done = subprocess.run([sys.executable, "-c", SIGNALLED_WRITE.format(name=name), str(tmp_path)],
+                          env={**os.environ, "PYTHONPATH": src}, capture_output=True, text=True, timeout=120)
+    assert done.returncode == -getattr(signal, name), done.stderr
+    assert done.stdout == ""  # ended at the signal, after the write
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["polish-generation-0001.json"]
+    assert (tmp_path / "polish-generation-0001.json").read_text() == '{"X": []}'
+
+
+def test_ctrl_c_during_a_write_keeps_the_file_and_raises_after_it(tmp_path, monkeypatch):
+    import os
+    import signal
+
+    import hapticdesign.files as files
+
+    written = files._write_new
+
+    def interrupted(path, data):
+        written(path, data)
+        os.kill(os.getpid(), signal.SIGINT)
+
+    monkeypatch.setattr(files, "_write_new", interrupted)
+    before = signal.getsignal(signal.SIGTERM)
+    with pytest.raises(KeyboardInterrupt):
+        files.write_atomically(tmp_path / "generation-0001.json", "{}")
+    assert [p.name for p in tmp_path.iterdir()] == ["generation-0001.json"]
+    assert signal.getsignal(signal.SIGTERM) is before
