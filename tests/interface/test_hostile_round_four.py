@@ -4,6 +4,8 @@ half-written and nothing outside ``--out``."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 from typer.testing import CliRunner
 
@@ -143,3 +145,108 @@ def test_ctrl_c_during_a_write_keeps_the_file_and_raises_after_it(tmp_path, monk
         files.write_atomically(tmp_path / "generation-0001.json", "{}")
     assert [p.name for p in tmp_path.iterdir()] == ["generation-0001.json"]
     assert signal.getsignal(signal.SIGTERM) is before
+
+
+# -- the seed studies' work folders: no link followed, no special file opened -------------------------------------
+def _appendix_c_into(work: Path) -> None:
+    from hapticdesign.studies.phantom import PhantomSettings
+    from hapticdesign.studies.phantom_rendering import _appendix_c_csv
+    from hapticdesign.studies.steps import Context, SilentProgress
+
+    work.mkdir(exist_ok=True)
+    _appendix_c_csv(Context(PhantomSettings.for_scale("smoke"), work, SilentProgress()), work / "appendix_c_1.csv", 1)
+
+
+def test_a_link_planted_in_the_phantom_work_folder_is_replaced_not_followed(tmp_path):
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    work = tmp_path / "o" / "work"
+    work.mkdir(parents=True)
+    (work / "appendix_c_1.csv").symlink_to(elsewhere / "x.csv")
+    _appendix_c_into(work)
+    assert list(elsewhere.iterdir()) == []
+    written = work / "appendix_c_1.csv"
+    assert not written.is_symlink() and written.read_text().startswith("design,level,ln,")
+
+
+def test_a_named_pipe_in_the_phantom_work_folder_is_refused_not_waited_on(tmp_path):
+    import os
+    import threading
+
+    from hapticdesign.errors import UserError
+
+    work = tmp_path / "o" / "work"
+    work.mkdir(parents=True)
+    pipe = work / "appendix_c_1.csv"
+    os.mkfifo(pipe)
+    raised: list[BaseException] = []
+
+    def attempt() -> None:
+        try:
+            _appendix_c_into(work)
+        except BaseException as exc:  # noqa: BLE001 - handed to the test's thread
+            raised.append(exc)
+
+    thread = threading.Thread(target=attempt, daemon=True)
+    thread.start()
+    thread.join(60)
+    if thread.is_alive():  # blocked opening the pipe: release it, then fail
+        os.close(os.open(pipe, os.O_RDONLY | os.O_NONBLOCK))
+        pytest.fail("the study waited on a named pipe in its work folder")
+    assert len(raised) == 1 and isinstance(raised[0], UserError), raised
+    assert "named pipe" in str(raised[0]) and pipe.is_fifo()
+
+
+# -- forged checkpoints: a recomputed checksum does not make a value trusted -------------------------------------
+def _forged(path: Path, change) -> None:
+    """Change a checkpoint file's values and recompute its checksum as :class:`Checkpoint` does (not keyed)."""
+    import hashlib
+    import json
+
+    run = json.loads((path.parent / "run.json").read_text())
+    data = json.loads(path.read_text())
+    change(data)
+    key = f"{run['study']}:{run['seed']}"
+    data["checksum"] = hashlib.sha256(json.dumps([key, data["X"], data["reduced"], data["reasons"]]).encode()
+                                      ).hexdigest()
+    path.write_text(json.dumps(data))
+
+
+def _huge_integer(data: dict) -> None:
+    data["reduced"][0][0] = 10 ** 400
+
+
+def _largest_float(data: dict) -> None:
+    data["reduced"] = [[1e308 for _ in row] for row in data["reduced"]]
+
+
+def _huge_design(data: dict) -> None:
+    data["X"][0][0] = 10 ** 400
+
+
+def _integer_design(data: dict) -> None:
+    data["X"][0][0] = 1
+
+
+@pytest.mark.parametrize("change", [_huge_integer, _largest_float, _huge_design, _integer_design])
+@pytest.mark.parametrize("name", ["generation-0002.json", "polish-generation-0001.json"])
+def test_a_forged_checkpoint_is_evaluated_again_with_a_warning(tmp_path, change, name):
+    import yaml
+
+    from tests.optimization.test_study_run import small_study
+
+    study = small_study(tmp_path)
+    data = yaml.safe_load(study.read_text())
+    data["algorithm"]["polish"] = "ends"
+    study.write_text(yaml.safe_dump(data, sort_keys=False))
+    args = ["optimize", str(study), "--seed", "3", "--json"]
+    clean = runner.invoke(app, [*args, "--out", str(tmp_path / "clean")])
+    assert clean.exit_code == 0, clean.output
+    out = tmp_path / "out"
+    assert runner.invoke(app, [*args, "--out", str(out)]).exit_code == 0
+    path = out / "checkpoint" / name
+    _forged(path, change)
+    again = runner.invoke(app, [*args, "--out", str(out)])
+    assert again.exit_code == 0, again.output
+    assert f"checkpoint {path} is not trusted" in again.stderr and "evaluated again" in again.stderr
+    assert again.stdout == clean.stdout.replace(str(tmp_path / "clean"), str(out))  # as an unforged run's

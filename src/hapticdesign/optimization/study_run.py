@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -181,7 +182,9 @@ class Checkpoint:
     Each file carries a SHA-256 checksum over its content, the study's fingerprint and the seed. A file that fails
     it (edited answers, a file of another run), that holds other designs than those asked for, or whose answers are
     not numbers and texts of the study's shape is not trusted: its generation is evaluated again, and a
-    :class:`~hapticdesign.errors.RunWarning` says so."""
+    :class:`~hapticdesign.errors.RunWarning` says so. The checksum is not keyed (it catches damage, not forgery), so
+    the values are checked as a study file's are: floats as this class writes them (not integers such as 10^400),
+    designs of the study's width, answers within +-:data:`MAX_ANSWER` (or inf or NaN)."""
 
     def __init__(self, folder: Path | None, study: Study, seed: int, prefix: str = ""):
         self.folder = folder
@@ -218,7 +221,7 @@ class Checkpoint:
         try:
             kept = json.loads(read_text(path, "checkpoint"))
             problem = self._problem(kept, X)
-        except (ValueError, UserError) as exc:
+        except (ValueError, UserError, RecursionError) as exc:
             problem = f"it is not a checkpoint ({str(exc)[:80]})"
         if problem is None:
             return [Answer(tuple(float(v) for v in r), s) for r, s in zip(kept["reduced"], kept["reasons"])]
@@ -232,27 +235,41 @@ class Checkpoint:
             return "it lacks the designs, answers or checksum"
         if kept["checksum"] != self._checksum(kept["X"], kept["reduced"], kept["reasons"]):
             return "its checksum does not match its content, the study and the seed"
-        reduced, reasons = kept["reduced"], kept["reasons"]
+        reduced, reasons, designs = kept["reduced"], kept["reasons"], kept["X"]
         if not (isinstance(reduced, list) and isinstance(reasons, list) and len(reduced) == len(reasons) == len(X)
                 and all(isinstance(r, list) and len(r) == self.width and all(_number(v) for v in r) for r in reduced)
                 and all(isinstance(s, str) for s in reasons)):
             return "its answers are not numbers and reasons of this study"
-        try:
-            same = np.array_equal(np.array(kept["X"], dtype=float).reshape(X.shape), X)
-        except (ValueError, TypeError):
-            same = False
-        return None if same else "it holds other designs"
+        if not all(_value(v) for r in reduced for v in r):
+            return f"an answer is not a value an index gives (a number within +-{MAX_ANSWER:g}, inf or NaN)"
+        if not (isinstance(designs, list) and len(designs) == len(X)
+                and all(isinstance(x, list) and len(x) == X.shape[1] and all(_number(v) for v in x) for x in designs)):
+            return "its designs are not numbers of this study"
+        return None if np.array_equal(np.array(designs, dtype=float), X) else "it holds other designs"
 
     def save(self, generation: int, X: np.ndarray, answers: list[Answer]) -> None:
         if self.folder is None:
             return
-        x, reduced, reasons = X.tolist(), [list(a.reduced) for a in answers], [a.reason for a in answers]
+        x, reasons = np.asarray(X, dtype=float).tolist(), [a.reason for a in answers]
+        reduced = [[float(v) for v in a.reduced] for a in answers]
         kept = {"X": x, "reduced": reduced, "reasons": reasons, "checksum": self._checksum(x, reduced, reasons)}
         write_atomically(self._path(generation), json.dumps(kept))
 
 
+MAX_ANSWER = 1e300
+"""The largest finite index value a checkpoint may hold: none of the toolkit's indices comes near it, and one
+beyond leaves no room for the sums and differences of the front and the polishing (a forged 1e308)."""
+
+
 def _number(value: object) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
+    """A number as :meth:`Checkpoint.save` writes it: a float (JSON writes every float with a point or an exponent,
+    so an integer, 10^400 among them, was never written by it)."""
+    return isinstance(value, float)
+
+
+def _value(value: float) -> bool:
+    """An index value: within +-:data:`MAX_ANSWER`, or inf or NaN (no value; the record says why)."""
+    return not math.isfinite(value) or abs(value) <= MAX_ANSWER
 
 
 class StudyProblem(Problem):

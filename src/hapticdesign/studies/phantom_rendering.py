@@ -3,7 +3,6 @@ and the campaigns behind Tables 4.4 and 4.6 (seed 000 §4.1-4.2)."""
 
 from __future__ import annotations
 
-import csv
 import hashlib
 import inspect
 import warnings
@@ -13,6 +12,7 @@ import numpy as np
 
 from hapticdesign.analysis.linearity.form import device_form
 from hapticdesign.errors import PhysicalConsistencyWarning
+from hapticdesign.files import csv_rows, write_atomically
 from hapticdesign.model.inertia import SEED_FIELDS, seed_parameter_name
 from hapticdesign.analysis.sampled_loop import SampledLoop, joint_limit
 from hapticdesign.simulation.boundary import simulated_boundary
@@ -180,7 +180,9 @@ def boundary(ctx: Context) -> Outcome:
 
 
 def _appendix_c_csv(ctx: Context, path: Path, per_level: int) -> None:
-    """Appendix C's designs as a campaign design file (link 1 from the built-in default, as eq. 3.33 prints it)."""
+    """Appendix C's designs as a campaign design file (link 1 from the built-in default, as eq. 3.33 prints it),
+    written as every output is (:func:`~hapticdesign.files.write_atomically`: a link planted at ``path`` is replaced,
+    never followed; a named pipe there is refused)."""
     device = ctx.settings.device()
     form = device_form(device)
     names = device.inertial_names()
@@ -191,14 +193,12 @@ def _appendix_c_csv(ctx: Context, path: Path, per_level: int) -> None:
         seen[d["level"]] = seen.get(d["level"], 0) + 1
         if seen[d["level"]] <= per_level:
             chosen.append((f"C{i + 1:02d}", d))
-    with open(path, "w", newline="") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(["design", "level", "ln", "ln_H", "ln_C", "ln_G", *names])
-        for name, d in chosen:
-            params = {**{k: 0.0 for k in names}, **link1, **d["params"]}
-            seed = np.array([params[k] for k in names])
-            parts = form.parts_seed(seed)
-            writer.writerow([name, d["level"], parts.sum(), *parts, *(params[k] for k in names)])
+    rows = []
+    for name, d in chosen:
+        params = {**{k: 0.0 for k in names}, **link1, **d["params"]}
+        parts = form.parts_seed(np.array([params[k] for k in names]))
+        rows.append([name, d["level"], parts.sum(), *parts, *(params[k] for k in names)])
+    write_atomically(path, csv_rows(["design", "level", "ln", "ln_H", "ln_C", "ln_G", *names], rows))
 
 
 def campaign(ctx: Context) -> Outcome:
