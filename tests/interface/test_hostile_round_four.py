@@ -250,3 +250,26 @@ def test_a_forged_checkpoint_is_evaluated_again_with_a_warning(tmp_path, change,
     assert again.exit_code == 0, again.output
     assert f"checkpoint {path} is not trusted" in again.stderr and "evaluated again" in again.stderr
     assert again.stdout == clean.stdout.replace(str(tmp_path / "clean"), str(out))  # as an unforged run's
+
+
+# -- names on pages: escaped, nothing runs ------------------------------------------------------------------------
+HOSTILE_STUDY = "<img src=x onerror=document.title='X'>.yaml"
+
+
+@pytest.mark.slow  # a browser
+def test_a_hostile_study_file_name_stays_text_in_the_report(browser, tmp_path):
+    """The study file's name reaches report.html (its title and heading): escaped, it is text, and nothing runs."""
+    from tests.optimization.test_study_run import small_study
+
+    study = small_study(tmp_path).rename(tmp_path / HOSTILE_STUDY)
+    out = tmp_path / "out"
+    result = runner.invoke(app, ["optimize", str(study), "--seed", "3", "--out", str(out), "--quiet"])
+    assert result.exit_code == 0, result.output
+    browser.get((out / "report.html").resolve().as_uri())
+    sources = browser.execute_script("return Array.from(document.images).map(function (i) { return i.src; })")
+    assert sources and all(s.startswith("data:image/png;base64,") for s in sources)  # no <img src=x> was made
+    title = browser.execute_script("return document.title")
+    assert title != "X" and HOSTILE_STUDY in title
+    assert HOSTILE_STUDY in browser.find_element("tag name", "h1").text
+    page = (out / "report.html").read_text()
+    assert "<img src=x" not in page and "&lt;img src=x onerror=document.title=&#x27;X&#x27;&gt;.yaml" in page
