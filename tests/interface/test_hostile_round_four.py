@@ -31,14 +31,28 @@ def one_line_error(args: list[str], fragment: str) -> str:
 
 # -- the sampled loop's settings: one validation, work estimated before it is built ------------------------------
 @pytest.mark.parametrize("args, fragment", [
-    (["--b-values", "1e308", "--json"], "the wall damping must be at most 1e+09 (N s/m or N m s/rad), got 1e+308 "
+    (["--b-values", "1e308", "--json"], "the wall damping must be at most 1e+12 (N s/m or N m s/rad), got 1e+308 "
                                         "(--b-values)"),
-    (["--b-values", "0.1,1e12"], "got 1e+12 (--b-values)"),
+    (["--b-values", "0.1,1e13"], "got 1e+13 (--b-values)"),
     (["--delay", "1000000000"], "a delay of 1,000,000,000 samples) would take 2e+09 rows, above the limit of 600 rows"),
     (["--period", "1e-300", "--json"], "the sample period must be at least 1e-12 s, got 1e-300 (--period)"),
 ])
 def test_zwidth_refuses_loops_out_of_range_before_building_them(args, fragment):
     one_line_error([*ZWIDTH, *args], fragment)
+
+
+@pytest.mark.parametrize("args, fragment", [
+    (["impedance-range", "--hand-mass", "1e308"], "the hand's mass must be at most 1e+12 (SI units), got 1e+308 "
+                                                  "(--hand-mass)"),
+    (["impedance-range", "--hand-stiffness", "1e13"], "(--hand-stiffness)"),
+    (["impedance-range", "--wall-damping", "1e308"], "(--wall-damping)"),
+    (["impedance-range", "--hand-damping", "1e308"], "(--hand-damping)"),
+    (["spec", "--no-workspace", "--hand-mass", "1e308"], "(--hand-mass)"),
+    (["stability-boundary", "--inertia", "0.04", "--damping", "0.5", "--period", "1e-300"], "--period 1e-300 is outside"),
+    (["impedance-range", "--period", "1e-300"], "at least 1e-12 s, got 1e-300 (--period)"),
+])
+def test_every_sampled_loop_command_refuses_settings_out_of_range(args, fragment):
+    one_line_error(args, fragment)
 
 
 def test_a_delay_of_a_billion_samples_is_refused_even_when_forced(monkeypatch):
@@ -54,7 +68,7 @@ def test_the_loop_record_owns_the_ranges_and_the_estimate():
 
     with pytest.raises(InputError, match="at least 1e-12 s"):
         SampledLoop(period=1e-300)
-    with pytest.raises(InputError, match="at most 1e\\+09"):
+    with pytest.raises(InputError, match="at most 1e\\+12"):
         SampledLoop(virtual_damping=1e308)
     assert SampledLoop(delay=300, compensation="full").order() == 2 * 301 + 301
     with pytest.raises(WorkloadTooLarge, match="above the limit of 600 rows"):
@@ -66,7 +80,7 @@ def test_the_default_damper_grid_stops_at_the_largest_damper():
     from hapticdesign.analysis.sampled_loop import MAX_VIRTUAL_DAMPING, SampledLoop
     from hapticdesign.simulation.zwidth import damping_grid
 
-    grid = damping_grid(1e4, 0.5, SampledLoop(period=1e-6, delay=0, velocity="sampled"), points=3)
+    grid = damping_grid(1e7, 0.5, SampledLoop(period=1e-6, delay=0, velocity="sampled"), points=3)
     assert grid[-1] <= MAX_VIRTUAL_DAMPING
 
 

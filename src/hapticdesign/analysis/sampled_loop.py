@@ -350,6 +350,16 @@ class _Search:
         return out
 
 
+SCALE_RANGE = (1e-12, 1e12)
+"""The magnitudes (SI units) a loop's settings and plants are computed for: beyond them the loop's ratios (``J / T``,
+``B / T``, the damper grid's ``4 J / T``) and the stiffness search (up to 1e12) lose their meaning in double
+precision. A setting that may be off (a damper, a hand) may be 0."""
+MIN_PERIOD = SCALE_RANGE[0]
+"""The shortest sample period (s) of a loop (longer periods are checked where a plant meets them, as its ratios)."""
+MAX_VIRTUAL_DAMPING = SCALE_RANGE[1]
+"""The largest wall damper (N s/m, or N m s/rad on a joint)."""
+
+
 @dataclass(frozen=True)
 class Hand:
     """A linear hand at the handle: mass (kg), damping (N s/m) and stiffness (N/m) to ground, the same in every
@@ -364,6 +374,10 @@ class Hand:
         if not all(math.isfinite(v) and v >= 0 for v in values):
             raise InputError(f"the hand's mass, damping and stiffness must be finite and non-negative, got "
                              f"{', '.join(f'{v:g}' for v in values)}", "hand_mass", "hand_damping", "hand_stiffness")
+        for name, value in zip(("mass", "damping", "stiffness"), values):
+            if value > SCALE_RANGE[1]:
+                raise InputError(f"the hand's {name} must be at most {SCALE_RANGE[1]:g} (SI units), got {value:g}",
+                                 f"hand_{name}")
 
     @staticmethod
     def optional(mass: float = 0.0, damping: float = 0.0, stiffness: float = 0.0) -> "Hand | None":
@@ -390,14 +404,6 @@ sampled velocity itself (the seed's perfect sensor, seed 000 §4.1.3 ix)."""
 COMPENSATIONS = ("none", "gravity", "full")
 """What the controller feeds forward: nothing, the gravity torque (practice), or the full inverse dynamics with the
 sampled acceleration (the seed's, seed 000 §4.1.1.2)."""
-
-
-MIN_PERIOD = 1e-12
-"""The shortest sample period (s) of a loop: below a picosecond the loop's ratios (``J / T``, the damper grid's
-``4 J / T``) leave double precision (longer periods are checked where a plant meets them, as their ratios)."""
-MAX_VIRTUAL_DAMPING = 1e9
-"""The largest wall damper (N s/m, or N m s/rad on a joint), as the springs searched stop at ``k_max`` = 1e9: its
-gain ``B / T`` must stay a finite entry of the loop's map."""
 
 
 @dataclass(frozen=True)

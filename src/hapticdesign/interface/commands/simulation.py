@@ -14,10 +14,6 @@ from hapticdesign.interface.common import (joint_units, note, parse_vector, prin
                                            user_errors, write_atomically)
 from hapticdesign.workload import allow_large
 
-# Magnitudes the 1-DOF boundary is computed for (SI units); outside them exp(-b T / J) and the
-# stiffness search (up to 1e12) lose their meaning in double precision.
-SCALE_RANGE = (1e-12, 1e12)
-
 
 
 def _sim_type(value: int) -> int:
@@ -270,7 +266,10 @@ def _check_chirp(amplitude: float, f0: float, f1: float, sweep: float, period: f
 
 
 def _check_scale(**values: float) -> None:
-    """Refuse magnitudes outside :data:`SCALE_RANGE` (zero allowed where a flag may be off)."""
+    """Refuse magnitudes outside the loop's :data:`~hapticdesign.analysis.sampled_loop.SCALE_RANGE` (zero allowed
+    where a flag may be off)."""
+    from hapticdesign.analysis.sampled_loop import SCALE_RANGE
+
     lo, hi = SCALE_RANGE
     for name, value in values.items():
         if value != 0 and not (lo <= abs(value) <= hi):
