@@ -48,7 +48,6 @@ def test_zwidth_refuses_loops_out_of_range_before_building_them(args, fragment):
     (["impedance-range", "--wall-damping", "1e308"], "(--wall-damping)"),
     (["impedance-range", "--hand-damping", "1e308"], "(--hand-damping)"),
     (["spec", "--no-workspace", "--hand-mass", "1e308"], "(--hand-mass)"),
-    (["stability-boundary", "--inertia", "0.04", "--damping", "0.5", "--period", "1e-300"], "--period 1e-300 is outside"),
     (["impedance-range", "--period", "1e-300"], "at least 1e-12 s, got 1e-300 (--period)"),
 ])
 def test_every_sampled_loop_command_refuses_settings_out_of_range(args, fragment):
@@ -238,11 +237,7 @@ def _huge_design(data: dict) -> None:
     data["X"][0][0] = 10 ** 400
 
 
-def _integer_design(data: dict) -> None:
-    data["X"][0][0] = 1
-
-
-@pytest.mark.parametrize("change", [_huge_integer, _largest_float, _huge_design, _integer_design])
+@pytest.mark.parametrize("change", [_huge_integer, _largest_float, _huge_design])
 @pytest.mark.parametrize("name", ["generation-0002.json", "polish-generation-0001.json"])
 def test_a_forged_checkpoint_is_evaluated_again_with_a_warning(tmp_path, change, name):
     import yaml
