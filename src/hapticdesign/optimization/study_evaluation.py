@@ -14,7 +14,7 @@ from __future__ import annotations
 import copy
 import json
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -177,14 +177,43 @@ class BoundStudy:
         full = self.study.spec.with_parameters(values)
         return {name: float(full[name]) for name in self.space.names}
 
-    def evaluate(self, batch: list[dict[str, float]], objectives: bool = True) -> list[Answer]:
+    def baseline(self) -> tuple[dict[str, float] | None, str]:
+        """The device file's own design: each variable at the value the device file states, and what is to be said of
+        it. A variable that only the ``parameters`` formulas read takes the file's value of a device value that a
+        formula sets to it alone (``actuators.q1.gear_ratio: "ratio1"``). None, and why, when the file fixes a
+        variable nowhere (or leaves a motor field unset); else the values and, when there is any, a note naming the
+        values outside the study's range and the device values the study's formulas set otherwise than the file."""
+        spec = self.study.spec
+        stated = self.space.defaults()
+        alone = {f.text.strip(): name for name, f in spec.parameters.items() if name in stated}
+        values = {}
+        for name in spec.variables:
+            value = stated.get(name, stated.get(alone.get(name, ""), math.nan))
+            if not math.isfinite(value):
+                return None, (f"device file {self.study.device_path.name} states no value of variable {name} (a "
+                              "parameters formula setting a device value to it alone would give it)")
+            values[name] = value
+        notes = []
+        for name, variable in spec.variables.items():
+            low, high = ((min(variable.values), max(variable.values)) if isinstance(variable, Choice)
+                         else variable)
+            if not low <= values[name] <= high:
+                notes.append(f"{name} = {values[name]:.6g} is outside the study's range [{low:g}, {high:g}]")
+        for name, value in self.device_values(values).items():
+            if not math.isclose(value, stated[name], rel_tol=1e-9, abs_tol=1e-15):
+                notes.append(f"the study's formula sets {name} = {value:.6g} where the file states {stated[name]:.6g}")
+        return values, "; ".join(notes)
+
+    def evaluate(self, batch: list[dict[str, float]], objectives: bool = True,
+                 every_objective: bool = False) -> list[Answer]:
         """Answers for a batch of designs, in order: the registry evaluates the pose indices together (through the
         compiled kernels where it can, :func:`~hapticdesign.analysis.metrics.indices.evaluate_designs`), each
         reduced here; a design the device file refuses or that misses a workspace point has none, and says why.
         The parameter indices are evaluated for the whole batch at once (no device is built when the study asks
         only for them); those only the objectives read are evaluated only for the designs that meet every
         constraint (NSGA-II's constrained domination never reads the objectives of the others), and for none
-        without ``objectives``."""
+        without ``objectives`` (for every valid design with ``every_objective``: the device file's design, whose
+        objectives are compared even when it breaks a constraint)."""
         device_values = [self.device_values(v) for v in batch]
         if self.requests:
             results = evaluate_designs(self.space, device_values, self.points, self.requests, self.registry)
@@ -196,7 +225,7 @@ class BoundStudy:
         failed = self._parameter_values(first, [device_values[k] for k in valid], valid, values)
         valid = [k for k in valid if k not in failed]
         if objectives:
-            feasible = [k for k in valid if self._feasible(batch[k], values[k])]
+            feasible = [k for k in valid if every_objective or self._feasible(batch[k], values[k])]
             later = [r for r in self.parameter_requests if r.key not in self.constrained]
             failed |= self._parameter_values(later, [device_values[k] for k in feasible], feasible, values)
         nothing = (math.nan,) * len(self.keys)
@@ -287,13 +316,14 @@ class BoundStudy:
             v.write(data, float(values[v.name]))
         return data
 
-    def device_file_text(self, values: dict[str, float]) -> str:
-        """:meth:`device_mapping` as YAML, headed by where it comes from and where the study evaluated it
-        (:meth:`where_evaluated`)."""
+    def device_file_text(self, values: dict[str, float], comments: Sequence[str] = ()) -> str:
+        """:meth:`device_mapping` as YAML, headed by where it comes from, the ``comments`` lines (the device file's
+        design beside it) and where the study evaluated it (:meth:`where_evaluated`)."""
         shown = ", ".join(f"{k} = {v!r}" for k, v in values.items())
         names = (json.dumps(self.study.path.name), json.dumps(self.study.device_path.name))  # no line break in them
         header = f"# The design selected by study {names[0]} from device file {names[1]}:\n# {shown}\n"
-        return (header + self.where_evaluated(values)
+        lines = "".join(f"# {' '.join(line.splitlines())}\n" for line in comments)  # a reason's line break stays a comment
+        return (header + lines + self.where_evaluated(values)
                 + yaml.safe_dump(self.device_mapping(values), sort_keys=False, allow_unicode=False))
 
     def _at_points(self, values: dict[str, float]) -> tuple[Device, WorkspacePoses | None, dict | None]:

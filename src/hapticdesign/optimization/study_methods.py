@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -24,7 +25,7 @@ from hapticdesign.optimization.study_convex import run_convex
 from hapticdesign.optimization.study_evaluation import BoundStudy
 from hapticdesign.optimization.study_file import StudySpec
 from hapticdesign.optimization.study_polish import polish
-from hapticdesign.optimization.study_run import Evaluator, StudyRun, run_study
+from hapticdesign.optimization.study_run import Encoding, Evaluator, StudyRun, record_of, run_study
 
 Progress = Callable[[int, int], None]
 
@@ -143,6 +144,18 @@ METHODS = {method.name: method for method in (PopulationSearch("nsga2", "NSGA-II
                                                PopulationSearch("nsga3", "NSGA-III"),
                                                PopulationSearch("pso", "Particle swarm"), ConvexProgram())}
 """The study file's methods by name (their settings: :data:`~hapticdesign.optimization.study_file.SETTINGS`)."""
+
+
+def with_baseline(run: StudyRun, bound: BoundStudy) -> StudyRun:
+    """``run`` with the device file's own design (:meth:`~.study_evaluation.BoundStudy.baseline`) evaluated through
+    the bound study's registry as every design is, its objectives even when it breaks a constraint (generation 0,
+    kept apart from the records and the front); without one, the note says why."""
+    values, note = bound.baseline()
+    if values is None:
+        return replace(run, baseline_note=note)
+    answer = bound.evaluate([values], every_objective=True)[0]
+    record = record_of(run.spec, 0, Encoding.of(run.spec).encode(values), values, answer)
+    return replace(run, baseline=record, baseline_note=note)
 
 
 def method_of(spec: StudySpec) -> PopulationSearch | ConvexProgram:

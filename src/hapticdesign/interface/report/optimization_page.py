@@ -5,6 +5,7 @@ string (names, expressions, reasons, the device's name) is escaped."""
 from __future__ import annotations
 
 import base64
+import math
 import re
 from dataclasses import dataclass
 from html import escape
@@ -13,8 +14,8 @@ from hapticdesign.interface.report.html import STYLE
 from hapticdesign.interface.report.tables import cell_text
 from hapticdesign.optimization.study_file import Choice
 from hapticdesign.optimization.study_methods import method_of
-from hapticdesign.optimization.study_outputs import Selection
-from hapticdesign.optimization.study_run import StudyRun, constraint_labels
+from hapticdesign.optimization.study_outputs import Selection, at_bounds, changes, closest_designs
+from hapticdesign.optimization.study_run import Record, StudyRun, constraint_labels
 
 
 @dataclass(frozen=True)
@@ -96,6 +97,46 @@ def _reasons(run: StudyRun) -> str:
                   "each design's reason)", ["reason", "designs", "numbers (#, in order: range)"], rows)
 
 
+def _baseline(run: StudyRun, chosen: Record | None = None) -> str:
+    """The device file's design: what to know of it and, in a table, its variables, objectives and constrained values
+    (beside ``chosen``'s, with each objective's change from it, gained or lost, and ``chosen``'s variables at a bound
+    of their range)."""
+    spec, base = run.spec, run.baseline
+    if base is None:
+        words = f"No device file's design to compare: {run.baseline_note}."
+    else:
+        words = ("The device file's design is " + ("feasible" if base.feasible else f"not feasible: {base.reason}")
+                 + (f"; {run.baseline_note}" if run.baseline_note else "") + ".")
+    text = f"<p>{escape(words, quote=False)}</p>"
+    names, labels = [o.name for o in spec.objectives], constraint_labels(spec)
+    if chosen is None:
+        if base is None:
+            return text
+        rows = ([[name, base.values[name]] for name in spec.variables] + [[*row] for row in zip(names, base.objectives)]
+                + [[*row] for row in zip(labels, base.constraints)])
+        return text + _table("The device file's design", ["quantity", "device file's design"], rows)
+    bounds = at_bounds(spec, chosen.values)
+    moved = changes(run, chosen)
+    old = (lambda values: [None] * len(values)) if base is None else (lambda values: values)
+    rows = ([[name, None if base is None else base.values[name], chosen.values[name], "", bounds.get(name, "")]
+             for name in spec.variables]
+            + [[name, o, n, "", ""] for name, o, n in zip(names, old(chosen.objectives), chosen.objectives)]
+            + [[label, o, n, "", ""] for label, o, n in zip(labels, old(chosen.constraints), chosen.constraints)])
+    for k, change in enumerate(moved):  # the objectives' rows follow the variables'
+        percent = f"{change.percent:+.3g} %" if math.isfinite(change.percent) else ""
+        rows[len(spec.variables) + k][3:] = [percent, change.verdict]
+    return text + _table("The selected design beside the device file's design (selected.yaml)",
+                         ["quantity", "device file's design", "selected", "change", "gained or lost; at a bound"],
+                         rows)
+
+
+def _document(title: str, body: list[str], files: list[str]) -> str:
+    """One HTML document of ``body``'s parts and the list of ``files``."""
+    parts = [*body, "<h2>Files</h2><ul class=\"files\">", *(f"<li>{escape(f)}</li>" for f in files), "</ul>"]
+    return (f'<!DOCTYPE html><html lang="en"><head><meta charset="utf-8"><title>{escape(title)}</title>'
+            f"<style>{STYLE}</style></head><body>{''.join(parts)}</body></html>\n")
+
+
 def render(run: StudyRun, selection: Selection, title: str, pareto: Picture, pictures: list[Picture],
            files: list[str]) -> str:
     """The report as one HTML document."""
@@ -105,8 +146,6 @@ def render(run: StudyRun, selection: Selection, title: str, pareto: Picture, pic
     rows = [[n, *run.records[k].objectives, *(run.records[k].values[v] for v in spec.variables),
              *run.records[k].constraints] for n, k in enumerate(run.front, start=1)]
     chosen = run.records[selection.record]
-    selected_rows = ([[name, chosen.values[name]] for name in spec.variables]
-                     + [[name, value] for name, value in zip(names, chosen.objectives)])
     body = [f"<h1>Optimization study: {escape(title)}</h1>", "<h2>Study</h2>", _study_rows(run),
             "<h2>Pareto front</h2>", _image(pareto),
             _table(f"The front: {len(run.front)} feasible, non-dominated designs (front.csv)", columns, rows,
@@ -114,9 +153,33 @@ def render(run: StudyRun, selection: Selection, title: str, pareto: Picture, pic
             "<h2>Selected design</h2>",
             f"<p>Design {selection.position + 1} of the front, by the {escape(selection.rule)}; as a device file: "
             "selected.yaml.</p>",
-            _table("Selected design", ["quantity", "value"], selected_rows),
+            _baseline(run, chosen),
             *(_image(p) for p in pictures),
-            "<h2>Infeasible designs</h2>", _reasons(run),
-            "<h2>Files</h2><ul class=\"files\">", *(f"<li>{escape(f)}</li>" for f in files), "</ul>"]
-    return (f'<!DOCTYPE html><html lang="en"><head><meta charset="utf-8"><title>{escape(title)}</title>'
-            f"<style>{STYLE}</style></head><body>{''.join(body)}</body></html>\n")
+            "<h2>Infeasible designs</h2>", _reasons(run)]
+    return _document(title, body, files)
+
+
+def _closest(run: StudyRun) -> str:
+    """The designs closest to feasible (:func:`~hapticdesign.optimization.study_outputs.closest_designs`) in a table."""
+    spec = run.spec
+    closest = closest_designs(run)
+    if not closest:
+        return ("<p>No design has constrained values: each misses a workspace point or the device file refuses it (the "
+                "sentence above names the design that reaches the most points).</p>")
+    columns = ["evaluation", "why not feasible", "scaled violation", *(o.name for o in spec.objectives),
+               *spec.variables, *constraint_labels(spec)]
+    rows = [[k + 1, run.records[k].reason or "meets the constraints; the keep filters remove it",
+             run.records[k].violation, *run.records[k].objectives, *(run.records[k].values[v] for v in spec.variables),
+             *run.records[k].constraints] for k in closest]
+    return _table(f"The {len(rows)} designs closest to feasible (least total scaled constraint violation; "
+                  "evaluations.csv has every design)", columns, rows)
+
+
+def render_failure(run: StudyRun, why: str, title: str, files: list[str]) -> str:
+    """The report of a run without a feasible design as one HTML document: ``why`` (the run's one-line error), the
+    closest designs, the device file's design and the reasons counted by kind."""
+    body = [f"<h1>Optimization study: {escape(title)}</h1>", "<h2>Study</h2>", _study_rows(run),
+            "<h2>No feasible design</h2>", f"<p>{escape(why, quote=False)}</p>", _closest(run),
+            "<h2>The device file's design</h2>", _baseline(run),
+            "<h2>Infeasible designs</h2>", _reasons(run)]
+    return _document(title, body, files)
