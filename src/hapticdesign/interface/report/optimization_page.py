@@ -117,11 +117,13 @@ def _baseline(run: StudyRun, chosen: Record | None = None) -> str:
         return text + _table("The device file's design", ["quantity", "device file's design"], rows)
     bounds = at_bounds(spec, chosen.values)
     moved = changes(run, chosen)
-    old = (lambda values: [None] * len(values)) if base is None else (lambda values: values)
+    def old(attribute: str) -> tuple:
+        return (None,) * len(getattr(chosen, attribute)) if base is None else getattr(base, attribute)
+
     rows = ([[name, None if base is None else base.values[name], chosen.values[name], "", bounds.get(name, "")]
              for name in spec.variables]
-            + [[name, o, n, "", ""] for name, o, n in zip(names, old(chosen.objectives), chosen.objectives)]
-            + [[label, o, n, "", ""] for label, o, n in zip(labels, old(chosen.constraints), chosen.constraints)])
+            + [[name, o, n, "", ""] for name, o, n in zip(names, old("objectives"), chosen.objectives)]
+            + [[label, o, n, "", ""] for label, o, n in zip(labels, old("constraints"), chosen.constraints)])
     for k, change in enumerate(moved):  # the objectives' rows follow the variables'
         percent = f"{change.percent:+.3g} %" if math.isfinite(change.percent) else ""
         rows[len(spec.variables) + k][3:] = [percent, change.verdict]
