@@ -1,6 +1,7 @@
-"""The HTML report of ``optimize``: the study, the front, the selected design with its picture and index
-maps, and the files beside it. One document, inline styles, base64 PNG figures, no scripts; every user
-string (names, expressions, reasons, the device's name) is escaped."""
+"""The HTML report of ``optimize``: the study, the front, the selected design beside the device file's design with
+its picture and index maps, and the files beside it; for a run without a feasible design (:func:`render_failure`),
+why, the closest designs and the device file's design. One document, inline styles, base64 PNG figures, no
+scripts; every user string (names, expressions, reasons, the device's name) is escaped."""
 
 from __future__ import annotations
 
