@@ -112,8 +112,7 @@ def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Select
     paths = [out / "front.csv", out / "evaluations.csv", *pareto_figure(run, selection, out, registry=bound.registry)]
     chosen = run.records[selection.record]
     write_atomically(out / "selected.yaml", bound.device_file_text(chosen.values, baseline_lines(run, chosen)))
-    values = chosen.values
-    pictures = [Picture(png, caption) for png, caption in bound.pictures(values)]
+    pictures = [Picture(png, caption) for png, caption in bound.pictures(chosen.values)]
     kept = (["checkpoint/ (one file per generation; a rerun into this folder continues)"]
             if method_of(run.spec).checkpointed else [])
     page = render(run, selection, bound.title, Picture((out / "pareto.png").read_bytes(), "Pareto front"), pictures,

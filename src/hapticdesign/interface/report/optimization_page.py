@@ -118,6 +118,7 @@ def _baseline(run: StudyRun, chosen: Record | None = None) -> str:
         return text + _table("The device file's design", ["quantity", "device file's design"], rows)
     bounds = at_bounds(spec, chosen.values)
     moved = changes(run, chosen)
+
     def old(attribute: str) -> tuple:
         return (None,) * len(getattr(chosen, attribute)) if base is None else getattr(base, attribute)
 
