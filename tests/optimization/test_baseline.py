@@ -136,6 +136,9 @@ def test_the_pareto_figure_draws_the_device_files_design_within_its_axes(tmp_pat
     assert "device file's design" in [t.get_text() for t in ax.get_legend().get_texts()]
     marked = [c for c in ax.collections if c.get_label() == "device file's design"]
     assert np.array_equal(marked[0].get_offsets(), [[0.5, 0.9]])
+    broken = Record(0, (0.0,), {"l1": 0.1}, (0.5, 0.9), (1.0,), "", "force = 1, not >= 1.4", 0.3)
+    pareto_figure(StudyRun(run.spec, 1, records, [0, 1, 2], baseline=broken), None, tmp_path)
+    assert "device file's design (not feasible)" in [t.get_text() for t in kept[1].axes[0].get_legend().get_texts()]
 
 
 def test_a_study_without_a_feasible_design_writes_why_then_one_line(tmp_path):

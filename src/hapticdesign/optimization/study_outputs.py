@@ -215,7 +215,7 @@ def normalized_like_front(run: StudyRun, objectives: np.ndarray) -> np.ndarray:
 def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: str = "pareto",
                   registry: Mapping[str, Index] = INDICES) -> list[Path]:
     """The front in pairs of objectives (every feasible design in grey, the front in blue, the selected
-    design as a red star, the device file's design as a black diamond; the axes span the front's range and the
+    design as a red star, the device file's design as a black diamond, said when it is not feasible; the axes span the front's range and the
     device file's design, :func:`front_limits`, and the legend counts the feasible designs beyond them); one
     objective: its value per evaluation (the device file's design a dashed line); more than three: parallel
     coordinates of the normalized front (0 best; the device file's design dashed, normalized alike)."""
@@ -230,6 +230,7 @@ def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: s
     pick = None if selection is None else F[selection.position]
     base = (np.array(run.baseline.objectives) if run.baseline is not None
             and np.all(np.isfinite(run.baseline.objectives)) else None)
+    baseline = BASELINE if base is None or run.baseline.feasible else f"{BASELINE} (not feasible)"
     k = len(labels)
     if k == 1:
         fig, ax = plt.subplots(figsize=(6, 4), dpi=100)
@@ -238,7 +239,7 @@ def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: s
         if pick is not None:
             ax.scatter([selection.record + 1], [pick[0]], marker="*", s=140, color="red", label="selected")
         if base is not None:
-            ax.axhline(base[0], color="black", linestyle="--", linewidth=1.0, label=BASELINE)
+            ax.axhline(base[0], color="black", linestyle="--", linewidth=1.0, label=baseline)
         ax.set_xlabel("evaluation")
         ax.set_ylabel(labels[0])
         ax.legend(fontsize=8)
@@ -256,7 +257,7 @@ def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: s
             if pick is not None:
                 ax.scatter([pick[i]], [pick[j]], marker="*", s=160, color="red", label="selected")
             if base is not None:
-                ax.scatter([base[i]], [base[j]], marker="D", s=50, color="black", label=BASELINE)
+                ax.scatter([base[i]], [base[j]], marker="D", s=50, color="black", label=baseline)
             ax.set_xlim(x_low, x_high)
             ax.set_ylim(y_low, y_high)
             ax.set_xlabel(labels[i])
@@ -271,7 +272,7 @@ def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: s
             ax.plot(range(k), normalized[selection.position], color="red", linewidth=2.2, label="selected")
         if base is not None:
             ax.plot(range(k), normalized_like_front(run, base), color="black", linestyle="--", linewidth=1.6,
-                    label=BASELINE)
+                    label=baseline)
         if selection is not None or base is not None:
             ax.legend(fontsize=8)
         ax.set_xticks(range(k), [o.name for o in spec.objectives], rotation=20)
