@@ -115,6 +115,7 @@ def evaluate_designs(space: DesignFamily, designs: Sequence[Mapping[str, float]]
         got.q[ok].reshape(-1, n_a), motor_map=None if v.motor_map is None else v.motor_map[per_pose],
         torque_limits={k: None if t is None else t[per_pose] for k, t in v.torques.items()},
         moving_mass=got.moving_mass[per_pose], name=space.base.name,
+        transmission=None if v.transmission is None else v.transmission.taken(per_pose),
         model=lambda error: tuple(x[ok].reshape(-1, n_a, n_a) for x in got.model(error)),
         **({} if got.gravity is None else {"gravity": got.gravity[ok].reshape(-1, n_a, n_a)}))
     if sections:
