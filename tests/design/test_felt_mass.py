@@ -11,6 +11,7 @@ Jacobian differentiated by hand (tests/helpers/phantom_premium_mass.py), the app
 from __future__ import annotations
 
 import copy
+import importlib.util
 import itertools
 import json
 import re
@@ -99,7 +100,7 @@ def test_a_study_reduces_the_published_phantoms_apparent_mass_as_the_closed_form
     centre, = [t for t in header.splitlines() if t.startswith("# center apparent_mass")]
     np.testing.assert_allclose(_point_in(centre), center, atol=1e-6)
     row, = bound.spread_rows(PUBLISHED)
-    assert row[-1] == line.split(" at ")[1].split(";")[0]
+    assert row[-1] == line.split(" at ")[1].split(";")[0] + " (one of 4 points)"  # the far corners, mirrored in y, z
     assert [float(v) for v in row[2:5]] == pytest.approx([expected[k] for k in ("centre", "median", "mean")],
                                                          rel=1e-5)
 
@@ -132,9 +133,10 @@ def test_maps_states_the_spread_and_the_worst_point_of_a_plane(tmp_path):
     assert got["median"] == pytest.approx(np.median(masses), rel=1e-9)
     assert got["mean"] == pytest.approx(masses.mean(), rel=1e-9)
     assert got["max"] == pytest.approx(masses.max(), rel=1e-9)
-    for at, value in (("max_at", masses.max()), ("min_at", masses.min())):  # a grid point taking the extreme (ties)
-        assert np.min(np.abs(points - got[at]).max(axis=1)) < 1e-12
-        assert apparent_mass(closed_form(np.array(got[at]))) == pytest.approx(value, rel=1e-9)
+    for how, value in (("max", masses.max()), ("min", masses.min())):  # a grid point taking the extreme (ties)
+        assert np.min(np.abs(points - got[f"{how}_at"]).max(axis=1)) < 1e-12
+        assert apparent_mass(closed_form(np.array(got[f"{how}_at"]))) == pytest.approx(value, rel=1e-9)
+        assert got[f"{how}_count"] == np.count_nonzero(np.isclose(masses, value, rtol=1e-7, atol=0))
     text = runner.invoke(app, args[:-1])
     assert "over 25 of 25 points, grid 5" in text.stdout
 
@@ -145,7 +147,8 @@ def test_the_reductions_by_hand():
     assert reduce(v, "center", 2) == 4.0
     assert reduced_at(v, "max") == 4 and reduced_at(v, "min") == 1 and reduced_at(v, "mean") is None
     assert spread(v, None) == {"min": 1.0, "max": 9.0, "mean": 20.5 / 6, "median": 2.5, "center": None,
-                               "min_at": 1, "max_at": 4}
+                               "min_at": 1, "max_at": 4, "min_count": 1, "max_count": 1}
+    assert spread(np.array([2.0, 5.0, 1.0, 5.0 * (1 + 1e-12)]))["max_count"] == 2
     assert reduction_label("max", 27, 3) == "max of 27 points, grid 3"
     with pytest.raises(UserError, match="^unknown reduction 'worst' \\(use min, max, mean, median, center\\)$"):
         reduce(v, "worst")
@@ -166,3 +169,22 @@ def test_a_bad_reduction_is_one_line_and_exit_2(tmp_path, change, message):
     assert result.exit_code == 2
     assert message in result.output and "Traceback" not in result.output
     assert len(result.output.strip().splitlines()) == 1
+
+
+def test_the_docs_table_is_a_fresh_runs_and_the_closed_forms():
+    """docs/indices.md's grid 3 against grid 5 table equals docs/scripts/felt_mass.py's output now, whose numbers
+    the closed form gives (g, to the table's 0.1 g)."""
+    spec = importlib.util.spec_from_file_location("felt_mass", ROOT / "docs" / "scripts" / "felt_mass.py")
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    fresh = script.table()
+    doc = (ROOT / "docs" / "indices.md").read_text()
+    assert doc[doc.index(script.BEGIN) + len(script.BEGIN):doc.index(script.END)].strip() == fresh
+    center, size = box()
+    for grid, row in zip((3, 5), fresh.splitlines()[2:4]):
+        masses = 1000 * oracle(grid_points(grid, center, size))
+        cells = [c.strip() for c in row.strip("|").split("|")]
+        assert cells[0] == f"{grid ** 3} points, grid {grid}"
+        centre = 1000 * apparent_mass(closed_form(center))
+        assert [float(c) for c in cells[1:4]] == pytest.approx([centre, np.median(masses), masses.mean()], abs=0.051)
+        assert float(cells[5].split()[0]) == pytest.approx(masses.max(), abs=0.051)

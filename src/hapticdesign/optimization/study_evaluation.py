@@ -368,8 +368,14 @@ class BoundStudy:
             named = r.index + (json.dumps(r.options, sort_keys=True) if r.options else "")
             rows.append([named, self.registry[r.index].unit,
                          *("" if s[c] is None else f"{s[c]:.6g}" for c in ("center", "median", "mean", "min")),
-                         _point(self.points[s["min_at"]]), f"{s['max']:.6g}", _point(self.points[s["max_at"]])])
+                         self._extreme(s, "min"), f"{s['max']:.6g}", self._extreme(s, "max")])
         return rows
+
+    def _extreme(self, s: dict, how: str) -> str:
+        """Where an extreme of :func:`~hapticdesign.analysis.metrics.indices.spread` is taken, and at how many points
+        when it ties (a symmetric device's mirrored corners)."""
+        ties = s[f"{how}_count"]
+        return _point(self.points[s[f"{how}_at"]]) + (f" (one of {ties} points)" if ties > 1 else "")
 
     def pictures(self, values: dict[str, float]) -> list[tuple[bytes, str]]:
         """The selected design's picture at the workspace centre (at home when the centre is out of reach) and
@@ -395,7 +401,8 @@ class BoundStudy:
 
 SPREAD_COLUMNS = ("center", "median", "mean", "min", "min_at", "max", "max_at")
 """What :meth:`BoundStudy.spread_rows` gives of an index over the workspace points, in order: the value at the box's
-centre, the median, the mean, the smallest and its point, the largest and its point."""
+centre, the median, the mean, the smallest and its point, the largest and its point (with how many points tie for an
+extreme)."""
 
 
 def _point(p: np.ndarray) -> str:

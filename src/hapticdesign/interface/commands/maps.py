@@ -79,8 +79,8 @@ def maps(
 def _spread(found, key: str, center: int | None, grid: int) -> dict | None:
     """The index ``key`` over the points reached by every reduction
     (:func:`~hapticdesign.analysis.metrics.indices.spread`; ``center`` None when the centre is not reached), the
-    extremes' points (``min_at``, ``max_at``: x, y, z in m), how many points it is over and the grid; None when no
-    point is reached."""
+    extremes' points (``min_at``, ``max_at``: x, y, z in m) and how many points tie for them (``min_count``,
+    ``max_count``), how many points it is over and the grid; None when no point is reached."""
     from hapticdesign.analysis.metrics.indices import spread
 
     reached = found.reached.nonzero()[0]
@@ -99,9 +99,10 @@ def _spread_line(got: dict | None, total: int) -> str:
     if got is None:
         return ""
     center = "" if got["center"] is None else f"center {got['center']:.6g}, "
-    at = {k: "(" + ", ".join(f"{x:.6g}" for x in got[k]) + ") m" for k in ("min_at", "max_at")}
+    at = {k: "(" + ", ".join(f"{x:.6g}" for x in got[f"{k}_at"]) + ") m"
+          + (f" (one of {got[f'{k}_count']} points)" if got[f"{k}_count"] > 1 else "") for k in ("min", "max")}
     return (f"; over {got['points']} of {total} points, grid {got['grid']}: {center}median {got['median']:.6g}, mean "
-            f"{got['mean']:.6g}; min at {at['min_at']}, max at {at['max_at']}")
+            f"{got['mean']:.6g}; min at {at['min']}, max at {at['max']}")
 
 
 def _finite(values, how) -> float | None:

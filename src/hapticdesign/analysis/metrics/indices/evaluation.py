@@ -205,12 +205,20 @@ def reduced_at(values: np.ndarray, how: str, center: int | None = None) -> int |
     return None
 
 
+TIE = 1e-9
+"""Relative difference within which two points' values tie for an extreme (:func:`spread`)."""
+
+
 def spread(values: np.ndarray, center: int | None = None) -> dict[str, float | int | None]:
-    """An index over the points (P,) by every reduction (``center`` None where the centre is not among them) and
-    where the extremes are taken: ``min_at`` and ``max_at``, places among the points."""
+    """An index over the points (P,) by every reduction (``center`` None where the centre is not among them), where
+    the extremes are taken (``min_at``, ``max_at``: the first place among the points) and at how many points
+    (``min_count``, ``max_count``: the points within :data:`TIE` of the extreme, e.g. a symmetric device's mirrored
+    corners)."""
     out: dict[str, float | int | None] = {
         how: None if how == "center" and center is None else reduce(values, how, center) for how in REDUCTIONS}
-    out["min_at"], out["max_at"] = reduced_at(values, "min"), reduced_at(values, "max")
+    for how in ("min", "max"):
+        out[f"{how}_at"] = reduced_at(values, how)
+        out[f"{how}_count"] = int(np.count_nonzero(np.abs(values - out[how]) <= TIE * abs(out[how])))
     return out
 
 
