@@ -188,3 +188,17 @@ def test_the_docs_table_is_a_fresh_runs_and_the_closed_forms():
         centre = 1000 * apparent_mass(closed_form(center))
         assert [float(c) for c in cells[1:4]] == pytest.approx([centre, np.median(masses), masses.mean()], abs=0.051)
         assert float(cells[5].split()[0]) == pytest.approx(masses.max(), abs=0.051)
+
+
+def test_a_studys_report_and_selected_design_state_the_grid_and_the_spread(tmp_path):
+    data = yaml.safe_load(felt_study(tmp_path, 3).read_text())
+    data["algorithm"] = {"method": "nsga2", "population": 4, "generations": 1}
+    path = tmp_path / "tiny.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    result = runner.invoke(app, ["optimize", str(path), "--seed", "1", "--out", str(tmp_path / "out"), "--quiet"])
+    assert result.exit_code == 0, result.output
+    report = (tmp_path / "out" / "report.html").read_text()
+    assert "max of 27 points, grid 3" in report and "median of 27 points, grid 3" in report
+    assert "indices over the workspace (27 points, grid 3)" in report
+    header = (tmp_path / "out" / "selected.yaml").read_text()
+    assert "# apparent_mass over the study's 27 points, grid 3 (kg): center " in header

@@ -387,7 +387,9 @@ class StudySpec(_StudyModel):
             raise ValueError("workspace: the region the handle must reach is required (only method convex, whose "
                              "LN is over the joint region, and a study of parameter indices alone do without)")
         centered = [use.index for use in self.index_uses if use.reduce == "center"]
-        if centered and self.workspace is not None and self.workspace.grid % 2 == 0 and any(self.workspace.box.size):
+        if centered and self.workspace is None:
+            raise ValueError(f"workspace: reduce center ({centered[0]}) needs a workspace, whose box's centre it reads")
+        if centered and self.workspace.grid % 2 == 0 and any(self.workspace.box.size):
             raise ValueError(f"workspace.grid: reduce center ({centered[0]}) needs the box's centre among the grid "
                              f"points, an odd grid; got {self.workspace.grid}")
         if isinstance(self.algorithm, _PopulationSearch) and self.algorithm.one_objective and len(self.objectives) > 1:
