@@ -115,7 +115,7 @@ def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Select
     kept = (["checkpoint/ (one file per generation; a rerun into this folder continues)"]
             if method_of(run.spec).checkpointed else [])
     page = render(run, selection, bound.title, Picture((out / "pareto.png").read_bytes(), "Pareto front"), pictures,
-                  [*FILES, *kept])
+                  [*FILES, *kept], bound.coarseness, bound.spread_rows(values))
     write_atomically(out / "report.html", page)
     return [*paths, out / "selected.yaml", out / "report.html"]
 

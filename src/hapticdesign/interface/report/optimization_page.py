@@ -11,6 +11,7 @@ from html import escape
 
 from hapticdesign.interface.report.html import STYLE
 from hapticdesign.interface.report.tables import cell_text
+from hapticdesign.optimization.study_evaluation import SPREAD_COLUMNS
 from hapticdesign.optimization.study_file import Choice
 from hapticdesign.optimization.study_methods import method_of
 from hapticdesign.optimization.study_outputs import Selection
@@ -50,11 +51,12 @@ def _options(options: dict) -> str:
     return ", ".join(f"{k} = {v}" for k, v in options.items())
 
 
-def _study_rows(run: StudyRun) -> str:
+def _study_rows(run: StudyRun, coarseness: str) -> str:
     spec = run.spec
+    over = f" of {coarseness}" if coarseness else ""
     variables = [[name, *(("choice of " + ", ".join(f"{v:g}" for v in var.values), "") if isinstance(var, Choice)
                           else (f"{var[0]:g}", f"{var[1]:g}"))] for name, var in spec.variables.items()]
-    objectives = [[o.name, o.index, _options(o.options), o.reduce, o.sense] for o in spec.objectives]
+    objectives = [[o.name, o.index, _options(o.options), o.reduce + over, o.sense] for o in spec.objectives]
     constraints = [[c.label + (f" ({_options(c.options)})" if getattr(c, "options", None) else ""),
                     "" if c.at_least is None else c.at_least, "" if c.at_most is None else c.at_most]
                    for c in spec.constraints]
@@ -97,8 +99,10 @@ def _reasons(run: StudyRun) -> str:
 
 
 def render(run: StudyRun, selection: Selection, title: str, pareto: Picture, pictures: list[Picture],
-           files: list[str]) -> str:
-    """The report as one HTML document."""
+           files: list[str], coarseness: str = "", spread: list[list] | None = None) -> str:
+    """The report as one HTML document; ``coarseness`` says how coarse the workspace grid is (``27 points, grid 3``),
+    ``spread`` gives the selected design's pose indices over the points
+    (:meth:`~hapticdesign.optimization.study_evaluation.BoundStudy.spread_rows`)."""
     spec = run.spec
     names = [o.name for o in spec.objectives]
     columns = ["design", *names, *spec.variables, *constraint_labels(spec)]  # the objectives first: what a front is
@@ -107,14 +111,17 @@ def render(run: StudyRun, selection: Selection, title: str, pareto: Picture, pic
     chosen = run.records[selection.record]
     selected_rows = ([[name, chosen.values[name]] for name in spec.variables]
                      + [[name, value] for name, value in zip(names, chosen.objectives)])
-    body = [f"<h1>Optimization study: {escape(title)}</h1>", "<h2>Study</h2>", _study_rows(run),
+    over = [_table(f"The selected design's indices over the workspace ({coarseness}): at the box's centre, median, "
+                   "mean and the extremes with the points where they are taken", ["index", "unit", *SPREAD_COLUMNS],
+                   spread)] if spread else []
+    body = [f"<h1>Optimization study: {escape(title)}</h1>", "<h2>Study</h2>", _study_rows(run, coarseness),
             "<h2>Pareto front</h2>", _image(pareto),
             _table(f"The front: {len(run.front)} feasible, non-dominated designs (front.csv)", columns, rows,
                    selection.position),
             "<h2>Selected design</h2>",
             f"<p>Design {selection.position + 1} of the front, by the {escape(selection.rule)}; as a device file: "
             "selected.yaml.</p>",
-            _table("Selected design", ["quantity", "value"], selected_rows),
+            _table("Selected design", ["quantity", "value"], selected_rows), *over,
             *(_image(p) for p in pictures),
             "<h2>Infeasible designs</h2>", _reasons(run),
             "<h2>Files</h2><ul class=\"files\">", *(f"<li>{escape(f)}</li>" for f in files), "</ul>"]
