@@ -175,3 +175,29 @@ def test_a_checkpoint_whose_reasons_were_edited_is_not_trusted(tmp_path, alter):
     path.write_text(json.dumps(data))
     with pytest.warns(RunWarning, match="checksum does not match"):
         assert checkpoint.load(1, X) is None
+
+
+def test_when_no_design_reaches_the_workspace_the_closest_is_the_one_reaching_the_most_points(tmp_path):
+    """Four workspace points on the base's x axis at 0.30, 0.33, 0.36 and 0.39 m from the shoulder; the forearm
+    ``l2`` is 0.12, 0.15 or 0.18 m, so by the two-link closed form (``r <= l1 + l2``) a design reaches 1, 2 or 3 of
+    them and none the whole workspace. The empty front's message names, among the last generation's designs, one
+    whose closed-form count is the largest there, and states that count (the generation holds designs of different
+    counts, so the design reaching the fewest would be another)."""
+    from hapticdesign.optimization.study_methods import CLOSEST_CANDIDATES, METHODS
+    from tests.helpers.planar_arm import points_reached
+
+    xs = (0.30, 0.33, 0.36, 0.39)
+    path = write_study(tmp_path, {"l2": {"values": [0.12, 0.15, 0.18]}}, [ISOTROPY], population=8, generations=2,
+                       center=[sum(xs) / 4, 0.0, 0.0], size=(xs[-1] - xs[0], 0.0, 0.0), grid=4)
+    study = load_study(path)
+    bound = bind_study(study)
+    assert np.allclose(sorted(p[0] for p in bound.points), xs) and len(bound.points) == 4
+    run = run_study(study, 1, bound.evaluate)
+    assert all(r.invalid for r in run.records)
+    last = [r for r in run.records if r.generation == run.records[-1].generation][:CLOSEST_CANDIDATES]
+    counts = {r.values["l2"]: points_reached(L1, r.values["l2"], [(x, 0.0, 0.0) for x in xs]) for r in last}
+    assert len(set(counts.values())) > 1, counts
+    most = max(counts.values())
+    (closest,) = [l2 for l2, n in counts.items() if n == most]
+    message = str(METHODS["nsga2"].empty_front(run, bound))
+    assert f"the closest (l2 = {closest:.6g}) reaches {most} of 4 points" in message, message
