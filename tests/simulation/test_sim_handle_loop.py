@@ -94,6 +94,10 @@ def test_one_joint_loop_is_the_seed_limits_closed_form():
 
 
 def test_kmax_index_is_the_wall_limit_with_its_options(five_bar):
+    """The index's options reach the loop as this test writes it (``period``, ``delay``, ``damping`` as the wall's
+    damper, ``"grasp"`` as the default grasp, the direction, gravity's gradient at the pose): the plumbing, checked
+    against :func:`wall_limit`, whose values are pinned independently, python-control's loop with the hand and the
+    delay in this file's other tests and gravity's gradient in test_sim_gravity_gradient.py."""
     device, point, jv, h, b = five_bar
     options = {"period": 0.0005, "delay": 2, "damping": 0.5, "hand": "grasp"}
     u = np.array([0.6, 0.0, 0.8])
