@@ -53,6 +53,7 @@ against the spectral radius of the exactly discretized loop and the simulated lo
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -359,6 +360,8 @@ class Hand:
     mass: float = 0.0
     damping: float = 0.0
     stiffness: float = 0.0
+    name: str | None = None
+    """The preset's name (:data:`HANDS`), None for a hand of one's own."""
 
     def __post_init__(self) -> None:
         values = (self.mass, self.damping, self.stiffness)
@@ -371,19 +374,55 @@ class Hand:
         """A hand when any of its values is non-zero, else None (no hand)."""
         return Hand(mass, damping, stiffness) if (mass or damping or stiffness) else None
 
+    @staticmethod
+    def named(name: str) -> "Hand":
+        """The preset ``name`` of :data:`HANDS` (``grasp``, its former name, is ``light`` with a deprecation line);
+        a one-line error for another name."""
+        if name == "grasp":
+            warnings.warn("the hand 'grasp' is now called 'light' (the same 0.1 kg, 2 N s/m, 200 N/m); 'grasp' "
+                          "will be removed", FutureWarning, stacklevel=2)
+            name = "light"
+        if name not in HANDS:
+            raise UserError(f"unknown hand {str(name)[:40]!r}; choose one of {', '.join(HANDS)} or give mass, damping "
+                            "and stiffness")
+        return HANDS[name]
+
     def as_dict(self) -> dict:
-        return {"mass": self.mass, "damping": self.damping, "stiffness": self.stiffness}
+        return {"mass": self.mass, "damping": self.damping, "stiffness": self.stiffness,
+                **({} if self.name is None else {"name": self.name})}
+
+    def describe(self) -> str:
+        """``light hand (0.1 kg, 2 N s/m, 200 N/m)``: what an output states of it."""
+        return (f"{self.name or 'a'} hand ({self.mass:g} kg, {self.damping:g} N s/m, {self.stiffness:g} N/m)")
 
 
-GRASP = Hand(mass=0.1, damping=2.0, stiffness=200.0)
-"""The default grasp of the "with the hand" limit: a light fingertip or pen grasp, 0.1 kg, 2 N s/m, 200 N/m, at the
-low (least stabilizing) end of the hand and fingertip impedances measured by Tsuji, Morasso, Goto & Ito (1995,
-"Human hand impedance characteristics during maintained posture", Biol. Cybern. 72) and Hajian & Howe (1997,
-"Identification of the mechanical impedance at the human finger tip", J. Biomech. Eng. 119). Colgate & Brown (1994,
-"Factors affecting the Z-width of a haptic display", ICRA) and Hulin, Preusche & Hirzinger (2008, "Stability boundary
-for haptic rendering: influence of human operator", IROS) show how the operator's impedance enlarges the stable
-region; a firmer grasp renders stiffer walls. A user changes it (``hand_mass``, ``hand_damping``,
-``hand_stiffness``)."""
+HANDS: dict[str, Hand] = {
+    "light": Hand(mass=0.1, damping=2.0, stiffness=200.0, name="light"),
+    "firm": Hand(mass=0.554, damping=6.45, stiffness=135.0, name="firm"),
+}
+"""The hands a wall is designed for, linear mass-damper-springs at the handle.
+
+- ``light``: a light fingertip or pen grasp, 0.1 kg, 2 N s/m, 200 N/m, at the low (least stabilizing) end of the
+  hand and fingertip impedances measured by Tsuji, Morasso, Goto & Ito (1995, "Human hand impedance characteristics
+  during maintained posture", Biol. Cybern. 72) and Hajian & Howe (1997, "Identification of the mechanical impedance
+  at the human finger tip", J. Biomech. Eng. 119): the hand that stabilizes least, so the wall to design for.
+- ``firm``: a firm grasp of a stylus or knob, 0.554 kg, 6.45 N s/m, 135 N/m: figures quoted from a published
+  second-order fit of a grasping hand whose source this project has not checked, so an assumption of the right
+  order, not a measurement: stylus and knob grasps identified by Fu & Cavusoglu ("Three-dimensional human arm and
+  hand dynamics and variability model for a stylus-based haptic interface", ICRA 2010) and Hasser & Cutkosky
+  ("System identification of the human hand grasping a haptic knob", Haptics Symposium 2002) are of this kind, their
+  damping and stiffness rising with the grip force.
+
+Colgate & Brown (1994, "Factors affecting the Z-width of a haptic display", ICRA), Hulin, Preusche & Hirzinger (2008,
+"Stability boundary for haptic rendering: influence of human operator", IROS) and Diaz & Gil (2010, "Influence of
+vibration modes and human operator on the stability of haptic rendering", IEEE T-RO 26) show how the operator's
+impedance enlarges the stable region: a firmer grasp renders stiffer walls, and a wall designed for the light hand
+holds for the firm one. Without a hand, the limit is set by the device's own viscous damping alone (about
+``2 b / T``), which rewards friction and damping rather than the design (docs/simulation.md)."""
+
+GRASP = HANDS["light"]
+"""The default hand of the "with the hand" limit (``light`` of :data:`HANDS`). A user changes it (``hand`` by name, or
+``hand_mass``, ``hand_damping``, ``hand_stiffness``)."""
 
 VELOCITIES = ("difference", "sampled")
 """How the virtual damper's velocity is formed: the backward difference of the sampled positions (practice), or the
@@ -469,8 +508,7 @@ class SampledLoop:
 
     def describe(self) -> str:
         """One line for a text output."""
-        hand = "no hand" if self.hand is None else (f"hand {self.hand.mass:g} kg, {self.hand.damping:g} N s/m, "
-                                                     f"{self.hand.stiffness:g} N/m")
+        hand = "no hand" if self.hand is None else self.hand.describe()
         held = f", joints {', '.join(str(j + 1) for j in self.held)} held" if self.held else ", every joint free"
         comp = self.compensation + (f" (model error {self.model_error:g} %)" if self.compensation == "full"
                                     and self.model_error else "")

@@ -30,7 +30,7 @@ import numpy as np
 
 from hapticdesign.analysis.dynamics import cartesian
 from hapticdesign.analysis.metrics.kinematic import handle_range_basis
-from hapticdesign.analysis.sampled_loop import GRASP, Hand, SampledLoop, handle_intervals, handle_limits
+from hapticdesign.analysis.sampled_loop import GRASP, HANDS, Hand, SampledLoop, handle_intervals, handle_limits
 from hapticdesign.errors import UserError
 from hapticdesign.model.actuators import Transmission
 
@@ -155,8 +155,8 @@ discretization of a handle's mass over much longer periods overflows."""
 KMAX_OPTIONS = {"period": 0.001, "delay": 1, "damping": 0.0, "direction": None, "velocity": "difference",
                 "compensation": "gravity", "error_percent": 0.0, "hand": None}
 """The ``kmax`` index's options and defaults: the settings of :class:`SampledLoop` (``damping`` the wall's damper in
-N s/m), ``direction`` a base-frame vector (default: the worst direction) and ``hand`` None, ``"grasp"`` (the default
-grasp :data:`~hapticdesign.analysis.sampled_loop.GRASP`) or ``{mass, damping, stiffness}``."""
+N s/m), ``direction`` a base-frame vector (default: the worst direction) and ``hand`` None, a preset's name of
+:data:`~hapticdesign.analysis.sampled_loop.HANDS` (``light``, ``firm``) or ``{mass, damping, stiffness}``."""
 
 
 def kmax_loop(options: Mapping[str, object]) -> tuple[SampledLoop, np.ndarray | None]:
@@ -192,12 +192,15 @@ def kmax_loop(options: Mapping[str, object]) -> tuple[SampledLoop, np.ndarray | 
 def _hand(value: object) -> Hand | None:
     if value is None or value is False:
         return None
-    if value == "grasp" or value is True:
+    if value is True:
         return GRASP
+    if isinstance(value, str):
+        return Hand.named(value)
     if isinstance(value, Mapping) and set(value) <= {"mass", "damping", "stiffness"} and all(
             isinstance(v, (int, float)) and not isinstance(v, bool) for v in value.values()):
         return Hand(**{k: float(v) for k, v in value.items()})
-    raise UserError(f"the hand is none, 'grasp' or a mapping of mass, damping and stiffness, got {str(value)[:60]!r}")
+    raise UserError(f"the hand is none, a name ({', '.join(HANDS)}) or a mapping of mass, damping and stiffness, got "
+                    f"{str(value)[:60]!r}")
 
 
 def kmax(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray,
