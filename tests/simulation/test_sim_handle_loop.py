@@ -19,7 +19,7 @@ import pytest
 from hapticdesign.analysis.configuration import configuration_of, handle_pose
 from hapticdesign.analysis.dynamics.device import gravity_gradient, mass_matrix
 from hapticdesign.analysis.sampled_loop import GRASP, HANDS, Hand, SampledLoop, compensated_boundary
-from hapticdesign.analysis.wall_stiffness import wall_limit
+from hapticdesign.analysis.wall_stiffness import KMAX_OPTIONS, kmax_loop, wall_limit
 from hapticdesign.devices.device_file import load_device_file
 from hapticdesign.errors import UserError
 from hapticdesign.analysis.metrics.indices import Request, evaluate
@@ -120,6 +120,6 @@ def test_the_kmax_index_takes_a_hand_by_name(five_bar):
     gain, spring = _loop_gain(jv, h, b, u, Hand(0.554, 6.45, 135.0), 1)
     assert named == pytest.approx(_independent_limit(gain, spring), rel=1e-6)
     with pytest.raises(UserError, match="unknown hand 'soft'; choose one of light, firm"):
-        evaluate(device, point[None], [Request("kmax", {"hand": "soft"}, "x")])
+        kmax_loop({**KMAX_OPTIONS, "hand": "soft"})
     with pytest.warns(FutureWarning, match="now called 'light'"):
         assert Hand.named("grasp") == HANDS["light"] == GRASP
