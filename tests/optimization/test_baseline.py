@@ -126,7 +126,7 @@ def test_the_pareto_figure_draws_the_device_files_design_within_its_axes(tmp_pat
     front = [(0.9, 0.30), (0.8, 0.36), (0.7, 0.42)]
     records = [Record(1, (0.0,), {"l1": 0.1}, f, (), "", "", 0.0) for f in front]
     base = Record(0, (0.0,), {"l1": 0.1}, (0.5, 0.9), (), "", "", 0.0)  # far beyond the front
-    run = StudyRun(SimpleNamespace(objectives=objectives), 1, records, [0, 1, 2], baseline=base)
+    run = StudyRun(SimpleNamespace(objectives=objectives, workspace=None), 1, records, [0, 1, 2], baseline=base)
     kept = []
     monkeypatch.setattr(plt, "close", kept.append)
     monkeypatch.setattr(study_outputs, "save_figure", lambda fig, path: path)

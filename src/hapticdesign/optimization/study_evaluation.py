@@ -22,7 +22,7 @@ import yaml
 
 from hapticdesign.analysis.metrics.indices import (
     INDICES, Evaluation, Index, Registry, Request, evaluate_at, evaluate_designs, evaluate_parameters, reduce,
-    requests_of,
+    reduced_at, reduction_label, requests_of, spread,
 )
 from hapticdesign.analysis.metrics.indices.registry import EVALUATION_LIMIT, require_evaluations
 from hapticdesign.analysis.configuration import configuration_of
@@ -121,6 +121,10 @@ class BoundStudy:
             raise UserError(f"{study.path}: {exc}") from None
         workspace = workspace_of(study)
         self.points = np.zeros((0, 3)) if workspace is None else workspace.points()
+        self.center = None if workspace is None else workspace.center_index
+        """The place of the box's centre among the points (None for an even grid), which ``reduce: center`` reads."""
+        self.coarseness = "" if workspace is None else workspace.describe()
+        """How coarse the workspace grid is: ``27 points, grid 3``."""
         self.title = f"{self.space.base.name} ({study.path.name})"
         self._evaluated: dict[tuple, tuple] = {}
 
@@ -236,7 +240,7 @@ class BoundStudy:
                 out.append(Answer(nothing, reason))
             else:
                 got = values[k]
-                out.append(Answer(tuple(reduce(got[label], key[2]) if (label := self.labels[key[:2]]) in got
+                out.append(Answer(tuple(reduce(got[label], key[2], self.center) if (label := self.labels[key[:2]]) in got
                                         else math.nan for key in self.keys)))
         return out
 
@@ -286,7 +290,7 @@ class BoundStudy:
         constrained = []
         for c in spec.constraints:
             if isinstance(c, IndexConstraint):
-                constrained.append(reduce(values[self.labels[c.key[:2]]], c.reduce))
+                constrained.append(reduce(values[self.labels[c.key[:2]]], c.reduce, self.center))
             else:
                 constrained.append(c.value(variables))
         g, _ = violations(spec, constrained)
@@ -344,25 +348,64 @@ class BoundStudy:
         return self._evaluated[key]
 
     def where_evaluated(self, values: dict[str, float]) -> str:
-        """Comment lines naming, for each index the study reduced over its workspace points by ``min`` or ``max``,
-        the point where the design takes that value and its actuated coordinates there, with the ``spec`` command
-        that gives the sheet at that pose (issue 35: a sheet at home, outside the study's box, reads another pose's
-        numbers; at this pose its renderable stiffness is the study's ``kmax`` with the same loop settings)."""
+        """Comment lines naming, for each index the study reduced over its workspace points, the value with how coarse
+        the grid is (``max of 27 points, grid 3``) and, for ``min``, ``max`` and ``center``, the point where the design
+        takes it and its actuated coordinates there, with the ``spec`` command that gives the sheet at that pose
+        (issue 35: a sheet at home, outside the study's box, reads another pose's numbers; at this pose its renderable
+        stiffness is the study's ``kmax`` with the same loop settings); then each pose index by every reduction
+        (:meth:`spread_rows`)."""
         device, poses, got = self._at_points(values)
         if got is None:
             return ""
         lines = []
         for index, options, how in self.keys:
             label = self.labels.get((index, options))
-            if how not in ("min", "max") or label not in got:
+            if label not in got:
                 continue
-            k = int(np.argmin(got[label]) if how == "min" else np.argmax(got[label]))
             named = index + (json.dumps(dict(options), sort_keys=True) if options else "")
+            value = reduce(got[label], how, self.center)
+            head = (f"# {how} {named} over the study's points ({reduction_label(how, len(self.points), self.grid)}) = "
+                    f"{value:.6g} {self.registry[index].unit}")
+            k = reduced_at(got[label], how, self.center)
+            if k is None:
+                lines.append(head + "\n")
+                continue
             point = ", ".join(f"{x:.6g}" for x in self.points[k])
             q = ",".join(repr(float(x)) for x in poses.q[k])
-            lines.append(f"# {how} {named} over the study's points = {got[label][k]:.6g} {self.registry[index].unit} at "
-                         f"({point}) m; the sheet there: hapticdesign spec --device THIS_FILE --q {q}\n")
+            lines.append(f"{head} at ({point}) m; the sheet there: hapticdesign spec --device THIS_FILE --q {q}\n")
+        for row in self.spread_rows(values):
+            named, unit, *numbers = row
+            shown = ", ".join(f"{how} {v}" for how, v in zip(SPREAD_COLUMNS, numbers) if v != "")
+            lines.append(f"# {named} over the study's {self.coarseness} ({unit}): {shown}\n")
         return "".join(lines)
+
+    @property
+    def grid(self) -> int:
+        """The workspace's points per axis (0 without a workspace)."""
+        workspace = self.study.spec.workspace
+        return 0 if workspace is None else workspace.grid
+
+    def spread_rows(self, values: dict[str, float]) -> list[list]:
+        """Each index of the study at the workspace's poses over the points, for a design: the index (with its
+        options), its unit and :data:`SPREAD_COLUMNS` (the extremes' points as ``(x, y, z)`` in m; ``center`` blank for
+        an even grid); none when the design does not reach every point."""
+        _, _, got = self._at_points(values)
+        if got is None:
+            return []
+        rows = []
+        for r in self.requests:
+            s = spread(got[r.key], self.center)
+            named = r.index + (json.dumps(r.options, sort_keys=True) if r.options else "")
+            rows.append([named, self.registry[r.index].unit,
+                         *("" if s[c] is None else f"{s[c]:.6g}" for c in ("center", "median", "mean", "min")),
+                         self._extreme(s, "min"), f"{s['max']:.6g}", self._extreme(s, "max")])
+        return rows
+
+    def _extreme(self, s: dict, how: str) -> str:
+        """Where an extreme of :func:`~hapticdesign.analysis.metrics.indices.spread` is taken, and at how many points
+        when it ties (a symmetric device's mirrored corners)."""
+        ties = s[f"{how}_count"]
+        return _point(self.points[s[f"{how}_at"]]) + (f" (one of {ties} points)" if ties > 1 else "")
 
     def pictures(self, values: dict[str, float]) -> list[tuple[bytes, str]]:
         """The selected design's picture at the workspace centre (at home when the centre is out of reach) and
@@ -384,6 +427,16 @@ class BoundStudy:
             out.append((index_maps(self.points, maps, "The selected design's indices over the workspace"),
                         "The selected design's indices at the workspace points"))
         return out
+
+
+SPREAD_COLUMNS = ("center", "median", "mean", "min", "min_at", "max", "max_at")
+"""What :meth:`BoundStudy.spread_rows` gives of an index over the workspace points, in order: the value at the box's
+centre, the median, the mean, the smallest and its point, the largest and its point (with how many points tie for an
+extreme)."""
+
+
+def _point(p: np.ndarray) -> str:
+    return "(" + ", ".join(f"{x:.6g}" for x in p) + ") m"
 
 
 def bind_study(study: Study, indices: Iterable[Index] = (), registry: Registry = INDICES) -> BoundStudy:

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from hapticdesign.analysis.metrics.indices import INDICES, Index
+from hapticdesign.analysis.workspace import Workspace
 from hapticdesign.errors import UserError
 from hapticdesign.files import csv_rows, figure_bytes, save_figure
 from hapticdesign.optimization.front_selection import least_rms, normalize
@@ -214,16 +215,20 @@ def normalized_like_front(run: StudyRun, objectives: np.ndarray) -> np.ndarray:
 
 def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: str = "pareto",
                   registry: Mapping[str, Index] = INDICES) -> list[Path]:
-    """The front in pairs of objectives (every feasible design in grey, the front in blue, the selected
-    design as a red star, the device file's design as a black diamond, said when it is not feasible; the axes span the front's range and the
-    device file's design, :func:`front_limits`, and the legend counts the feasible designs beyond them); one
-    objective: its value per evaluation (the device file's design a dashed line); more than three: parallel
-    coordinates of the normalized front (0 best; the device file's design dashed, normalized alike)."""
+    """The front in pairs of objectives, each labelled with its reduction and how coarse the grid is (every feasible
+    design in grey, the front in blue, the selected design as a red star, the device file's design as a black
+    diamond, said when it is not feasible; the axes span the front's range and the device file's design,
+    :func:`front_limits`, and the legend counts the feasible designs beyond them); one objective: its value per
+    evaluation (the device file's design a dashed line); more than three: parallel coordinates of the normalized
+    front (0 best; the device file's design dashed, normalized alike)."""
     plt = _pyplot()
     spec = run.spec
     units = {o.index: registry[o.index].unit for o in spec.objectives}
-    labels = [f"{o.name}: {o.reduce} {o.index} ({'-' if units[o.index] == '1' else units[o.index]}), {o.sense}imize"
-              for o in spec.objectives]
+    box = spec.workspace
+    grids = {o.index: "" if box is None or registry[o.index].of_parameters
+             else "; " + Workspace(box.box.center, box.box.size, box.grid).describe() for o in spec.objectives}
+    labels = [f"{o.name}: {o.reduce} {o.index} ({'-' if units[o.index] == '1' else units[o.index]}{grids[o.index]}), "
+              f"{o.sense}imize" for o in spec.objectives]
     feasible = [r for r in run.records if r.feasible]
     F_all = np.array([r.objectives for r in feasible]).reshape(len(feasible), len(labels))
     F = np.array([run.records[k].objectives for k in run.front]).reshape(len(run.front), len(labels))

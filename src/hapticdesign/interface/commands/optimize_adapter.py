@@ -116,7 +116,7 @@ def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Select
     kept = (["checkpoint/ (one file per generation; a rerun into this folder continues)"]
             if method_of(run.spec).checkpointed else [])
     page = render(run, selection, bound.title, Picture((out / "pareto.png").read_bytes(), "Pareto front"), pictures,
-                  [*FILES, *kept])
+                  [*FILES, *kept], bound.coarseness, bound.spread_rows(chosen.values))
     write_atomically(out / "report.html", page)
     return [*paths, out / "selected.yaml", out / "report.html"]
 
@@ -128,7 +128,7 @@ def write_failure(out: Path, run: StudyRun, bound: BoundStudy, error: UserError)
     kept = (["checkpoint/ (one file per generation; a rerun into this folder continues)"]
             if method_of(run.spec).checkpointed else [])
     write_atomically(out / "report.html", render_failure(run, str(error), bound.title,
-                                                         ["evaluations.csv", "report.html", *kept]))
+                                                         ["evaluations.csv", "report.html", *kept], bound.coarseness))
     return [out / "evaluations.csv", out / "report.html"]
 
 

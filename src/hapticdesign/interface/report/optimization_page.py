@@ -13,6 +13,7 @@ from html import escape
 
 from hapticdesign.interface.report.html import STYLE
 from hapticdesign.interface.report.tables import cell_text
+from hapticdesign.optimization.study_evaluation import SPREAD_COLUMNS
 from hapticdesign.optimization.study_file import Choice
 from hapticdesign.optimization.study_methods import method_of
 from hapticdesign.optimization.study_outputs import Selection, at_bounds, changes, closest_designs
@@ -52,11 +53,12 @@ def _options(options: dict) -> str:
     return ", ".join(f"{k} = {v}" for k, v in options.items())
 
 
-def _study_rows(run: StudyRun) -> str:
+def _study_rows(run: StudyRun, coarseness: str) -> str:
     spec = run.spec
+    over = f" of {coarseness}" if coarseness else ""
     variables = [[name, *(("choice of " + ", ".join(f"{v:g}" for v in var.values), "") if isinstance(var, Choice)
                           else (f"{var[0]:g}", f"{var[1]:g}"))] for name, var in spec.variables.items()]
-    objectives = [[o.name, o.index, _options(o.options), o.reduce, o.sense] for o in spec.objectives]
+    objectives = [[o.name, o.index, _options(o.options), o.reduce + over, o.sense] for o in spec.objectives]
     constraints = [[c.label + (f" ({_options(c.options)})" if getattr(c, "options", None) else ""),
                     "" if c.at_least is None else c.at_least, "" if c.at_most is None else c.at_most]
                    for c in spec.constraints]
@@ -142,22 +144,27 @@ def _document(title: str, body: list[str], files: list[str]) -> str:
 
 
 def render(run: StudyRun, selection: Selection, title: str, pareto: Picture, pictures: list[Picture],
-           files: list[str]) -> str:
-    """The report as one HTML document."""
+           files: list[str], coarseness: str = "", spread: list[list] | None = None) -> str:
+    """The report as one HTML document; ``coarseness`` says how coarse the workspace grid is (``27 points, grid 3``),
+    ``spread`` gives the selected design's pose indices over the points
+    (:meth:`~hapticdesign.optimization.study_evaluation.BoundStudy.spread_rows`)."""
     spec = run.spec
     names = [o.name for o in spec.objectives]
     columns = ["design", *names, *spec.variables, *constraint_labels(spec)]  # the objectives first: what a front is
     rows = [[n, *run.records[k].objectives, *(run.records[k].values[v] for v in spec.variables),
              *run.records[k].constraints] for n, k in enumerate(run.front, start=1)]
     chosen = run.records[selection.record]
-    body = [f"<h1>Optimization study: {escape(title)}</h1>", "<h2>Study</h2>", _study_rows(run),
+    over = [_table(f"The selected design's indices over the workspace ({coarseness}): at the box's centre, median, "
+                   "mean and the extremes with the points where they are taken", ["index", "unit", *SPREAD_COLUMNS],
+                   spread)] if spread else []
+    body = [f"<h1>Optimization study: {escape(title)}</h1>", "<h2>Study</h2>", _study_rows(run, coarseness),
             "<h2>Pareto front</h2>", _image(pareto),
             _table(f"The front: {len(run.front)} feasible, non-dominated designs (front.csv)", columns, rows,
                    selection.position),
             "<h2>Selected design</h2>",
             f"<p>Design {selection.position + 1} of the front, by the {escape(selection.rule)}; as a device file: "
             "selected.yaml.</p>",
-            _baseline(run, chosen),
+            _baseline(run, chosen), *over,
             *(_image(p) for p in pictures),
             "<h2>Infeasible designs</h2>", _reasons(run)]
     return _document(title, body, files)
@@ -179,10 +186,10 @@ def _closest(run: StudyRun) -> str:
                   "evaluations.csv has every design)", columns, rows)
 
 
-def render_failure(run: StudyRun, why: str, title: str, files: list[str]) -> str:
+def render_failure(run: StudyRun, why: str, title: str, files: list[str], coarseness: str = "") -> str:
     """The report of a run without a feasible design as one HTML document: ``why`` (the run's one-line error), the
-    closest designs, the device file's design and the reasons counted by kind."""
-    body = [f"<h1>Optimization study: {escape(title)}</h1>", "<h2>Study</h2>", _study_rows(run),
+    closest designs, the device file's design and the reasons counted by kind; ``coarseness`` as for :func:`render`."""
+    body = [f"<h1>Optimization study: {escape(title)}</h1>", "<h2>Study</h2>", _study_rows(run, coarseness),
             "<h2>No feasible design</h2>", f"<p>{escape(why, quote=False)}</p>", _closest(run),
             "<h2>The device file's design</h2>", _baseline(run),
             "<h2>Infeasible designs</h2>", _reasons(run)]
