@@ -4,10 +4,12 @@ Runs ``hapticdesign optimize examples/studies/phantom-premium-redesign.yaml --se
 report.html, pareto.png, front.csv and selected.yaml in docs/figures/optimization/phantom-premium-redesign/, and
 evaluates the published Phantom Premium 1.5 (examples/devices/phantom-premium.yaml, unmodified) through the same
 index registry at the study's workspace points. It prints the Markdown of the section: the run, a table of the
-published design beside front designs (the study's objectives, then what they cost: the worst continuous and peak
-force, the lightest point, the largest box of the study's proportions and centre each design reaches on the study's
-grid, as a fraction of the data sheet's) and draws front_vs_published.png (the front, every feasible design evaluated,
-the published design).
+published design beside front designs (the felt mass at the median of the points, at the box's centre and at the
+heaviest point; the weakest wall with the light hand and without a hand; the worst continuous and peak force; the
+largest box of the study's proportions and centre each design reaches on the study's grid, as a fraction of the
+data sheet's), what the selected design gained and lost, the wall the published design renders with compliant
+capstans of a few stiffnesses (an illustration: no stiffness is published), and draws front_vs_published.png (the
+front, every feasible design evaluated, the published design).
 
 Run: ``PYTHONPATH=src .venv/bin/python docs/scripts/phantom_redesign.py`` (a few minutes on a shared 2-core
 machine).
@@ -52,8 +54,12 @@ device file's x, y, z."""
 SHOWN = 8
 """Front designs in the table: both ends, the selected one and evenly spaced others."""
 
-REQUESTS = [Request("apparent_mass", {}, "mass"), Request("kmax", {"period": 0.001, "delay": 1}, "wall"),
-            Request("force", {"torque": "continuous"}, "force"), Request("force", {"torque": "peak"}, "peak")]
+LOOP = {"period": 0.001, "delay": 1}
+REQUESTS = [Request("apparent_mass", {}, "mass"), Request("kmax", {**LOOP, "hand": "light"}, "wall"),
+            Request("kmax", LOOP, "bare"), Request("force", {"torque": "continuous"}, "force"),
+            Request("force", {"torque": "peak"}, "peak")]
+CABLES = (200.0, 1000.0, 5000.0, 20000.0)
+"""Transmission stiffnesses (N m/rad at each joint) of the compliance illustration: no figure is published."""
 
 
 def published_variables() -> dict[str, float]:
@@ -82,13 +88,15 @@ def run_study(scratch: Path) -> tuple[dict, float]:
     return summary, elapsed
 
 
-def indices(device, points: np.ndarray) -> dict[str, float]:
+def indices(device, points: np.ndarray, center: int) -> dict[str, float]:
+    """The table's reduced indices of ``device`` at the ``points``, the box's centre the ``center``-th."""
     result = evaluate(device, points, REQUESTS)
     if result.reason is not None:
         raise SystemExit(f"a design of the table does not reach the workspace: {result.reason}")
     v = result.values
-    return {"mass": reduce(v["mass"], "max"), "wall": reduce(v["wall"], "min"), "force": reduce(v["force"], "min"),
-            "peak": reduce(v["peak"], "min"), "lightest": reduce(v["mass"], "min")}
+    return {"mass": reduce(v["mass"], "median"), "centre": reduce(v["mass"], "center", center),
+            "heaviest": reduce(v["mass"], "max"), "wall": reduce(v["wall"], "min"), "bare": reduce(v["bare"], "min"),
+            "force": reduce(v["force"], "min"), "peak": reduce(v["peak"], "min")}
 
 
 def largest_scale(device, box) -> float:
@@ -126,10 +134,31 @@ def data_sheet_box(device, box) -> str:
 
 def finer_grid(device, box) -> str:
     """The published design's reduced indices on grid 5 (125 points) of the study's box."""
-    got = indices(device, Workspace(box.center, box.size, 5).points())
-    return (f"On grid 5 (125 points) of the study's box the published design gives heaviest apparent mass "
-            f"{1000 * got['mass']:.1f} g, weakest wall {got['wall']:.3f} N/m, worst continuous force "
-            f"{got['force']:.3f} N.")
+    fine = Workspace(box.center, box.size, 5)
+    got = indices(device, fine.points(), fine.center_index)
+    return (f"On grid 5 (125 points) of the study's box the published design gives a median felt mass of "
+            f"{1000 * got['mass']:.1f} g (heaviest {1000 * got['heaviest']:.1f} g), weakest wall with the light hand "
+            f"{got['wall']:.1f} N/m, worst continuous force {got['force']:.3f} N.")
+
+
+def cable_walls(points: np.ndarray) -> str:
+    """The published design's weakest wall (light and firm hand) with every capstan given the same compliance."""
+    data = yaml.safe_load(DEVICE.read_text())
+    lines = ["| transmission stiffness at each joint (N m/rad) | weakest wall, light hand (N/m) | weakest wall, firm "
+             "hand (N/m) | first resonance of q1's motor on its cable (Hz) |", "| --- | --- | --- | --- |"]
+    rotor = 1.08e-6 * 13.3 ** 2
+    hands = [Request("kmax", {**LOOP, "hand": name}, name) for name in ("light", "firm")]
+    for cable in (None, *CABLES):
+        data["actuators"] = [{k: v for k, v in a.items() if k != "transmission_stiffness"}
+                             | ({} if cable is None else {"transmission_stiffness": cable}) for a in data["actuators"]]
+        with tempfile.TemporaryDirectory() as scratch:
+            path = Path(scratch) / "phantom-premium-cables.yaml"
+            path.write_text(yaml.safe_dump(data))
+            values = evaluate(load_device_file(path), points, hands).values
+        resonance = "rigid" if cable is None else f"{np.sqrt(cable / rotor) / (2 * np.pi):.0f}"
+        lines.append(f"| {'rigid (the device file)' if cable is None else f'{cable:g}'} "
+                     f"| {reduce(values['light'], 'min'):.1f} | {reduce(values['firm'], 'min'):.1f} | {resonance} |")
+    return "\n".join(lines)
 
 
 def shown_designs(front: list[dict], selected: int) -> list[int]:
@@ -141,8 +170,8 @@ def shown_designs(front: list[dict], selected: int) -> list[int]:
 def front_ranges(front: list[dict]) -> str:
     mass = [1000 * d["objectives"]["mass"] for d in front]
     wall = [d["objectives"]["wall"] for d in front]
-    return (f"heaviest apparent mass {min(mass):.1f} to {max(mass):.1f} g, weakest wall {min(wall):.3f} to "
-            f"{max(wall):.3f} N/m")
+    return (f"median felt mass {min(mass):.1f} to {max(mass):.1f} g, weakest wall with the light hand "
+            f"{min(wall):.1f} to {max(wall):.1f} N/m")
 
 
 def at_bounds(study, front: list[dict]) -> str:
@@ -157,28 +186,21 @@ def at_bounds(study, front: list[dict]) -> str:
 
 
 def figure(rows: dict, feasible: list[tuple[float, float]], front: list[dict]) -> Path:
-    """Left: every feasible design, the front and the published design (mass on a log scale); right: the front."""
-    fig, (whole, near) = plt.subplots(1, 2, figsize=(10, 4.4), dpi=110)
+    """Every feasible design, the front and the published design: the median felt mass against the weakest wall with
+    the light hand."""
+    fig, whole = plt.subplots(1, 1, figsize=(7, 4.6), dpi=110)
     mass = [1000 * d["objectives"]["mass"] for d in front]
     wall = [d["objectives"]["wall"] for d in front]
     published = rows["published"]
     whole.scatter([1000 * m for m, _ in feasible], [w for _, w in feasible], s=8, color="0.75",
                   label="feasible designs evaluated")
-    whole.scatter(mass, wall, s=18, color="tab:blue", label="front")
+    whole.plot(mass, wall, "o-", color="tab:blue", markersize=4, label=f"front ({len(front)} designs)")
     whole.scatter([1000 * published["mass"]], [published["wall"]], marker="*", s=220, color="tab:red",
                   label=f"published Phantom Premium 1.5\n(worst continuous force {published['force']:.2f} N < 1.4 N)")
-    whole.set_xscale("log")
-    whole.set_xlabel("heaviest apparent mass over the workspace (g, log scale)")
-    whole.set_ylabel("weakest renderable wall kmax (N/m)")
-    whole.set_title("every feasible design and the published one", fontsize=10)
+    whole.set_xlabel("median apparent mass over the box's 27 points (g)")
+    whole.set_ylabel("weakest wall kmax, light hand (N/m)")
     whole.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2)
-    whole.grid(True, which="both", alpha=0.3)
-    near.plot(mass, wall, "o-", color="tab:blue", markersize=4)
-    near.set_xlabel("heaviest apparent mass over the workspace (g)")
-    near.set_ylabel("weakest renderable wall kmax (N/m)")
-    near.set_title(f"the front ({len(front)} designs; the published design: {1000 * published['mass']:.0f} g, "
-                   f"{published['wall']:.2f} N/m)", fontsize=10)
-    near.grid(True, alpha=0.3)
+    whole.grid(True, alpha=0.3)
     fig.tight_layout()
     path = TARGET / "front_vs_published.png"
     fig.savefig(path, metadata={"Software": None}, bbox_inches="tight")
@@ -186,11 +208,20 @@ def figure(rows: dict, feasible: list[tuple[float, float]], front: list[dict]) -
     return path
 
 
+def change(before: float, after: float, unit: str, scale: float = 1.0, digits: int = 1, lower_is_better=True) -> str:
+    """``74.1 -> 70.2 g (-5.3 %, better)``."""
+    percent = 100.0 * (after / before - 1.0)
+    better = (after < before) == lower_is_better
+    word = "same" if abs(percent) < 0.05 else ("better" if better else "worse")
+    return f"{scale * before:.{digits}f} -> {scale * after:.{digits}f} {unit} ({percent:+.1f} %, {word})"
+
+
 def main() -> None:
     study = load_study(STUDY)
     bound = bind_study(study)
     box = study.spec.workspace.box
     points = bound.points
+    center = Workspace(box.center, box.size, study.spec.workspace.grid).center_index
     published = published_variables()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the published be and df bodies' triangle-inequality note (device file)
@@ -199,11 +230,13 @@ def main() -> None:
         with tempfile.TemporaryDirectory() as scratch:
             summary, elapsed = run_study(Path(scratch))
         front, selected = summary["front"], summary["selected"]["design"]
-        rows = {"published": {**published, **indices(unmodified, points), "scale": largest_scale(unmodified, box)}}
+        rows = {"published": {**published, **indices(unmodified, points, center),
+                              "scale": largest_scale(unmodified, box)}}
         for k in shown_designs(front, selected):
             values = front[k - 1]["variables"]
             device = bound.space.device(bound.device_values(values))
-            rows[k] = {**values, **indices(device, points), "scale": largest_scale(device, box)}
+            rows[k] = {**values, **indices(device, points, center), "scale": largest_scale(device, box)}
+        cables = cable_walls(points)
     read = [o.name for o in study.spec.objectives] + ["force"]  # the study's reduced indices, in its order
     same = {name: (as_study.reduced[i], rows["published"][name]) for i, name in enumerate(read)}
     path = figure(rows, summary["feasible"], front)
@@ -216,23 +249,31 @@ def main() -> None:
           + ", ".join(f"{n} = {a:.6g} (the unmodified device file: {b:.6g})" for n, (a, b) in same.items())
           + ".\n")
     print(data_sheet_box(unmodified, box), finer_grid(unmodified, box), "\n")
-    print("| design | l1, l2, l3 (mm) | ratios q1, q2, q3 | heaviest apparent mass (g) | weakest wall kmax (N/m) "
-          "| worst continuous force (N) | worst peak force (N) | lightest apparent mass (g) "
-          "| largest box reached (of 381 x 267 x 191 mm) |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    print("| design | l1, l2, l3 (mm) | ratios q1, q2, q3 | median felt mass (g) | at the centre (g) | heaviest (g) "
+          "| weakest wall, light hand (N/m) | weakest wall, no hand (N/m) | worst continuous force (N) "
+          "| worst peak force (N) | largest box reached (of 381 x 267 x 191 mm) |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for name, r in rows.items():
         label = "published" if name == "published" else f"front {name}" + (" (selected)" if name == selected else "")
         print(f"| {label} | {1000 * r['l1']:.1f}, {1000 * r['l2']:.1f}, {1000 * r['l3']:.1f} "
-              f"| {r['ratio1']:.2f}, {r['ratio2']:.2f}, {r['ratio3']:.2f} | {1000 * r['mass']:.1f} | {r['wall']:.3f} "
-              f"| {r['force']:.3f} | {r['peak']:.2f} | {1000 * r['lightest']:.1f} | {100 * r['scale']:.1f} % |")
+              f"| {r['ratio1']:.2f}, {r['ratio2']:.2f}, {r['ratio3']:.2f} | {1000 * r['mass']:.1f} "
+              f"| {1000 * r['centre']:.1f} | {1000 * r['heaviest']:.1f} | {r['wall']:.1f} | {r['bare']:.3f} "
+              f"| {r['force']:.3f} | {r['peak']:.2f} | {100 * r['scale']:.1f} % |")
     print(f"\nThe whole front ({len(front)} designs): {front_ranges(front)}; {at_bounds(study, front)}.")
     base, best = rows["published"], rows[selected]
-    print(f"\nSelected design {selected} against the published one: heaviest apparent mass "
-          f"{base['mass'] / best['mass']:.2f}x lower, weakest wall {best['wall'] / base['wall']:.2f}x higher, worst "
-          f"continuous force {base['force']:.3f} -> {best['force']:.3f} N; lightest point "
-          f"{1000 * base['lightest']:.1f} -> {1000 * best['lightest']:.1f} g; lengths l1 + l2 "
+    print(f"\nSelected design {selected} against the published one: median felt mass "
+          f"{change(base['mass'], best['mass'], 'g', 1000)}; at the box's centre "
+          f"{change(base['centre'], best['centre'], 'g', 1000)}; heaviest point "
+          f"{change(base['heaviest'], best['heaviest'], 'g', 1000)}; weakest wall with the light hand "
+          f"{change(base['wall'], best['wall'], 'N/m', lower_is_better=False)} (without a hand "
+          f"{change(base['bare'], best['bare'], 'N/m', digits=3, lower_is_better=False)}); worst continuous force "
+          f"{change(base['force'], best['force'], 'N', digits=3, lower_is_better=False)}; worst peak force "
+          f"{change(base['peak'], best['peak'], 'N', digits=2, lower_is_better=False)}; lengths l1 + l2 "
           f"{1000 * (base['l1'] + base['l2']):.1f} -> {1000 * (best['l1'] + best['l2']):.1f} mm.")
     print(f"\n![The front beside the published design]({path.relative_to(ROOT / 'docs').as_posix()})")
+    print("\nThe published design with compliant capstans (every motor's `transmission_stiffness` the same; an "
+          "illustration, no stiffness is published), at the study's points:\n")
+    print(cables)
 
 
 if __name__ == "__main__":

@@ -2,7 +2,8 @@
 time (:func:`hapticdesign.analysis.metrics.indices.evaluate` of ``DesignSpace.device``, whose indices are checked
 against closed forms, finite differences, kinetic energy and the VJM's own references in test_indices.py and
 test_indices_force_stiffness.py): same values, same failures, for every kind of design variable, trees and closed
-loops."""
+loops. An elastic post under the five-bar's loop (tests/devices/five_bar_on_a_post.yaml) is also checked against the
+Euler-Bernoulli cantilever's closed form and the series law (tests/helpers/cantilever.py)."""
 
 from __future__ import annotations
 
@@ -197,3 +198,92 @@ def test_a_home_given_as_a_handle_position_follows_each_design_batched_as_one_at
         assert fast.reason is None and slow.reason is None
         for key in slow.values:
             np.testing.assert_allclose(fast.values[key], slow.values[key], rtol=1e-9, err_msg=key)
+
+
+POST = ROOT / "tests" / "devices" / "five_bar_on_a_post.yaml"
+"""The five-bar of elastic tubes on an elastic post: the post's end (``top``) is ahead of both ends of the closure."""
+E_POST, G_POST = 2.0e11, 8.0e10  # the post's moduli as the fixture file gives them (Pa)
+POST_POINTS = np.array([[x, -0.03, z] for x in (0.033, 0.053) for z in (0.44, 0.46)])
+"""Handle positions about the fixture's home (the five-bar's plane is y = oy = -0.03 m)."""
+POST_DESIGNS = [{"links.post.D": 0.006, "ox": 0.04}, {"links.post.D": 0.009, "ox": 0.035},
+                {"links.post.D": 0.0045, "ox": 0.046}]
+
+
+def _post_fixture(tmp_path: Path, keep: set[str]) -> Path:
+    """The fixture file with only the elastic links ``keep``; a body that was a dropped link becomes a point mass on
+    the link's start frame (masses do not enter the stiffness)."""
+    data = yaml.safe_load(POST.read_text())
+    start = {link["name"]: link["from"] for link in data["links"]}
+    data["links"] = [link for link in data["links"] if link["name"] in keep]
+    data["bodies"] = [body if body.get("link", next(iter(keep))) in keep else
+                      {"name": body["name"], "frame": start[body["link"]], "m": 0.05, "rx": 0.05}
+                      for body in data["bodies"]]
+    path = tmp_path / f"post-{'-'.join(sorted(keep))}.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
+def _post_compliance(design: dict, point: np.ndarray, height: float = 0.25) -> np.ndarray:
+    """The closed form of the post alone at the handle: the steel rod's cantilever end compliance (its axis the
+    base's z, ``height`` long) carried rigidly to the handle at ``point``."""
+    from tests.helpers.cantilever import cantilever_compliance, carried_compliance, rod_rigidities
+
+    top = np.array([0.0, 0.0, height])
+    rigid = rod_rigidities(E_POST, G_POST, design["links.post.D"])
+    return carried_compliance(cantilever_compliance(top, *rigid), point - top)
+
+
+def _batched_stiffness(path: Path, designs: list[dict]):
+    """The compiled path's ``K_C`` (D, P, 6, 6) of ``designs`` at :data:`POST_POINTS`, its actuated poses and its
+    design space."""
+    from hapticdesign.analysis.design_batch import DesignBatch
+
+    space = design_space(path, sorted(designs[0]))
+    batch = DesignBatch(space.base)
+    got = batch.evaluate(space.batch_values(designs, batch), POST_POINTS, stiffness=True)
+    assert got.ok.all(), got.reasons
+    return got.stiffness, got.q, space
+
+
+def _same_matrix(found: np.ndarray, expected: np.ndarray, rtol: float) -> None:
+    """Equal to ``rtol`` of the largest entry (entries span five decades)."""
+    np.testing.assert_allclose(found, expected, rtol=rtol, atol=rtol * np.abs(expected).max())
+
+
+def test_an_elastic_post_under_a_closed_loop_is_the_cantilevers_closed_form_batched(tmp_path):
+    """Only the post elastic, the five-bar rigid (its motors locked): a deformation of the post moves the whole loop
+    rigidly and opens no closure, so the handle's compliance is the post's cantilever end compliance carried to the
+    handle (Euler-Bernoulli closed form, tests/helpers/cantilever.py), for each design (the post's diameter, the
+    loop's offset from the post) and point. The compiled batch and the one-design VJM both give it; a closure row
+    that counts the post's twist at the second frame with the wrong sign (its value at both ends added, not
+    subtracted) would have the post open the loop."""
+    from hapticdesign.analysis.stiffness.device import cartesian_stiffness
+
+    path = _post_fixture(tmp_path, {"post"})
+    batched, q, space = _batched_stiffness(path, POST_DESIGNS)
+    for d, design in enumerate(POST_DESIGNS):
+        device = space.device(design)
+        for p, point in enumerate(POST_POINTS):
+            expected = np.linalg.inv(_post_compliance(design, point))
+            _same_matrix(batched[d, p], expected, 1e-8)
+            _same_matrix(cartesian_stiffness(device, q[d, p]), expected, 1e-8)
+
+
+def test_an_elastic_post_is_in_series_with_the_elastic_loop_on_it_batched(tmp_path):
+    """The post and the five-bar's four tubes elastic: the post carries the whole wrench and moves the loop rigidly,
+    so the handle's compliance is the five-bar's on a rigid post (the one-design VJM of the fixture without the post's
+    link) plus the post's closed form carried to the handle (springs in series). The compiled batch of the whole
+    fixture equals that sum and the one-design VJM of the whole fixture, design by design (the post's and a distal
+    tube's diameters, the loop's offset) and point by point."""
+    from hapticdesign.analysis.stiffness.device import cartesian_stiffness
+
+    designs = [{**design, "links.dist1.D": dist} for design, dist in zip(POST_DESIGNS, (0.010, 0.0085, 0.012))]
+    batched, q, space = _batched_stiffness(POST, designs)
+    loop_only = design_space(_post_fixture(tmp_path, {"prox1", "prox2", "dist1", "dist2"}), ["links.dist1.D", "ox"])
+    for d, design in enumerate(designs):
+        whole = space.device(design)
+        rigid_post = loop_only.device({k: v for k, v in design.items() if k != "links.post.D"})
+        for p, point in enumerate(POST_POINTS):
+            _same_matrix(batched[d, p], cartesian_stiffness(whole, q[d, p]), 1e-9)
+            series = np.linalg.inv(cartesian_stiffness(rigid_post, q[d, p])) + _post_compliance(design, point)
+            _same_matrix(batched[d, p], np.linalg.inv(series), 1e-8)

@@ -238,9 +238,17 @@ def test_the_r_cube_indices_are_an_entry_point_of_the_installed_package():
 
 
 def test_the_kmax_index_takes_the_sampled_loops_options_and_defaults():
-    from hapticdesign.analysis.wall_stiffness import KMAX_OPTIONS
+    """The ``kmax`` index's options and defaults are those docs/indices.md states (written here from its row: 1 kHz,
+    one sample of delay, no wall damper, the worst direction, backward-difference velocity, gravity compensation, no
+    model error, no hand), and :class:`SampledLoop`'s defaults, the loop every command uses, are the same loop."""
+    from hapticdesign.analysis.sampled_loop import SampledLoop
 
-    assert dict(INDICES["kmax"].options) == KMAX_OPTIONS
+    documented = {"period": 0.001, "delay": 1, "damping": 0.0, "direction": None, "velocity": "difference",
+                  "compensation": "gravity", "error_percent": 0.0, "hand": None}
+    assert dict(INDICES["kmax"].options) == documented
+    loop = SampledLoop()
+    assert (loop.period, loop.delay, loop.virtual_damping, loop.velocity, loop.compensation, loop.model_error,
+            loop.hand, loop.held) == (0.001, 1, 0.0, "difference", "gravity", 0.0, None, ())
 
 
 def test_kmax_with_a_modelling_error_takes_the_compensators_model_batched_and_one_at_a_time():

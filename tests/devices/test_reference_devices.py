@@ -1,8 +1,8 @@
 """The reference devices of examples/devices against their published models.
 
 - ``phantom-premium.yaml`` against Cavusoglu & Feygin's (2001) closed-form mass matrix and gravity vector
-  of the Phantom 1.5 (UC Berkeley ERL memo M01/15; the formulas written out below from the memo's
-  transcription in github.com/mahilab/Phantom, ``step_dynamics_cavusoglu``), plus the reflected rotor
+  of the Phantom 1.5 (UC Berkeley ERL memo M01/15; the formulas written out in tests/helpers/phantom_premium_mass.py
+  and below from the memo's transcription in github.com/mahilab/Phantom, ``step_dynamics_cavusoglu``), plus the reflected rotor
   inertia ``n^2 J_r`` of its motors, and the memo's own test vectors at g = 9.81.
 - ``falcon.yaml`` against the closed-form inverse kinematics of Stamper's delta as libnifalcon states
   it (``FalconKinematicStamper::IK``, the geometry of ``FalconGeometry.h``), re-derived below.
@@ -23,30 +23,11 @@ from hapticdesign.analysis.configuration import handle_pose
 from hapticdesign.devices.device_file import load_device_file
 from hapticdesign.devices.loading import resolve_device
 from hapticdesign.errors import PhysicalConsistencyWarning, UserError
+from tests.helpers.phantom_premium_mass import (
+    IBE, IDF, L1, L2, L3, L5, L6, MA, MBE, MC, MDF, ROTOR, cavusoglu_mass_matrix,
+)
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "devices"
-L1, L2, L3, L5, L6 = 0.215, 0.170, 0.0325, -0.0368, 0.0527
-MA, MC, MBE, MDF = 0.0202, 0.0249, 0.2359, 0.1906
-IA = (0.4864e-4, 0.001843e-4, 0.4864e-4)
-IC = (0.959e-4, 0.959e-4, 0.0051e-4)
-IBE = (11.09e-4, 10.06e-4, 0.591e-4)
-IDF = (7.11e-4, 0.629e-4, 6.246e-4)
-IBASE_YY = 11.87e-4
-ROTOR = 1.08e-6 * np.array([13.3, 11.2, 11.2]) ** 2
-
-
-def cavusoglu_mass_matrix(q) -> np.ndarray:
-    """The memo's M(q) (without motors)."""
-    _, q2, q3 = q
-    m11 = (0.125 * (4 * IA[1] + 4 * IA[2] + 8 * IBASE_YY + 4 * IBE[1] + 4 * IBE[2] + 4 * IC[1] + 4 * IC[2]
-                    + 4 * IDF[1] + 4 * IDF[2] + 4 * L1**2 * MA + L2**2 * MA + L1**2 * MC + 4 * L3**2 * MC)
-           + 0.125 * (4 * IBE[1] - 4 * IBE[2] + 4 * IC[1] - 4 * IC[2] + L1**2 * (4 * MA + MC)) * math.cos(2 * q2)
-           + 0.125 * (4 * IA[1] - 4 * IA[2] + 4 * IDF[1] - 4 * IDF[2] - L2**2 * MA - 4 * L3**2 * MC) * math.cos(2 * q3)
-           + L1 * (L2 * MA + L3 * MC) * math.cos(q2) * math.sin(q3))
-    m22 = IBE[0] + IC[0] + L1**2 * MA + 0.25 * L1**2 * MC
-    m23 = -0.5 * L1 * (L2 * MA + L3 * MC) * math.sin(q2 - q3)
-    m33 = IA[0] + IDF[0] + 0.25 * L2**2 * MA + L3**2 * MC
-    return np.array([[m11, 0, 0], [0, m22, m23], [0, m23, m33]])
 
 
 def cavusoglu_gravity(q, g: float) -> np.ndarray:

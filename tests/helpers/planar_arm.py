@@ -40,3 +40,16 @@ def planar_arm(l1: float = 0.2, l2: float = 0.2 / math.sqrt(2.0), elbow: float =
     if link_bodies:
         arm["bodies"] = [{"name": "1", "link": "upper"}, {"name": "2", "link": "lower"}]
     return arm
+
+
+def reaches(l1: float, l2: float, point) -> bool:
+    """Whether the two-link arm (links ``l1``, ``l2``, joints free) reaches ``point`` (x, y, z; m) of its x-z plane: the
+    closed form ``|l1 - l2| <= r <= l1 + l2``, ``r`` the point's distance from the shoulder (at the origin)."""
+    x, y, z = (float(v) for v in point)
+    r = math.hypot(x, z)
+    return abs(y) < 1e-12 and abs(l1 - l2) <= r <= l1 + l2
+
+
+def points_reached(l1: float, l2: float, points) -> int:
+    """How many of ``points`` the two-link arm reaches (:func:`reaches`)."""
+    return sum(reaches(l1, l2, p) for p in points)

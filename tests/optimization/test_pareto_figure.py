@@ -22,7 +22,7 @@ def test_the_front_fills_the_axes_and_the_far_designs_are_counted(tmp_path, monk
     far = [(0.2, 1.6), (0.1, 1.2), (0.75, 0.45)]
     objectives = [SimpleNamespace(name="isotropy", reduce="min", index="isotropy", sense="max"),
                   SimpleNamespace(name="mass", reduce="max", index="apparent_mass", sense="min")]
-    run = StudyRun(SimpleNamespace(objectives=objectives), 1, [_record(f) for f in front + far], [0, 1, 2, 3])
+    run = StudyRun(SimpleNamespace(objectives=objectives, workspace=None), 1, [_record(f) for f in front + far], [0, 1, 2, 3])
     kept = []
     monkeypatch.setattr(plt, "close", kept.append)
     monkeypatch.setattr(study_outputs, "save_figure", lambda fig, path: path)

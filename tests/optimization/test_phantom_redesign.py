@@ -11,6 +11,7 @@ beat on both objectives.
 from __future__ import annotations
 
 import copy
+import csv
 import json
 import math
 import warnings
@@ -32,6 +33,7 @@ from tests.helpers.phantom_premium_ik import reachable
 ROOT = Path(__file__).resolve().parents[2]
 STUDY = ROOT / "examples" / "studies" / "phantom-premium-redesign.yaml"
 DEVICE = ROOT / "examples" / "devices" / "phantom-premium.yaml"
+FRONT = ROOT / "docs" / "figures" / "optimization" / "phantom-premium-redesign" / "front.csv"
 CONTINUOUS_FORCE = 1.4  # N, the data sheet's continuous exertable force (the study's constraint)
 
 
@@ -85,10 +87,10 @@ def test_the_published_design_reaches_the_study_workspace(bound):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         result = evaluate(load_device_file(DEVICE), bound.points,
-                          [Request("apparent_mass"), Request("kmax", {"period": 0.001, "delay": 1}),
+                          [Request("apparent_mass"), Request("kmax", {"period": 0.001, "delay": 1, "hand": "light"}),
                            Request("force", {"torque": "continuous"})])
     assert result.reason is None
-    direct = (reduce(result.values["apparent_mass"], "max"), reduce(result.values["kmax"], "min"),
+    direct = (reduce(result.values["apparent_mass"], "median"), reduce(result.values["kmax"], "min"),
               reduce(result.values["force"], "min"))
     np.testing.assert_allclose(answer.reduced, direct, rtol=1e-9)
 
@@ -113,4 +115,20 @@ def test_a_front_design_of_a_small_seeded_run_beats_the_published_design(bound, 
         assert answer.reason == ""
         assert answer.reduced[:2] == pytest.approx((design["objectives"]["mass"], design["objectives"]["wall"]),
                                                    rel=1e-9)
+        assert answer.reduced[2] >= CONTINUOUS_FORCE
+
+
+def test_the_documented_front_holds_on_this_machine(bound):
+    """Every design of the committed front (docs/figures/optimization/phantom-premium-redesign/front.csv, which
+    docs/scripts/phantom_redesign.py writes) evaluated here gives the objectives and the force the file states, to
+    1e-9: the documented numbers do not hinge on the machine that ran the search (which designs NSGA-II visits may)."""
+    with open(FRONT, newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    assert rows
+    names = list(bound.study.spec.variables)
+    answers = bound.evaluate([{name: float(row[name]) for name in names} for row in rows])
+    for row, answer in zip(rows, answers):
+        assert answer.reason == ""
+        stated = [float(row[key]) for key in ("mass", "wall", "min_force[torque=continuous]")]
+        np.testing.assert_allclose(answer.reduced, stated, rtol=1e-9, err_msg=row["design"])
         assert answer.reduced[2] >= CONTINUOUS_FORCE

@@ -200,12 +200,31 @@ def test_nsga3_is_pymoos_nsga3_on_the_same_problem_with_the_same_seed(tmp_path):
         tuple(np.round(run.records[k].x, 15)) for k in run.front)
 
 
-def test_every_method_of_the_table_is_reachable_from_a_study_file():
+DOCUMENTED_METHODS = {"nsga2": ("NSGA-II", True), "nsga3": ("NSGA-III", True), "pso": ("Particle swarm", True),
+                      "convex": (None, False)}
+"""The methods docs/optimization.md names (its table of methods), each with the algorithm it names and whether it keeps
+a checkpoint (the population searches do; convex is one program), written here from the page."""
+
+
+def test_every_documented_method_is_reachable_from_a_study_file():
+    """The methods table of docs/optimization.md (the first cells of its rows, read from the page) is
+    :data:`DOCUMENTED_METHODS`, and each name in a study file's ``algorithm`` gives a method of that name, the
+    algorithm the page names and the checkpointing it states; without a ``method``, ``nsga2`` (the page's default)."""
+    import re
+
+    page = (Path(__file__).resolve().parents[2] / "docs" / "optimization.md").read_text(encoding="utf-8")
+    table = page.split("| method | what it is | its own settings |", 1)[1].split("\n\n", 1)[0]
+    rows = re.findall(r"^\| `([a-z0-9]+)`(?: \(default\))? \| ", table, flags=re.M)
+    assert set(rows) == set(DOCUMENTED_METHODS) == set(METHODS)
+    assert re.search(r"^\| `nsga2` \(default\) \|", table, flags=re.M)
     base = {"device": "arm.yaml", "variables": {"l2": [0.1, 0.2]}, "objectives": [ISOTROPY],
             "workspace": {"box": {"center": [0.1, 0.0, 0.1], "size": [0.0, 0.0, 0.0]}}}
-    for name in METHODS:
+    for name, (title, checkpointed) in DOCUMENTED_METHODS.items():
         spec = study_from_mapping({**base, "algorithm": {"method": name}})
-        assert method_of(spec) is METHODS[name] and spec.algorithm.method == name
+        method = method_of(spec)
+        assert method.name == name == spec.algorithm.method
+        assert getattr(method, "title", None) == title and method.checkpointed is checkpointed
+    assert method_of(study_from_mapping(base)).name == "nsga2"
 
 
 @pytest.mark.parametrize("algorithm, message", [

@@ -9,6 +9,7 @@ indicator, and the uninterrupted run (for resume).
 from __future__ import annotations
 
 import itertools
+import json
 import math
 from pathlib import Path
 
@@ -137,3 +138,66 @@ def test_an_interrupted_run_continues_from_its_checkpoint_and_ends_with_the_same
     assert first == 2 and len(asked) == first + 2  # generations 3 and 4 only
     assert front_csv(resumed) == front_csv(whole)
     assert [r.objectives for r in resumed.records] == [r.objectives for r in whole.records]
+
+
+def _reasons_blanked(data: dict) -> None:
+    """The infeasible designs' reasons emptied: they would read as valid designs whose answers are NaN."""
+    data["reasons"] = ["" for _ in data["reasons"]]
+
+
+def _reasons_reworded(data: dict) -> None:
+    """Every infeasible design's reason replaced by another text (the valid designs' empty ones kept)."""
+    data["reasons"] = [reason and "the handle cannot reach any point" for reason in data["reasons"]]
+
+
+@pytest.mark.parametrize("alter", [_reasons_blanked, _reasons_reworded])
+def test_a_checkpoint_whose_reasons_were_edited_is_not_trusted(tmp_path, alter):
+    """A generation's file with infeasible designs (the evaluator's own reasons, for an arm too short for the
+    workspace) loads back as saved; with its reasons edited (values, designs and checksum untouched) it fails the
+    checksum: ``load`` returns None and warns that the file is not trusted."""
+    from hapticdesign.errors import RunWarning
+    from hapticdesign.optimization.study_run import Checkpoint
+
+    study = load_study(small_study(tmp_path))
+    designs = [{"l2": 0.15, "actuators.q2.gear_ratio": 4.0}, {"l2": 0.02, "actuators.q2.gear_ratio": 8.0},
+               {"l2": 0.2, "actuators.q2.gear_ratio": 16.0}, {"l2": 0.03, "actuators.q2.gear_ratio": 4.0}]
+    answers = bind_study(study).evaluate(designs)
+    assert [bool(a.reason) for a in answers] == [False, True, False, True]  # l1 - l2 > 0.15 m: out of reach
+    X = np.array([[d["l2"], float(k)] for d, k in zip(designs, (0, 1, 2, 0))])
+    checkpoint = Checkpoint(tmp_path / "out", study, 5)
+    checkpoint.save(1, X, answers)
+    loaded = checkpoint.load(1, X)
+    assert [a.reason for a in loaded] == [a.reason for a in answers]
+    path = tmp_path / "out" / "generation-0001.json"
+    data = json.loads(path.read_text())
+    alter(data)
+    assert data["reasons"] != [a.reason for a in answers]
+    path.write_text(json.dumps(data))
+    with pytest.warns(RunWarning, match="checksum does not match"):
+        assert checkpoint.load(1, X) is None
+
+
+def test_when_no_design_reaches_the_workspace_the_closest_is_the_one_reaching_the_most_points(tmp_path):
+    """Four workspace points on the base's x axis at 0.30, 0.33, 0.36 and 0.39 m from the shoulder; the forearm
+    ``l2`` is 0.12, 0.15 or 0.18 m, so by the two-link closed form (``r <= l1 + l2``) a design reaches 1, 2 or 3 of
+    them and none the whole workspace. The empty front's message names, among the last generation's designs, one
+    whose closed-form count is the largest there, and states that count (the generation holds designs of different
+    counts, so the design reaching the fewest would be another)."""
+    from hapticdesign.optimization.study_methods import CLOSEST_CANDIDATES, METHODS
+    from tests.helpers.planar_arm import points_reached
+
+    xs = (0.30, 0.33, 0.36, 0.39)
+    path = write_study(tmp_path, {"l2": {"values": [0.12, 0.15, 0.18]}}, [ISOTROPY], population=8, generations=2,
+                       center=[sum(xs) / 4, 0.0, 0.0], size=(xs[-1] - xs[0], 0.0, 0.0), grid=4)
+    study = load_study(path)
+    bound = bind_study(study)
+    assert np.allclose(sorted(p[0] for p in bound.points), xs) and len(bound.points) == 4
+    run = run_study(study, 1, bound.evaluate)
+    assert all(r.invalid for r in run.records)
+    last = [r for r in run.records if r.generation == run.records[-1].generation][:CLOSEST_CANDIDATES]
+    counts = {r.values["l2"]: points_reached(L1, r.values["l2"], [(x, 0.0, 0.0) for x in xs]) for r in last}
+    assert len(set(counts.values())) > 1, counts
+    most = max(counts.values())
+    (closest,) = [l2 for l2, n in counts.items() if n == most]
+    message = str(METHODS["nsga2"].empty_front(run, bound))
+    assert f"the closest (l2 = {closest:.6g}) reaches {most} of 4 points" in message, message

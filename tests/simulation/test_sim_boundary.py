@@ -215,13 +215,33 @@ def _random_joints(rng, count: int) -> tuple[np.ndarray, np.ndarray]:
 @pytest.mark.parametrize("compensate", [False, True])
 def test_batched_limits_are_each_joints_limit(delay, compensate):
     """One batched search over random joints gives each joint's own limit, searched alone, to 1e-9 (a virtual damper
-    and a 5 % model error in the compensated case)."""
+    and a 5 % model error in the compensated case), and, uncompensated, python-control's loop of each joint to 1e-8."""
     j, b = _random_joints(np.random.default_rng(10 * delay + compensate), 4)
     loop = SampledLoop(period=5e-4, delay=delay, velocity="sampled", compensation="full" if compensate else "none",
                        model_error=5.0 if compensate else 0.0, virtual_damping=0.005)
     batched = joint_limits(j, b, loop)
     for inertia, damping, limit in zip(j, b, batched):
         assert limit == pytest.approx(joint_limit(inertia, damping, loop), rel=1e-9)
+        if not compensate:  # python-control's loop of the joint, built here
+            assert limit == pytest.approx(_python_control_joint_limit(inertia, damping, 5e-4, delay, 0.005), rel=1e-8)
+
+
+def _python_control_joint_limit(j: float, b: float, period: float, delay: int, wall_damping: float) -> float:
+    """The stable spring of an uncompensated joint ``J qdd + b qd = u`` (zero-order hold, ``control.c2d``) whose
+    sampled position and velocity reach the wall ``u = -(K q + B_w qd)`` ``delay`` samples late (``z^-d``), closed
+    with ``control.feedback``: the spring at which the largest pole modulus reaches 1 (brentq)."""
+    import control
+
+    plant = control.c2d(control.ss([[0.0, 1.0], [0.0, -b / j]], [[0.0], [1.0 / j]], np.eye(2), [[0.0], [0.0]]),
+                        period, "zoh")
+    late = plant * control.ss(control.tf([1.0], [1.0] + [0.0] * delay, period)) if delay else plant
+
+    def radius(k: float) -> float:
+        return float(np.abs(control.poles(control.feedback(late, np.array([[k, wall_damping]])))).max())
+
+    hi = next(2.0 ** e for e in range(-10, 80) if radius(2.0 ** e) >= 1.0)
+    return brentq(lambda k: radius(k) - 1.0, hi / 2.0 if radius(hi / 2.0) < 1.0 else 1e-9, hi, xtol=1e-14,
+                  rtol=1e-12)
 
 
 def test_grouped_search_gives_each_groups_smallest_limit():

@@ -65,18 +65,21 @@ def test_the_gradient_is_m_g_l_cos_q(q):
     assert gravity_gradient(device, np.array([q]))[0, 0] == pytest.approx(M * G * L * math.cos(q), rel=1e-8)
 
 
-@pytest.mark.parametrize("loop", [SampledLoop(compensation="none"), SampledLoop(compensation="none", delay=0),
-                                  SampledLoop(compensation="none", delay=2, velocity="sampled"),
-                                  SampledLoop(model_error=30.0), SampledLoop(model_error=60.0, delay=2)])
-def test_the_pendulums_limit_is_python_controls_loop_with_its_gravity_stiffness(loop):
-    """Without compensation (``s = 0``) or with a wrong model (``s = 1 - E/100``), at the hanging pose and tilted."""
+@pytest.mark.parametrize("loop, share", [(SampledLoop(compensation="none"), 0.0),
+                                         (SampledLoop(compensation="none", delay=0), 0.0),
+                                         (SampledLoop(compensation="none", delay=2, velocity="sampled"), 0.0),
+                                         (SampledLoop(model_error=30.0), 0.7), (SampledLoop(model_error=60.0, delay=2), 0.4)])
+def test_the_pendulums_limit_is_python_controls_loop_with_its_gravity_stiffness(loop, share):
+    """Without compensation (``s = 0``) or with a wrong model (``s = 1 - E/100``: the bob sits on the tip frame with no
+    mass-centre offset, so a model whose mass is ``1 - E/100`` times the bob's feeds that share of ``m g l sin q``;
+    written here, not read from the loop), at the hanging pose and tilted."""
     device = _pendulum()
     for q in (0.0, 0.6):
         k_g = M * G * L * math.cos(q)
         pose = np.array([q])
         ours = wall_limit(np.array([[1.0], [0.0], [0.0]]), mass_matrix(device, pose), device.damping_matrix, loop,
                           np.array([1.0, 0.0, 0.0]), gravity_gradient(device, pose))
-        expected = _python_control_limit(M * L * L, B, k_g, loop.gravity_share, loop.delay)
+        expected = _python_control_limit(M * L * L, B, k_g, share, loop.delay)
         assert ours == pytest.approx(expected, rel=1e-7)
         without = _python_control_limit(M * L * L, B, 0.0, 0.0, loop.delay)
         assert abs(expected / without - 1.0) > 1e-6  # 10 times the tolerance: leaving gravity out would fail
@@ -283,3 +286,41 @@ def test_the_spec_command_states_the_upright_pendulums_lower_end(tmp_path):
     low, high = _upright_interval()
     assert row["exact_lower"] == pytest.approx(low / L ** 2, rel=1e-6)
     assert row["exact"] == pytest.approx(high / L ** 2, rel=1e-6)
+
+
+TILT = 0.6
+"""The tilted pendulum's angle from hanging at q = 0 (rad): gravity's torque ``m g l sin(TILT + q)`` is not 0 there."""
+
+
+@pytest.mark.parametrize("compensation, error, share", [("none", 0.0, 0.0), ("gravity", 50.0, 0.5)])
+def test_a_cartesian_wall_holds_a_tilted_pendulum_where_its_spring_and_the_leftover_gravity_balance(
+        compensation, error, share):
+    """A Cartesian wall (N/m) along the handle's motion at q = 0 (the tangent ``n = (cos t, 0, sin t)`` of the tilted
+    pendulum, ``t`` = :data:`TILT`), resting there, at 50 Hz: the handle's coordinate along ``n`` is ``l sin q``, so
+    the wall's joint row is ``w = l cos q`` (``|w| = l``, not 1) and its spring acts on the joint as ``K w^2``. The
+    gravity the compensator leaves (all of it, or the half a 50 % light model leaves: the bob sits on the tip frame,
+    so the model's gravity is ``0.5 m g l sin``) pushes the handle into the spring, which holds it where ``K l^2 x +
+    (1 - s) m g l sin(t + x) = 0`` (the wall's row at its rest, SciPy's brentq), and the exact limit is the fixed
+    point of python-control's limit of the loop linearized there (``m g l cos(t + x)``, the compensator's late ``s``
+    share, the spring ``K l^2 cos^2 x``; brentq again). Dividing the rest's Newton step by ``|w|`` instead of ``|w|^2``
+    (a joint wall's ``|w| = 1`` hides it) moves the rest and the limit by more than 10 %."""
+    period = 0.02
+    direction = (math.cos(TILT), 0.0, math.sin(TILT))
+    device = device_from_mapping(_pendulum_file("tilted pendulum", f"-pi/2 + {TILT}"))
+    loop = SampledLoop(period=period, compensation=compensation, model_error=error)
+    found = stability_limit(device, loop, equilibrium=0.0, direction=direction)
+
+    def held(k: float) -> float:
+        return brentq(lambda x: k * L ** 2 * x + (1.0 - share) * M * G * L * math.sin(TILT + x), -TILT, 0.0,
+                      xtol=1e-15)
+
+    def limit_where_held(k: float) -> float:
+        x = held(k)
+        joint = _python_control_limit(M * L * L, B, M * G * L * math.cos(TILT + x), share, 1, period)
+        return joint / (L * math.cos(x)) ** 2
+
+    expected = brentq(lambda k: limit_where_held(k) - k, 1e-2, 1e3, xtol=1e-14)
+    assert found.stiffness == pytest.approx(expected, rel=1e-7)
+    assert found.pose[0] == pytest.approx(held(expected), abs=1e-9)
+    at_rest = _python_control_limit(M * L * L, B, M * G * L * math.cos(TILT), share, 1, period) / L ** 2
+    assert abs(at_rest / expected - 1.0) > 0.05  # leaving the leftover gravity's push out would fail

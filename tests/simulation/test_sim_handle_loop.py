@@ -18,9 +18,10 @@ import pytest
 
 from hapticdesign.analysis.configuration import configuration_of, handle_pose
 from hapticdesign.analysis.dynamics.device import gravity_gradient, mass_matrix
-from hapticdesign.analysis.sampled_loop import GRASP, Hand, SampledLoop, compensated_boundary
-from hapticdesign.analysis.wall_stiffness import wall_limit
+from hapticdesign.analysis.sampled_loop import GRASP, HANDS, Hand, SampledLoop, compensated_boundary
+from hapticdesign.analysis.wall_stiffness import KMAX_OPTIONS, kmax_loop, wall_limit
 from hapticdesign.devices.device_file import load_device_file
+from hapticdesign.errors import UserError
 from hapticdesign.analysis.metrics.indices import Request, evaluate
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "devices"
@@ -73,7 +74,7 @@ def _independent_limit(gain, spring) -> float:
     return 0.5 * (lo + hi)
 
 
-@pytest.mark.parametrize("hand", [None, GRASP, Hand(0.5, 8.0, 600.0)])
+@pytest.mark.parametrize("hand", [None, GRASP, HANDS["firm"], Hand(0.5, 8.0, 600.0)])
 @pytest.mark.parametrize("u", [np.array([1.0, 0.0, 0.0]), np.array([0.6, 0.0, 0.8])])
 def test_the_wall_limit_is_python_controls_closed_loop(five_bar, hand, u):
     _, _, jv, h, b = five_bar
@@ -94,8 +95,12 @@ def test_one_joint_loop_is_the_seed_limits_closed_form():
 
 
 def test_kmax_index_is_the_wall_limit_with_its_options(five_bar):
+    """The index's options reach the loop as this test writes it (``period``, ``delay``, ``damping`` as the wall's
+    damper, ``"light"`` as the light hand, the direction, gravity's gradient at the pose): the plumbing, checked
+    against :func:`wall_limit`, whose values are pinned independently, python-control's loop with the hand and the
+    delay in this file's other tests and gravity's gradient in test_sim_gravity_gradient.py."""
     device, point, jv, h, b = five_bar
-    options = {"period": 0.0005, "delay": 2, "damping": 0.5, "hand": "grasp"}
+    options = {"period": 0.0005, "delay": 2, "damping": 0.5, "hand": "light"}
     u = np.array([0.6, 0.0, 0.8])
     result = evaluate(device, point[None], [Request("kmax", {**options, "direction": u}, "along"),
                                             Request("kmax", options, "worst")])
@@ -103,3 +108,18 @@ def test_kmax_index_is_the_wall_limit_with_its_options(five_bar):
     gravity = gravity_gradient(device, handle_pose(device, point).q)  # the index linearizes gravity's pull too
     assert result.values["along"][0] == pytest.approx(wall_limit(jv, h, b, loop, u, gravity), rel=1e-9)
     assert result.values["worst"][0] <= result.values["along"][0]
+
+
+def test_the_kmax_index_takes_a_hand_by_name(five_bar):
+    """``hand: firm`` in a study is the firm hand's loop, python-control's closed loop with 0.554 kg, 6.45 N s/m and
+    135 N/m at the handle; an unknown name is one line; ``grasp`` is the light hand with a deprecation line."""
+    device, point, jv, h, b = five_bar
+    u = np.array([0.6, 0.0, 0.8])
+    named = evaluate(device.with_params({"g": 0.0}), point[None],
+                     [Request("kmax", {"hand": "firm", "direction": u}, "firm")]).values["firm"][0]
+    gain, spring = _loop_gain(jv, h, b, u, Hand(0.554, 6.45, 135.0), 1)
+    assert named == pytest.approx(_independent_limit(gain, spring), rel=1e-6)
+    with pytest.raises(UserError, match="unknown hand 'soft'; choose one of light, firm"):
+        kmax_loop({**KMAX_OPTIONS, "hand": "soft"})
+    with pytest.warns(FutureWarning, match="now called 'light'"):
+        assert Hand.named("grasp") == HANDS["light"] == GRASP

@@ -33,7 +33,7 @@ def test_where_the_loop_is_linear_the_simulated_wall_is_the_exact_one():
     device = load_device_file(FIVE_BAR)
     points = _home_point(device) + np.array([[0.0, 0.0, 0.0], [0.015, 0.0, 0.0]])
     linear = Request("kmax_simulated", {"friction": False, "quantization": False, "rel_tol": 1e-3}, "linear")
-    found = evaluate(device, points, ["kmax", linear, Request("kmax_simulated", {"hand": "grasp"}, "hand")])
+    found = evaluate(device, points, ["kmax", linear, Request("kmax_simulated", {"hand": "light"}, "hand")])
     assert found.reason is None, found.reason
     np.testing.assert_allclose(found.values["linear"], found.values["kmax"], rtol=2e-3)
     assert np.all(found.values["hand"] > 2.0 * found.values["kmax"])
@@ -47,7 +47,7 @@ def test_a_study_can_ask_for_a_wall_with_a_hand_and_friction(tmp_path):
     study = {"device": str(FIVE_BAR), "variables": {"l1": [0.09, 0.11]},
              "workspace": {"box": {"center": [0.0, 0.0, 0.18], "size": [0.0, 0.0, 0.0]}, "grid": 1},
              "objectives": [{"name": "isotropy", "index": "isotropy", "reduce": "min", "sense": "max"}],
-             "constraints": [{"index": "kmax_simulated", "options": {"hand": "grasp"}, "reduce": "min",
+             "constraints": [{"index": "kmax_simulated", "options": {"hand": "light"}, "reduce": "min",
                               ">=": 1000}],
              "algorithm": {"method": "nsga2", "population": 4, "generations": 1}}
     path = tmp_path / "wall.yaml"
@@ -56,7 +56,7 @@ def test_a_study_can_ask_for_a_wall_with_a_hand_and_friction(tmp_path):
     assert len(result.records) == 4
     for record in result.records:
         device = load_device_file(FIVE_BAR).with_params({"l1": record.values["l1"]})
-        alone = evaluate(device, np.array([[0.0, 0.0, 0.18]]), [Request("kmax_simulated", {"hand": "grasp"})])
+        alone = evaluate(device, np.array([[0.0, 0.0, 0.18]]), [Request("kmax_simulated", {"hand": "light"})])
         assert record.invalid == "" and alone.values["kmax_simulated"][0] > 1000
         assert record.constraints[0] == pytest.approx(alone.values["kmax_simulated"][0], rel=1e-12)
     study["algorithm"] = {"method": "nsga2", "population": 20, "generations": 6}  # 120 designs x 1000 > 1e5

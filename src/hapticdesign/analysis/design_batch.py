@@ -45,6 +45,7 @@ from hapticdesign.analysis.reach_kernel import MESSAGES, Reached, reach_designs,
 from hapticdesign.analysis.stiffness import vjm
 from hapticdesign.analysis.stiffness.device import end_compliance
 from hapticdesign.errors import UserError
+from hapticdesign.model.actuators import Transmission
 from hapticdesign.model.compensator_model import scaled_standard
 from hapticdesign.model.device import Device, build_mechanism
 from hapticdesign.model.walk import MotionPlan, Tree, frame_jacobian, node_poses, planned_poses, trig_workspace
@@ -253,6 +254,8 @@ class DesignValues(NamedTuple):
     torques: dict
     rigidity: np.ndarray | None
     refused: list
+    transmission: Transmission | None = None
+    """The motors' compliant transmissions (D, n_a, n_a) each, None when the motors are rigid."""
 
 
 class Evaluated(NamedTuple):

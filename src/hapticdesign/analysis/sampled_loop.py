@@ -53,12 +53,14 @@ against the spectral radius of the exactly discretized loop and the simulated lo
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.linalg import expm
 
 from hapticdesign.errors import InputError, UserError
+from hapticdesign.model.actuators import Transmission
 from hapticdesign.workload import EIGEN_ORDER_LIMIT, require_memory, require_within
 
 
@@ -368,6 +370,8 @@ class Hand:
     mass: float = 0.0
     damping: float = 0.0
     stiffness: float = 0.0
+    name: str | None = None
+    """The preset's name (:data:`HANDS`), None for a hand of one's own."""
 
     def __post_init__(self) -> None:
         values = (self.mass, self.damping, self.stiffness)
@@ -384,19 +388,55 @@ class Hand:
         """A hand when any of its values is non-zero, else None (no hand)."""
         return Hand(mass, damping, stiffness) if (mass or damping or stiffness) else None
 
+    @staticmethod
+    def named(name: str) -> "Hand":
+        """The preset ``name`` of :data:`HANDS` (``grasp``, its former name, is ``light`` with a deprecation line);
+        a one-line error for another name."""
+        if name == "grasp":
+            warnings.warn("the hand 'grasp' is now called 'light' (the same 0.1 kg, 2 N s/m, 200 N/m); 'grasp' "
+                          "will be removed", FutureWarning, stacklevel=2)
+            name = "light"
+        if name not in HANDS:
+            raise UserError(f"unknown hand {str(name)[:40]!r}; choose one of {', '.join(HANDS)} or give mass, damping "
+                            "and stiffness")
+        return HANDS[name]
+
     def as_dict(self) -> dict:
-        return {"mass": self.mass, "damping": self.damping, "stiffness": self.stiffness}
+        return {"mass": self.mass, "damping": self.damping, "stiffness": self.stiffness,
+                **({} if self.name is None else {"name": self.name})}
+
+    def describe(self) -> str:
+        """``light hand (0.1 kg, 2 N s/m, 200 N/m)``: what an output states of it."""
+        return (f"{self.name or 'a'} hand ({self.mass:g} kg, {self.damping:g} N s/m, {self.stiffness:g} N/m)")
 
 
-GRASP = Hand(mass=0.1, damping=2.0, stiffness=200.0)
-"""The default grasp of the "with the hand" limit: a light fingertip or pen grasp, 0.1 kg, 2 N s/m, 200 N/m, at the
-low (least stabilizing) end of the hand and fingertip impedances measured by Tsuji, Morasso, Goto & Ito (1995,
-"Human hand impedance characteristics during maintained posture", Biol. Cybern. 72) and Hajian & Howe (1997,
-"Identification of the mechanical impedance at the human finger tip", J. Biomech. Eng. 119). Colgate & Brown (1994,
-"Factors affecting the Z-width of a haptic display", ICRA) and Hulin, Preusche & Hirzinger (2008, "Stability boundary
-for haptic rendering: influence of human operator", IROS) show how the operator's impedance enlarges the stable
-region; a firmer grasp renders stiffer walls. A user changes it (``hand_mass``, ``hand_damping``,
-``hand_stiffness``)."""
+HANDS: dict[str, Hand] = {
+    "light": Hand(mass=0.1, damping=2.0, stiffness=200.0, name="light"),
+    "firm": Hand(mass=0.554, damping=6.45, stiffness=135.0, name="firm"),
+}
+"""The hands a wall is designed for, linear mass-damper-springs at the handle.
+
+- ``light``: a light fingertip or pen grasp, 0.1 kg, 2 N s/m, 200 N/m, at the low (least stabilizing) end of the
+  hand and fingertip impedances measured by Tsuji, Morasso, Goto & Ito (1995, "Human hand impedance characteristics
+  during maintained posture", Biol. Cybern. 72) and Hajian & Howe (1997, "Identification of the mechanical impedance
+  at the human finger tip", J. Biomech. Eng. 119): the hand that stabilizes least, so the wall to design for.
+- ``firm``: a firm grasp of a stylus or knob, 0.554 kg, 6.45 N s/m, 135 N/m: figures quoted from a published
+  second-order fit of a grasping hand whose source this project has not checked, so an assumption of the right
+  order, not a measurement: stylus and knob grasps identified by Fu & Cavusoglu ("Three-dimensional human arm and
+  hand dynamics and variability model for a stylus-based haptic interface", ICRA 2010) and Hasser & Cutkosky
+  ("System identification of the human hand grasping a haptic knob", Haptics Symposium 2002) are of this kind, their
+  damping and stiffness rising with the grip force.
+
+Colgate & Brown (1994, "Factors affecting the Z-width of a haptic display", ICRA), Hulin, Preusche & Hirzinger (2008,
+"Stability boundary for haptic rendering: influence of human operator", IROS) and Diaz & Gil (2010, "Influence of
+vibration modes and human operator on the stability of haptic rendering", IEEE T-RO 26) show how the operator's
+impedance enlarges the stable region: a firmer grasp renders stiffer walls, and a wall designed for the light hand
+holds for the firm one. Without a hand, the limit is set by the device's own viscous damping alone (about
+``2 b / T``), which rewards friction and damping rather than the design (docs/simulation.md)."""
+
+GRASP = HANDS["light"]
+"""The default hand of the "with the hand" limit (``light`` of :data:`HANDS`). A user changes it (``hand`` by name, or
+``hand_mass``, ``hand_damping``, ``hand_stiffness``)."""
 
 VELOCITIES = ("difference", "sampled")
 """How the virtual damper's velocity is formed: the backward difference of the sampled positions (practice), or the
@@ -457,19 +497,22 @@ class SampledLoop:
         if self.hand is not None and not isinstance(self.hand, Hand):
             raise UserError(f"the hand must be a Hand, got {type(self.hand).__name__}")
 
-    def order(self, joints: int = 1) -> int:
+    def order(self, joints: int = 1, motors: bool = False) -> int:
         """The order of the exact loop's one-sample map for ``joints`` free joints (:func:`handle_loops`): position
-        and velocity over the delay (one sample more for a differenced damper), the held torques with full
+        and velocity of each coordinate (a joint's, and its motor's behind a compliant transmission when
+        ``motors``) over the delay (one sample more for a differenced damper), the held torques with full
         compensation."""
+        coordinates = 2 * joints if motors else joints
         differenced = self.velocity == "difference" and self.virtual_damping > 0
         torques = joints * (self.delay + 1) if self.compensation == "full" else 0
-        return 2 * joints * (self.delay + int(differenced) + 1) + torques
+        return 2 * coordinates * (self.delay + int(differenced) + 1) + torques
 
-    def require_exact(self, joints: int, count: int) -> None:
-        """Estimate the exact loops of ``count`` systems of ``joints`` free joints before they are built: their
-        order at most :data:`~hapticdesign.workload.EIGEN_ORDER_LIMIT` rows, their matrices within the memory
-        limits (a delay of 10^9 samples is refused here, not when its matrix is allocated)."""
-        order = self.order(joints)
+    def require_exact(self, joints: int, count: int, motors: bool = False) -> None:
+        """Estimate the exact loops of ``count`` systems of ``joints`` free joints (with their motors' coordinates
+        when ``motors``) before they are built: their order at most
+        :data:`~hapticdesign.workload.EIGEN_ORDER_LIMIT` rows, their matrices within the memory limits (a delay of
+        10^9 samples is refused here, not when its matrix is allocated)."""
+        order = self.order(joints, motors)
         what = (f"the closed-loop matrices of {count:,} loop{'s' if count != 1 else ''} of order {order:,} (a delay "
                 f"of {self.delay:,} samples)")
         require_within(what, order, EIGEN_ORDER_LIMIT, "rows")
@@ -505,8 +548,7 @@ class SampledLoop:
 
     def describe(self) -> str:
         """One line for a text output."""
-        hand = "no hand" if self.hand is None else (f"hand {self.hand.mass:g} kg, {self.hand.damping:g} N s/m, "
-                                                     f"{self.hand.stiffness:g} N/m")
+        hand = "no hand" if self.hand is None else self.hand.describe()
         held = f", joints {', '.join(str(j + 1) for j in self.held)} held" if self.held else ", every joint free"
         comp = self.compensation + (f" (model error {self.model_error:g} %)" if self.compensation == "full"
                                     and self.model_error else "")
@@ -516,7 +558,8 @@ class SampledLoop:
 
 def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, spring: np.ndarray,
                  loop: SampledLoop, poses: np.ndarray | None = None, gravity: np.ndarray | None = None,
-                 model: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[SpringLoops, np.ndarray]:
+                 model: tuple[np.ndarray, np.ndarray] | None = None,
+                 transmission: Transmission | None = None) -> tuple[SpringLoops, np.ndarray]:
     """The sampled loops of S handles under a wall whose spring acts on the joints as ``K w w^T`` (``spring``: the
     rows ``w`` (S, n); ``J_v^T u`` for a Cartesian wall along a unit ``u``, ``e_j`` for a wall on joint j), every
     joint free but ``loop.held``, and a starting guess of their limits (S,).
@@ -530,10 +573,15 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
     K_G`` (:attr:`SampledLoop.fraction`, :attr:`SampledLoop.gravity_share`); the compensation setting switches them
     (``none``: neither, ``gravity``: ``K_Gm`` only). The plant ``H_h qdd + B_h qd + (K_h + K_G) q =
     u`` (the hand's mass, damping and stiffness added as ``x J_v^T J_v``) is discretized exactly under a zero-order
-    hold (:func:`held_plant`). Every period the controller holds, ``d`` samples late,
-    ``u_k = H_m a_(k-d) + K_Gm q_(k-d) - K w w^T q_(k-d) - B_w w w^T v^_(k-d)``, ``a`` the acceleration sampled
-    under the previous torque, ``K_Gm q`` the linearized gravity compensation, ``v^`` the sampled velocity or the
-    backward difference of positions. The state is ``[x_k, ..., x_(k-L), u_(k-1), ..., u_(k-d-1)]`` (``x = (q, qd)``; the torques only with the
+    hold (:func:`held_plant`). With a ``transmission`` (:class:`~hapticdesign.model.actuators.Transmission`, each
+    (n, n) or (P, n, n)) the motors sit behind springs: the plant's coordinates are the motors' ``phi`` and the
+    links' ``q``, ``M_r phi'' + B_m phi' + K_t (phi - q) = u`` and ``(H_h - M_r) q'' + (B_h - B_m) q' + (K_h + K_G)
+    q + K_t (q - phi) = 0`` (the rotors and the motors' damping on the motor side, the links, the hand and gravity on
+    the other), and the controller senses ``phi`` (the encoders are on the motors). Every period the controller
+    holds, ``d`` samples late, ``u_k = H_m a_(k-d) + K_Gm q_(k-d) - K w w^T q_(k-d) - B_w w w^T v^_(k-d)``, ``q``,
+    ``a`` the sensed position and the acceleration sampled under the previous torque, ``K_Gm q`` the linearized
+    gravity compensation, ``v^`` the sampled velocity or the backward difference of positions. The state is ``[x_k,
+    ..., x_(k-L), u_(k-1), ..., u_(k-d-1)]`` (``x`` the plant's coordinates and rates; the torques only with the
     compensator), and ``K`` enters as the rank-one term of :class:`SpringLoops`. The pose changes along the wall
     (``w^T q = 0``) that no static stiffness resists are fixed points (eigenvalue 1) whatever ``K``, a neutral
     drift of the handle along the wall, not an instability; they are deflated (:func:`_deflated`).
@@ -546,47 +594,53 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
         raise UserError("every joint is held: nothing moves under the wall")
     jv = np.asarray(jacobian, dtype=float)[:, :, free]
     h = np.asarray(mass, dtype=float)[:, free][:, :, free]
-    b = np.broadcast_to(np.asarray(damping, dtype=float)[..., free, :][..., free], h.shape)
+
+    def joints(x) -> np.ndarray:  # the free joints' block of an (n, n) or (P, n, n) matrix, one per pose
+        return np.broadcast_to(np.asarray(x, dtype=float)[..., free, :][..., free], h.shape)
+
+    b = joints(damping)
     n = len(free)
     jtj = np.swapaxes(jv, 1, 2) @ jv
     hand = loop.hand or Hand()
     hh, bh, kp = h + hand.mass * jtj, b + hand.damping * jtj, hand.stiffness * jtj
-    grad = np.zeros_like(kp) if gravity is None else np.broadcast_to(
-        np.asarray(gravity, dtype=float)[..., free, :][..., free], h.shape)
+    grad = np.zeros_like(kp) if gravity is None else joints(gravity)
     kp = kp + grad
     if model is None:  # held: the compensator's gravity gradient, on the sensed pose
         h_model, held = loop.fraction * h, loop.gravity_share * grad
     else:
-        h_model, held = (np.broadcast_to(np.asarray(x, dtype=float)[..., free, :][..., free], h.shape) for x in model)
+        h_model, held = (joints(x) for x in model)
     if loop.compensation != "full":
         h_model = np.zeros_like(h)
     if loop.compensation == "none":
         held = np.zeros_like(h)
-    phi, gamma = held_plant(hh, bh, kp, loop.period)
+    plant = (hh, bh, kp) if transmission is None else _compliant_plant(hh, bh, kp, *(joints(x) for x in transmission))
+    phi, gamma = held_plant(*plant, loop.period, inputs=n)
     if poses is not None:  # each loop takes its pose's plant
-        phi, gamma, h_model, hh, bh, kp, held = (x[np.asarray(poses, dtype=np.int64)]
-                                                 for x in (phi, gamma, h_model, hh, bh, kp, held))
+        pick = np.asarray(poses, dtype=np.int64)
+        phi, gamma, h_model, bh, held = (x[pick] for x in (phi, gamma, h_model, bh, held))
+        plant = tuple(x[pick] for x in plant)
     w = np.asarray(spring, dtype=float)[:, free]
-    count = len(w)
+    count, coords = len(w), plant[0].shape[-1]  # coords: n, or 2 n with the motors' own coordinates
     d = loop.delay
     differenced = loop.velocity == "difference" and loop.virtual_damping > 0
     depth = d + int(differenced)
     compensated = bool(np.any(h_model))
-    nx, size = 2 * n, 2 * n * (depth + 1) + (n * (d + 1) if compensated else 0)
-    u0 = 2 * n * (depth + 1)  # first column of the torque buffer
+    nx, size = 2 * coords, 2 * coords * (depth + 1) + (n * (d + 1) if compensated else 0)
+    u0 = nx * (depth + 1)  # first column of the torque buffer
+    at, rate = nx * d, nx * d + coords  # the sensed sample's positions and rates
     law = np.zeros((count, n, size))  # u_k from the state, spring left out
     ww = w[:, :, None] * w[:, None, :]
-    if compensated:
-        feed = h_model @ np.linalg.inv(hh)  # H_m a, a = H_h^-1 (u_prev - B_h v - K_h q)
-        law[:, :, u0 + n * d:u0 + n * (d + 1)] += feed
-        law[:, :, nx * d:nx * d + n] -= feed @ kp
-        law[:, :, nx * d + n:nx * (d + 1)] -= feed @ bh
-    law[:, :, nx * d:nx * d + n] += held
+    if compensated:  # H_m a, a the sensed coordinates' rows of M^-1 (u_prev - D v - K q)
+        feed = h_model @ np.linalg.inv(plant[0])[:, :n, :]
+        law[:, :, u0 + n * d:u0 + n * (d + 1)] += feed[:, :, :n]
+        law[:, :, at:at + coords] -= feed @ plant[2]
+        law[:, :, rate:rate + coords] -= feed @ plant[1]
+    law[:, :, at:at + n] += held
     if differenced:
-        law[:, :, nx * d:nx * d + n] -= loop.virtual_damping / loop.period * ww
-        law[:, :, nx * (d + 1):nx * (d + 1) + n] += loop.virtual_damping / loop.period * ww
+        law[:, :, at:at + n] -= loop.virtual_damping / loop.period * ww
+        law[:, :, at + nx:at + nx + n] += loop.virtual_damping / loop.period * ww
     else:
-        law[:, :, nx * d + n:nx * (d + 1)] -= loop.virtual_damping * ww
+        law[:, :, rate:rate + n] -= loop.virtual_damping * ww
     m = np.zeros((count, size, size))
     m[:, :nx, :nx] = phi
     m[:, :nx] += gamma @ law
@@ -601,9 +655,11 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
     if compensated:
         g[:, u0:u0 + n] = w
     hvec = np.zeros((count, size))
-    hvec[:, nx * d:nx * d + n] = w
+    hvec[:, at:at + n] = w
     if n > 1:
-        net = (kp - held) * loop.period ** 2 / np.linalg.norm(hh, axis=(1, 2))[:, None, None]
+        net = plant[2].copy()
+        net[:, :n, :n] -= held
+        net *= loop.period ** 2 / np.linalg.norm(plant[0], axis=(1, 2))[:, None, None]
         m, g, hvec, law = _deflated(m, g, hvec, law, w, net, held, depth, u0 if compensated else None)
     reach = np.einsum("sn,sn->s", w, w)
     viscous = np.einsum("sn,snm,sm->s", w, bh, w) / np.maximum(reach, 1e-300) ** 2 + loop.virtual_damping
@@ -611,17 +667,34 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
     return SpringLoops(m, g, hvec, law, w), guess
 
 
+def _compliant_plant(mass: np.ndarray, damping: np.ndarray, stiffness: np.ndarray, rotor: np.ndarray,
+                     motor_damping: np.ndarray, spring: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The plant of :func:`handle_loops` with compliant transmissions over ``(phi, q)`` (P, 2n, 2n each): the rotors
+    ``M_r`` and the motors' damping ``B_m`` moved from the rigid ``H_h`` and ``B_h`` to the motor side, the
+    transmissions' ``K_t`` between the sides; a one-line error when the link side keeps no positive definite
+    inertia (a link of no mass but the rotor's)."""
+    link = mass - rotor
+    if not np.all(np.linalg.eigvalsh(link)[..., 0] > 0) or not np.all(np.linalg.eigvalsh(rotor)[..., 0] > 0):
+        raise UserError("a compliant transmission needs a rotor inertia on every motor and a link side of positive "
+                        "definite inertia (H minus the rotors' n^2 J_r)")
+    zero = np.zeros_like(mass)
+    return (np.block([[rotor, zero], [zero, link]]), np.block([[motor_damping, zero], [zero, damping - motor_damping]]),
+            np.block([[spring, -spring], [-spring, spring + stiffness]]))
+
+
 def held_plant(mass: np.ndarray, damping: np.ndarray, stiffness: np.ndarray,
-               period: float) -> tuple[np.ndarray, np.ndarray]:
-    """The plants ``H qdd + B qd + K q = u`` ((P, n, n) each) over ``period`` under a held ``u``, exactly: ``Phi``
-    (P, 2n, 2n) and ``Gamma`` (P, 2n, n) of ``x = (q, qd)``, ``x+ = Phi x + Gamma u`` (``scipy.linalg.expm`` of the
-    augmented matrix)."""
+               period: float, inputs: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The plants ``H qdd + B qd + K q = S u`` ((P, N, N) each) over ``period`` under a held ``u``, exactly: ``Phi``
+    (P, 2N, 2N) and ``Gamma`` (P, 2N, m) of ``x = (q, qd)``, ``x+ = Phi x + Gamma u`` (``scipy.linalg.expm`` of the
+    augmented matrix), the torques ``u`` acting on the first ``inputs`` = m coordinates (``S`` their columns of the
+    identity; None: every coordinate)."""
     n = mass.shape[-1]
-    aug = np.zeros((len(mass), 3 * n, 3 * n))
+    m = n if inputs is None else inputs
+    aug = np.zeros((len(mass), 2 * n + m, 2 * n + m))
     aug[:, :n, n:2 * n] = np.eye(n)
     aug[:, n:2 * n, :n] = -np.linalg.solve(mass, stiffness)
     aug[:, n:2 * n, n:2 * n] = -np.linalg.solve(mass, damping)
-    aug[:, n:2 * n, 2 * n:] = np.linalg.inv(mass)
+    aug[:, n:2 * n, 2 * n:] = np.linalg.inv(mass)[:, :, :m]
     e = expm(aug * period)
     return e[:, :2 * n, :2 * n], e[:, :2 * n, 2 * n:]
 
@@ -629,31 +702,34 @@ def held_plant(mass: np.ndarray, damping: np.ndarray, stiffness: np.ndarray,
 def _deflated(m: np.ndarray, g: np.ndarray, h: np.ndarray, law: np.ndarray, w: np.ndarray, net: np.ndarray,
               held: np.ndarray, depth: int,
               u0: int | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The maps with their spring-independent fixed points removed: a pose change ``q*`` along the wall (``w^T q* =
-    0``) that no static stiffness resists (``(K_h + (1 - s) K_G) q* = 0``; ``net`` that stiffness times ``T^2 /
-    |H_h|``, the share of the inertia's scale it reaches over a period) is held still whatever ``K`` (the state
-    ``[q*, 0, q*, 0, ..., 0]``, the torque buffer ``s K_G q*``; ``held`` ``s K_G``): eigenvalue 1, a
-    neutral drift of the handle along the wall, not an instability. In an orthonormal basis ``[Q1 Q2]`` with ``Q1``
-    spanning them the map is block triangular, so the other eigenvalues are those of ``Q2^T m Q2`` (and the spring's
-    term stays rank one, ``(Q2^T g)(Q2^T h)^T``); when the loops have different numbers of them, ``(I - P) m (I -
-    P)`` with ``P`` the orthogonal projector on them has the same eigenvalues and zeros, at one size for all. The
-    torque law is taken into the same coordinates."""
+    """The maps with their spring-independent fixed points removed: a pose change ``q*`` of the plant's N
+    coordinates (the first n sensed) along the wall (``w^T q*_sensed = 0``) that no static stiffness resists
+    (``(K - S K_Gm S^T) q* = 0``, ``K`` the plant's stiffness with the hand's and gravity's, ``S`` the sensed
+    coordinates; ``net`` that stiffness times ``T^2 / |M|``, the share of the inertia's scale it reaches over a
+    period) is held still whatever ``K`` (the state ``[q*, 0, q*, 0, ..., 0]``, the torque buffer ``K_Gm q*_sensed``;
+    ``held`` ``K_Gm``): eigenvalue 1, a neutral drift of the handle along the wall, not an instability. In an
+    orthonormal basis ``[Q1 Q2]`` with ``Q1`` spanning them the map is block triangular, so the other eigenvalues
+    are those of ``Q2^T m Q2`` (and the spring's term stays rank one, ``(Q2^T g)(Q2^T h)^T``); when the loops have
+    different numbers of them, ``(I - P) m (I - P)`` with ``P`` the orthogonal projector on them has the same
+    eigenvalues and zeros, at one size for all. The torque law is taken into the same coordinates."""
     count, size = m.shape[0], m.shape[1]
-    n = w.shape[1]
-    rows = np.concatenate([(w / np.linalg.norm(w, axis=1, keepdims=True))[:, None, :], net], axis=1)
+    n, coords = w.shape[1], net.shape[-1]
+    wall = np.zeros((count, 1, coords))
+    wall[:, 0, :n] = w / np.linalg.norm(w, axis=1, keepdims=True)
+    rows = np.concatenate([wall, net], axis=1)
     _, sv, vt = np.linalg.svd(rows)
     free = sv <= NULL_TOL  # the last rows of vt (singular values descending)
     ranks = free.sum(axis=1)
     uniform = bool(np.all(ranks == ranks[0]))
-    null = vt[:, n - ranks[0]:, :] if uniform else vt * free[:, :, None]  # rows spanning the fixed pose changes
+    null = vt[:, coords - ranks[0]:, :] if uniform else vt * free[:, :, None]  # rows spanning the fixed pose changes
     r = null.shape[1]
     if r == 0:
         return m, g, h, law
     fixed = np.zeros((count, size, r))
     for k in range(depth + 1):
-        fixed[:, 2 * n * k:2 * n * k + n] = np.swapaxes(null, 1, 2)
+        fixed[:, 2 * coords * k:2 * coords * k + coords] = np.swapaxes(null, 1, 2)
     if u0 is not None:
-        torque = held @ np.swapaxes(null, 1, 2)
+        torque = held @ np.swapaxes(null[:, :, :n], 1, 2)
         for k in range((size - u0) // n):
             fixed[:, u0 + n * k:u0 + n * (k + 1)] = torque
     if uniform:
@@ -673,21 +749,24 @@ gravity gradient leaves the drift free."""
 def handle_intervals(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, spring: np.ndarray,
                      loop: SampledLoop, groups: np.ndarray | None = None, k_max: float = 1e9,
                      poses: np.ndarray | None = None, gravity: np.ndarray | None = None,
-                     model: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray]:
+                     model: tuple[np.ndarray, np.ndarray] | None = None,
+                     transmission: Transmission | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The exact stable wall stiffnesses ``[low, high]`` (N/m) of each handle loop of :func:`handle_loops` (S,
     each), or of each group (:func:`loop_intervals`; ``low`` 0 unless gravity pulls the handle off the wall)."""
-    loop.require_exact(np.shape(jacobian)[-1] - len(loop.held), len(spring))
-    loops, guess = handle_loops(jacobian, mass, damping, spring, loop, poses, gravity, model)
+    loop.require_exact(np.shape(jacobian)[-1] - len(loop.held), len(spring), transmission is not None)
+    loops, guess = handle_loops(jacobian, mass, damping, spring, loop, poses, gravity, model, transmission)
     return loop_intervals(loops, guess, groups, k_max)
 
 
 def handle_limits(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, spring: np.ndarray,
                   loop: SampledLoop, groups: np.ndarray | None = None, k_max: float = 1e9,
                   poses: np.ndarray | None = None, gravity: np.ndarray | None = None,
-                  model: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+                  model: tuple[np.ndarray, np.ndarray] | None = None,
+                  transmission: Transmission | None = None) -> np.ndarray:
     """The upper ends of :func:`handle_intervals`: the exact stable wall stiffness (N/m) of each handle loop (S,),
     or the smallest in each group."""
-    return handle_intervals(jacobian, mass, damping, spring, loop, groups, k_max, poses, gravity, model)[1]
+    return handle_intervals(jacobian, mass, damping, spring, loop, groups, k_max, poses, gravity, model,
+                            transmission)[1]
 
 
 def _joint(inertia, damping, model_inertia=None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,

@@ -30,8 +30,9 @@ import numpy as np
 
 from hapticdesign.analysis.dynamics import cartesian
 from hapticdesign.analysis.metrics.kinematic import handle_range_basis
-from hapticdesign.analysis.sampled_loop import GRASP, Hand, SampledLoop, handle_intervals, handle_limits
+from hapticdesign.analysis.sampled_loop import GRASP, HANDS, Hand, SampledLoop, handle_intervals, handle_limits
 from hapticdesign.errors import UserError
+from hapticdesign.model.actuators import Transmission
 
 DIRECTIONS = 60
 """Directions spread over the sphere (circle for a planar device) for the worst wall direction."""
@@ -76,25 +77,29 @@ CHUNK_BYTES = 1 << 24
 
 def wall_limit(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, loop: SampledLoop | None = None,
                direction: np.ndarray | None = None, gravity: np.ndarray | None = None,
-               model: tuple[np.ndarray, np.ndarray] | None = None) -> float:
+               model: tuple[np.ndarray, np.ndarray] | None = None, transmission: Transmission | None = None) -> float:
     """The exact stable wall stiffness (N/m) at one pose along ``direction`` (a unit base-frame 3-vector), or the
     smallest over :func:`wall_directions` when it is None (see the module docstring); ``gravity`` the gradient
     ``dG/dq`` (n, n) at the pose (None: 0), ``model`` the compensator's ``H_m`` and ``dG_m/dq`` there (None: the
-    loop's shares, :func:`~hapticdesign.analysis.sampled_loop.handle_loops`)."""
+    loop's shares, :func:`~hapticdesign.analysis.sampled_loop.handle_loops`), ``transmission`` the motors'
+    compliant transmissions (n, n) each (None: rigid)."""
     along = None if direction is None else np.reshape(direction, (1, 1, 3))
     return float(wall_limits(jacobian[None], mass[None], damping, loop, along,
                              None if gravity is None else np.asarray(gravity)[None],
-                             None if model is None else tuple(np.asarray(x, dtype=float)[None] for x in model))[0])
+                             None if model is None else tuple(np.asarray(x, dtype=float)[None] for x in model),
+                             transmission)[0])
 
 
 def wall_limits(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, loop: SampledLoop | None = None,
                 along: np.ndarray | None = None, gravity: np.ndarray | None = None,
-                model: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+                model: tuple[np.ndarray, np.ndarray] | None = None,
+                transmission: Transmission | None = None) -> np.ndarray:
     """:func:`wall_limit` at P poses at once: ``jacobian`` ``J_v`` (P, 3, n), ``mass`` ``H`` (P, n, n), ``damping``
     ``B`` (n, n) or (P, n, n), ``gravity`` ``dG/dq`` (P, n, n) or None; ``along`` None (the worst of
     :func:`wall_directions`) or (P, C, 3) unit base-frame rows (the smallest over them), ``model`` the compensator's
-    ``H_m`` and ``dG_m/dq`` (P, n, n) each or None (the loop's shares); (P,) in N/m, the loops
-    searched together in chunks of about :data:`CHUNK_BYTES` of matrices."""
+    ``H_m`` and ``dG_m/dq`` (P, n, n) each or None (the loop's shares), ``transmission`` the motors' compliant
+    transmissions ((n, n) or (P, n, n) each; None: rigid motors); (P,) in N/m, the loops searched together in chunks
+    of about :data:`CHUNK_BYTES` of matrices."""
     loop = loop or SampledLoop()
     jacobian, mass = np.asarray(jacobian, dtype=float), np.asarray(mass, dtype=float)
     damping = np.broadcast_to(np.asarray(damping, dtype=float), mass.shape)
@@ -105,7 +110,8 @@ def wall_limits(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, loo
     along = np.asarray(along, dtype=float)
     count, per_point = along.shape[:2]
     n = jacobian.shape[-1]
-    order = 2 * n * (loop.delay + 2) + n * (loop.delay + 1)
+    coords = n if transmission is None else 2 * n  # the motors' own coordinates beside the links'
+    order = 2 * coords * (loop.delay + 2) + n * (loop.delay + 1)
     per = max(1, CHUNK_BYTES // (8 * order * order * per_point))
     out = np.empty(count)
     for start in range(0, count, per):
@@ -115,18 +121,19 @@ def wall_limits(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, loo
         spring = np.einsum("sk,skn->sn", along[part].reshape(-1, 3), jacobian[rows])
         out[part] = handle_limits(jacobian[part], mass[part], damping[part], spring, loop,
                                   np.repeat(np.arange(size), per_point), poses=rows - start, gravity=gravity[part],
-                                  model=None if model is None else tuple(x[part] for x in model))
+                                  model=None if model is None else tuple(x[part] for x in model),
+                                  transmission=None if transmission is None else transmission.taken(part))
     return out
 
 
 def worst_direction(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, loop: SampledLoop | None = None,
-                    gravity: np.ndarray | None = None,
-                    model: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[float, np.ndarray, float]:
+                    gravity: np.ndarray | None = None, model: tuple[np.ndarray, np.ndarray] | None = None,
+                    transmission: Transmission | None = None) -> tuple[float, np.ndarray, float]:
     """The smallest exact wall limit at one pose over :func:`wall_directions`, the direction (unit, base frame)
     that gives it (every direction searched to the end) and the largest lower end over the directions (0 unless
     gravity pulls the handle off a wall: a wall in any direction is then stable for springs between the two, and
     for none when it is the larger);
-    ``gravity`` ``dG/dq`` (n, n) at the pose or None, ``model`` as :func:`wall_limit`'s."""
+    ``gravity`` ``dG/dq`` (n, n) at the pose or None, ``model`` and ``transmission`` as :func:`wall_limit`'s."""
     loop = loop or SampledLoop()
     jacobian, mass = np.asarray(jacobian, dtype=float)[None], np.asarray(mass, dtype=float)[None]
     damping = np.broadcast_to(np.asarray(damping, dtype=float), mass.shape)
@@ -136,7 +143,7 @@ def worst_direction(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray,
     lows, limits = handle_intervals(jacobian, mass, damping, along @ jacobian[0], loop,
                                     poses=np.zeros(count, dtype=np.int64),
                                     gravity=None if gravity is None else np.asarray(gravity, dtype=float)[None],
-                                    model=model)
+                                    model=model, transmission=transmission)
     best = int(np.argmin(limits))
     return float(limits[best]), along[best], float(lows.max())
 
@@ -148,8 +155,8 @@ discretization of a handle's mass over much longer periods overflows."""
 KMAX_OPTIONS = {"period": 0.001, "delay": 1, "damping": 0.0, "direction": None, "velocity": "difference",
                 "compensation": "gravity", "error_percent": 0.0, "hand": None}
 """The ``kmax`` index's options and defaults: the settings of :class:`SampledLoop` (``damping`` the wall's damper in
-N s/m), ``direction`` a base-frame vector (default: the worst direction) and ``hand`` None, ``"grasp"`` (the default
-grasp :data:`~hapticdesign.analysis.sampled_loop.GRASP`) or ``{mass, damping, stiffness}``."""
+N s/m), ``direction`` a base-frame vector (default: the worst direction) and ``hand`` None, a preset's name of
+:data:`~hapticdesign.analysis.sampled_loop.HANDS` (``light``, ``firm``) or ``{mass, damping, stiffness}``."""
 
 
 def kmax_loop(options: Mapping[str, object]) -> tuple[SampledLoop, np.ndarray | None]:
@@ -185,21 +192,26 @@ def kmax_loop(options: Mapping[str, object]) -> tuple[SampledLoop, np.ndarray | 
 def _hand(value: object) -> Hand | None:
     if value is None or value is False:
         return None
-    if value == "grasp" or value is True:
+    if value is True:
         return GRASP
+    if isinstance(value, str):
+        return Hand.named(value)
     if isinstance(value, Mapping) and set(value) <= {"mass", "damping", "stiffness"} and all(
             isinstance(v, (int, float)) and not isinstance(v, bool) for v in value.values()):
         return Hand(**{k: float(v) for k, v in value.items()})
-    raise UserError(f"the hand is none, 'grasp' or a mapping of mass, damping and stiffness, got {str(value)[:60]!r}")
+    raise UserError(f"the hand is none, a name ({', '.join(HANDS)}) or a mapping of mass, damping and stiffness, got "
+                    f"{str(value)[:60]!r}")
 
 
 def kmax(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray,
          ranges: tuple[np.ndarray, np.ndarray, np.ndarray], options: Mapping[str, object],
-         gravity: np.ndarray | None = None, model: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+         gravity: np.ndarray | None = None, model: tuple[np.ndarray, np.ndarray] | None = None,
+         transmission: Transmission | None = None) -> np.ndarray:
     """The ``kmax`` index (N/m) at P poses: ``J_v`` (P, 3, n), ``H`` (P, n, n), ``B`` (n, n) or (P, n, n), the
     handle's range as :func:`handle_range` gives it (the basis ``U``, mobility and damping in it, already known to
     the caller), the options of :data:`KMAX_OPTIONS`, gravity's gradient ``dG/dq`` (P, n, n) or None and the
-    compensator's ``H_m`` and ``dG_m/dq`` (P, n, n each; None: the loop's uniform shares)."""
+    compensator's ``H_m`` and ``dG_m/dq`` (P, n, n each; None: the loop's uniform shares) and the motors' compliant
+    transmissions (None: rigid)."""
     loop, direction = kmax_loop(options)
     basis, mobility, cartesian_damping = ranges
     if direction is None:
@@ -210,4 +222,4 @@ def kmax(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray,
             raise UserError(f"index kmax: the direction {np.round(direction, 6).tolist()} is not one the handle "
                             "moves in")
         along = np.broadcast_to(direction, (len(jacobian), 1, 3))
-    return wall_limits(jacobian, mass, damping, loop, along, gravity, model)
+    return wall_limits(jacobian, mass, damping, loop, along, gravity, model, transmission)

@@ -74,6 +74,21 @@ class Workspace:
         return np.array(out, dtype=float)
 
 
+    @property
+    def center_index(self) -> int | None:
+        """The place of the box's centre among :meth:`points`: the middle of every axis of nonzero size, which an
+        odd grid holds; None for an even grid (no point at the centre)."""
+        axes = sum(v > 0.0 for v in self.size)
+        if axes and self.grid % 2 == 0:
+            return None
+        return _snake([self.grid] * axes).index(((self.grid - 1) // 2,) * axes)
+
+    def describe(self) -> str:
+        """How coarse the grid is: ``27 points, grid 3``."""
+        count = len(self.points())
+        return f"{count} point{'s' if count > 1 else ''}, grid {self.grid}"
+
+
 def _snake(counts: list[int]) -> list[tuple[int, ...]]:
     """Grid indices in boustrophedon order: every other sweep of the inner axes runs backwards."""
     if not counts:

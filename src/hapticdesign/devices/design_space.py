@@ -52,13 +52,14 @@ from hapticdesign.devices.device_file import (
 from hapticdesign.devices.schema import HOME_POSITION, ActuatorSpec, DeviceFileSpec
 from hapticdesign.errors import UserError
 from hapticdesign.files import quote
-from hapticdesign.model.actuators import damping_matrix
+from hapticdesign.model.actuators import Transmission, damping_matrix
 from hapticdesign.model.device import Device
 from hapticdesign.model.elastic import Elasticity, ElasticLink
 from hapticdesign.model.inertia import SEED_FIELDS, check_body, seed_parameter_name, standard_from_seed, tube_seed
 from hapticdesign.model.params_io import read_mapping
 
-ACTUATOR_FIELDS = ("rotor_inertia", "gear_ratio", "coulomb", "damping", "torque_continuous", "torque_peak")
+ACTUATOR_FIELDS = ("rotor_inertia", "gear_ratio", "coulomb", "damping", "torque_continuous", "torque_peak",
+                   "transmission_stiffness")
 """The numeric fields of a motor a design variable may change (units as in the device file)."""
 MOTOR_SETS = 4096
 """Distinct sets of motor values whose matrices :meth:`DesignSpace.batch_values` keeps (a study's discrete ratios are
@@ -141,6 +142,7 @@ class Motors(NamedTuple):
     damping_matrix: np.ndarray
     motor_map: np.ndarray | None
     torques: dict
+    transmission: Transmission | None
 
 
 class DesignSpace:
@@ -390,9 +392,14 @@ class DesignSpace:
         torques = {which: None if any(b.torques[which] is None for b in built)
                    else np.array([b.torques[which] for b in built]) for which in ("continuous", "peak")}
         inverse = None if any(b.motor_map is None for b in built) else np.array([b.motor_map for b in built])
+        compliant = [b.transmission is not None for b in built]
+        if any(compliant) and not all(compliant):
+            raise UserError("design variables may change a transmission_stiffness, not add or remove one")
+        transmission = Transmission(*(np.array(x) for x in zip(*(b.transmission for b in built)))) if all(
+            compliant) and built else None
         return DesignValues(kinematic, standard, np.array([b.reflected for b in built]),
                             np.array([b.damping_matrix for b in built]),
-                            inverse, torques, rigidity, refused)
+                            inverse, torques, rigidity, refused, transmission)
 
     def _motors(self, key: tuple) -> "Motors":
         """The motors with the changes ``key`` (:attr:`Applied.motor_key`), built and validated once per distinct
@@ -404,7 +411,8 @@ class DesignSpace:
             device = self._with_actuators({k: dict(f) for k, f in key}) if key else self.base
             motors[key] = Motors(device.actuators, device.damping, device.reflected_inertia, device.damping_matrix,
                                  force.motor_map(device),
-                                 {which: force.torque_limits(device, which) for which in ("continuous", "peak")})
+                                 {which: force.torque_limits(device, which) for which in ("continuous", "peak")},
+                                 device.transmission)
         return motors[key]
 
     @staticmethod

@@ -160,7 +160,7 @@ def actuator_from_spec(a: ActuatorSpec, index: dict[str, int]) -> Actuator:
     offset = 0.0 if a.drives is None else float(a.drives.constant)
     limits = None if a.limits is None else (float(a.limits[0]), float(a.limits[1]))
     return Actuator(terms[0][0], a.rotor_inertia, a.gear_ratio, a.coulomb, a.damping, coupling, offset, limits,
-                    a.torque_continuous, a.torque_peak, a.encoder_cpr, a.quadrature)
+                    a.torque_continuous, a.torque_peak, a.encoder_cpr, a.quadrature, a.transmission_stiffness)
 
 
 def _location(loc: tuple) -> str:

@@ -162,7 +162,8 @@ class ActuatorSpec(_FileModel):
     ratio (rotor rad per joint rad or m), Coulomb friction (N m or N) and viscous damping on the side of
     what it turns, and optional ``limits`` of its travel (of ``drives``, in joint units); the motor's
     continuous and peak torque (N m at the motor) and its encoder's counts per revolution and
-    quadrature factor, where known."""
+    quadrature factor, where known; ``transmission_stiffness`` the stiffness between the motor and what it turns,
+    at the joint side (N m/rad or N/m; absent: rigid), given for every actuator or none."""
 
     joint: Identifier | None = None
     drives: Expression | None = None
@@ -175,6 +176,7 @@ class ActuatorSpec(_FileModel):
     torque_peak: Annotated[Number, Field(gt=0.0)] | None = None
     encoder_cpr: Annotated[int, Field(strict=True, gt=0, le=10**9)] | None = None
     quadrature: Literal[1, 2, 4] = 4
+    transmission_stiffness: Annotated[Number, Field(gt=0.0)] | None = None
 
     @model_validator(mode="after")
     def _reflected_finite(self) -> "ActuatorSpec":

@@ -14,14 +14,25 @@ link is neglected, as usual for geared or capstan drives (Spong, Hutchinson & Vi
 parameters ``pi`` (a constant has no variance over a region, so the Linearity Number of eq. 3.1-3.4
 is unchanged by it). Coulomb friction and viscous damping are given on the joint side (N m and
 N m s/rad, or N and N s/m), i.e. as the joint feels them through the transmission.
+
+A compliant transmission (``transmission_stiffness`` ``k``, N m/rad or N/m at the joint side: a capstan's cables,
+a belt, a gearbox's torsion) puts a spring between the motor and the link: the motor's coordinate ``phi`` (its
+angle divided by ``n``, in joint units) carries the rotor's ``n^2 J_r`` and the motor's damping ``b``, friction and
+encoder, and the link side the rest of H, the spring ``k (a^T q - phi)^2 / 2`` between them. Over the coordinates
+the motors turn this is :class:`Transmission` (``M_r = sum n^2 J_r a a^T``, ``B_m = sum b a a^T``,
+``K_t = sum k a a^T``); as ``k`` grows the two sides move as one and the rigid model above returns (the sampled
+loop's plant, :func:`hapticdesign.analysis.sampled_loop.handle_loops`).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
+
+from hapticdesign.errors import UserError
 
 Limits = tuple[float, float] | None
 """A joint's range ``(low, high)`` in rad or m, or ``None`` when it moves freely."""
@@ -37,7 +48,8 @@ class Actuator:
     travel, in joint units), or ``None``. ``torque_continuous`` and ``torque_peak`` are the motor's
     rated torques (N m at the motor shaft, before the transmission), ``encoder_cpr`` its encoder's
     counts per motor revolution as the data sheet gives them (lines; ``quadrature`` edges per line,
-    4 for x4 decoding); ``None`` when not known.
+    4 for x4 decoding); ``None`` when not known. ``transmission_stiffness`` the stiffness between the motor and
+    what it turns, at the joint side (N m/rad or N/m; ``None``: rigid).
     """
 
     joint: int
@@ -52,6 +64,7 @@ class Actuator:
     torque_peak: float | None = None
     encoder_cpr: int | None = None
     quadrature: int = 4
+    transmission_stiffness: float | None = None
 
     @property
     def counts_per_radian(self) -> float | None:
@@ -94,6 +107,42 @@ def damping_matrix(actuators: tuple[Actuator, ...], n_dof: int) -> np.ndarray:
     """``sum_k b_k a_k a_k^T`` (n_dof x n_dof): the motors' viscous damping on the coordinates."""
     a = transmission(actuators, n_dof)
     return a.T @ (np.array([x.damping for x in actuators]).reshape(-1, 1) * a)
+
+
+class Transmission(NamedTuple):
+    """The motors' side of compliant transmissions over the coordinates they turn (module docstring), each
+    (..., n, n): the rotors' reflected inertia ``M_r``, the motors' damping ``B_m`` and the transmissions' stiffness
+    ``K_t``. The plant of the sampled loop then has the motor coordinates ``phi`` beside ``q``:
+    ``M_r phi'' + B_m phi' + K_t (phi - q) = tau`` and ``(H - M_r) q'' + (B - B_m) q' + K_t (q - phi) = f_ext``."""
+
+    inertia: np.ndarray
+    damping: np.ndarray
+    stiffness: np.ndarray
+
+    def taken(self, index) -> "Transmission":
+        """The transmissions of the poses ``index`` (leading axis), or all of them where the arrays are one
+        design's (n, n)."""
+        return Transmission(*(x if x.ndim == 2 else x[index] for x in self))
+
+
+def transmission_of(actuators: tuple[Actuator, ...], n_dof: int) -> Transmission | None:
+    """The :class:`Transmission` of the motors, or None when none states a ``transmission_stiffness``; a one-line
+    error when some do and others do not (a rigid motor beside compliant ones would need a model of its own), or
+    when the stiffness is not a positive finite number."""
+    stated = [a.transmission_stiffness is not None for a in actuators]
+    if not any(stated):
+        return None
+    if not all(stated):
+        missing = ", ".join(str(a.joint + 1) for a in actuators if a.transmission_stiffness is None)
+        raise UserError(f"every actuator states its transmission_stiffness once one does (missing on the motors of "
+                        f"coordinates {missing})")
+    k = np.array([a.transmission_stiffness for a in actuators], dtype=float)
+    if not np.all(np.isfinite(k) & (k > 0)):
+        raise UserError(f"a transmission_stiffness is a positive finite number (N m/rad or N/m), got "
+                        f"{float(k[~(np.isfinite(k) & (k > 0))][0])!r}")
+    a = transmission(actuators, n_dof)
+    return Transmission(reflected_inertia_matrix(actuators, n_dof), damping_matrix(actuators, n_dof),
+                        a.T @ (k[:, None] * a))
 
 
 def motor_limit_warnings(q, actuators: tuple[Actuator, ...], names: tuple[str, ...]) -> list[str]:

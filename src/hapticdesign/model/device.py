@@ -28,7 +28,7 @@ import numpy as np
 
 from hapticdesign.errors import PhysicalConsistencyWarning, UserError
 from hapticdesign.model.actuators import (
-    Actuator, Limits, damping_matrix, full_turn, limit_warnings, motor_limit_warnings, reflected_inertia_matrix,
+    Actuator, Limits, Transmission, damping_matrix, full_turn, limit_warnings, motor_limit_warnings, reflected_inertia_matrix, transmission_of,
     transmission,
 )
 from hapticdesign.model.elastic import Elasticity
@@ -155,6 +155,12 @@ class Device:
         """The viscous damping matrix: ``diag(damping)`` plus the off-diagonal part of the motors' ``b a a^T``."""
         coupled = damping_matrix(self.actuators, self.n_dof)
         return np.diag(np.asarray(self.damping, dtype=float)) + coupled - np.diag(np.diag(coupled))
+
+    @property
+    def transmission(self) -> Transmission | None:
+        """The motors' compliant transmissions over the coordinates (:class:`~hapticdesign.model.actuators.
+        Transmission`), or None when the motors are rigid (no actuator states a ``transmission_stiffness``)."""
+        return transmission_of(self.actuators, self.n_dof)
 
     @property
     def friction(self) -> tuple[np.ndarray, np.ndarray]:

@@ -147,3 +147,13 @@ def run_convex(bound: BoundStudy, seed: int) -> StudyRun:
     x = [values[name] for name in spec.variables]
     record = record_of(spec, 1, x, values, Answer((result.ln,), reason))
     return StudyRun(spec, seed, [record], [0] if record.feasible else [], notes={"lower_bound": result.lower_bound})
+
+
+def ln_of(bound: BoundStudy, values: dict[str, float]) -> Answer:
+    """The LN of the design of variable ``values`` over the program's region (the device's joint limits), exactly as
+    the program's design is evaluated (:func:`run_convex`): the device file's design beside it."""
+    try:
+        device = bound.space.device(bound.device_values(values))
+    except UserError as exc:
+        return Answer((np.nan,), str(exc))
+    return Answer((float(device_form(device).ln(device.standard_parameters())),))

@@ -14,7 +14,7 @@ from __future__ import annotations
 import copy
 import json
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -22,7 +22,7 @@ import yaml
 
 from hapticdesign.analysis.metrics.indices import (
     INDICES, Evaluation, Index, Registry, Request, evaluate_at, evaluate_designs, evaluate_parameters, reduce,
-    requests_of,
+    reduced_at, reduction_label, requests_of, spread,
 )
 from hapticdesign.analysis.metrics.indices.registry import EVALUATION_LIMIT, require_evaluations
 from hapticdesign.analysis.configuration import configuration_of
@@ -121,6 +121,10 @@ class BoundStudy:
             raise UserError(f"{study.path}: {exc}") from None
         workspace = workspace_of(study)
         self.points = np.zeros((0, 3)) if workspace is None else workspace.points()
+        self.center = None if workspace is None else workspace.center_index
+        """The place of the box's centre among the points (None for an even grid), which ``reduce: center`` reads."""
+        self.coarseness = "" if workspace is None else workspace.describe()
+        """How coarse the workspace grid is: ``27 points, grid 3``."""
         self.title = f"{self.space.base.name} ({study.path.name})"
         self._evaluated: dict[tuple, tuple] = {}
 
@@ -177,14 +181,43 @@ class BoundStudy:
         full = self.study.spec.with_parameters(values)
         return {name: float(full[name]) for name in self.space.names}
 
-    def evaluate(self, batch: list[dict[str, float]], objectives: bool = True) -> list[Answer]:
+    def baseline(self) -> tuple[dict[str, float] | None, str]:
+        """The device file's own design: each variable at the value the device file states, and what is to be said of
+        it. A variable that only the ``parameters`` formulas read takes the file's value of a device value that a
+        formula sets to it alone (``actuators.q1.gear_ratio: "ratio1"``). None, and why, when the file fixes a
+        variable nowhere (or leaves a motor field unset); else the values and, when there is any, a note naming the
+        values outside the study's range and the device values the study's formulas set otherwise than the file."""
+        spec = self.study.spec
+        stated = self.space.defaults()
+        alone = {f.text.strip(): name for name, f in spec.parameters.items() if name in stated}
+        values = {}
+        for name in spec.variables:
+            value = stated.get(name, stated.get(alone.get(name, ""), math.nan))
+            if not math.isfinite(value):
+                return None, (f"device file {self.study.device_path.name} states no value of variable {name} (a "
+                              "parameters formula setting a device value to it alone would give it)")
+            values[name] = value
+        notes = []
+        for name, variable in spec.variables.items():
+            low, high = ((min(variable.values), max(variable.values)) if isinstance(variable, Choice)
+                         else variable)
+            if not low <= values[name] <= high:
+                notes.append(f"{name} = {values[name]:.6g} is outside the study's range [{low:g}, {high:g}]")
+        for name, value in self.device_values(values).items():
+            if not math.isclose(value, stated[name], rel_tol=1e-9, abs_tol=1e-15):
+                notes.append(f"the study's formula sets {name} = {value:.6g} where the file states {stated[name]:.6g}")
+        return values, "; ".join(notes)
+
+    def evaluate(self, batch: list[dict[str, float]], objectives: bool = True,
+                 every_objective: bool = False) -> list[Answer]:
         """Answers for a batch of designs, in order: the registry evaluates the pose indices together (through the
         compiled kernels where it can, :func:`~hapticdesign.analysis.metrics.indices.evaluate_designs`), each
         reduced here; a design the device file refuses or that misses a workspace point has none, and says why.
         The parameter indices are evaluated for the whole batch at once (no device is built when the study asks
         only for them); those only the objectives read are evaluated only for the designs that meet every
         constraint (NSGA-II's constrained domination never reads the objectives of the others), and for none
-        without ``objectives``."""
+        without ``objectives`` (for every valid design with ``every_objective``: the device file's design, whose
+        objectives are compared even when it breaks a constraint)."""
         device_values = [self.device_values(v) for v in batch]
         if self.requests:
             results = evaluate_designs(self.space, device_values, self.points, self.requests, self.registry)
@@ -196,7 +229,7 @@ class BoundStudy:
         failed = self._parameter_values(first, [device_values[k] for k in valid], valid, values)
         valid = [k for k in valid if k not in failed]
         if objectives:
-            feasible = [k for k in valid if self._feasible(batch[k], values[k])]
+            feasible = [k for k in valid if every_objective or self._feasible(batch[k], values[k])]
             later = [r for r in self.parameter_requests if r.key not in self.constrained]
             failed |= self._parameter_values(later, [device_values[k] for k in feasible], feasible, values)
         nothing = (math.nan,) * len(self.keys)
@@ -207,7 +240,7 @@ class BoundStudy:
                 out.append(Answer(nothing, reason))
             else:
                 got = values[k]
-                out.append(Answer(tuple(reduce(got[label], key[2]) if (label := self.labels[key[:2]]) in got
+                out.append(Answer(tuple(reduce(got[label], key[2], self.center) if (label := self.labels[key[:2]]) in got
                                         else math.nan for key in self.keys)))
         return out
 
@@ -257,7 +290,7 @@ class BoundStudy:
         constrained = []
         for c in spec.constraints:
             if isinstance(c, IndexConstraint):
-                constrained.append(reduce(values[self.labels[c.key[:2]]], c.reduce))
+                constrained.append(reduce(values[self.labels[c.key[:2]]], c.reduce, self.center))
             else:
                 constrained.append(c.value(variables))
         g, _ = violations(spec, constrained)
@@ -287,13 +320,14 @@ class BoundStudy:
             v.write(data, float(values[v.name]))
         return data
 
-    def device_file_text(self, values: dict[str, float]) -> str:
-        """:meth:`device_mapping` as YAML, headed by where it comes from and where the study evaluated it
-        (:meth:`where_evaluated`)."""
+    def device_file_text(self, values: dict[str, float], comments: Sequence[str] = ()) -> str:
+        """:meth:`device_mapping` as YAML, headed by where it comes from, the ``comments`` lines (the device file's
+        design beside it) and where the study evaluated it (:meth:`where_evaluated`)."""
         shown = ", ".join(f"{k} = {v!r}" for k, v in values.items())
         names = (json.dumps(self.study.path.name), json.dumps(self.study.device_path.name))  # no line break in them
         header = f"# The design selected by study {names[0]} from device file {names[1]}:\n# {shown}\n"
-        return (header + self.where_evaluated(values)
+        lines = "".join(f"# {' '.join(line.splitlines())}\n" for line in comments)  # a reason's line break stays a comment
+        return (header + lines + self.where_evaluated(values)
                 + yaml.safe_dump(self.device_mapping(values), sort_keys=False, allow_unicode=False))
 
     def _at_points(self, values: dict[str, float]) -> tuple[Device, WorkspacePoses | None, dict | None]:
@@ -314,25 +348,64 @@ class BoundStudy:
         return self._evaluated[key]
 
     def where_evaluated(self, values: dict[str, float]) -> str:
-        """Comment lines naming, for each index the study reduced over its workspace points by ``min`` or ``max``,
-        the point where the design takes that value and its actuated coordinates there, with the ``spec`` command
-        that gives the sheet at that pose (issue 35: a sheet at home, outside the study's box, reads another pose's
-        numbers; at this pose its renderable stiffness is the study's ``kmax`` with the same loop settings)."""
+        """Comment lines naming, for each index the study reduced over its workspace points, the value with how coarse
+        the grid is (``max of 27 points, grid 3``) and, for ``min``, ``max`` and ``center``, the point where the design
+        takes it and its actuated coordinates there, with the ``spec`` command that gives the sheet at that pose
+        (issue 35: a sheet at home, outside the study's box, reads another pose's numbers; at this pose its renderable
+        stiffness is the study's ``kmax`` with the same loop settings); then each pose index by every reduction
+        (:meth:`spread_rows`)."""
         device, poses, got = self._at_points(values)
         if got is None:
             return ""
         lines = []
         for index, options, how in self.keys:
             label = self.labels.get((index, options))
-            if how not in ("min", "max") or label not in got:
+            if label not in got:
                 continue
-            k = int(np.argmin(got[label]) if how == "min" else np.argmax(got[label]))
             named = index + (json.dumps(dict(options), sort_keys=True) if options else "")
+            value = reduce(got[label], how, self.center)
+            head = (f"# {how} {named} over the study's points ({reduction_label(how, len(self.points), self.grid)}) = "
+                    f"{value:.6g} {self.registry[index].unit}")
+            k = reduced_at(got[label], how, self.center)
+            if k is None:
+                lines.append(head + "\n")
+                continue
             point = ", ".join(f"{x:.6g}" for x in self.points[k])
             q = ",".join(repr(float(x)) for x in poses.q[k])
-            lines.append(f"# {how} {named} over the study's points = {got[label][k]:.6g} {self.registry[index].unit} at "
-                         f"({point}) m; the sheet there: hapticdesign spec --device THIS_FILE --q {q}\n")
+            lines.append(f"{head} at ({point}) m; the sheet there: hapticdesign spec --device THIS_FILE --q {q}\n")
+        for row in self.spread_rows(values):
+            named, unit, *numbers = row
+            shown = ", ".join(f"{how} {v}" for how, v in zip(SPREAD_COLUMNS, numbers) if v != "")
+            lines.append(f"# {named} over the study's {self.coarseness} ({unit}): {shown}\n")
         return "".join(lines)
+
+    @property
+    def grid(self) -> int:
+        """The workspace's points per axis (0 without a workspace)."""
+        workspace = self.study.spec.workspace
+        return 0 if workspace is None else workspace.grid
+
+    def spread_rows(self, values: dict[str, float]) -> list[list]:
+        """Each index of the study at the workspace's poses over the points, for a design: the index (with its
+        options), its unit and :data:`SPREAD_COLUMNS` (the extremes' points as ``(x, y, z)`` in m; ``center`` blank for
+        an even grid); none when the design does not reach every point."""
+        _, _, got = self._at_points(values)
+        if got is None:
+            return []
+        rows = []
+        for r in self.requests:
+            s = spread(got[r.key], self.center)
+            named = r.index + (json.dumps(r.options, sort_keys=True) if r.options else "")
+            rows.append([named, self.registry[r.index].unit,
+                         *("" if s[c] is None else f"{s[c]:.6g}" for c in ("center", "median", "mean", "min")),
+                         self._extreme(s, "min"), f"{s['max']:.6g}", self._extreme(s, "max")])
+        return rows
+
+    def _extreme(self, s: dict, how: str) -> str:
+        """Where an extreme of :func:`~hapticdesign.analysis.metrics.indices.spread` is taken, and at how many points
+        when it ties (a symmetric device's mirrored corners)."""
+        ties = s[f"{how}_count"]
+        return _point(self.points[s[f"{how}_at"]]) + (f" (one of {ties} points)" if ties > 1 else "")
 
     def pictures(self, values: dict[str, float]) -> list[tuple[bytes, str]]:
         """The selected design's picture at the workspace centre (at home when the centre is out of reach) and
@@ -354,6 +427,16 @@ class BoundStudy:
             out.append((index_maps(self.points, maps, "The selected design's indices over the workspace"),
                         "The selected design's indices at the workspace points"))
         return out
+
+
+SPREAD_COLUMNS = ("center", "median", "mean", "min", "min_at", "max", "max_at")
+"""What :meth:`BoundStudy.spread_rows` gives of an index over the workspace points, in order: the value at the box's
+centre, the median, the mean, the smallest and its point, the largest and its point (with how many points tie for an
+extreme)."""
+
+
+def _point(p: np.ndarray) -> str:
+    return "(" + ", ".join(f"{x:.6g}" for x in p) + ") m"
 
 
 def bind_study(study: Study, indices: Iterable[Index] = (), registry: Registry = INDICES) -> BoundStudy:

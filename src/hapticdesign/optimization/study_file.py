@@ -23,7 +23,7 @@ from typing import Annotated, ClassVar, Literal
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError, field_validator, model_validator
 
-from hapticdesign.analysis.metrics.indices import INDICES
+from hapticdesign.analysis.metrics.indices import INDICES, check_reduction
 from hapticdesign.devices.builder import LinearExpr
 from hapticdesign.devices.device_file import describe_validation_error
 from hapticdesign.devices.schema import parse_expression
@@ -31,9 +31,6 @@ from hapticdesign.errors import UserError
 from hapticdesign.files import load_structured, quote, read_text
 from hapticdesign.optimization.formula import Formula, formula
 
-REDUCTIONS = ("min", "max", "mean")
-"""Reductions of an index over the workspace points (``mean``: the arithmetic mean over the uniform
-Cartesian grid, so ``isotropy`` with ``mean`` is the global conditioning index on that measure)."""
 SENSES = ("min", "max")
 MAX_VARIABLES = 128
 MAX_CHOICES = 1000
@@ -137,8 +134,17 @@ class _IndexUse(_StudyModel):
     docs/indices.md) and its reduction over the workspace points."""
 
     index: str = Field(min_length=1, max_length=64)
-    reduce: Literal["min", "max", "mean"]
+    reduce: str = Field(max_length=64)
+    """One of :data:`hapticdesign.analysis.metrics.indices.REDUCTIONS` (``center`` needs an odd grid)."""
     options: dict[str, OptionValue] = Field({}, max_length=16)
+
+    @field_validator("reduce")
+    @classmethod
+    def _reduction(cls, how: str) -> str:
+        try:
+            return check_reduction(how)
+        except UserError as exc:
+            raise ValueError(str(exc)) from None
 
     @property
     def request(self) -> tuple[str, tuple]:
@@ -380,6 +386,12 @@ class StudySpec(_StudyModel):
         if self.workspace is None and self.algorithm.over_poses and not self.parameters_only:
             raise ValueError("workspace: the region the handle must reach is required (only method convex, whose "
                              "LN is over the joint region, and a study of parameter indices alone do without)")
+        centered = [use.index for use in self.index_uses if use.reduce == "center"]
+        if centered and self.workspace is None:
+            raise ValueError(f"workspace: reduce center ({centered[0]}) needs a workspace, whose box's centre it reads")
+        if centered and self.workspace.grid % 2 == 0 and any(self.workspace.box.size):
+            raise ValueError(f"workspace.grid: reduce center ({centered[0]}) needs the box's centre among the grid "
+                             f"points, an odd grid; got {self.workspace.grid}")
         if isinstance(self.algorithm, _PopulationSearch) and self.algorithm.one_objective and len(self.objectives) > 1:
             raise ValueError(f"objectives: method {self.algorithm.method} minimizes one objective, not "
                              f"{len(self.objectives)} (use method nsga2 or nsga3)")

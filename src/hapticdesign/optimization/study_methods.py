@@ -15,16 +15,17 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from hapticdesign.errors import UserError
-from hapticdesign.optimization.study_convex import run_convex
+from hapticdesign.optimization.study_convex import ln_of, run_convex
 from hapticdesign.optimization.study_evaluation import BoundStudy
 from hapticdesign.optimization.study_file import StudySpec
 from hapticdesign.optimization.study_polish import polish
-from hapticdesign.optimization.study_run import Evaluator, StudyRun, run_study
+from hapticdesign.optimization.study_run import Answer, Encoding, Evaluator, StudyRun, record_of, run_study
 
 Progress = Callable[[int, int], None]
 
@@ -53,6 +54,11 @@ class PopulationSearch:
         evaluate = evaluate or bound.evaluate
         run = run_study(bound.study, seed, evaluate, out, progress, bound.evaluate_constraints)
         return polish(run, bound.study, evaluate, out)
+
+    def evaluate_baseline(self, bound: BoundStudy, values: dict[str, float]) -> Answer:
+        """The answer for the device file's design of variable ``values``: the bound study's, as every design's, with
+        its objectives even when it breaks a constraint."""
+        return bound.evaluate([values], every_objective=True)[0]
 
     def describe(self, run: StudyRun) -> str:
         """The run in words (the report)."""
@@ -130,6 +136,10 @@ class ConvexProgram:
         program is solved here at once)."""
         return run_convex(bound, seed)
 
+    def evaluate_baseline(self, bound: BoundStudy, values: dict[str, float]) -> Answer:
+        """The LN of the device file's design of variable ``values``, as the program's design is evaluated."""
+        return ln_of(bound, values)
+
     def describe(self, run: StudyRun) -> str:
         return (f"Method convex: LN minimized exactly over the inertial parameters as one convex program (seed 000 eq. "
                 f"3.1-3.4), every body {run.spec.algorithm.realizability} realizable; the relaxation's lower bound on "
@@ -143,6 +153,19 @@ METHODS = {method.name: method for method in (PopulationSearch("nsga2", "NSGA-II
                                                PopulationSearch("nsga3", "NSGA-III"),
                                                PopulationSearch("pso", "Particle swarm"), ConvexProgram())}
 """The study file's methods by name (their settings: :data:`~hapticdesign.optimization.study_file.SETTINGS`)."""
+
+
+def with_baseline(run: StudyRun, bound: BoundStudy) -> StudyRun:
+    """``run`` with the device file's own design (:meth:`~.study_evaluation.BoundStudy.baseline`) evaluated by the
+    study's method as every design is (through the bound study's registry, or the convex program's LN), its
+    objectives even when it breaks a constraint (generation 0, kept apart from the records and the front); without
+    one, the note says why."""
+    values, note = bound.baseline()
+    if values is None:
+        return replace(run, baseline_note=note)
+    answer = method_of(run.spec).evaluate_baseline(bound, values)
+    record = record_of(run.spec, 0, Encoding.of(run.spec).encode(values), values, answer)
+    return replace(run, baseline=record, baseline_note=note)
 
 
 def method_of(spec: StudySpec) -> PopulationSearch | ConvexProgram:

@@ -9,6 +9,7 @@ gives the same bytes and reading them back gives the same floats.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -16,9 +17,11 @@ from pathlib import Path
 import numpy as np
 
 from hapticdesign.analysis.metrics.indices import INDICES, Index
+from hapticdesign.analysis.workspace import Workspace
 from hapticdesign.errors import UserError
 from hapticdesign.files import csv_rows, figure_bytes, save_figure
 from hapticdesign.optimization.front_selection import least_rms, normalize
+from hapticdesign.optimization.study_file import Choice, StudySpec
 from hapticdesign.optimization.study_run import Record, StudyRun, constraint_labels
 
 
@@ -60,6 +63,80 @@ def select_design(run: StudyRun, weights: dict[str, float] | None = None, design
             "least weighted RMS of the normalized objectives (seed 001 Fig. 7.3; weights "
             + ", ".join(f"{n} {x:g}" for n, x in zip(names, w)) + ")")
     return Selection(position, run.front[position], rule)
+
+
+@dataclass(frozen=True)
+class Change:
+    """One objective from the device file's design (``old``) to the selected design (``new``): the change in percent
+    of ``|old|`` and whether it was ``gained`` or ``lost`` in the objective's sense (``same``; empty when either has no
+    value)."""
+
+    name: str
+    old: float
+    new: float
+    percent: float
+    verdict: str
+
+    def __str__(self) -> str:
+        percent = f" ({self.percent:+.3g} %)" if np.isfinite(self.percent) else ""
+        return f"{self.name} {self.old:.6g} -> {self.new:.6g}{percent}{', ' + self.verdict if self.verdict else ''}"
+
+
+def changes(run: StudyRun, record: Record) -> list[Change]:
+    """Each objective from the device file's design (:attr:`StudyRun.baseline`) to ``record``; none without it."""
+    if run.baseline is None:
+        return []
+    out = []
+    for objective, old, new in zip(run.spec.objectives, run.baseline.objectives, record.objectives):
+        percent = 100.0 * (new - old) / abs(old) if old != 0.0 else math.nan
+        better = new < old if objective.sense == "min" else new > old
+        verdict = ("" if not (np.isfinite(old) and np.isfinite(new)) else "same" if new == old
+                   else "gained" if better else "lost")
+        out.append(Change(objective.name, old, new, percent, verdict))
+    return out
+
+
+AT_BOUND = 1e-6
+"""How close to a bound of its range, as a fraction of the range, a continuous variable sits at it."""
+
+
+def at_bounds(spec: StudySpec, values: Mapping[str, float]) -> dict[str, str]:
+    """The variables of a design at a bound of their range (within :data:`AT_BOUND` of it; a choice at its least or
+    greatest value), each with the bound in words: the search may want to go beyond it."""
+    out = {}
+    for name, variable in spec.variables.items():
+        low, high = (min(variable.values), max(variable.values)) if isinstance(variable, Choice) else variable
+        tolerance = 0.0 if isinstance(variable, Choice) else AT_BOUND * (high - low)
+        for bound, word in ((low, "lower"), (high, "upper")):
+            if abs(values[name] - bound) <= tolerance:
+                out[name] = f"at the {word} bound {bound:g} of its range"
+    return out
+
+
+def baseline_lines(run: StudyRun, record: Record) -> list[str]:
+    """The device file's design beside ``record`` in words (selected.yaml's header): the device file's variables,
+    each objective gained or lost, and the variables of ``record`` at a bound of their range."""
+    if run.baseline is None:
+        lines = [f"No device file's design to compare: {run.baseline_note}"]
+    else:
+        shown = ", ".join(f"{k} = {v:.6g}" for k, v in run.baseline.values.items())
+        lines = [f"The device file's design ({shown}){': ' + run.baseline_note if run.baseline_note else ''}",
+                 "  " + ("feasible" if run.baseline.feasible else f"not feasible: {run.baseline.reason}")
+                 + "; from it to this design: " + "; ".join(map(str, changes(run, record)))]
+    bounds = at_bounds(run.spec, record.values)
+    lines += [f"At a bound: {name} = {record.values[name]:.6g} {words}" for name, words in bounds.items()]
+    return lines
+
+
+CLOSEST = 10
+"""Designs the report of a study without a feasible design lists as the closest."""
+
+
+def closest_designs(run: StudyRun, count: int = CLOSEST) -> list[int]:
+    """The ``count`` records with constrained values closest to feasible (least total scaled violation, the first
+    evaluated first; designs that meet the constraints, whose ``keep`` filters remove them, first of all)."""
+    valid = [k for k, r in enumerate(run.records) if not r.invalid]
+    return sorted(valid, key=lambda k: (run.records[k].violation, k))[:count]
 
 
 def _number(value: float) -> str:
@@ -120,21 +197,45 @@ def front_limits(values: np.ndarray, pad: float = 0.08) -> tuple[float, float]:
     return low - margin, high + margin
 
 
+BASELINE = "device file's design"
+"""The device file's own design in the figures' legends."""
+
+
+def normalized_like_front(run: StudyRun, objectives: np.ndarray) -> np.ndarray:
+    """``objectives`` normalized by the front's range as :func:`normalized_front` does (0 best; outside 0 to 1 when
+    beyond the front)."""
+    out = []
+    for k, (objective, value) in enumerate(zip(run.spec.objectives, objectives)):
+        column = np.array([run.records[i].objectives[k] for i in run.front])
+        low, span = column.min(), np.ptp(column)
+        n = (value - low) / span if span > 0.0 else 0.0
+        out.append(1.0 - n if objective.sense == "max" else n)
+    return np.array(out)
+
+
 def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: str = "pareto",
                   registry: Mapping[str, Index] = INDICES) -> list[Path]:
-    """The front in pairs of objectives (every feasible design in grey, the front in blue, the selected
-    design as a red star; the axes span the front's range, :func:`front_limits`, and the legend counts the
-    feasible designs beyond them); one objective: its value per evaluation; more than three: parallel coordinates
-    of the normalized front (0 best)."""
+    """The front in pairs of objectives, each labelled with its reduction and how coarse the grid is (every feasible
+    design in grey, the front in blue, the selected design as a red star, the device file's design as a black
+    diamond, said when it is not feasible; the axes span the front's range and the device file's design,
+    :func:`front_limits`, and the legend counts the feasible designs beyond them); one objective: its value per
+    evaluation (the device file's design a dashed line); more than three: parallel coordinates of the normalized
+    front (0 best; the device file's design dashed, normalized alike)."""
     plt = _pyplot()
     spec = run.spec
     units = {o.index: registry[o.index].unit for o in spec.objectives}
-    labels = [f"{o.name}: {o.reduce} {o.index} ({'-' if units[o.index] == '1' else units[o.index]}), {o.sense}imize"
-              for o in spec.objectives]
+    box = spec.workspace
+    grids = {o.index: "" if box is None or registry[o.index].of_parameters
+             else "; " + Workspace(box.box.center, box.box.size, box.grid).describe() for o in spec.objectives}
+    labels = [f"{o.name}: {o.reduce} {o.index} ({'-' if units[o.index] == '1' else units[o.index]}{grids[o.index]}), "
+              f"{o.sense}imize" for o in spec.objectives]
     feasible = [r for r in run.records if r.feasible]
     F_all = np.array([r.objectives for r in feasible]).reshape(len(feasible), len(labels))
     F = np.array([run.records[k].objectives for k in run.front]).reshape(len(run.front), len(labels))
     pick = None if selection is None else F[selection.position]
+    base = (np.array(run.baseline.objectives) if run.baseline is not None
+            and np.all(np.isfinite(run.baseline.objectives)) else None)
+    baseline = BASELINE if base is None or run.baseline.feasible else f"{BASELINE} (not feasible)"
     k = len(labels)
     if k == 1:
         fig, ax = plt.subplots(figsize=(6, 4), dpi=100)
@@ -142,6 +243,8 @@ def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: s
         ax.scatter(numbers, F_all[:, 0], s=6, color="0.6", label="feasible designs")
         if pick is not None:
             ax.scatter([selection.record + 1], [pick[0]], marker="*", s=140, color="red", label="selected")
+        if base is not None:
+            ax.axhline(base[0], color="black", linestyle="--", linewidth=1.0, label=baseline)
         ax.set_xlabel("evaluation")
         ax.set_ylabel(labels[0])
         ax.legend(fontsize=8)
@@ -149,7 +252,8 @@ def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: s
         pairs = [(0, 1)] if k == 2 else [(0, 1), (0, 2), (1, 2)]
         fig, axes = plt.subplots(1, len(pairs), figsize=(5.5 * len(pairs), 4.5), dpi=100, squeeze=False)
         for ax, (i, j) in zip(axes[0], pairs):
-            (x_low, x_high), (y_low, y_high) = front_limits(F[:, i]), front_limits(F[:, j])
+            shown = F if base is None else np.vstack([F, base])
+            (x_low, x_high), (y_low, y_high) = front_limits(shown[:, i]), front_limits(shown[:, j])
             beyond = int(np.sum((F_all[:, i] < x_low) | (F_all[:, i] > x_high) | (F_all[:, j] < y_low)
                                 | (F_all[:, j] > y_high)))
             ax.scatter(F_all[:, i], F_all[:, j], s=6, color="0.75",
@@ -157,6 +261,8 @@ def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: s
             ax.scatter(F[:, i], F[:, j], s=22, color="tab:blue", label="front")
             if pick is not None:
                 ax.scatter([pick[i]], [pick[j]], marker="*", s=160, color="red", label="selected")
+            if base is not None:
+                ax.scatter([base[i]], [base[j]], marker="D", s=50, color="black", label=baseline)
             ax.set_xlim(x_low, x_high)
             ax.set_ylim(y_low, y_high)
             ax.set_xlabel(labels[i])
@@ -169,6 +275,10 @@ def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: s
             ax.plot(range(k), row, color="tab:blue", alpha=0.4, linewidth=0.8)
         if selection is not None:
             ax.plot(range(k), normalized[selection.position], color="red", linewidth=2.2, label="selected")
+        if base is not None:
+            ax.plot(range(k), normalized_like_front(run, base), color="black", linestyle="--", linewidth=1.6,
+                    label=baseline)
+        if selection is not None or base is not None:
             ax.legend(fontsize=8)
         ax.set_xticks(range(k), [o.name for o in spec.objectives], rotation=20)
         ax.set_ylabel("normalized objective (0 = best on the front)")

@@ -87,6 +87,12 @@ class Encoding:
     def discrete(self) -> tuple[int, ...]:
         return tuple(k for k, name in enumerate(self.names) if name in self.choices)
 
+    def encode(self, values: dict[str, float]) -> tuple[float, ...]:
+        """The design vector of variable ``values`` (a choice's value becomes its index, NaN for a value not among
+        the choices)."""
+        return tuple(float(self.choices[name].index(values[name]) if values[name] in self.choices[name] else math.nan)
+                     if name in self.choices else float(values[name]) for name in self.names)
+
     def decode(self, x: Sequence[float]) -> dict[str, float]:
         """Variable values of one design vector (a choice's index becomes its value)."""
         out = {}
@@ -97,10 +103,10 @@ class Encoding:
 
 @dataclass(frozen=True)
 class Record:
-    """One evaluated design: its generation (1 = the initial population), design vector, variable values,
-    objectives (the study's sense and units), constrained values, why it has no values (``invalid``) or
-    which constraint it breaks first (``violated``), both empty when it is feasible, and its total scaled
-    constraint violation."""
+    """One evaluated design: its generation (1 = the initial population, 0 = the device file's own design), design
+    vector, variable values, objectives (the study's sense and units), constrained values, why it has no values
+    (``invalid``) or which constraint it breaks first (``violated``), both empty when it is feasible, and its total
+    scaled constraint violation."""
 
     generation: int
     x: tuple[float, ...]
@@ -308,7 +314,9 @@ class StudyRun:
     (None: every record); ``start``: the minimized start design's variables (None without ``algorithm.start`` or
     when no start met the constraints); ``notes``: the method's own results by name, as ``optimize --json`` prints
     them (method convex: ``lower_bound``, :mod:`.study_convex`); ``probes``: designs the polishing evaluated beside
-    the polished ones it kept (:mod:`.study_polish`)."""
+    the polished ones it kept (:mod:`.study_polish`); ``baseline``: the device file's own design evaluated as every
+    design is (None when the file does not fix every variable), outside ``records`` and the front;
+    ``baseline_note``: why there is none, or what to know of it (:meth:`~.study_evaluation.BoundStudy.baseline`)."""
 
     spec: StudySpec
     seed: int
@@ -318,6 +326,8 @@ class StudyRun:
     start: dict[str, float] | None = None
     notes: dict[str, float] = field(default_factory=dict)
     probes: int = 0
+    baseline: Record | None = None
+    baseline_note: str = ""
 
     @property
     def evaluations(self) -> int:

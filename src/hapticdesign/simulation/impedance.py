@@ -170,7 +170,7 @@ def stability_limit(device: Device, loop: SampledLoop | None = None, wall_joint:
         low, high = handle_intervals(handle_jacobian(device, pose)[:3][None], mass_matrix(device, pose)[None],
                                      device.damping_matrix, spring[None], loop, k_max=k_max,
                                      gravity=gravity_gradient(device, pose)[None],
-                                     model=loop_model(device, loop, pose))
+                                     model=loop_model(device, loop, pose), transmission=device.transmission)
         settled = found is not None and abs(high[0] - found.stiffness) <= 1e-9 * found.stiffness
         found = StabilityLimit(float(high[0]), pose, loop, float(low[0]))
         if settled or not (0.0 < high[0] < np.inf):

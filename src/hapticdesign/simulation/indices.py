@@ -42,6 +42,9 @@ def kmax_simulated(pose: HandleStates, period: float = 0.001, delay: int = 1, ve
                "error_percent": error_percent, "hand": hand}
     loop, _ = kmax_loop(options)
     device = pose.device
+    if device.transmission is not None:
+        raise UserError("index kmax_simulated: the simulated loop's plant is rigid; a device whose actuators state a "
+                        "transmission_stiffness has the exact limit kmax, which models it")
     counts = device_counts(device) if quantization else None
     model = None if error_percent == 0 else pose.compensator(error_percent)
     out = np.empty(len(pose.full))

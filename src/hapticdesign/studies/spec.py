@@ -140,7 +140,7 @@ def renderable_stiffness(device: Device, h: Handle, loop: SampledLoop | None = N
     (:func:`hapticdesign.analysis.wall_stiffness.wall_limit`), gravity's gradient at the pose in the loop."""
     loop = loop or SampledLoop()
     return wall_limit(h.jacobian, h.states.H[0], device.damping_matrix, loop, gravity=gravity_gradient(device, h.q),
-                      model=loop_model(device, loop, h.q))
+                      model=loop_model(device, loop, h.q), transmission=device.transmission)
 
 
 def renderable(device: Device, h: Handle, loop: SampledLoop, res: float | None,
@@ -152,11 +152,11 @@ def renderable(device: Device, h: Handle, loop: SampledLoop, res: float | None,
 
     exact, direction, lower = worst_direction(h.jacobian, h.states.H[0], device.damping_matrix,
                                               replace(loop, hand=None), gravity_gradient(device, h.q),
-                                              loop_model(device, loop, h.q))
+                                              loop_model(device, loop, h.q), device.transmission)
     hand = loop.hand or GRASP
     counts = device_counts(device)
     simulated = None
-    if simulate:
+    if simulate and device.transmission is None:  # the simulated loop's plant is rigid
         simulated = simulated_limit(device, replace(loop, hand=None), direction=direction, equilibrium=TOUCH,
                                     counts=counts, start=max(exact, 1.0), k_limit=SIMULATED_CAP)
     return {

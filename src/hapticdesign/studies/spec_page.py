@@ -64,8 +64,8 @@ def value_text(sheet: dict, key: str) -> str:
                  if value["passivity_viscous"] == 0.0 and not value["passivity_coulomb"] else
                  f"stable from {value['exact_lower']:.4g} to {value['exact']:.4g}" if value.get("exact_lower")
                  else f"{value['exact']:.4g}")
-        return (f"exact {exact}; with the hand ({hand['mass']:g} kg, {hand['damping']:g} N s/m, "
-                f"{hand['stiffness']:g} N/m) {value['exact_with_hand']:.4g}; simulated with dry friction and "
+        return (f"exact {exact}; with the {hand.get('name', 'given')} hand ({hand['mass']:g} kg, {hand['damping']:g} "
+                f"N s/m, {hand['stiffness']:g} N/m) {value['exact_with_hand']:.4g}; simulated with dry friction and "
                 f"quantization {simulated}; passivity: 2b/T = {value['passivity_viscous']:.4g}, 2 f_c / Delta = "
                 + ("n/a" if value["passivity_coulomb"] is None else f"{value['passivity_coulomb']:.4g}")
                 + f" (at {value['rate']:g} Hz, delay {value['delay_samples']}, every joint free)")

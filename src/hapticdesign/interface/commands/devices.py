@@ -91,8 +91,9 @@ def spec(
     rate: float = typer.Option(1000.0, "--rate", min=1.0, max=1e6, help="Servo rate of the renderable stiffness [Hz]."),
     delay: int = typer.Option(1, "--delay", min=0, max=100, help="Delay of the renderable stiffness's loop [samples]."),
     compensation: str = typer.Option("gravity", "--compensation", help="none, gravity or full (inverse dynamics)."),
-    hand_mass: Optional[float] = typer.Option(None, "--hand-mass", help="The hand of the 'with the hand' limit [kg]; "
-                                              "default: a light grasp (docs/simulation.md)."),
+    hand: str = typer.Option("light", "--hand", help="The hand of the 'with the hand' limit: light or firm "
+                             "(docs/simulation.md); --hand-mass, --hand-damping, --hand-stiffness change it."),
+    hand_mass: Optional[float] = typer.Option(None, "--hand-mass", help="The hand's mass [kg]."),
     hand_damping: Optional[float] = typer.Option(None, "--hand-damping", help="Its damping [N s/m]."),
     hand_stiffness: Optional[float] = typer.Option(None, "--hand-stiffness", help="Its stiffness [N/m]."),
     simulate: bool = typer.Option(True, "--simulate/--no-simulate", help="Simulate the renderable stiffness with "
@@ -109,7 +110,7 @@ def spec(
     from hapticdesign.files import dumps_json, write_atomically
     from dataclasses import replace
 
-    from hapticdesign.analysis.sampled_loop import GRASP, SampledLoop
+    from hapticdesign.analysis.sampled_loop import Hand, SampledLoop
     from hapticdesign.studies.spec import spec_sheet
     from hapticdesign.interface.report.spec_page import spec_page
     from hapticdesign.interface.round_off import without_round_off
@@ -119,9 +120,11 @@ def spec(
 
         dev = resolve_device(preset, device, params, strict=strict)
         pose = None if q is None else parse_vector(q, dev.n_dof, "q")
-        given = {"mass": hand_mass, "damping": hand_damping, "stiffness": hand_stiffness}
+        given = {k: v for k, v in {"mass": hand_mass, "damping": hand_damping, "stiffness": hand_stiffness}.items()
+                 if v is not None}
+        preset = Hand.named(hand)
         loop = SampledLoop(period=1.0 / rate, delay=delay, compensation=compensation,
-                           hand=replace(GRASP, **{k: v for k, v in given.items() if v is not None}))
+                           hand=replace(preset, **given, name=None) if given else preset)
         sheet = spec_sheet(dev, pose, loop, workspace=workspace, simulate=simulate)
         sheet["handle"] = without_round_off(sheet["handle"])  # a position's 1e-18 m residue is 0
         if out is not None:

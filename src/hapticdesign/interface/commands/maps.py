@@ -60,18 +60,49 @@ def maps(
         found = device_map(dev, points, names)
         used = options_used(requests_of(names))
         files = _write(out, found, names, plane)
+        spreads = {k: _spread(found, k, workspace.center_index, grid) for k in names}
         note(f"wrote {len(files)} files to {out} ({int(found.reached.sum())} of {len(points)} points reached)",
              quiet or json_out)
         if json_out:
             print_json({"device": dev.name, "out": str(out), "files": files, "points": len(points),
                         "reached": int(found.reached.sum()),
                         "range": {k: [_finite(v, min), _finite(v, max)] for k, v in found.values.items()},
-                        "units": {k: INDICES[k].unit for k in names}, "options": used})
+                        "spread": spreads, "units": {k: INDICES[k].unit for k in names}, "options": used})
             return
         for key, values in found.values.items():
             low, high = _finite(values, min), _finite(values, max)
             span = "no point reached" if low is None else f"{low:.6g} to {high:.6g} {INDICES[key].unit}"
-            typer.echo(f"{key}: {span}" + (f" ({options_line(used[key])})" if key in used else ""))
+            typer.echo(f"{key}: {span}" + (f" ({options_line(used[key])})" if key in used else "")
+                       + _spread_line(spreads[key], len(points)))
+
+
+def _spread(found, key: str, center: int | None, grid: int) -> dict | None:
+    """The index ``key`` over the points reached by every reduction
+    (:func:`~hapticdesign.analysis.metrics.indices.spread`; ``center`` None when the centre is not reached), the
+    extremes' points (``min_at``, ``max_at``: x, y, z in m) and how many points tie for them (``min_count``,
+    ``max_count``), how many points it is over and the grid; None when no point is reached."""
+    from hapticdesign.analysis.metrics.indices import spread
+
+    reached = found.reached.nonzero()[0]
+    if not len(reached):
+        return None
+    kept = [int(k) for k in reached]
+    got = spread(found.values[key][reached], kept.index(center) if center in kept else None)
+    for at in ("min_at", "max_at"):
+        got[at] = [float(x) for x in found.points[reached[got[at]]]]
+    return {**got, "points": len(reached), "grid": grid}
+
+
+def _spread_line(got: dict | None, total: int) -> str:
+    """:func:`_spread` in words: ``; over 121 of 121 points, grid 11: center ..., median ..., mean ...; min at (x, y,
+    z) m, max at (...) m``."""
+    if got is None:
+        return ""
+    center = "" if got["center"] is None else f"center {got['center']:.6g}, "
+    at = {k: "(" + ", ".join(f"{x:.6g}" for x in got[f"{k}_at"]) + ") m"
+          + (f" (one of {got[f'{k}_count']} points)" if got[f"{k}_count"] > 1 else "") for k in ("min", "max")}
+    return (f"; over {got['points']} of {total} points, grid {got['grid']}: {center}median {got['median']:.6g}, mean "
+            f"{got['mean']:.6g}; min at {at['min']}, max at {at['max']}")
 
 
 def _finite(values, how) -> float | None:

@@ -3,8 +3,9 @@ on a Dask cluster), select, write the outputs, and answer an :class:`Optimizatio
 
 The command and the Python door are one function, :func:`optimize`: it never prints, and a user error raises
 :class:`~hapticdesign.errors.UserError`. Every file goes into the output folder through
-:func:`~hapticdesign.files.write_atomically`; the final files are written only after the run succeeded, so a
-failed or interrupted run leaves complete checkpoint files and nothing half-written.
+:func:`~hapticdesign.files.write_atomically`; the final files are written only after the run finished, so an
+interrupted run leaves complete checkpoint files and nothing half-written. A run that finished without a feasible
+design writes evaluations.csv and the report of why (:func:`write_failure`), then raises the one-line error.
 """
 
 from __future__ import annotations
@@ -19,12 +20,12 @@ from pathlib import Path
 from hapticdesign.analysis.metrics.indices import Index
 from hapticdesign.errors import RunWarning, UserError
 from hapticdesign.files import quote, write_atomically
-from hapticdesign.interface.report.optimization_page import Picture, render
+from hapticdesign.interface.report.optimization_page import Picture, render, render_failure
 from hapticdesign.optimization.study_evaluation import BoundStudy, bind_study, require_study_workload
 from hapticdesign.optimization.study_file import Study, load_study
-from hapticdesign.optimization.study_methods import ConvexProgram, PopulationSearch, method_of
-from hapticdesign.optimization.study_outputs import (Selection, evaluations_csv, front_csv, pareto_figure,
-                                                     select_design)
+from hapticdesign.optimization.study_methods import ConvexProgram, PopulationSearch, method_of, with_baseline
+from hapticdesign.optimization.study_outputs import (Selection, baseline_lines, evaluations_csv, front_csv,
+                                                     pareto_figure, select_design)
 from hapticdesign.optimization.study_run import Record, StudyRun
 
 FILES = ("front.csv", "evaluations.csv", "pareto.png", "pareto.svg", "selected.yaml", "report.html")
@@ -109,15 +110,26 @@ def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Select
     write_atomically(out / "front.csv", front_csv(run))
     write_atomically(out / "evaluations.csv", evaluations_csv(run))
     paths = [out / "front.csv", out / "evaluations.csv", *pareto_figure(run, selection, out, registry=bound.registry)]
-    values = run.records[selection.record].values
-    write_atomically(out / "selected.yaml", bound.device_file_text(values))
-    pictures = [Picture(png, caption) for png, caption in bound.pictures(values)]
+    chosen = run.records[selection.record]
+    write_atomically(out / "selected.yaml", bound.device_file_text(chosen.values, baseline_lines(run, chosen)))
+    pictures = [Picture(png, caption) for png, caption in bound.pictures(chosen.values)]
     kept = (["checkpoint/ (one file per generation; a rerun into this folder continues)"]
             if method_of(run.spec).checkpointed else [])
     page = render(run, selection, bound.title, Picture((out / "pareto.png").read_bytes(), "Pareto front"), pictures,
-                  [*FILES, *kept])
+                  [*FILES, *kept], bound.coarseness, bound.spread_rows(chosen.values))
     write_atomically(out / "report.html", page)
     return [*paths, out / "selected.yaml", out / "report.html"]
+
+
+def write_failure(out: Path, run: StudyRun, bound: BoundStudy, error: UserError) -> list[Path]:
+    """What a run without a feasible design leaves in ``out``: every evaluation (evaluations.csv) and the report of
+    why (``error``'s sentence, the reasons counted by kind, the closest designs, the device file's design)."""
+    write_atomically(out / "evaluations.csv", evaluations_csv(run))
+    kept = (["checkpoint/ (one file per generation; a rerun into this folder continues)"]
+            if method_of(run.spec).checkpointed else [])
+    write_atomically(out / "report.html", render_failure(run, str(error), bound.title,
+                                                         ["evaluations.csv", "report.html", *kept], bound.coarseness))
+    return [out / "evaluations.csv", out / "report.html"]
 
 
 @dataclass(frozen=True)
@@ -187,7 +199,9 @@ def optimize(study: Path | str, seed: int = 1, out: Path | str | None = None, *,
     process), which the study may name beside the registered ones. Nothing is printed; a bad study, seed or
     selection raises :class:`~hapticdesign.errors.UserError`; a ``kmax`` constraint that no design can meet, known
     before the run (:meth:`~hapticdesign.optimization.study_evaluation.BoundStudy.unmeetable_walls`), is a
-    :class:`~hapticdesign.errors.RunWarning` before the run starts."""
+    :class:`~hapticdesign.errors.RunWarning` before the run starts. The device file's own design is evaluated beside
+    the run (:func:`~hapticdesign.optimization.study_methods.with_baseline`); a run without a feasible design
+    writes evaluations.csv and report.html to ``out`` before its UserError."""
     if isinstance(indices, (str, Path)):
         indices = index_module(Path(indices))
     own = list(indices)
@@ -208,8 +222,13 @@ def optimize(study: Path | str, seed: int = 1, out: Path | str | None = None, *,
     with ExitStack() as stack:
         evaluate = _evaluator(bound, scheduler, quiet, stack)
         run = method.run(bound, seed, evaluate, out, progress)
+    run = with_baseline(run, bound)
     if not run.front:
-        raise method.empty_front(run, bound)
+        error = method.empty_front(run, bound)
+        if out is None:
+            raise error
+        write_failure(out, run, bound, error)
+        raise UserError(f"{error} (why, by reason, and the closest designs: {out / 'report.html'})")
     selection = select_design(run, weights, design)
     written = [] if out is None else write_outputs(out, run, bound, selection)
     return OptimizationResult(study, method, run, selection, written)

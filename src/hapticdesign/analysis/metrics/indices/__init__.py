@@ -7,18 +7,21 @@
   entry-point group of installed packages' indices;
 - :mod:`.builtin`: the built-in indices (``isotropy``, ``apparent_mass``, ``force``, ``kmax``, ``ln``, ...);
 - :mod:`.evaluation`: :func:`evaluate` (one design at workspace points), :func:`evaluate_designs` (many, through the
-  compiled kernels where they serve), :func:`evaluate_parameters`, :func:`reduce`.
+  compiled kernels where they serve), :func:`evaluate_parameters`, :func:`reduce` (and where it is taken,
+  :func:`reduced_at`; every reduction at once, :func:`spread`).
 """
 
 from hapticdesign.analysis.metrics.indices import builtin  # noqa: F401  (registers the built-in indices)
 from hapticdesign.analysis.metrics.indices.evaluation import (
-    REDUCTIONS, Evaluation, evaluate, evaluate_at, evaluate_designs, evaluate_parameters, reduce,
+    REDUCTIONS, Evaluation, check_reduction, evaluate, evaluate_at, evaluate_designs,
+    evaluate_parameters, reduce, reduced_at, reduction_label, spread,
 )
 from hapticdesign.analysis.metrics.indices.registry import (
     INDICES, Index, Registry, Request, index, options_line, options_used, register, requests_of,
 )
 from hapticdesign.analysis.metrics.indices.states import HandleStates, ParameterStates, handle_jacobians, moving_mass
 
-__all__ = ["INDICES", "REDUCTIONS", "Evaluation", "HandleStates", "Index", "ParameterStates", "Registry", "Request",
-           "evaluate", "evaluate_at", "evaluate_designs", "evaluate_parameters", "handle_jacobians", "index",
-           "moving_mass", "options_line", "options_used", "register", "reduce", "requests_of"]
+__all__ = ["INDICES", "REDUCTIONS", "Evaluation", "HandleStates", "Index", "ParameterStates",
+           "Registry", "Request", "check_reduction", "evaluate", "evaluate_at", "evaluate_designs",
+           "evaluate_parameters", "handle_jacobians", "index", "moving_mass", "options_line", "options_used",
+           "reduce", "reduced_at", "reduction_label", "register", "requests_of", "spread"]

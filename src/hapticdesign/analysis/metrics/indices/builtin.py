@@ -150,7 +150,8 @@ def kmax(pose: HandleStates, period: float = 0.001, delay: int = 1, damping: flo
     options = dict(period=period, delay=delay, damping=damping, direction=direction, velocity=velocity,
                    compensation=compensation, error_percent=error_percent, hand=hand)
     return wall_kmax(pose.J_v, pose.H, pose.B, (pose.svd[0], pose.mobility, pose.cartesian_damping), options,
-                     pose.gravity, None if error_percent == 0 else pose.compensator(error_percent))
+                     pose.gravity, None if error_percent == 0 else pose.compensator(error_percent),
+                     pose.transmission)
 
 
 @index(unit="LN", formula="Linearity Number over the joint region (limits, else full turns)",

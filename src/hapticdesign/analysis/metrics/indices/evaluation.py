@@ -27,13 +27,25 @@ from hapticdesign.analysis.workspace import reach_workspace
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 
-REDUCTIONS: dict[str, Callable[[np.ndarray], float]] = {
-    "min": lambda v: float(np.min(v)),
-    "max": lambda v: float(np.max(v)),
-    "mean": lambda v: float(np.mean(v)),
+
+def _at_center(values: np.ndarray, center: int | None) -> float:
+    if center is None:
+        raise UserError("reduction center needs the box's centre among the workspace points (an odd grid)")
+    return float(values[center])
+
+
+REDUCTIONS: dict[str, Callable[[np.ndarray, int | None], float]] = {
+    "min": lambda v, _: float(np.min(v)),
+    "max": lambda v, _: float(np.max(v)),
+    "mean": lambda v, _: float(np.mean(v)),
+    "median": lambda v, _: float(np.median(v)),
+    "center": _at_center,
 }
-"""Reductions of an index over the workspace points (the mean weighs each grid point alike; ``isotropy`` with
-``mean`` over a uniform Cartesian grid is the global conditioning index of Gosselin & Angeles (1991))."""
+"""Reductions of an index over the workspace points (P,), given the place of the box's centre among them (None when
+it is not one of them). Each weighs the grid's points alike: ``mean`` is the arithmetic mean (``isotropy`` with
+``mean`` over a uniform Cartesian grid is the global conditioning index of Gosselin & Angeles (1991)), ``median`` the
+middle value (the mean of the two middle ones for an even count), ``min`` and ``max`` the extremes of the points
+(a finer grid that holds the coarser one's points, grid 5 of grid 3's, can only widen them), ``center`` the value at the box's centre (docs/indices.md)."""
 
 
 class Evaluation(NamedTuple):
@@ -115,6 +127,7 @@ def evaluate_designs(space: DesignFamily, designs: Sequence[Mapping[str, float]]
         got.q[ok].reshape(-1, n_a), motor_map=None if v.motor_map is None else v.motor_map[per_pose],
         torque_limits={k: None if t is None else t[per_pose] for k, t in v.torques.items()},
         moving_mass=got.moving_mass[per_pose], name=space.base.name,
+        transmission=None if v.transmission is None else v.transmission.taken(per_pose),
         model=lambda error: tuple(x[ok].reshape(-1, n_a, n_a) for x in got.model(error)),
         **({} if got.gravity is None else {"gravity": got.gravity[ok].reshape(-1, n_a, n_a)}))
     if sections:
@@ -169,8 +182,47 @@ def _one(space: DesignFamily, values: Mapping[str, float], points: np.ndarray, r
         return Evaluation({}, str(exc))
 
 
-def reduce(values: np.ndarray, how: str) -> float:
-    """An index over the workspace points reduced by ``min``, ``max`` or ``mean``."""
+def check_reduction(how: str) -> str:
+    """``how`` when it names a reduction (:data:`REDUCTIONS`), else a one-line UserError."""
     if how not in REDUCTIONS:
         raise UserError(f"unknown reduction {how!r} (use {', '.join(REDUCTIONS)})")
-    return REDUCTIONS[how](values)
+    return how
+
+
+def reduce(values: np.ndarray, how: str, center: int | None = None) -> float:
+    """An index over the workspace points (P,) reduced by ``how`` (:data:`REDUCTIONS`); ``center``: the place of the
+    box's centre among the points, which ``center`` reads
+    (:attr:`~hapticdesign.analysis.workspace.Workspace.center_index`)."""
+    return REDUCTIONS[check_reduction(how)](values, center)
+
+
+def reduced_at(values: np.ndarray, how: str, center: int | None = None) -> int | None:
+    """The place among the points (P,) where the reduction ``how`` takes its value: the first smallest (``min``), the
+    first largest (``max``), ``center``; None for ``mean`` and ``median``, which no one point holds."""
+    if check_reduction(how) == "center":
+        return center
+    if how in ("min", "max"):
+        return int(np.argmin(values) if how == "min" else np.argmax(values))
+    return None
+
+
+TIE = 1e-9
+"""Relative difference within which two points' values tie for an extreme (:func:`spread`)."""
+
+
+def spread(values: np.ndarray, center: int | None = None) -> dict[str, float | int | None]:
+    """An index over the points (P,) by every reduction (``center`` None where the centre is not among them), where
+    the extremes are taken (``min_at``, ``max_at``: the first place among the points) and at how many points
+    (``min_count``, ``max_count``: the points within :data:`TIE` of the extreme, e.g. a symmetric device's mirrored
+    corners)."""
+    out: dict[str, float | int | None] = {
+        how: None if how == "center" and center is None else reduce(values, how, center) for how in REDUCTIONS}
+    for how in ("min", "max"):
+        out[f"{how}_at"] = reduced_at(values, how)
+        out[f"{how}_count"] = int(np.count_nonzero(np.abs(values - out[how]) <= TIE * abs(out[how])))
+    return out
+
+
+def reduction_label(how: str, points: int, grid: int) -> str:
+    """How coarse a reduction over a grid is, in words: ``max of 27 points, grid 3``."""
+    return f"{check_reduction(how)} of {points} points, grid {grid}"

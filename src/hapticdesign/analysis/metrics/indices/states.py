@@ -30,6 +30,7 @@ from hapticdesign.analysis.metrics.kinematic import handle_range_basis
 from hapticdesign.analysis.stiffness.device import cartesian_stiffness_at
 from hapticdesign.errors import UserError
 from hapticdesign.model.dense import symmetric_eigenvalues
+from hapticdesign.model.actuators import Transmission
 from hapticdesign.model.compensator_model import model_device
 from hapticdesign.model.device import Device
 
@@ -107,6 +108,12 @@ class HandleStates:
         """``B`` (n_a, n_a), or (P, n_a, n_a) per pose: the joints' and motors' viscous damping
         (:attr:`~hapticdesign.model.device.Device.damping_matrix`)."""
         return self._device.damping_matrix
+
+    @cached_property
+    def transmission(self) -> Transmission | None:
+        """The motors' compliant transmissions (:class:`~hapticdesign.model.actuators.Transmission`, (n_a, n_a) or
+        (P, n_a, n_a) each), None for rigid motors (:attr:`~hapticdesign.model.device.Device.transmission`)."""
+        return self._device.transmission
 
     @cached_property
     def gravity(self) -> np.ndarray:
@@ -194,13 +201,14 @@ class HandleStates:
         :mod:`hapticdesign.analysis.design_batch`), with any other quantity of :data:`BATCH_NEEDS` known per pose by
         its name (``stiffness`` (P, k, k), ``motor_map``, ``torque_limits``, ``moving_mass``, ``name``, ``gravity``
         (P, n_a, n_a), ``model``: the compensator's ``H_m`` and ``dG_m/dq`` for a modelling error in percent, as
-        :meth:`compensator` gives them): enough for an index that needs at most :data:`BATCH_NEEDS`, of those
+        :meth:`compensator` gives them, ``transmission``: the motors' compliant transmissions, None when rigid): enough for an index that needs at most :data:`BATCH_NEEDS`, of those
         quantities given."""
-        unknown = set(known) - {"stiffness", "motor_map", "torque_limits", "moving_mass", "name", "gravity", "model"}
+        unknown = set(known) - {"stiffness", "motor_map", "torque_limits", "moving_mass", "name", "gravity", "model",
+                                "transmission"}
         if unknown:
             raise TypeError(f"HandleStates.of: unknown quantities {sorted(unknown)}")
         states = cls(None, np.zeros((len(J_v), 0)))
-        states.__dict__.update(J_v=J_v, H=H, **known)
+        states.__dict__.update(J_v=J_v, H=H, **{"transmission": None, **known})
         for name, value in (("B", B), ("q", q)):
             if value is not None:
                 states.__dict__[name] = value
