@@ -74,6 +74,19 @@ def test_the_loop_record_owns_the_ranges_and_the_estimate():
         joint_limits(0.039, 0.5, SampledLoop(delay=10**9))
 
 
+def test_the_analytic_criteria_estimate_their_loops_before_building_them():
+    """``impedance-range --method analytic --delay 1000`` built loops of order 3003 and searched them for minutes."""
+    import numpy as np
+
+    from hapticdesign.simulation.analytic import WallJoint, wall_loops
+    from hapticdesign.simulation.config import LoopConfig, Sensors
+    from hapticdesign.workload import WorkloadTooLarge
+
+    wall = WallJoint(0.04, 0.5, np.array([1.0, 0.0, 0.0]), 0.0, 0.04, 0.0, 0.0, True)
+    with pytest.raises(WorkloadTooLarge, match="order 3,003 .* above the limit of 600 rows"):
+        wall_loops([wall], LoopConfig(sensors=Sensors(delay_samples=1000)))
+
+
 def test_the_default_damper_grid_stops_at_the_largest_damper():
     """A heavy joint at a short period reaches the damper cap: the grid ends there instead of overflowing."""
     from hapticdesign.analysis.sampled_loop import MAX_VIRTUAL_DAMPING, SampledLoop

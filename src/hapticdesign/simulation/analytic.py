@@ -109,6 +109,7 @@ def wall_loops(walls: list[WallJoint], config: LoopConfig) -> SpringLoops:
                        config.wall.damping, config.hand)
     column = np.array([[[w.inertia]] for w in walls]), np.array([[[w.damping]] for w in walls])
     model = np.array([[[w.model_inertia]] for w in walls]), np.array([[[w.model_gravity]] for w in walls])
+    loop.require_exact(1, len(walls))
     return handle_loops(np.array([w.reach for w in walls])[:, :, None], *column,
                         np.array([[w.scale] for w in walls]), loop,
                         gravity=np.array([[[w.gravity]] for w in walls]), model=model)[0]
