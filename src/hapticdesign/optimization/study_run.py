@@ -227,7 +227,7 @@ class Checkpoint:
         try:
             kept = json.loads(read_text(path, "checkpoint"))
             problem = self._problem(kept, X)
-        except (ValueError, UserError, RecursionError) as exc:
+        except (ValueError, UserError) as exc:
             problem = f"it is not a checkpoint ({str(exc)[:80]})"
         if problem is None:
             return [Answer(tuple(float(v) for v in r), s) for r, s in zip(kept["reduced"], kept["reasons"])]
