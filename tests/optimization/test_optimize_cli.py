@@ -152,6 +152,15 @@ def test_bad_selection_is_one_line(tmp_path, select, message):
     _error([small_study(tmp_path), "--seed", 1, "--select", select], message)
 
 
+@pytest.mark.parametrize("select, message", [("0", "--select 0: a front design is numbered from 1"),
+                                             ("999999", "the study evaluates at most"),
+                                             ("nope=1", "no objective named 'nope'")])
+def test_a_bad_selection_is_refused_before_any_design_is_evaluated(tmp_path, select, message):
+    out = tmp_path / "out"
+    _error([small_study(tmp_path), "--seed", 1, "--out", out, "--select", select], message, out)
+    assert not (out / "checkpoint").exists()  # no generation was evaluated
+
+
 def test_another_study_in_the_same_folder_is_refused(tmp_path):
     study = small_study(tmp_path)
     assert optimize(study, "--seed", 1, "--out", tmp_path / "out").exit_code == 0

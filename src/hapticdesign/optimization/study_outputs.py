@@ -43,20 +43,33 @@ def normalized_front(run: StudyRun) -> np.ndarray:
     return np.column_stack(columns)
 
 
+def check_selection(spec, weights: dict[str, float] | None = None, design: int | None = None,
+                    designs: int | None = None) -> None:
+    """What a selection can be refused for before the study runs (``spec`` the study's): a front design number
+    below 1 or above the ``designs`` the study may evaluate (the front holds at most that many), a weight named after
+    no objective (a one-line :class:`~hapticdesign.errors.UserError`). :func:`select_design` checks it again with
+    the front's size."""
+    if design is not None and not 1 <= design <= (design if designs is None else designs):
+        raise UserError(f"--select {design}: a front design is numbered from 1" + (
+            "" if design < 1 or designs is None else f" and the study evaluates at most {designs} designs"))
+    names = [o.name for o in spec.objectives]
+    unknown = [n for n in (weights or {}) if n not in names]
+    if unknown:
+        raise UserError(f"no objective named {unknown[0]!r} to weigh (objectives: {', '.join(names)})")
+
+
 def select_design(run: StudyRun, weights: dict[str, float] | None = None, design: int | None = None) -> Selection:
     """The least-RMS design of the front, the least weighted RMS with ``weights`` per objective name
     (objectives not named weigh 1), or the front's ``design``-th row (1-based, as in front.csv)."""
     if not run.front:
         raise UserError("no feasible design to select: the front is empty")
+    check_selection(run.spec, weights, design)
     if design is not None:
         if not 1 <= design <= len(run.front):
             raise UserError(f"the front has designs 1 to {len(run.front)}, not {design}")
         return Selection(design - 1, run.front[design - 1], f"design {design} of the front, chosen by hand")
     names = [o.name for o in run.spec.objectives]
     weights = dict(weights or {})
-    unknown = [n for n in weights if n not in names]
-    if unknown:
-        raise UserError(f"no objective named {unknown[0]!r} to weigh (objectives: {', '.join(names)})")
     w = [float(weights.get(n, 1.0)) for n in names]
     position = least_rms(normalized_front(run), w)
     rule = ("least RMS of the normalized objectives (seed 001 Fig. 7.2)" if not weights else

@@ -22,10 +22,11 @@ from hapticdesign.errors import RunWarning, UserError
 from hapticdesign.files import quote, write_atomically
 from hapticdesign.interface.report.optimization_page import Picture, render, render_failure
 from hapticdesign.optimization.study_evaluation import BoundStudy, bind_study, require_study_workload
+from hapticdesign.optimization.study_polish import most_designs
 from hapticdesign.optimization.study_file import Study, load_study
 from hapticdesign.optimization.study_methods import ConvexProgram, PopulationSearch, method_of, with_baseline
-from hapticdesign.optimization.study_outputs import (Selection, baseline_lines, evaluations_csv, front_csv,
-                                                     pareto_figure, select_design)
+from hapticdesign.optimization.study_outputs import (Selection, baseline_lines, check_selection, evaluations_csv,
+                                                     front_csv, pareto_figure, select_design)
 from hapticdesign.optimization.study_run import Record, StudyRun
 
 FILES = ("front.csv", "evaluations.csv", "pareto.png", "pareto.svg", "selected.yaml", "report.html")
@@ -208,6 +209,7 @@ def optimize(study: Path | str, seed: int = 1, out: Path | str | None = None, *,
     if own and scheduler is not None:
         raise UserError("your own indices live in this process; the workers of a scheduler would not have them")
     study = load_study(study)
+    check_selection(study.spec, weights, design, study.spec.algorithm.designs + most_designs(study.spec))
     bound = bind_study(study, indices=own)
     require_study_workload(study, bound.registry)
     for message in bound.unmeetable_walls():
