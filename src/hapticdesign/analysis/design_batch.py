@@ -35,12 +35,10 @@ import numpy as np
 from numba import njit
 
 from hapticdesign.analysis.configuration import IK_SINGULAR, check_limits, configuration_of, reach_settings
-from hapticdesign.analysis.dynamics.actuated_kernel import (
-    Bodies, factor_pose, mass_and_gravity, passive_paths, reduce_pose, world_parameters,
-)
+from hapticdesign.analysis.dynamics.actuated_kernel import Bodies, passive_paths, pose_dynamics, pose_terms, terms_into
 from hapticdesign.analysis.dynamics.device import GRADIENT_STEP
 from hapticdesign.analysis.loops import closure_kernel as ck
-from hapticdesign.analysis.loops.records import NO_HOME, OK, ClosureScratch, closure_scratch
+from hapticdesign.analysis.loops.records import NO_HOME, OK
 from hapticdesign.analysis.reach_kernel import MESSAGES, Reached, reach_designs, structure_of
 from hapticdesign.analysis.stiffness import vjm
 from hapticdesign.analysis.stiffness.device import end_compliance
@@ -50,69 +48,20 @@ from hapticdesign.model.compensator_model import scaled_standard
 from hapticdesign.model.device import Device, build_mechanism
 from hapticdesign.model.walk import MotionPlan, Tree, frame_jacobian, node_poses, planned_poses, trig_workspace
 
-class PoseDynamics(NamedTuple):
-    """Scratch of one pose's ``H`` and ``G`` in the actuated coordinates (:func:`_pose_terms`): the closed-loop
-    kernels' ``closure`` scratch, the bodies' parameters in the world frame ``world`` (1, B, 10), ``h`` (n_a, n_a),
-    ``g`` (n_a,) and one body's ``mj`` (6, n_a)."""
-
-    closure: ClosureScratch
-    world: np.ndarray
-    h: np.ndarray
-    g: np.ndarray
-    mj: np.ndarray
-
-
-@njit(cache=True)
-def pose_dynamics(shape, loops, bodies, n: int) -> PoseDynamics:
-    """A zeroed :class:`PoseDynamics` for designs of the tree ``shape`` with ``n`` coordinates."""
-    na = loops.actuated.shape[0]
-    n_body = bodies.body_node.shape[0]
-    return PoseDynamics(closure_scratch(shape.parent.shape[0], n, na, loops.passive, n_body),
-                        np.zeros((1, n_body, 10)), np.zeros((na, na)), np.zeros(na), np.zeros((6, na)))
-
-
-@njit(cache=True, _nrt=False)
-def _pose_terms(q, tree, plan, bodies, loops, sets, s):
-    """``H`` and ``G`` in the actuated coordinates at the full pose ``q`` into ``s.h`` and ``s.g`` (eq. 2.44: ``sum_b
-    (J_b T)^T M_b (J_b T)`` with the closed-loop dynamics' own pose kernels; ``T`` of the pose left in
-    ``s.closure.t``); allocates nothing."""
-    ws, body_node = s.closure, bodies.body_node
-    if loops.passive.shape[0] > 0:
-        factor_pose(q, tree, plan, loops, ws)
-    else:
-        planned_poses(q, tree, plan, np.int64(0), tree.parent.shape[0], ws.rot, ws.pos, ws.trig)
-    reduce_pose(tree, plan, body_node, loops, ws)
-    world_parameters(ws.rot, body_node, sets, np.int64(0), s.world)
-    for i in range(s.h.shape[0]):
-        s.g[i] = 0.0
-        for j in range(s.h.shape[1]):
-            s.h[i, j] = 0.0
-    for b in range(body_node.shape[0]):
-        if body_node[b] >= 0:
-            mass_and_gravity(ws.ja, b, bodies.gravity, s.world, 0, s.h, s.g, s.mj, False)
-
-
 @njit(cache=True)
 def mass_designs(offsets, full, status, shape, plan, bodies, loops, params, out):
     """``H`` (actuated coordinates, without the reflected rotor inertia) at the poses ``full`` (D, P, N) of the
     designs whose status is OK, for their standard parameters ``params`` (D, 10 B), into ``out`` (D, P, n_a, n_a)
-    (:func:`_pose_terms`)."""
-    s = pose_dynamics(shape, loops, bodies, full.shape[2])
+    (:func:`~hapticdesign.analysis.dynamics.actuated_kernel.terms_into`, the kernel of one device's ``H`` and
+    ``G`` at closed poses)."""
+    n_pose = full.shape[1]
+    s = pose_dynamics(shape.parent.shape[0], loops, bodies, full.shape[2])
+    g = np.zeros((n_pose, s.g.shape[0]))
+    ratios = np.zeros(n_pose)
     for d in range(full.shape[0]):
         if status[d] == OK:
             tree = Tree(shape.parent, shape.axis, shape.coef, offsets[d], shape.const_rot, shape.const_pos)
-            _design_masses(full[d], tree, plan, bodies, loops, params[d:d + 1], s, out[d])
-
-
-@njit(cache=True, _nrt=False)
-def _design_masses(full, tree, plan, bodies, loops, sets, s, out):
-    """:func:`mass_designs` of one design at its poses ``full`` (P, N) into ``out`` (P, n_a, n_a); allocates nothing
-    (no reference counts on the records' arrays per pose)."""
-    for p in range(full.shape[0]):
-        _pose_terms(full[p], tree, plan, bodies, loops, sets, s)
-        for i in range(s.h.shape[0]):
-            for j in range(s.h.shape[1]):
-                out[p, i, j] = s.h[i, j]
+            terms_into(full[d], tree, plan, bodies, loops, params[d:d + 1], s, out[d], g, ratios)
 
 
 @njit(cache=True)
@@ -122,7 +71,7 @@ def gravity_designs(offsets, full, status, shape, plan, bodies, loops, params, s
     motion ``T e_j`` (the passive coordinates follow to first order; the second-order miss of the closure is even in
     the step and cancels in the difference)."""
     n_design, n_pose, n = full.shape
-    s = pose_dynamics(shape, loops, bodies, n)
+    s = pose_dynamics(shape.parent.shape[0], loops, bodies, n)
     na = s.h.shape[0]
     g_up = np.zeros(na)
     t = np.zeros((n, na))
@@ -133,16 +82,16 @@ def gravity_designs(offsets, full, status, shape, plan, bodies, loops, params, s
         tree = Tree(shape.parent, shape.axis, shape.coef, offsets[d], shape.const_rot, shape.const_pos)
         sets = params[d:d + 1]
         for p in range(n_pose):
-            _pose_terms(full[d, p], tree, plan, bodies, loops, sets, s)
+            pose_terms(full[d, p], tree, plan, bodies, loops, sets, s)
             t[:] = s.closure.t
             for j in range(na):
                 for i in range(n):
                     q[i] = full[d, p, i] + step * t[i, j]
-                _pose_terms(q, tree, plan, bodies, loops, sets, s)
+                pose_terms(q, tree, plan, bodies, loops, sets, s)
                 g_up[:] = s.g
                 for i in range(n):
                     q[i] = full[d, p, i] - step * t[i, j]
-                _pose_terms(q, tree, plan, bodies, loops, sets, s)
+                pose_terms(q, tree, plan, bodies, loops, sets, s)
                 for i in range(na):
                     out[d, p, i, j] = (g_up[i] - s.g[i]) / (2.0 * step)
 
@@ -235,6 +184,12 @@ def vjm_designs(offsets, full, status, shape, plan, loops, handle, ends, rows, v
                         if b >= 0 and _moves(parent, e, b):
                             value -= _virtual_twist(rot, pos, e, i, b, c)
                         virtual[d, p, 6 + r, col] = value
+
+
+def _per_design(params: np.ndarray, d: int) -> np.ndarray:
+    """Standard parameters (D, 10 B) of ``d`` designs from one set (10 B,) or one per design: always a new writable
+    C array, so that the kernels see one array type (a read-only broadcast view would compile them once more)."""
+    return np.array(np.broadcast_to(np.atleast_2d(params), (d, np.shape(params)[-1])), dtype=float, order="C")
 
 
 class DesignValues(NamedTuple):
@@ -372,7 +327,7 @@ class DesignBatch:
         d, p = reached.status.shape[0], reached.full.shape[1]
         na = len(self.closures.actuated)
         h = np.zeros((d, p, na, na))
-        params = np.ascontiguousarray(np.broadcast_to(np.atleast_2d(params), (d, np.shape(params)[-1])), dtype=float)
+        params = _per_design(params, d)
         mass_designs(np.ascontiguousarray(offsets, dtype=float), reached.full, reached.status, self.shape, self.plan,
                      self.bodies, self.closures, params, h)
         return h + (reflected[:, None] if np.ndim(reflected) == 3 else reflected)
@@ -383,7 +338,7 @@ class DesignBatch:
         d, p = reached.status.shape[0], reached.full.shape[1]
         na = len(self.closures.actuated)
         out = np.zeros((d, p, na, na))
-        params = np.ascontiguousarray(np.broadcast_to(np.atleast_2d(params), (d, np.shape(params)[-1])), dtype=float)
+        params = _per_design(params, d)
         gravity_designs(np.ascontiguousarray(offsets, dtype=float), reached.full, reached.status, self.shape,
                         self.plan, self.bodies, self.closures, params, GRADIENT_STEP, out)
         return out

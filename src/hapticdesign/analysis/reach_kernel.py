@@ -259,7 +259,8 @@ def reach_designs(offsets, targets, shape, plan, loops, settings, reach, out):
         branch = _branch(loops, ws)
         for c in range(3):
             here[c] = ws.pos[reach.handle, c]
-        code, mode = _newton(q, tree, plan, loops, settings, reach, here, 0.0, True, True, ws)
+        code, mode = _newton(q, tree, plan, loops, settings, reach, here, 0.0, np.bool_(True), np.bool_(True),
+                             ws)  # literal True would compile a second _newton (Literal[bool] beside bool)
         for p in range(targets.shape[0]):
             if code != OK:
                 break

@@ -359,6 +359,67 @@ def mass_and_gravity(ja, b, gravity, pw, s, h, g, mj, keep):
                 h[j, i] += e
 
 
+class PoseDynamics(NamedTuple):
+    """Scratch of one pose's ``H`` and ``G`` in the actuated coordinates (:func:`pose_terms`): the closed-loop
+    kernels' ``closure`` scratch, the bodies' parameters in the world frame ``world`` (1, B, 10), ``h`` (n_a, n_a),
+    ``g`` (n_a,) and one body's ``mj`` (6, n_a)."""
+
+    closure: ClosureScratch
+    world: np.ndarray
+    h: np.ndarray
+    g: np.ndarray
+    mj: np.ndarray
+
+
+@njit(cache=True)
+def pose_dynamics(n_node: int, loops, bodies, n: int) -> PoseDynamics:
+    """A zeroed :class:`PoseDynamics` for a tree of ``n_node`` nodes and ``n`` coordinates (its number of nodes, not
+    the tree: one device's tree and a design batch's shape are records of different types)."""
+    na = loops.actuated.shape[0]
+    n_body = bodies.body_node.shape[0]
+    return PoseDynamics(closure_scratch(n_node, n, na, loops.passive, n_body),
+                        np.zeros((1, n_body, 10)), np.zeros((na, na)), np.zeros(na), np.zeros((6, na)))
+
+
+@njit(cache=True, _nrt=False)
+def pose_terms(q, tree, plan, bodies, loops, sets, s):
+    """``H`` and ``G`` in the actuated coordinates at the full pose ``q`` into ``s.h`` and ``s.g`` (eq. 2.44: ``sum_b
+    (J_b T)^T M_b (J_b T)``; eq. 2.46) for the parameter set ``sets[0]``, ``T`` of the pose left in ``s.closure.t``;
+    returns the pivot ratio of ``Phi_p`` (0: singular; 1 for a tree). The same arithmetic as :func:`pose_entries`'
+    H and G, without the velocity terms; allocates nothing."""
+    ws, body_node = s.closure, bodies.body_node
+    ratio = 1.0
+    if loops.passive.shape[0] > 0:
+        ratio, _ = factor_pose(q, tree, plan, loops, ws)
+    else:
+        planned_poses(q, tree, plan, np.int64(0), tree.parent.shape[0], ws.rot, ws.pos, ws.trig)
+    reduce_pose(tree, plan, body_node, loops, ws)
+    world_parameters(ws.rot, body_node, sets, np.int64(0), s.world)
+    for i in range(s.h.shape[0]):
+        s.g[i] = 0.0
+        for j in range(s.h.shape[1]):
+            s.h[i, j] = 0.0
+    for b in range(body_node.shape[0]):
+        if body_node[b] >= 0:
+            mass_and_gravity(ws.ja, b, bodies.gravity, s.world, 0, s.h, s.g, s.mj, False)
+    return ratio
+
+
+@njit(cache=True, _nrt=False)
+def terms_into(qs, tree, plan, bodies, loops, sets, s, h, g, ratios):
+    """``H`` and ``G`` (:func:`pose_terms`) at the closed full poses ``qs`` (P, N) into ``h`` (P, n_a, n_a) and ``g``
+    (P, n_a), the pivot ratio of ``Phi_p`` per pose into ``ratios`` (P,); ``s``: :func:`pose_dynamics`. It
+    allocates nothing, so it is compiled without reference counting. One device's ``H`` and ``G`` at given poses
+    (:meth:`~hapticdesign.analysis.dynamics.closed_loop.ClosedLoopModel.terms_at`) and a design batch's ``H``
+    (:func:`~hapticdesign.analysis.design_batch.mass_designs`) share it."""
+    for p in range(qs.shape[0]):
+        ratios[p] = pose_terms(qs[p], tree, plan, bodies, loops, sets, s)
+        for i in range(s.h.shape[0]):
+            g[p, i] = s.g[i]
+            for j in range(s.h.shape[1]):
+                h[p, i, j] = s.h[i, j]
+
+
 def passive_paths(parent: np.ndarray, plan, body_node: np.ndarray, passive: np.ndarray) -> tuple:
     """Per body, the nodes from its node to the base that a passive coordinate moves: ``(ptr, nodes)``, body
     ``b``'s being ``nodes[ptr[b]:ptr[b + 1]]`` (what :func:`passive_inertia` walks). ``plan``: the loop

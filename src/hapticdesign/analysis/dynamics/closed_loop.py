@@ -25,6 +25,8 @@ from hapticdesign.analysis.dynamics.actuated_kernel import (
     actuated_regressor,
     motion_entries,
     passive_paths,
+    pose_dynamics,
+    terms_into,
 )
 from hapticdesign.analysis.configuration import LoopConfiguration
 from hapticdesign.analysis.dynamics.model import EquationsOfMotion, pair_index
@@ -73,11 +75,15 @@ class ClosedLoopModel(EquationsOfMotion):
             out, ratios = actuated_regressor(*args)
         else:
             out, ratios = actuated_entries(*args, np.ascontiguousarray(params, dtype=float))
+        self._check_ratios(q_full, ratios)
+        return out
+
+    def _check_ratios(self, q_full: np.ndarray, ratios: np.ndarray) -> None:
+        """Refuse the poses where ``Phi_p`` is singular (pivot ratio at most the solver's)."""
         bad = np.flatnonzero(ratios <= SINGULAR_RATIO)
         if bad.size:
-            pose = ", ".join(f"{v:.6g}" for v in q_full[bad[0], a.actuated])
+            pose = ", ".join(f"{v:.6g}" for v in q_full[bad[0], self.solver.closures.actuated])
             raise UserError(f"at q = ({pose}): {MESSAGES[SINGULAR]}")
-        return out
 
     def full_coordinates(self, q: np.ndarray) -> np.ndarray:
         """Actuated poses (n_a,) or a motion (P, n_a) -> closed full coordinates (continued from home)."""
@@ -110,9 +116,44 @@ class ClosedLoopModel(EquationsOfMotion):
             out += self.constant
         return out[:, 0, :] if pi.ndim == 1 else np.moveaxis(out, 1, 0)
 
+    def terms_at(self, q_full: np.ndarray, pi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """H_a (P, n_a, n_a) and G_a (P, n_a) at closed full poses (P, N) for one parameter set (n_params,): the
+        numbers of :meth:`entries_at` without the velocity terms, from the kernel a design batch's ``H`` takes too
+        (:func:`.actuated_kernel.terms_into`), which compiles in a fraction of the time of the whole entries."""
+        pi = self._params(pi)
+        if pi.ndim != 1:
+            raise UserError(f"expected one set of {self.n_params} standard inertial parameters, got shape {pi.shape}")
+        q_full = np.ascontiguousarray(np.atleast_2d(q_full), dtype=float)
+        s, a = self.solver, self.solver.closures
+        n_pose = len(q_full)
+        h, g, ratios = np.zeros((n_pose, self.n_dof, self.n_dof)), np.zeros((n_pose, self.n_dof)), np.zeros(n_pose)
+        terms_into(q_full, s.tree, s.plan, self.bodies, a, np.ascontiguousarray(pi[None]),
+                   pose_dynamics(len(s.tree.parent), a, self.bodies, q_full.shape[1]), h, g, ratios)
+        self._check_ratios(q_full, ratios)
+        if self.constant is not None:
+            h += self._h_from(self.constant)
+        return h, g
+
     def H_at(self, q_full: np.ndarray, pi: np.ndarray) -> np.ndarray:
-        """H_a (eq. 2.50 in the actuated coordinates) at closed full poses (P, N): (P, n_a, n_a)."""
+        """H_a (eq. 2.50 in the actuated coordinates) at closed full poses (P, N): (P, n_a, n_a), or (S, P, n_a, n_a)
+        for parameter sets (S, n_params)."""
+        if np.ndim(pi) == 1:
+            return self.terms_at(q_full, pi)[0]
         return self._h_from(self.entries_at(np.atleast_2d(q_full), pi))
+
+    def H(self, q: np.ndarray, pi: np.ndarray) -> np.ndarray:
+        """H_a (eq. 2.50) at actuated poses as :meth:`entries` gives it; at one pose (n_a,) for one parameter set from
+        :meth:`terms_at` at the pose continued from home (the pose and the numbers :meth:`entries` has there), so that
+        a mass matrix compiles no velocity terms."""
+        if np.ndim(q) == 1 and np.ndim(pi) == 1:
+            return self.terms_at(self.full_coordinates(q), pi)[0][0]
+        return super().H(q, pi)
+
+    def G(self, q: np.ndarray, pi: np.ndarray) -> np.ndarray:
+        """G_a (eq. 2.50) at actuated poses, at one pose for one parameter set from :meth:`terms_at` (as :meth:`H`)."""
+        if np.ndim(q) == 1 and np.ndim(pi) == 1:
+            return self.terms_at(self.full_coordinates(q), pi)[1][0]
+        return super().G(q, pi)
 
     def regressor_at(self, q_full: np.ndarray) -> np.ndarray:
         """Every entry as a row of the standard parameters at closed full poses: (P, E, n_params)."""

@@ -102,8 +102,8 @@ def gravity_gradient_at(device: Device, q_full: np.ndarray) -> np.ndarray:
     """``dG/dq_a`` (P, n_a, n_a) at closed full poses (P, N), by central differences of G over ``+-``
     :data:`GRADIENT_STEP` along each actuated coordinate's motion ``T e_j`` (the passive coordinates follow to first
     order; the second-order miss of the closure is even in the step and cancels in the difference): a tree's G from
-    the compiled regressor kernel, a closed-loop device's from its model's entries at those poses (as
-    :func:`mass_matrix_at`)."""
+    the compiled regressor kernel, a closed-loop device's from its model's H and G at those poses
+    (:meth:`~.closed_loop.ClosedLoopModel.terms_at`, as :func:`mass_matrix_at`)."""
     space = configuration_for(device.builder, device.kinematic_values())
     q_full = np.atleast_2d(np.asarray(q_full, dtype=float))
     steps = GRADIENT_STEP * np.swapaxes(space.velocity_transform(q_full), 1, 2)  # (P, n_a, N)
@@ -115,8 +115,7 @@ def gravity_gradient_at(device: Device, q_full: np.ndarray) -> np.ndarray:
         _, yg = regressor_kernel(np.ascontiguousarray(poses), *c.tree.arrays, c.tree.body_node, c.gravity)
         torques = yg @ params
     else:
-        model = _model(device.builder, device.kinematic_values())
-        torques = model.entries_at(poses, params)[:, model.slice_g]
+        torques = _model(device.builder, device.kinematic_values()).terms_at(poses, params)[1]
     n = steps.shape[1]
     torques = torques.reshape(len(q_full), 2, n, -1)  # (P, +-, j, i)
     return np.swapaxes((torques[:, 0] - torques[:, 1]) / (2.0 * GRADIENT_STEP), 1, 2)
