@@ -208,7 +208,7 @@ def trig_workspace(n_node):
     return out
 
 
-@njit(cache=True, _nrt=False, inline="always")
+@njit(cache=True, _nrt=False, forceinline=True)
 def planned_poses(q, tree, plan, start, stop, rot, pos, trig):
     """:func:`node_poses` of the nodes ``order[start:stop]`` of a :class:`WalkPlan` ``plan`` on the :class:`Tree` ``tree``.
 

@@ -144,7 +144,7 @@ def _wrench_regressor(w, al, acc, out):
     out[3, 9], out[4, 9], out[5, 9] = w1 * w1 - w2 * w2, l2 - w0 * w1, l1 + w0 * w2
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, forceinline=True)
 def factor_pose(q, tree, plan, loops, ws):
     """Every node's pose, ``Phi`` and ``Phi_p^-1`` at a closed full pose ``q`` into ``ws`` (for :func:`reduce_pose`).
 
@@ -164,7 +164,7 @@ def factor_pose(q, tree, plan, loops, ws):
     return lu_in_place(lu, pinv)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, forceinline=True)
 def reduce_pose(tree, plan, body_node, loops, ws):
     """``T = [I; S]``, ``coef T`` and every body's Jacobian ``J_b T`` into ``ws``, from its node poses, ``Phi`` and
     ``Phi_p^-1`` at a closed pose (:func:`factor_pose`).
@@ -332,7 +332,7 @@ def body_wrench(w, al, ac, nb, pw, s, b):
     return f0, f1, f2, n0, n1, n2
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, forceinline=True)
 def mass_and_gravity(ja, b, gravity, pw, s, h, g, mj, keep):
     """Add body ``b``'s ``(J_b T)^T M (J_b T)`` to ``h`` (n x n) and ``-(J_b T)^T`` of its weight's wrench to
     ``g`` (eq. 2.44, 2.46), world parameters ``pw[s, b]``: ``M [v; w] = [m v + w x h; h x v + J w]``.
@@ -401,7 +401,7 @@ def pose_terms(q, tree, plan, bodies, loops, sets, s):
             s.h[i, j] = 0.0
     for b in range(body_node.shape[0]):
         if body_node[b] >= 0:
-            mass_and_gravity(ws.ja, b, bodies.gravity, s.world, 0, s.h, s.g, s.mj, False)
+            mass_and_gravity(ws.ja, b, bodies.gravity, s.world, np.int64(0), s.h, s.g, s.mj, np.bool_(False))
     return ratio
 
 
@@ -518,7 +518,7 @@ def pose_entries(tree, plan, bodies, loops, params, active, ws, scratch, out):
         g = out[s, m + na * m:]
         for b in range(n_body):
             if active[b] and body_node[b] >= 0:
-                mass_and_gravity(ja, b, gravity, pw, s, h[s], g, mj, True)
+                mass_and_gravity(ja, b, gravity, pw, s, h[s], g, mj, np.bool_(True))
                 passive_inertia(b, bodies, axis, plan, slot, rot, pos, mj, hap[s])
         e = 0
         for i in range(na):

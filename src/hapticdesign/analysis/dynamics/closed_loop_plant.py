@@ -119,7 +119,7 @@ def closed_loop_terms(qa, qda, structure, ws, h, cqd, g):
             h[i, j] = constant[i, j]
     for b in range(body_node.shape[0]):
         if active[b] and body_node[b] >= 0:
-            mass_and_gravity(ja, b, bodies.gravity, pw, 0, h, g, h, False)
+            mass_and_gravity(ja, b, bodies.gravity, pw, np.int64(0), h, g, h, np.bool_(False))
     velocity_state(qda, -1, -1, tree.axis, plan, bodies.motion, loops, dyn)
     for b in range(body_node.shape[0]):
         nb = body_node[b]

@@ -61,7 +61,7 @@ def _component(c, v0, v1, v2, w0, w1, w2):
     return w0 if c == 3 else (w1 if c == 4 else w2)
 
 
-@njit(cache=True, _nrt=False, inline="always")
+@njit(cache=True, _nrt=False, forceinline=True)
 def closure_residual(loops, rot, pos, out):
     """``phi`` (m,): origin differences and the skew-part vector of ``R_A R_B^T`` in the base frame."""
     frame_a, frame_b, row_loop, row_comp = loops.frame_a, loops.frame_b, loops.row_loop, loops.row_comp
@@ -84,7 +84,7 @@ def closure_residual(loops, rot, pos, out):
             out[i] = 0.5 * acc
 
 
-@njit(cache=True, _nrt=False, inline="always")
+@njit(cache=True, _nrt=False, forceinline=True)
 def closure_jacobian(loops, tree, plan, rot, pos, phi):
     """``Phi = select(J_A - J_B)`` (m x N) at the current node poses.
 
