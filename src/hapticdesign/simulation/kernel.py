@@ -147,9 +147,10 @@ def _handle_normal(q, handle):
     return n[0] * pos[node, 0] + n[1] * pos[node, 1] + n[2] * pos[node, 2]
 
 
-@nb.njit(cache=True, error_model="numpy", inline="always")
-def _tree_handle(q, qd, handle, record, jn, want_jn):
-    """``n . p`` of a tree's handle at q and, when ``want_jn``, ``J_n = n^T J_v`` into ``jn``."""
+@nb.njit(**CALLED)
+def _tree_handle(q, handle, jn, want_jn):
+    """``n . p`` of a tree's handle at q and, when ``want_jn``, ``J_n = n^T J_v`` into ``jn``: compiled once for the
+    plant's and the compensator's records alike (it reads neither), inlined by LLVM (:data:`CALLED`)."""
     x = _handle_normal(q, handle)
     if want_jn:
         jac, n = handle.jac, handle.direction
@@ -204,7 +205,9 @@ def _terms_impl(q, qd, record):
 
 @overload(_handle, jit_options=CALLED)
 def _handle_impl(q, qd, handle, record, jn, want_jn):
-    return (_loop_handle if _is_loop(record) else _tree_handle).py_func
+    if _is_loop(record):
+        return _loop_handle.py_func
+    return lambda q, qd, handle, record, jn, want_jn: _tree_handle(q, handle, jn, want_jn)
 
 
 @overload(_status, jit_options=CALLED)
