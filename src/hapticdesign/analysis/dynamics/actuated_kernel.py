@@ -219,7 +219,7 @@ def reduce_pose(tree, plan, body_node, loops, ws):
             e = parent[e]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, forceinline=True)
 def motion_state(qd_a, j, k, axis, motion, loops, ws):
     """Node motions at ``qd = T qd_a`` and ``qdd = 0`` and the closures' bias ``Phidot qd`` (:func:`closure_bias`)
     into ``ws``.
@@ -242,7 +242,7 @@ def motion_state(qd_a, j, k, axis, motion, loops, ws):
     closure_bias(loops, ws.al, ws.ac, ws.bias)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, forceinline=True)
 def velocity_state(qd_a, j, k, axis, plan, motion, loops, ws):
     """Node motions at ``qd = T qd_a`` and ``qdd = [0; gamma]``, ``gamma = -Phi_p^-1 (Phidot qd)``, into ``ws``.
 
@@ -488,7 +488,7 @@ def entries_scratch(n_sets, na, npas, n_body):
                           np.zeros(0))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, forceinline=True)
 def pose_entries(tree, plan, bodies, loops, params, active, ws, scratch, out):
     """Entries (unique H, C, G, eq. 2.44-2.50) at a closed pose whose node poses, ``Phi`` and ``Phi_p^-1`` are in
     ``ws``, for the parameter sets ``params`` (K, 10 B), added into ``out`` (K, E) (zero on entry).

@@ -120,7 +120,7 @@ def closed_loop_terms(qa, qda, structure, ws, h, cqd, g):
     for b in range(body_node.shape[0]):
         if active[b] and body_node[b] >= 0:
             mass_and_gravity(ja, b, bodies.gravity, pw, np.int64(0), h, g, h, np.bool_(False))
-    velocity_state(qda, -1, -1, tree.axis, plan, bodies.motion, loops, dyn)
+    velocity_state(qda, np.int64(-1), np.int64(-1), tree.axis, plan, bodies.motion, loops, dyn)
     for b in range(body_node.shape[0]):
         nb = body_node[b]
         if not active[b] or nb < 0:
