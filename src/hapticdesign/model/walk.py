@@ -350,7 +350,7 @@ def unit_twist(rot, pos, axis, n, point):
     return u1 * r2 - u2 * r1, u2 * r0 - u0 * r2, u0 * r1 - u1 * r0, u0, u1, u2
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, forceinline=True)
 def frame_jacobian(node, parent, axis, coef, rot, pos, body, jac):
     """Jacobian (6 x N, rows v then w) of the origin of node ``node`` (-1: the base) at the poses ``rot, pos``;
     only its rows ``v`` when ``jac`` has 3 rows.
