@@ -121,12 +121,21 @@ def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Select
     designs = front_designs(run, bound)
     for design in designs:
         write_atomically(out / design.file, design.text)
+    _remove_stale_designs(out, len(designs))
     write_atomically(out / PLOTLY, plotly_js())
     page = render(run, selection, bound.title, Picture((out / "pareto.png").read_bytes(), "Pareto front"), pictures,
                   [*FILES, *kept], explorer_data(run, bound, selection, designs), bound.coarseness,
                   bound.spread_rows(chosen.values))
     write_atomically(out / "report.html", page)
     return [*paths, out / "selected.yaml", *(out / d.file for d in designs), out / PLOTLY, out / "report.html"]
+
+
+def _remove_stale_designs(out: Path, count: int) -> None:
+    """Remove the device files of front designs beyond ``count`` that an earlier run into ``out`` wrote."""
+    for path in (out / DESIGNS).glob("design-*.yaml"):
+        number = path.stem.removeprefix("design-")
+        if number.isascii() and number.isdigit() and int(number) > count:
+            path.unlink()
 
 
 def write_failure(out: Path, run: StudyRun, bound: BoundStudy, error: UserError) -> list[Path]:

@@ -514,8 +514,9 @@
       var i = varying.length ? varying[0] : 0;
       tracesOut.push({ type: "scatter", mode: "lines+markers", x: points.map(function (p) { return 1000 * p[i]; }), y: map.values });
       marks.forEach(function (r) {
-        tracesOut.push({ type: "scatter", mode: "markers+text", x: [1000 * points[r.at][i]], y: [map.values[r.at]], text: [plotlyText(r.how + " " + r.name)],
-                         textposition: "top center", marker: { symbol: "circle-open", size: 14, color: "#e02020", line: { width: 2 } } });
+        tracesOut.push({ type: "scatter", mode: "markers", x: [1000 * points[r.at][i]], y: [map.values[r.at]], hoverinfo: "text",
+                         hovertext: [plotlyText(r.name + ": the " + r.how + ", " + shown(r.value))],
+                         marker: { symbol: "circle-open", size: 14, color: "#e02020", line: { width: 2 } } });
       });
       layout.xaxis = { title: { text: axisName(i) } };
     } else {
@@ -533,8 +534,8 @@
         marks.forEach(function (r) {
           var p = points[r.at];
           if (level !== null && p[varying[2]] !== level) { return; }
-          tracesOut.push({ type: "scatter", mode: "markers+text", x: [1000 * p[a]], y: [1000 * p[b]], xaxis: "x" + n, yaxis: "y" + n,
-                           text: [plotlyText(r.how + " " + r.name)], textposition: "top center", textfont: { color: "#fff" }, hoverinfo: "skip",
+          tracesOut.push({ type: "scatter", mode: "markers", x: [1000 * p[a]], y: [1000 * p[b]], xaxis: "x" + n, yaxis: "y" + n,
+                           hoverinfo: "text", hovertext: [plotlyText(r.name + ": the " + r.how + ", " + shown(r.value))],
                            marker: { symbol: "circle-open", size: 16, color: "#e02020", line: { width: 3 } } });
         });
         layout["xaxis" + n] = { domain: [s * (width + gap), s * (width + gap) + width], anchor: "y" + n,
@@ -544,7 +545,7 @@
       layout.coloraxis = { colorscale: "Viridis", colorbar: { thickness: 10 } };
       layout.width = Math.min(900, 170 + 260 * slices.length);
     }
-    Plotly.newPlot(div, tracesOut, layout, { displaylogo: false, staticPlot: false });
+    Plotly.newPlot(div, tracesOut, layout, { displayModeBar: false, responsive: false });
   }
 
   function drawCard() {
@@ -606,6 +607,10 @@
         maps.appendChild(div);
         mapPlot(div, { name: m, unit: detail.maps[m].unit, values: detail.maps[m].values, reductions: detail.maps[m].reductions },
                 data.workspace.points);
+        detail.maps[m].reductions.forEach(function (r) {
+          var where = r.at === null ? " (no one point holds it)" : " at (" + data.workspace.points[r.at].map(function (v) { return shown(1000 * v); }).join(", ") + ") mm, circled";
+          div.appendChild(element("p", r.name + " = the " + r.how + " = " + shown(r.value) + " " + detail.maps[m].unit + where, "note"));
+        });
       });
     }
     card.appendChild(element("h4", "To reproduce it (in the output folder)"));

@@ -172,6 +172,8 @@ EXPLORER_STYLE = """
                 border-radius: 3px; pointer-events: none; }
 #design-card { border: 2px solid #f39c12; border-radius: 6px; padding: .2em 1em 1em; margin: 1em 0; }
 .card-row { display: flex; flex-wrap: wrap; gap: 1.2em; align-items: flex-start; }
+.card-row > * { flex: 0 0 auto; margin: 0; }
+.card-row figure { max-width: 400px; }
 .card-row canvas { border: 1px solid #dde; background: #fbfbfd; cursor: grab; }
 .maps { display: flex; flex-wrap: wrap; gap: .6em; }
 .map { min-width: 300px; }
