@@ -248,3 +248,34 @@ def test_one_objective_is_plotted_against_each_variable(browser, tmp_path):
                                     " return L[k].title.text; })")
     assert sorted(t.split(" ")[0] for t in titles) == sorted(VARIABLES)
     assert _console(browser) == []
+
+
+def test_a_box_dragged_on_the_plot_and_a_range_brushed_on_an_axis_filter(browser, two):
+    from selenium.webdriver.common.action_chains import ActionChains
+
+    out, _ = two
+    rows = _rows(out / "evaluations.csv")
+    _open(browser, (out / "report.html").resolve().as_uri())
+    drag = browser.find_element("css selector", "#objective-space .nsewdrag")
+    browser.execute_script("arguments[0].scrollIntoView({block: 'center'})", drag)
+    ActionChains(browser).move_to_element_with_offset(drag, -250, -150).click_and_hold().move_by_offset(200, 120) \
+        .move_by_offset(200, 120).release().perform()
+    time.sleep(0.5)
+    state = browser.execute_script("return window.hdExplorer.state()")
+    x0, x1, y0, y1 = state["selection"]["box"]
+    inside = [int(r["evaluation"]) for r in rows if r["iso"] and r["mass"]
+              and min(x0, x1) <= float(r["iso"]) <= max(x0, x1) and min(y0, y1) <= float(r["mass"]) <= max(y0, y1)]
+    assert state["selection"]["x"] == "obj:iso" and state["passing"] == inside
+    browser.find_element("id", "clear-filters").click()
+    canvas = browser.find_element("id", "parallel")
+    browser.execute_script("arguments[0].scrollIntoView({block: 'center'})", canvas)
+    first_axis = browser.execute_script("return window.hdExplorer.parallelLine(1)[0][0]")  # the l1 axis, in pixels
+    width = canvas.size["width"]
+    ActionChains(browser).move_to_element_with_offset(canvas, int(first_axis - width / 2), -80).click_and_hold() \
+        .move_by_offset(0, 60).move_by_offset(0, 60).release().perform()
+    time.sleep(0.3)
+    state = browser.execute_script("return window.hdExplorer.state()")
+    assert state["selection"] is None and list(state["ranges"]) == ["var:l1"]
+    low, high = state["ranges"]["var:l1"]
+    assert low < high and state["passing"] == [int(r["evaluation"]) for r in rows if low <= float(r["l1"]) <= high]
+    assert _console(browser) == []
