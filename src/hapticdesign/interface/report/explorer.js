@@ -428,7 +428,16 @@
   })();
 
   // ---- a still picture of a design (the skeleton of `show`, at one pose), turned by dragging
-  function devicePicture(canvas, picture) {
+  function pictureExtent(picture) {  // the largest side of the box holding the picture's points [m]
+    var all = Object.keys(picture.origins).map(function (n) { return picture.origins[n]; });
+    picture.bars.forEach(function (b) { all.push(b[1]); });
+    picture.masses.forEach(function (m) { all.push(m.p); });
+    return Math.max.apply(null, [0, 1, 2].map(function (i) {
+      return Math.max.apply(null, all.map(function (p) { return p[i]; })) - Math.min.apply(null, all.map(function (p) { return p[i]; }));
+    }).concat([1e-3]));
+  }
+
+  function devicePicture(canvas, picture, common) {  // common: the extent [m] shared by pictures shown side by side
     var ctx = canvas.getContext("2d"), view = { az: -0.9, el: 0.45 };
     var names = Object.keys(picture.origins), all = names.map(function (n) { return picture.origins[n]; });
     picture.bars.forEach(function (b) { all.push(b[1]); });
@@ -436,7 +445,7 @@
     var low = [0, 1, 2].map(function (i) { return Math.min.apply(null, all.map(function (p) { return p[i]; })); });
     var high = [0, 1, 2].map(function (i) { return Math.max.apply(null, all.map(function (p) { return p[i]; })); });
     var centre = [0, 1, 2].map(function (i) { return 0.5 * (low[i] + high[i]); });
-    var extent = Math.max(high[0] - low[0], high[1] - low[1], high[2] - low[2], 1e-3);
+    var extent = common || pictureExtent(picture);
     function project(p) {
       var ca = Math.cos(view.az), sa = Math.sin(view.az), ce = Math.cos(view.el), se = Math.sin(view.el);
       var d = [p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]], s = 0.8 * Math.min(canvas.width, canvas.height) / extent;
@@ -602,14 +611,15 @@
       var maps = element("div", null, "maps");
       card.appendChild(maps);
       names.forEach(function (m) {
-        var div = element("div", null, "map");
-        div.setAttribute("data-map", m);
-        maps.appendChild(div);
+        var box = element("div", null, "map"), div = element("div");
+        box.setAttribute("data-map", m);
+        box.appendChild(div);
+        maps.appendChild(box);
         mapPlot(div, { name: m, unit: detail.maps[m].unit, values: detail.maps[m].values, reductions: detail.maps[m].reductions },
                 data.workspace.points);
         detail.maps[m].reductions.forEach(function (r) {
           var where = r.at === null ? " (no one point holds it)" : " at (" + data.workspace.points[r.at].map(function (v) { return shown(1000 * v); }).join(", ") + ") mm, circled";
-          div.appendChild(element("p", r.name + " = the " + r.how + " = " + shown(r.value) + " " + detail.maps[m].unit + where, "note"));
+          box.appendChild(element("p", r.name + " = the " + r.how + " = " + shown(r.value) + " " + detail.maps[m].unit + where, "note"));
         });
       });
     }
@@ -632,7 +642,7 @@
     box.textContent = "";
     if (!state.pins.length) { box.appendChild(element("p", "Pin up to four designs (the card's button) to compare them here.", "note")); return; }
     var table = element("table"), head = element("tr");
-    table.appendChild(element("caption", "Pinned designs side by side: rows that differ shaded, the best of each objective in bold"));
+    table.appendChild(element("caption", "Pinned designs side by side: rows that differ shaded, the best of each objective in bold; the pictures at one scale"));
     head.appendChild(element("th", "quantity"));
     state.pins.forEach(function (k, i) { var th = element("th", name(k)); th.style.color = PIN_COLOURS[i]; head.appendChild(th); });
     table.appendChild(head);
@@ -652,7 +662,10 @@
     var wrap = element("div", null, "table-wrap");
     wrap.appendChild(table);
     box.appendChild(wrap);
-    var row = element("div", null, "card-row");
+    var row = element("div", null, "card-row"), pictures = state.pins.map(function (k) {
+      return frontOf[k] && data.designs[frontOf[k] - 1].picture;
+    }).filter(Boolean);
+    var common = pictures.length ? Math.max.apply(null, pictures.map(pictureExtent)) : null;
     state.pins.forEach(function (k, i) {
       var figure = element("figure", null, "pinned");
       if (frontOf[k]) { figure.setAttribute("data-design", String(frontOf[k])); } else { figure.setAttribute("data-evaluation", String(k + 1)); }
@@ -661,7 +674,7 @@
         var canvas = element("canvas");
         canvas.width = 240; canvas.height = 210;
         figure.appendChild(canvas);
-        devicePicture(canvas, detail.picture);
+        devicePicture(canvas, detail.picture, common);
       }
       var caption = element("figcaption", name(k) + " ");
       caption.style.color = PIN_COLOURS[i];
