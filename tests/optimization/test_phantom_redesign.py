@@ -108,7 +108,7 @@ def test_a_small_seeded_runs_front_meets_what_the_published_design_misses(bound,
     data = yaml.safe_load(STUDY.read_text())
     small = copy.deepcopy(data)
     small["device"] = str(DEVICE)
-    small["algorithm"] = {"method": "nsga2", "population": 16, "generations": 5}
+    small["algorithm"] = {"method": "nsga2", "population": 12, "generations": 3, "polish": "none"}
     path = tmp_path / "small.yaml"
     path.write_text(yaml.safe_dump(small, sort_keys=False))
     run = CliRunner().invoke(app, ["optimize", str(path), "--seed", "1", "--json", "--quiet"])
