@@ -52,6 +52,7 @@ friction reach the handle as follows:
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -59,7 +60,7 @@ import numpy as np
 from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.analysis.dynamics.device import gravity_gradient
 from hapticdesign.analysis.metrics import force as polytope
-from hapticdesign.analysis.metrics.indices import INDICES, HandleStates
+from hapticdesign.analysis.metrics.indices import INDICES, HandleStates, Index, Request, evaluate_at, requests_of
 from hapticdesign.errors import UserError
 from hapticdesign.model.actuators import transmission
 from hapticdesign.model.device import Device
@@ -198,10 +199,12 @@ def workspace_cube(device: Device, h: Handle) -> float:
 
 
 def spec_sheet(device: Device, q=None, loop: SampledLoop | None = None, workspace: bool = True,
-               simulate: bool = True) -> dict:
+               simulate: bool = True, indices: Sequence[str | Request] = (),
+               registry: Mapping[str, Index] = INDICES) -> dict:
     """Every quantity of the module docstring at pose ``q`` (default: home), as a JSON-ready dict; the renderable
     stiffness under the loop settings ``loop`` (default: practice's, :class:`SampledLoop`), its simulated limit
-    only with ``simulate``."""
+    only with ``simulate``; and, as ``indices`` (name -> value, its unit in ``units``), the design ``indices`` of
+    ``registry`` at the pose (a user's own among them, docs/indices.md)."""
     loop = loop or SampledLoop()
     q = configuration_of(device).home.copy() if q is None else np.asarray(q, dtype=float)
     h = handle_at(device, q)
@@ -222,6 +225,11 @@ def spec_sheet(device: Device, q=None, loop: SampledLoop | None = None, workspac
                   "backdrive_friction": "N", "stiffness": "N/m", "workspace": "mm", "renderable_stiffness": "N/m",
                   "rate": "Hz", "handle": "m", "q": "rad or m"},
     }
+    if indices:
+        checked = requests_of(indices, registry)
+        found = evaluate_at(device, configuration_of(device).full(q)[None], checked, registry=registry).values
+        sheet["indices"] = {key: float(value[0]) for key, value in found.items()}
+        sheet["units"]["indices"] = {r.key: registry[r.index].unit for r in checked}
     return sheet
 
 
