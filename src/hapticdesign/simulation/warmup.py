@@ -38,10 +38,10 @@ from numba.core import event
 
 LOCK_FILE = "hapticdesign-compile.lock"
 GROUPS: tuple[tuple[str, float, tuple[str, ...]], ...] = (
-    ("the rendering loop", 11.0, ("hapticdesign.simulation.kernel", "hapticdesign.analysis.dynamics.closed_loop_plant")),
-    ("the closed-loop kernels", 10.0, ("hapticdesign.analysis.loops.closure_kernel", "hapticdesign.analysis.loops.records",
+    ("the rendering loop", 10.0, ("hapticdesign.simulation.kernel", "hapticdesign.analysis.dynamics.closed_loop_plant")),
+    ("the closed-loop kernels", 12.0, ("hapticdesign.analysis.loops.closure_kernel", "hapticdesign.analysis.loops.records",
                                        "hapticdesign.analysis.dynamics.actuated_kernel")),
-    ("the design kernels", 8.0, ("hapticdesign.analysis.reach_kernel", "hapticdesign.analysis.design_batch")),
+    ("the design kernels", 7.0, ("hapticdesign.analysis.reach_kernel", "hapticdesign.analysis.design_batch")),
 )
 """The kernels whose first compile takes long enough to announce: per group its name, about how many CPU seconds
 its first compile takes (``benchmarks/bench_compile.py`` on a 2-core machine: the Phantom's rendering loop, the
