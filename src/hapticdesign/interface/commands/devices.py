@@ -46,9 +46,21 @@ def ik(
             return
         typer.echo(f"{dev.name}: handle at ({', '.join(f'{v:.6g}' for v in target)}) m")
         for name, value in zip(result["coordinates"], pose.q):
-            typer.echo(f"  {name} = {value:.9g}")
+            typer.echo(f"  {name} = {_coordinate_text(dev, name, value)}")
         for name, value in zip(result["passive_coordinates"], pose.passive):
-            typer.echo(f"  {name} = {value:.9g} (passive)")
+            typer.echo(f"  {name} = {_coordinate_text(dev, name, value)}, passive")
+
+
+def _coordinate_text(dev, name: str, value: float) -> str:
+    """A joint coordinate with its unit: metres for a prismatic joint, radians and degrees for a revolute one."""
+    import math
+
+    from hapticdesign.model.mechanism import JointType
+
+    mechanism = dev.mechanism
+    if mechanism.joint_types[mechanism.coordinates.index(name)] == JointType.PRISMATIC:
+        return f"{value:.9g} m"
+    return f"{value:.9g} rad ({math.degrees(value):.6g} deg)"
 
 
 def export(

@@ -1,7 +1,8 @@
 """The work of ``optimize`` and its Python door ``hapticdesign.optimize``: read the study, run its method (here or
 on a Dask cluster), select, write the outputs, and answer an :class:`OptimizationResult`.
 
-The command and the Python door are one function, :func:`optimize`: it never prints, and a user error raises
+The command and the Python door are one function, :func:`optimize`: it prints nothing on stdout, its progress goes to
+stderr unless told ``quiet=True`` (or given its own ``progress``), and a user error raises
 :class:`~hapticdesign.errors.UserError`. Every file goes into the output folder through
 :func:`~hapticdesign.files.write_atomically`; the final files are written only after the run finished, so an
 interrupted run leaves complete checkpoint files and nothing half-written. A run that finished without a feasible
@@ -64,6 +65,19 @@ def _evaluator(bound: BoundStudy, scheduler: str | None, quiet: bool, stack):
     client = dask_client(scheduler, None, quiet)
     stack.callback(close_client, client, False)
     return cluster_evaluator(client, bound.study)
+
+
+def _shown_progress(stack: ExitStack) -> Callable[[int, int], None]:
+    """Generations done on stderr (:func:`~hapticdesign.interface.common.progress_bar`) and the kernels' first
+    compile (:func:`~hapticdesign.simulation.warmup.compile_notice`), for as long as ``stack`` is open."""
+    import sys
+
+    from hapticdesign.interface.common import progress_bar
+    from hapticdesign.simulation.warmup import compile_notice
+
+    report = stack.enter_context(progress_bar(True))
+    stack.enter_context(compile_notice(lambda line: print(line, file=sys.stderr, flush=True)))
+    return lambda done, total: report("generations", done, total)
 
 
 def _check_out(out: Path) -> None:
@@ -189,15 +203,18 @@ def index_module(path: Path) -> list[Index]:
 
 def optimize(study: Path | str, seed: int = 1, out: Path | str | None = None, *, scheduler: str | None = None,
              weights: dict[str, float] | None = None, design: int | None = None,
-             progress: Callable[[int, int], None] | None = None, quiet: bool = True,
+             progress: Callable[[int, int], None] | None = None, quiet: bool = False,
              indices: Sequence[Index] | Path | str = ()) -> OptimizationResult:
     """Run the study file ``study`` with ``seed`` by its method and select a front design: the least RMS of the
     normalized objectives, the least weighted RMS with ``weights`` (objective name -> weight), or the front's
     ``design``-th (seed 001 §7.2). ``out``: a folder for the outputs and the checkpoint (a rerun into it
     continues); ``scheduler``: a Dask scheduler's address whose workers evaluate the designs;
-    ``progress(generation, generations)``; ``quiet``: Dask's own logging silenced; ``indices``: your own design
+    ``progress(generation, generations)``, called after each generation; without it the run shows its progress on
+    stderr (:func:`~hapticdesign.interface.common.progress_bar`: a bar with the time left on a terminal, a line each
+    tenth in a log) and says when the toolkit's kernels compile for the first time on the machine, unless ``quiet``;
+    ``quiet``: nothing on stderr, Dask's own logging silenced too; ``indices``: your own design
     indices (functions decorated with :func:`hapticdesign.index`, or a Python file defining them, run in this
-    process), which the study may name beside the registered ones. Nothing is printed; a bad study, seed or
+    process), which the study may name beside the registered ones. Nothing is printed on stdout; a bad study, seed or
     selection raises :class:`~hapticdesign.errors.UserError`; a ``kmax`` constraint that no design can meet, known
     before the run (:meth:`~hapticdesign.optimization.study_evaluation.BoundStudy.unmeetable_walls`), is a
     :class:`~hapticdesign.errors.RunWarning` before the run starts. The device file's own design is evaluated beside
@@ -222,6 +239,8 @@ def optimize(study: Path | str, seed: int = 1, out: Path | str | None = None, *,
         raise UserError(f"a scheduler distributes the evaluation of designs; method {method.name} solves one program "
                         "here")
     with ExitStack() as stack:
+        if progress is None and not quiet:
+            progress = _shown_progress(stack)
         evaluate = _evaluator(bound, scheduler, quiet, stack)
         run = method.run(bound, seed, evaluate, out, progress)
     run = with_baseline(run, bound)
