@@ -66,6 +66,22 @@ def test_work_that_ends_within_two_seconds_writes_no_progress_to_a_log(capsys, m
     assert capsys.readouterr().err == ""
 
 
+def test_a_short_step_after_a_long_one_writes_nothing_to_a_log(capsys, monkeypatch):
+    """The 2 s count per step: a 13-step bisection of 0.1 s after a 10-s step (the spec sheet's workspace cube after
+    its first compile) says nothing, while the long step said where it was."""
+    clock = Clock()
+    monkeypatch.setattr("time.monotonic", clock)
+    with progress_bar(True) as report:
+        for done in range(1, 11):
+            clock.now = 1.0 * done
+            report("long", done, 10)
+        for done in range(1, 14):
+            clock.now = 10.0 + 0.1 * done
+            report("short", done, 13)
+    err = capsys.readouterr().err
+    assert "long: 10 of 10" in err and "short" not in err
+
+
 def test_robustness_states_its_size_and_the_time_left(tmp_path):
     """The README's robustness run, small: before the searches their number, then the estimate (stderr of a
     child process, as in a log); --json stays quiet."""

@@ -303,24 +303,48 @@ def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: s
 
 
 def index_maps(points: np.ndarray, values: dict[str, np.ndarray], title: str) -> bytes:
-    """PNG of each index over the workspace points (one panel per index, colour = value): the two axes of
-    the box that vary for a planar workspace, a 3D scatter for a solid one."""
+    """PNG of :func:`index_figure`."""
     plt = _pyplot()
-    varying = [k for k in range(3) if np.ptp(points[:, k]) > 0.0]
-    n = len(values)
-    solid = len(varying) == 3
-    fig = plt.figure(figsize=(4.6 * n, 4.0), dpi=100)
-    for i, (label, v) in enumerate(values.items(), start=1):
-        ax = fig.add_subplot(1, n, i, projection="3d" if solid else None)
-        axes = varying if solid or len(varying) == 2 else (varying + [k for k in range(3) if k not in varying])[:2]
-        coordinates = [points[:, k] * 1e3 for k in axes]
-        shown = ax.scatter(*coordinates, c=v, cmap="viridis", s=60 if not solid else 40)
-        for k, name in zip(axes, ("set_xlabel", "set_ylabel", "set_zlabel")):
-            getattr(ax, name)(f"{'xyz'[k]} (mm)")
-        fig.colorbar(shown, ax=ax, shrink=0.8)
-        ax.set_title(label, fontsize=9)
-    fig.suptitle(title)
-    fig.tight_layout()
+    fig = index_figure(points, values, title)
     png = figure_bytes(fig, "png")
     plt.close(fig)
     return png
+
+
+def index_figure(points: np.ndarray, values: dict[str, np.ndarray], title: str):
+    """Each index over the workspace points (one panel per index, labelled with its unit; colour = value): the two
+    axes of the box that vary for a planar workspace, a 3D scatter for a solid one, its colour bar under it (clear of
+    the z axis's ticks). An index the same at every point is drawn in one colour and says so instead of a scale."""
+    plt = _pyplot()
+    from matplotlib.ticker import MaxNLocator
+
+    varying = [k for k in range(3) if np.ptp(points[:, k]) > 0.0]
+    n = len(values)
+    solid = len(varying) == 3
+    fig = plt.figure(figsize=(4.6 * n, 4.6 if solid else 4.0), dpi=100, layout="constrained")
+    axes = varying if solid or len(varying) == 2 else (varying + [k for k in range(3) if k not in varying])[:2]
+    coordinates = [points[:, k] * 1e3 for k in axes]
+    for i, (label, v) in enumerate(values.items(), start=1):
+        ax = fig.add_subplot(1, n, i, projection="3d" if solid else None)
+        v = np.asarray(v, dtype=float)
+        finite = v[np.isfinite(v)]
+        constant = finite.size > 0 and np.ptp(finite) <= 1e-9 * max(float(np.max(np.abs(finite))), 1e-300)
+        if constant:
+            shown = ax.scatter(*coordinates, color="tab:blue", s=40 if solid else 60)
+        else:
+            shown = ax.scatter(*coordinates, c=v, cmap="viridis", s=40 if solid else 60)
+        for k, name in zip(axes, ("set_xlabel", "set_ylabel", "set_zlabel")):
+            getattr(ax, name)(f"{'xyz'[k]} (mm)", fontsize=8)
+        for axis in (ax.xaxis, ax.yaxis, *((ax.zaxis,) if solid else ())):
+            axis.set_major_locator(MaxNLocator(4))
+        ax.tick_params(labelsize=7)
+        if constant:
+            ax.set_title(f"{label}\n{float(finite[0]):.6g} at every point", fontsize=9)
+            continue
+        bar = fig.colorbar(shown, ax=ax, shrink=0.8, location="bottom" if solid else "right", pad=0.08 if solid else 0.02)
+        bar.set_label(label, fontsize=8)
+        bar.ax.tick_params(labelsize=7)
+        (bar.ax.xaxis if solid else bar.ax.yaxis).set_major_locator(MaxNLocator(4))
+        ax.set_title(label, fontsize=9)
+    fig.suptitle(title)
+    return fig

@@ -51,6 +51,7 @@ friction reach the handle as follows:
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -68,6 +69,14 @@ from hapticdesign.simulation.config import loop_model
 
 CUBE_SEARCH = (0.0, 0.4, 12)
 """Bisection of the workspace cube's half edge: lower and upper bound (m) and number of halvings."""
+Report = Callable[[str, int, int | None], None]
+"""``progress(step, done, total)``: how far a long part of the sheet is (as the command line's progress bars take it)."""
+CUBE_STEP = "workspace cube (bisection steps)"
+RENDERING_STEP = "renderable stiffness (exact, with the hand, simulated)"
+
+
+def no_progress(step: str, done: int, total: int | None) -> None:
+    """A progress report that shows nothing."""
 
 
 @dataclass(frozen=True)
@@ -144,24 +153,30 @@ def renderable_stiffness(device: Device, h: Handle, loop: SampledLoop | None = N
 
 
 def renderable(device: Device, h: Handle, loop: SampledLoop, res: float | None,
-               friction: tuple[float, float] | None, simulate: bool = True) -> dict:
+               friction: tuple[float, float] | None, simulate: bool = True, progress: Report = no_progress) -> dict:
     """The renderable-stiffness rows: the exact limit without the hand (worst direction) and with the hand, the
     simulated limit along that direction with the device's dry friction and encoder quantization, and the passivity
-    bounds from the sheet's resolution ``res`` and backdrive ``friction`` (see the module docstring)."""
+    bounds from the sheet's resolution ``res`` and backdrive ``friction`` (see the module docstring); ``progress``
+    hears of each of the three (:data:`RENDERING_STEP`)."""
     from hapticdesign.simulation.impedance import SIMULATED_CAP, TOUCH, device_counts, simulated_limit
 
+    progress(RENDERING_STEP, 0, 3)
     exact, direction, lower = worst_direction(h.jacobian, h.states.H[0], device.damping_matrix,
                                               replace(loop, hand=None), gravity_gradient(device, h.q),
                                               loop_model(device, loop, h.q), device.transmission)
+    progress(RENDERING_STEP, 1, 3)
     hand = loop.hand or GRASP
+    with_hand = renderable_stiffness(device, h, replace(loop, hand=hand))
+    progress(RENDERING_STEP, 2, 3)
     counts = device_counts(device)
     simulated = None
     if simulate and device.transmission is None:  # the simulated loop's plant is rigid
         simulated = simulated_limit(device, replace(loop, hand=None), direction=direction, equilibrium=TOUCH,
                                     counts=counts, start=max(exact, 1.0), k_limit=SIMULATED_CAP)
+    progress(RENDERING_STEP, 3, 3)
     return {
         "exact": exact, "exact_lower": lower, "direction": direction,
-        "exact_with_hand": renderable_stiffness(device, h, replace(loop, hand=hand)), "hand": hand.as_dict(),
+        "exact_with_hand": with_hand, "hand": hand.as_dict(),
         "simulated": simulated, "simulated_counts": counts, "simulated_touch": TOUCH,
         "passivity_viscous": 2.0 * float(np.linalg.eigvalsh(h.states.cartesian_damping[0]).min()) * loop.rate,
         "passivity_coulomb": None if friction is None or res is None else 2.0 * friction[0] / res,
@@ -169,8 +184,9 @@ def renderable(device: Device, h: Handle, loop: SampledLoop, res: float | None,
     }
 
 
-def workspace_cube(device: Device, h: Handle) -> float:
-    """Edge (m) of the largest cube (square) around the home handle position reached from home."""
+def workspace_cube(device: Device, h: Handle, progress: Report = no_progress) -> float:
+    """Edge (m) of the largest cube (square) around the home handle position reached from home; ``progress`` hears
+    of each bisection step (:data:`CUBE_STEP`)."""
     basis = h.basis
     signs = [s for s in np.ndindex(*(3,) * basis.shape[1]) if any(v != 1 for v in s)]
     offsets = np.array([[v - 1.0 for v in s] for s in signs]) @ basis.T
@@ -184,19 +200,24 @@ def workspace_cube(device: Device, h: Handle) -> float:
         return True
 
     lo, hi, halvings = CUBE_SEARCH
+    progress(CUBE_STEP, 0, halvings + 1)
     if reaches(hi):
+        progress(CUBE_STEP, halvings + 1, halvings + 1)
         return 2 * hi
-    for _ in range(halvings):
+    for k in range(halvings):
+        progress(CUBE_STEP, k + 1, halvings + 1)
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if reaches(mid) else (lo, mid)
+    progress(CUBE_STEP, halvings + 1, halvings + 1)
     return 2 * lo
 
 
 def spec_sheet(device: Device, q=None, loop: SampledLoop | None = None, workspace: bool = True,
-               simulate: bool = True) -> dict:
+               simulate: bool = True, progress: Report = no_progress) -> dict:
     """Every quantity of the module docstring at pose ``q`` (default: home), as a JSON-ready dict; the renderable
     stiffness under the loop settings ``loop`` (default: practice's, :class:`SampledLoop`), its simulated limit
-    only with ``simulate``."""
+    only with ``simulate``; ``progress(step, done, total)`` hears how far the long parts are (the workspace cube's
+    bisection, the renderable stiffness)."""
     loop = loop or SampledLoop()
     q = configuration_of(device).home.copy() if q is None else np.asarray(q, dtype=float)
     h = handle_at(device, q)
@@ -211,8 +232,8 @@ def spec_sheet(device: Device, q=None, loop: SampledLoop | None = None, workspac
         "apparent_mass": {"min": mass[0], "max": mass[1]},
         "backdrive_friction": None if friction is None else {"min": friction[0], "max": friction[1]},
         "stiffness": _stiffness(device, h),
-        "workspace": {"cube": 1000.0 * workspace_cube(device, h)} if workspace else None,
-        "renderable_stiffness": renderable(device, h, loop, res, friction, simulate),
+        "workspace": {"cube": 1000.0 * workspace_cube(device, h, progress)} if workspace else None,
+        "renderable_stiffness": renderable(device, h, loop, res, friction, simulate, progress),
         "units": {"resolution": "m", "force_continuous": "N", "force_peak": "N", "apparent_mass": "kg",
                   "backdrive_friction": "N", "stiffness": "N/m", "workspace": "mm", "renderable_stiffness": "N/m",
                   "rate": "Hz", "handle": "m", "q": "rad or m"},

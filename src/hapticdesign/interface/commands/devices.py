@@ -10,7 +10,7 @@ from typing import Optional
 import typer
 
 from hapticdesign.errors import UserError
-from hapticdesign.interface.common import note, parse_vector, print_json, user_errors
+from hapticdesign.interface.common import note, parse_vector, print_json, progress_bar, user_errors
 from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
 
 
@@ -123,7 +123,7 @@ def spec(
     from dataclasses import replace
 
     from hapticdesign.analysis.sampled_loop import Hand, SampledLoop
-    from hapticdesign.studies.spec import spec_sheet
+    from hapticdesign.studies.spec import no_progress, spec_sheet
     from hapticdesign.interface.report.spec_page import spec_page
     from hapticdesign.interface.round_off import without_round_off
 
@@ -137,24 +137,12 @@ def spec(
         preset = Hand.named(hand)
         loop = SampledLoop(period=1.0 / rate, delay=delay, compensation=compensation,
                            hand=replace(preset, **given, name=None) if given else preset)
-        sheet = spec_sheet(dev, pose, loop, workspace=workspace, simulate=simulate)
-        sheet["handle"] = without_round_off(sheet["handle"])  # a position's 1e-18 m residue is 0
+        with progress_bar(not (quiet or json_out)) as report:
+            report = report or no_progress
+            sheet = spec_sheet(dev, pose, loop, workspace=workspace, simulate=simulate, progress=report)
+            sheet["handle"] = without_round_off(sheet["handle"])  # a position's 1e-18 m residue is 0
+            figures = [] if out is None else _spec_figures(dev, sheet, report)
         if out is not None:
-            figures = []
-            if sheet["workspace"] is not None and sheet["workspace"]["cube"] > 0.0:
-                from hapticdesign.studies.spec_maps import SECTION_SPAN, quantity_png, sheet_sections, workspace_png
-
-                sections, edge = sheet_sections(dev, sheet)
-                figures.append(("Workspace sections", f"Planes through the home handle position, {SECTION_SPAN:g} "
-                                "cube edges wide: blue where the handle gets by inverse kinematics on the home branch "
-                                "(within the joint limits, no singularity), the workspace cube's section in red.",
-                                workspace_png(dev, sections, edge)))
-                quantities = quantity_png(dev, sections, edge)
-                if quantities is not None:
-                    figures.append(("Quantities over the workspace", "The sheet's resolution, continuous force, "
-                                    "largest apparent mass and largest backdrive friction at each point of the "
-                                    "sections above, at the pose the inverse kinematics finds there (blank: not "
-                                    "reached); the workspace cube's section in red.", quantities))
             write_atomically(out / "spec.json", dumps_json(sheet) + "\n")
             write_atomically(out / "spec.html", spec_page(sheet, figures))
             note(f"wrote {out / 'spec.html'} and {out / 'spec.json'}", quiet)
@@ -165,6 +153,27 @@ def spec(
         for key, value in sheet.items():
             if key != "units":
                 typer.echo(f"{key}: {_text(value)}" + (f" [{units[key]}]" if key in units else ""))
+
+
+def _spec_figures(dev, sheet: dict, report) -> list[tuple[str, str, bytes]]:
+    """The spec page's figures (title, caption, PNG): the workspace sections and the quantities over them, where
+    the sheet has a workspace cube; ``report`` hears how far their inverse kinematics is."""
+    figures = []
+    if sheet["workspace"] is not None and sheet["workspace"]["cube"] > 0.0:
+        from hapticdesign.studies.spec_maps import SECTION_SPAN, quantity_png, sheet_sections, workspace_png
+
+        sections, edge = sheet_sections(dev, sheet, progress=report)
+        figures.append(("Workspace sections", f"Planes through the home handle position, {SECTION_SPAN:g} "
+                        "cube edges wide: blue where the handle gets by inverse kinematics on the home branch "
+                        "(within the joint limits, no singularity), the workspace cube's section in red.",
+                        workspace_png(dev, sections, edge)))
+        quantities = quantity_png(dev, sections, edge, report)
+        if quantities is not None:
+            figures.append(("Quantities over the workspace", "The sheet's resolution, continuous force, "
+                            "largest apparent mass and largest backdrive friction at each point of the "
+                            "sections above, at the pose the inverse kinematics finds there (blank: not "
+                            "reached); the workspace cube's section in red.", quantities))
+    return figures
 
 
 def _text(value) -> str:
