@@ -163,12 +163,34 @@ def _polished(run: StudyRun) -> tuple[list[str], Callable[[Record], list[str]]]:
     return ["polished"], lambda r: ["yes" if r.polished else "no"]
 
 
-def front_csv(run: StudyRun) -> str:
+def with_unit(name: str, units: Mapping[str, str] | None) -> str:
+    """A column's header: ``name [unit]`` where ``units`` knows its unit (:meth:`BoundStudy.units
+    <hapticdesign.optimization.study_evaluation.BoundStudy.units>`), else the name alone (:func:`without_unit`
+    reads the name back)."""
+    unit = (units or {}).get(name, "")
+    return f"{name} [{unit}]" if unit else name
+
+
+def without_unit(header: str) -> str:
+    """The study's name of a column of front.csv or evaluations.csv: ``l1 [m]`` -> ``l1``,
+    ``min_force[torque=continuous] [N]`` -> ``min_force[torque=continuous]``, ``design`` -> ``design``."""
+    head, sep, unit = header.rpartition(" [")
+    return head if sep and unit.endswith("]") else header
+
+
+def _quantity_columns(spec: StudySpec, units: Mapping[str, str] | None) -> list[str]:
+    """The headers of the variables, objectives and constrained values, with their units."""
+    return [with_unit(name, units) for name in (*spec.variables, *(o.name for o in spec.objectives),
+                                                *constraint_labels(spec))]
+
+
+def front_csv(run: StudyRun, units: Mapping[str, str] | None = None) -> str:
     """One row per front design: its number, variables, objectives and constrained values (and whether it was
-    polished, for a study that polishes)."""
+    polished, for a study that polishes); each quantity's header carries its unit in brackets where ``units`` knows
+    it (``l1 [m]``, ``mass [kg]``): one header row, every other row numbers."""
     spec = run.spec
     polished, cell = _polished(run)
-    header = ["design", *spec.variables, *(o.name for o in spec.objectives), *constraint_labels(spec), *polished]
+    header = ["design", *_quantity_columns(spec, units), *polished]
     rows = []
     for n, k in enumerate(run.front, start=1):
         r = run.records[k]
@@ -177,14 +199,14 @@ def front_csv(run: StudyRun) -> str:
     return csv_rows(header, rows)
 
 
-def evaluations_csv(run: StudyRun) -> str:
+def evaluations_csv(run: StudyRun, units: Mapping[str, str] | None = None) -> str:
     """Every evaluated design: generation, variables, objectives, constrained values, feasible or why not (and
     whether it was polished, for a study that polishes: the polished designs follow the last generation; the
-    polishing's other probes are counted in the run's evaluations, not listed)."""
+    polishing's other probes are counted in the run's evaluations, not listed); units in the headers as in
+    :func:`front_csv`."""
     spec = run.spec
     polished, cell = _polished(run)
-    header = ["evaluation", "generation", *spec.variables, *(o.name for o in spec.objectives),
-              *constraint_labels(spec), "feasible", "reason", *polished]
+    header = ["evaluation", "generation", *_quantity_columns(spec, units), "feasible", "reason", *polished]
     rows = []
     for n, r in enumerate(run.records, start=1):
         rows.append([str(n), str(r.generation), *(_number(r.values[v]) for v in spec.variables),

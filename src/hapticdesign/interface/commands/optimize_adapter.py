@@ -122,8 +122,8 @@ def summary_lines(summary: dict) -> list[str]:
 
 def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Selection) -> list[Path]:
     """Every output file of the run in ``out`` (see :data:`FILES`)."""
-    write_atomically(out / "front.csv", front_csv(run))
-    write_atomically(out / "evaluations.csv", evaluations_csv(run))
+    write_atomically(out / "front.csv", front_csv(run, bound.units()))
+    write_atomically(out / "evaluations.csv", evaluations_csv(run, bound.units()))
     paths = [out / "front.csv", out / "evaluations.csv", *pareto_figure(run, selection, out, registry=bound.registry)]
     chosen = run.records[selection.record]
     write_atomically(out / "selected.yaml", bound.device_file_text(chosen.values, baseline_lines(run, chosen)))
@@ -131,7 +131,7 @@ def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Select
     kept = (["checkpoint/ (one file per generation; a rerun into this folder continues)"]
             if method_of(run.spec).checkpointed else [])
     page = render(run, selection, bound.title, Picture((out / "pareto.png").read_bytes(), "Pareto front"), pictures,
-                  [*FILES, *kept], bound.coarseness, bound.spread_rows(chosen.values))
+                  [*FILES, *kept], bound.coarseness, bound.spread_rows(chosen.values), bound.units())
     write_atomically(out / "report.html", page)
     return [*paths, out / "selected.yaml", out / "report.html"]
 
@@ -139,11 +139,12 @@ def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Select
 def write_failure(out: Path, run: StudyRun, bound: BoundStudy, error: UserError) -> list[Path]:
     """What a run without a feasible design leaves in ``out``: every evaluation (evaluations.csv) and the report of
     why (``error``'s sentence, the reasons counted by kind, the closest designs, the device file's design)."""
-    write_atomically(out / "evaluations.csv", evaluations_csv(run))
+    write_atomically(out / "evaluations.csv", evaluations_csv(run, bound.units()))
     kept = (["checkpoint/ (one file per generation; a rerun into this folder continues)"]
             if method_of(run.spec).checkpointed else [])
     write_atomically(out / "report.html", render_failure(run, str(error), bound.title,
-                                                         ["evaluations.csv", "report.html", *kept], bound.coarseness))
+                                                         ["evaluations.csv", "report.html", *kept], bound.coarseness,
+                                                         bound.units()))
     return [out / "evaluations.csv", out / "report.html"]
 
 
