@@ -340,6 +340,8 @@ def index_figure(points: np.ndarray, values: dict[str, np.ndarray], title: str):
     plt = _pyplot()
     from matplotlib.ticker import MaxNLocator
 
+    from hapticdesign.simulation.figures import colour_scale
+
     varying = [k for k in range(3) if np.ptp(points[:, k]) > 0.0]
     n = len(values)
     solid = len(varying) == 3
@@ -349,9 +351,8 @@ def index_figure(points: np.ndarray, values: dict[str, np.ndarray], title: str):
     for i, (label, v) in enumerate(values.items(), start=1):
         ax = fig.add_subplot(1, n, i, projection="3d" if solid else None)
         v = np.asarray(v, dtype=float)
-        finite = v[np.isfinite(v)]
-        constant = finite.size > 0 and np.ptp(finite) <= 1e-9 * max(float(np.max(np.abs(finite))), 1e-300)
-        if constant:
+        constant = colour_scale(v)[2]  # the value of an index the same at every point (round-off aside), else None
+        if constant is not None:
             shown = ax.scatter(*coordinates, color="tab:blue", s=40 if solid else 60)
         else:
             shown = ax.scatter(*coordinates, c=v, cmap="viridis", s=40 if solid else 60)
@@ -361,7 +362,7 @@ def index_figure(points: np.ndarray, values: dict[str, np.ndarray], title: str):
             axis.set_major_locator(MaxNLocator(4))
         ax.tick_params(labelsize=7)
         if constant:
-            ax.set_title(f"{label}\n{float(finite[0]):.6g} at every point", fontsize=9)
+            ax.set_title(f"{label}\n{constant[0]:.6g} at every point", fontsize=9)
             continue
         bar = fig.colorbar(shown, ax=ax, shrink=0.8, location="bottom" if solid else "right", pad=0.08 if solid else 0.02)
         bar.set_label(label, fontsize=8)

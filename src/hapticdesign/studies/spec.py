@@ -218,6 +218,10 @@ def spec_sheet(device: Device, q=None, loop: SampledLoop | None = None, workspac
     stiffness under the loop settings ``loop`` (default: practice's, :class:`SampledLoop`), its simulated limit
     only with ``simulate``; ``progress(step, done, total)`` hears how far the long parts are (the workspace cube's
     bisection, the renderable stiffness)."""
+    from hapticdesign.studies.spec_page import check_reference
+
+    if device.reference:
+        check_reference(device.reference)  # refused before the work
     loop = loop or SampledLoop()
     q = configuration_of(device).home.copy() if q is None else np.asarray(q, dtype=float)
     h = handle_at(device, q)
@@ -225,7 +229,7 @@ def spec_sheet(device: Device, q=None, loop: SampledLoop | None = None, workspac
     friction = backdrive_friction(device, h)
     mass = apparent_mass(device, h)
     sheet = {
-        "device": device.name, "q": q, "handle": h.position, "dimensions": h.basis.shape[1],
+        "device": device.name, **({"reference": device.reference} if device.reference else {}), "q": q, "handle": h.position, "dimensions": h.basis.shape[1],
         "resolution": res,
         "force_continuous": inscribed_force(device, h, "continuous"),
         "force_peak": inscribed_force(device, h, "peak"),

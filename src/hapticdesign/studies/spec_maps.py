@@ -239,6 +239,7 @@ def quantity_figure(name: str, sections: list[Section], edge: float, maps: dict[
     from matplotlib.ticker import MaxNLocator
 
     from hapticdesign.analysis.metrics.maps import ABOVE, BELOW, ROBUST_PERCENTILES, UNREACHED, robust_limits
+    from hapticdesign.simulation.figures import colour_scale
 
     rows = [(key, label, unit) for key, label, unit in QUANTITIES if key in maps]
     if not rows:
@@ -250,10 +251,9 @@ def quantity_figure(name: str, sections: list[Section], edge: float, maps: dict[
     beyond = False
     for r, (key, label, unit) in enumerate(rows):
         values = np.concatenate([m.ravel() for m in maps[key]])
-        low, high = robust_limits(values) or (0.0, 1.0)
-        constant = high - low <= 1e-9 * max(abs(high), abs(low), 1e-300)
-        if constant:
-            low, high = low - max(abs(low), 1.0) * 1e-3, high + max(abs(high), 1.0) * 1e-3
+        low, high, constant = colour_scale(values)  # a constant: one tick at its value
+        if constant is None:
+            low, high = robust_limits(values) or (low, high)
         finite = values[np.isfinite(values)]
         above, below = bool(np.any(finite > high)), bool(np.any(finite < low))
         beyond = beyond or above or below
@@ -276,8 +276,8 @@ def quantity_figure(name: str, sections: list[Section], edge: float, maps: dict[
         extend = {(False, False): "neither", (True, False): "max", (False, True): "min", (True, True): "both"}
         bar = fig.colorbar(image, ax=list(axes[r]), shrink=0.9, aspect=25, extend=extend[(above, below)])
         bar.ax.tick_params(labelsize=7)
-        if constant:
-            value = float(finite[0])
+        if constant is not None:
+            value = constant[0]
             bar.set_ticks([value])
             bar.set_label(f"{label} [{unit}]: {value:.4g} at every point", fontsize=8)
         else:
