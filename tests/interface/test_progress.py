@@ -98,3 +98,43 @@ def test_robustness_states_its_size_and_the_time_left(tmp_path):
     assert err[-1] == "robustness searches: 164 of 164"
     quiet = subprocess.run([*args, "--json"], capture_output=True, text=True, env=env, cwd=tmp_path, check=False)
     assert quiet.returncode == 0 and quiet.stderr == ""
+
+
+def test_a_study_steps_title_is_never_cut_on_a_terminal():
+    """The step's whole title (its references in parentheses aside) on an 80-column terminal, wrapped where it must
+    be, not cut with an ellipsis (issue 45: "Analytic linearization and a realizable lin…")."""
+    import io
+
+    from rich.console import Console
+
+    from hapticdesign.interface.commands.study import RichProgress
+
+    title = "Campaigns over the design sets: stable impedance and transparency (§4.1.4, §4.2.4)"
+    screen = io.StringIO()
+    progress = RichProgress(Console(file=screen, width=80, force_terminal=True, color_system=None))
+    with progress.bars:
+        progress.begin(title)
+        progress.update(3, 10)
+    text = " ".join(screen.getvalue().split())
+    assert "…" not in text
+    words = "Campaigns over the design sets: stable impedance and transparency".split()
+    last = text.rsplit("Campaigns", 1)[1]
+    assert [w for w in words[1:] if w in last] == words[1:]
+
+
+def test_a_study_in_a_log_says_each_step_when_it_starts_and_ends(capsys, monkeypatch):
+    from hapticdesign.interface.commands.study import LineProgress
+    from hapticdesign.studies.steps import STATUS_DONE, Outcome, StepResult
+
+    clock = Clock()
+    monkeypatch.setattr("time.monotonic", clock)
+    lines = []
+    progress = LineProgress(lines.append)
+    title = "Analytic linearization and a realizable linear design (§3.2.1)"
+    progress.begin(title)
+    for done in range(1, 11):
+        clock.now = float(done)
+        progress.update(done, 10)
+    progress.end(StepResult("linearization", title, STATUS_DONE, 10.0, Outcome()))
+    assert lines[0] == "Analytic linearization and a realizable linear design..."
+    assert lines[1] == "  1 of 10" and lines[-2] == "  9 of 10, about 1 s left" and lines[-1] == "  done in 10 s"

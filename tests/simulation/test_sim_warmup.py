@@ -47,8 +47,8 @@ def test_the_notice_names_the_area_once_then_says_every_half_minute_that_compili
         clock.now = 200.0
         toy(True)  # past the typical time
     assert shown[1:] == ["still compiling the toy kernels: 3 so far in 40 s; about 80 s left...",
-                         "still compiling the toy kernels: 5 so far in 3.3 min; longer than on a quiet machine (the "
-                         "machine is busy)..."]
+                         "still compiling the toy kernels: 5 so far in 3.3 min; longer than the 2 min of a quiet "
+                         "machine..."]
     assert shown[0].startswith("compiling the toy kernels (once per machine") and "about 2 min" in shown[0]
     with warmup.compile_notice(shown.append):
         toy(np.zeros(3))  # in memory: no compile, no notice

@@ -64,7 +64,7 @@ def notice(area: str, minutes: float) -> str:
 def still(area: str, kernels: int, seconds: float, minutes: float) -> str:
     """The line that says a compile of ``area``'s kernels is still going, with the time left of the typical time."""
     left = 60.0 * minutes - seconds
-    rest = (f"about {_duration(left)} left" if left > 0 else "longer than on a quiet machine (the machine is busy)")
+    rest = f"about {_duration(left)} left" if left > 0 else f"longer than the {minutes:g} min of a quiet machine"
     return f"still compiling the {area} kernels: {kernels} so far in {_duration(seconds)}; {rest}..."
 
 
