@@ -24,17 +24,21 @@ def tick_labels(ax, renderer):
     return out
 
 
+TICK_GAP = 6.0
+"""Pixels at least between two tick labels of one axis (closer, they read as one number: "-1000 100")."""
+
+
 def layout_problems(fig, min_map_px: float = 0.0, maps=()) -> list[str]:
     """What is wrong with ``fig``'s layout once drawn: an axes (with its tick labels, axis labels and title) or a
-    legend outside the figure or overlapping another; tick labels of one axis running into each other or into another
-    axes; a map of ``maps`` narrower or lower than ``min_map_px``. Empty when it reads."""
+    legend outside the figure, by any part of a pixel, or overlapping another; tick labels of one axis closer than
+    :data:`TICK_GAP`; a map of ``maps`` narrower or lower than ``min_map_px``. Empty when it reads."""
     fig.canvas.draw()
     renderer = fig.canvas.get_renderer()
     width, height = fig.bbox.width, fig.bbox.height
     problems = []
     boxes = _boxes(fig) + [(f"legend {k}", legend.get_window_extent(renderer)) for k, legend in enumerate(fig.legends)]
     for name, box in boxes:
-        if box.x0 < -1 or box.y0 < -1 or box.x1 > width + 1 or box.y1 > height + 1:
+        if box.x0 < -0.5 or box.y0 < -0.5 or box.x1 > width + 0.5 or box.y1 > height + 0.5:
             problems.append(f"{name} leaves the figure: {box.bounds} in {width:.0f} x {height:.0f}")
     for i, (a, box_a) in enumerate(boxes):
         for b, box_b in boxes[i + 1:]:
@@ -44,7 +48,7 @@ def layout_problems(fig, min_map_px: float = 0.0, maps=()) -> list[str]:
         for labels in tick_labels(ax, renderer):
             for i, (text_a, box_a) in enumerate(labels):
                 for text_b, box_b in labels[i + 1:]:
-                    if _overlap(box_a, box_b, slack=0.0):
+                    if _overlap(box_a.padded(TICK_GAP / 2), box_b.padded(TICK_GAP / 2), slack=0.0):
                         problems.append(f"axes {k}: tick labels {text_a!r} and {text_b!r} collide")
     for ax in maps:
         box = ax.get_window_extent(renderer)

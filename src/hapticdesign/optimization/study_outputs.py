@@ -248,6 +248,10 @@ def normalized_like_front(run: StudyRun, objectives: np.ndarray) -> np.ndarray:
     return np.array(out)
 
 
+AXIS_LABEL_WIDTH = 44
+"""Characters of an axis label's line in the Pareto figure (a longer label wraps, so that it stays in the figure)."""
+
+
 def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: str = "pareto",
                   registry: Mapping[str, Index] = INDICES) -> list[Path]:
     """The front in pairs of objectives, each labelled with its reduction and how coarse the grid is (every feasible
@@ -256,14 +260,18 @@ def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: s
     :func:`front_limits`, and the legend counts the feasible designs beyond them); one objective: its value per
     evaluation (the device file's design a dashed line); more than three: parallel coordinates of the normalized
     front (0 best; the device file's design dashed, normalized alike)."""
+    import textwrap
+
+    from matplotlib.ticker import MaxNLocator
+
     plt = _pyplot()
     spec = run.spec
     units = {o.index: registry[o.index].unit for o in spec.objectives}
     box = spec.workspace
     grids = {o.index: "" if box is None or registry[o.index].of_parameters
              else "; " + Workspace(box.box.center, box.box.size, box.grid).describe() for o in spec.objectives}
-    labels = [f"{o.name}: {o.reduce} {o.index} ({'-' if units[o.index] == '1' else units[o.index]}{grids[o.index]}), "
-              f"{o.sense}imize" for o in spec.objectives]
+    labels = [textwrap.fill(f"{o.name}: {o.reduce} {o.index} ({'-' if units[o.index] == '1' else units[o.index]}"
+                            f"{grids[o.index]}), {o.sense}imize", AXIS_LABEL_WIDTH) for o in spec.objectives]
     feasible = [r for r in run.records if r.feasible]
     F_all = np.array([r.objectives for r in feasible]).reshape(len(feasible), len(labels))
     F = np.array([run.records[k].objectives for k in run.front]).reshape(len(run.front), len(labels))
@@ -300,6 +308,8 @@ def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: s
                 ax.scatter([base[i]], [base[j]], marker="D", s=50, color="black", label=baseline)
             ax.set_xlim(x_low, x_high)
             ax.set_ylim(y_low, y_high)
+            ax.xaxis.set_major_locator(MaxNLocator(5))  # a narrow range of long numbers: few ticks, none colliding
+            ax.yaxis.set_major_locator(MaxNLocator(6))
             ax.set_xlabel(labels[i])
             ax.set_ylabel(labels[j])
             ax.legend(fontsize=8)
