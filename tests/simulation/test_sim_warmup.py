@@ -32,14 +32,14 @@ def test_the_notice_names_the_area_once_then_says_every_half_minute_that_compili
     with warmup.compile_notice(shown.append):
         toy(1.0)  # a kernel outside the toolkit (a user's): no notice
     assert shown == []
-    monkeypatch.setattr(warmup, "AREAS", (*warmup.AREAS, (toy.py_func.__module__, "toy", 2.0)))
+    monkeypatch.setattr(warmup, "AREAS", (*warmup.AREAS, (toy.py_func.__module__, "toy", 120.0)))
     clock = Clock()
     with warmup.compile_notice(shown.append, clock):
         toy(np.zeros(2))  # a new signature: numba compiles it
         toy(np.ones(2))  # compiled already: nothing to say
         clock.now = 10.0
         toy(3)  # another compile 10 s later: the first line is enough
-        assert shown == [warmup.notice("toy", 2.0)]
+        assert shown == [warmup.notice("toy", 120.0)]
         clock.now = 40.0
         toy(np.zeros((2, 2)))  # 40 s in: still compiling, with the time left of the typical 2 min
         clock.now = 50.0
@@ -47,9 +47,9 @@ def test_the_notice_names_the_area_once_then_says_every_half_minute_that_compili
         clock.now = 200.0
         toy(True)  # past the typical time
     assert shown[1:] == ["still compiling the toy kernels: 3 so far in 40 s; about 80 s left...",
-                         "still compiling the toy kernels: 5 so far in 3.3 min; longer than the 2 min of a quiet "
-                         "machine..."]
-    assert shown[0].startswith("compiling the toy kernels (once per machine") and "about 2 min" in shown[0]
+                         "still compiling the toy kernels: 5 so far in 3.3 min; longer than the usual 2.0 min (a busy "
+                         "machine)..."]
+    assert shown[0].startswith("compiling the toy kernels (once per machine") and "about 2.0 min" in shown[0]
     with warmup.compile_notice(shown.append):
         toy(np.zeros(3))  # in memory: no compile, no notice
     assert len(shown) == 3

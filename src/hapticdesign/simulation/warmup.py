@@ -32,39 +32,41 @@ import numba
 from numba.core import event
 
 LOCK_FILE = "hapticdesign-compile.lock"
-AREAS = (("hapticdesign.simulation", "rendering", 1.5),
-         ("hapticdesign.analysis.dynamics.closed_loop_plant", "rendering", 1.5),
-         ("hapticdesign.analysis.dynamics", "dynamics", 2.0),
-         ("hapticdesign.analysis.design_batch", "design-index", 2.0),
-         ("hapticdesign", "kinematics", 1.0))
-"""Kernel areas by module prefix (the longest matching prefix wins): the area's name and the minutes its first
-compile took on this project's quiet 2-core machine (``ik`` on the Falcon for the kinematics, ``dynamics`` for
-the dynamics, ``impedance-range`` for the rendering loop), which the notice quotes as the time to expect."""
+AREAS = (("hapticdesign.simulation", "rendering", 35.0),
+         ("hapticdesign.analysis.dynamics.closed_loop_plant", "rendering", 35.0),
+         ("hapticdesign.analysis.dynamics", "dynamics", 15.0),
+         ("hapticdesign.analysis.design_batch", "design-index", 35.0),
+         ("hapticdesign", "kinematics", 30.0))
+"""Kernel areas by module prefix (the longest matching prefix wins): the area's name and the seconds its first
+compile took on this project's 2-core machine at a load average of 2-4 (wall time of the compiles, empty cache:
+``spec`` of examples/devices/falcon-assumed-motors.yaml for the kinematics, the closed-loop dynamics and the rendering
+loop, ``optimize`` of examples/studies/falcon-redesign.yaml for the design indices), which the notice quotes as the
+time to expect."""
 HEARTBEAT = 30.0
 """Seconds between the lines that say a long compile is still going."""
 
 
 def area_of(module: str) -> tuple[str, float] | None:
-    """The area of :data:`AREAS` a kernel's module belongs to and its typical first compile (minutes), or None
+    """The area of :data:`AREAS` a kernel's module belongs to and its typical first compile (seconds), or None
     for a kernel outside the toolkit (a user's)."""
-    found = [(prefix, name, minutes) for prefix, name, minutes in AREAS
+    found = [(prefix, name, typical) for prefix, name, typical in AREAS
              if module == prefix or module.startswith(prefix + ".")]
     if not found:
         return None
-    _, name, minutes = max(found, key=lambda item: len(item[0]))
-    return name, minutes
+    _, name, typical = max(found, key=lambda item: len(item[0]))
+    return name, typical
 
 
-def notice(area: str, minutes: float) -> str:
-    """The line a first compile of ``area``'s kernels starts with."""
+def notice(area: str, typical: float) -> str:
+    """The line a first compile of ``area``'s kernels starts with (``typical``: seconds it takes, :data:`AREAS`)."""
     return (f"compiling the {area} kernels (once per machine: later runs load them from numba's cache); about "
-            f"{minutes:g} min on a quiet 2-core machine, longer under load...")
+            f"{_duration(typical)} on a 2-core machine, longer under load...")
 
 
-def still(area: str, kernels: int, seconds: float, minutes: float) -> str:
-    """The line that says a compile of ``area``'s kernels is still going, with the time left of the typical time."""
-    left = 60.0 * minutes - seconds
-    rest = f"about {_duration(left)} left" if left > 0 else f"longer than the {minutes:g} min of a quiet machine"
+def still(area: str, kernels: int, seconds: float, typical: float) -> str:
+    """The line that says a compile of ``area``'s kernels is still going, with what is left of the typical time."""
+    left = typical - seconds
+    rest = f"about {_duration(left)} left" if left > 0 else f"longer than the usual {_duration(typical)} (a busy machine)"
     return f"still compiling the {area} kernels: {kernels} so far in {_duration(seconds)}; {rest}..."
 
 
@@ -122,16 +124,16 @@ class _FirstCompile(event.Listener):
         found = area_of(module)
         if found is None:
             return
-        area, minutes = found
+        area, typical = found
         now = self.clock()
         self.count[area] = self.count.get(area, 0) + 1
         if area not in self.started:
-            self.started[area] = (now, minutes)
+            self.started[area] = (now, typical)
             self.last = now
-            self.show(notice(area, minutes))
+            self.show(notice(area, typical))
         elif now - self.last >= HEARTBEAT:
             self.last = now
-            self.show(still(area, self.count[area], now - self.started[area][0], minutes))
+            self.show(still(area, self.count[area], now - self.started[area][0], typical))
 
     def on_end(self, ev) -> None:
         """Nothing to do when a compile ends."""
