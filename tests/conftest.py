@@ -61,9 +61,8 @@ CHROMIUM_FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic
                   "--disable-background-networking", "--disable-component-update", "--disable-sync")
 
 
-@pytest.fixture(scope="module")
-def browser():
-    """Debian's Chromium through Selenium, headless, with a fresh profile (``make browser`` installs it)."""
+def _chromium(logs: dict):
+    """Debian's Chromium through Selenium, headless, with a fresh profile and the ``logs`` kept (yields the driver)."""
     from selenium import webdriver
     from selenium.webdriver.chrome.service import Service
 
@@ -75,8 +74,20 @@ def browser():
     for flag in CHROMIUM_FLAGS:
         options.add_argument(flag)
     options.add_argument(f"--user-data-dir={profile}")
-    options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+    options.set_capability("goog:loggingPrefs", logs)
     driver = webdriver.Chrome(service=Service(DRIVER), options=options)
     yield driver
     driver.quit()
     shutil.rmtree(profile, ignore_errors=True)
+
+
+@pytest.fixture(scope="module")
+def browser():
+    """Debian's Chromium through Selenium, headless, with a fresh profile (``make browser`` installs it)."""
+    yield from _chromium({"browser": "ALL"})
+
+
+@pytest.fixture(scope="module")
+def network_browser():
+    """:func:`browser` that also logs every request the page makes (``driver.get_log("performance")``)."""
+    yield from _chromium({"browser": "ALL", "performance": "ALL"})

@@ -9,6 +9,7 @@ them again at the point of export.
 
 from __future__ import annotations
 
+import json
 import keyword
 
 from hapticdesign.errors import UserError
@@ -34,6 +35,15 @@ def docstring_text(text: str) -> str:
 def latex_text(text: str) -> str:
     """``text`` as literal LaTeX text (special characters escaped)."""
     return "".join(_LATEX.get(ch, ch) for ch in str(text))
+
+
+def script_json(data) -> str:
+    """``data`` as JSON safe inside an HTML ``<script type="application/json">`` element: ``<``, ``>`` and ``&``
+    written as ``\\u003c``, ``\\u003e``, ``\\u0026`` (and every character outside ASCII escaped), so no string in
+    it can close the element (``</script>``) or open a comment; ``JSON.parse`` of the element's text gives the data
+    back. NaN and infinities are refused (write them as ``None``)."""
+    text = json.dumps(data, allow_nan=False, separators=(",", ":"))
+    return text.replace("&", "\\u0026").replace("<", "\\u003c").replace(">", "\\u003e")
 
 
 def python_identifier(name: str) -> str:

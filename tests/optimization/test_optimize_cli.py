@@ -171,7 +171,7 @@ def test_bad_selection_is_one_line(tmp_path, select, message):
     _error([small_study(tmp_path), "--seed", 1, "--select", select], message)
 
 
-@pytest.mark.parametrize("select, message", [("0", "--select 0: a front design is numbered from 1"),
+@pytest.mark.parametrize("select, message", [("0", "front design 0: a front design is numbered from 1"),
                                              ("999999", "the study evaluates at most"),
                                              ("nope=1", "no objective named 'nope'")])
 def test_a_bad_selection_is_refused_before_any_design_is_evaluated(tmp_path, select, message):

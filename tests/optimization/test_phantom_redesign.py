@@ -4,8 +4,9 @@ Oracles: the device file's own numbers (the study's formulas must give back the 
 damping and friction at the published lengths and ratios), the closed-form inverse kinematics of Cavusoglu &
 Feygin's coordinates with the file's joint limits (every workspace point is reached by the published design),
 the unmodified device file evaluated through the registry (the same values as the published design evaluated as a
-design of the study), and the published design evaluated here, which a front design of a small seeded run must
-beat on both objectives.
+design of the study), the published design evaluated here, whose force every front design of a small seeded run
+must beat, and the committed front (docs/figures/optimization/phantom-premium-redesign/front.csv) re-evaluated
+here.
 """
 
 from __future__ import annotations
@@ -36,7 +37,8 @@ STUDY = ROOT / "examples" / "studies" / "phantom-premium-redesign.yaml"
 DEVICE = ROOT / "examples" / "devices" / "phantom-premium.yaml"
 FRONT = ROOT / "docs" / "figures" / "optimization" / "phantom-premium-redesign" / "front.csv"
 CONTINUOUS_FORCE = 1.4
-HEAVIEST = 1.0  # kg, the study's bound on the heaviest point of the box  # N, the data sheet's continuous exertable force (the study's constraint)
+HEAVIEST = 1.0  # kg, the study's bound on the heaviest point of the box
+WALL = 1340.0  # N/m, the study's least wall under the light hand  # N, the data sheet's continuous exertable force (the study's constraint)
 
 
 def device_data() -> dict:
@@ -51,6 +53,11 @@ def published() -> dict[str, float]:
             "ratio1": ratio["q1"], "ratio2": ratio["q2"], "ratio3": ratio["q3"]}
 
 
+def _meets_the_constraints(reduced) -> None:
+    """The study's constraints on its reduced indices (median mass, weakest force, weakest wall, heaviest point)."""
+    assert reduced[1] >= CONTINUOUS_FORCE and reduced[2] >= WALL and reduced[3] <= HEAVIEST
+
+
 @pytest.fixture(scope="module")
 def bound():
     with warnings.catch_warnings():
@@ -61,7 +68,7 @@ def bound():
 def test_the_study_binds_and_its_formulas_give_back_the_published_device(bound):
     spec = bound.study.spec
     assert set(spec.variables) == {"l1", "l2", "l3", "ratio1", "ratio2", "ratio3"}
-    assert [o.index for o in spec.objectives] == ["apparent_mass", "kmax"]
+    assert [o.index for o in spec.objectives] == ["apparent_mass", "force"]
     assert len(bound.points) == 27
     data = device_data()
     expected = {name: float(data["parameters"][name]) for name in ("l1", "l2", "l3")}
@@ -92,32 +99,32 @@ def test_the_published_design_reaches_the_study_workspace(bound):
                           [Request("apparent_mass"), Request("kmax", {"period": 0.001, "delay": 1, "hand": "light"}),
                            Request("force", {"torque": "continuous"})])
     assert result.reason is None
-    direct = (reduce(result.values["apparent_mass"], "median"), reduce(result.values["kmax"], "min"),
-              reduce(result.values["force"], "min"), reduce(result.values["apparent_mass"], "max"))
+    direct = (reduce(result.values["apparent_mass"], "median"), reduce(result.values["force"], "min"),
+              reduce(result.values["kmax"], "min"), reduce(result.values["apparent_mass"], "max"))
     np.testing.assert_allclose(answer.reduced, direct, rtol=1e-9)
 
 
 @pytest.mark.slow
-def test_a_front_design_of_a_small_seeded_run_beats_the_published_design(bound, tmp_path):
+def test_a_small_seeded_runs_front_meets_what_the_published_design_misses(bound, tmp_path):
     data = yaml.safe_load(STUDY.read_text())
     small = copy.deepcopy(data)
     small["device"] = str(DEVICE)
-    small["algorithm"] = {"method": "nsga2", "population": 16, "generations": 5}
+    small["algorithm"] = {"method": "nsga2", "population": 12, "generations": 3, "polish": "none"}
     path = tmp_path / "small.yaml"
     path.write_text(yaml.safe_dump(small, sort_keys=False))
     run = CliRunner().invoke(app, ["optimize", str(path), "--seed", "1", "--json", "--quiet"])
     assert run.exit_code == 0, run.output
     front = json.loads(run.stdout)["front"]
     assert front
-    mass, wall, force, heaviest = bound.evaluate([published()])[0].reduced
-    beating = [d for d in front if d["objectives"]["mass"] < mass and d["objectives"]["wall"] > wall]
-    assert beating, (mass, wall, front)
+    force = bound.evaluate([published()])[0].reduced[1]
+    beating = [d for d in front if d["objectives"]["force"] > force]  # the published design misses the 1.4 N
+    assert beating == front, (force, front)
     again = bound.evaluate([d["variables"] for d in beating])  # each meets the constraint the study claims
     for design, answer in zip(beating, again):
         assert answer.reason == ""
-        assert answer.reduced[:2] == pytest.approx((design["objectives"]["mass"], design["objectives"]["wall"]),
+        assert answer.reduced[:2] == pytest.approx((design["objectives"]["mass"], design["objectives"]["force"]),
                                                    rel=1e-9)
-        assert answer.reduced[2] >= CONTINUOUS_FORCE and answer.reduced[3] <= HEAVIEST
+        _meets_the_constraints(answer.reduced)
 
 
 def test_the_documented_front_holds_on_this_machine(bound):
@@ -131,6 +138,10 @@ def test_the_documented_front_holds_on_this_machine(bound):
     answers = bound.evaluate([{name: float(row[name]) for name in names} for row in rows])
     for row, answer in zip(rows, answers):
         assert answer.reason == ""
-        stated = [float(value) for key, value in row.items() if key != "design" and key not in names]
+        wall = next(key for key in row if key.startswith("min_kmax["))
+        assert row["min_force[torque=continuous]"] == row["force"]
+        stated = [float(row[key]) for key in ("mass", "force", wall, "max_apparent_mass")]
         np.testing.assert_allclose(answer.reduced, stated, rtol=1e-9, err_msg=row["design"])
-        assert answer.reduced[2] >= CONTINUOUS_FORCE and answer.reduced[3] <= HEAVIEST
+        _meets_the_constraints(answer.reduced)
+    mass, force = bound.evaluate([published()])[0].reduced[:2]  # what the docs' headline compares with
+    assert min(a.reduced[0] for a in answers) < 0.9 * mass and min(a.reduced[1] for a in answers) > force

@@ -60,14 +60,16 @@ def best_isotropy_on_the_length_bound() -> float:
     return -found.fun
 
 
-def length_study(folder: Path, method: str = "nsga2", polish: str = "ends", objectives=(ISOTROPY,),
+def length_study(folder: Path, method: str = "nsga2", polish: str | None = "ends", objectives=(ISOTROPY,),
                  population: int = 8, generations: int = 4) -> Path:
-    """Both link lengths vary, the handle must reach one point at distance R, the total length is bounded by S."""
+    """Both link lengths vary, the handle must reach one point at distance R, the total length is bounded by S;
+    ``polish`` None leaves ``algorithm.polish`` out of the file (its default)."""
     (folder / "arm.yaml").write_text(yaml.safe_dump(planar_arm(0.2)))
     study = {"device": "arm.yaml", "variables": {"l1": [0.1, 0.3], "l2": [0.05, 0.3]},
              "workspace": {"box": {"center": point(R), "size": [0.0, 0.0, 0.0]}, "grid": 1},
              "objectives": list(objectives), "constraints": [{"expression": "l1 + l2", "<=": S}],
-             "algorithm": {"method": method, "population": population, "generations": generations, "polish": polish}}
+             "algorithm": {"method": method, "population": population, "generations": generations,
+                           **({} if polish is None else {"polish": polish})}}
     (folder / "study.yaml").write_text(yaml.safe_dump(study, sort_keys=False))
     return folder / "study.yaml"
 
@@ -99,6 +101,24 @@ def test_polishing_reaches_the_closed_form_optimum_the_search_alone_misses(tmp_p
     assert polished.evaluations > len(polished.records) == len(raw.records) + 1
 
 
+@pytest.mark.parametrize("method", ["nsga2", "pso"])
+def test_a_study_file_without_polish_reaches_the_closed_form_optimum(tmp_path, method):
+    """Issue 45: the front's ends are the optima by default; the raw search of the same file stops short."""
+    optimum = best_isotropy_on_the_length_bound()
+    path = length_study(tmp_path, method, polish=None)
+    assert "polish" not in yaml.safe_load(path.read_text())["algorithm"]
+    run = run_of(path)
+    best = max(run.front, key=lambda k: run.records[k].objectives[0])
+    assert run.records[best].objectives[0] == pytest.approx(optimum, rel=1e-3)
+    assert run.records[best].values["l1"] + run.records[best].values["l2"] == pytest.approx(S, rel=1e-3)  # on the bound
+    assert "Polished (polish: ends, the default: each objective's best front design refined by SLSQP" in (
+        METHODS[method].describe(run))
+    (tmp_path / "raw").mkdir()
+    raw = run_of(length_study(tmp_path / "raw", method, polish="none"))
+    assert max(raw.records[k].objectives[0] for k in raw.front) < optimum * (1 - 1e-3)
+    assert "Not polished (polish: none)" in METHODS[method].describe(raw)
+
+
 def test_ends_of_a_two_objective_front_are_polished_and_marked(tmp_path):
     run = run_of(length_study(tmp_path, objectives=(ISOTROPY, MASS)), seed=3)
     polished = [k for k in run.front if run.records[k].polished]
@@ -111,7 +131,8 @@ def test_ends_of_a_two_objective_front_are_polished_and_marked(tmp_path):
     assert sum(line.endswith(",yes") for line in evaluations_csv(run).splitlines()[1:]) == sum(
         r.polished for r in run.records)
     numbers = ", ".join(str(n) for n, k in enumerate(run.front, start=1) if run.records[k].polished)
-    assert f"Polished (ends of the front, SLSQP under the constraints): front designs {numbers};" in (
+    assert (f"Polished (polish: ends: each objective's best front design refined by SLSQP under the constraints): "
+            f"front designs {numbers};") in (
         METHODS["nsga2"].describe(run))
 
 
@@ -174,7 +195,7 @@ def test_nsga3_is_pymoos_nsga3_on_the_same_problem_with_the_same_seed(tmp_path):
     path = write_study(tmp_path, variables, [ISOTROPY, MASS], population=8, generations=5, center=point(0.15),
                        size=(0.02, 0.0, 0.02), grid=2)
     data = yaml.safe_load(path.read_text())
-    data["algorithm"] = {"method": "nsga3", "population": 8, "generations": 5, "front": "final"}
+    data["algorithm"] = {"method": "nsga3", "population": 8, "generations": 5, "front": "final", "polish": "none"}
     path.write_text(yaml.safe_dump(data, sort_keys=False))
     bound = bind_study(load_study(path))
     evaluated = []
@@ -273,8 +294,10 @@ def test_the_python_door_is_the_command(tmp_path, capsys):
     assert result.front[0].keys() == {"variables", "objectives"}
     assert result.method is METHODS["nsga2"] and result.study.path == study
     assert len(result.records) == summary["evaluations"]
-    assert [p.name for p in result.files] == ["front.csv", "evaluations.csv", "pareto.png", "pareto.svg",
-                                              "selected.yaml", "report.html"]
+    designs = [f"designs/design-{n}.yaml" for n in range(1, len(result.front) + 1)]  # each front design's device file
+    assert [p.relative_to(tmp_path / "api").as_posix() for p in result.files] == [
+        "front.csv", "evaluations.csv", "pareto.png", "pareto.svg", "selected.yaml", *designs, "plotly.min.js",
+        "report.html"]
     for name in ("front.csv", "evaluations.csv", "selected.yaml"):
         assert (tmp_path / "api" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes()
     with pytest.raises(UserError, match="the seed must be at least 0"):

@@ -35,12 +35,14 @@ def point(r: float) -> list[float]:
 
 
 def write_study(folder: Path, variables: dict, objectives: list, population: int, generations: int,
-                center=None, size=(0.0, 0.0, 0.0), grid: int = 1, constraints=()) -> Path:
+                center=None, size=(0.0, 0.0, 0.0), grid: int = 1, constraints=(), polish: str = "none") -> Path:
+    """A study of the planar arm; ``polish: none`` stated by default: these tests test the raw search (a study file
+    without it polishes the front's ends)."""
     (folder / "arm.yaml").write_text(yaml.safe_dump(planar_arm(L1)))
     study = {"device": "arm.yaml", "variables": variables,
              "workspace": {"box": {"center": center or point(L1 / math.sqrt(2.0)), "size": list(size)}, "grid": grid},
              "objectives": objectives, "constraints": list(constraints),
-             "algorithm": {"method": "nsga2", "population": population, "generations": generations}}
+             "algorithm": {"method": "nsga2", "population": population, "generations": generations, "polish": polish}}
     (folder / "study.yaml").write_text(yaml.safe_dump(study, sort_keys=False))
     return folder / "study.yaml"
 

@@ -49,7 +49,7 @@ def test_a_study_can_ask_for_a_wall_with_a_hand_and_friction(tmp_path):
              "objectives": [{"name": "isotropy", "index": "isotropy", "reduce": "min", "sense": "max"}],
              "constraints": [{"index": "kmax_simulated", "options": {"hand": "light"}, "reduce": "min",
                               ">=": 1000}],
-             "algorithm": {"method": "nsga2", "population": 4, "generations": 1}}
+             "algorithm": {"method": "nsga2", "population": 4, "generations": 1, "polish": "none"}}
     path = tmp_path / "wall.yaml"
     path.write_text(yaml.safe_dump(study, sort_keys=False))
     result = hd.optimize(path, seed=4)

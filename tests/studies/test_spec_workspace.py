@@ -1,7 +1,8 @@
 """The spec sheet's workspace cube of the Phantom Premium against an oracle that does not use the toolkit: the
 closed-form inverse kinematics of Cavusoglu & Feygin's coordinates (q1 = atan2(y, x); q2 and q3 from the triangle
 shoulder-elbow-handle with sides l1 = 0.215 m and l2 = 0.170 m, the elbow-down branch of home), the file's joint
-limits (q1 in [-90, 90], q2 in [-124, 119], q3 in [-29, 214] deg) and bisection on the cube's half edge."""
+limits (q1 in [-90, 90], q2 in [-124, 119], q3 in [-29, 214] deg) and bisection on the cube's half edge; and the
+Falcon's cube used as a study's box (issue 45: the sheet and a study mean the same by "reached")."""
 
 from __future__ import annotations
 
@@ -12,17 +13,20 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 
 from hapticdesign.devices.device_file import load_device_file
 from hapticdesign.studies.spec import CUBE_SEARCH, spec_sheet
 from tests.helpers.phantom_premium_ik import L1, L2, reachable
 
 HOME = np.array([L1, 0.0, -L2])  # q = 0: x = l1 cos q2 + l2 sin q3, z = l1 sin q2 - l2 cos q3
-STENCIL = [np.array(s) - 1.0 for s in itertools.product(range(3), repeat=3) if s != (1, 1, 1)]
+STENCIL = [np.array(s) / 2.0 - 1.0 for s in itertools.product(range(5), repeat=3)]  # grid 5 (it holds grid 3)
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def oracle_edge() -> float:
-    """Largest edge (m) whose corners, edge midpoints and face centres are reachable, bisected to 1e-9 m."""
+    """Largest edge (m) whose study box on grid 5 (holding grid 3's corners, edge midpoints and face centres) is
+    reachable, bisected to 1e-9 m."""
     lo, hi = 0.0, 0.4
     while hi - lo > 1e-9:
         mid = 0.5 * (lo + hi)
@@ -100,3 +104,40 @@ def test_resolution_map_equals_the_closed_form_jacobian_at_every_point_reached()
     assert checked > 20
     centre = len(sections[0].u) // 2
     assert maps["resolution"][0][centre, centre] == pytest.approx(1000 * sheet["resolution"], rel=1e-12)
+
+
+def falcon_study(folder: Path, edge: float, grid: int, center) -> Path:
+    """A study of the Falcon (examples/devices/falcon.yaml) whose box is a cube of ``edge`` (m) around ``center``."""
+    study = {"device": str(ROOT / "examples" / "devices" / "falcon.yaml"), "variables": {"a": [0.05, 0.07]},
+             "workspace": {"box": {"center": [float(v) for v in center], "size": [edge] * 3}, "grid": grid},
+             "objectives": [{"index": "isotropy", "reduce": "min", "sense": "max"}],
+             "algorithm": {"population": 4, "generations": 1}}
+    (folder / f"falcon-{grid}-{edge}.yaml").write_text(yaml.safe_dump(study))
+    return folder / f"falcon-{grid}-{edge}.yaml"
+
+
+def test_the_falcon_cube_of_the_sheet_is_reached_as_a_study_box_and_the_next_step_is_not(tmp_path):
+    """Issue 45: the sheet said 92.77 mm while a study box of 92.7 mm lost rank on the way. Now the sheet's cube, as a
+    study's box on grid 3 and on the default grid 5, is reached by the study's evaluation (the batched kernel, the
+    device file's design), and the cube one bisection step larger is not, on one of the two grids."""
+    from hapticdesign.optimization.study_evaluation import bind_study
+    from hapticdesign.optimization.study_file import load_study
+    from hapticdesign.analysis.configuration import configuration_of
+    from hapticdesign.studies.spec import handle_at, workspace_cube
+
+    device = load_device_file(ROOT / "examples" / "devices" / "falcon.yaml")
+    h = handle_at(device, configuration_of(device).home)
+    edge = workspace_cube(device, h)
+    lo, hi, halvings = CUBE_SEARCH
+    step = 2 * (hi - lo) / 2**halvings
+    assert 0.05 < edge < 0.0927  # the 4-inch (101.6 mm) cube Novint states is not all reached in this model
+
+    def reasons(size: float) -> list[str]:
+        out = []
+        for grid in (3, 5):
+            bound = bind_study(load_study(falcon_study(tmp_path, size, grid, h.position)))
+            out.append(bound.evaluate([{"a": 0.060}])[0].reason)
+        return out
+
+    assert reasons(edge) == ["", ""]
+    assert any("cannot reach" in reason for reason in reasons(edge + step))

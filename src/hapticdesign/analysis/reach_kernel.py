@@ -9,7 +9,9 @@ the loop solver's :func:`~.loops.solver.settings_of`; the statuses are those eve
 
 :func:`reach_designs` reaches the points of every design in one compiled call: from the start pose (the loops closed
 by the loop solver's Newton, :func:`~.loops.closure_kernel.newton`) to the first point and from point to point along
-straight Cartesian segments in steps of at most ``IK_STEP``, with Newton on all coordinates at once: the closures
+straight Cartesian segments in steps of at most ``IK_STEP`` (a point whose way from the point before it fails is
+tried once more straight from the start: a point is reached when either way gets there on the start's branch), with
+Newton on all coordinates at once: the closures
 ``phi(q) = 0`` and the handle's position on the directions it moves, ``U^T (p(q) - goal) = 0``. With ``k = n_a <= 3``
 actuated coordinates the system ``[Phi; U^T J_v]`` is square; a redundant device (``n_a > 3``, ``U = I``) takes the
 least-norm step ``A^T (A A^T)^-1 r`` (for a tree, the least-squares step on ``J_v``). Each iteration changes no
@@ -245,6 +247,8 @@ def reach_designs(offsets, targets, shape, plan, loops, settings, reach, out):
     closing = closure_scratch(n_node, n, na, loops.passive, np.int64(0))
     here = np.zeros(3)
     goal = np.zeros(3)
+    origin = np.zeros(3)
+    q0 = np.zeros(n)
     for d in range(offsets.shape[0]):
         tree = Tree(shape.parent, shape.axis, shape.coef, offsets[d], shape.const_rot, shape.const_pos)
         q = reach.guess.copy()
@@ -260,20 +264,31 @@ def reach_designs(offsets, targets, shape, plan, loops, settings, reach, out):
         for c in range(3):
             here[c] = ws.pos[reach.handle, c]
         code, mode = _newton(q, tree, plan, loops, settings, reach, here, 0.0, True, True, ws)
+        q0[:] = q
+        origin[:] = here
         for p in range(targets.shape[0]):
             if code != OK:
                 break
-            dist = np.sqrt((targets[p, 0] - here[0]) ** 2 + (targets[p, 1] - here[1]) ** 2
-                           + (targets[p, 2] - here[2]) ** 2)
-            steps = max(1, int(np.ceil(dist / reach.step)))
-            for s in range(1, steps + 1):
-                for c in range(3):
-                    goal[c] = here[c] + (targets[p, c] - here[c]) * (s / steps)
-                code, _ = _newton(q, tree, plan, loops, settings, reach, goal, mode, s == steps, s == 1, ws)
-                if code != OK:
+            for attempt in range(2):  # from the point before, then (when that way fails) straight from the start
+                if attempt == 1:
+                    if p == 0:
+                        break
+                    q[:] = q0
+                    here[:] = origin
+                    _walk(q, tree, plan, loops, reach, ws, plan.n_fixed)
+                dist = np.sqrt((targets[p, 0] - here[0]) ** 2 + (targets[p, 1] - here[1]) ** 2
+                               + (targets[p, 2] - here[2]) ** 2)
+                steps = max(1, int(np.ceil(dist / reach.step)))
+                for s in range(1, steps + 1):
+                    for c in range(3):
+                        goal[c] = here[c] + (targets[p, c] - here[c]) * (s / steps)
+                    code, _ = _newton(q, tree, plan, loops, settings, reach, goal, mode, s == steps, s == 1, ws)
+                    if code != OK:
+                        break
+                if code == OK and _branch(loops, ws) != branch:
+                    code = BRANCH_CHANGE
+                if code == OK:
                     break
-            if code == OK and _branch(loops, ws) != branch:
-                code = BRANCH_CHANGE
             if code != OK:
                 out.point[d] = p
                 break

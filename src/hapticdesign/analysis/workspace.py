@@ -106,9 +106,29 @@ class WorkspacePoses:
     full: np.ndarray
 
 
-def reach_workspace(device: Device, points: np.ndarray, frame: str | None = None) -> WorkspacePoses:
-    """The poses that put the handle (or ``frame``'s origin) at ``points`` (P, 3), reached in order from home."""
+def reach_workspace(device: Device, points: np.ndarray, frame: str | None = None,
+                    start: np.ndarray | None = None) -> WorkspacePoses:
+    """The poses that put the handle (or ``frame``'s origin) at ``points`` (P, 3), reached in order from home (or
+    from the actuated coordinates ``start``, on home's branch). A point is reached when the way from the point
+    before it, or else the straight way from the start, gets there on the start's branch (no singularity crossed,
+    the loops' assembly branch kept) and its pose is within the joint limits: the one meaning of "reached" of a
+    study's workspace and of the spec sheet's cube (:func:`cube_points`)."""
     points = np.asarray(points, dtype=float)
-    q, full = configuration_of(device).reach(points, frame)
+    space = configuration_of(device)
+    q, full = space.reach(points, frame, None if start is None else space.full(np.asarray(start, dtype=float)))
     check_limits(device, q, points)
     return WorkspacePoses(points, q, full)
+
+
+def cube_points(center, basis: np.ndarray, edge: float, grid: int) -> np.ndarray:
+    """The grid points (snake order) of the cube of ``edge`` (m) centred at ``center`` on the directions ``basis``
+    (3, k) spans (a square for a planar device, a segment for one axis): the study box ``Workspace(center, size,
+    grid)`` with ``edge`` on the base axes the directions are (every axis when k = 3), else the same grid on the
+    basis itself (a plane no study box lies in)."""
+    basis = np.asarray(basis, dtype=float)
+    k = basis.shape[1]
+    axes = [0, 1, 2] if k == 3 else [int(np.argmax(np.abs(column))) for column in basis.T]
+    if k == 3 or (len(set(axes)) == k and all(abs(basis[a, j]) > 1.0 - 1e-9 for j, a in enumerate(axes))):
+        return Workspace(tuple(center), tuple(edge if a in axes else 0.0 for a in range(3)), grid).points()
+    offsets = Workspace((0.0, 0.0, 0.0), (edge,) * k + (0.0,) * (3 - k), grid).points()[:, :k]
+    return np.asarray(center, dtype=float) + offsets @ basis.T

@@ -256,7 +256,7 @@ class Start(_StudyModel):
 
 POLISH = ("none", "ends", "all")
 """What a population search's front has refined by a local search (:mod:`.study_polish`): nothing, the best design
-of each objective, or every front design."""
+of each objective (the default), or every front design."""
 
 
 class _PopulationSearch(_StudyModel):
@@ -271,7 +271,9 @@ class _PopulationSearch(_StudyModel):
     runs: list[dict[str, Variable]] = Field([], max_length=100)
     front: Literal["archive", "final"] = "archive"
     start: Start | None = None
-    polish: Literal["none", "ends", "all"] = "none"
+    polish: Literal["none", "ends", "all"] = "ends"
+    """``ends`` by default: the front's ends are the optima (a population search alone stops near them); ``none``
+    keeps the raw search (faster)."""
 
     over_poses: ClassVar[bool] = True
     """Whether the method evaluates designs at the workspace's poses (a study then needs a workspace)."""

@@ -31,6 +31,8 @@ Progress = Callable[[int, int], None]
 
 CLOSEST_CANDIDATES = 12
 """Designs of the last generation tried point by point when no design reaches the workspace."""
+POLISHED = {"ends": "each objective's best front design", "all": "every front design"}
+"""What a polishing setting refines, in words (the report)."""
 
 
 class PopulationSearch:
@@ -70,10 +72,15 @@ class PopulationSearch:
             where = (f"Workspace: box centred at {list(box.center)} m, edges {list(box.size)} m, {spec.workspace.grid} "
                      "points per axis of nonzero size. ")
         polished = [n for n, k in enumerate(run.front, start=1) if run.records[k].polished]
-        polishing = ("" if settings.polish == "none" else
-                     f" Polished ({settings.polish} of the front, SLSQP under the constraints): "
-                     + (f"front designs {', '.join(map(str, polished))}" if polished else "no design improved")
-                     + f"; the local search evaluated {run.probes} more designs, not listed in evaluations.csv.")
+        if settings.polish == "none":
+            polishing = (" Not polished (polish: none): the front is the search's alone, whose ends may stop short of "
+                         "the optima (the default, polish: ends, refines them).")
+        else:
+            default = ", the default" if "polish" not in settings.model_fields_set else ""
+            polishing = (f" Polished (polish: {settings.polish}{default}: {POLISHED[settings.polish]} refined by "
+                         "SLSQP under the constraints): "
+                         + (f"front designs {', '.join(map(str, polished))}" if polished else "no design improved")
+                         + f"; the local search evaluated {run.probes} more designs, not listed in evaluations.csv.")
         return (f"{where}{self.title}, population {settings.population}, {settings.generations} generations, seed "
                 f"{run.seed}: {len(run.records)} designs evaluated, {sum(r.feasible for r in run.records)} "
                 f"feasible.{polishing}")

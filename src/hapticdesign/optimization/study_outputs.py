@@ -50,7 +50,7 @@ def check_selection(spec, weights: dict[str, float] | None = None, design: int |
     no objective (a one-line :class:`~hapticdesign.errors.UserError`). :func:`select_design` checks it again with
     the front's size."""
     if design is not None and not 1 <= design <= (design if designs is None else designs):
-        raise UserError(f"--select {design}: a front design is numbered from 1" + (
+        raise UserError(f"front design {design}: a front design is numbered from 1" + (
             "" if design < 1 or designs is None else f" and the study evaluates at most {designs} designs"))
     names = [o.name for o in spec.objectives]
     unknown = [n for n in (weights or {}) if n not in names]

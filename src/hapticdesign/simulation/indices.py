@@ -49,7 +49,7 @@ def kmax_simulated(pose: HandleStates, period: float = 0.001, delay: int = 1, ve
     model = None if error_percent == 0 else pose.compensator(error_percent)
     out = np.empty(len(pose.full))
     for k in range(len(pose.full)):
-        exact, direction, _ = worst_direction(pose.J_v[k], pose.H[k], pose.B, loop, pose.gravity[k],
+        exact, direction, _ = worst_direction(pose.J_v[k], pose.H[k], pose.B[k], loop, pose.gravity[k],
                                               None if model is None else (model[0][k], model[1][k]))
         out[k] = simulated_limit(device, loop, direction=direction, equilibrium=TOUCH, counts=counts,
                                  rel_tol=float(rel_tol), start=max(exact, 1.0), k_limit=SIMULATED_CAP,

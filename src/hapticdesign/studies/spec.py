@@ -21,9 +21,10 @@ friction reach the handle as follows:
   ``K_C`` on the directions the handle moves, where the file's links carry sections
   (:mod:`hapticdesign.analysis.stiffness.device`).
 - ``workspace`` (mm): the edge of the largest cube (square for a planar device) centred on the home handle
-  position whose corners, edge midpoints and face centres the handle reaches from home by inverse
-  kinematics (:func:`hapticdesign.analysis.configuration.handle_pose`) within the joint limits and without a
-  singularity, found by bisection.
+  position that a study reaches as its workspace box (``box: {center: <the handle at home>, size: [edge, ...]}``
+  on grid 3, its corners, edge midpoints and face centres, and on a study's default grid 5): every point reached
+  by :func:`hapticdesign.analysis.workspace.reach_workspace`, the one meaning of "reached" (from the point before
+  it, or else straight from home, without crossing a singularity, within the joint limits), found by bisection.
 - ``renderable_stiffness`` (N/m), side by side, under one set of loop settings
   (:class:`~hapticdesign.analysis.sampled_loop.SampledLoop`, stated in the output; practice's by default: 1 kHz,
   one sample of delay, backward-difference velocity, gravity compensation):
@@ -51,24 +52,28 @@ friction reach the handle as follows:
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
 
-from hapticdesign.analysis.configuration import configuration_of, handle_pose
+from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.analysis.dynamics.device import gravity_gradient
 from hapticdesign.analysis.metrics import force as polytope
-from hapticdesign.analysis.metrics.indices import INDICES, HandleStates
+from hapticdesign.analysis.metrics.indices import INDICES, HandleStates, Index, Request, evaluate_at, requests_of
 from hapticdesign.errors import UserError
 from hapticdesign.model.actuators import transmission
 from hapticdesign.model.device import Device
 from hapticdesign.analysis.sampled_loop import GRASP, SampledLoop
 from hapticdesign.analysis.wall_stiffness import wall_limit, worst_direction
+from hapticdesign.analysis.workspace import cube_points, reach_workspace
 from hapticdesign.simulation.config import loop_model
 
 CUBE_SEARCH = (0.0, 0.4, 12)
 """Bisection of the workspace cube's half edge: lower and upper bound (m) and number of halvings."""
+CUBE_GRIDS = (3, 5)
+"""The grids (points per axis) of the study box the workspace cube is reached on: its corners, edge midpoints and
+face centres (3) and a study's default grid (5)."""
 Report = Callable[[str, int, int | None], None]
 """``progress(step, done, total)``: how far a long part of the sheet is (as the command line's progress bars take it)."""
 CUBE_STEP = "workspace cube (bisection steps)"
@@ -185,16 +190,15 @@ def renderable(device: Device, h: Handle, loop: SampledLoop, res: float | None,
 
 
 def workspace_cube(device: Device, h: Handle, progress: Report = no_progress) -> float:
-    """Edge (m) of the largest cube (square) around the home handle position reached from home; ``progress`` hears
-    of each bisection step (:data:`CUBE_STEP`)."""
-    basis = h.basis
-    signs = [s for s in np.ndindex(*(3,) * basis.shape[1]) if any(v != 1 for v in s)]
-    offsets = np.array([[v - 1.0 for v in s] for s in signs]) @ basis.T
+    """Edge (m) of the largest cube (square for a planar device) centred on the handle's position whose study box is
+    reached: its points on each grid of :data:`CUBE_GRIDS` (:func:`~hapticdesign.analysis.workspace.cube_points`),
+    reached by :func:`~hapticdesign.analysis.workspace.reach_workspace` from the sheet's pose (home by default, as a
+    study reaches its box), found by bisection; ``progress`` hears of each bisection step (:data:`CUBE_STEP`)."""
 
     def reaches(half: float) -> bool:
-        for offset in offsets:
+        for grid in CUBE_GRIDS:
             try:
-                handle_pose(device, h.position + half * offset, start=h.q)
+                reach_workspace(device, cube_points(h.position, h.basis, 2 * half, grid), start=h.q)
             except UserError:
                 return False
         return True
@@ -213,11 +217,13 @@ def workspace_cube(device: Device, h: Handle, progress: Report = no_progress) ->
 
 
 def spec_sheet(device: Device, q=None, loop: SampledLoop | None = None, workspace: bool = True,
-               simulate: bool = True, progress: Report = no_progress) -> dict:
+               simulate: bool = True, indices: Sequence[str | Request] = (),
+               registry: Mapping[str, Index] = INDICES, progress: Report = no_progress) -> dict:
     """Every quantity of the module docstring at pose ``q`` (default: home), as a JSON-ready dict; the renderable
     stiffness under the loop settings ``loop`` (default: practice's, :class:`SampledLoop`), its simulated limit
-    only with ``simulate``; ``progress(step, done, total)`` hears how far the long parts are (the workspace cube's
-    bisection, the renderable stiffness)."""
+    only with ``simulate``; and, as ``indices`` (name -> value, its unit in ``units``), the design ``indices`` of
+    ``registry`` at the pose (a user's own among them, docs/indices.md); ``progress(step, done, total)`` hears how far
+    the long parts are (the workspace cube's bisection, the renderable stiffness)."""
     from hapticdesign.studies.spec_page import check_reference
 
     if device.reference:
@@ -229,7 +235,8 @@ def spec_sheet(device: Device, q=None, loop: SampledLoop | None = None, workspac
     friction = backdrive_friction(device, h)
     mass = apparent_mass(device, h)
     sheet = {
-        "device": device.name, **({"reference": device.reference} if device.reference else {}), "q": q, "handle": h.position, "dimensions": h.basis.shape[1],
+        "device": device.name, **({"reference": device.reference} if device.reference else {}),
+        "q": q, "handle": h.position, "dimensions": h.basis.shape[1],
         "resolution": res,
         "force_continuous": inscribed_force(device, h, "continuous"),
         "force_peak": inscribed_force(device, h, "peak"),
@@ -242,6 +249,11 @@ def spec_sheet(device: Device, q=None, loop: SampledLoop | None = None, workspac
                   "backdrive_friction": "N", "stiffness": "N/m", "workspace": "mm", "renderable_stiffness": "N/m",
                   "rate": "Hz", "handle": "m", "q": "rad or m"},
     }
+    if indices:
+        checked = requests_of(indices, registry)
+        found = evaluate_at(device, configuration_of(device).full(q)[None], checked, registry=registry).values
+        sheet["indices"] = {key: float(value[0]) for key, value in found.items()}
+        sheet["units"]["indices"] = {r.key: registry[r.index].unit for r in checked}
     return sheet
 
 

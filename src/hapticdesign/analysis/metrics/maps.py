@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from hapticdesign.analysis.configuration import check_limits, configuration_of
+from hapticdesign.analysis.configuration import Configuration, check_limits, configuration_of
 from hapticdesign.analysis.metrics.indices import INDICES, Index, Request, evaluate_at, requests_of
 from hapticdesign.analysis.metrics.indices.registry import require_evaluations
 from hapticdesign.errors import UserError
@@ -122,10 +122,26 @@ class DeviceMap:
     reasons: list[str | None]
 
 
+def _reach(device: Device, space: Configuration, point: np.ndarray, frame: str | None,
+           start: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """The pose of ``point`` from the last point reached, or else straight from home (the one meaning of reached,
+    :func:`~hapticdesign.analysis.workspace.reach_workspace`)."""
+    try:
+        q_a, q = space.reach(point[None], frame, start)
+        check_limits(device, q_a, point[None])
+    except UserError:
+        if start is None:
+            raise
+        q_a, q = space.reach(point[None], frame)
+        check_limits(device, q_a, point[None])
+    return q_a, q
+
+
 def device_map(device: Device, points: np.ndarray, requests: Iterable[str | Request], frame: str | None = None,
                registry: Mapping[str, Index] = INDICES) -> DeviceMap:
     """The indices ``requests`` at each of ``points`` (P, 3) that the handle reaches: in order, each from the last
-    point reached (from home at first and after a point out of reach), by the project's inverse kinematics
+    point reached, or else straight from home (from home at first and after a point out of reach), by the project's
+    inverse kinematics
     (:meth:`~hapticdesign.analysis.configuration.Configuration.reach`, within the joint limits); a point the
     handle does not reach is NaN with its reason, and the map goes on."""
     checked = requests_of(requests, registry)
@@ -135,8 +151,7 @@ def device_map(device: Device, points: np.ndarray, requests: Iterable[str | Requ
     full, reasons, start = [], [], None
     for point in points:
         try:
-            q_a, q = space.reach(point[None], frame, start)
-            check_limits(device, q_a, point[None])
+            q_a, q = _reach(device, space, point, frame, start)
         except UserError as exc:
             reasons.append(str(exc))
             start = None

@@ -13,9 +13,10 @@ from __future__ import annotations
 
 import base64
 import hashlib
-import json
 from html import escape
 from importlib.resources import files
+
+from hapticdesign.escape import script_json
 
 STYLE = """
 body { font-family: "DejaVu Sans", Arial, sans-serif; margin: 1.5em; color: #222; }
@@ -36,9 +37,9 @@ def script() -> str:
 
 
 def embedded_json(data: dict) -> str:
-    """JSON safe inside ``<script type="application/json">``: no ``<``, ``>`` or ``&`` left to close it."""
-    text = json.dumps(data, allow_nan=False, separators=(",", ":"))
-    return text.replace("&", "\\u0026").replace("<", "\\u003c").replace(">", "\\u003e")
+    """JSON safe inside ``<script type="application/json">``: no ``<``, ``>`` or ``&`` left to close it
+    (:func:`hapticdesign.escape.script_json`)."""
+    return script_json(data)
 
 
 def render_page(data: dict) -> str:

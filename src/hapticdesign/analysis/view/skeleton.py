@@ -222,3 +222,26 @@ def export(device: Device, q: np.ndarray) -> dict:
         "extent": extent,
         "scale": scale_length(extent),
     }
+
+
+def snapshot(device: Device, q: np.ndarray) -> dict:
+    """The device drawn at one pose, JSON-ready, for a still 3D view that turns but does not move the joints (the
+    optimization report's design card): the frame origins, the links between them, the bodies' bars, the rigid
+    plates (outlines of frame names), the mass centres with their masses, the end effector and a scale length, all
+    in metres in the base frame; ``q`` the actuated coordinates."""
+    poses = frame_poses(device, q)
+    origins = {name: [float(v) for v in pose[:3, 3]] for name, pose in poses.items()}
+    ends = [[origins[frame], [float(v) for v in (poses[frame] @ np.append(end, 1.0))[:3]]] for frame, end in bars(device)]
+    masses = [{"name": name, "m": float(m), "p": [float(v) for v in p]} for name, m, p in mass_centres(device, poses)]
+    points = np.array([*origins.values(), *(e[1] for e in ends), *(m["p"] for m in masses)])
+    extent = float(max(np.ptp(points, axis=0).max(), 1e-3))
+    return {
+        "q": [float(v) for v in q],
+        "origins": origins,
+        "links": [list(pair) for pair in links(device)],
+        "bars": ends,
+        "plates": plates(device, q),
+        "masses": masses,
+        "end_effector": device.mechanism.end_effector,
+        "scale": scale_length(extent),
+    }

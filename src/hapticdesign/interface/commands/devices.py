@@ -110,8 +110,13 @@ def spec(
     hand_stiffness: Optional[float] = typer.Option(None, "--hand-stiffness", help="Its stiffness [N/m]."),
     simulate: bool = typer.Option(True, "--simulate/--no-simulate", help="Simulate the renderable stiffness with "
                                   "the file's dry friction and encoder quantization (a few seconds)."),
-    workspace: bool = typer.Option(True, "--workspace/--no-workspace", help="Search the workspace cube (inverse "
-                                   "kinematics to 26 points per bisection step; the slow part)."),
+    workspace: bool = typer.Option(True, "--workspace/--no-workspace", help="Search the workspace cube (the "
+                                   "largest study box reached, on grids 3 and 5)."),
+    index: str = typer.Option("", "--index", help="Comma-separated design indices to add at the pose "
+                              "(docs/indices.md): built-in, a package's through its entry point, or one of --indices."),
+    indices: Optional[Path] = typer.Option(None, "--indices", help="A Python file of your own design indices "
+                                           "(decorated with @hapticdesign.index) that --index may name. Its code "
+                                           "RUNS, as 'python FILE' would."),
     strict: bool = STRICT,
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
@@ -137,9 +142,15 @@ def spec(
         preset = Hand.named(hand)
         loop = SampledLoop(period=1.0 / rate, delay=delay, compensation=compensation,
                            hand=replace(preset, **given, name=None) if given else preset)
+        from hapticdesign.analysis.metrics.indices import INDICES
+        from hapticdesign.interface.commands.optimize_adapter import index_module
+
+        registry = INDICES.with_indices(index_module(indices)) if indices is not None else INDICES
+        names = [name.strip() for name in index.split(",") if name.strip()]
         with progress_bar(not (quiet or json_out)) as report:
             report = report or no_progress
-            sheet = spec_sheet(dev, pose, loop, workspace=workspace, simulate=simulate, progress=report)
+            sheet = spec_sheet(dev, pose, loop, workspace=workspace, simulate=simulate, indices=names,
+                               registry=registry, progress=report)
             sheet["handle"] = without_round_off(sheet["handle"])  # a position's 1e-18 m residue is 0
             figures = [] if out is None else _spec_figures(dev, sheet, report)
         if out is not None:
@@ -151,7 +162,10 @@ def spec(
             return
         units = sheet["units"]
         for key, value in sheet.items():
-            if key != "units":
+            if key == "indices":
+                for name, number in value.items():
+                    typer.echo(f"{name}: {_text(number)} [{units['indices'][name]}]")
+            elif key != "units":
                 typer.echo(f"{key}: {_text(value)}" + (f" [{units[key]}]" if key in units else ""))
 
 

@@ -25,7 +25,10 @@ def maps(
                                          "the handle at home."),
     grid: int = typer.Option(11, "--grid", help="Points per side of the plane (edges included)."),
     index: str = typer.Option("isotropy,apparent_mass", "--index", help="Comma-separated design indices "
-                              "(docs/indices.md), e.g. isotropy,apparent_mass,force,kmax."),
+                              "(docs/indices.md), e.g. isotropy,apparent_mass,force,kmax, or one of --indices."),
+    indices: Optional[Path] = typer.Option(None, "--indices", help="A Python file of your own design indices "
+                                           "(decorated with @hapticdesign.index) that --index may name. Its code "
+                                           "RUNS, as 'python FILE' would."),
     preset: Optional[str] = PRESET,
     device: Optional[Path] = DEVICE,
     params: Optional[Path] = PARAMS,
@@ -44,7 +47,10 @@ def maps(
     with user_errors(strict=strict, quiet=quiet):
         from hapticdesign.devices.loading import resolve_device
 
+        from hapticdesign.interface.commands.optimize_adapter import index_module
+
         dev = resolve_device(preset, device, params, strict=strict)
+        registry = INDICES.with_indices(index_module(indices)) if indices is not None else INDICES
         sizes = parse_vector(size, 3, "size")
         plane = [k for k in range(3) if sizes[k] != 0.0]
         if len(plane) != 2:
@@ -57,9 +63,9 @@ def maps(
             raise UserError(f"--index: give at least one design index (docs/indices.md), got {index[:60]!r}")
         workspace = Workspace(tuple(middle), tuple(abs(sizes)), grid)
         points = workspace.points()
-        found = device_map(dev, points, names)
-        used = options_used(requests_of(names))
-        files = _write(out, found, names, plane)
+        found = device_map(dev, points, names, registry=registry)
+        used = options_used(requests_of(names, registry), registry)
+        files = _write(out, found, names, plane, {k: registry[k].unit for k in names})
         spreads = {k: _spread(found, k, workspace.center_index, grid) for k in names}
         note(f"wrote {len(files)} files to {out} ({int(found.reached.sum())} of {len(points)} points reached)",
              quiet or json_out)
@@ -67,11 +73,11 @@ def maps(
             print_json({"device": dev.name, "out": str(out), "files": files, "points": len(points),
                         "reached": int(found.reached.sum()),
                         "range": {k: [_finite(v, min), _finite(v, max)] for k, v in found.values.items()},
-                        "spread": spreads, "units": {k: INDICES[k].unit for k in names}, "options": used})
+                        "spread": spreads, "units": {k: registry[k].unit for k in names}, "options": used})
             return
         for key, values in found.values.items():
             low, high = _finite(values, min), _finite(values, max)
-            span = "no point reached" if low is None else f"{low:.6g} to {high:.6g} {INDICES[key].unit}"
+            span = "no point reached" if low is None else f"{low:.6g} to {high:.6g} {registry[key].unit}"
             typer.echo(f"{key}: {span}" + (f" ({options_line(used[key])})" if key in used else "")
                        + _spread_line(spreads[key], len(points)))
 
@@ -111,13 +117,13 @@ def _finite(values, how) -> float | None:
     return how(kept) if kept else None
 
 
-def _write(out: Path, found, names: list[str], plane: list[int]) -> list[str]:
-    """map_<index>.png per index (the grid in its two axes) and maps.csv (every point, its values or why not)."""
+def _write(out: Path, found, names: list[str], plane: list[int], units: dict[str, str]) -> list[str]:
+    """map_<index>.png per index (the grid in its two axes, its unit by name in ``units``) and maps.csv (every point,
+    its values or why not)."""
     import numpy as np
 
     from hapticdesign.analysis.metrics.maps import save_map
     from hapticdesign.files import write_atomically
-    from hapticdesign.analysis.metrics.indices import INDICES
     from hapticdesign.interface.report.tables import csv_text
     from hapticdesign.studies.steps import Table
 
@@ -129,7 +135,7 @@ def _write(out: Path, found, names: list[str], plane: list[int]) -> list[str]:
         grid = np.full((len(xs), len(ys)), np.nan)
         grid[np.searchsorted(xs, points[:, first]), np.searchsorted(ys, points[:, second])] = found.values[key]
         path = save_map(Path(out) / f"map_{key}.png", grid, xs - xs.mean(), f"{key}", (AXES[first], AXES[second]),
-                        ys - ys.mean(), unit=INDICES[key].unit)
+                        ys - ys.mean(), unit=units[key])
         files.append(str(path))
     rows = [[*p, bool(r), *(found.values[k][i] for k in names), reason or ""]
             for i, (p, r, reason) in enumerate(zip(points, found.reached, found.reasons))]

@@ -21,8 +21,9 @@ from pathlib import Path
 from hapticdesign.analysis.metrics.indices import Index
 from hapticdesign.errors import RunWarning, UserError
 from hapticdesign.files import quote, write_atomically
-from hapticdesign.interface.report.optimization_page import Picture, render, render_failure
+from hapticdesign.interface.report.optimization_page import PLOTLY, Picture, plotly_js, render, render_failure
 from hapticdesign.optimization.study_evaluation import BoundStudy, bind_study, require_study_workload
+from hapticdesign.optimization.study_explorer import DESIGNS, explorer_data, front_designs
 from hapticdesign.optimization.study_polish import most_designs
 from hapticdesign.optimization.study_file import Study, load_study
 from hapticdesign.optimization.study_methods import ConvexProgram, PopulationSearch, method_of, with_baseline
@@ -30,7 +31,8 @@ from hapticdesign.optimization.study_outputs import (Selection, baseline_lines, 
                                                      front_csv, pareto_figure, select_design)
 from hapticdesign.optimization.study_run import Record, StudyRun
 
-FILES = ("front.csv", "evaluations.csv", "pareto.png", "pareto.svg", "selected.yaml", "report.html")
+FILES = ("front.csv", "evaluations.csv", "pareto.png", "pareto.svg", "selected.yaml", "report.html", PLOTLY,
+         f"{DESIGNS}/design-N.yaml (each front design's device file)")
 
 
 def parse_select(text: str) -> dict:
@@ -130,10 +132,24 @@ def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Select
     pictures = [Picture(png, caption) for png, caption in bound.pictures(chosen.values)]
     kept = (["checkpoint/ (one file per generation; a rerun into this folder continues)"]
             if method_of(run.spec).checkpointed else [])
+    designs = front_designs(run, bound)
+    for design in designs:
+        write_atomically(out / design.file, design.text)
+    _remove_stale_designs(out, len(designs))
+    write_atomically(out / PLOTLY, plotly_js())
     page = render(run, selection, bound.title, Picture((out / "pareto.png").read_bytes(), "Pareto front"), pictures,
-                  [*FILES, *kept], bound.coarseness, bound.spread_rows(chosen.values), bound.units())
+                  [*FILES, *kept], explorer_data(run, bound, selection, designs), bound.coarseness,
+                  bound.spread_rows(chosen.values), bound.units())
     write_atomically(out / "report.html", page)
-    return [*paths, out / "selected.yaml", out / "report.html"]
+    return [*paths, out / "selected.yaml", *(out / d.file for d in designs), out / PLOTLY, out / "report.html"]
+
+
+def _remove_stale_designs(out: Path, count: int) -> None:
+    """Remove the device files of front designs beyond ``count`` that an earlier run into ``out`` wrote."""
+    for path in (out / DESIGNS).glob("design-*.yaml"):
+        number = path.stem.removeprefix("design-")
+        if number.isascii() and number.isdigit() and int(number) > count:
+            path.unlink()
 
 
 def write_failure(out: Path, run: StudyRun, bound: BoundStudy, error: UserError) -> list[Path]:

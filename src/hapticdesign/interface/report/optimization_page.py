@@ -1,17 +1,29 @@
-"""The HTML report of ``optimize``: the study, the front, the selected design beside the device file's design with
-its picture and index maps, and the files beside it; for a run without a feasible design (:func:`render_failure`),
-why, the closest designs and the device file's design. One document, inline styles, base64 PNG figures, no
-scripts; every user string (names, expressions, reasons, the device's name) is escaped."""
+"""The HTML report of ``optimize``, which is the study's design explorer: every evaluated design in the objective
+space and in parallel coordinates (click to pick a design, box, lasso or brush to filter), the card of the picked
+design (its numbers, picture, index maps and the commands that reproduce it), up to four pinned designs compared, the
+state in the address's hash; then the study, the front, the selected design beside the device file's design with its
+picture and index maps, why designs were infeasible, and the files beside it. For a run without a feasible design
+(:func:`render_failure`): why, the closest designs and the device file's design, a page without scripts.
+
+The page opens from disk with no server and no network: its data is JSON in a ``<script type="application/json">``
+element (:func:`hapticdesign.escape.script_json`), its own script is inline (``explorer.js`` next to this module) and
+Plotly.js is the installed ``plotly`` package's, written once beside the page (:data:`PLOTLY`, loaded by a relative
+``<script src>``: inlined, its 4.8 MB would be copied into every report). A Content-Security-Policy allows only those
+two scripts and no network request. Every user string (names, expressions, reasons, the device's name) is escaped
+here, and set as text by the script."""
 
 from __future__ import annotations
 
 import base64
+import hashlib
 import math
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from html import escape
+from importlib.resources import files as package_files
 
+from hapticdesign.escape import script_json
 from hapticdesign.interface.report.html import STYLE
 from hapticdesign.interface.report.tables import cell_text
 from hapticdesign.optimization.study_evaluation import SPREAD_COLUMNS
@@ -38,7 +50,7 @@ def _image(picture: Picture) -> str:
 TEXT = ' class="text"'
 
 
-def _table(title: str, columns: list[str], rows: list[list], highlight: int | None = None) -> str:
+def _table(title: str, columns: list[str], rows: list[list], highlight: int | None = None, ident: str = "") -> str:
     head = "".join(f"<th>{escape(c)}</th>" for c in columns)
     body = []
     for k, row in enumerate(rows):
@@ -46,7 +58,8 @@ def _table(title: str, columns: list[str], rows: list[list], highlight: int | No
         cells = "".join(f"<td{TEXT if isinstance(v, str) else ''}>{escape(cell_text(v))}</td>" for v in row)
         body.append(f"<tr{style}>{cells}</tr>")
     wide = ' class="wide"' if len(columns) > 8 else ""
-    return (f'<div class="table-wrap"><table{wide}><caption>{escape(title)}</caption><thead><tr>{head}</tr></thead>'
+    ident = f' id="{escape(ident)}"' if ident else ""
+    return (f'<div class="table-wrap"><table{ident}{wide}><caption>{escape(title)}</caption><thead><tr>{head}</tr></thead>'
             f"<tbody>{''.join(body)}</tbody></table></div>")
 
 
@@ -140,19 +153,86 @@ def _baseline(run: StudyRun, units: Mapping[str, str], chosen: Record | None = N
                           "gained or lost; at a bound"], rows)
 
 
-def _document(title: str, body: list[str], files: list[str]) -> str:
-    """One HTML document of ``body``'s parts and the list of ``files``."""
+def _document(title: str, body: list[str], files: list[str], scripts: str = "", policy: str = "") -> str:
+    """One HTML document of ``body``'s parts, the list of ``files`` and the ``scripts`` at the end, under the
+    Content-Security-Policy ``policy``."""
     parts = [*body, "<h2>Files</h2><ul class=\"files\">", *(f"<li>{escape(f)}</li>" for f in files), "</ul>"]
-    return (f'<!DOCTYPE html><html lang="en"><head><meta charset="utf-8"><title>{escape(title)}</title>'
-            f"<style>{STYLE}</style></head><body>{''.join(parts)}</body></html>\n")
+    meta = f'<meta http-equiv="Content-Security-Policy" content="{escape(policy)}">' if policy else ""
+    return (f'<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">{meta}<title>{escape(title)}</title>'
+            f'<link rel="icon" href="data:,"><style>{STYLE}{EXPLORER_STYLE if scripts else ""}</style></head>'
+            f"<body>{''.join(parts)}{scripts}</body></html>\n")
+
+
+PLOTLY = "plotly.min.js"
+"""Plotly.js as the report loads it, from the output folder (:func:`plotly_js`)."""
+
+EXPLORER_STYLE = """
+#explorer .toolbar { display: flex; flex-wrap: wrap; gap: .4em 1em; align-items: center; font-size: .9em; }
+#explorer select { max-width: 22em; }
+#filter-status { color: #444; }
+#explorer-note { color: #a01818; }
+#parallel { display: block; border: 1px solid #dde; background: #fff; cursor: crosshair; margin: .4em 0; }
+#parallel-tip { position: absolute; background: #222; color: #fff; font-size: .8em; padding: .15em .4em;
+                border-radius: 3px; pointer-events: none; }
+#design-card { border: 2px solid #f39c12; border-radius: 6px; padding: .2em 1em 1em; margin: 1em 0; }
+.card-row { display: flex; flex-wrap: wrap; gap: 1.2em; align-items: flex-start; }
+.card-row > * { flex: 0 0 auto; margin: 0; }
+.card-row figure { max-width: 400px; }
+.card-row canvas { border: 1px solid #dde; background: #fbfbfd; cursor: grab; }
+.maps { display: flex; flex-wrap: wrap; gap: .6em; }
+.map { min-width: 300px; }
+#compare tr.differs td { background: #fff6d6; }
+#compare td.best { font-weight: bold; color: #1a6b1a; }
+#compare figure.pinned { margin: 0; }
+#front-table tbody tr { cursor: pointer; }
+#front-table tbody tr:hover { background: #eef4ff; }
+"""
+
+
+def plotly_js() -> str:
+    """The installed ``plotly`` package's Plotly.js (minified), which the report loads from :data:`PLOTLY`."""
+    from plotly.offline import get_plotlyjs
+
+    return get_plotlyjs()
+
+
+def _explorer_script() -> str:
+    return package_files("hapticdesign.interface.report").joinpath("explorer.js").read_text(encoding="utf-8")
+
+
+def _explorer(data: dict) -> tuple[str, str, str]:
+    """The explorer's section, its scripts (the data, Plotly.js, the explorer's own) and the page's policy: the
+    inline script by its hash, Plotly.js from the page's folder (a ``file:`` address), no network."""
+    code = _explorer_script()
+    digest = base64.b64encode(hashlib.sha256(code.encode("utf-8")).digest()).decode("ascii")
+    policy = (f"default-src 'none'; script-src 'sha256-{digest}' file: 'self'; style-src 'unsafe-inline'; "
+              "img-src data: blob:; font-src data:")
+    section = (
+        '<section id="explorer"><h2>Explore the designs</h2>'
+        '<p class="note">Every evaluated design: click a point or a line to pick a design (its card follows), drag a '
+        "box or a lasso on a plot or along an axis of the parallel coordinates to filter (a click on an axis clears "
+        "its range), pin up to four designs to compare them. The address keeps the view: a link reopens it. "
+        "Each quantity's unit is in brackets (a variable's from its device file). <code>window.hdExplorer</code> scripts it (docs/optimization.md)."
+        '</p><p id="explorer-note"></p>'
+        '<div class="toolbar"><label>x <select id="x-axis"></select></label><label>y <select id="y-axis"></select>'
+        '</label><button id="clear-filters" type="button">Clear filters</button><span id="filter-status"></span></div>'
+        '<div id="objective-space"></div><div id="pairs"></div>'
+        "<h3>Parallel coordinates of the feasible designs (the front in blue)</h3>"
+        '<canvas id="parallel" height="380" width="1000"></canvas><div id="parallel-tip" hidden></div>'
+        '<h3>The picked design</h3><div id="design-card"></div>'
+        '<h3>Compare</h3><div id="compare"></div></section>')
+    scripts = (f'<script type="application/json" id="explorer-data">{script_json(data)}</script>'
+               f'<script src="{PLOTLY}"></script><script>{code}</script>')
+    return section, scripts, policy
 
 
 def render(run: StudyRun, selection: Selection, title: str, pareto: Picture, pictures: list[Picture],
-           files: list[str], coarseness: str = "", spread: list[list] | None = None,
+           files: list[str], explorer: dict, coarseness: str = "", spread: list[list] | None = None,
            units: Mapping[str, str] | None = None) -> str:
-    """The report as one HTML document; ``coarseness`` says how coarse the workspace grid is (``27 points, grid 3``),
-    ``spread`` gives the selected design's pose indices over the points
-    (:meth:`~hapticdesign.optimization.study_evaluation.BoundStudy.spread_rows`), ``units`` each quantity's unit
+    """The report as one HTML document: the explorer of ``explorer``'s data
+    (:func:`~hapticdesign.optimization.study_explorer.explorer_data`), then the static report; ``coarseness`` says how
+    coarse the workspace grid is (``27 points, grid 3``), ``spread`` gives the selected design's pose indices over the
+    points (:meth:`~hapticdesign.optimization.study_evaluation.BoundStudy.spread_rows`), ``units`` each quantity's unit
     (:meth:`~hapticdesign.optimization.study_evaluation.BoundStudy.units`), shown in the tables' headers or a unit
     column."""
     spec = run.spec
@@ -165,17 +245,19 @@ def render(run: StudyRun, selection: Selection, title: str, pareto: Picture, pic
     over = [_table(f"The selected design's indices over the workspace ({coarseness}): at the box's centre, median, "
                    "mean and the extremes with the points where they are taken", ["index", "unit", *SPREAD_COLUMNS],
                    spread)] if spread else []
-    body = [f"<h1>Optimization study: {escape(title)}</h1>", "<h2>Study</h2>", _study_rows(run, coarseness, units),
+    section, scripts, policy = _explorer(explorer)
+    body = [f"<h1>Optimization study: {escape(title)}</h1>", section, "<h2>Study</h2>",
+            _study_rows(run, coarseness, units),
             "<h2>Pareto front</h2>", _image(pareto),
-            _table(f"The front: {len(run.front)} feasible, non-dominated designs (front.csv)", columns, rows,
-                   selection.position),
+            _table(f"The front: {len(run.front)} feasible, non-dominated designs (front.csv; click a row to pick it)",
+                   columns, rows, selection.position, ident="front-table"),
             "<h2>Selected design</h2>",
             f"<p>Design {selection.position + 1} of the front, by the {escape(selection.rule)}; as a device file: "
             "selected.yaml.</p>",
             _baseline(run, units, chosen), *over,
             *(_image(p) for p in pictures),
             "<h2>Infeasible designs</h2>", _reasons(run)]
-    return _document(title, body, files)
+    return _document(title, body, files, scripts, policy)
 
 
 def _closest(run: StudyRun, units: Mapping[str, str]) -> str:

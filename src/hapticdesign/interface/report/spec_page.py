@@ -32,6 +32,9 @@ def spec_page(sheet: dict, figures=()) -> str:
             number, vendor_unit, why = vendor.get(key, (None, "", ""))
             cells += ["" if number is None else f"{number:g} {vendor_unit}", why]
         rows.append("<tr>" + "".join(f'<td class="text">{escape(c)}</td>' for c in cells) + "</tr>")
+    for name, number in sheet.get("indices", {}).items():
+        cells = [f"index {name}", f"{number:.4g}", sheet["units"]["indices"][name], *(("", "") if vendor else ())]
+        rows.append("<tr>" + "".join(f'<td class="text">{escape(c)}</td>' for c in cells) + "</tr>")
     head = "".join(f"<th>{escape(c)}</th>" for c in columns)
     pose = ", ".join(f"{v:.4g}" for v in sheet["q"])
     handle = ", ".join(f"{1000 * v:.4g}" for v in sheet["handle"])

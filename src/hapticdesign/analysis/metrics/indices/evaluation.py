@@ -124,7 +124,7 @@ def evaluate_designs(space: DesignFamily, designs: Sequence[Mapping[str, float]]
     n_a = got.jacobian.shape[-1]
     states = HandleStates.of(
         got.jacobian[ok].reshape(-1, 3, n_a), got.mass[ok].reshape(-1, n_a, n_a), v.damping[per_pose],
-        got.q[ok].reshape(-1, n_a), motor_map=None if v.motor_map is None else v.motor_map[per_pose],
+        got.q[ok].reshape(-1, n_a), int(ok.sum()), motor_map=None if v.motor_map is None else v.motor_map[per_pose],
         torque_limits={k: None if t is None else t[per_pose] for k, t in v.torques.items()},
         moving_mass=got.moving_mass[per_pose], name=space.base.name,
         transmission=None if v.transmission is None else v.transmission.taken(per_pose),

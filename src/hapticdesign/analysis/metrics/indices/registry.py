@@ -33,6 +33,8 @@ ENTRY_POINTS = "hapticdesign.indices"
 NEEDS = POSE_NEEDS | PARAMETER_NEEDS
 """What an index may need of its state (:mod:`.states`)."""
 NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,63}")
+OVER = ("poses", "points")
+"""What one value of an index is of (:attr:`Index.over`): a pose, or all of a design's points."""
 
 
 @dataclass(frozen=True)
@@ -49,10 +51,27 @@ class Index:
     cost: float = 1.0
     """How many ordinary evaluations (a pose's kinematics and dynamics) one evaluation of it costs: a study's
     workload counts it so (an index that runs the sampled loop costs about a thousand)."""
+    over: str = "poses"
+    """``poses``: one value per pose (P,); ``points``: one value per design (D,) from all of its points at once
+    (``state.designs`` designs, their poses one after the other), taken at each of its points."""
 
     def values(self, state, options: Mapping[str, object] | None = None) -> np.ndarray:
-        """The index of ``state`` with ``options`` over its defaults, as floats."""
-        return np.asarray(self.function(state, **{**self.options, **(options or {})}), dtype=float)
+        """The index of ``state`` with ``options`` over its defaults, as floats, one per pose of ``state`` (one per
+        design for an index of the parameters). A function that raises, or answers another shape or a value that
+        is not a number, is a one-line UserError naming the index."""
+        try:
+            found = np.asarray(self.function(state, **{**self.options, **(options or {})}), dtype=float)
+        except UserError:
+            raise
+        except Exception as exc:  # the index's own code (a user's): one line naming it, not a traceback
+            raise UserError(f"index {self.name} ({self.source}) failed: {type(exc).__name__}: {exc}") from None
+        designs = state.designs if self.over == "points" else None
+        wanted = state.count if designs is None else designs
+        if found.shape != (wanted,):
+            what = "one value per design" if designs is not None or self.of_parameters else "one value per pose"
+            raise UserError(f"index {self.name} ({self.source}) returned shape {found.shape}, not ({wanted},): "
+                            f"{what}")
+        return found if designs is None else np.repeat(found, state.count // designs)
 
     def __call__(self, state, **options) -> np.ndarray:
         return self.values(state, options)
@@ -149,12 +168,15 @@ INDICES = Registry()
 
 def index(function: Callable | None = None, *, unit: str, formula: str | None = None, source: str | None = None,
           name: str | None = None, needs: Iterable[str] = ("kinematics", "dynamics"), cost: float = 1.0,
-          registry: Registry = INDICES):
+          over: str = "poses", registry: Registry = INDICES):
     """Register ``function(state, **options)`` as an index (a decorator; the :class:`Index` it returns is callable
     like the function). Its name is the function's (or ``name``), its options its keyword parameters with their
     defaults; ``formula`` defaults to the first line of its docstring, ``source`` to where it is defined. A pose
-    index reads ``state.J_v`` (P, 3, n_a), ``state.H`` (P, n_a, n_a), ``state.q`` (P, n_a), ... and returns (P,)
-    values; an index that ``needs`` ``parameters`` reads ``state.params`` (name -> (D,) values) and returns (D,)."""
+    index reads ``state.J_v`` (P, 3, n_a), ``state.H`` (P, n_a, n_a), ``state.q`` (P, n_a), ... (every field with
+    the leading axis of the P poses, docs/indices.md) and returns (P,) values; with ``over="points"`` it returns one
+    value per design, (``state.designs``,), from all of each design's points (the poses are the designs' one after
+    the other); an index that ``needs`` ``parameters`` reads ``state.params`` (name -> (D,) values) and returns
+    (D,)."""
 
     def make(f: Callable) -> Index:
         label = name or getattr(f, "__name__", "")
@@ -169,8 +191,11 @@ def index(function: Callable | None = None, *, unit: str, formula: str | None = 
         doc = (inspect.getdoc(f) or "").strip().splitlines()
         if not (isinstance(cost, (int, float)) and not isinstance(cost, bool) and 1.0 <= cost < float("inf")):
             raise UserError(f"index {label}: cost is a number of ordinary evaluations, at least 1, got {cost!r}")
+        if over not in OVER or (over == "points" and "parameters" in wanted):
+            raise UserError(f"index {label}: over is poses (one value per pose) or points (one value per design "
+                            f"from all its points; not with needs parameters), got {over!r}")
         made = Index(label, unit, formula or (doc[0] if doc else label), source or ".".join(_origin(f)), f,
-                     _options(f, label), wanted, float(cost))
+                     _options(f, label), wanted, float(cost), over)
         return registry.register(made)
 
     return make if function is None else make(function)

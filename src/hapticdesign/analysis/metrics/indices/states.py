@@ -104,16 +104,29 @@ class HandleStates:
         return mass_matrix_at(self._device, self.full)
 
     @cached_property
+    def count(self) -> int:
+        """How many poses the states hold (P): the leading axis of every per-pose field, and how many values a pose
+        index returns."""
+        return len(self.full)
+
+    @cached_property
+    def designs(self) -> int:
+        """How many designs the poses belong to (D, 1 for a device at poses): the poses are the designs' one after the
+        other, ``P / D`` points each, and an index ``over="points"`` returns one value per design."""
+        return 1
+
+    @cached_property
     def B(self) -> np.ndarray:
-        """``B`` (n_a, n_a), or (P, n_a, n_a) per pose: the joints' and motors' viscous damping
+        """``B`` (P, n_a, n_a): the joints' and motors' viscous damping at each pose
         (:attr:`~hapticdesign.model.device.Device.damping_matrix`)."""
-        return self._device.damping_matrix
+        return per_pose(self._device.damping_matrix, self.count, 2)
 
     @cached_property
     def transmission(self) -> Transmission | None:
-        """The motors' compliant transmissions (:class:`~hapticdesign.model.actuators.Transmission`, (n_a, n_a) or
-        (P, n_a, n_a) each), None for rigid motors (:attr:`~hapticdesign.model.device.Device.transmission`)."""
-        return self._device.transmission
+        """The motors' compliant transmissions (:class:`~hapticdesign.model.actuators.Transmission`, (P, n_a, n_a)
+        each), None for rigid motors (:attr:`~hapticdesign.model.device.Device.transmission`)."""
+        found = self._device.transmission
+        return None if found is None else Transmission(*(per_pose(x, self.count, 2) for x in found))
 
     @cached_property
     def gravity(self) -> np.ndarray:
@@ -142,15 +155,17 @@ class HandleStates:
 
     @cached_property
     def motor_map(self) -> np.ndarray | None:
-        """The motors' ``A^-1`` (n_a, n_a), or (P, n_a, n_a) per pose; None unless one motor per coordinate
-        (:func:`~hapticdesign.analysis.metrics.force.motor_map`)."""
-        return force.motor_map(self._device)
+        """The motors' ``A^-1`` (P, n_a, n_a) at each pose (coordinates x motors); None unless one motor per
+        coordinate (:func:`~hapticdesign.analysis.metrics.force.motor_map`)."""
+        found = force.motor_map(self._device)
+        return None if found is None else per_pose(found, self.count, 2)
 
     @cached_property
     def torque_limits(self) -> dict[str, np.ndarray | None]:
-        """``n_k tau_k`` (n_a,), or (P, n_a) per pose, for ``continuous`` and ``peak`` torques; None where a motor
-        lacks it (:func:`~hapticdesign.analysis.metrics.force.torque_limits`)."""
-        return {which: force.torque_limits(self._device, which) for which in ("continuous", "peak")}
+        """``n_k tau_k`` (P, n_a) at each pose (N m or N on the coordinates' side) for ``continuous`` and ``peak``
+        torques; None where a motor lacks it (:func:`~hapticdesign.analysis.metrics.force.torque_limits`)."""
+        found = {which: force.torque_limits(self._device, which) for which in ("continuous", "peak")}
+        return {which: None if x is None else per_pose(x, self.count, 1) for which, x in found.items()}
 
     @cached_property
     def moving_mass(self) -> np.ndarray:
@@ -195,21 +210,31 @@ class HandleStates:
 
     @classmethod
     def of(cls, J_v: np.ndarray, H: np.ndarray, B: np.ndarray | None = None, q: np.ndarray | None = None,
-           **known) -> "HandleStates":
+           designs: int = 1, **known) -> "HandleStates":
         """The states of poses whose ``J_v`` (P, 3, n_a), ``H`` (P, n_a, n_a), ``B`` ((n_a, n_a) or per pose) and
         actuated coordinates ``q`` (P, n_a) are known already (many designs' poses at once,
         :mod:`hapticdesign.analysis.design_batch`), with any other quantity of :data:`BATCH_NEEDS` known per pose by
         its name (``stiffness`` (P, k, k), ``motor_map``, ``torque_limits``, ``moving_mass``, ``name``, ``gravity``
         (P, n_a, n_a), ``model``: the compensator's ``H_m`` and ``dG_m/dq`` for a modelling error in percent, as
         :meth:`compensator` gives them, ``transmission``: the motors' compliant transmissions, None when rigid): enough for an index that needs at most :data:`BATCH_NEEDS`, of those
-        quantities given."""
+        quantities given. ``designs``: how many designs the poses belong to, one after the other. One design's
+        ``B``, ``motor_map``, ``torque_limits`` or ``transmission`` (without the leading axis) is taken at every pose,
+        so that every field has the leading axis P (the class's docstrings give each shape)."""
         unknown = set(known) - {"stiffness", "motor_map", "torque_limits", "moving_mass", "name", "gravity", "model",
                                 "transmission"}
         if unknown:
             raise TypeError(f"HandleStates.of: unknown quantities {sorted(unknown)}")
-        states = cls(None, np.zeros((len(J_v), 0)))
-        states.__dict__.update(J_v=J_v, H=H, **{"transmission": None, **known})
-        for name, value in (("B", B), ("q", q)):
+        count = len(J_v)
+        if "motor_map" in known and known["motor_map"] is not None:
+            known["motor_map"] = per_pose(known["motor_map"], count, 2)
+        if "torque_limits" in known:
+            known["torque_limits"] = {k: None if x is None else per_pose(x, count, 1)
+                                      for k, x in known["torque_limits"].items()}
+        if known.get("transmission") is not None:
+            known["transmission"] = Transmission(*(per_pose(x, count, 2) for x in known["transmission"]))
+        states = cls(None, np.zeros((count, 0)))
+        states.__dict__.update(J_v=J_v, H=H, designs=int(designs), **{"transmission": None, **known})
+        for name, value in (("B", None if B is None else per_pose(B, count, 2)), ("q", q)):
             if value is not None:
                 states.__dict__[name] = value
         return states
@@ -223,10 +248,26 @@ class ParameterStates:
     params: Mapping[str, np.ndarray]
     cache: dict = field(default_factory=dict)
 
+    @property
+    def count(self) -> int:
+        """How many designs the parameters are of (D): how many values an index of the parameters returns."""
+        return len(next(iter(self.params.values()), ()))
+
     @classmethod
     def of_device(cls, device: Device) -> "ParameterStates":
         """The one design ``device`` (its parameters as 1-element arrays)."""
         return cls({name: np.array([float(value)]) for name, value in device.params.items()})
+
+
+def per_pose(value: np.ndarray, count: int, dims: int) -> np.ndarray:
+    """``value`` with the leading axis of ``count`` poses: one design's (``dims`` axes) taken at every pose, or
+    values per pose (``dims + 1`` axes, ``count`` first) as they are."""
+    value = np.asarray(value, dtype=float)
+    if value.ndim == dims:
+        return np.repeat(value[None], count, axis=0)
+    if value.ndim != dims + 1 or len(value) != count:
+        raise ValueError(f"a per-pose quantity is ({count}, ...) with {dims} more axes, got shape {value.shape}")
+    return value
 
 
 def moving_mass(device: Device) -> float:
