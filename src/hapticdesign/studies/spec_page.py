@@ -42,8 +42,8 @@ VENDOR = {
                        "falcon.yaml has no force; falcon-assumed-motors.yaml assumes a peak torque that gives 9.0 N at "
                        "home in the weakest direction (an assumption fitted to this number, not a check of it)."),
         "workspace": (101.6, "mm", "Novint publishes a 4 x 4 x 4 in touch space (101.6 mm), presumably the extent of "
-                      "the handle's travel; ours is the largest cube centred on home whose corners, edge midpoints and "
-                      "face centres the home branch reaches (92.8 mm with libnifalcon's geometry)."),
+                      "the handle's travel; ours is the largest cube centred on home that a study reaches as its box on "
+                      "grids 3 and 5 (90.0 mm with libnifalcon's geometry)."),
         "renderable_stiffness": (3000.0, "N/m", "CHAI3D's stiffness for the Falcon. falcon.yaml has no damping or "
                                  "friction data (libnifalcon gives none), so the model's exact limit and passivity "
                                  "bounds are zero; the Falcon renders walls thanks to its drives' friction and the hand: "
