@@ -138,3 +138,19 @@ def test_a_study_in_a_log_says_each_step_when_it_starts_and_ends(capsys, monkeyp
     progress.end(StepResult("linearization", title, STATUS_DONE, 10.0, Outcome()))
     assert lines[0] == "Analytic linearization and a realizable linear design..."
     assert lines[1] == "  1 of 10" and lines[-2] == "  9 of 10, about 1 s left" and lines[-1] == "  done in 10 s"
+
+
+def test_a_map_reports_each_point_and_its_indices():
+    """``maps`` feeds its bar from ``device_map``: every point once, in order, then the indices' batch."""
+    import numpy as np
+
+    from hapticdesign.analysis.metrics.maps import INDICES_STEP, REACH_STEP, device_map
+    from hapticdesign.devices.loading import load_device
+
+    device = load_device(ROOT / "examples" / "devices" / "five-bar.yaml")
+    points = np.array([[0.0, 0.0, 0.2], [0.01, 0.0, 0.19], [5.0, 0.0, 0.0]])  # the last out of reach
+    heard = []
+    found = device_map(device, points, ["isotropy"], progress=lambda *report: heard.append(report))
+    assert found.reached.tolist() == [True, True, False]
+    assert heard == [(REACH_STEP, 0, 3), (REACH_STEP, 1, 3), (REACH_STEP, 2, 3), (REACH_STEP, 3, 3),
+                     (INDICES_STEP, 0, None), (INDICES_STEP, 1, 1)]

@@ -5,13 +5,17 @@ other simulators (:func:`hapticdesign.analysis.configuration.handle_pose`, :mod:
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Optional
+from typing import TYPE_CHECKING, Optional
 
 import typer
 
 from hapticdesign.errors import UserError
 from hapticdesign.interface.common import note, parse_vector, print_json, progress_bar, user_errors
 from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
+
+if TYPE_CHECKING:  # for the hints only: the commands import no engine until they run
+    from hapticdesign.model.device import Device
+    from hapticdesign.studies.spec import Report
 
 
 def ik(
@@ -51,7 +55,7 @@ def ik(
             typer.echo(f"  {name} = {_coordinate_text(dev, name, value)}, passive")
 
 
-def _coordinate_text(dev, name: str, value: float) -> str:
+def _coordinate_text(dev: Device, name: str, value: float) -> str:
     """A joint coordinate with its unit: metres for a prismatic joint, radians and degrees for a revolute one."""
     import math
 
@@ -169,7 +173,7 @@ def spec(
                 typer.echo(f"{key}: {_text(value)}" + (f" [{units[key]}]" if key in units else ""))
 
 
-def _spec_figures(dev, sheet: dict, report) -> list[tuple[str, str, bytes]]:
+def _spec_figures(dev: Device, sheet: dict, report: Report) -> list[tuple[str, str, bytes]]:
     """The spec page's figures (title, caption, PNG): the workspace sections and the quantities over them, where
     the sheet has a workspace cube; ``report`` hears how far their inverse kinematics is."""
     figures = []
