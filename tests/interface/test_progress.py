@@ -154,3 +154,19 @@ def test_a_map_reports_each_point_and_its_indices():
     assert found.reached.tolist() == [True, True, False]
     assert heard == [(REACH_STEP, 0, 3), (REACH_STEP, 1, 3), (REACH_STEP, 2, 3), (REACH_STEP, 3, 3),
                      (INDICES_STEP, 0, None), (INDICES_STEP, 1, 1)]
+
+
+def test_a_progress_bars_step_name_is_never_cut_on_a_terminal(monkeypatch):
+    """The command line's bars (progress_bar) keep a long step name whole on an 80-column terminal."""
+    import io
+
+    from rich.console import Console
+
+    screen = io.StringIO()
+    monkeypatch.setattr("rich.console.Console", lambda **kw: Console(file=screen, width=80, force_terminal=True,
+                                                                     color_system=None))
+    step = "renderable stiffness (exact, with the hand, simulated) of the device at its home pose"
+    with progress_bar(True) as report:
+        report(step, 1, 3)
+    text = " ".join(screen.getvalue().split())
+    assert "…" not in text and all(word in text for word in step.split())

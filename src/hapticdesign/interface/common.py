@@ -146,7 +146,8 @@ def progress_bar(enabled: bool) -> Iterator[Report | None]:
     """Progress of long work on stderr, fed by ``report(step, done, total)`` (``total`` None: unknown).
 
     Each step with a known total first states its size and the time it will take, once its pace is known
-    (:class:`TimeLeft`). On a terminal a rich bar follows with the time elapsed and the time left; in a log or
+    (:class:`TimeLeft`). On a terminal a rich bar follows with the time elapsed and the time left (the step's name
+    whole, wrapped rather than cut where the terminal is narrow); in a log or
     a pipe one line each tenth, with the time left, once the step has run :data:`LOG_AFTER` seconds (a step that
     ends sooner writes nothing). Yields None (nothing on stderr) when ``enabled`` is false
     (``--quiet`` or ``--json``), so progress never mixes with a command's output on stdout."""
@@ -189,9 +190,11 @@ def progress_bar(enabled: bool) -> Iterator[Report | None]:
         return
     from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn,
                                TimeRemainingColumn)
+    from rich.table import Column
 
-    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-                  TextColumn("left"), TimeRemainingColumn(), console=console, transient=True) as bars:
+    title = TextColumn("{task.description}", markup=False, table_column=Column(overflow="fold", ratio=1))
+    with Progress(title, BarColumn(bar_width=20), MofNCompleteColumn(), TimeElapsedColumn(), TextColumn("left"),
+                  TimeRemainingColumn(), console=console, transient=True, expand=True) as bars:
         tasks: dict[str, int] = {}
 
         def report(step: str, done: int, total: int | None) -> None:
