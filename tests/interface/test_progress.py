@@ -88,14 +88,14 @@ def test_robustness_states_its_size_and_the_time_left(tmp_path):
     designs = write_designs(tmp_path / "designs.csv")
     env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
     args = [sys.executable, "-c", "from hapticdesign.interface.cli import main; main()", "robustness", "--designs", str(designs), "--errors", "0,5",
-            "--draws", "40"]
+            "--draws", "10"]
     run = subprocess.run(args, capture_output=True, text=True, env=env, cwd=tmp_path, check=False)
     assert run.returncode == 0, run.stderr
     err = run.stderr.splitlines()
-    assert err[0] == ("robustness: 4 designs x 2 error levels (40 draws at each level above 0) = 164 stable-range "
+    assert err[0] == ("robustness: 4 designs x 2 error levels (10 draws at each level above 0) = 44 stable-range "
                       "searches (analytic)")
-    assert any(line.startswith("robustness searches: 164 in all; at the pace so far, about ") for line in err)
-    assert err[-1] == "robustness searches: 164 of 164"
+    assert any(line.startswith("robustness searches: 44 in all; at the pace so far, about ") for line in err)
+    assert err[-1] == "robustness searches: 44 of 44"
     quiet = subprocess.run([*args, "--json"], capture_output=True, text=True, env=env, cwd=tmp_path, check=False)
     assert quiet.returncode == 0 and quiet.stderr == ""
 

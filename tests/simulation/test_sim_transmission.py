@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 import yaml
 from scipy.integrate import solve_ivp
+from typer.testing import CliRunner
 
 from hapticdesign.analysis.configuration import configuration_of, handle_pose
 from hapticdesign.analysis.dynamics.device import mass_matrix
@@ -27,6 +28,7 @@ from hapticdesign.analysis.wall_stiffness import wall_limit
 from hapticdesign.devices.design_space import design_space
 from hapticdesign.devices.device_file import load_device_file
 from hapticdesign.errors import UserError
+from hapticdesign.interface.cli import app
 from hapticdesign.model.actuators import Transmission
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "devices"
@@ -224,3 +226,28 @@ def test_a_transmission_on_some_motors_only_is_refused(tmp_path):
     path.write_text(yaml.safe_dump(data))
     with pytest.raises(UserError, match="transmission_stiffness"):
         load_device_file(path).transmission
+
+
+@pytest.mark.parametrize("value, fragment", [(".nan", "expected a finite number"), (".inf", "expected a finite number"),
+                                             ("-1", "greater than 0"), ("0", "greater than 0"),
+                                             ("'abc'", "must be a number"), ("1e308", "the motors resonate"),
+                                             ("[1, 2]", "transmission_stiffness")])
+def test_a_hostile_transmission_stiffness_is_one_line(tmp_path, value, fragment):
+    """A stiffness that is no number, not positive, or so large that the loop's exact discretization would overflow
+    (the rigid model is its answer there): one line, exit 2, through the spec sheet."""
+    text = (EXAMPLES / "phantom-premium.yaml").read_text().replace(
+        "encoder_cpr: 1024, coulomb", f"encoder_cpr: 1024, transmission_stiffness: {value}, coulomb")
+    path = tmp_path / "phantom.yaml"
+    path.write_text(text)
+    result = CliRunner().invoke(app, ["spec", "--device", str(path), "--no-simulate", "--no-workspace", "--json"])
+    lines = [line for line in result.output.strip().splitlines() if line]
+    assert result.exit_code == 2 and len(lines) == 1 and lines[0].startswith("error:"), result.output
+    assert fragment in lines[0]
+
+
+@pytest.mark.parametrize("name", ["nope", "ｌｉｇｈｔ", "", "<img src=x>"])
+def test_an_unknown_hand_is_one_line(name):
+    result = CliRunner().invoke(app, ["spec", "--device", str(EXAMPLES / "phantom-premium.yaml"), "--no-simulate",
+                                      "--no-workspace", "--json", "--hand", name])
+    lines = [line for line in result.output.strip().splitlines() if line]
+    assert result.exit_code == 2 and len(lines) == 1 and "unknown hand" in lines[0], result.output

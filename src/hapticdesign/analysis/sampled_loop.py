@@ -613,7 +613,8 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
         h_model = np.zeros_like(h)
     if loop.compensation == "none":
         held = np.zeros_like(h)
-    plant = (hh, bh, kp) if transmission is None else _compliant_plant(hh, bh, kp, *(joints(x) for x in transmission))
+    plant = (hh, bh, kp) if transmission is None else _compliant_plant(hh, bh, kp, *(joints(x) for x in transmission),
+                                                                        period=loop.period)
     phi, gamma = held_plant(*plant, loop.period, inputs=n)
     if poses is not None:  # each loop takes its pose's plant
         pick = np.asarray(poses, dtype=np.int64)
@@ -668,18 +669,34 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
 
 
 def _compliant_plant(mass: np.ndarray, damping: np.ndarray, stiffness: np.ndarray, rotor: np.ndarray,
-                     motor_damping: np.ndarray, spring: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                     motor_damping: np.ndarray, spring: np.ndarray,
+                     period: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The plant of :func:`handle_loops` with compliant transmissions over ``(phi, q)`` (P, 2n, 2n each): the rotors
     ``M_r`` and the motors' damping ``B_m`` moved from the rigid ``H_h`` and ``B_h`` to the motor side, the
     transmissions' ``K_t`` between the sides; a one-line error when the link side keeps no positive definite
-    inertia (a link of no mass but the rotor's)."""
+    inertia (a link of no mass but the rotor's), or when a motor resonates on its transmission more than
+    :data:`RESONANCE_LIMIT` radians per period (the exact discretization loses its precision there, and the rigid
+    model, which the compliant one tends to, is the answer)."""
     link = mass - rotor
     if not np.all(np.linalg.eigvalsh(link)[..., 0] > 0) or not np.all(np.linalg.eigvalsh(rotor)[..., 0] > 0):
         raise UserError("a compliant transmission needs a rotor inertia on every motor and a link side of positive "
                         "definite inertia (H minus the rotors' n^2 J_r)")
+    with np.errstate(over="ignore", invalid="ignore"):
+        ratio = np.linalg.solve(rotor, spring)
+    fastest = float(np.sqrt(np.max(np.linalg.eigvals(ratio).real))) if np.all(np.isfinite(ratio)) else math.inf
+    if not fastest * period <= RESONANCE_LIMIT:
+        raise UserError(f"the motors resonate on their transmissions at {fastest / (2 * math.pi):.3g} Hz, more than "
+                        f"{RESONANCE_LIMIT / (2 * math.pi):.3g} times the loop's rate: the transmission is rigid for "
+                        "this loop (leave out transmission_stiffness)")
     zero = np.zeros_like(mass)
     return (np.block([[rotor, zero], [zero, link]]), np.block([[motor_damping, zero], [zero, damping - motor_damping]]),
             np.block([[spring, -spring], [-spring, spring + stiffness]]))
+
+
+RESONANCE_LIMIT = 1e4
+"""The most radians a motor turns on its transmission's spring per sample period (``sqrt(K_t / M_r) T``) that the
+compliant plant takes: the rigid limit is reached long before (1e-4 relative at ``1e7`` N m/rad on the Phantom's
+joint, ``sqrt(K_t / M_r) T`` about 230)."""
 
 
 def held_plant(mass: np.ndarray, damping: np.ndarray, stiffness: np.ndarray,
