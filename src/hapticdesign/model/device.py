@@ -58,6 +58,8 @@ class Device:
     actuators: tuple[Actuator, ...] = ()
     limits: tuple[Limits, ...] = ()
     elasticity: Elasticity | None = None
+    reference: str = ""
+    """The published device a device file derives from (its ``reference:``), "" for one that is its own."""
 
     # -- parameters ---------------------------------------------------------------------------
     @property

@@ -10,10 +10,9 @@ process on the machine loads it from there in milliseconds. What this module add
   pytest-xdist workers) wait for the one compiling and then load its result, instead of all compiling
   the same kernel, and so that two processes never write one kernel's cache index at the same time
   (numba rewrites the index whole: two writers compiling different record types could lose one entry);
-- :func:`compile_notice`: calls back once per group of kernels (:data:`GROUPS`: the rendering loop, the
-  closed-loop kernels, the design kernels), when a kernel of the group actually starts compiling (a cache
-  miss), with the CPU time that group's first compile takes, so that a command says why its first run on a
-  machine takes longer, and nothing once the kernels are in the cache.
+- :func:`compile_notice`: calls back when the kernels of an area (kinematics, dynamics, rendering, design
+  indices) actually start compiling (a cache miss) with the time a first compile takes, then every half minute
+  while they go on, so that a command's first run on a machine says why it takes longer and for how long.
 
 What a first run compiles is kept small where the kernels call each other: a constant argument written
 as a literal (``0``, ``True``) to a separately compiled kernel makes numba compile that kernel once more
@@ -30,6 +29,7 @@ from __future__ import annotations
 
 import fcntl
 import os
+import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
@@ -37,20 +37,46 @@ import numba
 from numba.core import event
 
 LOCK_FILE = "hapticdesign-compile.lock"
-GROUPS: tuple[tuple[str, float, tuple[str, ...]], ...] = (
-    ("the rendering loop", 10.0, ("hapticdesign.simulation.kernel", "hapticdesign.analysis.dynamics.closed_loop_plant")),
-    ("the closed-loop kernels", 12.0, ("hapticdesign.analysis.loops.closure_kernel", "hapticdesign.analysis.loops.records",
-                                       "hapticdesign.analysis.dynamics.actuated_kernel")),
-    ("the design kernels", 7.0, ("hapticdesign.analysis.reach_kernel", "hapticdesign.analysis.design_batch")),
-)
-"""The kernels whose first compile takes long enough to announce: per group its name, about how many CPU seconds
-its first compile takes (``benchmarks/bench_compile.py`` on a 2-core machine: the Phantom's rendering loop, the
-delta's closed-loop kernels, the five-bar study's design kernels beyond those) and its modules."""
+AREAS = (("hapticdesign.simulation", "rendering", 35.0),
+         ("hapticdesign.analysis.dynamics.closed_loop_plant", "rendering", 35.0),
+         ("hapticdesign.analysis.dynamics", "dynamics", 15.0),
+         ("hapticdesign.analysis.design_batch", "design-index", 35.0),
+         ("hapticdesign", "kinematics", 30.0))
+"""Kernel areas by module prefix (the longest matching prefix wins): the area's name and the seconds its first
+compile took on this project's 2-core machine at a load average of 2-4 (wall time of the compiles, empty cache:
+``spec`` of examples/devices/falcon-assumed-motors.yaml for the kinematics, the closed-loop dynamics and the rendering
+loop, ``optimize`` of examples/studies/falcon-redesign.yaml for the design indices), which the notice quotes as the
+time to expect."""
+HEARTBEAT = 30.0
+"""Seconds between the lines that say a long compile is still going."""
 
 
-def notice(group: str, seconds: float) -> str:
-    """The line that says a group of kernels is compiling."""
-    return f"compiling {group}, once per machine: about {seconds:g} CPU-s (later runs load them from numba's cache)"
+def area_of(module: str) -> tuple[str, float] | None:
+    """The area of :data:`AREAS` a kernel's module belongs to and its typical first compile (seconds), or None
+    for a kernel outside the toolkit (a user's)."""
+    found = [(prefix, name, typical) for prefix, name, typical in AREAS
+             if module == prefix or module.startswith(prefix + ".")]
+    if not found:
+        return None
+    _, name, typical = max(found, key=lambda item: len(item[0]))
+    return name, typical
+
+
+def notice(area: str, typical: float) -> str:
+    """The line a first compile of ``area``'s kernels starts with (``typical``: seconds it takes, :data:`AREAS`)."""
+    return (f"compiling the {area} kernels (once per machine: later runs load them from numba's cache); about "
+            f"{_duration(typical)} on a 2-core machine, longer under load...")
+
+
+def still(area: str, kernels: int, seconds: float, typical: float) -> str:
+    """The line that says a compile of ``area``'s kernels is still going, with what is left of the typical time."""
+    left = typical - seconds
+    rest = f"about {_duration(left)} left" if left > 0 else f"longer than the usual {_duration(typical)} (a busy machine)"
+    return f"still compiling the {area} kernels: {kernels} so far in {_duration(seconds)}; {rest}..."
+
+
+def _duration(seconds: float) -> str:
+    return f"{seconds:.0f} s" if seconds < 90 else f"{seconds / 60:.1f} min"
 
 
 def cache_folder(dispatcher) -> str | None:
@@ -88,31 +114,39 @@ def ensure_compiled(dispatcher, *args) -> None:
 
 
 class _FirstCompile(event.Listener):
-    """Calls ``show`` with the group's :func:`notice` at the start of the first compile of a kernel of each of
-    :data:`GROUPS` that a command compiles itself (not the callees a kernel of another group compiles with it)."""
+    """Calls ``show`` with :func:`notice` at the start of the first compile of each area's kernels (:data:`AREAS`),
+    then with :func:`still` at most every :data:`HEARTBEAT` seconds while kernels of that area keep compiling."""
 
-    def __init__(self, show: Callable[[str], None]):
+    def __init__(self, show: Callable[[str], None], clock: Callable[[], float] = time.monotonic):
         self.show = show
-        self.shown: set[str] = set()
-        self.depth = 0
+        self.clock = clock
+        self.started: dict[str, tuple[float, float]] = {}
+        self.count: dict[str, int] = {}
+        self.last = 0.0
 
     def on_start(self, ev) -> None:
-        self.depth += 1
-        if self.depth > 1:
-            return
         module = getattr(getattr(ev.data.get("dispatcher"), "py_func", None), "__module__", "") or ""
-        for group, seconds, modules in GROUPS:
-            if module in modules and group not in self.shown:
-                self.shown.add(group)
-                self.show(notice(group, seconds))
+        found = area_of(module)
+        if found is None:
+            return
+        area, typical = found
+        now = self.clock()
+        self.count[area] = self.count.get(area, 0) + 1
+        if area not in self.started:
+            self.started[area] = (now, typical)
+            self.last = now
+            self.show(notice(area, typical))
+        elif now - self.last >= HEARTBEAT:
+            self.last = now
+            self.show(still(area, self.count[area], now - self.started[area][0], typical))
 
     def on_end(self, ev) -> None:
-        self.depth -= 1
+        """Nothing to do when a compile ends."""
 
 
 @contextmanager
-def compile_notice(show: Callable[[str], None]) -> Iterator[None]:
-    """Within the block, ``show`` a group's :func:`notice` once when a kernel of the group starts compiling (not when
-    it loads from the cache)."""
-    with event.install_listener("numba:compile", _FirstCompile(show)):
+def compile_notice(show: Callable[[str], None], clock: Callable[[], float] = time.monotonic) -> Iterator[None]:
+    """Within the block, ``show`` a line when an area's kernels start compiling (not when they load from the
+    cache), then one every :data:`HEARTBEAT` seconds while they go on (see :class:`_FirstCompile`)."""
+    with event.install_listener("numba:compile", _FirstCompile(show, clock)):
         yield
