@@ -14,7 +14,10 @@ Cases (``main(["phantom", ...])`` runs only the named ones; the three of the iss
 2. ``delta``: ``impedance-range --device examples/devices/delta.yaml --joint 1 --duration 1 --resolution 0.002
    --k-limit 1 --json`` (the first closed-loop run);
 3. ``five-bar``: ``optimize examples/studies/five-bar-geometry.yaml --seed 1`` (into a temporary folder);
-4. ``demo`` (only when named): ``hapticdesign demo``, the README's ``make demo``.
+4. ``demo`` (only when named): ``hapticdesign demo``, the README's ``make demo``;
+5. ``falcon-spec`` and ``falcon-study`` (only when named): ``spec`` of examples/devices/falcon-assumed-motors.yaml
+   and ``optimize examples/studies/falcon-redesign.yaml --seed 1``, the commands whose first compiles the compile
+   notice's typical times per area (:data:`hapticdesign.simulation.warmup.AREAS`) were measured on.
 
 Figures are CPU seconds (user + system) of the child process (``resource.getrusage(RUSAGE_CHILDREN)``
 before and after it), not wall time: the machine may be shared, and a compile spends CPU whether or not
@@ -40,6 +43,8 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 DELTA = ROOT / "examples" / "devices" / "delta.yaml"
 FIVE_BAR = ROOT / "examples" / "studies" / "five-bar-geometry.yaml"
+FALCON = ROOT / "examples" / "devices" / "falcon-assumed-motors.yaml"
+FALCON_STUDY = ROOT / "examples" / "studies" / "falcon-redesign.yaml"
 ONE_CORE = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1", "NUMBA_NUM_THREADS": "1"}
 
 CASES: dict[str, Callable[[Path], list[str]]] = {
@@ -48,6 +53,8 @@ CASES: dict[str, Callable[[Path], list[str]]] = {
                            "--resolution", "0.002", "--k-limit", "1", "--json"],
     "five-bar": lambda work: ["optimize", str(FIVE_BAR), "--seed", "1", "--out", str(work / "five-bar")],
     "demo": lambda work: ["demo"],
+    "falcon-spec": lambda work: ["spec", "--device", str(FALCON), "--out", str(work / "falcon-spec")],
+    "falcon-study": lambda work: ["optimize", str(FALCON_STUDY), "--seed", "1", "--out", str(work / "falcon-study")],
 }
 DEFAULT = ("phantom", "delta", "five-bar")
 GOALS = {"phantom": 15.0, "delta": 20.0, "five-bar": 40.0}
@@ -140,6 +147,20 @@ def kernel_table(result: dict, top: int) -> list[str]:
     return rows
 
 
+def area_line(result: dict) -> str:
+    """Compile CPU seconds (self) per area of the compile notice (:func:`hapticdesign.simulation.warmup.area_of`),
+    to set against the typical times the notice quotes."""
+    sys.path.insert(0, str(ROOT / "src"))
+    from hapticdesign.simulation.warmup import area_of
+
+    spent: dict[str, float] = {}
+    for c in result["compiles"]:
+        found = area_of(c["kernel"].rsplit(".", 1)[0])
+        area = found[0] if found else "numba's own"
+        spent[area] = spent.get(area, 0.0) + c["self"]
+    return "Compile CPU-s per area of the compile notice: " + ", ".join(f"{a} {s:.1f}" for a, s in spent.items())
+
+
 def summary(name: str, result: dict) -> dict[str, float]:
     """Totals of one cold run: CPU, compile CPU (top-level compiles), kernels, specializations, several-signature kernels."""
     compiled = {c["kernel"] for c in result["compiles"]}
@@ -177,6 +198,7 @@ def main(argv: list[str] | None = None) -> None:
         if s["multiple"]:
             print(f"\nKernels with more than one specialization: "
                   + ", ".join(f"`{k.removeprefix('hapticdesign.')}` ({len(cold['kernels'][k])})" for k in s["multiple"]))
+        print(f"\n{area_line(cold)}")
         print(f"\nCPU {s['cpu']:.1f} s, of which compiling {s['compile']:.1f} s; wall {cold['wall']:.1f} s\n", flush=True)
         goal = GOALS.get(name)
         verdict = f"<= {goal:g}: {'met' if s['cpu'] <= goal else 'not met'}" if goal else ""
