@@ -37,16 +37,18 @@ import numba
 from numba.core import event
 
 LOCK_FILE = "hapticdesign-compile.lock"
-AREAS = (("hapticdesign.simulation", "rendering", 35.0),
-         ("hapticdesign.analysis.dynamics.closed_loop_plant", "rendering", 35.0),
-         ("hapticdesign.analysis.dynamics", "dynamics", 15.0),
-         ("hapticdesign.analysis.design_batch", "design-index", 35.0),
-         ("hapticdesign", "kinematics", 30.0))
+AREAS = (("hapticdesign.simulation", "rendering", 30.0),
+         ("hapticdesign.analysis.dynamics.closed_loop_plant", "rendering", 30.0),
+         ("hapticdesign.analysis.dynamics", "dynamics", 7.0),
+         ("hapticdesign.analysis.design_batch", "design-index", 8.0),
+         ("hapticdesign", "kinematics", 11.0))
 """Kernel areas by module prefix (the longest matching prefix wins): the area's name and the seconds its first
 compile took on this project's 2-core machine at a load average of 2-4 (wall time of the compiles, empty cache:
 ``spec`` of examples/devices/falcon-assumed-motors.yaml for the kinematics, the closed-loop dynamics and the rendering
 loop, ``optimize`` of examples/studies/falcon-redesign.yaml for the design indices), which the notice quotes as the
-time to expect."""
+time to expect. Issue 43 cut these compiles; the figures were scaled by the CPU time each area's compiles took in
+the same two commands before and after (``benchmarks/bench_compile.py falcon-spec falcon-study``: kinematics 37-38
+-> 13-14 CPU-s, dynamics 12 -> 5-6, rendering 24 -> 21, design indices 23 -> 5)."""
 HEARTBEAT = 30.0
 """Seconds between the lines that say a long compile is still going."""
 
