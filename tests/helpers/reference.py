@@ -4,8 +4,8 @@ Between samples the held torques are constant, so each sample period is one ``so
 on the free joints, with the prescribed joints following their paths and the dynamics from
 :class:`~hapticdesign.analysis.dynamics.model.DynamicsModel` in NumPy. This is the optional
 adaptive integrator, the cross-check of the numba kernel, and the speed baseline of the
-benchmark. It shares only the configuration types with the fast loop (:mod:`.config`), none of
-its code. Records are taken at the sample instants; the excursion stop and the safety switch are
+benchmark. It shares only the configuration types with the fast loop (:mod:`hapticdesign.simulation.config`), none of
+its code (a test helper, outside the package). Records are taken at the sample instants; the excursion stop and the safety switch are
 checked at every plant-step instant (``config.step``) from the dense output of each period, as the
 fast loop checks them, and a tripped switch removes the torques from that instant on. A Cartesian
 wall takes the handle's position and Jacobian from :mod:`hapticdesign.analysis.kinematics` (for a closed-loop
