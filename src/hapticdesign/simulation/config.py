@@ -1,7 +1,7 @@
 """What a sampled-data simulation is configured with and what it returns (seed 000 §4.1.1).
 
 Shared by the fast loop (:mod:`.loop`, :mod:`.kernel`) and the independent SciPy loop
-(:mod:`.reference`), so that neither imports the other. Defaults follow the seed: plant step
+(``tests/helpers/reference.py``), so that neither imports the other. Defaults follow the seed: plant step
 1e-4 s, sample period 1 ms, perfect sensors (condition ix), no modelling error (condition vi), no
 hand (condition vii), safety switch at 0.06 rad (Fig. 4.7).
 """
