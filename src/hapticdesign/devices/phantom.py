@@ -19,6 +19,10 @@ Default gimbal (6 DOF, our choice, physically consistent, documented in the READ
 because ``C(0,3) u3 = C(0,4) u2``) and moments 2e-6 kg m^2; link 5 an 8 g ring centred at
 ``P_4`` with moments 1e-6 kg m^2; link 6 a 12 g, 30 mm stylus along ``u3`` of frame 6 with
 its mass centre 15 mm out (moments 9e-7, 9e-7, 5e-8 kg m^2, a slender rod).
+
+What the generic engines read from the presets (:class:`~hapticdesign.model.device.PresetData`): the practical
+bounds of links 2, 3, 2a and 3a (eq. 3.29-3.32) and ours of the gimbal's, the seed's dependent variables of LN = 0
+(eq. 3.12-3.26) with their pivots, and the seed's loop settings as the commands' default.
 """
 
 from __future__ import annotations
