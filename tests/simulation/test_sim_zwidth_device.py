@@ -115,7 +115,7 @@ def test_the_device_wall_is_impedance_ranges_limit(index, loop):
     dampers = [0.0, 0.7]
     result = wall_zwidth(device, home, direction, loop, dampers)
     for b, k in zip(dampers, result.K):
-        assert k == pytest.approx(stability_limit(device, replace(loop, virtual_damping=b), equilibrium=0.0,
+        assert k == pytest.approx(stability_limit(device, replace(loop, wall_damping=b), equilibrium=0.0,
                                                   direction=direction).stiffness, rel=1e-12)
     assert result.passivity is None and result.as_dict()["units"] == {"B": "N s/m", "K": "N/m"}
 

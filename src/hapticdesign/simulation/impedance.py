@@ -164,14 +164,14 @@ def stability_limit(device: Device, loop: SampledLoop | None = None, wall_joint:
     loop = loop or SampledLoop()
     rest = wall_pose(device, wall_joint, equilibrium, direction)
     pose, found = rest, None
-    exact = loop.compensation != "none" and loop.model_error == 0.0
+    exact = loop.compensation != "none" and loop.error_percent == 0.0
     for _ in range(1 if exact else REST_STEPS):
         low, high = wall_interval(device, pose, loop, wall_joint, direction, k_max)
         settled = found is not None and abs(high - found.stiffness) <= 1e-9 * found.stiffness
         found = StabilityLimit(high, pose, loop, low)
         if settled or not (0.0 < high < np.inf):
             break
-        model = None if loop.compensation == "none" else model_device(device, loop.model_error)
+        model = None if loop.compensation == "none" else model_device(device, loop.error_percent)
         moved = spring_rest(device, model, rest, _wall_row(device, rest, wall_joint, direction), high,
                             [j for j in range(device.n_dof) if j not in set(loop.held)])
         if moved is None:

@@ -38,7 +38,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from hapticdesign.analysis.dynamics.device import mass_matrix
-from hapticdesign.analysis.sampled_loop import FLOOR, MAX_VIRTUAL_DAMPING, SampledLoop, joint_limit, joint_limits, joint_loops
+from hapticdesign.analysis.sampled_loop import FLOOR, MAX_WALL_DAMPING, SampledLoop, joint_limit, joint_limits, joint_loops
 from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.compensator_model import model_device
 from hapticdesign.simulation.config import handle_jacobian, unit_direction
@@ -47,22 +47,22 @@ MAX_DAMPERS = 1000
 """Most virtual dampers of one Z-width (each one a search of K_max over about 60 eigenvalue problems)."""
 
 
-def max_stiffness(inertia: float, damping: float, loop: SampledLoop, virtual_damping: float = 0.0,
+def max_stiffness(inertia: float, damping: float, loop: SampledLoop, wall_damping: float = 0.0,
                   k_limit: float = 1e9, model_inertia: float | None = None) -> float:
     """The largest stable ``K`` of the joint for a virtual damper ``B`` (0 when even a tiny spring is unstable, inf
     when none up to ``k_limit`` destabilizes it); ``model_inertia`` the full compensator's inertia (default ``c
     J``)."""
-    return joint_limit(inertia, damping, replace(loop, virtual_damping=virtual_damping), k_limit, model_inertia)
+    return joint_limit(inertia, damping, replace(loop, wall_damping=wall_damping), k_limit, model_inertia)
 
 
-def passivity_stiffness(damping: float, loop: SampledLoop, virtual_damping: float) -> float:
+def passivity_stiffness(damping: float, loop: SampledLoop, wall_damping: float) -> float:
     """The passivity bound ``K < 2 (b - |B|) / (T (1 + 2 N))`` (Colgate & Schenkel; delay as Hulin et al.)."""
-    return max(0.0, 2.0 * (damping - abs(virtual_damping)) / (loop.period * (1 + 2 * loop.delay)))
+    return max(0.0, 2.0 * (damping - abs(wall_damping)) / (loop.period * (1 + 2 * loop.delay)))
 
 
-def linear_approximation(damping: float, loop: SampledLoop, virtual_damping: float) -> float:
+def linear_approximation(damping: float, loop: SampledLoop, wall_damping: float) -> float:
     """Short-delay linear boundary ``K = 2 (b + B) / (T + 2 N T)`` (Gil et al. 2009, as we read it)."""
-    return max(0.0, 2.0 * (damping + virtual_damping) / (loop.period * (1 + 2 * loop.delay)))
+    return max(0.0, 2.0 * (damping + wall_damping) / (loop.period * (1 + 2 * loop.delay)))
 
 
 def along_wall(inertia: float, damping: float, reach: float) -> tuple[float, float]:
@@ -99,9 +99,9 @@ class ZWidth:
 def damping_grid(inertia: float, damping: float, loop: SampledLoop, points: int = 25,
                  model_inertia: float | None = None) -> list[float]:
     """Virtual dampers from 0 to where a damper alone destabilizes the loop (bisected to 0.1 %), at most
-    :data:`~hapticdesign.analysis.sampled_loop.MAX_VIRTUAL_DAMPING`."""
+    :data:`~hapticdesign.analysis.sampled_loop.MAX_WALL_DAMPING`."""
     def usable(b: float) -> bool:
-        loops = joint_loops(inertia, damping, replace(loop, virtual_damping=b), model_inertia)
+        loops = joint_loops(inertia, damping, replace(loop, wall_damping=b), model_inertia)
         return bool(loops.radii(np.array([FLOOR]))[0] < 1.0)
 
     return _grid(usable, 4.0 * inertia / loop.period + 4.0 * damping, points)
@@ -109,14 +109,14 @@ def damping_grid(inertia: float, damping: float, loop: SampledLoop, points: int 
 
 def _grid(usable, start: float, points: int) -> list[float]:
     """``points`` dampers from 0 to the largest ``usable`` one (doubled from ``start``, bisected to 0.1 %), at most
-    :data:`~hapticdesign.analysis.sampled_loop.MAX_VIRTUAL_DAMPING`."""
+    :data:`~hapticdesign.analysis.sampled_loop.MAX_WALL_DAMPING`."""
     if not 2 <= points <= 1000:
         raise UserError(f"the damper grid needs 2 to 1000 points, got {points}")
-    lo, hi = 0.0, min(start, MAX_VIRTUAL_DAMPING)
+    lo, hi = 0.0, min(start, MAX_WALL_DAMPING)
     while usable(hi):
-        if hi == MAX_VIRTUAL_DAMPING:  # usable up to the largest damper a loop takes
+        if hi == MAX_WALL_DAMPING:  # usable up to the largest damper a loop takes
             return [float(b) for b in np.linspace(0.0, hi, points)]
-        lo, hi = hi, min(2.0 * hi, MAX_VIRTUAL_DAMPING)
+        lo, hi = hi, min(2.0 * hi, MAX_WALL_DAMPING)
     while hi - lo > 1e-3 * hi:
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if usable(mid) else (lo, mid)
@@ -153,7 +153,7 @@ def wall_zwidth(device, pose: np.ndarray, direction, loop: SampledLoop, dampers:
     mobility = float(unit @ jv @ np.linalg.solve(mass_matrix(device, pose), jv.T) @ unit)
 
     def limit(b: float) -> float:
-        return wall_interval(device, pose, replace(loop, virtual_damping=b), direction=unit)[1]
+        return wall_interval(device, pose, replace(loop, wall_damping=b), direction=unit)[1]
 
     limit(0.0)  # a direction the handle does not move along, or a bad pose, refused before any search
     values = (_grid(lambda b: limit(b) > 0.0, 4.0 / (mobility * loop.period), points) if dampers is None
@@ -171,7 +171,7 @@ def _dampers(dampers: list[float], loop: SampledLoop) -> list[float]:
                          f"{min(values, key=lambda b: b if math.isfinite(b) else -math.inf):g}", "b_values")
     try:  # each damper's loop, validated before any search
         for b in values:
-            replace(loop, virtual_damping=b)
+            replace(loop, wall_damping=b)
     except InputError as exc:
         raise InputError(str(exc), "b_values") from None
     return values
@@ -217,6 +217,6 @@ def stiffness_map(device, joint: int, axes: tuple[int, int], n: int, loop: Sampl
     poses = np.zeros((n * n, device.n_dof))
     poses[:, axes[0]], poses[:, axes[1]] = np.repeat(grid, n), np.tile(grid, n)
     inertia = mass_matrix(device, poses)[:, joint, joint]
-    model = mass_matrix(model_device(device, loop.model_error), poses)[:, joint, joint] if loop.model_error else None
+    model = mass_matrix(model_device(device, loop.error_percent), poses)[:, joint, joint] if loop.error_percent else None
     values = joint_limits(inertia, float(device.damping[joint]), loop, model_inertia=model).reshape(n, n)
     return StiffnessMap(axes, grid.tolist(), grid.tolist(), values.tolist())

@@ -74,7 +74,7 @@ def sampled_loop(seed: bool, period: float, delay: Optional[int], velocity: Opti
     """The one loop record of a command's options: the seed's or practice's settings with the options given."""
     from hapticdesign.analysis.sampled_loop import Hand, SampledLoop
 
-    changes = {"period": period, "model_error": error_percent, "virtual_damping": wall_damping,
+    changes = {"period": period, "error_percent": error_percent, "wall_damping": wall_damping,
                "hand": Hand.optional(hand_mass, hand_damping, hand_stiffness), "held": held,
                **{k: v for k, v in (("delay", delay), ("velocity", velocity), ("compensation", compensation))
                   if v is not None}}

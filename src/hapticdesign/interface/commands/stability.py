@@ -137,7 +137,7 @@ def zwidth_command(
             figures = [str(p) for p in zwidth_chart(result, title, Path(out) / "zwidth", units[1:])]
             if map_joints is not None:
                 figures += _map(dev, joint, map_joints, map_points,
-                                replace(loop, virtual_damping=result.B[0]), Path(out))
+                                replace(loop, wall_damping=result.B[0]), Path(out))
             index = str(write_folder_index(Path(out), "Z-width", f"Exact Z-width of {'a device' if free else 'a 1-DOF'} "
                                            f"haptic display (seed 000 ch. 5 future work): {title}.", figures))
         about = ({"pose": pose.tolist(), "wall_direction": unit_direction(direction).tolist()} if free
