@@ -4,9 +4,9 @@ Docstrings (every string standing alone as a statement: a module's, a class's, a
 code as ``:mod:`...```, ``:func:`...```, ``:class:`...```, ``:meth:`...```, ``:data:`...``` and ``:attr:`...```
 (the API reference renders them as links). Each target is resolved the way the reference reads it: a fully dotted
 name by importing its longest module prefix and walking the attributes; ``.name`` from the module's own package
-(``.config`` beside ``simulation/zwidth.py``) or the module itself; a bare name among the enclosing classes' members, in the module's namespace (its own
-definitions and what it imports), or as a module. A dataclass field, an annotated name and what a class's methods
-assign to ``self`` count as the class's attributes.
+(``.config`` beside ``simulation/zwidth.py``) or the module itself; a bare name among the enclosing classes'
+members, in the module's namespace (its own definitions and what it imports), or as a module. A dataclass field, an
+annotated name and what a class's methods assign to ``self`` count as the class's attributes.
 """
 
 from __future__ import annotations
@@ -71,8 +71,9 @@ def _instance_attributes(klass: type) -> frozenset[str]:
         tree = ast.parse(textwrap.dedent(inspect.getsource(klass)))
     except (OSError, TypeError):
         return frozenset()
-    return frozenset(node.attr for node in ast.walk(tree) if isinstance(node, ast.Attribute)
-                     and isinstance(node.ctx, ast.Store) and isinstance(node.value, ast.Name) and node.value.id == "self")
+    return frozenset(node.attr for node in ast.walk(tree)
+                     if isinstance(node, ast.Attribute) and isinstance(node.ctx, ast.Store)
+                     and isinstance(node.value, ast.Name) and node.value.id == "self")
 
 
 def _attribute(owner, name: str):

@@ -38,7 +38,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from hapticdesign.analysis.dynamics.device import mass_matrix
-from hapticdesign.analysis.sampled_loop import FLOOR, MAX_WALL_DAMPING, SampledLoop, joint_limit, joint_limits, joint_loops
+from hapticdesign.analysis.sampled_loop import (
+    FLOOR, MAX_WALL_DAMPING, SampledLoop, joint_limit, joint_limits, joint_loops,
+)
 from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.compensator_model import model_device
 from hapticdesign.simulation.config import handle_jacobian, unit_direction
@@ -217,6 +219,7 @@ def stiffness_map(device, joint: int, axes: tuple[int, int], n: int, loop: Sampl
     poses = np.zeros((n * n, device.n_dof))
     poses[:, axes[0]], poses[:, axes[1]] = np.repeat(grid, n), np.tile(grid, n)
     inertia = mass_matrix(device, poses)[:, joint, joint]
-    model = mass_matrix(model_device(device, loop.error_percent), poses)[:, joint, joint] if loop.error_percent else None
+    model = (mass_matrix(model_device(device, loop.error_percent), poses)[:, joint, joint] if loop.error_percent
+             else None)
     values = joint_limits(inertia, float(device.damping[joint]), loop, model_inertia=model).reshape(n, n)
     return StiffnessMap(axes, grid.tolist(), grid.tolist(), values.tolist())

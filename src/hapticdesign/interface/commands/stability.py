@@ -138,8 +138,9 @@ def zwidth_command(
             if map_joints is not None:
                 figures += _map(dev, joint, map_joints, map_points,
                                 replace(loop, wall_damping=result.B[0]), Path(out))
-            index = str(write_folder_index(Path(out), "Z-width", f"Exact Z-width of {'a device' if free else 'a 1-DOF'} "
-                                           f"haptic display (seed 000 ch. 5 future work): {title}.", figures))
+            what = "a device" if free else "a 1-DOF"
+            index = str(write_folder_index(Path(out), "Z-width", f"Exact Z-width of {what} haptic display (seed 000 "
+                                           f"ch. 5 future work): {title}.", figures))
         about = ({"pose": pose.tolist(), "wall_direction": unit_direction(direction).tolist()} if free
                  else {"inertia": inertia, "damping": damping, **({} if model is None else {"model_inertia": model})})
         payload = {**result.as_dict(), "settings": shown.as_dict(), "loop": about,

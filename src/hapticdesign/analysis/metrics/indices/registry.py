@@ -193,7 +193,8 @@ def index(function: Callable | None = None, *, unit: str, formula: str | None = 
     the leading axis of the P poses, docs/indices.md) and returns (P,) values; with ``over="points"`` it returns one
     value per design, (``state.designs``,), from all of each design's points (the poses are the designs' one after
     the other); an index that ``needs`` ``parameters`` reads ``state.params`` (name -> (D,) values) and returns
-    (D,). ``renamed`` maps an option's former names to its current one (taken for one release, :meth:`Index.current`)."""
+    (D,). ``renamed`` maps an option's former names to its current one (taken for one release,
+    :meth:`Index.current`)."""
 
     def make(f: Callable) -> Index:
         label = name or getattr(f, "__name__", "")
