@@ -40,6 +40,7 @@ from hapticdesign.devices.device_file import load_device_file  # noqa: E402
 from hapticdesign.errors import UserError  # noqa: E402
 from hapticdesign.optimization.study_evaluation import bind_study  # noqa: E402
 from hapticdesign.optimization.study_file import load_study  # noqa: E402
+from hapticdesign.optimization.study_outputs import without_unit  # noqa: E402
 from hapticdesign.analysis.metrics.indices import evaluate  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -82,7 +83,8 @@ def run_study(scratch: Path) -> tuple[dict, float]:
     for name in KEPT:
         shutil.copyfile(out / name, TARGET / name)
     with open(out / "evaluations.csv", newline="") as handle:
-        feasible = [row for row in csv.DictReader(handle) if row["feasible"] == "yes"]
+        rows = [{without_unit(k): v for k, v in row.items()} for row in csv.DictReader(handle)]  # "mass [kg]": "mass"
+        feasible = [row for row in rows if row["feasible"] == "yes"]
     summary = json.loads(done.stdout)
     summary["feasible"] = [(float(r["mass"]), float(r["force"])) for r in feasible]
     return summary, elapsed

@@ -10,7 +10,8 @@ R-CUBE):
 - :func:`linearity_form` (LN as a quadratic form; ``form.ln``, ``form.parts``) and
   :func:`linear_conditions` (the linear equations of LN = 0).
 - :func:`impedance_range`, :func:`transparency`: the sampled-data rendering criteria.
-- :func:`optimize`: a study file's optimization (docs/optimization.md), answering the front as ``optimize --json``.
+- :func:`optimize`: a study file's optimization (docs/optimization.md), answering the front as ``optimize --json``; its
+  progress goes to stderr unless ``quiet=True``.
 - :func:`index`: register your own design index (a decorator; docs/indices.md), usable in study files.
 - :mod:`hapticdesign.analysis.rcube` and :mod:`hapticdesign.optimization`: the R-CUBE.
 """

@@ -28,6 +28,27 @@ def test_ik_json_puts_the_falcons_arms_at_14_567_degrees():
     assert len(out["passive"]) == 6
 
 
+def test_ik_text_states_each_coordinates_unit():
+    """Every coordinate line carries its unit: the Falcon's revolute joints in rad, with degrees beside."""
+    result = runner.invoke(app, ["ik", "--device", str(EXAMPLES / "falcon.yaml"), "--position", "0,0,0.11"])
+    assert result.exit_code == 0, result.stderr
+    lines = result.stdout.splitlines()
+    assert lines[0] == "falcon: handle at (0, 0, 0.11) m"
+    assert lines[1] == "  t1 = 0.254234872 rad (14.5666 deg)"
+    assert len(lines) == 10 and all(" rad (" in line and line.endswith("deg)" if k < 3 else "deg), passive")
+                                    for k, line in enumerate(lines[1:]))
+
+
+def test_ik_text_gives_a_prismatic_coordinate_in_metres(tmp_path):
+    slider = tmp_path / "slider.yaml"
+    slider.write_text("name: slider\njoints: [{name: x, type: prismatic}, {name: y, type: prismatic}]\n"
+                      "frames: [{name: a, transforms: [tx: x]}, {name: b, parent: a, transforms: [ty: y]}]\n"
+                      "bodies: [{name: b, frame: b, m: 0.1, Ixx: 1e-5, Iyy: 1e-5, Izz: 1e-5}]\nend_effector: b\n")
+    result = runner.invoke(app, ["ik", "--device", str(slider), "--position", "0.02,0.03,0"])
+    assert result.exit_code == 0, result.stderr
+    assert result.stdout.splitlines()[1:] == ["  x = 0.02 m", "  y = 0.03 m"]
+
+
 @pytest.mark.parametrize("position, message", [
     ("0.5,0,0", "out of reach"),
     ("0,0", "--position: expected 3 values"),

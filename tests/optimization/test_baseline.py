@@ -64,6 +64,8 @@ def test_the_device_files_design_is_evaluated_and_the_selected_design_compared_w
     best = two_link_isotropy(L1, 0.12, r)
     page = (tmp_path / "out" / "report.html").read_text()
     rows = {row[0]: row[1:] for row in _rows(page, "The selected design beside the device file's design")}
+    assert rows["l2"][0] == "m" and rows["iso"][0] == "1"  # each quantity's unit
+    rows = {name: row[1:] for name, row in rows.items()}
     assert float(rows["l2"][0]) == pytest.approx(L1 / math.sqrt(2.0), rel=1e-5)
     assert rows["l2"][1] == "0.12" and rows["l2"][3] == "at the upper bound 0.12 of its range"
     assert float(rows["iso"][0]) == pytest.approx(1.0, abs=1e-6)  # the file's design: isotropic
@@ -160,7 +162,7 @@ def test_a_study_without_a_feasible_design_writes_why_then_one_line(tmp_path):
     page = (out / "report.html").read_text()
     reasons = _rows(page, "Why designs were infeasible")
     assert reasons == [["l2 = #, not <= #", "32", reasons[0][2]]]
-    shortest = sorted(rows, key=lambda r: (float(r["l2"]), int(r["evaluation"])))[:10]
+    shortest = sorted(rows, key=lambda r: (float(r["l2 [m]"]), int(r["evaluation"])))[:10]
     closest = _rows(page, "The 10 designs closest to feasible")
     assert [row[0] for row in closest] == [r["evaluation"] for r in shortest]
     assert "The device file's design is not feasible: l2 = 0.141421, not <= 0.05" in unescape(page)

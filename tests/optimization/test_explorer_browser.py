@@ -21,6 +21,7 @@ import pytest
 from typer.testing import CliRunner
 
 from hapticdesign.interface.cli import app
+from hapticdesign.optimization.study_outputs import without_unit
 from tests.optimization.test_study_run import ISOTROPY, MASS, point, write_study
 
 pytestmark = pytest.mark.slow  # end to end in a browser: deselect with -m "not slow"
@@ -43,8 +44,9 @@ def _run(folder: Path, objectives: list[dict]) -> tuple[Path, dict]:
 
 
 def _rows(path: Path) -> list[dict[str, str]]:
+    """The CSV's rows keyed by the study's names (the headers carry units: ``l1 [m]`` -> ``l1``)."""
     with path.open(newline="") as f:
-        return list(csv.DictReader(f))
+        return [{without_unit(k): v for k, v in row.items()} for row in csv.DictReader(f)]
 
 
 @pytest.fixture(scope="module")

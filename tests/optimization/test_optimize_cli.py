@@ -35,6 +35,25 @@ def files(folder: Path) -> dict[str, bytes]:
     return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
 
 
+def test_the_csv_headers_carry_each_quantitys_unit_and_every_other_row_is_numbers(tmp_path):
+    """front.csv and evaluations.csv: one header row, ``name [unit]`` (the device file's length in m, a gear ratio in
+    1, the objectives' indices' units, an expression constraint in its variable's unit), then numbers only."""
+    import csv
+
+    study = small_study(tmp_path)
+    assert optimize(study, "--seed", 2, "--out", tmp_path / "out", "--quiet").exit_code == 0
+    quantities = ["l2 [m]", "actuators.q2.gear_ratio [1]", "iso [1]", "mass [kg]", "l2 [m]"]
+    with open(tmp_path / "out" / "front.csv", newline="") as handle:
+        header, *rows = list(csv.reader(handle))
+    assert header == ["design", *quantities] and rows
+    assert all(math.isfinite(float(cell)) for row in rows for cell in row)
+    with open(tmp_path / "out" / "evaluations.csv", newline="") as handle:
+        header = next(csv.reader(handle))
+    assert header == ["evaluation", "generation", *quantities, "feasible", "reason"]
+    page = (tmp_path / "out" / "report.html").read_text()
+    assert "<th>l2 [m]</th>" in page and "<th>mass [kg]</th>" in page
+
+
 def test_outputs_json_and_the_same_bytes_for_the_same_seed(tmp_path):
     study = small_study(tmp_path)
     first = optimize(study, "--seed", 7, "--out", tmp_path / "a", "--json")

@@ -33,3 +33,21 @@ def test_the_front_fills_the_axes_and_the_far_designs_are_counted(tmp_path, monk
     labels = [t.get_text() for t in ax.get_legend().get_texts()]
     assert labels[0] == "feasible designs (2 beyond the axes)"
     assert study_outputs.front_limits(np.array([2.0, 2.0])) == pytest.approx((1.9, 2.1))
+
+
+def test_a_narrow_front_of_long_numbers_and_long_labels_stays_readable(tmp_path, monkeypatch):
+    """The Falcon redesign's front (issue 45): walls 1340.4-1342.0 N/m, whose ticks ran into each other, and axis
+    labels longer than the axes, which left the figure; checked in pixels (tests/helpers/figure_layout.py)."""
+    from tests.helpers.figure_layout import layout_problems
+
+    front = [(1340.4 + 0.05 * k, 0.106 + 0.001 * k) for k in range(30)]
+    objectives = [SimpleNamespace(name="wall", reduce="min", index="kmax", sense="max"),
+                  SimpleNamespace(name="mass", reduce="median", index="apparent_mass", sense="min")]
+    box = SimpleNamespace(box=SimpleNamespace(center=(0.0, 0.0, 0.11), size=(0.1016,) * 3), grid=3)
+    run = StudyRun(SimpleNamespace(objectives=objectives, workspace=box), 1, [_record(f) for f in front],
+                   list(range(30)))
+    kept = []
+    monkeypatch.setattr(plt, "close", kept.append)
+    monkeypatch.setattr(study_outputs, "save_figure", lambda fig, path: path)
+    pareto_figure(run, Selection(1, 1, "least RMS"), tmp_path)
+    assert layout_problems(kept[0]) == []

@@ -28,6 +28,7 @@ from hapticdesign.devices.device_file import load_device_file
 from hapticdesign.interface.cli import app
 from hapticdesign.optimization.study_evaluation import bind_study
 from hapticdesign.optimization.study_file import load_study
+from hapticdesign.optimization.study_outputs import without_unit
 from hapticdesign.analysis.metrics.indices import evaluate
 from tests.helpers.phantom_premium_ik import reachable
 
@@ -131,7 +132,7 @@ def test_the_documented_front_holds_on_this_machine(bound):
     docs/scripts/phantom_redesign.py writes) evaluated here gives the objectives and the force the file states, to
     1e-9: the documented numbers do not hinge on the machine that ran the search (which designs NSGA-II visits may)."""
     with open(FRONT, newline="") as handle:
-        rows = list(csv.DictReader(handle))
+        rows = [{without_unit(k): v for k, v in row.items()} for row in csv.DictReader(handle)]  # "l1 [m]": "l1"
     assert rows
     names = list(bound.study.spec.variables)
     answers = bound.evaluate([{name: float(row[name]) for name in names} for row in rows])

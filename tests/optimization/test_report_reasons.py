@@ -49,4 +49,4 @@ def test_the_front_table_shows_the_objectives_first(tmp_path):
     page = (tmp_path / "out" / "report.html").read_text()
     table = page[page.index("<caption>The front:"):]
     heads = [unescape(h) for h in re.findall(r"<th>(.*?)</th>", table[:table.index("</thead>")])]
-    assert heads[:5] == ["design", "iso", "mass", "l2", "actuators.q2.gear_ratio"]
+    assert heads[:5] == ["design", "iso [1]", "mass [kg]", "l2 [m]", "actuators.q2.gear_ratio [1]"]

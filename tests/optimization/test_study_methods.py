@@ -285,7 +285,7 @@ def test_what_a_method_cannot_do_is_refused_in_one_line(tmp_path):
 
 def test_the_python_door_is_the_command(tmp_path, capsys):
     study = small_study(tmp_path)
-    result = hd.optimize(study, seed=2, out=tmp_path / "api")
+    result = hd.optimize(study, seed=2, out=tmp_path / "api", quiet=True)
     assert capsys.readouterr() == ("", "")  # nothing printed
     done = CliRunner().invoke(app, ["optimize", str(study), "--seed", "2", "--out", str(tmp_path / "cli"), "--json"])
     assert done.exit_code == 0, done.output
@@ -304,6 +304,20 @@ def test_the_python_door_is_the_command(tmp_path, capsys):
         hd.optimize(study, seed=-1)
     with pytest.raises(UserError, match="no objective named 'speed'"):
         hd.optimize(study, seed=2, weights={"speed": 1.0})
+
+
+def test_the_python_door_shows_its_progress_on_stderr_unless_quiet(tmp_path, capsys, monkeypatch):
+    """Without ``progress`` or ``quiet`` the generations go to stderr (in a log, as here, a line each tenth once the
+    work has run ``LOG_AFTER`` seconds, 0 here); stdout stays empty; ``progress`` given replaces the lines."""
+    monkeypatch.setattr("hapticdesign.interface.common.LOG_AFTER", 0.0)
+    study = small_study(tmp_path)
+    hd.optimize(study, seed=2)
+    out, err = capsys.readouterr()
+    generations = yaml.safe_load(study.read_text())["algorithm"]["generations"]
+    assert out == "" and f"generations: {generations} of {generations}" in err.splitlines(), err
+    seen = []
+    hd.optimize(study, seed=2, progress=lambda done, total: seen.append((done, total)))
+    assert capsys.readouterr() == ("", "") and seen[-1] == (generations, generations)
 
 
 def test_the_polishing_counts_in_the_workload_limit(tmp_path):

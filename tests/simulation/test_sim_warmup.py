@@ -18,21 +18,51 @@ def _toy_kernel():
     return toy
 
 
-def test_the_notice_comes_once_and_only_when_a_rendering_kernel_compiles(monkeypatch):
+class Clock:
+    def __init__(self):
+        self.now = 0.0
+
+    def __call__(self) -> float:
+        return self.now
+
+
+def test_the_notice_names_the_area_once_then_says_every_half_minute_that_compiling_goes_on(monkeypatch):
     toy = _toy_kernel()
     shown = []
     with warmup.compile_notice(shown.append):
-        toy(1.0)  # a kernel outside the rendering modules: no notice
+        toy(1.0)  # a kernel outside the toolkit (a user's): no notice
     assert shown == []
-    monkeypatch.setattr(warmup, "RENDERING", (toy.py_func.__module__,))
-    with warmup.compile_notice(shown.append):
+    monkeypatch.setattr(warmup, "AREAS", (*warmup.AREAS, (toy.py_func.__module__, "toy", 120.0)))
+    clock = Clock()
+    with warmup.compile_notice(shown.append, clock):
         toy(np.zeros(2))  # a new signature: numba compiles it
         toy(np.ones(2))  # compiled already: nothing to say
-        toy(3)  # another compile in the same run: one line is enough
-    assert shown == [warmup.NOTICE]
+        clock.now = 10.0
+        toy(3)  # another compile 10 s later: the first line is enough
+        assert shown == [warmup.notice("toy", 120.0)]
+        clock.now = 40.0
+        toy(np.zeros((2, 2)))  # 40 s in: still compiling, with the time left of the typical 2 min
+        clock.now = 50.0
+        toy(np.zeros((2, 2, 2)))  # 10 s after the last line: quiet
+        clock.now = 200.0
+        toy(True)  # past the typical time
+    assert shown[1:] == ["still compiling the toy kernels: 3 so far in 40 s; about 80 s left...",
+                         "still compiling the toy kernels: 5 so far in 3.3 min; longer than the usual 2.0 min (a busy "
+                         "machine)..."]
+    assert shown[0].startswith("compiling the toy kernels (once per machine") and "about 2.0 min" in shown[0]
     with warmup.compile_notice(shown.append):
         toy(np.zeros(3))  # in memory: no compile, no notice
-    assert shown == [warmup.NOTICE]
+    assert len(shown) == 3
+
+
+def test_each_kernel_module_of_the_toolkit_has_its_area():
+    assert warmup.area_of("hapticdesign.model.walk")[0] == "kinematics"
+    assert warmup.area_of("hapticdesign.analysis.loops.closure_kernel")[0] == "kinematics"
+    assert warmup.area_of("hapticdesign.analysis.dynamics.kernel")[0] == "dynamics"
+    assert warmup.area_of("hapticdesign.analysis.dynamics.closed_loop_plant")[0] == "rendering"
+    assert warmup.area_of("hapticdesign.simulation.kernel")[0] == "rendering"
+    assert warmup.area_of("hapticdesign.analysis.design_batch")[0] == "design-index"
+    assert warmup.area_of("hapticdesignx.model") is None and warmup.area_of("numpy.linalg") is None
 
 
 def test_ensure_compiled_compiles_the_arguments_signature_under_the_cache_folder_lock():

@@ -143,12 +143,14 @@ def assemble_device(
     actuators: tuple[Actuator, ...] = (),
     limits: tuple[Limits, ...] = (),
     elasticity: Elasticity | None = None,
+    reference: str = "",
 ) -> Device:
     """A Device whose ``params`` hold every kinematic and inertial name (``m2``, ``r2x``, ``Ixy2``...).
 
     ``damping`` is the joints' own; the diagonal of the actuators' viscous damping ``b a a^T`` is added to
     it per coordinate (the off-diagonal part is :attr:`Device.damping_matrix`'s).
-    ``elasticity`` (elastic links, joint springs) is checked against the geometry here.
+    ``elasticity`` (elastic links, joint springs) is checked against the geometry here; ``reference`` names the
+    published device a device file derives from.
     """
     params = dict(kinematic)
     for body, inertia in inertias.items():
@@ -160,7 +162,7 @@ def assemble_device(
     if actuators:
         damping = tuple(a + float(b) for a, b in zip(damping, np.diag(damping_matrix(actuators, len(damping)))))
     device = Device(name, description, tuple(kinematic), builder, params, damping, tuple(actuators),
-                    tuple(limits) if any(span is not None for span in limits) else (), elasticity)
+                    tuple(limits) if any(span is not None for span in limits) else (), elasticity, reference)
     mechanism = device.mechanism  # build once: geometry errors surface at load time, not at first use
     if elasticity is not None:  # import the solvers only for elastic devices
         from hapticdesign.analysis.stiffness.device import check_elasticity

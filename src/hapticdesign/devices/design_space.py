@@ -61,6 +61,10 @@ from hapticdesign.model.params_io import read_mapping
 ACTUATOR_FIELDS = ("rotor_inertia", "gear_ratio", "coulomb", "damping", "torque_continuous", "torque_peak",
                    "transmission_stiffness")
 """The numeric fields of a motor a design variable may change (units as in the device file)."""
+ACTUATOR_UNITS = {"rotor_inertia": ("kg m^2", "kg m^2"), "gear_ratio": ("1", "rad/m"), "coulomb": ("N m", "N"),
+                  "damping": ("N m s/rad", "N s/m"), "torque_continuous": ("N m", "N m"), "torque_peak": ("N m", "N m"),
+                  "transmission_stiffness": ("N m/rad", "N/m")}
+"""Units of :data:`ACTUATOR_FIELDS` on a revolute and on a prismatic joint (the torques are the motor's own)."""
 MOTOR_SETS = 4096
 """Distinct sets of motor values whose matrices :meth:`DesignSpace.batch_values` keeps (a study's discrete ratios are
 a few; continuous motor variables give one per design, so the cache starts again past this many)."""
@@ -85,6 +89,25 @@ class Variable:
             return float(getattr(spec.links[self.target].section, self.field))
         value = getattr(spec.actuators[self.target], self.field)
         return math.nan if value is None else float(value)
+
+    def unit(self, spec: DeviceFileSpec) -> str:
+        """Its unit in the device file ``spec``: a parameter's rad where a rotation (a frame's Rx, Ry, Rz or a DH row's
+        alpha, theta) reads it, else m; an inertial parameter's kg, m or kg m^2; a section's m; a motor field's unit
+        on the joint it drives (revolute: N m, prismatic: N; :data:`ACTUATOR_FIELDS`)."""
+        if self.kind == "parameter":
+            rotations = [t.value for frame in spec.frames for t in frame.transforms if t.axis.is_rotation]
+            rotations += [e for row in spec.dh for e in (row.alpha, row.theta)]
+            return "rad" if any(self.name in e.names for e in rotations) else "m"
+        if self.kind == "inertial":
+            field = next(f for f in SEED_FIELDS if seed_parameter_name(f, self.target) == self.name)
+            return "kg" if field == "m" else "m" if field.startswith("r") else "kg m^2"
+        if self.kind == "section":
+            return "m"
+        actuator = spec.actuators[self.target]
+        joints = {j.name: j.type for j in spec.joints}
+        driven = [actuator.joint] if actuator.joint else list(actuator.drives.names)
+        prismatic = any(joints.get(name) == "prismatic" for name in driven)
+        return ACTUATOR_UNITS[self.field][prismatic]
 
     def write(self, data: dict, value: float) -> None:
         """Write ``value`` where the variable sits in the device file's mapping ``data`` (a design written back)."""

@@ -71,6 +71,7 @@ def _device(spec: DeviceFileSpec, loops: ClosedLoops | None) -> Device:
         tuple(None if j.limits is None else (float(j.limits[0]), float(j.limits[1])) for j in spec.joints
               if j.actuated),
         _elasticity(spec),
+        spec.reference or "",
     )
 
 

@@ -318,6 +318,9 @@ class DeviceFileSpec(_FileModel):
 
     name: Name
     description: str = ""
+    reference: Name | None = None
+    """The published device this file derives from (``falcon``, ``phantom-premium``): the spec sheet shows that
+    device's published numbers beside this file's (:data:`hapticdesign.studies.spec_page.VENDOR`)."""
     parameters: dict[Identifier, Number] = {}
     g: Annotated[Number, Field(ge=0.0)] = 9.81
     joints: list[JointSpec] = Field(min_length=1)

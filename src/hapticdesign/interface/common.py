@@ -140,7 +140,7 @@ def estimate_line(step: str, total: int, seconds_left: float) -> str:
 
 
 LOG_AFTER = 2.0
-"""Seconds of work after which progress is written to a log (work that ends sooner needs none)."""
+"""Seconds of a step after which its progress is written to a log (a step that ends sooner needs none)."""
 
 
 @contextmanager
@@ -148,8 +148,10 @@ def progress_bar(enabled: bool) -> Iterator[Report | None]:
     """Progress of long work on stderr, fed by ``report(step, done, total)`` (``total`` None: unknown).
 
     Each step with a known total first states its size and the time it will take, once its pace is known
-    (:class:`TimeLeft`). On a terminal a rich bar follows with the time elapsed and the time left; in a log or
-    a pipe one line each tenth, with the time left, once the work has run :data:`LOG_AFTER` seconds. Yields None (nothing on stderr) when ``enabled`` is false
+    (:class:`TimeLeft`). On a terminal a rich bar follows with the time elapsed and the time left (the step's name
+    whole, wrapped rather than cut where the terminal is narrow); in a log or
+    a pipe one line each tenth, with the time left, once the step has run :data:`LOG_AFTER` seconds (a step that
+    ends sooner writes nothing). Yields None (nothing on stderr) when ``enabled`` is false
     (``--quiet`` or ``--json``), so progress never mixes with a command's output on stdout."""
     from rich.console import Console
 
@@ -167,11 +169,15 @@ def progress_bar(enabled: bool) -> Iterator[Report | None]:
 
     if not console.is_terminal:
         tenths: dict[str, set[int]] = {}
-        began = left.clock()
+        began: dict[str, float] = {}
+        last = [left.clock()]  # the time of the last report: a step's work began after the report before its first
 
         def lines(step: str, done: int, total: int | None) -> None:
             seconds = left(step, done, total)
-            if left.clock() - began < LOG_AFTER:
+            now = left.clock()
+            began.setdefault(step, last[0])
+            last[0] = now
+            if now - began[step] < LOG_AFTER:
                 return
             first_estimate(step, done, total, seconds, lambda text: typer.echo(text, err=True))
             if total is None:
@@ -186,9 +192,11 @@ def progress_bar(enabled: bool) -> Iterator[Report | None]:
         return
     from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn,
                                TimeRemainingColumn)
+    from rich.table import Column
 
-    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-                  TextColumn("left"), TimeRemainingColumn(), console=console, transient=True) as bars:
+    title = TextColumn("{task.description}", markup=False, table_column=Column(overflow="fold", ratio=1))
+    with Progress(title, BarColumn(bar_width=20), MofNCompleteColumn(), TimeElapsedColumn(), TextColumn("left"),
+                  TimeRemainingColumn(), console=console, transient=True, expand=True) as bars:
         tasks: dict[str, int] = {}
 
         def report(step: str, done: int, total: int | None) -> None:

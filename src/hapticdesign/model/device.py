@@ -78,6 +78,8 @@ class Device:
     actuators: tuple[Actuator, ...] = ()
     limits: tuple[Limits, ...] = ()
     elasticity: Elasticity | None = None
+    reference: str = ""
+    """The published device a device file derives from (its ``reference:``), "" for one that is its own."""
     preset_data: PresetData = field(default_factory=PresetData, compare=False, repr=False)
 
     # -- parameters ---------------------------------------------------------------------------

@@ -176,6 +176,25 @@ class BoundStudy:
                        "geometry, inertias, damping or gear ratios it depends on)")
         return out
 
+    def units(self) -> dict[str, str]:
+        """The unit of each column of the study's tables (front.csv, evaluations.csv, the report): a device variable's
+        in its device file (:meth:`~hapticdesign.devices.design_space.Variable.unit`), a variable that only a
+        ``parameters`` formula reads the unit of the device value that formula sets to it alone, an objective's and
+        an index constraint's their index's, an expression constraint's its variables' when they share one; ``""``
+        where none is known."""
+        spec = self.study.spec
+        device = {v.name: v.unit(self.space.spec) for v in self.space.variables}
+        alone = {f.text.strip(): name for name, f in spec.parameters.items() if name in device}
+        out = {name: device.get(name, device.get(alone.get(name, ""), "")) for name in spec.variables}
+        out.update({o.name: self.registry[o.index].unit for o in spec.objectives})
+        for c in spec.constraints:
+            if isinstance(c, IndexConstraint):
+                out[c.label] = self.registry[c.index].unit
+            else:
+                shared = {out.get(name, "") for name, _ in c.parsed.terms}
+                out[c.label] = shared.pop() if len(shared) == 1 else ""
+        return out
+
     def device_values(self, values: dict[str, float]) -> dict[str, float]:
         """The device design variables' values of a design: its variables' and the ``parameters`` formulas'."""
         full = self.study.spec.with_parameters(values)

@@ -143,12 +143,13 @@ def _record(run: StudyRun, record: Record) -> dict:
 
 
 def explorer_data(run: StudyRun, bound: BoundStudy, selection: Selection, designs: list[FrontDesign]) -> dict:
-    """Everything the explorer shows, JSON-ready: the study's variables, objectives (with units and reductions) and
-    constraints; every evaluated design as columns (evaluations.csv's numbers, None where it has none); the front as
+    """Everything the explorer shows, JSON-ready: the study's variables (with their units, :meth:`BoundStudy.units`,
+    "" where none is known), objectives (with units and reductions) and constraints; every evaluated design as columns (evaluations.csv's numbers, None where it has none); the front as
     record indices (0-based); the selected design; the device file's design; the workspace points; and the front
     designs' cards (:func:`front_designs`)."""
     spec = bound.study.spec
     records = run.records
+    units = bound.units()
     grid = "" if not bound.coarseness else f" ({bound.coarseness})"
     objectives = []
     for o in spec.objectives:
@@ -158,13 +159,14 @@ def explorer_data(run: StudyRun, bound: BoundStudy, selection: Selection, design
                            "sense": o.sense, "about": f"{o.sense}imize the {o.reduce} of {o.index}{over}"})
     constraints = []
     for c in spec.constraints:
-        unit = _unit(bound.registry[c.index].unit) if isinstance(c, IndexConstraint) else ""
+        unit = _unit(bound.registry[c.index].unit) if isinstance(c, IndexConstraint) else _unit(units[c.label])
         constraints.append({"name": c.label, "unit": unit, "at_least": c.at_least, "at_most": c.at_most})
     variables = []
     for name, v in spec.variables.items():
         choices = list(v.values) if isinstance(v, Choice) else None
         low, high = (min(v.values), max(v.values)) if choices else v
-        variables.append({"name": name, "low": float(low), "high": float(high), "choices": choices})
+        variables.append({"name": name, "unit": _unit(units[name]), "low": float(low), "high": float(high),
+                          "choices": choices})
     return {
         "title": bound.title,
         "study": bound.study.path.name,

@@ -163,12 +163,34 @@ def _polished(run: StudyRun) -> tuple[list[str], Callable[[Record], list[str]]]:
     return ["polished"], lambda r: ["yes" if r.polished else "no"]
 
 
-def front_csv(run: StudyRun) -> str:
+def with_unit(name: str, units: Mapping[str, str] | None) -> str:
+    """A column's header: ``name [unit]`` where ``units`` knows its unit (:meth:`BoundStudy.units
+    <hapticdesign.optimization.study_evaluation.BoundStudy.units>`), else the name alone (:func:`without_unit`
+    reads the name back)."""
+    unit = (units or {}).get(name, "")
+    return f"{name} [{unit}]" if unit else name
+
+
+def without_unit(header: str) -> str:
+    """The study's name of a column of front.csv or evaluations.csv: ``l1 [m]`` -> ``l1``,
+    ``min_force[torque=continuous] [N]`` -> ``min_force[torque=continuous]``, ``design`` -> ``design``."""
+    head, sep, unit = header.rpartition(" [")
+    return head if sep and unit.endswith("]") else header
+
+
+def _quantity_columns(spec: StudySpec, units: Mapping[str, str] | None) -> list[str]:
+    """The headers of the variables, objectives and constrained values, with their units."""
+    return [with_unit(name, units) for name in (*spec.variables, *(o.name for o in spec.objectives),
+                                                *constraint_labels(spec))]
+
+
+def front_csv(run: StudyRun, units: Mapping[str, str] | None = None) -> str:
     """One row per front design: its number, variables, objectives and constrained values (and whether it was
-    polished, for a study that polishes)."""
+    polished, for a study that polishes); each quantity's header carries its unit in brackets where ``units`` knows
+    it (``l1 [m]``, ``mass [kg]``): one header row, every other row numbers."""
     spec = run.spec
     polished, cell = _polished(run)
-    header = ["design", *spec.variables, *(o.name for o in spec.objectives), *constraint_labels(spec), *polished]
+    header = ["design", *_quantity_columns(spec, units), *polished]
     rows = []
     for n, k in enumerate(run.front, start=1):
         r = run.records[k]
@@ -177,14 +199,14 @@ def front_csv(run: StudyRun) -> str:
     return csv_rows(header, rows)
 
 
-def evaluations_csv(run: StudyRun) -> str:
+def evaluations_csv(run: StudyRun, units: Mapping[str, str] | None = None) -> str:
     """Every evaluated design: generation, variables, objectives, constrained values, feasible or why not (and
     whether it was polished, for a study that polishes: the polished designs follow the last generation; the
-    polishing's other probes are counted in the run's evaluations, not listed)."""
+    polishing's other probes are counted in the run's evaluations, not listed); units in the headers as in
+    :func:`front_csv`."""
     spec = run.spec
     polished, cell = _polished(run)
-    header = ["evaluation", "generation", *spec.variables, *(o.name for o in spec.objectives),
-              *constraint_labels(spec), "feasible", "reason", *polished]
+    header = ["evaluation", "generation", *_quantity_columns(spec, units), "feasible", "reason", *polished]
     rows = []
     for n, r in enumerate(run.records, start=1):
         rows.append([str(n), str(r.generation), *(_number(r.values[v]) for v in spec.variables),
@@ -226,6 +248,10 @@ def normalized_like_front(run: StudyRun, objectives: np.ndarray) -> np.ndarray:
     return np.array(out)
 
 
+AXIS_LABEL_WIDTH = 44
+"""Characters of an axis label's line in the Pareto figure (a longer label wraps, so that it stays in the figure)."""
+
+
 def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: str = "pareto",
                   registry: Mapping[str, Index] = INDICES) -> list[Path]:
     """The front in pairs of objectives, each labelled with its reduction and how coarse the grid is (every feasible
@@ -234,14 +260,18 @@ def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: s
     :func:`front_limits`, and the legend counts the feasible designs beyond them); one objective: its value per
     evaluation (the device file's design a dashed line); more than three: parallel coordinates of the normalized
     front (0 best; the device file's design dashed, normalized alike)."""
+    import textwrap
+
+    from matplotlib.ticker import MaxNLocator
+
     plt = _pyplot()
     spec = run.spec
     units = {o.index: registry[o.index].unit for o in spec.objectives}
     box = spec.workspace
     grids = {o.index: "" if box is None or registry[o.index].of_parameters
              else "; " + Workspace(box.box.center, box.box.size, box.grid).describe() for o in spec.objectives}
-    labels = [f"{o.name}: {o.reduce} {o.index} ({'-' if units[o.index] == '1' else units[o.index]}{grids[o.index]}), "
-              f"{o.sense}imize" for o in spec.objectives]
+    labels = [textwrap.fill(f"{o.name}: {o.reduce} {o.index} ({'-' if units[o.index] == '1' else units[o.index]}"
+                            f"{grids[o.index]}), {o.sense}imize", AXIS_LABEL_WIDTH) for o in spec.objectives]
     feasible = [r for r in run.records if r.feasible]
     F_all = np.array([r.objectives for r in feasible]).reshape(len(feasible), len(labels))
     F = np.array([run.records[k].objectives for k in run.front]).reshape(len(run.front), len(labels))
@@ -278,6 +308,8 @@ def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: s
                 ax.scatter([base[i]], [base[j]], marker="D", s=50, color="black", label=baseline)
             ax.set_xlim(x_low, x_high)
             ax.set_ylim(y_low, y_high)
+            ax.xaxis.set_major_locator(MaxNLocator(5))  # a narrow range of long numbers: few ticks, none colliding
+            ax.yaxis.set_major_locator(MaxNLocator(6))
             ax.set_xlabel(labels[i])
             ax.set_ylabel(labels[j])
             ax.legend(fontsize=8)
@@ -303,24 +335,49 @@ def pareto_figure(run: StudyRun, selection: Selection | None, out: Path, name: s
 
 
 def index_maps(points: np.ndarray, values: dict[str, np.ndarray], title: str) -> bytes:
-    """PNG of each index over the workspace points (one panel per index, colour = value): the two axes of
-    the box that vary for a planar workspace, a 3D scatter for a solid one."""
+    """PNG of :func:`index_figure`."""
     plt = _pyplot()
-    varying = [k for k in range(3) if np.ptp(points[:, k]) > 0.0]
-    n = len(values)
-    solid = len(varying) == 3
-    fig = plt.figure(figsize=(4.6 * n, 4.0), dpi=100)
-    for i, (label, v) in enumerate(values.items(), start=1):
-        ax = fig.add_subplot(1, n, i, projection="3d" if solid else None)
-        axes = varying if solid or len(varying) == 2 else (varying + [k for k in range(3) if k not in varying])[:2]
-        coordinates = [points[:, k] * 1e3 for k in axes]
-        shown = ax.scatter(*coordinates, c=v, cmap="viridis", s=60 if not solid else 40)
-        for k, name in zip(axes, ("set_xlabel", "set_ylabel", "set_zlabel")):
-            getattr(ax, name)(f"{'xyz'[k]} (mm)")
-        fig.colorbar(shown, ax=ax, shrink=0.8)
-        ax.set_title(label, fontsize=9)
-    fig.suptitle(title)
-    fig.tight_layout()
+    fig = index_figure(points, values, title)
     png = figure_bytes(fig, "png")
     plt.close(fig)
     return png
+
+
+def index_figure(points: np.ndarray, values: dict[str, np.ndarray], title: str):
+    """Each index over the workspace points (one panel per index, labelled with its unit; colour = value): the two
+    axes of the box that vary for a planar workspace, a 3D scatter for a solid one, its colour bar under it (clear of
+    the z axis's ticks). An index the same at every point is drawn in one colour and says so instead of a scale."""
+    plt = _pyplot()
+    from matplotlib.ticker import MaxNLocator
+
+    from hapticdesign.simulation.figures import colour_scale
+
+    varying = [k for k in range(3) if np.ptp(points[:, k]) > 0.0]
+    n = len(values)
+    solid = len(varying) == 3
+    fig = plt.figure(figsize=(4.6 * n, 4.6 if solid else 4.0), dpi=100, layout="constrained")
+    axes = varying if solid or len(varying) == 2 else (varying + [k for k in range(3) if k not in varying])[:2]
+    coordinates = [points[:, k] * 1e3 for k in axes]
+    for i, (label, v) in enumerate(values.items(), start=1):
+        ax = fig.add_subplot(1, n, i, projection="3d" if solid else None)
+        v = np.asarray(v, dtype=float)
+        constant = colour_scale(v)[2]  # the value of an index the same at every point (round-off aside), else None
+        if constant is not None:
+            shown = ax.scatter(*coordinates, color="tab:blue", s=40 if solid else 60)
+        else:
+            shown = ax.scatter(*coordinates, c=v, cmap="viridis", s=40 if solid else 60)
+        for k, name in zip(axes, ("set_xlabel", "set_ylabel", "set_zlabel")):
+            getattr(ax, name)(f"{'xyz'[k]} (mm)", fontsize=8)
+        for axis in (ax.xaxis, ax.yaxis, *((ax.zaxis,) if solid else ())):
+            axis.set_major_locator(MaxNLocator(4))
+        ax.tick_params(labelsize=7)
+        if constant:
+            ax.set_title(f"{label}\n{constant[0]:.6g} at every point", fontsize=9)
+            continue
+        bar = fig.colorbar(shown, ax=ax, shrink=0.8, location="bottom" if solid else "right", pad=0.08 if solid else 0.02)
+        bar.set_label(label, fontsize=8)
+        bar.ax.tick_params(labelsize=7)
+        (bar.ax.xaxis if solid else bar.ax.yaxis).set_major_locator(MaxNLocator(4))
+        ax.set_title(label, fontsize=9)
+    fig.suptitle(title)
+    return fig

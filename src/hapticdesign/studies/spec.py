@@ -52,7 +52,7 @@ friction reach the handle as follows:
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -74,6 +74,14 @@ CUBE_SEARCH = (0.0, 0.4, 12)
 CUBE_GRIDS = (3, 5)
 """The grids (points per axis) of the study box the workspace cube is reached on: its corners, edge midpoints and
 face centres (3) and a study's default grid (5)."""
+Report = Callable[[str, int, int | None], None]
+"""``progress(step, done, total)``: how far a long part of the sheet is (as the command line's progress bars take it)."""
+CUBE_STEP = "workspace cube (bisection steps)"
+RENDERING_STEP = "renderable stiffness (exact, with the hand, simulated)"
+
+
+def no_progress(step: str, done: int, total: int | None) -> None:
+    """A progress report that shows nothing."""
 
 
 @dataclass(frozen=True)
@@ -150,24 +158,30 @@ def renderable_stiffness(device: Device, h: Handle, loop: SampledLoop | None = N
 
 
 def renderable(device: Device, h: Handle, loop: SampledLoop, res: float | None,
-               friction: tuple[float, float] | None, simulate: bool = True) -> dict:
+               friction: tuple[float, float] | None, simulate: bool = True, progress: Report = no_progress) -> dict:
     """The renderable-stiffness rows: the exact limit without the hand (worst direction) and with the hand, the
     simulated limit along that direction with the device's dry friction and encoder quantization, and the passivity
-    bounds from the sheet's resolution ``res`` and backdrive ``friction`` (see the module docstring)."""
+    bounds from the sheet's resolution ``res`` and backdrive ``friction`` (see the module docstring); ``progress``
+    hears of each of the three (:data:`RENDERING_STEP`)."""
     from hapticdesign.simulation.impedance import SIMULATED_CAP, TOUCH, device_counts, simulated_limit
 
+    progress(RENDERING_STEP, 0, 3)
     exact, direction, lower = worst_direction(h.jacobian, h.states.H[0], device.damping_matrix,
                                               replace(loop, hand=None), gravity_gradient(device, h.q),
                                               loop_model(device, loop, h.q), device.transmission)
+    progress(RENDERING_STEP, 1, 3)
     hand = loop.hand or GRASP
+    with_hand = renderable_stiffness(device, h, replace(loop, hand=hand))
+    progress(RENDERING_STEP, 2, 3)
     counts = device_counts(device)
     simulated = None
     if simulate and device.transmission is None:  # the simulated loop's plant is rigid
         simulated = simulated_limit(device, replace(loop, hand=None), direction=direction, equilibrium=TOUCH,
                                     counts=counts, start=max(exact, 1.0), k_limit=SIMULATED_CAP)
+    progress(RENDERING_STEP, 3, 3)
     return {
         "exact": exact, "exact_lower": lower, "direction": direction,
-        "exact_with_hand": renderable_stiffness(device, h, replace(loop, hand=hand)), "hand": hand.as_dict(),
+        "exact_with_hand": with_hand, "hand": hand.as_dict(),
         "simulated": simulated, "simulated_counts": counts, "simulated_touch": TOUCH,
         "passivity_viscous": 2.0 * float(np.linalg.eigvalsh(h.states.cartesian_damping[0]).min()) * loop.rate,
         "passivity_coulomb": None if friction is None or res is None else 2.0 * friction[0] / res,
@@ -175,11 +189,11 @@ def renderable(device: Device, h: Handle, loop: SampledLoop, res: float | None,
     }
 
 
-def workspace_cube(device: Device, h: Handle) -> float:
+def workspace_cube(device: Device, h: Handle, progress: Report = no_progress) -> float:
     """Edge (m) of the largest cube (square for a planar device) centred on the handle's position whose study box is
     reached: its points on each grid of :data:`CUBE_GRIDS` (:func:`~hapticdesign.analysis.workspace.cube_points`),
     reached by :func:`~hapticdesign.analysis.workspace.reach_workspace` from the sheet's pose (home by default, as a
-    study reaches its box), found by bisection."""
+    study reaches its box), found by bisection; ``progress`` hears of each bisection step (:data:`CUBE_STEP`)."""
 
     def reaches(half: float) -> bool:
         for grid in CUBE_GRIDS:
@@ -190,21 +204,30 @@ def workspace_cube(device: Device, h: Handle) -> float:
         return True
 
     lo, hi, halvings = CUBE_SEARCH
+    progress(CUBE_STEP, 0, halvings + 1)
     if reaches(hi):
+        progress(CUBE_STEP, halvings + 1, halvings + 1)
         return 2 * hi
-    for _ in range(halvings):
+    for k in range(halvings):
+        progress(CUBE_STEP, k + 1, halvings + 1)
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if reaches(mid) else (lo, mid)
+    progress(CUBE_STEP, halvings + 1, halvings + 1)
     return 2 * lo
 
 
 def spec_sheet(device: Device, q=None, loop: SampledLoop | None = None, workspace: bool = True,
                simulate: bool = True, indices: Sequence[str | Request] = (),
-               registry: Mapping[str, Index] = INDICES) -> dict:
+               registry: Mapping[str, Index] = INDICES, progress: Report = no_progress) -> dict:
     """Every quantity of the module docstring at pose ``q`` (default: home), as a JSON-ready dict; the renderable
     stiffness under the loop settings ``loop`` (default: practice's, :class:`SampledLoop`), its simulated limit
     only with ``simulate``; and, as ``indices`` (name -> value, its unit in ``units``), the design ``indices`` of
-    ``registry`` at the pose (a user's own among them, docs/indices.md)."""
+    ``registry`` at the pose (a user's own among them, docs/indices.md); ``progress(step, done, total)`` hears how far
+    the long parts are (the workspace cube's bisection, the renderable stiffness)."""
+    from hapticdesign.studies.spec_page import check_reference
+
+    if device.reference:
+        check_reference(device.reference)  # refused before the work
     loop = loop or SampledLoop()
     q = configuration_of(device).home.copy() if q is None else np.asarray(q, dtype=float)
     h = handle_at(device, q)
@@ -212,15 +235,16 @@ def spec_sheet(device: Device, q=None, loop: SampledLoop | None = None, workspac
     friction = backdrive_friction(device, h)
     mass = apparent_mass(device, h)
     sheet = {
-        "device": device.name, "q": q, "handle": h.position, "dimensions": h.basis.shape[1],
+        "device": device.name, **({"reference": device.reference} if device.reference else {}),
+        "q": q, "handle": h.position, "dimensions": h.basis.shape[1],
         "resolution": res,
         "force_continuous": inscribed_force(device, h, "continuous"),
         "force_peak": inscribed_force(device, h, "peak"),
         "apparent_mass": {"min": mass[0], "max": mass[1]},
         "backdrive_friction": None if friction is None else {"min": friction[0], "max": friction[1]},
         "stiffness": _stiffness(device, h),
-        "workspace": {"cube": 1000.0 * workspace_cube(device, h)} if workspace else None,
-        "renderable_stiffness": renderable(device, h, loop, res, friction, simulate),
+        "workspace": {"cube": 1000.0 * workspace_cube(device, h, progress)} if workspace else None,
+        "renderable_stiffness": renderable(device, h, loop, res, friction, simulate, progress),
         "units": {"resolution": "m", "force_continuous": "N", "force_peak": "N", "apparent_mass": "kg",
                   "backdrive_friction": "N", "stiffness": "N/m", "workspace": "mm", "renderable_stiffness": "N/m",
                   "rate": "Hz", "handle": "m", "q": "rad or m"},

@@ -21,12 +21,15 @@ import numpy as np
 from hapticdesign.analysis.configuration import handle_pose
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
+from hapticdesign.studies.spec import Report, no_progress
 
 SECTION_POINTS = 15
 """Grid points per side of each section."""
 SECTION_SPAN = 3.0
 """Side of each section in cube edges."""
 AXES = "xyz"
+SECTIONS_STEP = "workspace sections (grid lines)"
+QUANTITIES_STEP = "quantities over the workspace (points reached)"
 
 
 @dataclass(frozen=True)
@@ -60,12 +63,15 @@ def planes(basis: np.ndarray) -> list[tuple[tuple[str, str], np.ndarray]]:
 
 
 def workspace_sections(device: Device, q: np.ndarray, home: np.ndarray, basis: np.ndarray, edge: float,
-                       points: int = SECTION_POINTS) -> list[Section]:
+                       points: int = SECTION_POINTS, progress: Report = no_progress) -> list[Section]:
     """Sections of :func:`planes` (``basis``: the handle's directions of motion at home) around the handle's home
-    position ``home`` (m), each ``SECTION_SPAN * edge`` wide."""
+    position ``home`` (m), each ``SECTION_SPAN * edge`` wide; ``progress`` hears of each grid line walked
+    (:data:`SECTIONS_STEP`)."""
     offsets = np.linspace(-0.5, 0.5, points) * SECTION_SPAN * edge
     out = []
-    for names, axes in planes(basis):
+    chosen = planes(basis)
+    progress(SECTIONS_STEP, 0, len(chosen) * points)
+    for names, axes in chosen:
         reached = np.zeros((points, points), dtype=bool)
         poses = np.full((points, points, len(q)), np.nan)
         last = np.asarray(q, dtype=float)
@@ -76,6 +82,7 @@ def workspace_sections(device: Device, q: np.ndarray, home: np.ndarray, basis: n
                 if pose is not None:
                     reached[i, j], last = True, pose
                     poses[i, j] = pose
+            progress(SECTIONS_STEP, len(out) * points + i + 1, len(chosen) * points)
         out.append(Section(names, axes, offsets, offsets.copy(), reached, poses))
     return out
 
@@ -136,7 +143,8 @@ def section_figure(sections: list[Section], edge: float, title: str):
     return fig
 
 
-def sheet_sections(device: Device, sheet: dict, points: int = SECTION_POINTS) -> tuple[list[Section], float]:
+def sheet_sections(device: Device, sheet: dict, points: int = SECTION_POINTS,
+                   progress: Report = no_progress) -> tuple[list[Section], float]:
     """The sections around the sheet's pose (:func:`hapticdesign.studies.spec.spec_sheet` with its workspace
     cube) and the cube's edge (m)."""
     from hapticdesign.studies.spec import handle_at
@@ -145,7 +153,7 @@ def sheet_sections(device: Device, sheet: dict, points: int = SECTION_POINTS) ->
     edge = sheet["workspace"]["cube"] / 1000.0
     if edge <= 0.0:
         raise UserError("the workspace cube is empty at this pose, so there is no section to draw around it")
-    return workspace_sections(device, h.q, h.position, h.basis, edge, points), edge
+    return workspace_sections(device, h.q, h.position, h.basis, edge, points, progress), edge
 
 
 def workspace_png(device: Device, sections: list[Section], edge: float) -> bytes:
@@ -182,48 +190,103 @@ def quantity_at(device: Device, q: np.ndarray) -> dict[str, float | None]:
             "backdrive_friction": None if friction is None else friction[1]}
 
 
-def quantity_maps(device: Device, sections: list[Section]) -> dict[str, list[np.ndarray]]:
-    """Each quantity of :data:`QUANTITIES` the file states, per section, on its grid (NaN where not reached)."""
+def quantity_maps(device: Device, sections: list[Section], progress: Report = no_progress) -> dict[str, list[np.ndarray]]:
+    """Each quantity of :data:`QUANTITIES` the file states, per section, on its grid (NaN where not reached);
+    ``progress`` hears of each point reached (:data:`QUANTITIES_STEP`)."""
     maps: dict[str, list[np.ndarray]] = {}
+    total, done = sum(int(section.reached.sum()) for section in sections), 0
+    progress(QUANTITIES_STEP, 0, total)
     for k, section in enumerate(sections):
         grid = section.reached.shape
         for i, j in zip(*np.nonzero(section.reached)):
             for key, value in quantity_at(device, section.poses[i, j]).items():
                 if value is not None:
                     maps.setdefault(key, [np.full(grid, np.nan) for _ in sections])[k][i, j] = value
+            done += 1
+            progress(QUANTITIES_STEP, done, total)
     return maps
 
 
-def quantity_png(device: Device, sections: list[Section], edge: float) -> bytes | None:
-    """PNG of :func:`quantity_maps`: one row per quantity, one panel per section (None when no quantity applies)."""
+def quantity_png(device: Device, sections: list[Section], edge: float, progress: Report = no_progress) -> bytes | None:
+    """PNG of :func:`quantity_maps` (:func:`quantity_figure`; None when no quantity applies)."""
+    import matplotlib.pyplot as plt
+
+    from hapticdesign.files import figure_bytes
+
+    fig = quantity_figure(device.name, sections, edge, quantity_maps(device, sections, progress))
+    if fig is None:
+        return None
+    png = figure_bytes(fig, "png", dpi=100)
+    plt.close(fig)
+    return png
+
+
+MAP_INCHES = 3.3
+"""Width and height of one map of :func:`quantity_figure` (inches)."""
+
+
+def quantity_figure(name: str, sections: list[Section], edge: float, maps: dict[str, list[np.ndarray]]):
+    """A matplotlib figure of ``maps`` (:func:`quantity_maps`): one row per quantity, one map per section, each row on
+    one colour scale (its colour bar at the row's end: a quantity reads the same across the planes) between the
+    :data:`~hapticdesign.analysis.metrics.maps.ROBUST_PERCENTILES` of its values, the few beyond in the bar's end
+    colours; a quantity the same at every point reached is drawn in one colour and says so instead of a scale. One
+    legend under the figure names the colours that are not values. None when no quantity applies."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.patches import Patch
+    from matplotlib.ticker import MaxNLocator
 
-    from hapticdesign.analysis.metrics.maps import draw_map
-    from hapticdesign.files import figure_bytes
+    from hapticdesign.analysis.metrics.maps import ABOVE, BELOW, ROBUST_PERCENTILES, UNREACHED, robust_limits
+    from hapticdesign.simulation.figures import colour_scale
 
-    maps = quantity_maps(device, sections)
     rows = [(key, label, unit) for key, label, unit in QUANTITIES if key in maps]
     if not rows:
         return None
-    fig, axes = plt.subplots(len(rows), len(sections), figsize=(panel_width(len(sections)), 3.6 * len(rows)),
-                             squeeze=False, constrained_layout=True)
+    columns = len(sections)
+    fig, axes = plt.subplots(len(rows), columns, figsize=(MAP_INCHES * columns + 1.6, MAP_INCHES * len(rows) + 1.0),
+                             squeeze=False, layout="constrained")
     half = 500.0 * edge
+    beyond = False
     for r, (key, label, unit) in enumerate(rows):
-        for ax, section, values in zip(axes[r], sections, maps[key]):
+        values = np.concatenate([m.ravel() for m in maps[key]])
+        low, high, constant = colour_scale(values)  # a constant: one tick at its value
+        if constant is None:
+            low, high = robust_limits(values) or (low, high)
+        finite = values[np.isfinite(values)]
+        above, below = bool(np.any(finite > high)), bool(np.any(finite < low))
+        beyond = beyond or above or below
+        cmap = plt.get_cmap("viridis").with_extremes(bad=UNREACHED, over=ABOVE, under=BELOW)
+        for ax, section, grid in zip(axes[r], sections, maps[key]):
             step = 1000.0 * (section.u[1] - section.u[0])
             extent = (1000.0 * section.u[0] - step / 2, 1000.0 * section.u[-1] + step / 2,
                       1000.0 * section.v[0] - step / 2, 1000.0 * section.v[-1] + step / 2)
-            draw_map(fig, ax, values, extent, f"{label} [{unit}]")
+            image = ax.imshow(np.ma.masked_invalid(grid).T, origin="lower", extent=extent, cmap=cmap, vmin=low,
+                              vmax=high, interpolation="nearest")
             ax.plot([-half, half, half, -half, -half], [-half, -half, half, half, -half], color="#c0392b",
                     linewidth=1.0)
-            ax.set_xlabel(f"{section.names[0]} - home [mm]")
-            ax.set_ylabel(f"{section.names[1]} - home [mm]")
+            ax.set_xlabel(f"{section.names[0]} - home [mm]", fontsize=8)
+            ax.set_ylabel(f"{section.names[1]} - home [mm]", fontsize=8)
             ax.set_title(f"{label}, {section.names[0]}-{section.names[1]} plane", fontsize=9)
+            ax.xaxis.set_major_locator(MaxNLocator(5))
+            ax.yaxis.set_major_locator(MaxNLocator(5))
+            ax.tick_params(labelsize=7)
             ax.set_aspect("equal")
-    fig.suptitle(wrapped(f"{device.name[:60]}: the sheet's quantities over the workspace reached", fig), fontsize=10)
-    png = figure_bytes(fig, "png", dpi=100)
-    plt.close(fig)
-    return png
+        extend = {(False, False): "neither", (True, False): "max", (False, True): "min", (True, True): "both"}
+        bar = fig.colorbar(image, ax=list(axes[r]), shrink=0.9, aspect=25, extend=extend[(above, below)])
+        bar.ax.tick_params(labelsize=7)
+        if constant is not None:
+            value = constant[0]
+            bar.set_ticks([value])
+            bar.set_label(f"{label} [{unit}]: {value:.4g} at every point", fontsize=8)
+        else:
+            bar.set_label(f"{label} [{unit}]", fontsize=8)
+    handles = [Patch(color=UNREACHED, label="not reached"), Patch(color="#c0392b", label="workspace cube")]
+    if beyond:
+        handles += [Patch(color=ABOVE, label=f"the highest {100 - ROBUST_PERCENTILES[1]:g} % of a row's values"),
+                    Patch(color=BELOW, label=f"the lowest {ROBUST_PERCENTILES[0]:g} %")]
+    fig.legend(handles=handles, loc="outside lower center", ncol=min(len(handles), 2 * columns), fontsize=8,
+               frameon=False)
+    fig.suptitle(wrapped(f"{name[:60]}: the sheet's quantities over the workspace reached", fig), fontsize=10)
+    return fig

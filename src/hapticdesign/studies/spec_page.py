@@ -2,11 +2,15 @@
 each value in words, and the vendor's numbers beside ours with the reason for each difference.
 
 Vendor numbers (stated where they are known): the Phantom Premium 1.5's data sheet (nominal position
-resolution 0.03 mm, continuous force 1.4 N, peak force 8.5 N, apparent mass at the tip under 75 g) and the
-stiffness CHAI3D recommends for rendering on it (800 N/m) and on the Novint Falcon (3000 N/m).
+resolution 0.03 mm, continuous force 1.4 N, peak force 8.5 N, apparent mass at the tip under 75 g), Novint's published
+figures of the Novint Falcon (4 x 4 x 4 in touch space, force over 2 lb, resolution over 400 dpi), and the stiffness
+CHAI3D recommends for rendering on each (800 N/m, 3000 N/m). They are keyed by the published device's name: a device
+file named so, or one deriving from it (``reference: falcon``), shows them.
 """
 
 from __future__ import annotations
+
+from hapticdesign.errors import UserError
 
 VENDOR = {
     "phantom-premium": {
@@ -31,12 +35,36 @@ VENDOR = {
                                  "former."),
     },
     "falcon": {
-        "renderable_stiffness": (3000.0, "N/m", "the file has no damping or friction data (libnifalcon gives "
-                                 "none), so the model's exact limit and passivity bounds are zero; the Falcon "
-                                 "renders walls thanks to its drives' friction and the hand, which the file "
-                                 "does not hold."),
+        "resolution": (0.0635, "mm", "Novint publishes \"> 400 dpi\", a step under 25.4 / 400 = 0.0635 mm; ours is the "
+                       "largest handle step of one count of any motor at the pose (320-slot wheels read in quadrature, "
+                       "through the 0.110 / 0.01425 capstans): 0.038 mm at home, within Novint's figure."),
+        "force_peak": (8.9, "N", "Novint publishes \"> 2 lb\" (8.9 N); libnifalcon states no motor torques, so "
+                       "falcon.yaml has no force; falcon-assumed-motors.yaml assumes a peak torque that gives 9.0 N at "
+                       "home in the weakest direction (an assumption fitted to this number, not a check of it)."),
+        "workspace": (101.6, "mm", "Novint publishes a 4 x 4 x 4 in touch space (101.6 mm), presumably the extent of "
+                      "the handle's travel; ours is the largest cube centred on home that a study reaches as its box on "
+                      "grids 3 and 5 (90.0 mm with libnifalcon's geometry)."),
+        "renderable_stiffness": (3000.0, "N/m", "CHAI3D's stiffness for the Falcon. falcon.yaml has no damping or "
+                                 "friction data (libnifalcon gives none), so the model's exact limit and passivity "
+                                 "bounds are zero; the Falcon renders walls thanks to its drives' friction and the hand: "
+                                 "falcon-assumed-motors.yaml's assumed motor friction gives the simulated row."),
     },
 }
+
+
+def vendor_numbers(name: str) -> dict:
+    """The published numbers of :data:`VENDOR` for the device ``name`` (a device file's own name, or the
+    ``reference:`` a derived file names): none for a device without published numbers."""
+    return VENDOR.get(name, {})
+
+
+def check_reference(name: str) -> None:
+    """A device file's ``reference:`` must name a device whose published numbers are known (:data:`VENDOR`); a
+    one-line :class:`~hapticdesign.errors.UserError` otherwise."""
+    if name not in VENDOR:
+        raise UserError(f"reference: no published numbers of a device named {name!r} are known (known: "
+                        f"{', '.join(VENDOR)})")
+
 
 ROWS = [("resolution", "resolution", "mm"), ("force_continuous", "continuous force", "N"),
         ("force_peak", "peak force", "N"), ("apparent_mass", "apparent mass (min - max)", "kg"),

@@ -137,32 +137,44 @@ def _reach(device: Device, space: Configuration, point: np.ndarray, frame: str |
     return q_a, q
 
 
+REACH_STEP = "reaching the map's points (inverse kinematics)"
+INDICES_STEP = "design indices at the points reached"
+
+
 def device_map(device: Device, points: np.ndarray, requests: Iterable[str | Request], frame: str | None = None,
-               registry: Mapping[str, Index] = INDICES) -> DeviceMap:
+               registry: Mapping[str, Index] = INDICES,
+               progress: Callable[[str, int, int | None], None] | None = None) -> DeviceMap:
     """The indices ``requests`` at each of ``points`` (P, 3) that the handle reaches: in order, each from the last
     point reached, or else straight from home (from home at first and after a point out of reach), by the project's
     inverse kinematics
     (:meth:`~hapticdesign.analysis.configuration.Configuration.reach`, within the joint limits); a point the
-    handle does not reach is NaN with its reason, and the map goes on."""
+    handle does not reach is NaN with its reason, and the map goes on. ``progress(step, done, total)`` hears of each
+    point (:data:`REACH_STEP`) and of the indices' one batch (:data:`INDICES_STEP`)."""
+    report = progress or (lambda step, done, total: None)
     checked = requests_of(requests, registry)
     points = np.asarray(points, dtype=float)
     require_evaluations(f"a map of {len(points)} points", len(points), [r.index for r in checked], registry)
     space = configuration_of(device)
     full, reasons, start = [], [], None
-    for point in points:
+    report(REACH_STEP, 0, len(points))
+    for k, point in enumerate(points, start=1):
         try:
             q_a, q = _reach(device, space, point, frame, start)
         except UserError as exc:
             reasons.append(str(exc))
             start = None
+            report(REACH_STEP, k, len(points))
             continue
         reasons.append(None)
         full.append(q[0])
         start = q[0]
+        report(REACH_STEP, k, len(points))
     reached = np.array([r is None for r in reasons], dtype=bool)
     values = {r.key: np.full(len(points), np.nan) for r in checked}
     if full:
+        report(INDICES_STEP, 0, None)
         found = evaluate_at(device, np.array(full), checked, frame, registry).values
+        report(INDICES_STEP, 1, 1)
         for key, v in found.items():
             values[key][reached] = v
     return DeviceMap(points, values, reached, reasons)

@@ -5,13 +5,17 @@ other simulators (:func:`hapticdesign.analysis.configuration.handle_pose`, :mod:
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Optional
+from typing import TYPE_CHECKING, Optional
 
 import typer
 
 from hapticdesign.errors import UserError
-from hapticdesign.interface.common import note, parse_vector, print_json, user_errors
+from hapticdesign.interface.common import note, parse_vector, print_json, progress_bar, user_errors
 from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
+
+if TYPE_CHECKING:  # for the hints only: the commands import no engine until they run
+    from hapticdesign.model.device import Device
+    from hapticdesign.studies.spec import Report
 
 
 def ik(
@@ -46,9 +50,21 @@ def ik(
             return
         typer.echo(f"{dev.name}: handle at ({', '.join(f'{v:.6g}' for v in target)}) m")
         for name, value in zip(result["coordinates"], pose.q):
-            typer.echo(f"  {name} = {value:.9g}")
+            typer.echo(f"  {name} = {_coordinate_text(dev, name, value)}")
         for name, value in zip(result["passive_coordinates"], pose.passive):
-            typer.echo(f"  {name} = {value:.9g} (passive)")
+            typer.echo(f"  {name} = {_coordinate_text(dev, name, value)}, passive")
+
+
+def _coordinate_text(dev: Device, name: str, value: float) -> str:
+    """A joint coordinate with its unit: metres for a prismatic joint, radians and degrees for a revolute one."""
+    import math
+
+    from hapticdesign.model.mechanism import JointType
+
+    mechanism = dev.mechanism
+    if mechanism.joint_types[mechanism.coordinates.index(name)] == JointType.PRISMATIC:
+        return f"{value:.9g} m"
+    return f"{value:.9g} rad ({math.degrees(value):.6g} deg)"
 
 
 def export(
@@ -116,7 +132,7 @@ def spec(
     from dataclasses import replace
 
     from hapticdesign.analysis.sampled_loop import Hand, SampledLoop
-    from hapticdesign.studies.spec import spec_sheet
+    from hapticdesign.studies.spec import no_progress, spec_sheet
     from hapticdesign.interface.report.spec_page import spec_page
     from hapticdesign.interface.round_off import without_round_off
 
@@ -135,24 +151,13 @@ def spec(
 
         registry = INDICES.with_indices(index_module(indices)) if indices is not None else INDICES
         names = [name.strip() for name in index.split(",") if name.strip()]
-        sheet = spec_sheet(dev, pose, loop, workspace=workspace, simulate=simulate, indices=names, registry=registry)
-        sheet["handle"] = without_round_off(sheet["handle"])  # a position's 1e-18 m residue is 0
+        with progress_bar(not (quiet or json_out)) as report:
+            report = report or no_progress
+            sheet = spec_sheet(dev, pose, loop, workspace=workspace, simulate=simulate, indices=names,
+                               registry=registry, progress=report)
+            sheet["handle"] = without_round_off(sheet["handle"])  # a position's 1e-18 m residue is 0
+            figures = [] if out is None else _spec_figures(dev, sheet, report)
         if out is not None:
-            figures = []
-            if sheet["workspace"] is not None and sheet["workspace"]["cube"] > 0.0:
-                from hapticdesign.studies.spec_maps import SECTION_SPAN, quantity_png, sheet_sections, workspace_png
-
-                sections, edge = sheet_sections(dev, sheet)
-                figures.append(("Workspace sections", f"Planes through the home handle position, {SECTION_SPAN:g} "
-                                "cube edges wide: blue where the handle gets by inverse kinematics on the home branch "
-                                "(within the joint limits, no singularity), the workspace cube's section in red.",
-                                workspace_png(dev, sections, edge)))
-                quantities = quantity_png(dev, sections, edge)
-                if quantities is not None:
-                    figures.append(("Quantities over the workspace", "The sheet's resolution, continuous force, "
-                                    "largest apparent mass and largest backdrive friction at each point of the "
-                                    "sections above, at the pose the inverse kinematics finds there (blank: not "
-                                    "reached); the workspace cube's section in red.", quantities))
             write_atomically(out / "spec.json", dumps_json(sheet) + "\n")
             write_atomically(out / "spec.html", spec_page(sheet, figures))
             note(f"wrote {out / 'spec.html'} and {out / 'spec.json'}", quiet)
@@ -166,6 +171,27 @@ def spec(
                     typer.echo(f"{name}: {_text(number)} [{units['indices'][name]}]")
             elif key != "units":
                 typer.echo(f"{key}: {_text(value)}" + (f" [{units[key]}]" if key in units else ""))
+
+
+def _spec_figures(dev: Device, sheet: dict, report: Report) -> list[tuple[str, str, bytes]]:
+    """The spec page's figures (title, caption, PNG): the workspace sections and the quantities over them, where
+    the sheet has a workspace cube; ``report`` hears how far their inverse kinematics is."""
+    figures = []
+    if sheet["workspace"] is not None and sheet["workspace"]["cube"] > 0.0:
+        from hapticdesign.studies.spec_maps import SECTION_SPAN, quantity_png, sheet_sections, workspace_png
+
+        sections, edge = sheet_sections(dev, sheet, progress=report)
+        figures.append(("Workspace sections", f"Planes through the home handle position, {SECTION_SPAN:g} "
+                        "cube edges wide: blue where the handle gets by inverse kinematics on the home branch "
+                        "(within the joint limits, no singularity), the workspace cube's section in red.",
+                        workspace_png(dev, sections, edge)))
+        quantities = quantity_png(dev, sections, edge, report)
+        if quantities is not None:
+            figures.append(("Quantities over the workspace", "The sheet's resolution, continuous force, "
+                            "largest apparent mass and largest backdrive friction at each point of the "
+                            "sections above, at the pose the inverse kinematics finds there (blank: not "
+                            "reached); the workspace cube's section in red.", quantities))
+    return figures
 
 
 def _text(value) -> str:

@@ -12,7 +12,7 @@ from typing import Optional
 import typer
 
 from hapticdesign.errors import UserError
-from hapticdesign.interface.common import note, parse_vector, print_json, user_errors
+from hapticdesign.interface.common import note, parse_vector, print_json, progress_bar, user_errors
 from hapticdesign.interface.options import DEVICE, JSON_OUT, PARAMS, PRESET, QUIET, STRICT
 
 AXES = "xyz"
@@ -63,7 +63,8 @@ def maps(
             raise UserError(f"--index: give at least one design index (docs/indices.md), got {index[:60]!r}")
         workspace = Workspace(tuple(middle), tuple(abs(sizes)), grid)
         points = workspace.points()
-        found = device_map(dev, points, names, registry=registry)
+        with progress_bar(not (quiet or json_out)) as report:
+            found = device_map(dev, points, names, registry=registry, progress=report)
         used = options_used(requests_of(names, registry), registry)
         files = _write(out, found, names, plane, {k: registry[k].unit for k in names})
         spreads = {k: _spread(found, k, workspace.center_index, grid) for k in names}

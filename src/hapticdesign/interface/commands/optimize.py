@@ -35,7 +35,7 @@ def register(app: typer.Typer) -> None:
             rule = parse_select(select)
             with progress_bar(not (quiet or json_out)) as report:
                 progress = (lambda done, total: report("generations", done, total)) if report else None
-                result = run(study, seed, out, scheduler=scheduler, progress=progress, quiet=quiet,
+                result = run(study, seed, out, scheduler=scheduler, progress=progress, quiet=quiet or json_out,
                              indices=indices or (), **rule)
             if out is not None:
                 note(f"wrote {len(result.files)} files to {out}", quiet)

@@ -1,7 +1,8 @@
 """The work of ``optimize`` and its Python door ``hapticdesign.optimize``: read the study, run its method (here or
 on a Dask cluster), select, write the outputs, and answer an :class:`OptimizationResult`.
 
-The command and the Python door are one function, :func:`optimize`: it never prints, and a user error raises
+The command and the Python door are one function, :func:`optimize`: it prints nothing on stdout, its progress goes to
+stderr unless told ``quiet=True`` (or given its own ``progress``), and a user error raises
 :class:`~hapticdesign.errors.UserError`. Every file goes into the output folder through
 :func:`~hapticdesign.files.write_atomically`; the final files are written only after the run finished, so an
 interrupted run leaves complete checkpoint files and nothing half-written. A run that finished without a feasible
@@ -68,6 +69,19 @@ def _evaluator(bound: BoundStudy, scheduler: str | None, quiet: bool, stack):
     return cluster_evaluator(client, bound.study)
 
 
+def _shown_progress(stack: ExitStack) -> Callable[[int, int], None]:
+    """Generations done on stderr (:func:`~hapticdesign.interface.common.progress_bar`) and the kernels' first
+    compile (:func:`~hapticdesign.simulation.warmup.compile_notice`), for as long as ``stack`` is open."""
+    import sys
+
+    from hapticdesign.interface.common import progress_bar
+    from hapticdesign.simulation.warmup import compile_notice
+
+    report = stack.enter_context(progress_bar(True))
+    stack.enter_context(compile_notice(lambda line: print(line, file=sys.stderr, flush=True)))
+    return lambda done, total: report("generations", done, total)
+
+
 def _check_out(out: Path) -> None:
     if out.exists() and not out.is_dir():
         raise UserError(f"cannot write to {out}: it is a file, not a folder")
@@ -110,8 +124,8 @@ def summary_lines(summary: dict) -> list[str]:
 
 def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Selection) -> list[Path]:
     """Every output file of the run in ``out`` (see :data:`FILES`)."""
-    write_atomically(out / "front.csv", front_csv(run))
-    write_atomically(out / "evaluations.csv", evaluations_csv(run))
+    write_atomically(out / "front.csv", front_csv(run, bound.units()))
+    write_atomically(out / "evaluations.csv", evaluations_csv(run, bound.units()))
     paths = [out / "front.csv", out / "evaluations.csv", *pareto_figure(run, selection, out, registry=bound.registry)]
     chosen = run.records[selection.record]
     write_atomically(out / "selected.yaml", bound.device_file_text(chosen.values, baseline_lines(run, chosen)))
@@ -125,7 +139,7 @@ def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Select
     write_atomically(out / PLOTLY, plotly_js())
     page = render(run, selection, bound.title, Picture((out / "pareto.png").read_bytes(), "Pareto front"), pictures,
                   [*FILES, *kept], explorer_data(run, bound, selection, designs), bound.coarseness,
-                  bound.spread_rows(chosen.values))
+                  bound.spread_rows(chosen.values), bound.units())
     write_atomically(out / "report.html", page)
     return [*paths, out / "selected.yaml", *(out / d.file for d in designs), out / PLOTLY, out / "report.html"]
 
@@ -141,11 +155,12 @@ def _remove_stale_designs(out: Path, count: int) -> None:
 def write_failure(out: Path, run: StudyRun, bound: BoundStudy, error: UserError) -> list[Path]:
     """What a run without a feasible design leaves in ``out``: every evaluation (evaluations.csv) and the report of
     why (``error``'s sentence, the reasons counted by kind, the closest designs, the device file's design)."""
-    write_atomically(out / "evaluations.csv", evaluations_csv(run))
+    write_atomically(out / "evaluations.csv", evaluations_csv(run, bound.units()))
     kept = (["checkpoint/ (one file per generation; a rerun into this folder continues)"]
             if method_of(run.spec).checkpointed else [])
     write_atomically(out / "report.html", render_failure(run, str(error), bound.title,
-                                                         ["evaluations.csv", "report.html", *kept], bound.coarseness))
+                                                         ["evaluations.csv", "report.html", *kept], bound.coarseness,
+                                                         bound.units()))
     return [out / "evaluations.csv", out / "report.html"]
 
 
@@ -205,15 +220,18 @@ def index_module(path: Path) -> list[Index]:
 
 def optimize(study: Path | str, seed: int = 1, out: Path | str | None = None, *, scheduler: str | None = None,
              weights: dict[str, float] | None = None, design: int | None = None,
-             progress: Callable[[int, int], None] | None = None, quiet: bool = True,
+             progress: Callable[[int, int], None] | None = None, quiet: bool = False,
              indices: Sequence[Index] | Path | str = ()) -> OptimizationResult:
     """Run the study file ``study`` with ``seed`` by its method and select a front design: the least RMS of the
     normalized objectives, the least weighted RMS with ``weights`` (objective name -> weight), or the front's
     ``design``-th (seed 001 §7.2). ``out``: a folder for the outputs and the checkpoint (a rerun into it
     continues); ``scheduler``: a Dask scheduler's address whose workers evaluate the designs;
-    ``progress(generation, generations)``; ``quiet``: Dask's own logging silenced; ``indices``: your own design
+    ``progress(generation, generations)``, called after each generation; without it the run shows its progress on
+    stderr (:func:`~hapticdesign.interface.common.progress_bar`: a bar with the time left on a terminal, a line each
+    tenth in a log) and says when the toolkit's kernels compile for the first time on the machine, unless ``quiet``;
+    ``quiet``: nothing on stderr, Dask's own logging silenced too; ``indices``: your own design
     indices (functions decorated with :func:`hapticdesign.index`, or a Python file defining them, run in this
-    process), which the study may name beside the registered ones. Nothing is printed; a bad study, seed or
+    process), which the study may name beside the registered ones. Nothing is printed on stdout; a bad study, seed or
     selection raises :class:`~hapticdesign.errors.UserError`; a ``kmax`` constraint that no design can meet, known
     before the run (:meth:`~hapticdesign.optimization.study_evaluation.BoundStudy.unmeetable_walls`), is a
     :class:`~hapticdesign.errors.RunWarning` before the run starts. The device file's own design is evaluated beside
@@ -238,6 +256,8 @@ def optimize(study: Path | str, seed: int = 1, out: Path | str | None = None, *,
         raise UserError(f"a scheduler distributes the evaluation of designs; method {method.name} solves one program "
                         "here")
     with ExitStack() as stack:
+        if progress is None and not quiet:
+            progress = _shown_progress(stack)
         evaluate = _evaluator(bound, scheduler, quiet, stack)
         run = method.run(bound, seed, evaluate, out, progress)
     run = with_baseline(run, bound)

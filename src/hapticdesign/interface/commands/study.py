@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from contextlib import nullcontext
 from pathlib import Path
 from typing import Optional
 
 import typer
 
 from hapticdesign.errors import UserError
-from hapticdesign.interface.common import print_json, user_errors
+from hapticdesign.interface.common import TimeLeft, duration_text, print_json, user_errors
 from hapticdesign.interface.options import DEVICE, FORCE, FORCE_HINT, JSON_OUT, PRESET, QUIET, SEED
 from hapticdesign.workload import allow_large
 from hapticdesign.studies.steps import STATUS_DONE, STATUS_FAILED, STATUS_SKIPPED, StepResult
@@ -29,9 +31,12 @@ class RichProgress:
     def __init__(self, console) -> None:
         from rich.progress import (BarColumn, MofNCompleteColumn, Progress, SpinnerColumn, TextColumn,
                                    TimeElapsedColumn, TimeRemainingColumn)
+        from rich.table import Column
 
-        self.bars = Progress(SpinnerColumn(), TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                             TimeElapsedColumn(), TextColumn("left"), TimeRemainingColumn(), console=console)
+        title = TextColumn("{task.description}", markup=False, table_column=Column(overflow="fold", ratio=1))
+        self.bars = Progress(SpinnerColumn(), title, BarColumn(bar_width=20), MofNCompleteColumn(),
+                             TimeElapsedColumn(), TextColumn("left"), TimeRemainingColumn(), console=console,
+                             expand=True)
         self.task = None
 
     def begin(self, title: str) -> None:
@@ -45,10 +50,38 @@ class RichProgress:
         self.bars.update(self.task, description=_short(result.title) + mark, total=1, completed=1)
 
 
-def _short(title: str, width: int = 44) -> str:
-    """A step title cut at its first parenthesis or at ``width`` characters, for the progress column."""
-    head = title.split(" (")[0]
-    return head if len(head) <= width else head[: width - 1] + "…"
+class LineProgress:
+    """Study progress in a log or a pipe (where a bar cannot redraw): a line when a step starts, one at each tenth of
+    a step that reports its progress, with the time left, and one when it ends, with its time."""
+
+    def __init__(self, echo: Callable[[str], None]) -> None:
+        self.echo = echo
+        self.title = ""
+        self.left = TimeLeft()
+        self.tenths: set[int] = set()
+        self.bars = nullcontext()
+        """Nothing to open or close (a :class:`RichProgress`'s live bars)."""
+
+    def begin(self, title: str) -> None:
+        self.title, self.left, self.tenths = _short(title), TimeLeft(), set()
+        self.echo(f"{self.title}...")
+
+    def update(self, done: int, total: int) -> None:
+        seconds = self.left(self.title, done, total)
+        tenth = (10 * done) // max(total, 1)
+        if 0 < done < total and tenth not in self.tenths:
+            self.tenths.add(tenth)
+            after = "" if seconds is None else f", about {duration_text(seconds)} left"
+            self.echo(f"  {done} of {total}{after}")
+
+    def end(self, result: StepResult) -> None:
+        self.echo(f"  {result.status} in {duration_text(result.seconds)}")
+
+
+def _short(title: str) -> str:
+    """A step title without its references (what follows its first parenthesis), never cut within its words: a
+    title wider than the progress column wraps onto the next line."""
+    return title.split(" (")[0]
 
 
 def _scale(quick: bool, scale: Optional[str]) -> str:
@@ -84,16 +117,17 @@ def _run(module, settings, out: Path, quiet: bool, as_json: bool) -> dict:
         minutes = settings.estimate_seconds() / 60
         size = f"{settings.scale} run, " if hasattr(settings, "scale") else ""
         console.print(f"{module.TITLE}\n{size}estimated {minutes:.1f} min on a quiet 2-core machine with compiled "
-                      "kernels (longer on a busy machine; a first run compiles them, several minutes more)")
+                      "kernels (longer on a busy machine; a first run compiles them, several minutes more)",
+                      soft_wrap=True, markup=False)
     if show:
-        progress = RichProgress(console)
+        progress = RichProgress(console) if console.is_terminal else LineProgress(lambda line: typer.echo(line, err=True))
         with progress.bars:
             result = module.run(settings, out / "work", progress)
     else:
         result = module.run(settings, out / "work")
     report = write_report(result, out)
     if show:
-        console.print(f"{result.title}: {result.seconds:.1f} s")
+        console.print(f"{result.title}: {result.seconds:.1f} s", soft_wrap=True, markup=False)
     return summary(result, report)
 
 

@@ -14,7 +14,7 @@
   // ---- quantities: variables, objectives, constraints and the evaluation number, each a column over the records
   var dims = [];
   data.variables.forEach(function (v, k) {
-    dims.push({ key: "var:" + v.name, name: v.name, kind: "variable", unit: "SI", values: E.variables[k] });
+    dims.push({ key: "var:" + v.name, name: v.name, kind: "variable", unit: v.unit || "SI", values: E.variables[k] });
   });
   data.objectives.forEach(function (o, k) {
     dims.push({ key: "obj:" + o.name, name: o.name, kind: "objective", unit: o.unit, sense: o.sense, about: o.about,

@@ -18,6 +18,7 @@ import base64
 import hashlib
 import math
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass
 from html import escape
 from importlib.resources import files as package_files
@@ -28,7 +29,7 @@ from hapticdesign.interface.report.tables import cell_text
 from hapticdesign.optimization.study_evaluation import SPREAD_COLUMNS
 from hapticdesign.optimization.study_file import Choice
 from hapticdesign.optimization.study_methods import method_of
-from hapticdesign.optimization.study_outputs import Selection, at_bounds, changes, closest_designs
+from hapticdesign.optimization.study_outputs import Selection, at_bounds, changes, closest_designs, with_unit
 from hapticdesign.optimization.study_run import Record, StudyRun, constraint_labels
 
 
@@ -66,20 +67,21 @@ def _options(options: dict) -> str:
     return ", ".join(f"{k} = {v}" for k, v in options.items())
 
 
-def _study_rows(run: StudyRun, coarseness: str) -> str:
+def _study_rows(run: StudyRun, coarseness: str, units: Mapping[str, str]) -> str:
     spec = run.spec
     over = f" of {coarseness}" if coarseness else ""
-    variables = [[name, *(("choice of " + ", ".join(f"{v:g}" for v in var.values), "") if isinstance(var, Choice)
+    variables = [[name, units.get(name, ""), *(("choice of " + ", ".join(f"{v:g}" for v in var.values), "") if isinstance(var, Choice)
                           else (f"{var[0]:g}", f"{var[1]:g}"))] for name, var in spec.variables.items()]
-    objectives = [[o.name, o.index, _options(o.options), o.reduce + over, o.sense] for o in spec.objectives]
+    objectives = [[o.name, o.index, units.get(o.name, ""), _options(o.options), o.reduce + over, o.sense]
+                  for o in spec.objectives]
     constraints = [[c.label + (f" ({_options(c.options)})" if getattr(c, "options", None) else ""),
-                    "" if c.at_least is None else c.at_least, "" if c.at_most is None else c.at_most]
+                    units.get(c.label, ""), "" if c.at_least is None else c.at_least, "" if c.at_most is None else c.at_most]
                    for c in spec.constraints]
-    parts = [_table("Variables", ["variable", "low or choices", "high"], variables),
-             _table("Objectives (reduced over the workspace)", ["name", "index", "options", "reduction", "sense"],
-                    objectives)]
+    parts = [_table("Variables", ["variable", "unit", "low or choices", "high"], variables),
+             _table("Objectives (reduced over the workspace)", ["name", "index", "unit", "options", "reduction",
+                                                                  "sense"], objectives)]
     if constraints:
-        parts.append(_table("Constraints", ["constrained value", ">=", "<="], constraints))
+        parts.append(_table("Constraints", ["constrained value", "unit", ">=", "<="], constraints))
     parts.append(f"<p>{escape(method_of(spec).describe(run), quote=False)}</p>")
     return "".join(parts)
 
@@ -113,7 +115,7 @@ def _reasons(run: StudyRun) -> str:
                   "each design's reason)", ["reason", "designs", "numbers (#, in order: range)"], rows)
 
 
-def _baseline(run: StudyRun, chosen: Record | None = None) -> str:
+def _baseline(run: StudyRun, units: Mapping[str, str], chosen: Record | None = None) -> str:
     """The device file's design: what to know of it and, in a table, its variables, objectives and constrained values
     (beside ``chosen``'s, with each objective's change from it, gained or lost, and ``chosen``'s variables at a bound
     of their range)."""
@@ -130,7 +132,8 @@ def _baseline(run: StudyRun, chosen: Record | None = None) -> str:
             return text
         rows = ([[name, base.values[name]] for name in spec.variables] + [[*row] for row in zip(names, base.objectives)]
                 + [[*row] for row in zip(labels, base.constraints)])
-        return text + _table("The device file's design", ["quantity", "device file's design"], rows)
+        rows = [[row[0], units.get(row[0], ""), *row[1:]] for row in rows]
+        return text + _table("The device file's design", ["quantity", "unit", "device file's design"], rows)
     bounds = at_bounds(spec, chosen.values)
     moved = changes(run, chosen)
 
@@ -144,9 +147,10 @@ def _baseline(run: StudyRun, chosen: Record | None = None) -> str:
     for k, change in enumerate(moved):  # the objectives' rows follow the variables'
         percent = f"{change.percent:+.3g} %" if math.isfinite(change.percent) else ""
         rows[len(spec.variables) + k][3:] = [percent, change.verdict]
+    rows = [[row[0], units.get(row[0], ""), *row[1:]] for row in rows]
     return text + _table("The selected design beside the device file's design (selected.yaml)",
-                         ["quantity", "device file's design", "selected", "change", "gained or lost; at a bound"],
-                         rows)
+                         ["quantity", "unit", "device file's design", "selected", "change",
+                          "gained or lost; at a bound"], rows)
 
 
 def _document(title: str, body: list[str], files: list[str], scripts: str = "", policy: str = "") -> str:
@@ -208,7 +212,7 @@ def _explorer(data: dict) -> tuple[str, str, str]:
         '<p class="note">Every evaluated design: click a point or a line to pick a design (its card follows), drag a '
         "box or a lasso on a plot or along an axis of the parallel coordinates to filter (a click on an axis clears "
         "its range), pin up to four designs to compare them. The address keeps the view: a link reopens it. "
-        "Variables are in the device file's SI units. <code>window.hdExplorer</code> scripts it (docs/optimization.md)."
+        "Each quantity's unit is in brackets (a variable's from its device file). <code>window.hdExplorer</code> scripts it (docs/optimization.md)."
         '</p><p id="explorer-note"></p>'
         '<div class="toolbar"><label>x <select id="x-axis"></select></label><label>y <select id="y-axis"></select>'
         '</label><button id="clear-filters" type="button">Clear filters</button><span id="filter-status"></span></div>'
@@ -223,14 +227,18 @@ def _explorer(data: dict) -> tuple[str, str, str]:
 
 
 def render(run: StudyRun, selection: Selection, title: str, pareto: Picture, pictures: list[Picture],
-           files: list[str], explorer: dict, coarseness: str = "", spread: list[list] | None = None) -> str:
+           files: list[str], explorer: dict, coarseness: str = "", spread: list[list] | None = None,
+           units: Mapping[str, str] | None = None) -> str:
     """The report as one HTML document: the explorer of ``explorer``'s data
     (:func:`~hapticdesign.optimization.study_explorer.explorer_data`), then the static report; ``coarseness`` says how
     coarse the workspace grid is (``27 points, grid 3``), ``spread`` gives the selected design's pose indices over the
-    points (:meth:`~hapticdesign.optimization.study_evaluation.BoundStudy.spread_rows`)."""
+    points (:meth:`~hapticdesign.optimization.study_evaluation.BoundStudy.spread_rows`), ``units`` each quantity's unit
+    (:meth:`~hapticdesign.optimization.study_evaluation.BoundStudy.units`), shown in the tables' headers or a unit
+    column."""
     spec = run.spec
+    units = units or {}
     names = [o.name for o in spec.objectives]
-    columns = ["design", *names, *spec.variables, *constraint_labels(spec)]  # the objectives first: what a front is
+    columns = ["design", *(with_unit(c, units) for c in (*names, *spec.variables, *constraint_labels(spec)))]
     rows = [[n, *run.records[k].objectives, *(run.records[k].values[v] for v in spec.variables),
              *run.records[k].constraints] for n, k in enumerate(run.front, start=1)]
     chosen = run.records[selection.record]
@@ -238,28 +246,30 @@ def render(run: StudyRun, selection: Selection, title: str, pareto: Picture, pic
                    "mean and the extremes with the points where they are taken", ["index", "unit", *SPREAD_COLUMNS],
                    spread)] if spread else []
     section, scripts, policy = _explorer(explorer)
-    body = [f"<h1>Optimization study: {escape(title)}</h1>", section, "<h2>Study</h2>", _study_rows(run, coarseness),
+    body = [f"<h1>Optimization study: {escape(title)}</h1>", section, "<h2>Study</h2>",
+            _study_rows(run, coarseness, units),
             "<h2>Pareto front</h2>", _image(pareto),
             _table(f"The front: {len(run.front)} feasible, non-dominated designs (front.csv; click a row to pick it)",
                    columns, rows, selection.position, ident="front-table"),
             "<h2>Selected design</h2>",
             f"<p>Design {selection.position + 1} of the front, by the {escape(selection.rule)}; as a device file: "
             "selected.yaml.</p>",
-            _baseline(run, chosen), *over,
+            _baseline(run, units, chosen), *over,
             *(_image(p) for p in pictures),
             "<h2>Infeasible designs</h2>", _reasons(run)]
     return _document(title, body, files, scripts, policy)
 
 
-def _closest(run: StudyRun) -> str:
+def _closest(run: StudyRun, units: Mapping[str, str]) -> str:
     """The designs closest to feasible (:func:`~hapticdesign.optimization.study_outputs.closest_designs`) in a table."""
     spec = run.spec
     closest = closest_designs(run)
     if not closest:
         return ("<p>No design has constrained values: each misses a workspace point or the device file refuses it (the "
                 "sentence above names the design that reaches the most points).</p>")
-    columns = ["evaluation", "why not feasible", "scaled violation", *(o.name for o in spec.objectives),
-               *spec.variables, *constraint_labels(spec)]
+    columns = ["evaluation", "why not feasible", "scaled violation",
+               *(with_unit(c, units) for c in (*(o.name for o in spec.objectives), *spec.variables,
+                                               *constraint_labels(spec)))]
     rows = [[k + 1, run.records[k].reason or "meets the constraints; the keep filters remove it",
              run.records[k].violation, *run.records[k].objectives, *(run.records[k].values[v] for v in spec.variables),
              *run.records[k].constraints] for k in closest]
@@ -267,11 +277,14 @@ def _closest(run: StudyRun) -> str:
                   "evaluations.csv has every design)", columns, rows)
 
 
-def render_failure(run: StudyRun, why: str, title: str, files: list[str], coarseness: str = "") -> str:
+def render_failure(run: StudyRun, why: str, title: str, files: list[str], coarseness: str = "",
+                   units: Mapping[str, str] | None = None) -> str:
     """The report of a run without a feasible design as one HTML document: ``why`` (the run's one-line error), the
-    closest designs, the device file's design and the reasons counted by kind; ``coarseness`` as for :func:`render`."""
-    body = [f"<h1>Optimization study: {escape(title)}</h1>", "<h2>Study</h2>", _study_rows(run, coarseness),
-            "<h2>No feasible design</h2>", f"<p>{escape(why, quote=False)}</p>", _closest(run),
-            "<h2>The device file's design</h2>", _baseline(run),
+    closest designs, the device file's design and the reasons counted by kind; ``coarseness`` and ``units`` as for
+    :func:`render`."""
+    units = units or {}
+    body = [f"<h1>Optimization study: {escape(title)}</h1>", "<h2>Study</h2>", _study_rows(run, coarseness, units),
+            "<h2>No feasible design</h2>", f"<p>{escape(why, quote=False)}</p>", _closest(run, units),
+            "<h2>The device file's design</h2>", _baseline(run, units),
             "<h2>Infeasible designs</h2>", _reasons(run)]
     return _document(title, body, files)

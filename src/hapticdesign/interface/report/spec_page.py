@@ -9,7 +9,7 @@ import base64
 from html import escape
 
 from hapticdesign.interface.report.html import STYLE
-from hapticdesign.studies.spec_page import ROWS, VENDOR, value_text
+from hapticdesign.studies.spec_page import ROWS, value_text, vendor_numbers
 
 
 def _figure(title: str, caption: str, png: bytes) -> str:
@@ -21,8 +21,10 @@ def _figure(title: str, caption: str, png: bytes) -> str:
 def spec_page(sheet: dict, figures=()) -> str:
     """A self-contained HTML page of ``sheet`` (:func:`hapticdesign.studies.spec.spec_sheet`) and ``figures``
     (``(title, caption, png bytes)``, e.g. :func:`hapticdesign.studies.spec_maps.workspace_png`)."""
-    vendor = VENDOR.get(sheet["device"], {})
-    columns = ["quantity", "hapticdesign", "unit", *(("vendor", "why they differ") if vendor else ())]
+    reference = sheet.get("reference")
+    vendor = vendor_numbers(reference or sheet["device"])
+    published = f"vendor ({reference}, the published device)" if reference else "vendor"
+    columns = ["quantity", "hapticdesign", "unit", *((published, "why they differ") if vendor else ())]
     rows = []
     for key, label, unit in ROWS:
         cells = [label, value_text(sheet, key), unit]
