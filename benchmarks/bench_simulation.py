@@ -25,6 +25,7 @@ from __future__ import annotations
 import argparse
 import csv
 import os
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -36,7 +37,9 @@ from hapticdesign.simulation.campaign import META_COLUMNS, run_campaign
 from hapticdesign.simulation.impedance import type_paths
 from hapticdesign.simulation.config import LoopConfig, Wall
 from hapticdesign.simulation.loop import simulate
-from hapticdesign.simulation.reference import simulate_adaptive
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the repository root: the tests' SciPy loop
+from tests.helpers.reference import simulate_adaptive  # noqa: E402
 
 
 def _wall_run() -> None:

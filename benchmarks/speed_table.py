@@ -85,7 +85,8 @@ def simulation_rows() -> list[tuple[str, str, str]]:
     from hapticdesign.simulation.config import LoopConfig, Wall
     from hapticdesign.simulation.impedance import type_paths
     from hapticdesign.simulation.loop import simulate
-    from hapticdesign.simulation.reference import simulate_adaptive
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the repository root: the tests' SciPy loop
+    from tests.helpers.reference import simulate_adaptive
 
     b = _bench("bench_simulation")
     device = preset("phantom-3dof").with_params({"r3y": 0.01, "Ixy2": 4e-4, "m3": 0.05})

@@ -17,6 +17,11 @@ class RunWarning(UserWarning):
     failed verification, evaluated again)."""
 
 
+class RenamedWarning(FutureWarning):
+    """An old name still taken for one release (an index option, a hand): the command line says it in one
+    ``warning:`` line, once, and the run goes on with the new name's meaning."""
+
+
 class InputError(UserError):
     """Bad value of named inputs (``samples``, ``region``, ``q``): the message says the input in
     words and names no command-line flag; ``inputs`` lets a command line name the flags that carry

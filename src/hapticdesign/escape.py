@@ -14,9 +14,6 @@ import keyword
 
 from hapticdesign.errors import UserError
 
-_LATEX = {"\\": r"\textbackslash{}", "{": r"\{", "}": r"\}", "$": r"\$", "&": r"\&", "#": r"\#",
-          "^": r"\^{}", "_": r"\_", "%": r"\%", "~": r"\~{}"}
-
 
 def docstring_text(text: str) -> str:
     """``text`` safe inside a triple-quoted Python string: every character outside printable ASCII,
@@ -30,11 +27,6 @@ def docstring_text(text: str) -> str:
         else:
             out.append(ch.encode("unicode_escape").decode("ascii"))
     return "".join(out)
-
-
-def latex_text(text: str) -> str:
-    """``text`` as literal LaTeX text (special characters escaped)."""
-    return "".join(_LATEX.get(ch, ch) for ch in str(text))
 
 
 def script_json(data) -> str:

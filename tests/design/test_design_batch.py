@@ -24,7 +24,7 @@ ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples" / "devices"
 TUBES = ROOT / "examples" / "studies" / "five-bar-tubes.yaml"
 INDICES = ["isotropy", "apparent_mass", "condition", "manipulability", "inertia_uniformity", "kmax",
-           Request("kmax", {"period": 0.0005, "delay": 2, "damping": 0.05}, "kmax_damped")]
+           Request("kmax", {"period": 0.0005, "delay": 2, "wall_damping": 0.05}, "kmax_damped")]
 KEYS = [r if isinstance(r, str) else r.key for r in INDICES]
 CASES = {
     "five-bar": (["l1", "l2", "d"], Workspace((0.0, 0.0, 0.18), (0.06, 0.0, 0.06), 3),

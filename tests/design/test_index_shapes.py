@@ -29,6 +29,16 @@ from hapticdesign.optimization.study_file import load_study
 
 ROOT = Path(__file__).resolve().parents[2]
 DEVICE = ROOT / "examples" / "studies" / "five-bar-tubes.yaml"
+@pytest.fixture(autouse=True)
+def _global_registry_as_it_was():
+    """The user index files these tests run in-process (``--indices``, ``hd.optimize(indices=...)``) register into the
+    one registry, as a user's session would; other test modules then see the registry as it was."""
+    held = dict(INDICES._own)
+    yield
+    INDICES._own.clear()
+    INDICES._own.update(held)
+
+
 INDEX_FILE = '''import numpy as np
 import hapticdesign as hd
 

@@ -115,7 +115,7 @@ def test_kmax_worst_direction_is_below_every_direction():
     checked against python-control's closed loop in tests/simulation/test_sim_handle_loop.py)."""
     device = load_device_file(EXAMPLES / "five-bar.yaml")
     point = np.array([0.01, 0.0, 0.19])
-    options = {"period": 0.0005, "delay": 2, "damping": 0.5, "velocity": "sampled"}
+    options = {"period": 0.0005, "delay": 2, "wall_damping": 0.5, "velocity": "sampled"}
     requests = [Request("kmax", {**options, "direction": PLANE @ u}, name) for name, u in
                 (("x", [1, 0]), ("z", [0, 1]), ("diagonal", [1, 1]))] + [Request("kmax", options)]
     result = evaluate(device, point[None], requests)

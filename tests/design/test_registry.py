@@ -240,14 +240,21 @@ def test_the_r_cube_indices_are_an_entry_point_of_the_installed_package():
 def test_the_kmax_index_takes_the_sampled_loops_options_and_defaults():
     """The ``kmax`` index's options and defaults are those docs/indices.md states (written here from its row: 1 kHz,
     one sample of delay, no wall damper, the worst direction, backward-difference velocity, gravity compensation, no
-    model error, no hand), and :class:`SampledLoop`'s defaults, the loop every command uses, are the same loop."""
+    model error, no hand), and :class:`SampledLoop`'s defaults, the loop every command uses, are the same loop under
+    the same names (``damping``, the wall damper's former name, taken for one release)."""
+    from dataclasses import fields
+
     from hapticdesign.analysis.sampled_loop import SampledLoop
 
-    documented = {"period": 0.001, "delay": 1, "damping": 0.0, "direction": None, "velocity": "difference",
+    documented = {"period": 0.001, "delay": 1, "wall_damping": 0.0, "direction": None, "velocity": "difference",
                   "compensation": "gravity", "error_percent": 0.0, "hand": None}
     assert dict(INDICES["kmax"].options) == documented
+    assert INDICES["kmax"].renamed == {"damping": "wall_damping"}
+    settings = set(documented) - {"direction"}
+    assert settings <= {f.name for f in fields(SampledLoop)}
+    assert settings - {"hand"} <= set(SampledLoop().as_dict())
     loop = SampledLoop()
-    assert (loop.period, loop.delay, loop.virtual_damping, loop.velocity, loop.compensation, loop.model_error,
+    assert (loop.period, loop.delay, loop.wall_damping, loop.velocity, loop.compensation, loop.error_percent,
             loop.hand, loop.held) == (0.001, 1, 0.0, "difference", "gravity", 0.0, None, ())
 
 
@@ -273,6 +280,6 @@ def test_kmax_with_a_modelling_error_takes_the_compensators_model_batched_and_on
         np.testing.assert_allclose(fast.values["kmax"], slow.values["kmax"], rtol=1e-8)
     device = space.device(designs[-1])
     states = HandleStates(device, reach_workspace(device, points[:1]).full)
-    uniform = wall_limit(states.J_v[0], states.H[0], states.B, SampledLoop(compensation="full", model_error=20.0),
+    uniform = wall_limit(states.J_v[0], states.H[0], states.B, SampledLoop(compensation="full", error_percent=20.0),
                          gravity=states.gravity[0])
     assert uniform < 0.9 * slow.values["kmax"][0]

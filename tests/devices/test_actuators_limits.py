@@ -335,13 +335,13 @@ def test_phantom_motors_adds_the_reflected_inertia_to_the_preset():
 
 
 def test_coupled_motor_in_the_simulation_equals_the_scipy_loop():
-    """The kernel's friction and damping on ``a^T qd`` against the SciPy loop (simulation/reference.py, which sums
+    """The kernel's friction and damping on ``a^T qd`` against the SciPy loop (tests/helpers/reference.py, which sums
     ``A^T (f tanh(A qd / v))`` with NumPy): the Phantom with its motors, type 2, 0.3 s. The friction's slope
     ``f / v`` makes the plant stiff near rest (time constant about 1e-4 s), so RK4 takes 1e-5-s steps here."""
     from hapticdesign.simulation.config import LoopConfig, Wall
     from hapticdesign.simulation.criteria import type_paths
     from hapticdesign.simulation.loop import simulate
-    from hapticdesign.simulation.reference import simulate_adaptive
+    from tests.helpers.reference import simulate_adaptive
 
     motors = load_device_file(EXAMPLES / "phantom-3dof-motors.yaml")
     config = LoopConfig(duration=0.3, step=1e-5, wall=Wall(1, 20.0, 0.0, 0.01))

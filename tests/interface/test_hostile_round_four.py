@@ -68,7 +68,7 @@ def test_the_loop_record_owns_the_ranges_and_the_estimate():
     with pytest.raises(InputError, match="at least 1e-12 s"):
         SampledLoop(period=1e-300)
     with pytest.raises(InputError, match="at most 1e\\+12"):
-        SampledLoop(virtual_damping=1e308)
+        SampledLoop(wall_damping=1e308)
     assert SampledLoop(delay=300, compensation="full").order() == 2 * 301 + 301
     with pytest.raises(WorkloadTooLarge, match="above the limit of 600 rows"):
         joint_limits(0.039, 0.5, SampledLoop(delay=10**9))
@@ -89,11 +89,11 @@ def test_the_analytic_criteria_estimate_their_loops_before_building_them():
 
 def test_the_default_damper_grid_stops_at_the_largest_damper():
     """A heavy joint at a short period reaches the damper cap: the grid ends there instead of overflowing."""
-    from hapticdesign.analysis.sampled_loop import MAX_VIRTUAL_DAMPING, SampledLoop
+    from hapticdesign.analysis.sampled_loop import MAX_WALL_DAMPING, SampledLoop
     from hapticdesign.simulation.zwidth import damping_grid
 
     grid = damping_grid(1e7, 0.5, SampledLoop(period=1e-6, delay=0, velocity="sampled"), points=3)
-    assert grid[-1] <= MAX_VIRTUAL_DAMPING
+    assert grid[-1] <= MAX_WALL_DAMPING
 
 
 # -- options checked before the work is announced ---------------------------------------------------------------

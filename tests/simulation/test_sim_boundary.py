@@ -87,7 +87,7 @@ def test_bad_mass_damper_raises(kwargs):
 @pytest.mark.parametrize("fraction", [1.0, 0.99, 0.9, 0.5, 0.0])
 def test_closed_form_with_compensator_error_is_the_spectral_radius_boundary(inertia, damping, period, fraction):
     """K* = b^2 (1-a)(1-ac) / [J (1-a)(1-ac) - T a b (1-c)], a = exp(-bT/J), against eigenvalues."""
-    loop = (SampledLoop.seed(period=period, model_error=100.0 * (1.0 - fraction)) if fraction else
+    loop = (SampledLoop.seed(period=period, error_percent=100.0 * (1.0 - fraction)) if fraction else
             SampledLoop.seed(period=period, compensation="none"))
     assert compensated_boundary(inertia, damping, period, fraction) == pytest.approx(joint_limit(inertia, damping, loop),
                                                                                      rel=1e-8)
@@ -183,7 +183,7 @@ def test_closed_form_limits():
 def test_simulated_loop_with_compensator_error_meets_the_closed_form(error_percent):
     j, b, t = 0.039, 0.5, 1e-3
     c = 1 - error_percent / 100
-    simulated = simulated_boundary(j, b, SampledLoop.seed(period=t, model_error=error_percent), rel_tol=1e-4,
+    simulated = simulated_boundary(j, b, SampledLoop.seed(period=t, error_percent=error_percent), rel_tol=1e-4,
                                    samples=4000)
     assert simulated == pytest.approx(compensated_boundary(j, b, t, c), rel=2e-3)
 
@@ -218,7 +218,7 @@ def test_batched_limits_are_each_joints_limit(delay, compensate):
     and a 5 % model error in the compensated case), and, uncompensated, python-control's loop of each joint to 1e-8."""
     j, b = _random_joints(np.random.default_rng(10 * delay + compensate), 4)
     loop = SampledLoop(period=5e-4, delay=delay, velocity="sampled", compensation="full" if compensate else "none",
-                       model_error=5.0 if compensate else 0.0, virtual_damping=0.005)
+                       error_percent=5.0 if compensate else 0.0, wall_damping=0.005)
     batched = joint_limits(j, b, loop)
     for inertia, damping, limit in zip(j, b, batched):
         assert limit == pytest.approx(joint_limit(inertia, damping, loop), rel=1e-9)
@@ -252,7 +252,7 @@ def test_grouped_search_gives_each_groups_smallest_limit():
     rng = np.random.default_rng(3)
     j = np.concatenate([10 ** rng.uniform(-3, -2.7, 11), [0.039, 1e-3, 1e-3]])
     b = np.concatenate([10 ** rng.uniform(0.3, 0.7, 11), [0.5, 50.0, 50.0]])
-    loop = SampledLoop.seed(period=1e-4, delay=1, model_error=-5.0)
+    loop = SampledLoop.seed(period=1e-4, delay=1, error_percent=-5.0)
     groups = np.array([0] * 5 + [1] * 6 + [1] + [2] * 2)
     alone = np.array([joint_limit(i, d, loop, k_max=1e5) for i, d in zip(j, b)])
     smallest = joint_limits(j, b, loop, groups, k_max=1e5)

@@ -17,7 +17,7 @@ from hapticdesign.simulation.criteria import Criteria
 from hapticdesign.simulation.impedance import ImpedanceProblem, grid_search, impedance_range
 from hapticdesign.simulation.loop import simulate
 from hapticdesign.simulation.paths import Held, Sine
-from hapticdesign.simulation.reference import simulate_adaptive
+from tests.helpers.reference import simulate_adaptive
 
 GANTRY = """\
 name: gantry

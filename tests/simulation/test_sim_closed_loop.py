@@ -1,6 +1,6 @@
 """The rendering loop on closed-loop devices (the five-bar and the delta of examples/devices).
 
-References, none of which imports the numba loop: the plain SciPy loop (:mod:`hapticdesign.simulation.reference`,
+References, none of which imports the numba loop: the plain SciPy loop (:mod:`tests.helpers.reference`,
 ``solve_ivp`` RK45 with H, C, G from the closed-loop model's slow exact path); the 1-DOF limit
 ``b^2 / H_ww`` of full inertial compensation (seed 000 §4.1.2, :mod:`hapticdesign.analysis.sampled_loop`)
 with ``H_ww`` from :func:`hapticdesign.mass_matrix`; the kinetic energy ``qd^T H qd / 2`` of a free,
@@ -29,7 +29,7 @@ from hapticdesign.simulation.config import (
 )
 from hapticdesign.simulation.loop import simulate
 from hapticdesign.simulation.paths import Held, Sine
-from hapticdesign.simulation.reference import simulate_adaptive
+from tests.helpers.reference import simulate_adaptive
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "devices"
 WALL_JOINT = {"five-bar": 1, "delta": 2}

@@ -1,7 +1,7 @@
 """A Cartesian virtual wall and a hand on closed-loop devices (the five-bar and the delta of examples/devices).
 
 The wall acts along n at the handle, ``tau = J_n^T F`` with ``J_n = n^T J_v T`` in actuated coordinates. References,
-none of which imports the numba loop: the plain SciPy loop (:mod:`hapticdesign.simulation.reference`, the handle's
+none of which imports the numba loop: the plain SciPy loop (:mod:`tests.helpers.reference`, the handle's
 position and Jacobian from :meth:`~hapticdesign.analysis.configuration.Configuration.pose` / ``jacobian`` at the pose
 the loop solver closes); central differences of the handle's closed position; the 1-DOF limit ``b^2 / H_ww`` of full
 inertial compensation (seed 000 §4.1.2), which a Cartesian stiffness K meets at ``K J_n,w^2 = b^2 / H_ww``.
@@ -24,7 +24,7 @@ from hapticdesign.simulation.boundary import envelope_grows
 from hapticdesign.simulation.config import Compensator, Hand, LoopConfig, Sensors, Wall, normal_jacobian, rest_pose
 from hapticdesign.simulation.loop import simulate
 from hapticdesign.simulation.paths import Held, Sine
-from hapticdesign.simulation.reference import simulate_adaptive
+from tests.helpers.reference import simulate_adaptive
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "devices"
 WALL_JOINT = {"five-bar": 1, "delta": 2}

@@ -68,7 +68,7 @@ def test_the_gradient_is_m_g_l_cos_q(q):
 @pytest.mark.parametrize("loop, share", [(SampledLoop(compensation="none"), 0.0),
                                          (SampledLoop(compensation="none", delay=0), 0.0),
                                          (SampledLoop(compensation="none", delay=2, velocity="sampled"), 0.0),
-                                         (SampledLoop(model_error=30.0), 0.7), (SampledLoop(model_error=60.0, delay=2), 0.4)])
+                                         (SampledLoop(error_percent=30.0), 0.7), (SampledLoop(error_percent=60.0, delay=2), 0.4)])
 def test_the_pendulums_limit_is_python_controls_loop_with_its_gravity_stiffness(loop, share):
     """Without compensation (``s = 0``) or with a wrong model (``s = 1 - E/100``: the bob sits on the tip frame with no
     mass-centre offset, so a model whose mass is ``1 - E/100`` times the bob's feeds that share of ``m g l sin q``;
@@ -91,7 +91,7 @@ def test_the_undercompensated_pendulums_simulated_limit_is_the_exact_one():
     ``m g l`` and the compensator's late ``0.4 m g l`` in it (a joint wall resting 1 mrad from the start; the
     compensator's share moves the limit by far more than the tolerance)."""
     device = _pendulum()
-    loop = SampledLoop(model_error=60.0)
+    loop = SampledLoop(error_percent=60.0)
     exact = stability_limit(device, loop, equilibrium=1e-3).stiffness
     simulated = simulated_limit(device, loop, equilibrium=1e-3, rel_tol=1e-3, duration=4.0, friction=False)
     assert simulated == pytest.approx(exact, rel=2e-3)
@@ -117,7 +117,7 @@ def test_a_gravity_compensators_model_error_enters_as_its_model_devices_gradient
     device's, ``0.7^2 m g l`` at the hanging pose (python-control's loop), not ``0.7 m g l`` (whose limit is about 10 %
     higher). At the hanging pose the model's leftover gravity torque is 0, so the wall holds the pendulum at its
     spring's rest."""
-    device, loop = _offset_pendulum(), SampledLoop(model_error=30.0)
+    device, loop = _offset_pendulum(), SampledLoop(error_percent=30.0)
     for q in (0.0,):
         exact = stability_limit(device, loop, equilibrium=q).stiffness
         k_g = M * G * L * math.cos(q)
@@ -129,7 +129,7 @@ def test_a_full_compensators_model_error_is_the_simulated_compensators():
     """Full compensation with a 20 % modelling error on the offset pendulum, no friction: the simulated growth
     boundary (whose compensator is the model device, ``H_m = 0.8^3 m l^2``) is the exact limit built with the model
     device's inertia and gravity gradient; the uniform share ``0.8 H`` gives less than a third of it."""
-    device, loop = _offset_pendulum(), SampledLoop(compensation="full", model_error=20.0)
+    device, loop = _offset_pendulum(), SampledLoop(compensation="full", error_percent=20.0)
     exact = stability_limit(device, loop, equilibrium=1e-3).stiffness
     simulated = simulated_limit(device, loop, equilibrium=1e-3, rel_tol=1e-3, duration=4.0, friction=False)
     assert simulated == pytest.approx(exact, rel=2e-3)
@@ -185,7 +185,7 @@ def test_gravity_pulling_off_the_wall_leaves_a_stable_interval(up, share, delay)
     k_g = (-1.0 if up else 1.0) * M * G * L
     low, high = _python_control_interval(k_g, share, delay)
     loop = SampledLoop(compensation="none" if share == 0.0 else "gravity", delay=delay,
-                       model_error=100.0 * (1.0 - share) if share else 0.0, velocity="sampled")
+                       error_percent=100.0 * (1.0 - share) if share else 0.0, velocity="sampled")
     axis, mass = np.array([[[1.0], [0.0], [0.0]]]), np.array([[[M * L * L]]])
     found = handle_intervals(axis, mass, np.array([[B]]), np.array([[1.0]]), loop, gravity=np.array([[[k_g]]]))
     assert found[0][0] == pytest.approx(low, rel=1e-7) and found[1][0] == pytest.approx(high, rel=1e-7)
@@ -307,7 +307,7 @@ def test_a_cartesian_wall_holds_a_tilted_pendulum_where_its_spring_and_the_lefto
     period = 0.02
     direction = (math.cos(TILT), 0.0, math.sin(TILT))
     device = device_from_mapping(_pendulum_file("tilted pendulum", f"-pi/2 + {TILT}"))
-    loop = SampledLoop(period=period, compensation=compensation, model_error=error)
+    loop = SampledLoop(period=period, compensation=compensation, error_percent=error)
     found = stability_limit(device, loop, equilibrium=0.0, direction=direction)
 
     def held(k: float) -> float:

@@ -21,8 +21,8 @@ from hapticdesign.analysis.dynamics.device import gravity_gradient, mass_matrix
 from hapticdesign.analysis.sampled_loop import GRASP, HANDS, Hand, SampledLoop, compensated_boundary
 from hapticdesign.analysis.wall_stiffness import KMAX_OPTIONS, kmax_loop, wall_limit
 from hapticdesign.devices.device_file import load_device_file
-from hapticdesign.errors import UserError
-from hapticdesign.analysis.metrics.indices import Request, evaluate
+from hapticdesign.errors import RenamedWarning, UserError
+from hapticdesign.analysis.metrics.indices import INDICES, Request, evaluate, requests_of
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "devices"
 PERIOD = 1e-3
@@ -89,25 +89,41 @@ def test_one_joint_loop_is_the_seed_limits_closed_form():
     the closed form gives, with and without a modelling error."""
     jv, h, b = np.array([[1.0], [0.0], [0.0]]), np.array([[0.004]]), np.array([[0.0005]])
     for error in (0.0, 5.0, -0.5):
-        loop = SampledLoop.seed(model_error=error)
+        loop = SampledLoop.seed(error_percent=error)
         assert wall_limit(jv, h, b, loop, np.array([1.0, 0.0, 0.0])) == pytest.approx(
             compensated_boundary(0.004, 0.0005, PERIOD, 1.0 - error / 100.0), rel=1e-8)
 
 
 def test_kmax_index_is_the_wall_limit_with_its_options(five_bar):
-    """The index's options reach the loop as this test writes it (``period``, ``delay``, ``damping`` as the wall's
+    """The index's options reach the loop as this test writes it (``period``, ``delay``, ``wall_damping`` as the wall's
     damper, ``"light"`` as the light hand, the direction, gravity's gradient at the pose): the plumbing, checked
     against :func:`wall_limit`, whose values are pinned independently, python-control's loop with the hand and the
     delay in this file's other tests and gravity's gradient in test_sim_gravity_gradient.py."""
     device, point, jv, h, b = five_bar
-    options = {"period": 0.0005, "delay": 2, "damping": 0.5, "hand": "light"}
+    options = {"period": 0.0005, "delay": 2, "wall_damping": 0.5, "hand": "light"}
     u = np.array([0.6, 0.0, 0.8])
     result = evaluate(device, point[None], [Request("kmax", {**options, "direction": u}, "along"),
                                             Request("kmax", options, "worst")])
-    loop = SampledLoop(period=0.0005, delay=2, virtual_damping=0.5, hand=GRASP)
+    loop = SampledLoop(period=0.0005, delay=2, wall_damping=0.5, hand=GRASP)
     gravity = gravity_gradient(device, handle_pose(device, point).q)  # the index linearizes gravity's pull too
     assert result.values["along"][0] == pytest.approx(wall_limit(jv, h, b, loop, u, gravity), rel=1e-9)
     assert result.values["worst"][0] <= result.values["along"][0]
+
+
+def test_the_kmax_options_former_damping_is_the_wall_damping_for_one_release(five_bar):
+    """``damping`` (the option's former name) gives the same values as ``wall_damping`` with one deprecation line;
+    both at once is one line of error."""
+    device, point, *_ = five_bar
+    options = {"period": 0.0005, "delay": 2, "direction": [0.6, 0.0, 0.8]}
+    new = evaluate(device, point[None], [Request("kmax", {**options, "wall_damping": 0.5}, "k")]).values["k"][0]
+    with pytest.warns(RenamedWarning, match="'damping' is now called 'wall_damping'"):
+        old = evaluate(device, point[None], [Request("kmax", {**options, "damping": 0.5}, "k")]).values["k"][0]
+    assert old == new and new != evaluate(device, point[None], [Request("kmax", options, "k")]).values["k"][0]
+    with pytest.warns(RenamedWarning), pytest.raises(UserError, match="give wall_damping once"):
+        requests_of([Request("kmax", {"wall_damping": 0.5, "damping": 0.5})])
+    with pytest.warns(RenamedWarning):
+        assert requests_of([Request("kmax", {"damping": 0.5})])[0].options == {"wall_damping": 0.5}
+    assert "damping" not in INDICES["kmax"].options
 
 
 def test_the_kmax_index_takes_a_hand_by_name(five_bar):

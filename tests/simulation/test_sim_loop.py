@@ -9,7 +9,7 @@ from hapticdesign.errors import UserError
 from hapticdesign.simulation.config import Compensator, Hand, LoopConfig, Sensors, Wall
 from hapticdesign.simulation.loop import joint_index, simulate
 from hapticdesign.simulation.paths import Chirp, Held, Sine
-from hapticdesign.simulation.reference import simulate_adaptive
+from tests.helpers.reference import simulate_adaptive
 
 NONLINEAR = {"r3y": 0.01, "Ixy2": 4e-4, "m3": 0.05, "Ixz3": 1e-3, "r2az": 0.02}
 

@@ -111,7 +111,7 @@ def _joint_limit(spring: float | None, loop: SampledLoop) -> float:
 @pytest.mark.parametrize("spring", [20.0, 200.0, 2000.0])
 @pytest.mark.parametrize("delay, wall_damping", [(1, 0.0), (2, 0.0), (1, 0.05), (1, 2.0)])
 def test_the_two_mass_joint_is_python_controls_loop(hand, spring, delay, wall_damping):
-    loop = SampledLoop(period=PERIOD, delay=delay, virtual_damping=wall_damping, hand=hand)
+    loop = SampledLoop(period=PERIOD, delay=delay, wall_damping=wall_damping, hand=hand)
     expected = _limit(_wall_gain(_joint_plant(spring, hand), np.array([LEVER])), delay, wall_damping)
     assert _joint_limit(spring, loop) == pytest.approx(expected, rel=1e-6, abs=1e-9)
 

@@ -99,7 +99,7 @@ def test_each_output_states_its_settings_and_verdict():
     each says so."""
     runner = CliRunner()
     seed = json.loads(runner.invoke(app, ["impedance-range", "--method", "analytic", "--json"]).stdout)
-    assert seed["settings"]["compensation"] == "full" and seed["settings"]["delay_samples"] == 0
+    assert seed["settings"]["compensation"] == "full" and seed["settings"]["delay"] == 0
     assert seed["verdict"].startswith("seed performance criteria") and seed["k_max"] == 6.0
     path = str(EXAMPLES / "five-bar.yaml")
     practice = json.loads(runner.invoke(app, ["impedance-range", "--device", path, "--json"]).stdout)

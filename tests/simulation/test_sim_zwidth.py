@@ -99,14 +99,14 @@ def test_the_limit_is_python_controls_interconnection(delay, error, velocity):
     j, b, t = 0.02, 0.3, 1e-3
     for damper in (0.0, 0.2, 0.05):
         loop = SampledLoop(period=t, delay=delay, velocity=velocity, compensation="none" if error is None else "full",
-                           model_error=error or 0.0)
+                           error_percent=error or 0.0)
         expected = _oracle_limit(j, b, t, delay, velocity, loop.fraction, damper)
         assert max_stiffness(j, b, loop, damper) == pytest.approx(expected, rel=1e-8)
 
 
 @pytest.mark.parametrize("fraction", [1.0, 0.99, 0.9, 0.0])
 def test_compensator_case_is_the_closed_form(fraction):
-    loop = SampledLoop.seed(model_error=100.0 * (1.0 - fraction)) if fraction else SampledLoop.seed(compensation="none")
+    loop = SampledLoop.seed(error_percent=100.0 * (1.0 - fraction)) if fraction else SampledLoop.seed(compensation="none")
     assert max_stiffness(0.039, 0.5, loop) == pytest.approx(_closed_form(0.039, 0.5, 1e-3, fraction), rel=1e-8)
 
 
@@ -142,7 +142,7 @@ def test_bad_plants_are_user_errors(plant):
         zwidth(**{"inertia": 0.01, "damping": 0.5, "loop": SampledLoop(), **plant}, dampers=[0.0])
 
 
-@pytest.mark.parametrize("kwargs", [dict(delay=-1), dict(velocity="x"), dict(model_error=250.0),
+@pytest.mark.parametrize("kwargs", [dict(delay=-1), dict(velocity="x"), dict(error_percent=250.0),
                                     dict(period=math.inf), dict(compensation="exact")])
 def test_bad_settings_are_user_errors(kwargs):
     with pytest.raises(UserError):

@@ -15,7 +15,7 @@ from hapticdesign.studies.spec_maps import Section, planes, section_figure  # no
 SHEET = {"device": "five-bar", "q": [0.1, 0.2], "handle": [0.01, 0.0, 0.12], "resolution": 2e-5,
          "force_continuous": None, "force_peak": None, "apparent_mass": {"min": 0.05, "max": 0.2},
          "backdrive_friction": None, "stiffness": None, "workspace": {"cube": 60.0},
-         "renderable_stiffness": {"exact": 0.0, "rate": 1000.0, "delay_samples": 1, "passivity_viscous": 0.0,
+         "renderable_stiffness": {"exact": 0.0, "rate": 1000.0, "delay": 1, "passivity_viscous": 0.0,
                                   "passivity_coulomb": None, "exact_with_hand": 1345.0, "simulated": None,
                                   "hand": {"mass": 0.1, "damping": 2.0, "stiffness": 200.0}}}
 

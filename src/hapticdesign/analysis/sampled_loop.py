@@ -59,7 +59,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import expm
 
-from hapticdesign.errors import InputError, UserError
+from hapticdesign.errors import InputError, RenamedWarning, UserError
 from hapticdesign.model.actuators import Transmission
 from hapticdesign.workload import EIGEN_ORDER_LIMIT, require_memory, require_within
 
@@ -358,7 +358,7 @@ SCALE_RANGE = (1e-12, 1e12)
 precision. A setting that may be off (a damper, a hand) may be 0."""
 MIN_PERIOD = SCALE_RANGE[0]
 """The shortest sample period (s) of a loop (longer periods are checked where a plant meets them, as its ratios)."""
-MAX_VIRTUAL_DAMPING = SCALE_RANGE[1]
+MAX_WALL_DAMPING = SCALE_RANGE[1]
 """The largest wall damper (N s/m, or N m s/rad on a joint)."""
 
 
@@ -394,7 +394,7 @@ class Hand:
         a one-line error for another name."""
         if name == "grasp":
             warnings.warn("the hand 'grasp' is now called 'light' (the same 0.1 kg, 2 N s/m, 200 N/m); 'grasp' "
-                          "will be removed", FutureWarning, stacklevel=2)
+                          "will be removed", RenamedWarning, stacklevel=2)
             name = "light"
         if name not in HANDS:
             raise UserError(f"unknown hand {str(name)[:40]!r}; choose one of {', '.join(HANDS)} or give mass, damping "
@@ -451,10 +451,10 @@ class SampledLoop:
     """The settings of a sampled haptic loop, one record for every command and index.
 
     ``period`` (s) the servo period, ``delay`` whole samples between reading the sensors and applying the torque,
-    ``velocity`` of :data:`VELOCITIES`, ``compensation`` of :data:`COMPENSATIONS` with ``model_error`` (percent
+    ``velocity`` of :data:`VELOCITIES`, ``compensation`` of :data:`COMPENSATIONS` with ``error_percent`` (percent
     E: a bare joint's compensator feeds ``(1 - E/100)`` times its inertia; a device's is its model device, every
     mass, mass centre and inertia off by E %, :mod:`hapticdesign.model.compensator_model`, whose ``H`` and ``G``
-    the callers pass to :func:`handle_loops`), ``virtual_damping`` the wall's damper
+    the callers pass to :func:`handle_loops`), ``wall_damping`` the wall's damper
     (N s/m, or N m s/rad on a joint), ``hand`` a :class:`Hand` at the handle (None: none), ``held`` the joints held
     fixed (none by default: a Cartesian wall acts with every actuated joint free, as under a user's hand).
     The defaults are what practice uses: 1 kHz, one sample of delay, backward-difference velocity, gravity
@@ -466,8 +466,8 @@ class SampledLoop:
     delay: int = 1
     velocity: str = "difference"
     compensation: str = "gravity"
-    model_error: float = 0.0
-    virtual_damping: float = 0.0
+    error_percent: float = 0.0
+    wall_damping: float = 0.0
     hand: Hand | None = None
     held: tuple[int, ...] = ()
 
@@ -485,15 +485,15 @@ class SampledLoop:
         if self.compensation not in COMPENSATIONS:
             raise InputError(f"unknown compensation {str(self.compensation)[:40]!r}; choose one of "
                              f"{', '.join(COMPENSATIONS)}", "compensation")
-        if not (math.isfinite(self.model_error) and -100 < self.model_error < 100):
+        if not (math.isfinite(self.error_percent) and -100 < self.error_percent < 100):
             raise InputError(f"the error percentage must be a finite number between -100 and 100 (exclusive), got "
-                             f"{self.model_error}", "error_percent")
-        if not (math.isfinite(self.virtual_damping) and self.virtual_damping >= 0):
-            raise InputError(f"the wall damping must be a finite number >= 0, got {self.virtual_damping}",
+                             f"{self.error_percent}", "error_percent")
+        if not (math.isfinite(self.wall_damping) and self.wall_damping >= 0):
+            raise InputError(f"the wall damping must be a finite number >= 0, got {self.wall_damping}",
                              "wall_damping")
-        if self.virtual_damping > MAX_VIRTUAL_DAMPING:
-            raise InputError(f"the wall damping must be at most {MAX_VIRTUAL_DAMPING:g} (N s/m or N m s/rad), got "
-                             f"{self.virtual_damping:g}", "wall_damping")
+        if self.wall_damping > MAX_WALL_DAMPING:
+            raise InputError(f"the wall damping must be at most {MAX_WALL_DAMPING:g} (N s/m or N m s/rad), got "
+                             f"{self.wall_damping:g}", "wall_damping")
         if self.hand is not None and not isinstance(self.hand, Hand):
             raise UserError(f"the hand must be a Hand, got {type(self.hand).__name__}")
 
@@ -503,7 +503,7 @@ class SampledLoop:
         ``motors``) over the delay (one sample more for a differenced damper), the held torques with full
         compensation."""
         coordinates = 2 * joints if motors else joints
-        differenced = self.velocity == "difference" and self.virtual_damping > 0
+        differenced = self.velocity == "difference" and self.wall_damping > 0
         torques = joints * (self.delay + 1) if self.compensation == "full" else 0
         return 2 * coordinates * (self.delay + int(differenced) + 1) + torques
 
@@ -531,29 +531,29 @@ class SampledLoop:
     def fraction(self) -> float:
         """The compensator's share ``c`` of the inertia it feeds forward: ``1 - E/100`` with full compensation, else
         0."""
-        return 1.0 - self.model_error / 100.0 if self.compensation == "full" else 0.0
+        return 1.0 - self.error_percent / 100.0 if self.compensation == "full" else 0.0
 
     @property
     def gravity_share(self) -> float:
         """The share ``s`` of the gravity torque the compensator feeds forward: ``1 - E/100`` (its model's masses
         carry the modelling error, and gravity is linear in them) unless the compensation is none, 0 then."""
-        return 0.0 if self.compensation == "none" else 1.0 - self.model_error / 100.0
+        return 0.0 if self.compensation == "none" else 1.0 - self.error_percent / 100.0
 
     def as_dict(self) -> dict:
         """The settings as an output states them."""
-        return {"rate": self.rate, "period": self.period, "delay_samples": self.delay, "velocity": self.velocity,
-                "compensation": self.compensation, "model_error_percent": self.model_error,
-                "virtual_damping": self.virtual_damping, "hand": None if self.hand is None else self.hand.as_dict(),
+        return {"rate": self.rate, "period": self.period, "delay": self.delay, "velocity": self.velocity,
+                "compensation": self.compensation, "error_percent": self.error_percent,
+                "wall_damping": self.wall_damping, "hand": None if self.hand is None else self.hand.as_dict(),
                 "held_joints": [j + 1 for j in self.held]}
 
     def describe(self) -> str:
         """One line for a text output."""
         hand = "no hand" if self.hand is None else self.hand.describe()
         held = f", joints {', '.join(str(j + 1) for j in self.held)} held" if self.held else ", every joint free"
-        comp = self.compensation + (f" (model error {self.model_error:g} %)" if self.compensation == "full"
-                                    and self.model_error else "")
+        comp = self.compensation + (f" (model error {self.error_percent:g} %)" if self.compensation == "full"
+                                    and self.error_percent else "")
         return (f"{self.rate:g} Hz, delay {self.delay} sample{'s' if self.delay != 1 else ''}, {self.velocity} "
-                f"velocity, {comp} compensation, wall damper {self.virtual_damping:g}, {hand}{held}")
+                f"velocity, {comp} compensation, wall damper {self.wall_damping:g}, {hand}{held}")
 
 
 def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, spring: np.ndarray,
@@ -623,7 +623,7 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
     w = np.asarray(spring, dtype=float)[:, free]
     count, coords = len(w), plant[0].shape[-1]  # coords: n, or 2 n with the motors' own coordinates
     d = loop.delay
-    differenced = loop.velocity == "difference" and loop.virtual_damping > 0
+    differenced = loop.velocity == "difference" and loop.wall_damping > 0
     depth = d + int(differenced)
     compensated = bool(np.any(h_model))
     nx, size = 2 * coords, 2 * coords * (depth + 1) + (n * (d + 1) if compensated else 0)
@@ -638,10 +638,10 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
         law[:, :, rate:rate + coords] -= feed @ plant[1]
     law[:, :, at:at + n] += held
     if differenced:
-        law[:, :, at:at + n] -= loop.virtual_damping / loop.period * ww
-        law[:, :, at + nx:at + nx + n] += loop.virtual_damping / loop.period * ww
+        law[:, :, at:at + n] -= loop.wall_damping / loop.period * ww
+        law[:, :, at + nx:at + nx + n] += loop.wall_damping / loop.period * ww
     else:
-        law[:, :, rate:rate + n] -= loop.virtual_damping * ww
+        law[:, :, rate:rate + n] -= loop.wall_damping * ww
     m = np.zeros((count, size, size))
     m[:, :nx, :nx] = phi
     m[:, :nx] += gamma @ law
@@ -663,7 +663,7 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
         net *= loop.period ** 2 / np.linalg.norm(plant[0], axis=(1, 2))[:, None, None]
         m, g, hvec, law = _deflated(m, g, hvec, law, w, net, held, depth, u0 if compensated else None)
     reach = np.einsum("sn,sn->s", w, w)
-    viscous = np.einsum("sn,snm,sm->s", w, bh, w) / np.maximum(reach, 1e-300) ** 2 + loop.virtual_damping
+    viscous = np.einsum("sn,snm,sm->s", w, bh, w) / np.maximum(reach, 1e-300) ** 2 + loop.wall_damping
     guess = np.maximum(2.0 * viscous / (loop.period * (1 + 2 * d)), FLOOR)
     return SpringLoops(m, g, hvec, law, w), guess
 

@@ -152,16 +152,17 @@ MAX_PERIOD = 1.0
 """Longest sample period (s) of ``kmax``'s loop: a haptic loop samples far faster than 1 Hz, and the exact
 discretization of a handle's mass over much longer periods overflows."""
 
-KMAX_OPTIONS = {"period": 0.001, "delay": 1, "damping": 0.0, "direction": None, "velocity": "difference",
+KMAX_OPTIONS = {"period": 0.001, "delay": 1, "wall_damping": 0.0, "direction": None, "velocity": "difference",
                 "compensation": "gravity", "error_percent": 0.0, "hand": None}
-"""The ``kmax`` index's options and defaults: the settings of :class:`SampledLoop` (``damping`` the wall's damper in
-N s/m), ``direction`` a base-frame vector (default: the worst direction) and ``hand`` None, a preset's name of
+"""The ``kmax`` index's options and defaults: the settings of :class:`SampledLoop` under its names (``wall_damping``
+the wall's damper in N s/m; the index takes ``damping``, its former name, for one release with a deprecation line),
+``direction`` a base-frame vector (default: the worst direction) and ``hand`` None, a preset's name of
 :data:`~hapticdesign.analysis.sampled_loop.HANDS` (``light``, ``firm``) or ``{mass, damping, stiffness}``."""
 
 
 def kmax_loop(options: Mapping[str, object]) -> tuple[SampledLoop, np.ndarray | None]:
     """The loop settings and the unit direction (or None) of the ``kmax`` options; a one-line error for a bad one."""
-    period, delay, damping, direction = (options[k] for k in ("period", "delay", "damping", "direction"))
+    period, delay, damping, direction = (options[k] for k in ("period", "delay", "wall_damping", "direction"))
     if isinstance(period, bool) or not isinstance(period, (int, float)) or not 0 < period <= MAX_PERIOD:
         raise UserError(f"index kmax: the sample period is a positive number of seconds, at most {MAX_PERIOD:g} s, "
                         f"got {period!r}")

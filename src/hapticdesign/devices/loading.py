@@ -31,7 +31,7 @@ def resolve_device(
 ) -> Device:
     """The device named by ``--preset`` or ``--device``, with ``--params`` applied and checked.
 
-    Physical consistency errors raise :class:`UserError`; bodies that are positive definite but
+    Physical consistency errors raise :class:`~hapticdesign.errors.UserError`; bodies that are positive definite but
     break the triangle inequality warn (``strict`` makes them errors).
     """
     if preset_name and device_file:

@@ -19,6 +19,10 @@ Default gimbal (6 DOF, our choice, physically consistent, documented in the READ
 because ``C(0,3) u3 = C(0,4) u2``) and moments 2e-6 kg m^2; link 5 an 8 g ring centred at
 ``P_4`` with moments 1e-6 kg m^2; link 6 a 12 g, 30 mm stylus along ``u3`` of frame 6 with
 its mass centre 15 mm out (moments 9e-7, 9e-7, 5e-8 kg m^2, a slender rod).
+
+What the generic engines read from the presets (:class:`~hapticdesign.model.device.PresetData`): the practical
+bounds of links 2, 3, 2a and 3a (eq. 3.29-3.32) and ours of the gimbal's, the seed's dependent variables of LN = 0
+(eq. 3.12-3.26) with their pivots, and the seed's loop settings as the commands' default.
 """
 
 from __future__ import annotations
@@ -26,7 +30,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from math import pi
 
-from hapticdesign.model.device import Device
+from hapticdesign.model.device import Device, PresetData
 from hapticdesign.model.dh import dh_frames, revolute
 from hapticdesign.model.mechanism import BodyAttachment, Frame, JointType, Mechanism
 from hapticdesign.model.transforms import Rx, Rz, joint, tx, tz
@@ -100,10 +104,32 @@ def phantom_6dof_mechanism(p: Mapping[str, float]) -> Mechanism:
     )
 
 
-def _complete(device: Device, values: Mapping[str, float]) -> Device:
+def _arm_bounds(heavy: tuple[float, float], light: tuple[float, float]) -> dict:
+    r, moments = (-0.25, 0.25), (1e-5, 1e-2)
+    return {"2": (heavy, r, moments, 1e-2), "3a": (heavy, r, moments, 1e-2),
+            "2a": (light, r, moments, 1e-2), "3": (light, r, moments, 1e-2)}
+
+
+# Eq. 3.29-3.32 (= eq. 3.35-3.38): link 2 and 3a heavy, link 2a and 3 light.
+ARM_BOUNDS = _arm_bounds((0.15, 0.30), (0.02, 0.15))
+# Our practical bounds for the gimbal links (not in the seed): 5-50 g, moments 1e-7..1e-3 kg m^2.
+GIMBAL_BOUNDS = {b: ((0.005, 0.05), (-0.25, 0.25), (1e-7, 1e-3), 1e-3) for b in ("4", "5", "6")}
+# The seed's dependent variables (eq. 3.12-3.26) and the standard parameters used as pivots for them (r2z enters
+# through J2xz = -Ixz2 - m2 r2x r2z, r3y through J3yz).
+SEED_DEPENDENTS = ("r2x", "r2y", "r2z", "r2ay", "r3x", "r3y", "r3z", "r3ax", "r3az",
+                   "Iyy2a", "Izz3a", "Ixy2", "Iyz2", "Ixy3", "Ixz3")
+SEED_PIVOTS = ("h2x", "h2y", "J2xz", "h2ay", "h3x", "J3yz", "h3z", "h3ax", "h3az",
+               "J2ayy", "J3azz", "J2xy", "J2yz", "J3xy", "J3xz")
+# The seed's presets keep the seed's loop settings and performance criteria by default.
+DATA_3DOF = PresetData("seed", ARM_BOUNDS, SEED_DEPENDENTS, SEED_PIVOTS)
+DATA_6DOF = PresetData("seed", {**ARM_BOUNDS, **GIMBAL_BOUNDS})
+
+
+def _complete(device: Device, values: Mapping[str, float], data: PresetData) -> Device:
     base = {name: 0.0 for name in device.parameter_names()}
     base.update(values)
-    return Device(device.name, device.description, device.kinematic, device.builder, base, device.damping)
+    return Device(device.name, device.description, device.kinematic, device.builder, base, device.damping,
+                  preset_data=data)
 
 
 def phantom_3dof() -> Device:
@@ -116,7 +142,7 @@ def phantom_3dof() -> Device:
         kin,
         damping=(0.50, 0.50, 0.35),
     )
-    return _complete(skeleton, {**kin, **LINEAR_DESIGN_3DOF})
+    return _complete(skeleton, {**kin, **LINEAR_DESIGN_3DOF}, DATA_3DOF)
 
 
 def phantom_6dof() -> Device:
@@ -129,4 +155,4 @@ def phantom_6dof() -> Device:
         kin,
         damping=(0.50, 0.50, 0.35, 0.01, 0.01, 0.01),
     )
-    return _complete(skeleton, {**kin, **LINEAR_DESIGN_3DOF, **GIMBAL_DEFAULT})
+    return _complete(skeleton, {**kin, **LINEAR_DESIGN_3DOF, **GIMBAL_DEFAULT}, DATA_6DOF)

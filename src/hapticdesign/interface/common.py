@@ -18,22 +18,24 @@ import numpy as np
 import typer
 from typer._click.globals import get_current_context
 
-from hapticdesign.errors import InputError, PhysicalConsistencyWarning, RunWarning, UserError
+from hapticdesign.errors import InputError, PhysicalConsistencyWarning, RenamedWarning, RunWarning, UserError
 from hapticdesign.files import dumps_json, to_jsonable, write_atomically
 
 
 @contextmanager
 def user_errors(strict: bool = False, quiet: bool = False) -> Iterator[None]:
     """Turn user mistakes into ``error: ...`` on stderr and exit 2; consistency and run warnings into one line each,
-    as they are raised (a warning before a long run shows before it); other warnings are not shown."""
+    as they are raised (a warning before a long run shows before it), an old name's once; other warnings are not
+    shown."""
 
     def show(message, category, *args, **kwargs) -> None:
-        if not quiet and issubclass(category, (PhysicalConsistencyWarning, RunWarning)):
+        if not quiet and issubclass(category, (PhysicalConsistencyWarning, RunWarning, RenamedWarning)):
             typer.echo(f"warning: {message}", err=True)
 
     with warnings.catch_warnings():
         warnings.simplefilter("always", PhysicalConsistencyWarning)
         warnings.simplefilter("always", RunWarning)
+        warnings.simplefilter("once", RenamedWarning)
         warnings.showwarning = show
         try:
             yield

@@ -44,6 +44,26 @@ from hapticdesign.model.mechanism import Mechanism
 
 MechanismBuilder = Callable[[Mapping[str, float]], Mechanism]
 
+BoundsRow = tuple[tuple[float, float], tuple[float, float], tuple[float, float], float]
+"""One body's practical bounds: (mass), (mass-centre coordinates), (moments) as lower, upper, and the
+products' magnitude (:class:`hapticdesign.analysis.linearity.bounds.BodyBounds`'s fields)."""
+
+
+@dataclass(frozen=True)
+class PresetData:
+    """What a device's source knows beyond its mechanism (seed 000's Phantom presets give the seed's); the
+    generic engines read it here instead of knowing a device by its name.
+
+    ``loop_settings`` is the loop settings its commands use by default (``practice``, or ``seed``: seed 000's
+    settings and performance criteria); ``bounds`` its bodies' practical bounds for the linearity searches (none:
+    the generic ones); ``dependents`` the seed's dependent variables of LN = 0 and ``pivots`` the standard
+    parameters pivoted for them (none: chosen by the search)."""
+
+    loop_settings: str = "practice"
+    bounds: Mapping[str, BoundsRow] = field(default_factory=dict)
+    dependents: tuple[str, ...] = ()
+    pivots: tuple[str, ...] = ()
+
 
 @dataclass(frozen=True)
 class Device:
@@ -60,6 +80,7 @@ class Device:
     elasticity: Elasticity | None = None
     reference: str = ""
     """The published device a device file derives from (its ``reference:``), "" for one that is its own."""
+    preset_data: PresetData = field(default_factory=PresetData, compare=False, repr=False)
 
     # -- parameters ---------------------------------------------------------------------------
     @property

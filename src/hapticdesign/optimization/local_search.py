@@ -1,7 +1,7 @@
 """Local constrained minimization by SciPy's SLSQP from several starts, over the union of boxes.
 
 One generic search serves every local refinement of the package: the shortest R-CUBE design
-(:mod:`.shortest`), a study's ``algorithm.start`` and the polishing of a study's front (:mod:`.study_polish`).
+(:mod:`.rcube.shortest`), a study's ``algorithm.start`` and the polishing of a study's front (:mod:`.study_polish`).
 ``objective(x)`` is minimized under ``constraints(x) <= 0`` (a vector) within box bounds; the answer is kept
 only when it is ``feasible``. Gradients are SciPy's finite differences unless the caller gives them (a study's
 polishing evaluates a design and its neighbours in one batch).

@@ -3,7 +3,8 @@
 - :mod:`.tables`: the equations of motion as coefficient tables, evaluated inside numba.
 - :mod:`.loop`: the fixed-step plant with the digital side (sampling, quantization, delay,
   zero-order hold, model-based compensator, virtual wall, safety switch, optional hand).
-- :mod:`.reference`: the same loop written plainly with ``scipy.integrate.solve_ivp``.
+- ``tests/helpers/reference.py`` (outside the package, for the tests and benchmarks): the same loop written
+  plainly with ``scipy.integrate.solve_ivp``.
 - :mod:`.impedance`: the stable impedance range (seed §4.1.2-4.1.3).
 - :mod:`.boundary`: exact and simulated stability boundary of a 1-DOF mass-damper.
 - :mod:`.analytic` and :mod:`.analytic_driven`: the impedance range from the exact linear response of

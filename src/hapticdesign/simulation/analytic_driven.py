@@ -146,7 +146,7 @@ class DrivenLoop:
     @classmethod
     def build(cls, device: Device, model: Device, w: int, paths: dict[int, Path], start: np.ndarray, damping: float,
               switches: tuple[float, float, float], period: float, sub: int, samples: int, delay: int,
-              virtual_damping: float, equilibrium: float) -> "DrivenLoop":
+              wall_damping: float, equilibrium: float) -> "DrivenLoop":
         step = period / sub
         n_dof, n = device.n_dof, 4 + 3 * delay
         entries = dynamics_of(device).coefficients.shape[1]
@@ -180,7 +180,7 @@ class DrivenLoop:
             for r in range(3):
                 sensed[:, r, base + r] = 1.0
         lag = np.maximum(np.arange(samples) - delay, 0)
-        law = np.stack([comp.kappa[lag], comp.gamma[lag] - virtual_damping, switches[0] * comp.inertia[lag]], axis=1)
+        law = np.stack([comp.kappa[lag], comp.gamma[lag] - wall_damping, switches[0] * comp.inertia[lag]], axis=1)
         u0 = np.einsum("kr,krn->kn", law, sensed)
         u0[:, one] += comp.rho[lag]
         u1 = -sensed[:, 0].copy()

@@ -190,13 +190,13 @@ def signal_spectra(chirp: Chirp, step: float, sub: int, delay: int, seconds: flo
 
 
 def steady_response(loop: TransparencyLoop, frequency: np.ndarray, period: float, delay: int, stiffness: float,
-                    virtual_damping: float) -> np.ndarray:
+                    wall_damping: float) -> np.ndarray:
     """``Z(jw)`` felt in steady sinusoidal motion: the plant's ``J s^2 + b s + k`` plus the digital side's
     ``z^-N (K - g + B s - c s^2)`` on the samples of ``(s, s', s'')``, held (module docstring)."""
     w = 2 * np.pi * np.asarray(frequency, dtype=float)
     plant = control.tf([loop.inertia, loop.damping, loop.spring], [1.0])
     lag = control.tf([1.0], [1.0] + [0.0] * delay, period)
-    law = control.tf([-loop.compensated_inertia, virtual_damping, stiffness - loop.compensated_spring], [1.0])
+    law = control.tf([-loop.compensated_inertia, wall_damping, stiffness - loop.compensated_spring], [1.0])
     hold = (1 - np.exp(-1j * w * period)) / (1j * w * period)
     return plant(1j * w) + hold * lag(np.exp(1j * w * period)) * law(1j * w)
 
@@ -224,16 +224,16 @@ def analytic_transparency(
     if cfg.sensors.delay_samples * cfg.sensors.period >= chirp.sweep_time:
         raise UserError(f"the sensor delay ({cfg.sensors.delay_samples} samples) must be shorter than the sweep "
                         f"({chirp.sweep_time:g} s)")
-    virtual_damping = cfg.wall.damping
+    wall_damping = cfg.wall.damping
     loop = transparency_loop(device, sim_type, wall_joint, cfg, chirp.amplitude)
     delay = cfg.sensors.delay_samples
     f, z = signal_spectra(chirp, cfg.step, cfg.steps_per_sample(), delay, segment_seconds, window)
-    z_d = stiffness * z["pos"] + virtual_damping * z["vel"]
+    z_d = stiffness * z["pos"] + wall_damping * z["vel"]
     z_m = (loop.inertia * z["acc"] + loop.damping * z["vel"] + loop.spring * z["pos"]
            - loop.compensated_inertia * z["held_acc"] + (stiffness - loop.compensated_spring) * z["held_pos"]
-           + virtual_damping * z["held_vel"])
-    steady = steady_response(loop, f, cfg.sensors.period, delay, stiffness, virtual_damping)
-    z_steady_d = stiffness + 1j * virtual_damping * 2 * np.pi * f
+           + wall_damping * z["held_vel"])
+    steady = steady_response(loop, f, cfg.sensors.period, delay, stiffness, wall_damping)
+    z_steady_d = stiffness + 1j * wall_damping * 2 * np.pi * f
     gain_db = 20 * np.log10(np.abs(z_m / z_d))
     steady_db = 20 * np.log10(np.abs(steady / z_steady_d))
     return AnalyticTransparencyResult(f, z_d, z_m, first_exit(f, gain_db, band_db), band_db, {}, steady,

@@ -27,7 +27,7 @@ def grows(inertia: float, damping: float, loop: SampledLoop, stiffness: float, s
     its mass, damping and stiffness to the joint's) about the wall's rest grows (last vs second quarter)."""
     cfg = loop_config(loop, Wall(0, stiffness, 0.0, 0.01), duration=samples * loop.period, step=loop.period / substeps,
                       damping=(damping,), safety_limit=None, stop_excursion=1e6)
-    model = inertia * (1.0 - loop.model_error / 100.0)
+    model = inertia * (1.0 - loop.error_percent / 100.0)
     plant = DynamicsTables.constant_inertia(inertia)
     hand = loop.hand
     spring = 0.0 if hand is None else hand.stiffness

@@ -1,7 +1,7 @@
 """What a sampled-data simulation is configured with and what it returns (seed 000 §4.1.1).
 
 Shared by the fast loop (:mod:`.loop`, :mod:`.kernel`) and the independent SciPy loop
-(:mod:`.reference`), so that neither imports the other. Defaults follow the seed: plant step
+(``tests/helpers/reference.py``), so that neither imports the other. Defaults follow the seed: plant step
 1e-4 s, sample period 1 ms, perfect sensors (condition ix), no modelling error (condition vi), no
 hand (condition vii), safety switch at 0.06 rad (Fig. 4.7).
 """
@@ -80,14 +80,14 @@ def loop_config(loop: SampledLoop, wall: Wall | None = None, counts_per_revoluti
     delay, compensation (``gravity``: the gravity term only; ``full``: inertial, Coriolis and gravity terms with the
     modelling error), wall damper and hand; ``simulation`` the run's own fields (duration, step, ...). The simulated
     damper uses the sampled velocity: a backward difference with a damper is refused."""
-    if loop.velocity == "difference" and loop.virtual_damping > 0:
+    if loop.velocity == "difference" and loop.wall_damping > 0:
         raise InputError("the simulated wall's damper uses the sampled velocity; a backward-difference damper is "
                          "analysed exactly only", "velocity")
     full = loop.compensation == "full"
     wall = wall or Wall()
     return LoopConfig(sensors=Sensors(loop.period, counts_per_revolution, loop.delay),
-                      compensator=Compensator(full, full, loop.compensation != "none", loop.model_error),
-                      wall=Wall(wall.joint, wall.stiffness, loop.virtual_damping, wall.equilibrium, wall.direction),
+                      compensator=Compensator(full, full, loop.compensation != "none", loop.error_percent),
+                      wall=Wall(wall.joint, wall.stiffness, loop.wall_damping, wall.equilibrium, wall.direction),
                       hand=loop.hand, **simulation)
 
 
@@ -270,9 +270,9 @@ def loop_model(device: Device, loop: SampledLoop, pose: np.ndarray) -> tuple[np.
     too, so ``H_m`` and ``G_m`` are not ``(1 - E/100)`` times the device's, and motors' rotors are not scaled); None
     without a modelling error (the model is the device). The exact limits take them
     (:func:`hapticdesign.analysis.sampled_loop.handle_loops`), as the simulation's compensator does."""
-    if loop.model_error == 0:
+    if loop.error_percent == 0:
         return None
-    model = model_device(device, loop.model_error)
+    model = model_device(device, loop.error_percent)
     return mass_matrix(model, pose), gravity_gradient(model, pose)
 
 

@@ -164,24 +164,32 @@ def stability_limit(device: Device, loop: SampledLoop | None = None, wall_joint:
     loop = loop or SampledLoop()
     rest = wall_pose(device, wall_joint, equilibrium, direction)
     pose, found = rest, None
-    exact = loop.compensation != "none" and loop.model_error == 0.0
+    exact = loop.compensation != "none" and loop.error_percent == 0.0
     for _ in range(1 if exact else REST_STEPS):
-        spring = _wall_row(device, pose, wall_joint, direction)
-        low, high = handle_intervals(handle_jacobian(device, pose)[:3][None], mass_matrix(device, pose)[None],
-                                     device.damping_matrix, spring[None], loop, k_max=k_max,
-                                     gravity=gravity_gradient(device, pose)[None],
-                                     model=loop_model(device, loop, pose), transmission=device.transmission)
-        settled = found is not None and abs(high[0] - found.stiffness) <= 1e-9 * found.stiffness
-        found = StabilityLimit(float(high[0]), pose, loop, float(low[0]))
-        if settled or not (0.0 < high[0] < np.inf):
+        low, high = wall_interval(device, pose, loop, wall_joint, direction, k_max)
+        settled = found is not None and abs(high - found.stiffness) <= 1e-9 * found.stiffness
+        found = StabilityLimit(high, pose, loop, low)
+        if settled or not (0.0 < high < np.inf):
             break
-        model = None if loop.compensation == "none" else model_device(device, loop.model_error)
-        moved = spring_rest(device, model, rest, _wall_row(device, rest, wall_joint, direction), float(high[0]),
+        model = None if loop.compensation == "none" else model_device(device, loop.error_percent)
+        moved = spring_rest(device, model, rest, _wall_row(device, rest, wall_joint, direction), high,
                             [j for j in range(device.n_dof) if j not in set(loop.held)])
         if moved is None:
             break
         pose = moved
     return found
+
+
+def wall_interval(device: Device, pose: np.ndarray, loop: SampledLoop, wall_joint: int = 0, direction=None,
+                  k_max: float = 1e9) -> tuple[float, float]:
+    """The exact stable springs ``[low, high]`` of a wall on ``wall_joint`` (or along the Cartesian ``direction``) held
+    at ``pose``, every actuated joint free but ``loop.held`` (:func:`stability_limit`'s at one pose; ``low`` 0 unless
+    gravity pulls the handle off the wall)."""
+    low, high = handle_intervals(handle_jacobian(device, pose)[:3][None], mass_matrix(device, pose)[None],
+                                 device.damping_matrix, _wall_row(device, pose, wall_joint, direction)[None], loop,
+                                 k_max=k_max, gravity=gravity_gradient(device, pose)[None],
+                                 model=loop_model(device, loop, pose), transmission=device.transmission)
+    return float(low[0]), float(high[0])
 
 
 def _wall_row(device: Device, pose: np.ndarray, wall_joint: int, direction) -> np.ndarray:

@@ -68,7 +68,8 @@ class DynamicsTables:
 @nb.njit(cache=True, error_model="numpy", inline="always")
 def evaluate_entries(q, rows, cols, vals, index, kinds, degrees, values, phi, out):
     """All entries at ``q`` into ``out`` (E,) from the sparse table ``(rows, cols, vals)``;
-    ``values`` (N, max basis size) and ``phi`` (n_basis,) are workspace (:func:`.basis.basis_functions`)."""
+    ``values`` (N, max basis size) and ``phi`` (n_basis,) are workspace
+    (:func:`~hapticdesign.analysis.dynamics.basis.basis_functions`)."""
     basis_functions(q, kinds, degrees, index, values, phi)
     out[:] = 0.0
     for t in range(rows.shape[0]):

@@ -21,9 +21,11 @@ import numpy as np
 
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
+from hapticdesign.simulation.analytic import AnalyticProblem, linear_loop
 from hapticdesign.simulation.analytic_transparency import analytic_transparency
+from hapticdesign.simulation.boundary import growth_onset
 from hapticdesign.simulation.config import LoopConfig, Wall, rest_pose
-from hapticdesign.simulation.criteria import require_closed
+from hapticdesign.simulation.criteria import Criteria, require_closed
 from hapticdesign.simulation.loop import simulate
 from hapticdesign.simulation.paths import Chirp, Held, Path
 from hapticdesign.simulation.transparency_estimate import (
@@ -96,3 +98,28 @@ def transparency(
         "tau_imp": trace.tau_imp[:, wall_joint], "tau_D": tau_d, "tau_M": tau_m,
     }
     return TransparencyResult(f, z_d, z_m, first_exit(f, gain_db, band_db), band_db, signals)
+
+
+LIMIT_REL_TOL = 1e-9
+"""Relative width the wall joint's stable limit is bisected to."""
+LIMIT_DOUBLINGS = 60
+"""Doublings of the first estimate the search for the stable limit tries before it calls the wall stable for every
+stiffness."""
+LIMIT_STEP = 0.01
+"""The spring's rest from the start (Table 4.2), where the loop is linearized for the stable limit."""
+
+
+def stable_limit(device: Device, sim_type: int, wall_joint: int, config: LoopConfig) -> float | None:
+    """The stiffness at which the wall joint's sampled loop starts to grow: the loop linearized where the wall holds
+    the joint (the spring's rest, :data:`LIMIT_STEP` from the start pose), its growth boundary
+    (:meth:`~hapticdesign.simulation.analytic.AnalyticProblem.grows`: its one-sample map's spectral radius reaches 1;
+    with full inertial compensation and no delay the seed's 1-DOF closed form ``b^2 / H_ww``, seed 000 §4.1.2).
+    ``inf`` when no stiffness makes it grow, None where the linearization does not decide it (encoder counts, Coulomb
+    friction, a type 2 motion coupled to the wall joint)."""
+    if not linear_loop(device, config):
+        return None
+    problem = AnalyticProblem(device, sim_type, wall_joint, LIMIT_STEP, Criteria(), config)
+    if not problem.growth_is_exact:
+        return None
+    first = problem.estimate()
+    return growth_onset(problem.grows, 0.0, first, LIMIT_REL_TOL, first * 2.0 ** LIMIT_DOUBLINGS)

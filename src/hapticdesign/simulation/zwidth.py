@@ -18,6 +18,10 @@ torque held during interval k is computed from the samples of k - N)::
 inertial compensator ``c J a`` of full compensation with the acceleration read just before the sample under the held
 torque (``c = 1 - E/100`` for a modelling error of E percent, 0 without it).
 
+A device's Cartesian wall acts with every actuated joint free (:func:`wall_zwidth`): its ``K_max(B)`` is the exact
+n-joint limit of ``impedance-range --wall-direction`` and the spec sheet at each damper; the 1-DOF view of one joint
+with the others held (:func:`along_wall`) is another question, asked by name (``zwidth --one-dof``).
+
 Beside it: the passivity condition ``b > K T / 2 + |B|`` (Colgate & Schenkel 1997), with a delay
 ``t_d = N T`` ``b > K (T/2 + t_d) + |B|`` (as we read Hulin, Albu-Schäffer & Hirzinger 2014), i.e.
 ``K_pass = 2 (b - |B|) / (T (1 + 2 N))``, and the linear approximation of the stability boundary
@@ -34,30 +38,33 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from hapticdesign.analysis.dynamics.device import mass_matrix
-from hapticdesign.analysis.sampled_loop import FLOOR, MAX_VIRTUAL_DAMPING, SampledLoop, joint_limit, joint_limits, joint_loops
+from hapticdesign.analysis.sampled_loop import (
+    FLOOR, MAX_WALL_DAMPING, SampledLoop, joint_limit, joint_limits, joint_loops,
+)
 from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.compensator_model import model_device
+from hapticdesign.simulation.config import handle_jacobian, unit_direction
 
 MAX_DAMPERS = 1000
 """Most virtual dampers of one Z-width (each one a search of K_max over about 60 eigenvalue problems)."""
 
 
-def max_stiffness(inertia: float, damping: float, loop: SampledLoop, virtual_damping: float = 0.0,
+def max_stiffness(inertia: float, damping: float, loop: SampledLoop, wall_damping: float = 0.0,
                   k_limit: float = 1e9, model_inertia: float | None = None) -> float:
     """The largest stable ``K`` of the joint for a virtual damper ``B`` (0 when even a tiny spring is unstable, inf
     when none up to ``k_limit`` destabilizes it); ``model_inertia`` the full compensator's inertia (default ``c
     J``)."""
-    return joint_limit(inertia, damping, replace(loop, virtual_damping=virtual_damping), k_limit, model_inertia)
+    return joint_limit(inertia, damping, replace(loop, wall_damping=wall_damping), k_limit, model_inertia)
 
 
-def passivity_stiffness(damping: float, loop: SampledLoop, virtual_damping: float) -> float:
+def passivity_stiffness(damping: float, loop: SampledLoop, wall_damping: float) -> float:
     """The passivity bound ``K < 2 (b - |B|) / (T (1 + 2 N))`` (Colgate & Schenkel; delay as Hulin et al.)."""
-    return max(0.0, 2.0 * (damping - abs(virtual_damping)) / (loop.period * (1 + 2 * loop.delay)))
+    return max(0.0, 2.0 * (damping - abs(wall_damping)) / (loop.period * (1 + 2 * loop.delay)))
 
 
-def linear_approximation(damping: float, loop: SampledLoop, virtual_damping: float) -> float:
+def linear_approximation(damping: float, loop: SampledLoop, wall_damping: float) -> float:
     """Short-delay linear boundary ``K = 2 (b + B) / (T + 2 N T)`` (Gil et al. 2009, as we read it)."""
-    return max(0.0, 2.0 * (damping + virtual_damping) / (loop.period * (1 + 2 * loop.delay)))
+    return max(0.0, 2.0 * (damping + wall_damping) / (loop.period * (1 + 2 * loop.delay)))
 
 
 def along_wall(inertia: float, damping: float, reach: float) -> tuple[float, float]:
@@ -83,28 +90,35 @@ class ZWidth:
     K: list[float]
     passivity: list[float] | None
     linear: list[float] | None
+    units: tuple[str, str] = ("N m s/rad", "N m/rad")
+    """B's and K's: a joint's, or a Cartesian wall's N s/m and N/m."""
 
     def as_dict(self) -> dict:
         return {"B": self.B, "K": self.K, "passivity_K": self.passivity, "linear_approximation_K": self.linear,
-                "units": {"B": "N m s/rad", "K": "N m/rad"}}
+                "units": {"B": self.units[0], "K": self.units[1]}}
 
 
 def damping_grid(inertia: float, damping: float, loop: SampledLoop, points: int = 25,
                  model_inertia: float | None = None) -> list[float]:
     """Virtual dampers from 0 to where a damper alone destabilizes the loop (bisected to 0.1 %), at most
-    :data:`~hapticdesign.analysis.sampled_loop.MAX_VIRTUAL_DAMPING`."""
-    if not 2 <= points <= 1000:
-        raise UserError(f"the damper grid needs 2 to 1000 points, got {points}")
-
+    :data:`~hapticdesign.analysis.sampled_loop.MAX_WALL_DAMPING`."""
     def usable(b: float) -> bool:
-        loops = joint_loops(inertia, damping, replace(loop, virtual_damping=b), model_inertia)
+        loops = joint_loops(inertia, damping, replace(loop, wall_damping=b), model_inertia)
         return bool(loops.radii(np.array([FLOOR]))[0] < 1.0)
 
-    lo, hi = 0.0, min(4.0 * inertia / loop.period + 4.0 * damping, MAX_VIRTUAL_DAMPING)
+    return _grid(usable, 4.0 * inertia / loop.period + 4.0 * damping, points)
+
+
+def _grid(usable, start: float, points: int) -> list[float]:
+    """``points`` dampers from 0 to the largest ``usable`` one (doubled from ``start``, bisected to 0.1 %), at most
+    :data:`~hapticdesign.analysis.sampled_loop.MAX_WALL_DAMPING`."""
+    if not 2 <= points <= 1000:
+        raise UserError(f"the damper grid needs 2 to 1000 points, got {points}")
+    lo, hi = 0.0, min(start, MAX_WALL_DAMPING)
     while usable(hi):
-        if hi == MAX_VIRTUAL_DAMPING:  # usable up to the largest damper a loop takes
+        if hi == MAX_WALL_DAMPING:  # usable up to the largest damper a loop takes
             return [float(b) for b in np.linspace(0.0, hi, points)]
-        lo, hi = hi, min(2.0 * hi, MAX_VIRTUAL_DAMPING)
+        lo, hi = hi, min(2.0 * hi, MAX_WALL_DAMPING)
     while hi - lo > 1e-3 * hi:
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if usable(mid) else (lo, mid)
@@ -120,19 +134,49 @@ def zwidth(inertia: float, damping: float, loop: SampledLoop, dampers: list[floa
         raise InputError(f"give 1 to {MAX_DAMPERS} virtual dampers, got {len(dampers):,}", "b_values")
     _check_resolvable(inertia, damping, loop)
     values = (damping_grid(inertia, damping, loop, points, model_inertia) if dampers is None
-              else [float(b) for b in dampers])
+              else _dampers(dampers, loop))
+    bounds = loop.fraction == 0.0 and loop.hand is None
+    return ZWidth(values, [max_stiffness(inertia, damping, loop, b, model_inertia=model_inertia) for b in values],
+                  [passivity_stiffness(damping, loop, b) for b in values] if bounds else None,
+                  [linear_approximation(damping, loop, b) for b in values] if bounds else None)
+
+
+def wall_zwidth(device, pose: np.ndarray, direction, loop: SampledLoop, dampers: list[float] | None = None,
+                points: int = 25) -> ZWidth:
+    """The Z-width of a device's Cartesian wall along ``direction`` held at ``pose``, every actuated joint free but
+    ``loop.held``: ``K_max`` (N/m) for each virtual damper (N s/m), each the exact limit of
+    :func:`~.impedance.wall_interval` (the one ``impedance-range --wall-direction`` and the spec sheet take; gravity's
+    gradient at the pose in the loop). The default dampers reach the largest with which some spring is stable
+    (doubled from ``4 m_u / T``, ``m_u`` the handle's mass along the wall). No 1-DOF approximation stands beside it."""
+    from hapticdesign.simulation.impedance import wall_interval
+
+    jv = handle_jacobian(device, pose)[:3]
+    unit = unit_direction(direction)
+    mobility = float(unit @ jv @ np.linalg.solve(mass_matrix(device, pose), jv.T) @ unit)
+
+    def limit(b: float) -> float:
+        return wall_interval(device, pose, replace(loop, wall_damping=b), direction=unit)[1]
+
+    limit(0.0)  # a direction the handle does not move along, or a bad pose, refused before any search
+    values = (_grid(lambda b: limit(b) > 0.0, 4.0 / (mobility * loop.period), points) if dampers is None
+              else _dampers(dampers, loop))
+    return ZWidth(values, [limit(b) for b in values], None, None, ("N s/m", "N/m"))
+
+
+def _dampers(dampers: list[float], loop: SampledLoop) -> list[float]:
+    """The virtual dampers given, each checked as a loop's (one line naming ``--b-values``)."""
+    if not 1 <= len(dampers) <= MAX_DAMPERS:
+        raise InputError(f"give 1 to {MAX_DAMPERS} virtual dampers, got {len(dampers):,}", "b_values")
+    values = [float(b) for b in dampers]
     if any(not (math.isfinite(b) and b >= 0.0) for b in values):
         raise InputError(f"the virtual dampers must be finite and >= 0, got "
                          f"{min(values, key=lambda b: b if math.isfinite(b) else -math.inf):g}", "b_values")
     try:  # each damper's loop, validated before any search
         for b in values:
-            replace(loop, virtual_damping=b)
+            replace(loop, wall_damping=b)
     except InputError as exc:
         raise InputError(str(exc), "b_values") from None
-    bounds = loop.fraction == 0.0 and loop.hand is None
-    return ZWidth(values, [max_stiffness(inertia, damping, loop, b, model_inertia=model_inertia) for b in values],
-                  [passivity_stiffness(damping, loop, b) for b in values] if bounds else None,
-                  [linear_approximation(damping, loop, b) for b in values] if bounds else None)
+    return values
 
 
 def _check_resolvable(inertia: float, damping: float, loop: SampledLoop) -> None:
@@ -175,6 +219,7 @@ def stiffness_map(device, joint: int, axes: tuple[int, int], n: int, loop: Sampl
     poses = np.zeros((n * n, device.n_dof))
     poses[:, axes[0]], poses[:, axes[1]] = np.repeat(grid, n), np.tile(grid, n)
     inertia = mass_matrix(device, poses)[:, joint, joint]
-    model = mass_matrix(model_device(device, loop.model_error), poses)[:, joint, joint] if loop.model_error else None
+    model = (mass_matrix(model_device(device, loop.error_percent), poses)[:, joint, joint] if loop.error_percent
+             else None)
     values = joint_limits(inertia, float(device.damping[joint]), loop, model_inertia=model).reshape(n, n)
     return StiffnessMap(axes, grid.tolist(), grid.tolist(), values.tolist())

@@ -185,7 +185,7 @@ def renderable(device: Device, h: Handle, loop: SampledLoop, res: float | None,
         "simulated": simulated, "simulated_counts": counts, "simulated_touch": TOUCH,
         "passivity_viscous": 2.0 * float(np.linalg.eigvalsh(h.states.cartesian_damping[0]).min()) * loop.rate,
         "passivity_coulomb": None if friction is None or res is None else 2.0 * friction[0] / res,
-        "settings": replace(loop, hand=None).as_dict(), "rate": loop.rate, "delay_samples": loop.delay,
+        "settings": replace(loop, hand=None).as_dict(), "rate": loop.rate, "delay": loop.delay,
     }
 
 

@@ -96,7 +96,7 @@ def value_text(sheet: dict, key: str) -> str:
                 f"N s/m, {hand['stiffness']:g} N/m) {value['exact_with_hand']:.4g}; simulated with dry friction and "
                 f"quantization {simulated}; passivity: 2b/T = {value['passivity_viscous']:.4g}, 2 f_c / Delta = "
                 + ("n/a" if value["passivity_coulomb"] is None else f"{value['passivity_coulomb']:.4g}")
-                + f" (at {value['rate']:g} Hz, delay {value['delay_samples']}, every joint free)")
+                + f" (at {value['rate']:g} Hz, delay {value['delay']}, every joint free)")
     return f"{value:.4g}"
 
 

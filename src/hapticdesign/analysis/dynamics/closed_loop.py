@@ -9,8 +9,8 @@ evaluated pose by pose instead of an exact trigonometric basis (it is no :class:
 C (eq. 2.50's columns), C_cvt (eq. 2.52, from the Christoffel symbols of ``H_a``), G, inverse and forward
 dynamics are inherited.
 
-A batch of actuated poses is a motion (:meth:`LoopSolver.solve`): passive values are continued
-along it from the home assembly.
+A batch of actuated poses is a motion (:meth:`~hapticdesign.analysis.loops.solver.LoopSolver.solve`): passive values
+are continued along it from the home assembly.
 """
 
 from __future__ import annotations

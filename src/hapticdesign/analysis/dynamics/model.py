@@ -97,7 +97,7 @@ class EquationsOfMotion:
     """H, C, C_cvt, G, inverse and forward dynamics from the entries (unique H, C, G; eq. 2.50-2.52) of a subclass.
 
     A subclass sets ``mechanism``, ``n_dof``, ``n_params``, ``pairs`` and the slices ``slice_h``, ``slice_c``,
-    ``slice_g`` of its entries, and gives :meth:`entries` (P, E) or (S, P, E) and :meth:`entry_regressor`:
+    ``slice_g`` of its entries, and gives ``entries`` (P, E) or (S, P, E) and ``entry_regressor``:
     :class:`DynamicsModel` from its exact basis, :class:`~.closed_loop.ClosedLoopModel` pose by pose.
     Arrays of poses ``q`` have shape (P, N) or (N,); parameters have shape (n_params,) or (S, n_params) for
     S parameter sets at once (results then lead with S). ``constant`` (None, or one value per entry) is added

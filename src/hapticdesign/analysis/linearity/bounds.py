@@ -1,4 +1,4 @@
-"""Practical and coarse bounds on the inertial parameters (seed 000 eq. 3.29-3.32, 3.35-3.38, 3.40-3.42).
+"""Practical bounds on the inertial parameters (seed 000 eq. 3.29-3.32, 3.35-3.38).
 
 Bounds are per body, in the seed's variables: mass, mass-centre coordinates, the diagonal
 moments of inertia about the mass centre and the products of inertia. Bodies without bounds
@@ -82,40 +82,16 @@ def as_box(bounds: Bounds) -> SeedBox:
     return bounds if isinstance(bounds, SeedBox) else bounds.box()
 
 
-def _phantom_arm(heavy: tuple[float, float], light: tuple[float, float]) -> dict[str, BodyBounds]:
-    r, moments = (-0.25, 0.25), (1e-5, 1e-2)
-    return {
-        "2": BodyBounds(heavy, r, moments, 1e-2),
-        "3a": BodyBounds(heavy, r, moments, 1e-2),
-        "2a": BodyBounds(light, r, moments, 1e-2),
-        "3": BodyBounds(light, r, moments, 1e-2),
-    }
-
-
-# Eq. 3.29-3.32 (= eq. 3.35-3.38): link 2 and 3a heavy, link 2a and 3 light.
-PHANTOM_PRACTICAL = _phantom_arm((0.15, 0.30), (0.02, 0.15))
-# Our practical bounds for the gimbal links (not in the seed): 5-50 g, moments 1e-7..1e-3 kg m^2.
-GIMBAL_PRACTICAL = {b: BodyBounds((0.005, 0.05), (-0.25, 0.25), (1e-7, 1e-3), 1e-3) for b in ("4", "5", "6")}
-# Eq. 3.40-3.42, every link.
-COARSE = BodyBounds((1e-15, 1e15), (-1e15, 1e15), (1e-15, 1e15), 1e15)
-
-PRACTICAL: dict[str, dict[str, BodyBounds]] = {
-    "phantom-3dof": PHANTOM_PRACTICAL,
-    "phantom-6dof": {**PHANTOM_PRACTICAL, **GIMBAL_PRACTICAL},
-}
 GENERIC = BodyBounds((0.01, 1.0), (-0.5, 0.5), (1e-6, 1e-1), 1e-1)
+"""Every body with mass of a device whose source gives no practical bounds."""
 
 
 def practical_bounds(device: Device) -> dict[str, BodyBounds]:
-    """Eq. 3.29-3.32 for the Phantom; for other devices every body with mass gets generic bounds."""
-    if device.name in PRACTICAL:
-        return PRACTICAL[device.name]
+    """The device's own practical bounds (:attr:`~hapticdesign.model.device.Device.preset_data`; eq. 3.29-3.32 for
+    the Phantom presets); for other devices every body with mass gets generic bounds."""
+    if device.preset_data.bounds:
+        return {body: BodyBounds(*row) for body, row in device.preset_data.bounds.items()}
     return {b: GENERIC for b in device.body_names if device.body(b).m > 0}
-
-
-def coarse_bounds(device: Device) -> dict[str, BodyBounds]:
-    """Eq. 3.40-3.42 on every body."""
-    return {b: COARSE for b in device.body_names}
 
 
 def within_bounds(seed: np.ndarray, bodies: tuple[str, ...], bounds: dict[str, Bounds], rel_tol: float = 1e-9) -> bool:

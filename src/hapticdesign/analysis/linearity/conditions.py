@@ -21,20 +21,6 @@ from hapticdesign.analysis.linearity.quadratic import LinearityForm
 from hapticdesign.analysis.linearity.symbols import seed_symbols, standard_expressions, standard_names
 from hapticdesign.model.device import Device
 
-# The seed's dependent variables (eq. 3.12-3.26) and the standard parameters used as pivots
-# for them (r2z enters through J2xz = -Ixz2 - m2 r2x r2z, r3y through J3yz), per preset.
-SEED_DEPENDENTS: dict[str, tuple[str, ...]] = {
-    "phantom-3dof": (
-        "r2x", "r2y", "r2z", "r2ay", "r3x", "r3y", "r3z", "r3ax", "r3az",
-        "Iyy2a", "Izz3a", "Ixy2", "Iyz2", "Ixy3", "Ixz3",
-    ),
-}
-SEED_PIVOTS: dict[str, tuple[str, ...]] = {
-    "phantom-3dof": (
-        "h2x", "h2y", "J2xz", "h2ay", "h3x", "J3yz", "h3z", "h3ax", "h3az",
-        "J2ayy", "J3azz", "J2xy", "J2yz", "J3xy", "J3xz",
-    ),
-}
 # Pivot preference among standard parameters: first moments, then products, then moments, then masses.
 _FIELD_RANK = {"h": 0, "J": 1, "m": 3}
 
@@ -126,7 +112,7 @@ def linear_conditions(device: Device, form: LinearityForm, rel_tol: float = 1e-1
     _, sing, vt = np.linalg.svd(np.linalg.qr(stacked, mode="r"))
     row_space = vt[sing > rel_tol * max(sing.max(), 1e-300)]
     names = standard_names(device.body_names)
-    rows, pivots = _rref(row_space, _pivot_order(names, SEED_PIVOTS.get(device.name, ())), 1e-9)
+    rows, pivots = _rref(row_space, _pivot_order(names, device.preset_data.pivots), 1e-9)
     n = model.n_dof
     h0 = model.coefficients[0, model.slice_h]  # constant basis function is index 0
     iu, ju = np.triu_indices(n)
@@ -161,7 +147,7 @@ def seed_conditions(device: Device, conditions: LinearConditions, dependents: tu
     bodies = device.body_names
     symbols = seed_symbols(bodies)
     by_name = {s.name: s for s in symbols}
-    dependents = dependents or SEED_DEPENDENTS.get(device.name) or _mapped_pivots(conditions, bodies)
+    dependents = dependents or device.preset_data.dependents or _mapped_pivots(conditions, bodies)
     unknowns = [by_name[d] for d in dependents]
     std = sp.Matrix(standard_expressions(bodies))
     rows = _rational_rows(conditions.rows)

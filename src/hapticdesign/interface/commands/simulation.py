@@ -46,8 +46,6 @@ HAND_DAMPING = typer.Option(0.0, help="Hand damping at the handle [N s/m].")
 HAND_STIFFNESS = typer.Option(0.0, help="Hand stiffness at the handle [N/m].")
 
 
-SEED_PRESETS = ("phantom-3dof", "phantom-6dof")
-"""The seed's devices: their searches keep the seed's settings and performance criteria by default."""
 SETTINGS = typer.Option(
     None, help="Loop settings: practice (1 kHz, one sample of delay, backward-difference velocity, gravity "
                "compensation; every other device's default) or seed (full inverse-dynamics compensation, no delay, "
@@ -59,13 +57,15 @@ VELOCITY = typer.Option(None, help="The wall damper's velocity: difference (back
 HOLD = typer.Option(None, help="Joints held fixed under the limit method (e.g. 2,3); default: every joint free.")
 
 
-def seed_settings(preset: Optional[str], device: Optional[Path], settings: Optional[str]) -> bool:
-    """Whether a command uses the seed's settings: asked for, or by default on the seed's Phantom presets."""
+def seed_settings(device, settings: Optional[str]) -> bool:
+    """Whether a command uses the seed's settings: asked for, or by default where the device's source says so
+    (:attr:`~hapticdesign.model.device.PresetData.loop_settings`: the seed's Phantom presets); ``device`` None is a
+    bare loop, practice's."""
     if settings not in (None, "practice", "seed"):
         raise UserError(f"--settings must be practice or seed, got {settings!r}")
     if settings is not None:
         return settings == "seed"
-    return device is None and (preset is None or preset in SEED_PRESETS)
+    return device is not None and device.preset_data.loop_settings == "seed"
 
 
 def sampled_loop(seed: bool, period: float, delay: Optional[int], velocity: Optional[str],
@@ -74,7 +74,7 @@ def sampled_loop(seed: bool, period: float, delay: Optional[int], velocity: Opti
     """The one loop record of a command's options: the seed's or practice's settings with the options given."""
     from hapticdesign.analysis.sampled_loop import Hand, SampledLoop
 
-    changes = {"period": period, "model_error": error_percent, "virtual_damping": wall_damping,
+    changes = {"period": period, "error_percent": error_percent, "wall_damping": wall_damping,
                "hand": Hand.optional(hand_mass, hand_damping, hand_stiffness), "held": held,
                **{k: v for k, v in (("delay", delay), ("velocity", velocity), ("compensation", compensation))
                   if v is not None}}
@@ -134,7 +134,7 @@ def impedance_range_command(
         from hapticdesign.devices.loading import resolve_device
 
         dev = resolve_device(preset, device, params, strict=strict)
-        seed = seed_settings(preset, device, settings)
+        seed = seed_settings(dev, settings)
         method = method or ("fast" if seed else "limit")
         if equilibrium is None:
             equilibrium = 0.0 if method == "limit" else 0.01
@@ -208,7 +208,7 @@ def transparency_command(
     from hapticdesign.simulation.config import Compensator, LoopConfig, Sensors, Wall
     from hapticdesign.simulation.loop import joint_index
     from hapticdesign.simulation.paths import Chirp
-    from hapticdesign.simulation.transparency import transparency
+    from hapticdesign.simulation.transparency import stable_limit, transparency
 
     with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
         _check_chirp(amplitude, f0, f1, sweep, period)
@@ -222,7 +222,7 @@ def transparency_command(
             raise UserError(f"--band must be positive, got {band}")
         if method not in ("simulation", "analytic"):
             raise UserError(f"--method must be 'simulation' or 'analytic', got {method!r}")
-        from hapticdesign.interface.commands.transparency_adapter import bandwidth_note, finite_or_none, stable_limit
+        from hapticdesign.interface.commands.transparency_adapter import bandwidth_note, finite_or_none
 
         unit = joint_units(dev)[joint_index(dev, joint)]
         limit = stable_limit(dev, _sim_type(sim_type), joint_index(dev, joint), config)
@@ -313,7 +313,7 @@ def stability_boundary_command(
         if not (np.isfinite(inertia) and inertia > 0 and np.isfinite(period) and period > 0):
             raise UserError(f"--inertia and --period must be positive numbers, got {inertia:g} and {period:g}")
         _check_scale(inertia=inertia, damping=damping, period=period, wall_damping=wall_damping)
-        loop = sampled_loop(seed_settings(None, None, settings or "practice"), period, delay, velocity, compensation,
+        loop = sampled_loop(seed_settings(None, settings or "practice"), period, delay, velocity, compensation,
                             error_percent, wall_damping)
         if error_percent and loop.compensation != "full":
             raise UserError("--error-percent needs --compensation full (it scales the compensator's inertia)")

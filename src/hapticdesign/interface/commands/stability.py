@@ -17,28 +17,20 @@ def _dampers(text: Optional[str]) -> Optional[list[float]]:
     return None if text is None else [float(v) for v in parse_vector(text, None, "b-values")]
 
 
-def _device_joint(preset, device, params, strict, q, joint, direction, loop) -> tuple[float, float, int, int,
-                                                                                     float | None, float | None]:
-    """J = H_jj(q), b_j, the joint's index, the device's joint count, ``J_n = n^T J_v`` of the joint along a
-    Cartesian wall's ``direction`` (None without one) and the compensator's ``H_m,jj`` (its model device's, None
-    without a modelling error)."""
+def _device_joint(dev, pose, joint, direction, loop) -> tuple[float, float, int, float | None, float | None]:
+    """J = H_jj(q), b_j, the joint's index, ``J_n = n^T J_v`` of the joint along a Cartesian wall's ``direction``
+    (None without one) and the compensator's ``H_m,jj`` (its model device's, None without a modelling error)."""
     from hapticdesign.analysis.dynamics.device import mass_matrix
-    from hapticdesign.devices.loading import resolve_device
     from hapticdesign.simulation.config import Wall, loop_model, normal_jacobian
     from hapticdesign.simulation.loop import joint_index
 
-    dev = resolve_device(preset, device, params, strict=strict)
-    pose = parse_vector(q, dev.n_dof, "q")
     j = joint_index(dev, joint)
     inertia = float(mass_matrix(dev, pose)[j, j])
     reach = None
     if direction is not None:
-        vector = parse_vector(direction, 3, "wall-direction")
-        if not vector.any():
-            raise UserError("--wall-direction must not be the zero vector")
-        reach = float(normal_jacobian(dev, Wall(direction=tuple(vector.tolist())), pose)[j])
+        reach = float(normal_jacobian(dev, Wall(direction=tuple(direction.tolist())), pose)[j])
     model = loop_model(dev, loop, pose)
-    return inertia, float(dev.damping[j]), j, dev.n_dof, reach, None if model is None else float(model[0][j, j])
+    return inertia, float(dev.damping[j]), j, reach, None if model is None else float(model[0][j, j])
 
 
 def zwidth_command(
@@ -47,11 +39,16 @@ def zwidth_command(
     preset: Optional[str] = PRESET,
     device: Optional[Path] = DEVICE,
     params: Optional[Path] = PARAMS,
-    q: Optional[str] = typer.Option(None, help="Pose of the device [rad or m], comma-separated (default: zeros)."),
-    joint: str = typer.Option("1", help="The device's joint carrying the wall (1-based or coordinate name)."),
+    q: Optional[str] = typer.Option(None, help="Pose of the device where the wall holds it [rad or m], "
+                                               "comma-separated (default: its home, zeros for an open chain)."),
+    joint: str = typer.Option("1", help="The device's joint carrying the wall (1-based or coordinate name); with "
+                                        "--wall-direction and --one-dof the joint moving the handle."),
     wall_direction: Optional[str] = typer.Option(
-        None, help="Device mode: a Cartesian wall along x,y,z at the handle, moved by --joint (the others held); "
-                   "K in N/m, B in N s/m."),
+        None, help="Device mode: a Cartesian wall along x,y,z at the handle, every actuated joint free (the limit "
+                   "impedance-range --wall-direction and spec give); K in N/m, B in N s/m."),
+    one_dof: bool = typer.Option(False, "--one-dof", help="With --wall-direction: the 1-DOF display of --joint, the "
+                                                          "other joints held (the wall seen along its reach J_n; "
+                                                          "the earlier default). A joint wall is always this."),
     strict: bool = STRICT,
     period: float = PERIOD,
     settings: Optional[str] = SETTINGS,
@@ -71,60 +68,81 @@ def zwidth_command(
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
 ) -> None:
-    """Exact Z-width of a 1-DOF haptic display, K_max for each virtual damper B (seed 000 ch. 5 future work).
+    """Exact Z-width of a haptic display, K_max for each virtual damper B (seed 000 ch. 5 future work).
 
     Exact for the sampled-data loop (zero-order hold, delay, compensator) under every command's loop settings
     (practice's by default, the seed's on its Phantom presets), with the passivity bound of Colgate & Schenkel beside
-    it (Colgate & Brown 1994). J and b come from the options or from one joint of a device at a pose (the other
-    joints held). The output states the settings."""
+    it for a 1-DOF display (Colgate & Brown 1994). J and b come from the options or from one joint of a device at a
+    pose (the other joints held); a device's Cartesian wall (--wall-direction) acts with every actuated joint free,
+    as impedance-range's and the spec sheet's do (--one-dof: the held view). The output states the settings."""
     from dataclasses import replace
 
     from hapticdesign.interface.report.index import write_folder_index
     from hapticdesign.simulation.figures import zwidth_chart
-    from hapticdesign.simulation.zwidth import along_wall, zwidth
+    from hapticdesign.simulation.config import unit_direction
+    from hapticdesign.simulation.zwidth import along_wall, wall_zwidth, zwidth
 
     with user_errors(quiet=quiet):
         from hapticdesign.interface.commands.simulation import sampled_loop, seed_settings
 
         from_device = preset is not None or device is not None
-        seed = seed_settings(preset, device, settings) if from_device or settings is not None else False
-        loop = sampled_loop(seed, period, delay, velocity, compensation, error_percent, 0.0)
-        if error_percent and loop.compensation != "full":
-            raise UserError("--error-percent needs --compensation full (it scales the compensator's inertia)")
         if from_device == (inertia is not None or damping is not None):
             raise UserError("give either --inertia and --damping, or a device (--preset or --device) with --q and --joint")
         if wall_direction is not None and not from_device:
             raise UserError("--wall-direction needs a device (--preset or --device)")
         if wall_direction is not None and map_joints is not None:
             raise UserError("--map-joints charts a joint wall; leave out --wall-direction")
-        reach, shown, model = None, loop, None
-        if from_device:  # a 1-DOF display of the joint: the others held, a named option the settings state
-            inertia, damping, wall, count, reach, model = _device_joint(preset, device, params, strict, q, joint,
-                                                                        wall_direction, loop)
-            shown = replace(loop, held=tuple(j for j in range(count) if j != wall))
+        if one_dof and wall_direction is None:
+            raise UserError("--one-dof views a Cartesian wall from one joint; give --wall-direction (a joint wall is "
+                            "always the joint's 1-DOF display)")
         if map_joints is not None and not (from_device and out is not None):
             raise UserError("--map-joints needs a device (--preset or --device) and --out")
-        elif inertia is None or damping is None:
-            raise UserError("--inertia and --damping go together")
-        if reach is not None:
-            inertia, damping = along_wall(inertia, damping, reach)
-            model = None if model is None else model / reach ** 2
-        result = zwidth(inertia, damping, loop, _dampers(b_values), points, model)
-        units = ("kg", "N s/m", "N/m") if reach is not None else ("kg m^2", "N m s/rad", "N m/rad")
+        dev = None
+        if from_device:
+            from hapticdesign.analysis.configuration import configuration_of
+            from hapticdesign.devices.loading import resolve_device
+
+            dev = resolve_device(preset, device, params, strict=strict)
+            pose = configuration_of(dev).home.copy() if q is None else parse_vector(q, dev.n_dof, "q")
+            direction = None if wall_direction is None else parse_vector(wall_direction, 3, "wall-direction")
+            if direction is not None and not direction.any():
+                raise UserError("--wall-direction must not be the zero vector")
+        loop = sampled_loop(seed_settings(dev, settings), period, delay, velocity, compensation, error_percent, 0.0)
+        if error_percent and loop.compensation != "full":
+            raise UserError("--error-percent needs --compensation full (it scales the compensator's inertia)")
+        reach, shown, model, free = None, loop, None, from_device and wall_direction is not None and not one_dof
+        if free:  # the device's wall, every actuated joint free
+            result = wall_zwidth(dev, pose, direction, loop, _dampers(b_values), points)
+        else:
+            if from_device:  # a 1-DOF display of the joint: the others held, as the settings state
+                inertia, damping, wall, reach, model = _device_joint(dev, pose, joint, direction, loop)
+                shown = replace(loop, held=tuple(j for j in range(dev.n_dof) if j != wall))
+            elif inertia is None or damping is None:
+                raise UserError("--inertia and --damping go together")
+            if reach is not None:
+                inertia, damping = along_wall(inertia, damping, reach)
+                model = None if model is None else model / reach ** 2
+            result = zwidth(inertia, damping, loop, _dampers(b_values), points, model)
+        units = ("kg", "N s/m", "N/m") if wall_direction is not None else ("kg m^2", "N m s/rad", "N m/rad")
         figures, index = [], None
         if out is not None:
-            title = (f"J = {inertia:g} {units[0]}, b = {damping:g} {units[1]}, T = {period:g} s, N = {loop.delay}, "
-                     f"{loop.velocity} velocity, {loop.compensation} compensation"
+            plant = (f"{dev.name} at q = ({', '.join(f'{v:g}' for v in pose)}), wall along "
+                     f"({', '.join(f'{v:g}' for v in direction)}), every joint free" if free else
+                     f"J = {inertia:g} {units[0]}, b = {damping:g} {units[1]}")
+            title = (f"{plant}, T = {period:g} s, N = {loop.delay}, {loop.velocity} velocity, {loop.compensation} "
+                     "compensation"
                      + (f" (c = {loop.fraction if model is None else model / inertia:g})"
-                        if loop.compensation == "full" else "")
+                        if loop.compensation == "full" and not free else "")
                      + (" (Cartesian wall)" if reach is not None else ""))
             figures = [str(p) for p in zwidth_chart(result, title, Path(out) / "zwidth", units[1:])]
             if map_joints is not None:
-                figures += _map(preset, device, params, strict, joint, map_joints, map_points,
-                                replace(loop, virtual_damping=result.B[0]), Path(out))
-            index = str(write_folder_index(Path(out), "Z-width", "Exact Z-width of a 1-DOF haptic display (seed 000 "
+                figures += _map(dev, joint, map_joints, map_points,
+                                replace(loop, wall_damping=result.B[0]), Path(out))
+            what = "a device" if free else "a 1-DOF"
+            index = str(write_folder_index(Path(out), "Z-width", f"Exact Z-width of {what} haptic display (seed 000 "
                                            f"ch. 5 future work): {title}.", figures))
-        about = {"inertia": inertia, "damping": damping, **({} if model is None else {"model_inertia": model})}
+        about = ({"pose": pose.tolist(), "wall_direction": unit_direction(direction).tolist()} if free
+                 else {"inertia": inertia, "damping": damping, **({} if model is None else {"model_inertia": model})})
         payload = {**result.as_dict(), "settings": shown.as_dict(), "loop": about,
                    "figures": figures, **({"index": index} if index else {})}
         if reach is not None:
@@ -143,13 +161,11 @@ def zwidth_command(
             note(f"wrote {f}", quiet)
 
 
-def _map(preset, device, params, strict, joint, map_joints, points, loop, out: Path) -> list[str]:
-    from hapticdesign.devices.loading import resolve_device
+def _map(dev, joint, map_joints, points, loop, out: Path) -> list[str]:
     from hapticdesign.simulation.figures import stiffness_map_chart
     from hapticdesign.simulation.loop import joint_index
     from hapticdesign.simulation.zwidth import stiffness_map
 
-    dev = resolve_device(preset, device, params, strict=strict)
     names = [v for v in map_joints.replace(" ", "").split(",") if v]
     if len(names) != 2:
         raise UserError(f"--map-joints: give two joints, got {map_joints!r}")

@@ -20,12 +20,13 @@ import importlib.metadata
 import inspect
 import re
 from collections.abc import Callable, Iterable, Iterator, Mapping
-from dataclasses import dataclass, field
+import warnings
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from hapticdesign.analysis.metrics.indices.states import PARAMETER_NEEDS, POSE_NEEDS
-from hapticdesign.errors import UserError
+from hapticdesign.errors import RenamedWarning, UserError
 from hapticdesign.workload import require_within
 
 ENTRY_POINTS = "hapticdesign.indices"
@@ -54,13 +55,29 @@ class Index:
     over: str = "poses"
     """``poses``: one value per pose (P,); ``points``: one value per design (D,) from all of its points at once
     (``state.designs`` designs, their poses one after the other), taken at each of its points."""
+    renamed: Mapping[str, str] = field(default_factory=dict)
+    """Former option names -> their current ones, each taken for one release with a deprecation line
+    (:meth:`current`)."""
+
+    def current(self, options: Mapping[str, object]) -> dict[str, object]:
+        """``options`` under their current names: a former name (:attr:`renamed`) is taken with a
+        :class:`~hapticdesign.errors.RenamedWarning`; the two names of one option at once are a one-line error."""
+        out = dict(options)
+        for old, new in self.renamed.items():
+            if old in out:
+                warnings.warn(f"index {self.name}: the option {old!r} is now called {new!r}; {old!r} will be removed",
+                              RenamedWarning, stacklevel=3)
+                if new in out:
+                    raise UserError(f"index {self.name}: give {new} once ({old} is its former name)")
+                out[new] = out.pop(old)
+        return out
 
     def values(self, state, options: Mapping[str, object] | None = None) -> np.ndarray:
         """The index of ``state`` with ``options`` over its defaults, as floats, one per pose of ``state`` (one per
         design for an index of the parameters). A function that raises, or answers another shape or a value that
         is not a number, is a one-line UserError naming the index."""
         try:
-            found = np.asarray(self.function(state, **{**self.options, **(options or {})}), dtype=float)
+            found = np.asarray(self.function(state, **{**self.options, **self.current(options or {})}), dtype=float)
         except UserError:
             raise
         except Exception as exc:  # the index's own code (a user's): one line naming it, not a traceback
@@ -168,7 +185,7 @@ INDICES = Registry()
 
 def index(function: Callable | None = None, *, unit: str, formula: str | None = None, source: str | None = None,
           name: str | None = None, needs: Iterable[str] = ("kinematics", "dynamics"), cost: float = 1.0,
-          over: str = "poses", registry: Registry = INDICES):
+          over: str = "poses", renamed: Mapping[str, str] | None = None, registry: Registry = INDICES):
     """Register ``function(state, **options)`` as an index (a decorator; the :class:`Index` it returns is callable
     like the function). Its name is the function's (or ``name``), its options its keyword parameters with their
     defaults; ``formula`` defaults to the first line of its docstring, ``source`` to where it is defined. A pose
@@ -176,7 +193,8 @@ def index(function: Callable | None = None, *, unit: str, formula: str | None = 
     the leading axis of the P poses, docs/indices.md) and returns (P,) values; with ``over="points"`` it returns one
     value per design, (``state.designs``,), from all of each design's points (the poses are the designs' one after
     the other); an index that ``needs`` ``parameters`` reads ``state.params`` (name -> (D,) values) and returns
-    (D,)."""
+    (D,). ``renamed`` maps an option's former names to its current one (taken for one release,
+    :meth:`Index.current`)."""
 
     def make(f: Callable) -> Index:
         label = name or getattr(f, "__name__", "")
@@ -195,7 +213,7 @@ def index(function: Callable | None = None, *, unit: str, formula: str | None = 
             raise UserError(f"index {label}: over is poses (one value per pose) or points (one value per design "
                             f"from all its points; not with needs parameters), got {over!r}")
         made = Index(label, unit, formula or (doc[0] if doc else label), source or ".".join(_origin(f)), f,
-                     _options(f, label), wanted, float(cost), over)
+                     _options(f, label), wanted, float(cost), over, dict(renamed or {}))
         return registry.register(made)
 
     return make if function is None else make(function)
@@ -229,6 +247,7 @@ def requests_of(requests: Iterable[str | Request], registry: Mapping[str, Index]
         request = Request(request) if isinstance(request, str) else request
         if request.index not in registry:
             raise UserError(f"unknown index {request.index!r} (indices: {', '.join(registry)})")
+        request = replace(request, options=registry[request.index].current(request.options))
         known = registry[request.index].options
         unknown = [k for k in request.options if k not in known]
         if unknown:

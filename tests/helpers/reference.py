@@ -1,15 +1,14 @@
 """The same sampled-data loop written plainly with ``scipy.integrate.solve_ivp`` (adaptive RK45).
 
-Between samples the held torques are constant, so each sample period is one ``solve_ivp`` call
-on the free joints, with the prescribed joints following their paths and the dynamics from
-:class:`~hapticdesign.analysis.dynamics.model.DynamicsModel` in NumPy. This is the optional
-adaptive integrator, the cross-check of the numba kernel, and the speed baseline of the
-benchmark. It shares only the configuration types with the fast loop (:mod:`.config`), none of
-its code. Records are taken at the sample instants; the excursion stop and the safety switch are
-checked at every plant-step instant (``config.step``) from the dense output of each period, as the
-fast loop checks them, and a tripped switch removes the torques from that instant on. A Cartesian
-wall takes the handle's position and Jacobian from :mod:`hapticdesign.analysis.kinematics` (for a closed-loop
-device at the pose the loop solver closes, with ``J T``).
+Between samples the held torques are constant, so each sample period is one ``solve_ivp`` call on the free joints,
+with the prescribed joints following their paths and the dynamics from
+:class:`~hapticdesign.analysis.dynamics.model.DynamicsModel` in NumPy. It is the tests' cross-check of the numba
+kernel and the benchmarks' speed baseline, kept beside them (outside the package). It shares only the configuration
+types with the fast loop (:mod:`hapticdesign.simulation.config`), none of its code. Records are taken at the sample
+instants; the excursion stop and the safety switch are checked at every plant-step instant (``config.step``) from the
+dense output of each period, as the fast loop checks them, and a tripped switch removes the torques from that instant
+on. A Cartesian wall takes the handle's position and Jacobian from :mod:`hapticdesign.analysis.kinematics` (for a
+closed-loop device at the pose the loop solver closes, with ``J T``).
 """
 
 from __future__ import annotations
