@@ -162,7 +162,8 @@ def area_line(result: dict) -> str:
 
 
 def summary(name: str, result: dict) -> dict[str, float]:
-    """Totals of one cold run: CPU, compile CPU (top-level compiles), kernels, specializations, several-signature kernels."""
+    """Totals of one cold run: CPU, compile CPU (top-level compiles), kernels, specializations and the kernels of
+    several signatures."""
     compiled = {c["kernel"] for c in result["compiles"]}
     specializations = sum(1 for _ in result["compiles"])
     multiple = sorted(k for k, s in result["kernels"].items() if len(s) > 1)
@@ -196,10 +197,11 @@ def main(argv: list[str] | None = None) -> None:
         print(f"### `{' '.join(CASES[name](Path('OUT'))).replace(str(ROOT) + '/', '')}`\n", flush=True)
         print("\n".join(kernel_table(cold, args.top)))
         if s["multiple"]:
-            print(f"\nKernels with more than one specialization: "
-                  + ", ".join(f"`{k.removeprefix('hapticdesign.')}` ({len(cold['kernels'][k])})" for k in s["multiple"]))
+            several = (f"`{k.removeprefix('hapticdesign.')}` ({len(cold['kernels'][k])})" for k in s["multiple"])
+            print("\nKernels with more than one specialization: " + ", ".join(several))
         print(f"\n{area_line(cold)}")
-        print(f"\nCPU {s['cpu']:.1f} s, of which compiling {s['compile']:.1f} s; wall {cold['wall']:.1f} s\n", flush=True)
+        print(f"\nCPU {s['cpu']:.1f} s, of which compiling {s['compile']:.1f} s; wall {cold['wall']:.1f} s\n",
+              flush=True)
         goal = GOALS.get(name)
         verdict = f"<= {goal:g}: {'met' if s['cpu'] <= goal else 'not met'}" if goal else ""
         warm_cpu = f"{warm['cpu']:.1f}" if warm else ""
