@@ -91,3 +91,15 @@ def test_eom_latex_and_python():
     assert np.abs(np.array(g, dtype=float)).max() < 1e-9
     bad = runner.invoke(app, ["eom", "--symbolic", "m2,zz"])
     assert bad.exit_code == 2 and "unknown parameter name 'zz'" in bad.stderr
+
+
+def test_eom_says_what_it_derives_unless_quiet(tmp_path):
+    """The symbolic derivation takes seconds on six joints: a line on stderr says so first; --quiet silences it and
+    the equations written are the same."""
+    loud = runner.invoke(app, ["eom", "--preset", "phantom-3dof", "--symbolic", "m2,l2", "--format", "python",
+                               "--out", str(tmp_path / "a.py")])
+    quiet = runner.invoke(app, ["eom", "--preset", "phantom-3dof", "--symbolic", "m2,l2", "--format", "python",
+                                "--out", str(tmp_path / "b.py"), "--quiet"])
+    assert loud.exit_code == quiet.exit_code == 0
+    assert loud.stderr.startswith("eom: deriving the exact H, C and G of phantom-3dof (3 joints)")
+    assert quiet.stderr == "" and (tmp_path / "a.py").read_text() == (tmp_path / "b.py").read_text()

@@ -137,6 +137,10 @@ def eom(
         from hapticdesign.devices.loading import resolve_device
 
         dev = resolve_device(preset, device, params, strict=strict)
+        # on a terminal without --out the equations may be refused as too long to read: that error is the one line
+        stderr_note(f"eom: deriving the exact H, C and G of {dev.name} ({dev.n_dof} joints), then writing them as "
+                    f"{fmt}: seconds for six joints with every parameter a symbol (the 6-DOF Phantom: about 5 s, then "
+                    "as long again for LaTeX)", quiet or json_out or (out is None and _terminal()))
         text = export(derive(dev, symbolic), fmt, part)
         if out is not None and not json_out:
             write_atomically(out, text + "\n")
