@@ -12,7 +12,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.signal import csd, welch
 
-from hapticdesign.errors import UserError
+from hapticdesign.analysis.sampled_loop import SCALE_RANGE
+from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation.config import LoopConfig, require_device, require_options
 from hapticdesign.simulation.paths import Chirp
@@ -76,7 +77,10 @@ def check_request(device: Device, sim_type: int, stiffness: float, chirp: Chirp 
     if isinstance(stiffness, bool) or not isinstance(stiffness, (int, float)):
         raise UserError(f"the wall stiffness must be a number, got {stiffness!r}")
     if not (stiffness > 0 and math.isfinite(stiffness)):
-        raise UserError(f"the wall stiffness must be positive, got {stiffness}")
+        raise InputError(f"the wall stiffness must be positive, got {stiffness}", "stiffness")
+    if stiffness > SCALE_RANGE[1]:
+        raise InputError(f"the wall stiffness must be at most {SCALE_RANGE[1]:g} (SI units), got {stiffness:g}",
+                         "stiffness")
     chirp = chirp or Chirp()
     base = config or LoopConfig()
     base.steps_per_sample()
