@@ -44,6 +44,7 @@ from hapticdesign.simulation.impedance import (ImpedanceProblem, fast_search, pl
                                                require_search_workload)
 from hapticdesign.simulation.paths import Chirp
 from hapticdesign.simulation.transparency import transparency
+from hapticdesign.simulation.transparency_estimate import check_request
 from hapticdesign.workload import require_plant_steps, worker_count
 
 META_COLUMNS = ("level", "ln", "ln_H", "ln_C", "ln_G")
@@ -158,9 +159,11 @@ def _check_design(device) -> None:
 
 
 def _require_case_workload(options: CampaignOptions) -> None:
-    """Refuse cases whose own plant steps exceed the workload limit (a campaign has many; each is one job)."""
+    """Refuse cases whose own plant steps exceed the workload limit (a campaign has many; each is one job), and a
+    transparency request that every transparency case would refuse (:func:`check_request`)."""
     from hapticdesign.simulation.config import LoopConfig
 
+    check_request(preset(options.preset), 1, options.stiffness, options.chirp, options.conditions)
     require_search_workload(LoopConfig(duration=options.duration), planned_simulations("fast", options.k_limit))
     require_plant_steps(f"a transparency case of {options.chirp.sweep_time:g} s",
                         options.chirp.sweep_time / LoopConfig().step)

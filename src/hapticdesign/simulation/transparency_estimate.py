@@ -84,6 +84,9 @@ def check_request(device: Device, sim_type: int, stiffness: float, chirp: Chirp 
     chirp = chirp or Chirp()
     base = config or LoopConfig()
     base.steps_per_sample()
+    if not chirp.sweep_time >= base.sensors.period:
+        raise InputError(f"the chirp's sweep time {chirp.sweep_time:g} s is shorter than one sample period "
+                         f"({base.sensors.period:g} s)", "sweep")
     require_plant_steps(f"a chirp of {chirp.sweep_time:g} s at a plant step of {base.step:g} s",
                         chirp.sweep_time / base.step)
     nyquist = 0.5 / base.sensors.period
