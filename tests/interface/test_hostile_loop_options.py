@@ -192,3 +192,9 @@ def test_campaign_checks_its_transparency_request_before_making_its_folder(tmp_p
     """Before: the folder made and the error from the first transparency case (1e308), or a traceback from the
     spectra of a chirp shorter than a sample (1e-300)."""
     assert fragment in refused(_args("campaign", *args, tmp_path), tmp_path / "out")
+
+
+def test_campaign_estimates_the_analytic_loop_of_a_billion_samples_before_making_its_folder(tmp_path):
+    """Before: the folder made, then the first analytic case refused the loop's order."""
+    assert "above the limit of 600 rows" in refused(_args("campaign", "--delay", "1000000000", tmp_path),
+                                                    tmp_path / "out")

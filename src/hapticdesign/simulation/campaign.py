@@ -38,7 +38,7 @@ from hapticdesign.analysis.dynamics.device import coriolis_centrifugal, gravity,
 from hapticdesign.devices.registry import preset
 from hapticdesign.errors import InputError, PhysicalConsistencyWarning, UserError
 from hapticdesign.files import csv_rows, output_folder, read_text, write_atomically
-from hapticdesign.simulation.analytic import AnalyticProblem
+from hapticdesign.simulation.analytic import AnalyticProblem, wall_loop
 from hapticdesign.simulation.config import LoopConfig
 from hapticdesign.simulation.impedance import (ImpedanceProblem, fast_search, planned_simulations,
                                                require_search_workload)
@@ -164,6 +164,8 @@ def _require_case_workload(options: CampaignOptions) -> None:
     from hapticdesign.simulation.config import LoopConfig
 
     check_request(preset(options.preset), 1, options.stiffness, options.chirp, options.conditions)
+    if options.method == "analytic":  # each case's exact loop, estimated before the folder is made
+        wall_loop(options.conditions).require_exact(1, 1)
     require_search_workload(LoopConfig(duration=options.duration), planned_simulations("fast", options.k_limit))
     require_plant_steps(f"a transparency case of {options.chirp.sweep_time:g} s",
                         options.chirp.sweep_time / LoopConfig().step)
