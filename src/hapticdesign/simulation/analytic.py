@@ -101,12 +101,18 @@ class WallJoint:
         return self.inertia + hand.mass * r2, self.damping + hand.damping * r2, hand.stiffness * r2 + self.gravity
 
 
+def wall_loop(config: LoopConfig) -> SampledLoop:
+    """The settings of :func:`wall_loops` from ``config``: its period, delay, wall damper and hand, the sampled
+    velocity and the full compensator (each wall's own model)."""
+    return SampledLoop(config.sensors.period, config.sensors.delay_samples, "sampled", "full", 0.0,
+                       config.wall.damping, config.hand)
+
+
 def wall_loops(walls: list[WallJoint], config: LoopConfig) -> SpringLoops:
     """The sampled loops of the walls' joints under the settings of ``config`` (its period, delay, wall damper and
     hand; the sampled velocity, the seed's): the one-joint case of
     :func:`hapticdesign.analysis.sampled_loop.handle_loops`, with each wall's own compensator model."""
-    loop = SampledLoop(config.sensors.period, config.sensors.delay_samples, "sampled", "full", 0.0,
-                       config.wall.damping, config.hand)
+    loop = wall_loop(config)
     column = np.array([[[w.inertia]] for w in walls]), np.array([[[w.damping]] for w in walls])
     model = np.array([[[w.model_inertia]] for w in walls]), np.array([[[w.model_gravity]] for w in walls])
     loop.require_exact(1, len(walls))

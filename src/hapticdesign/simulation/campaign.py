@@ -38,12 +38,13 @@ from hapticdesign.analysis.dynamics.device import coriolis_centrifugal, gravity,
 from hapticdesign.devices.registry import preset
 from hapticdesign.errors import InputError, PhysicalConsistencyWarning, UserError
 from hapticdesign.files import csv_rows, output_folder, read_text, write_atomically
-from hapticdesign.simulation.analytic import AnalyticProblem
+from hapticdesign.simulation.analytic import AnalyticProblem, wall_loop
 from hapticdesign.simulation.config import LoopConfig
 from hapticdesign.simulation.impedance import (ImpedanceProblem, fast_search, planned_simulations,
                                                require_search_workload)
 from hapticdesign.simulation.paths import Chirp
 from hapticdesign.simulation.transparency import transparency
+from hapticdesign.simulation.transparency_estimate import check_request
 from hapticdesign.workload import require_plant_steps, worker_count
 
 META_COLUMNS = ("level", "ln", "ln_H", "ln_C", "ln_G")
@@ -158,9 +159,13 @@ def _check_design(device) -> None:
 
 
 def _require_case_workload(options: CampaignOptions) -> None:
-    """Refuse cases whose own plant steps exceed the workload limit (a campaign has many; each is one job)."""
+    """Refuse cases whose own plant steps exceed the workload limit (a campaign has many; each is one job), and a
+    transparency request that every transparency case would refuse (:func:`check_request`)."""
     from hapticdesign.simulation.config import LoopConfig
 
+    check_request(preset(options.preset), 1, options.stiffness, options.chirp, options.conditions)
+    if options.method == "analytic":  # each case's exact loop, estimated before the folder is made
+        wall_loop(options.conditions).require_exact(1, 1)
     require_search_workload(LoopConfig(duration=options.duration), planned_simulations("fast", options.k_limit))
     require_plant_steps(f"a transparency case of {options.chirp.sweep_time:g} s",
                         options.chirp.sweep_time / LoopConfig().step)

@@ -12,7 +12,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.signal import csd, welch
 
-from hapticdesign.errors import UserError
+from hapticdesign.analysis.sampled_loop import SCALE_RANGE
+from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation.config import LoopConfig, require_device, require_options
 from hapticdesign.simulation.paths import Chirp
@@ -76,10 +77,16 @@ def check_request(device: Device, sim_type: int, stiffness: float, chirp: Chirp 
     if isinstance(stiffness, bool) or not isinstance(stiffness, (int, float)):
         raise UserError(f"the wall stiffness must be a number, got {stiffness!r}")
     if not (stiffness > 0 and math.isfinite(stiffness)):
-        raise UserError(f"the wall stiffness must be positive, got {stiffness}")
+        raise InputError(f"the wall stiffness must be positive, got {stiffness}", "stiffness")
+    if stiffness > SCALE_RANGE[1]:
+        raise InputError(f"the wall stiffness must be at most {SCALE_RANGE[1]:g} (SI units), got {stiffness:g}",
+                         "stiffness")
     chirp = chirp or Chirp()
     base = config or LoopConfig()
     base.steps_per_sample()
+    if not chirp.sweep_time >= base.sensors.period:
+        raise InputError(f"the chirp's sweep time {chirp.sweep_time:g} s is shorter than one sample period "
+                         f"({base.sensors.period:g} s)", "sweep")
     require_plant_steps(f"a chirp of {chirp.sweep_time:g} s at a plant step of {base.step:g} s",
                         chirp.sweep_time / base.step)
     nyquist = 0.5 / base.sensors.period

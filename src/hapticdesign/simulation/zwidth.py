@@ -205,16 +205,22 @@ class StiffnessMap:
     K: list[list[float]]
 
 
+def check_map(device, joint: int, axes: tuple[int, int], n: int) -> None:
+    """The grid of :func:`stiffness_map` (``n`` points per axis of two joints ``axes`` other than the wall
+    ``joint``), checked before it or any other work is done."""
+    if not 2 <= n <= 101:
+        raise UserError(f"the map needs 2 to 101 points per axis, got {n}")
+    if len(set(axes)) != 2 or joint in axes or not all(0 <= a < device.n_dof for a in axes):
+        raise UserError(f"the map needs two joints other than the wall joint, of 1..{device.n_dof}")
+
+
 def stiffness_map(device, joint: int, axes: tuple[int, int], n: int, loop: SampledLoop,
                   span: tuple[float, float] = (-math.pi, math.pi)) -> StiffnessMap:
     """The Z-width's K at the loop's virtual damper over the workspace: ``J = H_jj(q)`` on an ``n x n`` grid of
     joints ``axes`` (the others at 0), each cell exact for the sampled loop with the other joints held (the cells
     searched at once, :func:`~hapticdesign.analysis.sampled_loop.joint_limits`; the compensator's inertia that of
     the model device, :func:`~.config.model_device`)."""
-    if not 2 <= n <= 101:
-        raise UserError(f"the map needs 2 to 101 points per axis, got {n}")
-    if len(set(axes)) != 2 or joint in axes or not all(0 <= a < device.n_dof for a in axes):
-        raise UserError(f"the map needs two joints other than the wall joint, of 1..{device.n_dof}")
+    check_map(device, joint, axes, n)
     grid = np.linspace(span[0], span[1], n)
     poses = np.zeros((n * n, device.n_dof))
     poses[:, axes[0]], poses[:, axes[1]] = np.repeat(grid, n), np.tile(grid, n)

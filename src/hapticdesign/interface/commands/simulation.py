@@ -209,6 +209,7 @@ def transparency_command(
     from hapticdesign.simulation.loop import joint_index
     from hapticdesign.simulation.paths import Chirp
     from hapticdesign.simulation.transparency import stable_limit, transparency
+    from hapticdesign.simulation.transparency_estimate import check_request
 
     with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
         _check_chirp(amplitude, f0, f1, sweep, period)
@@ -222,6 +223,7 @@ def transparency_command(
             raise UserError(f"--band must be positive, got {band}")
         if method not in ("simulation", "analytic"):
             raise UserError(f"--method must be 'simulation' or 'analytic', got {method!r}")
+        check_request(dev, _sim_type(sim_type), stiffness, Chirp(amplitude, f0, f1, sweep), config)
         from hapticdesign.interface.commands.transparency_adapter import bandwidth_note, finite_or_none
 
         unit = joint_units(dev)[joint_index(dev, joint)]

@@ -107,6 +107,7 @@ def zwidth_command(
             direction = None if wall_direction is None else parse_vector(wall_direction, 3, "wall-direction")
             if direction is not None and not direction.any():
                 raise UserError("--wall-direction must not be the zero vector")
+            axes = None if map_joints is None else _map_axes(dev, joint, map_joints, map_points)
         loop = sampled_loop(seed_settings(dev, settings), period, delay, velocity, compensation, error_percent, 0.0)
         if error_percent and loop.compensation != "full":
             raise UserError("--error-percent needs --compensation full (it scales the compensator's inertia)")
@@ -136,8 +137,7 @@ def zwidth_command(
                      + (" (Cartesian wall)" if reach is not None else ""))
             figures = [str(p) for p in zwidth_chart(result, title, Path(out) / "zwidth", units[1:])]
             if map_joints is not None:
-                figures += _map(dev, joint, map_joints, map_points,
-                                replace(loop, wall_damping=result.B[0]), Path(out))
+                figures += _map(dev, joint, axes, map_points, replace(loop, wall_damping=result.B[0]), Path(out))
             what = "a device" if free else "a 1-DOF"
             index = str(write_folder_index(Path(out), "Z-width", f"Exact Z-width of {what} haptic display (seed 000 "
                                            f"ch. 5 future work): {title}.", figures))
@@ -161,15 +161,26 @@ def zwidth_command(
             note(f"wrote {f}", quiet)
 
 
-def _map(dev, joint, map_joints, points, loop, out: Path) -> list[str]:
-    from hapticdesign.simulation.figures import stiffness_map_chart
+def _map_axes(dev, joint: str, map_joints: str, points: int) -> tuple[int, int]:
+    """The two joints of ``--map-joints``, checked with ``--map-points`` before the Z-width is computed or any
+    chart written."""
     from hapticdesign.simulation.loop import joint_index
-    from hapticdesign.simulation.zwidth import stiffness_map
+    from hapticdesign.simulation.zwidth import check_map
 
     names = [v for v in map_joints.replace(" ", "").split(",") if v]
     if len(names) != 2:
         raise UserError(f"--map-joints: give two joints, got {map_joints!r}")
     axes = (joint_index(dev, names[0]), joint_index(dev, names[1]))
+    check_map(dev, joint_index(dev, joint), axes, points)
+    return axes
+
+
+def _map(dev, joint: str, axes: tuple[int, int], points: int, loop, out: Path) -> list[str]:
+    """The K_max map over the joints ``axes`` (:func:`_map_axes`), charted into ``out``."""
+    from hapticdesign.simulation.figures import stiffness_map_chart
+    from hapticdesign.simulation.loop import joint_index
+    from hapticdesign.simulation.zwidth import stiffness_map
+
     wall = joint_index(dev, joint)
     result = stiffness_map(dev, wall, axes, points, loop)
     coordinates = dev.mechanism.coordinates
