@@ -14,6 +14,8 @@ inertia about the mass centre with products of inertia entering with a minus sig
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from dataclasses import dataclass, replace
 from fractions import Fraction
 from math import pi
@@ -365,8 +367,9 @@ def _christoffel(R: _Ring, H: list) -> list:
     return C
 
 
-def derive(device: Device, symbolic: str = "all") -> SymbolicEquations:
-    """Exact H, C, G of ``device`` with the parameters named in ``symbolic`` kept as symbols.
+def derive(device: Device, symbolic: str = "all", started: Callable[[], None] | None = None) -> SymbolicEquations:
+    """Exact H, C, G of ``device`` with the parameters named in ``symbolic`` kept as symbols; ``started()`` is called
+    once the request is checked, before the symbolic work (seconds on six joints).
 
     Open chains only: the equations of a device with closed loops hold on the closure manifold,
     with its passive joints fixed by the closures (no closed form here, see
@@ -379,6 +382,8 @@ def derive(device: Device, symbolic: str = "all") -> SymbolicEquations:
         raise UserError(f"{device.name} has closed loops (passive joints {passive}): its equations of motion are "
                         "reduced to the actuated joints numerically at each pose and have no symbolic form here")
     keep = _symbolic_names(device, symbolic)
+    if started is not None:
+        started()
     aff = _affine_offsets(device, [k for k in device.kinematic if k in keep])
     inertial = [name for name in device.inertial_names() if name in keep]
     R = _Ring.build(aff, inertial)
@@ -428,9 +433,8 @@ def rounded(eqs: SymbolicEquations, digits: int = 6, relative: float = 1e-12) ->
 
 def export(eqs: SymbolicEquations, fmt: str, part: str = "tau") -> str:
     """The equations as LaTeX, Python source (a function with common subexpressions) or text."""
+    check_export(fmt, part)
     parts = {"tau": eqs.tau, "H": eqs.H, "C": eqs.C, "G": eqs.G}
-    if part not in (*parts, "all"):
-        raise InputError(f"part: expected tau, H, C, G or all, got {part!r}", "part")
     chosen = parts if part == "all" else {part: parts[part]}
     if fmt == "latex":
         lines = []
@@ -442,9 +446,15 @@ def export(eqs: SymbolicEquations, fmt: str, part: str = "tau") -> str:
         return "\n".join(lines)
     if fmt == "text":
         return "\n".join(f"{name}[{','.join(str(i + 1) for i in idx)}] = {mat[idx]}" for name, mat in chosen.items() for idx in np.ndindex(mat.shape))
-    if fmt == "python":
-        return _python_source(eqs, chosen)
-    raise InputError(f"format: expected latex, python or text, got {fmt!r}", "format")
+    return _python_source(eqs, chosen)
+
+
+def check_export(fmt: str, part: str) -> None:
+    """A one-line error unless ``fmt`` is latex, python or text and ``part`` tau, H, C, G or all (:func:`export`'s)."""
+    if fmt not in ("latex", "python", "text"):
+        raise InputError(f"format: expected latex, python or text, got {fmt!r}", "format")
+    if part not in ("tau", "H", "C", "G", "all"):
+        raise InputError(f"part: expected tau, H, C, G or all, got {part!r}", "part")
 
 
 def _python_source(eqs: SymbolicEquations, chosen: dict[str, sp.Matrix]) -> str:

@@ -131,17 +131,19 @@ def eom(
 ) -> None:
     """Equations of motion as LaTeX, Python or text, symbols as chosen (seed 000 eq. 2.50, Appendix A). More than
     100 kB is not printed to a terminal: give --out FILE or pipe it."""
-    from hapticdesign.analysis.dynamics.symbolic import derive, export
+    from hapticdesign.analysis.dynamics.symbolic import check_export, derive, export
 
     with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
         from hapticdesign.devices.loading import resolve_device
 
         dev = resolve_device(preset, device, params, strict=strict)
+        check_export(fmt, part)
         # on a terminal without --out the equations may be refused as too long to read: that error is the one line
-        stderr_note(f"eom: deriving the exact H, C and G of {dev.name} ({dev.n_dof} joints), then writing them as "
-                    f"{fmt}: seconds for six joints with every parameter a symbol (the 6-DOF Phantom: about 5 s, then "
-                    "as long again for LaTeX)", quiet or json_out or (out is None and _terminal()))
-        text = export(derive(dev, symbolic), fmt, part)
+        silent = quiet or json_out or (out is None and _terminal())
+        text = export(derive(dev, symbolic, started=lambda: stderr_note(
+            f"eom: deriving the exact H, C and G of {dev.name} ({dev.n_dof} joints), then writing them as {fmt}: "
+            "seconds for six joints with every parameter a symbol (the 6-DOF Phantom: about 5 s, then as long again "
+            "for LaTeX)", silent)), fmt, part)
         if out is not None and not json_out:
             write_atomically(out, text + "\n")
             stderr_note(f"wrote {out} ({_size(len(text))} of {fmt})", quiet)
