@@ -93,7 +93,7 @@ class CampaignOptions:
     def __post_init__(self) -> None:
         if self.method not in ("simulation", "analytic"):
             raise UserError(f"the campaign method must be 'simulation' or 'analytic', got {self.method!r}")
-        if self.method == "analytic" and self.conditions.sensors.counts_per_revolution is not None:
+        if self.method == "analytic" and self.conditions.counts is not None:
             raise UserError("the analytic method has no encoder quantization (not linear): use the simulation")
         if self.method == "analytic" and self.conditions.coulomb is not None and any(self.conditions.coulomb):
             raise UserError("the analytic method has no Coulomb friction (not linear): use the simulation")
