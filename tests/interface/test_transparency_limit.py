@@ -70,9 +70,9 @@ def test_the_docs_quote_the_five_bar_limit(simulated_limit):
 def test_the_engine_gives_the_limit_and_says_where_the_linearization_does_not_decide(simulated_limit):
     """The search is the engine's (:func:`hapticdesign.simulation.transparency.stable_limit`), the command only
     reports it: the same limit from the API, None with encoder counts (a quantized loop is not linear)."""
-    from hapticdesign.simulation.config import LoopConfig, Sensors
+    from hapticdesign.simulation.config import LoopConfig
     from hapticdesign.simulation.transparency import stable_limit
 
     device = load_device_file(FIVE_BAR)
     assert stable_limit(device, 1, 0, LoopConfig()) == pytest.approx(simulated_limit, rel=2e-4)
-    assert stable_limit(device, 1, 0, LoopConfig(sensors=Sensors(counts_per_revolution=4096))) is None
+    assert stable_limit(device, 1, 0, LoopConfig(counts=4096)) is None
