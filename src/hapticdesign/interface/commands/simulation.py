@@ -32,9 +32,9 @@ STEP_CONTROL = typer.Option(
 COUNTS = typer.Option(None, help="Encoder counts per revolution (position quantization); none by default.")
 DELAY = typer.Option(0, help="Sensor delay in samples.")
 ERROR = typer.Option(0.0, help="Compensator modelling error in percent (scales its inertial parameters).")
-INERTIAL = typer.Option(True, "--inertial/--no-inertial", help="Compensate the inertial term H qdd.")
-CORIOLIS = typer.Option(True, "--coriolis/--no-coriolis", help="Compensate the Coriolis term C qd^2.")
-GRAVITY = typer.Option(True, "--gravity/--no-gravity", help="Compensate gravity G.")
+INERTIAL = typer.Option(True, "--inertial/--no-inertial", help="Keep the inertial term H qdd of --compensation full.")
+CORIOLIS = typer.Option(True, "--coriolis/--no-coriolis", help="Keep the Coriolis term C qd^2 of --compensation full.")
+GRAVITY = typer.Option(True, "--gravity/--no-gravity", help="Keep the gravity term G of --compensation.")
 WALL_DAMPING = typer.Option(0.0, help="Virtual wall damper [N m s/rad; N s/m for a Cartesian wall].")
 WALL_DIRECTION = typer.Option(
     None, help="Cartesian wall: its direction x,y,z at the handle (K in N/m, damper in N s/m, equilibrium and "
@@ -197,8 +197,11 @@ def transparency_command(
                                                   "start pose: the same estimate, plus the steady-state response)."),
     period: float = PERIOD, step: float = STEP, step_control: str = STEP_CONTROL, counts: Optional[int] = COUNTS,
     delay: int = DELAY,
+    compensation: Optional[str] = typer.Option(None, help="none, gravity or full (inverse dynamics with the sampled "
+                                                          "acceleration; the seed's, the default)."),
     error_percent: float = ERROR, inertial: bool = INERTIAL, coriolis: bool = CORIOLIS, gravity: bool = GRAVITY,
-    wall_damping: float = WALL_DAMPING,
+    wall_damping: float = WALL_DAMPING, hand_mass: float = HAND_MASS, hand_damping: float = HAND_DAMPING,
+    hand_stiffness: float = HAND_STIFFNESS,
     strict: bool = STRICT,
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
@@ -216,7 +219,8 @@ def transparency_command(
         from hapticdesign.devices.loading import resolve_device
 
         dev = resolve_device(preset, device, params, strict=strict)
-        loop = sampled_loop(True, period, delay, None, None, error_percent, wall_damping)
+        loop = sampled_loop(True, period, delay, None, compensation, error_percent, wall_damping, hand_mass,
+                            hand_damping, hand_stiffness)
         config = LoopConfig(duration=sweep, step=step, step_control=step_control, loop=loop, counts=counts,
                             compensator=Compensator(inertial, coriolis, gravity))
         if not (band > 0):
