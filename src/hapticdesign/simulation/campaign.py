@@ -85,10 +85,11 @@ class CampaignOptions:
     transmitted torque of :mod:`.analytic_transparency`; exact for type 1, and for type 2 when LN = 0)."""
 
     conditions: LoopConfig = field(default_factory=LoopConfig)
-    """Realistic conditions for every case (seed 000 ch. 5's first future-work item): sensors (period,
-    encoder quantization, delay), the compensator (its terms, its modelling error, per group with seeded
-    signs), Coulomb friction in the plant and the hand. The seed's ideal loop by default; ``duration`` above
-    sets the impedance runs' length, the campaign sets the wall."""
+    """Realistic conditions for every case (seed 000 ch. 5's first future-work item): the loop (its
+    :class:`~hapticdesign.analysis.sampled_loop.SampledLoop`: period, delay, modelling error, hand), encoder
+    quantization, the compensator (its terms, its error per group with seeded signs) and Coulomb friction in the
+    plant. The seed's ideal loop by default; ``duration`` above sets the impedance runs' length, the campaign sets
+    the wall."""
 
     def __post_init__(self) -> None:
         if self.method not in ("simulation", "analytic"):

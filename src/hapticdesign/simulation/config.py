@@ -115,7 +115,7 @@ class Compensator:
     ``inertial``, ``coriolis``, ``gravity`` keep (True) or drop each term the loop's ``compensation`` feeds forward
     (``full``: all three; ``gravity``: gravity only; ``none``: none): an ablation of the seed's law. The loop's
     ``error_percent`` scales every inertial parameter by ``1 - E/100`` (the seed's "error %" of masses, inertias
-    and mass centres alike). ``group_errors`` gives each group its own error in percent instead: ``{"mass": E_m,
+    and mass centres alike). ``group_errors`` gives each group its own error in percent on top: ``{"mass": E_m,
     "centre": E_r, "inertia": E_I}`` (masses ``m``; mass-centre offsets ``rx ry rz``; inertia entries ``Ixx ...
     Iyz``); with ``error_seed`` each parameter of a group gets a random sign (``numpy.random.default_rng(error_seed)``,
     in the order of the device's parameter names), so the model over- and underestimates as a real identification
@@ -196,6 +196,9 @@ class LoopConfig:
 
     def _fold_former(self) -> None:
         """Move the settings given in their former places into ``loop`` (and ``counts``)."""
+        for name, kind in (("wall", Wall), ("compensator", Compensator), ("sensors", (Sensors, type(None)))):
+            if not isinstance(getattr(self, name), kind):
+                raise UserError(f"{name} must be a {name.capitalize()}, got {type(getattr(self, name)).__name__}")
         changes, sensors = {}, self.sensors
         if sensors is not None:
             changes.update(period=sensors.period, delay=int(sensors.delay_samples))
