@@ -67,8 +67,7 @@ def handle_range(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray) ->
     """The basis ``U`` (P, 3, k) of the directions the handle moves, its mobility ``U^T J_v H^-1 J_v^T U`` and
     damping ``U^T J_v^+T B J_v^+ U`` (P, k, k) in it."""
     basis, _, along = handle_range_basis(jacobian)
-    pinv = np.linalg.pinv(jacobian) @ basis
-    return basis, cartesian.mobility(mass, along), np.swapaxes(pinv, 1, 2) @ damping @ pinv
+    return basis, cartesian.mobility(mass, along), cartesian.damping(jacobian, basis, damping)
 
 
 CHUNK_BYTES = 1 << 24

@@ -50,7 +50,7 @@ def wall_response(device, stiffness: float, duration: float = 5.0, step: float =
     the device's rest pose (0 for an open chain, ``home`` for a closed loop), the others held there, and the
     wall's spring rests ``step`` from joint 1's start."""
     rest = rest_pose(device)
-    wall = Wall(0, stiffness, 0.0, float(rest[0]) + step)
+    wall = Wall(0, stiffness, equilibrium=float(rest[0]) + step)
     return simulate(device, LoopConfig(duration=duration, wall=wall), type_paths(1, device.n_dof, 0, rest))
 
 
@@ -142,7 +142,7 @@ def _settings_table(device, config, driven) -> Table:
          f"{driven.amplitude:g} sin({driven.omega / np.pi:g} pi t)"],
         ["overshoot limit [rad] (§4.1.3)", 0.012, criteria.overshoot_limit],
         ["safety switch [rad] (Figure 4.7)", 0.06, criteria.safety_limit],
-        ["sample period [s] / plant step [s]", "0.001 / 0.0001", f"{config.sensors.period:g} / {config.step:g}"],
+        ["sample period [s] / plant step [s]", "0.001 / 0.0001", f"{config.loop.period:g} / {config.step:g}"],
         ["chirp (Table 4.5)", "0.3 rad, 0.1-15 Hz, 10 s",
          f"{chirp.amplitude:g} rad, {chirp.f0:g}-{chirp.f1:g} Hz, {chirp.sweep_time:g} s"],
     ]

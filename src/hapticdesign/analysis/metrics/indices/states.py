@@ -23,6 +23,7 @@ import numpy as np
 
 from hapticdesign.analysis import kinematics
 from hapticdesign.analysis.configuration import configuration_of
+from hapticdesign.analysis.dynamics import cartesian
 from hapticdesign.analysis.dynamics.cartesian import cartesian_inertia, mobility
 from hapticdesign.analysis.dynamics.device import gravity_gradient_at, mass_matrix_at
 from hapticdesign.analysis.metrics import force
@@ -190,8 +191,7 @@ class HandleStates:
     @cached_property
     def cartesian_damping(self) -> np.ndarray:
         """``U^T J_v^+T B J_v^+ U`` (P, k, k) in N s/m: the joints' and motors' damping felt at the handle."""
-        pinv = np.linalg.pinv(self.J_v) @ self.svd[0]
-        return np.swapaxes(pinv, 1, 2) @ self.B @ pinv
+        return cartesian.damping(self.J_v, self.svd[0], self.B)
 
     @cached_property
     def stiffness(self) -> np.ndarray:
