@@ -1,6 +1,8 @@
 """Regenerates the links' compliance numbers of docs/simulation.md ("A compliant transmission").
 
-For the five-bar of aluminium tubes (examples/studies/five-bar-tubes.yaml) at its home pose: the drive's joint-space
+For the R-CUBE and the five-bar of aluminium tubes at home, the wall's spring at the limit with the links' compliance
+and rigid, and the stiffness the handle then feels (the spring in series with the drive along the wall). For the
+five-bar of aluminium tubes (examples/studies/five-bar-tubes.yaml) at its home pose: the drive's joint-space
 stiffness (the links' compliance carried to the joints, no transmission), and the weakest wall with the light hand
 (``kmax``, worst direction, practice's loop) with the links' compliance and with the rigid model, for the file's
 proximal tubes (12 mm) and thinner ones (9 mm). Then the cost in a study: ``kmax`` (light hand) of 20 designs of the
@@ -26,10 +28,10 @@ from hapticdesign.analysis.metrics.indices import Request, evaluate_designs
 from hapticdesign.analysis.metrics.indices import evaluation
 from hapticdesign.analysis.metrics.indices.states import HandleStates
 from hapticdesign.analysis.sampled_loop import GRASP, SampledLoop
-from hapticdesign.analysis.wall_stiffness import wall_limit
+from hapticdesign.analysis.wall_stiffness import wall_limit, worst_direction
 from hapticdesign.analysis.workspace import Workspace
 from hapticdesign.devices.design_space import design_space
-from hapticdesign.devices.device_file import device_from_mapping
+from hapticdesign.devices.device_file import device_from_mapping, load_device_file
 
 ROOT = Path(__file__).resolve().parents[2]
 TUBES = ROOT / "examples" / "studies" / "five-bar-tubes.yaml"
@@ -58,7 +60,26 @@ def study_seconds(data: dict, designs: list[dict], points: np.ndarray) -> tuple[
     return time.perf_counter() - start, [float(np.min(g.values["kmax"])) if g.values else float("nan") for g in got]
 
 
+def felt(name: str, path: Path) -> None:
+    """A device at home, light hand, worst direction: the controller's spring at the limit with the links and rigid,
+    and the stiffness the handle feels with the links, the spring in series with the drive along the wall
+    (``1 / (1 / K + u^T J_v K_d^-1 J_v^T u)``)."""
+    device = load_device_file(path)
+    states = HandleStates(device, configuration_of(device).full(configuration_of(device).home.copy())[None])
+    loop = SampledLoop(hand=GRASP)
+    args = (states.J_v[0], states.H[0], states.B[0], loop, gravity_gradient_at(device, states.full)[0])
+    limit, direction, _ = worst_direction(*args, transmission=states.drive)
+    rigid, _, _ = worst_direction(*args)
+    jv = states.J_v[0]
+    drive = direction @ jv @ np.linalg.inv(states.drive.stiffness[0]) @ jv.T @ direction
+    print(f"{name} at home, light hand: the wall's spring at the limit {limit:.1f} N/m with the links "
+          f"({states.drive.inertia.any() and 'rotors' or 'massless motor side'}), {rigid:.1f} N/m rigid; the drive "
+          f"along the wall {1 / drive:.0f} N/m, so the handle feels {1 / (1 / limit + drive):.0f} N/m")
+
+
 def main() -> None:
+    felt("R-CUBE (examples/devices/rcube.yaml)", ROOT / "examples" / "devices" / "rcube.yaml")
+    felt("five-bar tubes", TUBES)
     data = yaml.safe_load(TUBES.read_text())
     for name, diameter in (("the file's 12 mm proximal tubes", None), ("9 mm proximal tubes", 0.009)):
         variant = yaml.safe_load(yaml.safe_dump(data))
