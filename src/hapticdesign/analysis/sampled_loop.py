@@ -577,7 +577,10 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
     (n, n) or (P, n, n)) the motors sit behind springs: the plant's coordinates are the motors' ``phi`` and the
     links' ``q``, ``M_r phi'' + B_m phi' + K_t (phi - q) = u`` and ``(H_h - M_r) q'' + (B_h - B_m) q' + (K_h + K_G)
     q + K_t (q - phi) = 0`` (the rotors and the motors' damping on the motor side, the links, the hand and gravity on
-    the other), and the controller senses ``phi`` (the encoders are on the motors). Every period the controller
+    the other), and the controller senses ``phi`` (the encoders are on the motors); ``K_t`` is the drive's full
+    symmetric stiffness, the transmissions' and the links' compliance in series
+    (:mod:`hapticdesign.analysis.stiffness.drive`), and motors of no rotor inertia make a massless motor side
+    (:func:`_massless_plant`: the encoders read ``q + K_t^-1 u``). Every period the controller
     holds, ``d`` samples late, ``u_k = H_m a_(k-d) + K_Gm q_(k-d) - K w w^T q_(k-d) - B_w w w^T v^_(k-d)``, ``q``,
     ``a`` the sensed position and the acceleration sampled under the previous torque, ``K_Gm q`` the linearized
     gravity compensation, ``v^`` the sampled velocity or the backward difference of positions. The state is ``[x_k,
