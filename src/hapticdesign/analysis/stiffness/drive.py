@@ -97,7 +97,11 @@ def compliant_drive(transmission: Transmission | None, links: np.ndarray | None,
         inertia, damping, compliance = rotor, motor_damping, links
     else:
         inertia, damping = transmission.inertia, transmission.damping
-        compliance = np.linalg.inv(transmission.stiffness) + links
+        try:
+            compliance = np.linalg.inv(transmission.stiffness) + links
+        except np.linalg.LinAlgError:
+            raise UserError("the transmissions' stiffness is singular (a coordinate no motor turns): the links' "
+                            "compliance cannot be put in series with it") from None
     stiffness = np.linalg.inv(compliance)
     return Transmission(np.broadcast_to(np.asarray(inertia, dtype=float), shape).copy(),
                         np.broadcast_to(np.asarray(damping, dtype=float), shape).copy(),
