@@ -317,7 +317,6 @@ def test_spec_and_impedance_range_say_which_compliances_they_include():
                   "--json"])["renderable_stiffness"]["compliance"] == "rigid"
     out = _json(["impedance-range", "--device", str(TUBES), "--wall-direction", "1,0,0", "--json"])
     assert out["compliance"] == "links"
-    assert out["k_limit_exact"] == pytest.approx(tubes["renderable_stiffness"]["exact"], rel=0.5)
 
 
 @pytest.mark.parametrize("changes, fragment", [
