@@ -211,6 +211,8 @@ class DesignValues(NamedTuple):
     refused: list
     transmission: Transmission | None = None
     """The motors' compliant transmissions (D, n_a, n_a) each, None when the motors are rigid."""
+    motor_damping: np.ndarray | None = None
+    """The motors' own damping ``B_m`` (D, n_a, n_a): the part of ``B`` on the motors' side of a compliant drive."""
 
 
 class Evaluated(NamedTuple):

@@ -422,7 +422,8 @@ class DesignSpace:
             compliant) and built else None
         return DesignValues(kinematic, standard, np.array([b.reflected for b in built]),
                             np.array([b.damping_matrix for b in built]),
-                            inverse, torques, rigidity, refused, transmission)
+                            inverse, torques, rigidity, refused, transmission,
+                            np.array([damping_matrix(b.actuators, base.n_dof) for b in built]))
 
     def _motors(self, key: tuple) -> "Motors":
         """The motors with the changes ``key`` (:attr:`Applied.motor_key`), built and validated once per distinct

@@ -31,6 +31,7 @@ import numpy as np
 from hapticdesign.analysis.configuration import configuration_of, handle_pose
 from hapticdesign.analysis.dynamics.device import gravity_gradient, mass_matrix
 from hapticdesign.analysis.sampled_loop import SampledLoop, handle_intervals
+from hapticdesign.analysis.stiffness.drive import device_drive
 from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.compensator_model import model_device
 from hapticdesign.model.device import Device
@@ -185,10 +186,12 @@ def wall_interval(device: Device, pose: np.ndarray, loop: SampledLoop, wall_join
     """The exact stable springs ``[low, high]`` of a wall on ``wall_joint`` (or along the Cartesian ``direction``) held
     at ``pose``, every actuated joint free but ``loop.held`` (:func:`stability_limit`'s at one pose; ``low`` 0 unless
     gravity pulls the handle off the wall)."""
-    low, high = handle_intervals(handle_jacobian(device, pose)[:3][None], mass_matrix(device, pose)[None],
+    jv = handle_jacobian(device, pose)[:3][None]
+    low, high = handle_intervals(jv, mass_matrix(device, pose)[None],
                                  device.damping_matrix, _wall_row(device, pose, wall_joint, direction)[None], loop,
                                  k_max=k_max, gravity=gravity_gradient(device, pose)[None],
-                                 model=loop_model(device, loop, pose), transmission=device.transmission)
+                                 model=loop_model(device, loop, pose),
+                                 transmission=device_drive(device, configuration_of(device).full(pose)[None], jv))
     return float(low[0]), float(high[0])
 
 

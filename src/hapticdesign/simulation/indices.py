@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from hapticdesign.analysis.metrics.indices import HandleStates, index
+from hapticdesign.analysis.stiffness.drive import compliances
 from hapticdesign.analysis.wall_stiffness import KMAX_OPTIONS, kmax_loop, worst_direction
 from hapticdesign.errors import UserError
 from hapticdesign.simulation.impedance import SIMULATED_CAP, TOUCH, device_counts, simulated_limit
@@ -44,9 +45,9 @@ def kmax_simulated(pose: HandleStates, period: float = 0.001, delay: int = 1, ve
                "error_percent": error_percent, "hand": hand, "wall_damping": wall_damping}
     loop, _ = kmax_loop(options)
     device = pose.device
-    if device.transmission is not None:
+    if compliances(device) != "rigid":
         raise UserError("index kmax_simulated: the simulated loop's plant is rigid; a device whose actuators state a "
-                        "transmission_stiffness has the exact limit kmax, which models it")
+                        "transmission_stiffness or whose links are elastic has the exact limit kmax, which models it")
     counts = device_counts(device) if quantization else None
     model = None if error_percent == 0 else pose.compensator(error_percent)
     out = np.empty(len(pose.full))

@@ -32,7 +32,10 @@ friction reach the handle as follows:
   - ``exact``: the registry's ``kmax`` design index at the pose: the exact stability limit of the n-joint sampled
     loop, every joint free, H and B (the joint and motor viscous damping) at the pose, the smallest over the axes,
     the principal directions and 60 evenly spread directions (:mod:`hapticdesign.analysis.wall_stiffness`), and
-    ``direction``, the worst one (:func:`~hapticdesign.analysis.wall_stiffness.worst_direction`). A pure spring uses the position only, so the velocity estimate does not enter. ``exact_lower``:
+    ``direction``, the worst one (:func:`~hapticdesign.analysis.wall_stiffness.worst_direction`), with the
+    compliance between the motors and the handle the file gives (``compliance``: ``rigid``, ``transmissions``,
+    ``links`` or both, :mod:`hapticdesign.analysis.stiffness.drive`; the simulated row, whose plant is rigid, is then
+    not run). A pure spring uses the position only, so the velocity estimate does not enter. ``exact_lower``:
     the smallest spring stable in every direction, 0 unless gravity pulls the handle off a wall (an over-compensating
     model, an inverted pose); the sheet then says "stable from exact_lower to exact";
   - ``exact_with_hand``: ``kmax`` with the hand (``hand``: the default grasp,
@@ -62,6 +65,7 @@ from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.analysis.dynamics.device import gravity_gradient
 from hapticdesign.analysis.metrics import force as polytope
 from hapticdesign.analysis.metrics.indices import INDICES, HandleStates, Index, Request, evaluate_at, requests_of
+from hapticdesign.analysis.stiffness.drive import compliances
 from hapticdesign.errors import UserError
 from hapticdesign.model.actuators import transmission
 from hapticdesign.model.device import Device
@@ -172,17 +176,17 @@ def renderable(device: Device, h: Handle, loop: SampledLoop, res: float | None,
     exact = _index("kmax", h, **_kmax_options(bare))
     _, direction, lower = worst_direction(h.jacobian, h.states.H[0], device.damping_matrix, bare,
                                           gravity_gradient(device, h.q), loop_model(device, loop, h.q),
-                                          device.transmission)
+                                          h.states.drive)
     progress(RENDERING_STEP, 1, 3)
     hand = loop.hand or GRASP
     with_hand = _index("kmax", h, **_kmax_options(replace(loop, hand=hand)))
     progress(RENDERING_STEP, 2, 3)
     simulated = None
-    if simulate and device.transmission is None:  # the simulated loop's plant is rigid
+    if simulate and h.states.drive is None:  # the simulated loop's plant is rigid
         simulated = _index("kmax_simulated", h, **_kmax_options(bare))
     progress(RENDERING_STEP, 3, 3)
     return {
-        "exact": exact, "exact_lower": lower, "direction": direction,
+        "exact": exact, "exact_lower": lower, "direction": direction, "compliance": compliances(device),
         "exact_with_hand": with_hand, "hand": hand.as_dict(),
         "simulated": simulated, "simulated_counts": device_counts(device), "simulated_touch": TOUCH,
         "passivity_viscous": 2.0 * float(np.linalg.eigvalsh(h.states.cartesian_damping[0]).min()) * loop.rate,

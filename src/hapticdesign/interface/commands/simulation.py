@@ -126,6 +126,7 @@ def impedance_range_command(
 
     Practice's default is the stability limit of the sampled loop; the seed's Phantom presets keep the seed's
     settings and performance criteria. The output states the settings and the verdict used."""
+    from hapticdesign.analysis.stiffness.drive import compliances
     from hapticdesign.simulation.config import LoopConfig, unit_direction
     from hapticdesign.simulation.impedance import Criteria, impedance_range
     from hapticdesign.simulation.loop import joint_index
@@ -150,9 +151,10 @@ def impedance_range_command(
                                  Criteria(overshoot, settle_tolerance, settle_window, safety), config, wall_joint,
                                  equilibrium, resolution, direction, true_boundary and not limit,
                                  simulate=true_boundary and limit)
+        compliance = compliances(dev)
         out = {"device": dev.name, "type": sim_type, "joint": wall_joint + 1,
                **({} if direction is None else {"wall_direction": unit_direction(direction).tolist()}),
-               "settings": loop.as_dict(), **result.as_dict()}
+               "settings": loop.as_dict(), "compliance": compliance if limit else "rigid", **result.as_dict()}
         unit = {"stiffness": "N/m", "position": "m"} if direction is not None else joint_units(dev)[wall_joint]
         out["units"] = {"k_max": unit["stiffness"], "k_min": unit["stiffness"], "peak_at_first_unstable": unit["position"],
                         "stopped_at_first_unstable": "s"}
@@ -173,6 +175,9 @@ def impedance_range_command(
                        f"{out['simulations']} simulations)")
         typer.echo(f"verdict: {out['verdict']}")
         typer.echo(f"settings: {loop.describe()}")
+        typer.echo("drive: " + ("rigid" if out["compliance"] == "rigid" else f"the compliance of the {compliance}")
+                   + ("" if limit or compliance == "rigid" else " left out (the simulated plant is rigid; the limit "
+                                                                "method models it)"))
         if true_boundary:
             what = "simulated with dry friction and quantization" if method == "limit" else "oscillation-growth"
             found = out["k_true_boundary"]
