@@ -377,7 +377,7 @@ def derive(device: Device, symbolic: str = "all", started: Callable[[], None] | 
     treat passive joints as driven and leave out the closure forces, so they are refused.
     """
     loops = device.mechanism.loops
-    if loops is not None:
+    if not loops.empty:
         passive = ", ".join(device.mechanism.coordinates[k] for k in loops.passive)
         raise UserError(f"{device.name} has closed loops (passive joints {passive}): its equations of motion are "
                         "reduced to the actuated joints numerically at each pose and have no symbolic form here")

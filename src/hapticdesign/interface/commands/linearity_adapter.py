@@ -113,7 +113,7 @@ def require_tree(device, command: str) -> None:
     trigonometric polynomials of the actuated joints, so those equations do not exist (its LN,
     from converged quadrature, is what ``ln`` gives).
     """
-    if device.mechanism.loops is not None:
+    if not device.mechanism.loops.empty:
         raise UserError(
             f"{command} needs a tree device: {device.name} has closed loops, whose equations of motion have no exact "
             "trigonometric basis for the LN = 0 conditions (eq. 3.12-3.27); 'hapticdesign ln' gives its LN"
