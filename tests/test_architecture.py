@@ -53,8 +53,9 @@ def test_no_module_above_the_kernels_asks_whether_a_device_is_a_tree():
     for path in sorted(ROOT.rglob("*.py")):
         if path.name.endswith("_kernel.py"):
             continue
-        found += [f"{path.relative_to(ROOT.parent)}:{line}" for line in tree_questions(path.read_text(encoding="utf-8"))]
-    assert found == [], "ask the loops for a capability (loops.empty, loops.closures), not for None: " + ", ".join(found)
+        lines = tree_questions(path.read_text(encoding="utf-8"))
+        found += [f"{path.relative_to(ROOT.parent)}:{line}" for line in lines]
+    assert found == [], "ask the loops for a capability (loops.empty, loops.closures), not None: " + ", ".join(found)
 
 
 def test_a_tree_takes_the_same_calls_with_nothing_to_close():

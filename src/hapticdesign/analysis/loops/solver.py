@@ -84,17 +84,10 @@ class LoopSolver:
         self.tol = self.settings.tol
         self.empty = mechanism.loops.empty
         """No closures (a tree): nothing to solve."""
-        self.home, self.branch = self._assemble(mechanism)
-        """Full coordinates (actuated and passive) of the home pose on the assembly branch, and the sign of
-        ``det Phi_p`` there (that of the branch; 1 without closures)."""
-
-    def _assemble(self, mechanism: Mechanism) -> tuple[np.ndarray, float]:
-        """The home pose closed by Newton from the assembly guess, and the sign of ``det Phi_p`` there."""
         loops = mechanism.loops
         q = loops.guess(self.n_dof)
-        if self.empty:
-            return q, 1.0
-        status, sign, _ = ck.newton(q, self.tree, self.plan, self.closures, self.settings)
+        status, sign, _ = (ck.OK, 1.0, 1.0) if self.empty else ck.newton(q, self.tree, self.plan, self.closures,
+                                                                          self.settings)
         names = ", ".join(f"{mechanism.coordinates[k]} = {q[k]:.4g}" for k in self.closures.passive)
         if status == ck.NO_CLOSURE:
             raise UserError(
@@ -103,7 +96,10 @@ class LoopSolver:
             )
         if status == ck.SINGULAR:
             raise UserError(f"the loops close at the home pose only at a singular constraint Jacobian ({names})")
-        return q, sign
+        self.home = q
+        """Full coordinates (actuated and passive) of the home pose on the assembly branch."""
+        self.branch = sign
+        """Sign of ``det Phi_p`` on the assembly branch (1 without closures)."""
 
     def _actuated(self, q_a: np.ndarray) -> np.ndarray:
         q_a = np.asarray(q_a, dtype=float)
