@@ -14,7 +14,7 @@ import numpy as np
 
 from hapticdesign.analysis.dynamics.closed_loop_plant import ClosedLoopPlant
 from hapticdesign.analysis.dynamics.device import dynamics_of
-from hapticdesign.analysis.dynamics.model import ExactBasis
+from hapticdesign.analysis.dynamics.model import has_trigonometric_basis
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation import kernel, records
@@ -55,7 +55,7 @@ def _scratch(dynamics: Dynamics) -> records.DynamicsScratch:
 def tables_of(device: Device) -> DynamicsTables | None:
     """The exact basis tables of a device whose model has an exact basis (an open chain), to reuse across runs;
     ``None`` for a closed-loop device, whose compiled plant :func:`simulate` builds for each run at its start pose."""
-    return DynamicsTables.from_device(device) if isinstance(dynamics_of(device), ExactBasis) else None
+    return DynamicsTables.from_device(device) if has_trigonometric_basis(device.mechanism) else None
 
 
 def _dynamics(device: Device, tables: DynamicsTables | None, q_start: np.ndarray) -> Dynamics:

@@ -17,7 +17,7 @@ import numpy as np
 from hapticdesign.analysis.configuration import configuration_for
 from hapticdesign.analysis.dynamics.closed_loop import ClosedLoopModel
 from hapticdesign.analysis.dynamics.kernel import regressor_kernel
-from hapticdesign.analysis.dynamics.model import DynamicsModel, EquationsOfMotion
+from hapticdesign.analysis.dynamics.model import DynamicsModel, EquationsOfMotion, has_trigonometric_basis
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device, MechanismBuilder
 from hapticdesign.model.mechanism import Mechanism
@@ -52,7 +52,7 @@ def _terms_at(device: Device, q_full: np.ndarray) -> tuple[np.ndarray, np.ndarra
     poses (:meth:`~.closed_loop.ClosedLoopModel.terms_at`)."""
     kinematic, params = device.kinematic_values(), device.standard_parameters()
     mechanism = configuration_for(device.builder, kinematic).mechanism
-    if mechanism.loops.empty:
+    if has_trigonometric_basis(mechanism):
         return tree_terms(mechanism, q_full, params)
     return _model(device.builder, kinematic).terms_at(q_full, params)
 
@@ -71,7 +71,7 @@ def tree_terms(mechanism: Mechanism, q: np.ndarray, parameters: np.ndarray) -> t
     """H (..., N, N) and G (..., N) (eq. 2.50) of a tree mechanism at poses ``(..., N)`` for standard inertial
     parameters ``(10 x bodies,)``, from the compiled regressor kernel; a mechanism with closures needs the loop
     solver's reduction (:func:`mass_matrix`)."""
-    if not mechanism.loops.empty:
+    if not has_trigonometric_basis(mechanism):
         raise UserError("a mechanism with closed loops needs the loop solver: use mass_matrix")
     q = np.asarray(q, dtype=float)
     n = mechanism.n_dof
@@ -138,7 +138,7 @@ def forward_dynamics(device: Device, q: np.ndarray, qd: np.ndarray, tau: np.ndar
 @lru_cache(maxsize=16)
 def _model(builder: MechanismBuilder, kinematic: tuple[tuple[str, float], ...]):
     space = configuration_for(builder, kinematic)
-    return DynamicsModel(space.mechanism) if space.mechanism.loops.empty else ClosedLoopModel(space)
+    return DynamicsModel(space.mechanism) if has_trigonometric_basis(space.mechanism) else ClosedLoopModel(space)
 
 
 @lru_cache(maxsize=16)
