@@ -18,10 +18,9 @@ Every analysis that needs "the device at actuated coordinates ``q_a``" asks :fun
   small Cartesian steps, point after point, by the compiled kernel the design batch runs over many designs
   (:func:`~.reach_kernel.reach_designs`, here a batch of one).
 
-Every device takes the same calls (Pinocchio's view: a tree is a device whose list of constraints is empty): a
-tree's loops are empty, its solver closes nothing (no constraints, no passive coordinates), so that its full
-coordinates are its actuated ones and ``T`` is the identity. The configuration owns the loop solver; a closed-loop
-device's dynamics model (:class:`~.dynamics.closed_loop.ClosedLoopModel`) takes it, so one solver serves every caller.
+Every device takes the same calls (Pinocchio's view: a tree's list of constraints is empty, so its solver closes
+nothing). The configuration owns the loop solver; a closed-loop device's dynamics model
+(:class:`~.dynamics.closed_loop.ClosedLoopModel`) takes it, so one solver serves every caller.
 """
 
 from __future__ import annotations

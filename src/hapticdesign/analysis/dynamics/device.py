@@ -46,10 +46,8 @@ def mass_matrix_at(device: Device, q_full: np.ndarray) -> np.ndarray:
 
 
 def _terms_at(device: Device, q_full: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """H (P, n_a, n_a) and G (P, n_a) at closed full poses (P, N) for the device's standard parameters, without the
-    rotors: a device without closures (whose H and G need no reduction to the actuated coordinates) straight from
-    the compiled kernel (:func:`tree_terms`, no fitted model), one with closures from its model's entries at those
-    poses (:meth:`~.closed_loop.ClosedLoopModel.terms_at`)."""
+    """H (P, n_a, n_a) and G (P, n_a) at closed full poses (P, N), the rotors left out: a tree's from the compiled
+    kernel (:func:`tree_terms`, no fitted model), a closed loop's from :meth:`~.closed_loop.ClosedLoopModel.terms_at`."""
     kinematic, params = device.kinematic_values(), device.standard_parameters()
     mechanism = configuration_for(device.builder, kinematic).mechanism
     if has_trigonometric_basis(mechanism):
@@ -58,19 +56,14 @@ def _terms_at(device: Device, q_full: np.ndarray) -> tuple[np.ndarray, np.ndarra
 
 
 def tree_mass_matrix(mechanism: Mechanism, q: np.ndarray, parameters: np.ndarray) -> np.ndarray:
-    """H (eq. 2.50) of a tree mechanism at poses ``(..., N)`` for standard inertial parameters
-    ``(10 x bodies,)``, straight from the compiled regressor kernel (:func:`tree_terms`).
-
-    Exact like :func:`mass_matrix`, without fitting the regressor model of :func:`dynamics_of`: the
-    cheaper choice for a geometry evaluated at a few poses (one candidate of an optimization).
-    """
+    """H (eq. 2.50) of a tree mechanism at poses ``(..., N)``: :func:`tree_terms`' H."""
     return tree_terms(mechanism, q, parameters)[0]
 
 
 def tree_terms(mechanism: Mechanism, q: np.ndarray, parameters: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """H (..., N, N) and G (..., N) (eq. 2.50) of a tree mechanism at poses ``(..., N)`` for standard inertial
-    parameters ``(10 x bodies,)``, from the compiled regressor kernel; a mechanism with closures needs the loop
-    solver's reduction (:func:`mass_matrix`)."""
+    parameters ``(10 x bodies,)``, straight from the compiled regressor kernel: exact like :func:`mass_matrix`,
+    without fitting the model of :func:`dynamics_of` (the cheaper choice for a geometry at a few poses)."""
     if not has_trigonometric_basis(mechanism):
         raise UserError("a mechanism with closed loops needs the loop solver: use mass_matrix")
     q = np.asarray(q, dtype=float)

@@ -62,8 +62,7 @@ def settings_of(mechanism: Mechanism) -> Settings:
 
 
 class LoopSolver:
-    """Passive coordinates of a mechanism (see the module docstring); a tree's loops are empty, so that its solver
-    has nothing to close: every pose is closed, its full coordinates are its actuated ones and ``T`` is the identity.
+    """Passive coordinates of a mechanism (see the module docstring; a tree's: none).
 
     ``tree``, ``plan``, ``closures`` and ``settings`` are the records the compiled kernels take
     (:mod:`.records`), on the folded node numbering (:data:`~hapticdesign.model.mechanism.FOLDED`).
