@@ -43,6 +43,7 @@ from threadpoolctl import ThreadpoolController
 from hapticdesign.analysis.dynamics.device import (
     coriolis_centrifugal, dynamics_of, gravity, gravity_gradient, mass_matrix,
 )
+from hapticdesign.analysis.dynamics.model import has_trigonometric_basis
 from hapticdesign.analysis.sampled_loop import Hand, SampledLoop, SpringLoops, handle_loops, held_plant
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
@@ -295,7 +296,7 @@ class AnalyticProblem(WallProblem):
         """Type 2 with the wall joint coupled to the motion, on a joint wall of an open chain without a hand."""
         cfg = self.config
         return (self.sim_type == 2 and not self.wall.exact and not cfg.wall.cartesian and cfg.loop.hand is None
-                and self.device.mechanism.loops is None)
+                and has_trigonometric_basis(self.device.mechanism))
 
     def _driven_loop(self) -> DrivenLoop:
         device, cfg, w = self.device, self.config, self.wall_joint

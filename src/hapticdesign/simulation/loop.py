@@ -14,6 +14,7 @@ import numpy as np
 
 from hapticdesign.analysis.dynamics.closed_loop_plant import ClosedLoopPlant
 from hapticdesign.analysis.dynamics.device import dynamics_of
+from hapticdesign.analysis.dynamics.model import has_trigonometric_basis
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation import kernel, records
@@ -52,18 +53,15 @@ def _scratch(dynamics: Dynamics) -> records.DynamicsScratch:
 
 
 def tables_of(device: Device) -> DynamicsTables | None:
-    """The exact basis tables of an open-chain device, to reuse across runs; ``None`` for a closed-loop
-    device, whose compiled plant :func:`simulate` builds for each run at its start pose."""
-    return None if device.mechanism.loops is not None else DynamicsTables.from_device(device)
+    """The exact basis tables of a device whose model has an exact basis (an open chain), to reuse across runs;
+    ``None`` for a closed-loop device, whose compiled plant :func:`simulate` builds for each run at its start pose."""
+    return DynamicsTables.from_device(device) if has_trigonometric_basis(device.mechanism) else None
 
 
 def _dynamics(device: Device, tables: DynamicsTables | None, q_start: np.ndarray) -> Dynamics:
     """The given tables, or the device's own: its tables, or its closed-loop plant started at ``q_start``."""
-    if tables is not None:
-        return tables
-    if device.mechanism.loops is None:
-        return DynamicsTables.from_device(device)
-    return ClosedLoopPlant(dynamics_of(device), device.standard_parameters(), q_start)
+    tables = tables_of(device) if tables is None else tables
+    return ClosedLoopPlant(dynamics_of(device), device.standard_parameters(), q_start) if tables is None else tables
 
 
 def simulate(

@@ -42,8 +42,7 @@ def ik(
         pose = handle_pose(dev, target)
         result = {"device": dev.name, "position": target, "q": pose.q, "passive": pose.passive,
                   "coordinates": list(dev.mechanism.actuated_coordinates),
-                  "passive_coordinates": [dev.mechanism.coordinates[k] for k in
-                                          (dev.mechanism.loops.passive if dev.mechanism.loops else ())],
+                  "passive_coordinates": [dev.mechanism.coordinates[k] for k in dev.mechanism.loops.passive],
                   "units": {"position": "m", "q": "rad or m", "passive": "rad or m"}}
         if json_out:
             print_json(result)
