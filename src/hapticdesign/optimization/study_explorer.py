@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 import math
 import shlex
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -21,6 +22,7 @@ from hapticdesign.analysis.metrics.indices import evaluate_designs, reduce, redu
 from hapticdesign.analysis.view.skeleton import home_pose, snapshot
 from hapticdesign.analysis.workspace import reach_workspace
 from hapticdesign.errors import UserError
+from hapticdesign.model.device import Device
 from hapticdesign.optimization.study_evaluation import BoundStudy, workspace_of
 from hapticdesign.optimization.study_file import Choice, IndexConstraint
 from hapticdesign.optimization.study_outputs import Selection, baseline_lines
@@ -55,10 +57,15 @@ class FrontDesign:
     maps: dict
     picture: dict | None
     commands: list[dict]
+    spec: list[dict] | None = None
+    """The spec summary at the design's home pose (rows ``{"name", "label", "value", "unit"}``, SI units), None when
+    it was not computed or the device cannot be built or is singular at home."""
 
     def data(self) -> dict:
         """The JSON-ready card (without the device file's text)."""
-        return {"file": self.file, "maps": self.maps, "picture": self.picture, "commands": self.commands}
+        spec = None if self.spec is None else [{**row, "value": _number(row["value"]) if row["value"] is not None
+                                                 else None} for row in self.spec]
+        return {"file": self.file, "maps": self.maps, "picture": self.picture, "commands": self.commands, "spec": spec}
 
 
 def _uses(bound: BoundStudy) -> dict[str, list[tuple[str, str]]]:
@@ -86,12 +93,27 @@ def _picture(bound: BoundStudy, device) -> tuple[dict, str]:
     return {**snapshot(device, q), "where": where}, where
 
 
+def _summary(summary: Summary | None, device: Device | None) -> list[dict] | None:
+    if summary is None or device is None:
+        return None
+    try:
+        return summary(device)
+    except UserError:
+        return None
+
+
 def _pose_text(q: np.ndarray) -> str:
     return ",".join(repr(float(v)) for v in q)
 
 
-def front_designs(run: StudyRun, bound: BoundStudy) -> list[FrontDesign]:
-    """The card of every front design, in front.csv's order (the indices of all of them evaluated in one batch)."""
+Summary = Callable[[Device], list[dict]]
+"""The spec summary of a device at its home pose (the interface passes
+:func:`hapticdesign.studies.spec.spec_summary`, a layer above this one)."""
+
+
+def front_designs(run: StudyRun, bound: BoundStudy, summary: Summary | None = None) -> list[FrontDesign]:
+    """The card of every front design, in front.csv's order (the indices of all of them evaluated in one batch), with
+    ``summary(device)`` as its spec summary when given (None where it raises a UserError: a pose singular at home)."""
     records = [run.records[k] for k in run.front]
     device_values = [bound.device_values(r.values) for r in records]
     evaluated = (evaluate_designs(bound.space, device_values, bound.points, bound.requests, bound.registry)
@@ -130,47 +152,40 @@ def front_designs(run: StudyRun, bound: BoundStudy) -> list[FrontDesign]:
                                "values": [_number(v) for v in got], "reductions": reductions}
         text = bound.device_file_text(record.values, [f"Front design {n} of the study's report (report.html)",
                                                       *baseline_lines(run, record)])
-        out.append(FrontDesign(file, text, maps, picture, commands))
+        out.append(FrontDesign(file, text, maps, picture, commands, _summary(summary, device)))
     return out
 
 
-def _record(run: StudyRun, record: Record) -> dict:
-    names = [o.name for o in run.spec.objectives]
+def _record(names: list[str], record: Record) -> dict:
     return {"variables": {k: _number(v) for k, v in record.values.items()},
             "objectives": dict(zip(names, map(_number, record.objectives))),
             "constraints": [_number(v) for v in record.constraints], "feasible": record.feasible,
             "reason": record.reason}
 
 
-def explorer_data(run: StudyRun, bound: BoundStudy, selection: Selection, designs: list[FrontDesign]) -> dict:
-    """Everything the explorer shows, JSON-ready: the study's variables (with their units, :meth:`BoundStudy.units`,
-    "" where none is known), objectives (with units and reductions) and constraints; every evaluated design as columns (evaluations.csv's numbers, None where it has none); the front as
-    record indices (0-based); the selected design; the device file's design; the workspace points; and the front
-    designs' cards (:func:`front_designs`)."""
-    spec = bound.study.spec
-    records = run.records
-    units = bound.units()
-    grid = "" if not bound.coarseness else f" ({bound.coarseness})"
-    objectives = []
-    for o in spec.objectives:
-        index = bound.registry[o.index]
-        over = "" if index.of_parameters else f" over the workspace{grid}"
-        objectives.append({"name": o.name, "index": o.index, "unit": _unit(index.unit), "reduce": o.reduce,
-                           "sense": o.sense, "about": f"{o.sense}imize the {o.reduce} of {o.index}{over}"})
-    constraints = []
-    for c in spec.constraints:
-        unit = _unit(bound.registry[c.index].unit) if isinstance(c, IndexConstraint) else _unit(units[c.label])
-        constraints.append({"name": c.label, "unit": unit, "at_least": c.at_least, "at_most": c.at_most})
-    variables = []
-    for name, v in spec.variables.items():
-        choices = list(v.values) if isinstance(v, Choice) else None
-        low, high = (min(v.values), max(v.values)) if choices else v
-        variables.append({"name": name, "unit": _unit(units[name]), "low": float(low), "high": float(high),
-                          "choices": choices})
+def quantity(name: str, unit: str, **more) -> dict:
+    """A column of the explorer (a variable, an objective or a constrained value): its ``name``, its ``unit`` ("1" is
+    shown as "-", "" where none is known) and what else the explorer reads of it: a variable's ``low``, ``high`` and
+    ``choices``; an objective's ``sense`` ("min" or "max"), ``about`` (in words), ``index`` and ``reduce``; a
+    constrained value's ``at_least`` and ``at_most``."""
+    return {"name": name, "unit": _unit(unit), **more}
+
+
+def explorer_table(title: str, study: str, device: str, variables: list[dict], objectives: list[dict],
+                   constraints: list[dict], records: list[Record], front: list[int], selected: dict,
+                   designs: list[dict], baseline: Record | None = None, workspace: dict | None = None) -> dict:
+    """The explorer's data, JSON-ready, of any set of evaluated designs (an optimization study's, or a seed's own
+    studies': ``rcube optimize``, ``study phantom``): the columns (:func:`quantity`), every design as a
+    :class:`~hapticdesign.optimization.study_run.Record` (its ``values`` keyed by the variables' names, its objectives
+    and constrained values in the columns' order), the ``front`` as record indices (0-based; front design n is
+    ``front[n - 1]``), the ``selected`` design (``{"position": its place on the front, "rule": in words}``), each front
+    design's card (``designs``, :meth:`FrontDesign.data`), the design to compare with (``baseline``, None without one)
+    and the ``workspace`` points the cards' maps are drawn on (None: no maps)."""
+    names = [o["name"] for o in objectives]
     return {
-        "title": bound.title,
-        "study": bound.study.path.name,
-        "device": bound.study.device_path.name,
+        "title": title,
+        "study": study,
+        "device": device,
         "variables": variables,
         "objectives": objectives,
         "constraints": constraints,
@@ -183,10 +198,40 @@ def explorer_data(run: StudyRun, bound: BoundStudy, selection: Selection, design
             "reason": [r.reason for r in records],
             "polished": [r.polished for r in records],
         },
-        "front": list(run.front),
-        "selected": {"position": selection.position, "rule": selection.rule},
-        "baseline": None if run.baseline is None else _record(run, run.baseline),
-        "workspace": {"points": [[float(x) for x in p] for p in bound.points], "center": bound.center,
-                      "coarseness": bound.coarseness},
-        "designs": [d.data() for d in designs],
+        "front": list(front),
+        "selected": selected,
+        "baseline": None if baseline is None else _record(names, baseline),
+        "workspace": workspace or {"points": [], "center": None, "coarseness": ""},
+        "designs": designs,
     }
+
+
+def explorer_data(run: StudyRun, bound: BoundStudy, selection: Selection, designs: list[FrontDesign]) -> dict:
+    """Everything the explorer shows of an optimization study (:func:`explorer_table`): the study's variables (with
+    their units, :meth:`BoundStudy.units`, "" where none is known), objectives (with units and reductions) and
+    constraints; every evaluated design (evaluations.csv's numbers, None where it has none); the front; the selected
+    design; the device file's design; the workspace points; and the front designs' cards (:func:`front_designs`)."""
+    spec = bound.study.spec
+    units = bound.units()
+    grid = "" if not bound.coarseness else f" ({bound.coarseness})"
+    objectives = []
+    for o in spec.objectives:
+        index = bound.registry[o.index]
+        over = "" if index.of_parameters else f" over the workspace{grid}"
+        objectives.append(quantity(o.name, index.unit, index=o.index, reduce=o.reduce, sense=o.sense,
+                                   about=f"{o.sense}imize the {o.reduce} of {o.index}{over}"))
+    constraints = []
+    for c in spec.constraints:
+        unit = bound.registry[c.index].unit if isinstance(c, IndexConstraint) else units[c.label]
+        constraints.append(quantity(c.label, unit, at_least=c.at_least, at_most=c.at_most))
+    variables = []
+    for name, v in spec.variables.items():
+        choices = list(v.values) if isinstance(v, Choice) else None
+        low, high = (min(v.values), max(v.values)) if choices else v
+        variables.append(quantity(name, units[name], low=float(low), high=float(high), choices=choices))
+    workspace = {"points": [[float(x) for x in p] for p in bound.points], "center": bound.center,
+                 "coarseness": bound.coarseness}
+    return explorer_table(bound.title, bound.study.path.name, bound.study.device_path.name, variables, objectives,
+                          constraints, run.records, run.front,
+                          {"position": selection.position, "rule": selection.rule}, [d.data() for d in designs],
+                          run.baseline, workspace)

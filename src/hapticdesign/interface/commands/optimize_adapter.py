@@ -132,7 +132,9 @@ def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Select
     pictures = [Picture(png, caption) for png, caption in bound.pictures(chosen.values)]
     kept = (["checkpoint/ (one file per generation; a rerun into this folder continues)"]
             if method_of(run.spec).checkpointed else [])
-    designs = front_designs(run, bound)
+    from hapticdesign.studies.spec import spec_summary
+
+    designs = front_designs(run, bound, spec_summary)  # the spec summary on each card (docs/optimization.md)
     for design in designs:
         write_atomically(out / design.file, design.text)
     _remove_stale_designs(out, len(designs))

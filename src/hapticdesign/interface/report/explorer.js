@@ -504,6 +504,25 @@
     return td;
   }
 
+  function specTable(rows) {  // the spec summary at home (hapticdesign spec's numbers), data-kind "spec"
+    var wrap = element("div", null, "table-wrap"), table = element("table");
+    table.id = "card-spec";
+    table.appendChild(element("caption", "Its spec summary at home (hapticdesign spec; blank: the device file lacks what it needs)"));
+    var head = element("tr");
+    ["quantity", "spec.json", "value", "unit"].forEach(function (h) { head.appendChild(element("th", h)); });
+    table.appendChild(head);
+    rows.forEach(function (r) {
+      var tr = element("tr");
+      tr.appendChild(element("td", r.label, "text"));
+      tr.appendChild(element("td", r.name, "text"));
+      tr.appendChild(numberCell("spec", r.name, r.value));
+      tr.appendChild(element("td", r.unit, "text"));
+      table.appendChild(tr);
+    });
+    wrap.appendChild(table);
+    return wrap;
+  }
+
   function quantities(k) {  // [kind, name, value, unit] of record k: variables, objectives, constrained values
     return dims.filter(function (d) { return d.kind !== "evaluation"; }).map(function (d) {
       return [d.kind, d.name, d.values[k], d.unit === "SI" ? "SI" : d.unit];
@@ -601,6 +620,7 @@
       devicePicture(canvas, detail.picture);
     }
     card.appendChild(row);
+    if (detail && detail.spec) { card.appendChild(specTable(detail.spec)); }
     if (!detail) {
       card.appendChild(element("p", "The maps, the picture and a device file are written for the front's designs; this one's numbers are evaluations.csv's.", "note"));
       return;
@@ -624,12 +644,14 @@
       });
     }
     card.appendChild(element("h4", "To reproduce it (in the output folder)"));
-    var link = element("p");
-    link.appendChild(document.createTextNode("Its device file: "));
-    var a = element("a", detail.file);
-    a.href = detail.file;
-    link.appendChild(a);
-    card.appendChild(link);
+    if (detail.file) {
+      var link = element("p");
+      link.appendChild(document.createTextNode("Its device file: "));
+      var a = element("a", detail.file);
+      a.href = detail.file;
+      link.appendChild(a);
+      card.appendChild(link);
+    }
     var pre = element("pre");
     pre.id = "card-commands";
     pre.textContent = detail.commands.map(function (c) { return "# " + c.what + "\n" + c.command; }).join("\n");
@@ -732,6 +754,7 @@
     out.file = detail.file;
     out.commands = detail.commands;
     out.picture = detail.picture;
+    out.spec = detail.spec || null;
     out.maps = {};
     Object.keys(detail.maps).forEach(function (m) {
       out.maps[m] = { points: data.workspace.points, values: detail.maps[m].values, unit: detail.maps[m].unit,

@@ -245,8 +245,7 @@ def render(run: StudyRun, selection: Selection, title: str, pareto: Picture, pic
     over = [_table(f"The selected design's indices over the workspace ({coarseness}): at the box's centre, median, "
                    "mean and the extremes with the points where they are taken", ["index", "unit", *SPREAD_COLUMNS],
                    spread)] if spread else []
-    section, scripts, policy = _explorer(explorer)
-    body = [f"<h1>Optimization study: {escape(title)}</h1>", section, "<h2>Study</h2>",
+    body = ["<h2>Study</h2>",
             _study_rows(run, coarseness, units),
             "<h2>Pareto front</h2>", _image(pareto),
             _table(f"The front: {len(run.front)} feasible, non-dominated designs (front.csv; click a row to pick it)",
@@ -257,7 +256,16 @@ def render(run: StudyRun, selection: Selection, title: str, pareto: Picture, pic
             _baseline(run, units, chosen), *over,
             *(_image(p) for p in pictures),
             "<h2>Infeasible designs</h2>", _reasons(run)]
-    return _document(title, body, files, scripts, policy)
+    return explorer_page(title, f"Optimization study: {title}", explorer, body, files)
+
+
+def explorer_page(title: str, heading: str, explorer: dict, body: list[str], files: list[str]) -> str:
+    """A design explorer as one HTML document, the one page every study's designs open in (``optimize``'s report,
+    ``rcube optimize``'s, ``study phantom``'s campaign): the ``heading``, the explorer of ``explorer``'s data
+    (:func:`~hapticdesign.optimization.study_explorer.explorer_table`), then ``body``'s parts (HTML, every user string
+    in them escaped) and the list of ``files`` beside it; Plotly.js is loaded from :data:`PLOTLY` beside the page."""
+    section, scripts, policy = _explorer(explorer)
+    return _document(title, [f"<h1>{escape(heading)}</h1>", section, *body], files, scripts, policy)
 
 
 def _closest(run: StudyRun, units: Mapping[str, str]) -> str:
