@@ -173,14 +173,16 @@ def quantity(name: str, unit: str, **more) -> dict:
 
 def explorer_table(title: str, study: str, device: str, variables: list[dict], objectives: list[dict],
                    constraints: list[dict], records: list[Record], front: list[int], selected: dict,
-                   designs: list[dict], baseline: Record | None = None, workspace: dict | None = None) -> dict:
+                   designs: list[dict], baseline: Record | None = None, workspace: dict | None = None,
+                   front_file: str = "front.csv") -> dict:
     """The explorer's data, JSON-ready, of any set of evaluated designs (an optimization study's, or a seed's own
     studies': ``rcube optimize``, ``study phantom``): the columns (:func:`quantity`), every design as a
     :class:`~hapticdesign.optimization.study_run.Record` (its ``values`` keyed by the variables' names, its objectives
     and constrained values in the columns' order), the ``front`` as record indices (0-based; front design n is
     ``front[n - 1]``), the ``selected`` design (``{"position": its place on the front, "rule": in words}``), each front
-    design's card (``designs``, :meth:`FrontDesign.data`), the design to compare with (``baseline``, None without one)
-    and the ``workspace`` points the cards' maps are drawn on (None: no maps)."""
+    design's card (``designs``, :meth:`FrontDesign.data`), the design to compare with (``baseline``, None without one),
+    the ``workspace`` points the cards' maps are drawn on (None: no maps) and the file that lists the front
+    (``front_file``, beside the page)."""
     names = [o["name"] for o in objectives]
     return {
         "title": title,
@@ -203,6 +205,7 @@ def explorer_table(title: str, study: str, device: str, variables: list[dict], o
         "baseline": None if baseline is None else _record(names, baseline),
         "workspace": workspace or {"points": [], "center": None, "coarseness": ""},
         "designs": designs,
+        "front_file": front_file,
     }
 
 

@@ -594,7 +594,7 @@
     card.appendChild(pin);
     var row = element("div", null, "card-row");
     var table = element("table");
-    table.appendChild(element("caption", n ? "Its numbers (front.csv, row " + n + ")" : "Its numbers (evaluations.csv, row " + (k + 1) + ")"));
+    table.appendChild(element("caption", n ? "Its numbers (" + (data.front_file || "front.csv") + ", row " + n + ")" : "Its numbers (evaluations.csv, row " + (k + 1) + ")"));
     var head = element("tr");
     ["quantity", "kind", "value", "unit"].forEach(function (h) { head.appendChild(element("th", h)); });
     table.appendChild(head);
