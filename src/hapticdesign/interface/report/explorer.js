@@ -11,7 +11,8 @@
   var PIN_COLOURS = ["#8e44ad", "#16a085", "#d35400", "#2c3e50"];
   var hasPlotly = typeof window.Plotly !== "undefined";
 
-  // ---- quantities: variables, objectives, constraints and the evaluation number, each a column over the records
+  // ---- quantities: variables, objectives, constraints (a "result" role: a value shown, not bounded) and the
+  // evaluation number, each a column over the records
   var dims = [];
   data.variables.forEach(function (v, k) {
     dims.push({ key: "var:" + v.name, name: v.name, kind: "variable", unit: v.unit || "SI", values: E.variables[k] });
@@ -21,7 +22,7 @@
                 values: E.objectives[k] });
   });
   data.constraints.forEach(function (c, k) {
-    dims.push({ key: "con:" + c.name, name: c.name, kind: "constraint", unit: c.unit, values: E.constraints[k] });
+    dims.push({ key: "con:" + c.name, name: c.name, kind: "constraint", role: c.role, unit: c.unit, values: E.constraints[k] });
   });
   var numbers = [];
   for (var r = 0; r < N; r++) { numbers.push(r + 1); }
@@ -525,7 +526,7 @@
 
   function quantities(k) {  // [kind, name, value, unit] of record k: variables, objectives, constrained values
     return dims.filter(function (d) { return d.kind !== "evaluation"; }).map(function (d) {
-      return [d.kind, d.name, d.values[k], d.unit === "SI" ? "SI" : d.unit];
+      return [d.role || d.kind, d.name, d.values[k], d.unit === "SI" ? "SI" : d.unit];
     });
   }
 
@@ -675,7 +676,7 @@
       if (finiteValues.some(function (v) { return v !== finiteValues[0]; }) || finiteValues.length !== values.length) { tr.className = "differs"; }
       var best = d.sense === "min" ? Math.min.apply(null, finiteValues) : d.sense === "max" ? Math.max.apply(null, finiteValues) : null;
       values.forEach(function (v) {
-        var td = numberCell(d.kind, d.name, v);
+        var td = numberCell(d.role || d.kind, d.name, v);
         if (best !== null && v === best && state.pins.length > 1) { td.className = "best"; }
         tr.appendChild(td);
       });

@@ -57,13 +57,11 @@ def rcube_page(data: dict, summary: dict, files: list[str]) -> str:
     return explorer_page(data["title"], data["title"], data, body, files)
 
 
-def phantom_page(data: dict, paragraphs: list[str], files: list[str]) -> str:
-    """``study phantom``'s campaign explorer: the design sets' designs with their LN and rendering results
-    (:func:`~hapticdesign.studies.phantom_explorer.campaign_explorer`), then ``paragraphs`` and the front."""
+def step_page(title: str, data: dict, paragraphs: list[str], files: list[str]) -> str:
+    """A study step's designs in the explorer (:class:`~hapticdesign.studies.steps.Explorer`: ``study phantom``'s
+    campaign, :func:`~hapticdesign.studies.phantom_explorer.campaign_explorer`), then ``paragraphs`` and the front."""
     head, front = _front_rows(data)
-    body = ["<h2>The campaign (seed 000 §3.2.2, §4.1.4, §4.2.4)</h2>",
-            *(f"<p>{escape(p, quote=False)}</p>" for p in paragraphs),
+    body = ["<h2>The designs</h2>", *(f"<p>{escape(p, quote=False)}</p>" for p in paragraphs),
             _table(f"The front: {len(front)} designs (click a row to pick it)", head, front,
                    data["selected"]["position"], ident="front-table")]
-    return explorer_page(data["title"], data["title"], data, body, files)
-
+    return explorer_page(title, title, data, body, files)
