@@ -1,6 +1,7 @@
 """The seeds' own studies in the design explorer (:func:`~hapticdesign.interface.report.optimization_page.explorer_page`,
-the page every study opens in): ``rcube optimize``'s synthesis (seed 001 §7.1-7.2) and ``study phantom``'s campaign
-over the design sets (seed 000 §3.2.2, §4.1.4), each as ``report.html`` with ``plotly.min.js`` beside it. The static
+the page every study opens in): ``rcube optimize``'s synthesis (seed 001 §7.1-7.2, :func:`rcube_page`) and a study
+step's designs (:func:`step_page`: ``study phantom``'s campaign over the design sets, seed 000 §3.2.2, §4.1.4), each
+as ``report.html`` with ``plotly.min.js`` beside it (:func:`write_explorer`). The static
 part under the explorer lists what the run found and the files beside the page; the numbers are the run's own."""
 
 from __future__ import annotations
