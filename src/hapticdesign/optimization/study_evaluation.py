@@ -15,7 +15,6 @@ import copy
 import json
 import math
 from collections.abc import Iterable, Mapping, Sequence
-from pathlib import Path
 
 import numpy as np
 import yaml
@@ -31,7 +30,7 @@ from hapticdesign.analysis.view.skeleton import home_pose
 from hapticdesign.analysis.workspace import Workspace, WorkspacePoses, reach_workspace
 from hapticdesign.devices.design_space import DesignSpace
 from hapticdesign.errors import UserError
-from hapticdesign.files import parse_structured, quote
+from hapticdesign.files import parse_structured, quote, structured_kind
 from hapticdesign.model.device import Device
 from hapticdesign.optimization.study_file import Choice, IndexConstraint, Study
 from hapticdesign.optimization.study_outputs import index_maps
@@ -77,10 +76,6 @@ def workspace_of(study: Study) -> Workspace | None:
         raise UserError(f"{study.path}: {exc}") from None
 
 
-def _kind(path: Path) -> str:
-    return {".yml": "yaml", ".yaml": "yaml", ".toml": "toml", ".json": "json"}.get(path.suffix.lower(), "")
-
-
 class BoundStudy:
     """A study with its device file's design space, its workspace points and its index names checked."""
 
@@ -89,7 +84,7 @@ class BoundStudy:
         self.registry = registry
         """The indices the study may name."""
         spec = study.spec
-        kind = _kind(study.device_path)
+        kind = structured_kind(study.device_path)
         if not kind:
             raise UserError(f"{study.path}: device {study.device_path.name!r} must be a device file (.yaml, .yml, "
                             ".toml or .json)")

@@ -1,6 +1,8 @@
-"""What the optimization report's design explorer reads: every evaluated design, the front, the selection, the
-device file's design and, per front design, its device file, its indices over the workspace points (the maps), a
-still picture of it and the commands that reproduce its numbers.
+"""What the optimization report's design explorer reads: every evaluated design (above :data:`EMBEDDED_LIMIT`, the
+front and a seeded sample of the others), the front, the selection, the device file's design and, per front design,
+its device file, its indices over the workspace points (the maps), a still picture of it and the commands that
+reproduce its numbers; and the copy of the study and device files (:data:`STUDY_COPY`) from which ``hapticdesign
+explore`` computes the card of any evaluated design (:func:`evaluation_card`).
 
 Everything here is JSON-ready (numbers as floats, NaN as None) and carries user strings (names, reasons, the device's
 name) as data: the page (:mod:`hapticdesign.interface.report.optimization_page`) embeds it with
@@ -17,17 +19,30 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pathlib import Path
+
 from hapticdesign.analysis.metrics.indices import evaluate_designs, reduce, reduced_at
 from hapticdesign.analysis.view.skeleton import home_pose, snapshot
 from hapticdesign.analysis.workspace import reach_workspace
 from hapticdesign.errors import UserError
+from hapticdesign.files import parse_structured, quote, read_text, structured_kind
 from hapticdesign.optimization.study_evaluation import BoundStudy, workspace_of
-from hapticdesign.optimization.study_file import Choice, IndexConstraint
+from hapticdesign.optimization.study_file import Choice, IndexConstraint, Study, StudySpec, study_from_mapping
 from hapticdesign.optimization.study_outputs import Selection, baseline_lines
-from hapticdesign.optimization.study_run import Record, StudyRun
+from hapticdesign.optimization.study_run import Encoding, Record, StudyRun, record_of
 
 DESIGNS = "designs"
 """The folder of the output holding each front design's device file (``designs/design-3.yaml``)."""
+
+
+EMBEDDED_LIMIT = 20_000
+"""Most evaluated designs off the front that the explorer's page embeds: above it, a sample of this many (seeded by the
+run's seed, :func:`embedded_records`) beside the front; the page says how many it shows of how many (the measured
+load and filter times behind the figure: benchmarks/bench_explorer.py, docs/optimization.md)."""
+
+STUDY_COPY = "study.json"
+"""The file of the output holding the study file's and the device file's names and texts, from which
+:func:`study_of_copy` rebuilds the study (``hapticdesign explore`` computes any design's card from it)."""
 
 
 def design_file(n: int) -> str:
@@ -90,16 +105,16 @@ def _pose_text(q: np.ndarray) -> str:
     return ",".join(repr(float(v)) for v in q)
 
 
-def front_designs(run: StudyRun, bound: BoundStudy) -> list[FrontDesign]:
-    """The card of every front design, in front.csv's order (the indices of all of them evaluated in one batch)."""
-    records = [run.records[k] for k in run.front]
-    device_values = [bound.device_values(r.values) for r in records]
+def design_cards(bound: BoundStudy, designs: list[dict[str, float]], files: list[str],
+                 headers: list[str]) -> list[FrontDesign]:
+    """The card of each design of variable ``designs`` (its indices evaluated with the others' in one batch), whose
+    device file would be ``files[i]`` (relative to the output folder) headed by ``headers[i]``."""
+    device_values = [bound.device_values(v) for v in designs]
     evaluated = (evaluate_designs(bound.space, device_values, bound.points, bound.requests, bound.registry)
-                 if bound.requests and len(bound.points) else [None] * len(records))
+                 if bound.requests and len(bound.points) else [None] * len(designs))
     uses = _uses(bound)
     out = []
-    for n, (record, values, evaluation) in enumerate(zip(records, device_values, evaluated), start=1):
-        file = design_file(n)
+    for variables, values, evaluation, file, header in zip(designs, device_values, evaluated, files, headers):
         quoted = shlex.quote(file)
         commands = [{"what": "the device file's spec sheet at its home pose", "command": f"hapticdesign spec --device {quoted}"}]
         try:
@@ -128,14 +143,39 @@ def front_designs(run: StudyRun, bound: BoundStudy) -> list[FrontDesign]:
                 named = r.index + (json.dumps(r.options, sort_keys=True) if r.options else "")
                 maps[named] = {"index": r.index, "unit": _unit(bound.registry[r.index].unit),
                                "values": [_number(v) for v in got], "reductions": reductions}
-        text = bound.device_file_text(record.values, [f"Front design {n} of the study's report (report.html)",
-                                                      *baseline_lines(run, record)])
-        out.append(FrontDesign(file, text, maps, picture, commands))
+        out.append(FrontDesign(file, bound.device_file_text(variables, header), maps, picture, commands))
     return out
 
 
-def _record(run: StudyRun, record: Record) -> dict:
-    names = [o.name for o in run.spec.objectives]
+def front_designs(run: StudyRun, bound: BoundStudy) -> list[FrontDesign]:
+    """The card of every front design, in front.csv's order (the indices of all of them evaluated in one batch)."""
+    records = [run.records[k] for k in run.front]
+    return design_cards(bound, [r.values for r in records], [design_file(n) for n in range(1, len(records) + 1)],
+                        [[f"Front design {n} of the study's report (report.html)", *baseline_lines(run, r)]
+                         for n, r in enumerate(records, start=1)])
+
+
+def evaluation_file(n: int) -> str:
+    """The name a card gives the device file of evaluation ``n`` off the front (``hapticdesign explore`` answers its
+    text; it is not written into the output folder)."""
+    return f"evaluation-{n}.yaml"
+
+
+def evaluation_card(bound: BoundStudy, evaluation: int, generation: int, values: dict[str, float]) -> dict:
+    """The card of evaluated design number ``evaluation`` (evaluations.csv's row, of ``generation``) of variable
+    ``values``, computed again from the study: its variables, objectives and constrained values as the run computed
+    them (:meth:`BoundStudy.evaluate`, :func:`~.study_run.record_of`), feasible or why not, and its maps, picture,
+    commands and device file's ``text`` (:func:`design_cards`; the file is named :func:`evaluation_file`)."""
+    spec = bound.study.spec
+    record = record_of(spec, generation, Encoding.of(spec).encode(values), values, bound.evaluate([values])[0])
+    card = design_cards(bound, [values], [evaluation_file(evaluation)],
+                        [[f"Evaluation {evaluation} of the study (evaluations.csv), computed by hapticdesign explore"]])[0]
+    return {"evaluation": evaluation, "generation": generation, **_record(spec, record),
+            **card.data(), "text": card.text}
+
+
+def _record(spec: StudySpec, record: Record) -> dict:
+    names = [o.name for o in spec.objectives]
     return {"variables": {k: _number(v) for k, v in record.values.items()},
             "objectives": dict(zip(names, map(_number, record.objectives))),
             "constraints": [_number(v) for v in record.constraints], "feasible": record.feasible,
@@ -144,11 +184,15 @@ def _record(run: StudyRun, record: Record) -> dict:
 
 def explorer_data(run: StudyRun, bound: BoundStudy, selection: Selection, designs: list[FrontDesign]) -> dict:
     """Everything the explorer shows, JSON-ready: the study's variables (with their units, :meth:`BoundStudy.units`,
-    "" where none is known), objectives (with units and reductions) and constraints; every evaluated design as columns (evaluations.csv's numbers, None where it has none); the front as
-    record indices (0-based); the selected design; the device file's design; the workspace points; and the front
-    designs' cards (:func:`front_designs`)."""
+    "" where none is known), objectives (with units and reductions) and constraints; the evaluated designs it embeds
+    (:func:`embedded_records`) as columns (evaluations.csv's numbers, None where it has none; ``evaluation``: their
+    numbers there) and ``count``, how many designs evaluations.csv holds; the front as indices into those columns
+    (0-based); the selected design; the device file's design; the workspace points; and the front designs' cards
+    (:func:`front_designs`)."""
     spec = bound.study.spec
-    records = run.records
+    embedded = embedded_records(run)
+    place = {k: i for i, k in enumerate(embedded)}
+    records = [run.records[k] for k in embedded]
     units = bound.units()
     grid = "" if not bound.coarseness else f" ({bound.coarseness})"
     objectives = []
@@ -174,7 +218,10 @@ def explorer_data(run: StudyRun, bound: BoundStudy, selection: Selection, design
         "variables": variables,
         "objectives": objectives,
         "constraints": constraints,
+        "count": len(run.records),
+        "sample": {"limit": EMBEDDED_LIMIT, "seed": run.seed},
         "evaluations": {
+            "evaluation": [k + 1 for k in embedded],
             "generation": [r.generation for r in records],
             "variables": [[_number(r.values[v["name"]]) for r in records] for v in variables],
             "objectives": [[_number(r.objectives[k]) for r in records] for k in range(len(objectives))],
@@ -183,10 +230,47 @@ def explorer_data(run: StudyRun, bound: BoundStudy, selection: Selection, design
             "reason": [r.reason for r in records],
             "polished": [r.polished for r in records],
         },
-        "front": list(run.front),
+        "front": [place[k] for k in run.front],
         "selected": {"position": selection.position, "rule": selection.rule},
-        "baseline": None if run.baseline is None else _record(run, run.baseline),
+        "baseline": None if run.baseline is None else _record(run.spec, run.baseline),
         "workspace": {"points": [[float(x) for x in p] for p in bound.points], "center": bound.center,
                       "coarseness": bound.coarseness},
         "designs": [d.data() for d in designs],
     }
+
+
+def embedded_records(run: StudyRun) -> list[int]:
+    """The records (0-based, in evaluation order) the explorer's page embeds: all of them when at most
+    :data:`EMBEDDED_LIMIT` lie off the front; else the front, the polished designs and :data:`EMBEDDED_LIMIT` of the
+    others drawn without replacement by a generator seeded with the run's seed (the same run, the same sample)."""
+    kept = set(run.front) | {k for k, r in enumerate(run.records) if r.polished}
+    others = [k for k in range(len(run.records)) if k not in kept]
+    if len(others) <= EMBEDDED_LIMIT:
+        return list(range(len(run.records)))
+    drawn = np.random.default_rng(run.seed).choice(len(others), size=EMBEDDED_LIMIT, replace=False)
+    return sorted(kept | {others[i] for i in drawn})
+
+
+def study_copy(study: Study) -> str:
+    """The text of :data:`STUDY_COPY`: the study file's and the device file's names and texts, as the run read them."""
+    return json.dumps({"study": {"name": study.path.name, "text": study.study_text},
+                       "device": {"name": study.device_path.name, "text": study.device_text}}, indent=1)
+
+
+def study_of_copy(path: Path) -> Study:
+    """The study saved in :data:`STUDY_COPY` at ``path`` (:func:`study_copy`), bound to the device file's text saved
+    beside it (its ``device`` entry is not read again: the device file may have changed or moved since the run); a
+    file that is not such a copy is a one-line UserError."""
+    try:
+        data = json.loads(read_text(path, "study copy"))
+        names = {part: data[part]["name"] for part in ("study", "device")}
+        texts = {part: data[part]["text"] for part in ("study", "device")}
+    except (ValueError, TypeError, KeyError):
+        raise UserError(f"{path}: not the copy of a study that optimize writes (study and device, each a name and a "
+                        "text)") from None
+    if not all(isinstance(v, str) and structured_kind(v) and Path(v).name == v for v in names.values()) or \
+            not all(isinstance(v, str) for v in texts.values()):
+        raise UserError(f"{path}: not the copy of a study that optimize writes (a name is not a study or device "
+                        f"file's: {quote(str(names))})")
+    spec = study_from_mapping(parse_structured(texts["study"], structured_kind(names["study"]), f"{path} (study)"), f"{path} (study)")
+    return Study(spec, path.parent / names["study"], path.parent / names["device"], texts["study"], texts["device"])
