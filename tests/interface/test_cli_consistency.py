@@ -138,7 +138,7 @@ def _json_cases(tmp: Path) -> dict[tuple[str, ...], list]:
     }
 
 
-OWN_TESTS = {("campaign",), ("rcube", "maps")}  # checked below, with their files
+OWN_TESTS = {("campaign",), ("rcube", "maps"), ("explore",)}  # checked below or in their own tests (explore serves)
 
 
 @pytest.mark.parametrize("path", [p for p in COMMANDS if p not in SLOW | OWN_TESTS], ids=" ".join)

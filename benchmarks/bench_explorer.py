@@ -1,0 +1,129 @@
+"""The design explorer of a 1e5-evaluation study in headless Chromium (issue 42, item 8): how long report.html takes to
+load from disk, to apply a filter (a range on one axis, as a brush on the parallel coordinates sets it) and to pick a
+design, and how large it is.
+
+The study is real: seed 001's R-CUBE synthesis (examples/devices/rcube.yaml; variables q_max, l2, l3; objectives O1 and
+O2 of eq. 6.82-6.83; two of its elbow constraints), NSGA-II, population 1000, 100 generations: 100,000 evaluations,
+run by ``optimize`` into a temporary folder (or into ``--out FOLDER``, where a rerun continues from the checkpoint).
+The page embeds the front and a sample of the other evaluations
+(:data:`~hapticdesign.optimization.study_explorer.EMBEDDED_LIMIT`). Times are the page's own
+(``performance.now()``): load is the navigation's ``loadEventEnd`` (every script run and the plots, the parallel
+coordinates and the card drawn); a filter or a pick is one call of ``window.hdExplorer`` (the plots, the parallel
+coordinates, the card and the counts redrawn); each the median of ``REPEATS``. Chromium runs with
+``--enable-unsafe-swiftshader``: the large scatter traces are WebGL (software-rendered here). The machine's load
+average is printed with the figures.
+
+Run: ``.venv/bin/python benchmarks/bench_explorer.py [--out FOLDER]``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+DEVICE = ROOT / "examples" / "devices" / "rcube.yaml"
+REPEATS = 5
+STUDY = """# 1e5 evaluations of seed 001's R-CUBE synthesis (benchmarks/bench_explorer.py)
+device: {device}
+variables: {{q_max: [0.07, 1.5], l2: [0.001, 0.500], l3: [0.001, 0.500]}}
+parameters: {{l1: "0.06 / sin(q_max)", S: "l1"}}
+objectives:
+  - {{name: O1, index: rcube_o1, reduce: max, sense: min}}
+  - {{name: O2, index: rcube_o2, reduce: max, sense: min}}
+constraints:
+  - {{index: rcube_constraint, options: {{point: C2}}, reduce: max, "<=": 0}}
+  - {{index: rcube_constraint, options: {{point: B1}}, reduce: max, "<=": 0}}
+algorithm: {{method: nsga2, population: 1000, generations: 100, polish: none}}
+"""
+CHROMIUM_FLAGS = ("--headless", "--no-sandbox", "--disable-quic", "--no-first-run", "--disable-background-networking",
+                  "--disable-component-update", "--disable-sync", "--enable-unsafe-swiftshader")
+
+
+def study_folder(out: Path) -> Path:
+    """The 1e5-evaluation study's output folder ``out`` (run by ``optimize``, seed 1)."""
+    from hapticdesign.interface.commands.optimize_adapter import optimize
+
+    out.mkdir(parents=True, exist_ok=True)
+    study = out.parent / f"{out.name}-study.yaml"
+    study.write_text(STUDY.format(device=json.dumps(str(DEVICE))))
+    start = time.perf_counter()
+    optimize(study, seed=1, out=out, quiet=True)
+    print(f"study run and written in {time.perf_counter() - start:.0f} s")
+    return out
+
+
+def chromium(profile: str):
+    from selenium import webdriver
+    from selenium.webdriver.chrome.service import Service
+
+    options = webdriver.ChromeOptions()
+    options.binary_location = shutil.which("chromium") or "/usr/bin/chromium"
+    for flag in CHROMIUM_FLAGS:
+        options.add_argument(flag)
+    options.add_argument(f"--user-data-dir={profile}")
+    options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+    return webdriver.Chrome(service=Service(shutil.which("chromedriver") or "/usr/bin/chromedriver"), options=options)
+
+
+def measure(out: Path) -> dict:
+    """Load, filter and pick times [ms] of ``out``'s report.html, the counts it states and its console's errors."""
+    profile = tempfile.mkdtemp(prefix="hd-bench-")
+    driver = chromium(profile)
+    try:
+        driver.set_window_size(1300, 1000)
+        url = (out / "report.html").resolve().as_uri()
+        loads = []
+        for _ in range(REPEATS):
+            driver.get("about:blank")
+            driver.get(url)
+            loads.append(driver.execute_script("return performance.getEntriesByType('navigation')[0].loadEventEnd"))
+        O1 = driver.execute_script("return window.hdExplorer.design(1).objectives.O1")
+        filters, picks = [], []
+        for k in range(REPEATS):
+            filters.append(driver.execute_script(
+                "var t = performance.now(); window.hdExplorer.filter('obj:O1', arguments[0], arguments[1]);"
+                " return performance.now() - t", O1 * (1 + 0.1 * k), O1 * (3 + k)))
+            picks.append(driver.execute_script(
+                "var t = performance.now(); window.hdExplorer.select(arguments[0]); return performance.now() - t", k + 2))
+        state = driver.execute_script("return window.hdExplorer.state()")
+        shown = driver.find_element("id", "shown-count")
+        errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
+        return {"load": statistics.median(loads), "filter": statistics.median(filters),
+                "pick": statistics.median(picks), "passing": len(state["passing"]),
+                "shown": int(shown.get_attribute("data-shown")), "count": int(shown.get_attribute("data-count")),
+                "errors": errors}
+    finally:
+        driver.quit()
+        shutil.rmtree(profile, ignore_errors=True)
+
+
+def main() -> None:
+    args = sys.argv[1:]
+    if "--out" in args:
+        out = Path(args[args.index("--out") + 1])
+        if not (out / "report.html").is_file():
+            study_folder(out)
+        figures = measure(out)
+    else:
+        with tempfile.TemporaryDirectory(prefix="hd-explorer-") as folder:
+            out = study_folder(Path(folder) / "out")
+            figures = measure(out)
+    size = (out / "report.html").stat().st_size if out.exists() else 0
+    print(f"load average {os.getloadavg()[0]:.1f} (2 cores); headless Chromium, software WebGL")
+    print(f"report.html: {figures['shown']:,} of {figures['count']:,} evaluations embedded"
+          + (f", {size / 2**20:.1f} MB" if size else ""))
+    print(f"load {figures['load'] / 1000:.2f} s; filter {figures['filter']:.0f} ms ({figures['passing']:,} designs "
+          f"pass); pick {figures['pick']:.0f} ms (medians of {REPEATS})")
+    if figures["errors"]:
+        print(f"console errors: {figures['errors']}")
+
+
+if __name__ == "__main__":
+    main()
