@@ -90,8 +90,8 @@ def measure(out: Path) -> dict:
             filters.append(driver.execute_script(
                 "var t = performance.now(); window.hdExplorer.filter('obj:O1', arguments[0], arguments[1]);"
                 " return performance.now() - t", O1 * (1 + 0.1 * k), O1 * (3 + k)))
-            picks.append(driver.execute_script(
-                "var t = performance.now(); window.hdExplorer.select(arguments[0]); return performance.now() - t", k + 2))
+            picks.append(driver.execute_script("var t = performance.now(); window.hdExplorer.select(arguments[0]);"
+                                               " return performance.now() - t", k + 2))
         state = driver.execute_script("return window.hdExplorer.state()")
         shown = driver.find_element("id", "shown-count")
         errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]

@@ -168,8 +168,8 @@ def evaluation_card(bound: BoundStudy, evaluation: int, generation: int, values:
     commands and device file's ``text`` (:func:`design_cards`; the file is named :func:`evaluation_file`)."""
     spec = bound.study.spec
     record = record_of(spec, generation, Encoding.of(spec).encode(values), values, bound.evaluate([values])[0])
-    card = design_cards(bound, [values], [evaluation_file(evaluation)],
-                        [[f"Evaluation {evaluation} of the study (evaluations.csv), computed by hapticdesign explore"]])[0]
+    header = f"Evaluation {evaluation} of the study (evaluations.csv), computed by hapticdesign explore"
+    card = design_cards(bound, [values], [evaluation_file(evaluation)], [[header]])[0]
     return {"evaluation": evaluation, "generation": generation, **_record(spec, record),
             **card.data(), "text": card.text}
 
@@ -272,5 +272,6 @@ def study_of_copy(path: Path) -> Study:
             not all(isinstance(v, str) for v in texts.values()):
         raise UserError(f"{path}: not the copy of a study that optimize writes (a name is not a study or device "
                         f"file's: {quote(str(names))})")
-    spec = study_from_mapping(parse_structured(texts["study"], structured_kind(names["study"]), f"{path} (study)"), f"{path} (study)")
+    where = f"{path} (study)"
+    spec = study_from_mapping(parse_structured(texts["study"], structured_kind(names["study"]), where), where)
     return Study(spec, path.parent / names["study"], path.parent / names["device"], texts["study"], texts["device"])

@@ -228,7 +228,8 @@ def _explorer(data: dict) -> tuple[str, str, str]:
         "box or a lasso on a plot or along an axis of the parallel coordinates to filter (a click on an axis clears "
         "its range), pin up to four designs to compare them. The address keeps the view: a link reopens it. "
         "Each quantity's unit is in brackets (a variable's from its device file). <code>window.hdExplorer</code> scripts it (docs/optimization.md)."
-        f'</p><p id="shown-count" class="note" data-shown="{shown}" data-count="{count}">{escape(shown_count(data))}</p>'
+        f'</p><p id="shown-count" class="note" data-shown="{shown}" data-count="{count}">'
+        f"{escape(shown_count(data))}</p>"
         '<p id="explorer-note"></p>'
         '<div class="toolbar"><label>x <select id="x-axis"></select></label><label>y <select id="y-axis"></select>'
         '</label><button id="clear-filters" type="button">Clear filters</button><span id="filter-status"></span></div>'
