@@ -300,6 +300,7 @@ def _bad_inputs(tmp: Path) -> dict[tuple[str, ...], list]:
         ("study", "device"): ["--device", tmp / "missing.yaml", "--out", tmp / "s"],
         ("maps",): ["--device", RCUBE_FILE.parent / "five-bar.yaml", "--size", "0.1,0,0", "--out", tmp / "m"],
         ("optimize",): [tmp / "missing-study.yaml", "--out", tmp / "o"],
+        ("explore",): [a_file],
     }
 
 

@@ -19,7 +19,7 @@ PORT = typer.Option(0, "--port", min=0, max=65535, help="The port on 127.0.0.1 (
 def register(app: typer.Typer) -> None:
     @app.command()
     def explore(out: Path = FOLDER, port: int = PORT, json_out: bool = JSON_OUT, quiet: bool = QUIET) -> None:
-        """Serve a study's output folder on 127.0.0.1 (read-only) until Ctrl-C: its report.html, whose card of any evaluated design (not only the front's) is computed here on demand."""
+        """Serve a study's output folder on 127.0.0.1 (read-only) until Ctrl-C: its report.html, the explorer of the front and every evaluated design (seed 001 §7.2 selects among them), with any design's card computed on demand."""
         from hapticdesign.interface.commands.explore_adapter import StudyFolder, address, server
 
         with user_errors(quiet=quiet):
