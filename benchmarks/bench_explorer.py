@@ -13,7 +13,8 @@ coordinates, the card and the counts redrawn); each the median of ``REPEATS``. C
 ``--enable-unsafe-swiftshader``: the large scatter traces are WebGL (software-rendered here). The machine's load
 average is printed with the figures.
 
-Run: ``.venv/bin/python benchmarks/bench_explorer.py [--out FOLDER]``.
+Run: ``.venv/bin/python benchmarks/bench_explorer.py [--out FOLDER] [--write]`` (``--write``: the figures into
+docs/optimization.md, between its ``explorer-benchmark`` markers).
 """
 
 from __future__ import annotations
@@ -104,25 +105,51 @@ def measure(out: Path) -> dict:
         shutil.rmtree(profile, ignore_errors=True)
 
 
+START, END = "<!-- explorer-benchmark:start -->", "<!-- explorer-benchmark:end -->"
+DOC = ROOT / "docs" / "optimization.md"
+
+
+def paragraph(figures: dict, front: int, size: int) -> str:
+    """The figures as docs/optimization.md states them (between :data:`START` and :data:`END`)."""
+    lines = (f"*How fast, at {figures['count']:,} evaluations* (`benchmarks/bench_explorer.py`: seed 001's R-CUBE "
+             f"synthesis with two objectives and two constraints, NSGA-II, population 1000, 100 generations, its "
+             f"{front:,}-design front; headless Chromium with software WebGL on this 2-core machine shared with other "
+             f"jobs, load average {figures['load_average']:.1f}): the page holds {figures['shown']:,} of the "
+             f"{figures['count']:,} designs ({size / 2**20:.1f} MB); it loads in {figures['load'] / 1000:.1f} s (the "
+             "navigation's `loadEventEnd`, plots and parallel coordinates drawn), a filter (a range on one axis, as a "
+             f"brush sets it) redraws everything in {figures['filter'] / 1000:.2f} s and a pick in "
+             f"{figures['pick'] / 1000:.2f} s (medians of {REPEATS}).")
+    words, out, line = lines.split(" "), [], ""
+    for word in words:  # wrapped at 118 characters, as the page's other paragraphs
+        if line and len(line) + 1 + len(word) > 118:
+            out.append(line)
+            line = word
+        else:
+            line = f"{line} {word}" if line else word
+    return "\n".join([*out, line])
+
+
 def main() -> None:
     args = sys.argv[1:]
-    if "--out" in args:
-        out = Path(args[args.index("--out") + 1])
+    with tempfile.TemporaryDirectory(prefix="hd-explorer-") as folder:
+        out = Path(args[args.index("--out") + 1]) if "--out" in args else Path(folder) / "out"
         if not (out / "report.html").is_file():
             study_folder(out)
         figures = measure(out)
-    else:
-        with tempfile.TemporaryDirectory(prefix="hd-explorer-") as folder:
-            out = study_folder(Path(folder) / "out")
-            figures = measure(out)
-    size = (out / "report.html").stat().st_size if out.exists() else 0
-    print(f"load average {os.getloadavg()[0]:.1f} (2 cores); headless Chromium, software WebGL")
-    print(f"report.html: {figures['shown']:,} of {figures['count']:,} evaluations embedded"
-          + (f", {size / 2**20:.1f} MB" if size else ""))
+        figures["load_average"] = os.getloadavg()[0]
+        size = (out / "report.html").stat().st_size
+        front = sum(1 for _ in (out / "front.csv").open()) - 1
+    print(f"load average {figures['load_average']:.1f} (2 cores); headless Chromium, software WebGL")
+    print(f"report.html: {figures['shown']:,} of {figures['count']:,} evaluations embedded, {size / 2**20:.1f} MB")
     print(f"load {figures['load'] / 1000:.2f} s; filter {figures['filter']:.0f} ms ({figures['passing']:,} designs "
           f"pass); pick {figures['pick']:.0f} ms (medians of {REPEATS})")
     if figures["errors"]:
         print(f"console errors: {figures['errors']}")
+    if "--write" in args:
+        text = DOC.read_text()
+        head, rest = text.split(START, 1)
+        DOC.write_text(f"{head}{START}\n{paragraph(figures, front, size)}\n{END}{rest.split(END, 1)[1]}")
+        print(f"wrote the figures into {DOC}")
 
 
 if __name__ == "__main__":

@@ -334,14 +334,15 @@ class BoundStudy:
             v.write(data, float(values[v.name]))
         return data
 
-    def device_file_text(self, values: dict[str, float], comments: Sequence[str] = ()) -> str:
+    def device_file_text(self, values: dict[str, float], comments: Sequence[str] = (), evaluated: bool = True) -> str:
         """:meth:`device_mapping` as YAML, headed by where it comes from, the ``comments`` lines (the device file's
-        design beside it) and where the study evaluated it (:meth:`where_evaluated`)."""
+        design beside it) and, with ``evaluated``, where the study evaluated it (:meth:`where_evaluated`; a design the
+        device file refuses has no such lines, and the comments say why)."""
         shown = ", ".join(f"{k} = {v!r}" for k, v in values.items())
         names = (json.dumps(self.study.path.name), json.dumps(self.study.device_path.name))  # no line break in them
         header = f"# The design selected by study {names[0]} from device file {names[1]}:\n# {shown}\n"
         lines = "".join(f"# {' '.join(line.splitlines())}\n" for line in comments)  # a reason's line break stays a comment
-        return (header + lines + self.where_evaluated(values)
+        return (header + lines + (self.where_evaluated(values) if evaluated else "")
                 + yaml.safe_dump(self.device_mapping(values), sort_keys=False, allow_unicode=False))
 
     def _at_points(self, values: dict[str, float]) -> tuple[Device, WorkspacePoses | None, dict | None]:

@@ -119,8 +119,8 @@ def design_cards(bound: BoundStudy, designs: list[dict[str, float]], files: list
         commands = [{"what": "the device file's spec sheet at its home pose", "command": f"hapticdesign spec --device {quoted}"}]
         try:
             device = bound.space.device(values)
-        except UserError:
-            device = None
+        except UserError as exc:
+            device, header = None, [*header, f"The device file refuses it: {exc}"]
         picture = None
         if device is not None:
             picture, where = _picture(bound, device)
@@ -143,7 +143,8 @@ def design_cards(bound: BoundStudy, designs: list[dict[str, float]], files: list
                 named = r.index + (json.dumps(r.options, sort_keys=True) if r.options else "")
                 maps[named] = {"index": r.index, "unit": _unit(bound.registry[r.index].unit),
                                "values": [_number(v) for v in got], "reductions": reductions}
-        out.append(FrontDesign(file, bound.device_file_text(variables, header), maps, picture, commands))
+        out.append(FrontDesign(file, bound.device_file_text(variables, header, evaluated=device is not None), maps,
+                               picture, commands))
     return out
 
 
