@@ -205,3 +205,20 @@ def test_the_command_prints_its_address_and_stops_on_ctrl_c(study):
     finally:
         process.kill()
     assert process.returncode == 0 and out == "" and err == "stopped\n"
+
+
+def test_a_damaged_study_copy_is_one_line_and_a_missing_one_leaves_the_front_s_cards(study, tmp_path):
+    copy = _tampered(study, tmp_path, lambda text: text)
+    (copy / "study.json").write_text('{"study": {"name": "../study.yaml", "text": ""}}')
+    _one_line_error(*_explore(copy), "not the copy of a study")
+    (copy / "study.json").unlink()
+    folder = StudyFolder(copy)  # an output written before study.json: served, without cards off the front
+    assert folder.bound is None and "study.json" in folder.why
+    httpd = server(folder)
+    threading.Thread(target=httpd.serve_forever, daemon=True).start()
+    try:
+        status, body = _get(httpd.server_address, "/api/card?evaluation=1")
+        assert status == 404 and "study.json" in json.loads(body)["error"]
+    finally:
+        httpd.shutdown()
+        httpd.server_close()
