@@ -13,8 +13,9 @@ coordinates, the card and the counts redrawn); each the median of ``REPEATS``. C
 ``--enable-unsafe-swiftshader``: the large scatter traces are WebGL (software-rendered here). The machine's load
 average is printed with the figures.
 
-Run: ``.venv/bin/python benchmarks/bench_explorer.py [--out FOLDER] [--write]`` (``--write``: the figures into
-docs/optimization.md, between its ``explorer-benchmark`` markers).
+Run: ``.venv/bin/python benchmarks/bench_explorer.py [--out FOLDER] [--limit N] [--write]`` (``--limit N``: the page
+written again with N in place of the limit, e.g. 100000 to embed every evaluation, the measurement behind the limit;
+``--write``: the figures into docs/optimization.md, between its ``explorer-benchmark`` markers).
 """
 
 from __future__ import annotations
@@ -47,9 +48,15 @@ CHROMIUM_FLAGS = ("--headless", "--no-sandbox", "--disable-quic", "--no-first-ru
                   "--disable-component-update", "--disable-sync", "--enable-unsafe-swiftshader")
 
 
-def study_folder(out: Path) -> Path:
-    """The 1e5-evaluation study's output folder ``out`` (run by ``optimize``, seed 1)."""
+def study_folder(out: Path, limit: int | None = None) -> Path:
+    """The 1e5-evaluation study's output folder ``out`` (run by ``optimize``, seed 1; a folder holding the run
+    already is written again from its checkpoint), its page embedding at most ``limit`` designs off the front
+    (None: :data:`~hapticdesign.optimization.study_explorer.EMBEDDED_LIMIT`)."""
     from hapticdesign.interface.commands.optimize_adapter import optimize
+    from hapticdesign.optimization import study_explorer
+
+    if limit is not None:
+        study_explorer.EMBEDDED_LIMIT = limit
 
     out.mkdir(parents=True, exist_ok=True)
     study = out.parent / f"{out.name}-study.yaml"
@@ -133,8 +140,9 @@ def main() -> None:
     args = sys.argv[1:]
     with tempfile.TemporaryDirectory(prefix="hd-explorer-") as folder:
         out = Path(args[args.index("--out") + 1]) if "--out" in args else Path(folder) / "out"
-        if not (out / "report.html").is_file():
-            study_folder(out)
+        limit = int(args[args.index("--limit") + 1]) if "--limit" in args else None
+        if limit is not None or not (out / "report.html").is_file():
+            study_folder(out, limit)
         figures = measure(out)
         figures["load_average"] = os.getloadavg()[0]
         size = (out / "report.html").stat().st_size

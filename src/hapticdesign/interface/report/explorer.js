@@ -514,7 +514,7 @@
   }
 
   // ---- the design card
-  var failures = {};  // why the server could not compute a card
+  var failures = {}, deviceUrl = null;  // why the server could not compute a card; the computed device file's address
   function detailOf(k) { return frontOf[k] ? data.designs[frontOf[k] - 1] : cards[k] || null; }
 
   function fetchCard(k) {  // the card of record k off the front, computed by `hapticdesign explore` (cards[k]; null: failed)
@@ -660,7 +660,8 @@
     link.appendChild(document.createTextNode("Its device file: "));
     var a = element("a", detail.file);
     if (detail.text === undefined) { a.href = detail.file; } else {  // computed on demand: not in the folder, saved from here
-      a.href = URL.createObjectURL(new Blob([detail.text], { type: "text/yaml" }));
+      if (deviceUrl) { URL.revokeObjectURL(deviceUrl); }
+      a.href = deviceUrl = URL.createObjectURL(new Blob([detail.text], { type: "text/yaml" }));
       a.download = detail.file;
       link.appendChild(document.createTextNode("(not in the folder: save it from here) "));
     }
