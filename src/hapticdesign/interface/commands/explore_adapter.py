@@ -18,6 +18,7 @@ import errno
 import json
 import math
 import mimetypes
+import sys
 import threading
 from dataclasses import dataclass
 from http import HTTPStatus
@@ -254,8 +255,22 @@ class _Handler(BaseHTTPRequestHandler):
                 except UserError as exc:
                     self._refuse(HTTPStatus.UNPROCESSABLE_ENTITY, str(exc), body)
                     return
+                except Exception as exc:  # noqa: BLE001 - a server answers every request: the failure in one line
+                    self._refuse(HTTPStatus.INTERNAL_SERVER_ERROR, f"{type(exc).__name__}: {exc}", body)
+                    return
             data = self.cards[n]
         self._send(HTTPStatus.OK, data, "application/json", body)
+
+
+class _Server(ThreadingHTTPServer):
+    daemon_threads = True
+
+    def handle_error(self, request, client_address) -> None:
+        """A connection the browser dropped (a page left while a file was sent) is no error; another is one line on
+        stderr, not a traceback."""
+        kind, exc = sys.exc_info()[:2]
+        if kind is not None and not issubclass(kind, ConnectionError):
+            print(f"error: a request failed: {kind.__name__}: {exc}", file=sys.stderr)
 
 
 def server(folder: StudyFolder, port: int = 0) -> ThreadingHTTPServer:
@@ -263,13 +278,12 @@ def server(folder: StudyFolder, port: int = 0) -> ThreadingHTTPServer:
     allowed is a one-line UserError."""
     handler = type("Handler", (_Handler,), {"folder": folder, "cards": {}, "lock": threading.Lock()})
     try:
-        httpd = ThreadingHTTPServer((HOST, port), handler)
+        httpd = _Server((HOST, port), handler)
     except OSError as exc:
         if exc.errno == errno.EADDRINUSE:
             raise UserError(f"port {port} on {HOST} is in use (choose another --port, or leave it out for a free "
                             "one)") from None
         raise UserError(f"cannot serve on {HOST} port {port}: {exc.strerror or exc}") from None
-    httpd.daemon_threads = True
     return httpd
 
 
