@@ -64,6 +64,11 @@ def console(driver) -> list[dict]:
     return [e for e in driver.get_log("browser") if e["level"] in ("SEVERE", "WARNING")]
 
 
+def read_rows(path: Path) -> list[dict[str, str]]:
+    with path.open(newline="") as f:
+        return list(csv.DictReader(f))
+
+
 def first_row(path: Path) -> dict[str, str]:
     with path.open(newline="") as f:
         return {without_unit(k): v for k, v in next(csv.DictReader(f)).items()}
@@ -106,4 +111,20 @@ def test_rcube_optimize_opens_in_the_explorer(browser, rcube_out):
     assert design["picture"]["origins"]["platform"] == pytest.approx([expected["l1"]] * 3, rel=1e-9)
     assert browser.execute_script("return window.hdExplorer.state().selected") == \
         int(first_row(rcube_out / "table_7_5_weighted_rms.csv")["solution"])
+    # every design it shows is embedded (no sample), numbered 1..count as the served page's data require
+    shown = browser.find_element("id", "shown-count")
+    count = int(shown.get_attribute("data-count"))
+    assert int(shown.get_attribute("data-shown")) == count >= len(read_rows(rcube_out / "table_7_2_front.csv"))
+    assert shown.text == f"This page holds all {count:,} evaluated designs."
     assert console(browser) == []
+
+
+def test_explore_refuses_rcube_optimizes_folder_in_one_line(rcube_out):
+    """``hapticdesign explore`` serves optimize's output folders; the R-CUBE chain's has no front.csv or
+    evaluations.csv: one line, exit status 2, nothing written."""
+    before = sorted(p.relative_to(rcube_out) for p in rcube_out.rglob("*"))
+    done = runner.invoke(app, ["explore", str(rcube_out)])
+    assert done.exit_code == 2 and done.stdout == "" and "Traceback" not in done.stderr
+    assert done.stderr.startswith("error: ") and done.stderr.count("\n") == 1
+    assert "is not a study's output folder" in done.stderr
+    assert sorted(p.relative_to(rcube_out) for p in rcube_out.rglob("*")) == before

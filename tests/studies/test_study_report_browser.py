@@ -9,6 +9,9 @@ import time
 from pathlib import Path
 
 import pytest
+from typer.testing import CliRunner
+
+from hapticdesign.interface.cli import app
 
 # end to end: deselect with -m "not slow"; one xdist worker takes every test of the shared smoke studies
 # (`make test` runs --dist loadgroup), so that the other worker is not left waiting on their lock
@@ -94,5 +97,11 @@ def test_the_phantom_campaign_opens_in_the_design_explorer(browser, phantom_stud
     for row in rows:
         ln, k = float(row["ln"]), k_max(row)
         assert not any(ln <= a and k >= b and (ln, k) != (a, b) for a, b in points)
+    shown = browser.find_element("id", "shown-count")  # every design of the design set, none sampled out
+    assert (int(shown.get_attribute("data-shown")), int(shown.get_attribute("data-count"))) == (len(rows), len(rows))
     problems = [e for e in browser.get_log("browser") if e["level"] in ("SEVERE", "WARNING")]
     assert problems == []
+    # hapticdesign explore serves optimize's folders: on the campaign's, one line and exit status 2
+    done = CliRunner().invoke(app, ["explore", str(out / "explorer" / "campaign")])
+    assert done.exit_code == 2 and done.stdout == "" and done.stderr.count("\n") == 1
+    assert done.stderr.startswith("error: ") and "is not a study's output folder" in done.stderr

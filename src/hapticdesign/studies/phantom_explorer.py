@@ -73,7 +73,7 @@ def campaign_explorer(designs: list[Design], cases: dict, preset_name: str) -> E
         cards.append(_card(preset_name, design, file))
     data = explorer_table(TITLE, "study phantom", preset_name, variables, objectives, results, records, front,
                           {"position": position, "rule": "largest K_max (type 1) on the front"}, cards,
-                          front_file="the front below")
+                          front_file="the front below", evaluations_file=None)
     paragraphs = [f"{len(designs)} designs of the design sets, each simulated in types 1 and 2 for the maximum stable "
                   "impedance and the transparency bandwidth. The objective space is LN against K_max (type 1); the "
                   "front holds the designs no other beats in both (a lower LN and a larger K_max). Variables: the "

@@ -200,20 +200,37 @@ def _explorer_script() -> str:
     return package_files("hapticdesign.interface.report").joinpath("explorer.js").read_text(encoding="utf-8")
 
 
+def shown_count(data: dict) -> str:
+    """How many of the evaluated designs the page holds, in words (the explorer's ``data``,
+    :func:`~hapticdesign.optimization.study_explorer.explorer_table`)."""
+    shown, count, front = len(data["evaluations"]["evaluation"]), data["count"], len(data["front"])
+    if shown == count:
+        return f"This page holds all {count:,} evaluated designs."
+    sample = data["sample"]
+    return (f"This page holds {shown:,} of the {count:,} evaluated designs: the front's {front:,} (and the polished "
+            f"ones) and a sample of {sample['limit']:,} of the others, drawn with the run's seed {sample['seed']} "
+            "(evaluations.csv has every one; hapticdesign explore computes the card of any design shown).")
+
+
 def _explorer(data: dict) -> tuple[str, str, str]:
     """The explorer's section, its scripts (the data, Plotly.js, the explorer's own) and the page's policy: the
-    inline script by its hash, Plotly.js from the page's folder (a ``file:`` address), no network."""
+    inline script by its hash, Plotly.js from the page's folder (a ``file:`` address, or the server's own when
+    ``hapticdesign explore`` serves the folder, which also answers the cards: ``connect-src 'self'``), no other
+    network."""
     code = _explorer_script()
     digest = base64.b64encode(hashlib.sha256(code.encode("utf-8")).digest()).decode("ascii")
-    policy = (f"default-src 'none'; script-src 'sha256-{digest}' file: 'self'; style-src 'unsafe-inline'; "
-              "img-src data: blob:; font-src data:")
+    policy = (f"default-src 'none'; script-src 'sha256-{digest}' file: 'self'; connect-src 'self'; "
+              "style-src 'unsafe-inline'; img-src data: blob:; font-src data:")
+    shown, count = len(data["evaluations"]["evaluation"]), data["count"]
     section = (
         '<section id="explorer"><h2>Explore the designs</h2>'
         '<p class="note">Every evaluated design: click a point or a line to pick a design (its card follows), drag a '
         "box or a lasso on a plot or along an axis of the parallel coordinates to filter (a click on an axis clears "
         "its range), pin up to four designs to compare them. The address keeps the view: a link reopens it. "
         "Each quantity's unit is in brackets (a variable's from its device file). <code>window.hdExplorer</code> scripts it (docs/optimization.md)."
-        '</p><p id="explorer-note"></p>'
+        f'</p><p id="shown-count" class="note" data-shown="{shown}" data-count="{count}">'
+        f"{escape(shown_count(data))}</p>"
+        '<p id="explorer-note"></p>'
         '<div class="toolbar"><label>x <select id="x-axis"></select></label><label>y <select id="y-axis"></select>'
         '</label><button id="clear-filters" type="button">Clear filters</button><span id="filter-status"></span></div>'
         '<div id="objective-space"></div><div id="pairs"></div>'

@@ -94,4 +94,4 @@ def chain_explorer(result: ChainResult, workspace: CubeWorkspace, bound_sets, ge
             "eq. 7.1-7.4, Table 7.5)")
     return explorer_table(TITLE, "rcube optimize", "the modified R-CUBE (seed 001)", variables, objectives,
                           constraints, records, front, {"position": selection.selected, "rule": rule}, designs,
-                          front_file=FRONT_FILE)
+                          front_file=FRONT_FILE, evaluations_file=None)
