@@ -85,9 +85,10 @@ def _errors(driver) -> list[dict]:
 
 
 def _card(driver) -> dict[str, float]:
+    """The card's variables, objectives and constrained values by name (not its spec summary, data-kind spec)."""
     cells = driver.execute_script(
-        "return Array.from(document.querySelectorAll('#design-card [data-name]')).map(function (e) {"
-        " return [e.getAttribute('data-name'), e.getAttribute('data-value')]; })")
+        "return Array.from(document.querySelectorAll('#design-card [data-name]:not([data-kind=spec])'))"
+        ".map(function (e) { return [e.getAttribute('data-name'), e.getAttribute('data-value')]; })")
     return {name: float(value) if value else math.nan for name, value in cells}
 
 
@@ -121,6 +122,7 @@ def test_served_the_page_gets_the_card_of_a_design_off_the_front(gl_browser, stu
         expected = {k: float(v) if v else math.nan for k, v in row.items()
                     if k not in ("evaluation", "generation", "feasible", "reason")}
         assert _card(gl_browser) == expected
+        assert gl_browser.find_elements("id", "card-spec")  # its spec summary too (tests/optimization/test_explore.py)
         requested = _requested(gl_browser)
         assert f"{origin}/api/card?evaluation={row['evaluation']}" in requested
         assert all(url.startswith((origin, "data:", "blob:")) for url in requested), requested
