@@ -167,6 +167,8 @@ def test_a_page_of_100000_evaluations_opens_and_says_how_many_it_shows(gl_browse
     passing = state["passing"]  # the embedded designs, by their evaluation numbers: rows of evaluations.csv
     assert len(passing) == front + EMBEDDED_LIMIT and passing == sorted(set(passing)) and passing[-1] <= count
     assert gl_browser.execute_script("return document.querySelectorAll('#objective-space .gl-container').length") > 0
+    # Plotly drew them (its WebGL traces compile functions: the page's policy allows it, else it shows this note)
+    assert "WebGL is not supported" not in gl_browser.find_element("id", "objective-space").text
     # a brush on the first parallel axis filters the 20,000 and more designs
     from selenium.webdriver.common.action_chains import ActionChains
 

@@ -216,10 +216,12 @@ def _explorer(data: dict) -> tuple[str, str, str]:
     """The explorer's section, its scripts (the data, Plotly.js, the explorer's own) and the page's policy: the
     inline script by its hash, Plotly.js from the page's folder (a ``file:`` address, or the server's own when
     ``hapticdesign explore`` serves the folder, which also answers the cards: ``connect-src 'self'``), no other
-    network."""
+    network. ``'unsafe-eval'`` lets those two scripts build functions from their own text: Plotly's WebGL traces (the
+    large scatter plots, ``scattergl``) compile their drawing commands so and show "WebGL is not supported" without it;
+    no inline script or handler runs (a user string in the page stays text)."""
     code = _explorer_script()
     digest = base64.b64encode(hashlib.sha256(code.encode("utf-8")).digest()).decode("ascii")
-    policy = (f"default-src 'none'; script-src 'sha256-{digest}' file: 'self'; connect-src 'self'; "
+    policy = (f"default-src 'none'; script-src 'sha256-{digest}' 'unsafe-eval' file: 'self'; connect-src 'self'; "
               "style-src 'unsafe-inline'; img-src data: blob:; font-src data:")
     shown, count = len(data["evaluations"]["evaluation"]), data["count"]
     section = (
