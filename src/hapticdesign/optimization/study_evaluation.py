@@ -15,7 +15,6 @@ import copy
 import json
 import math
 from collections.abc import Iterable, Mapping, Sequence
-from pathlib import Path
 
 import numpy as np
 import yaml
@@ -31,7 +30,7 @@ from hapticdesign.analysis.view.skeleton import home_pose
 from hapticdesign.analysis.workspace import Workspace, WorkspacePoses, reach_workspace
 from hapticdesign.devices.design_space import DesignSpace
 from hapticdesign.errors import UserError
-from hapticdesign.files import parse_structured, quote
+from hapticdesign.files import parse_structured, quote, structured_kind
 from hapticdesign.model.device import Device
 from hapticdesign.optimization.study_file import Choice, IndexConstraint, Study
 from hapticdesign.optimization.study_outputs import index_maps
@@ -77,10 +76,6 @@ def workspace_of(study: Study) -> Workspace | None:
         raise UserError(f"{study.path}: {exc}") from None
 
 
-def _kind(path: Path) -> str:
-    return {".yml": "yaml", ".yaml": "yaml", ".toml": "toml", ".json": "json"}.get(path.suffix.lower(), "")
-
-
 class BoundStudy:
     """A study with its device file's design space, its workspace points and its index names checked."""
 
@@ -89,7 +84,7 @@ class BoundStudy:
         self.registry = registry
         """The indices the study may name."""
         spec = study.spec
-        kind = _kind(study.device_path)
+        kind = structured_kind(study.device_path)
         if not kind:
             raise UserError(f"{study.path}: device {study.device_path.name!r} must be a device file (.yaml, .yml, "
                             ".toml or .json)")
@@ -339,14 +334,15 @@ class BoundStudy:
             v.write(data, float(values[v.name]))
         return data
 
-    def device_file_text(self, values: dict[str, float], comments: Sequence[str] = ()) -> str:
+    def device_file_text(self, values: dict[str, float], comments: Sequence[str] = (), evaluated: bool = True) -> str:
         """:meth:`device_mapping` as YAML, headed by where it comes from, the ``comments`` lines (the device file's
-        design beside it) and where the study evaluated it (:meth:`where_evaluated`)."""
+        design beside it) and, with ``evaluated``, where the study evaluated it (:meth:`where_evaluated`; a design the
+        device file refuses has no such lines, and the comments say why)."""
         shown = ", ".join(f"{k} = {v!r}" for k, v in values.items())
         names = (json.dumps(self.study.path.name), json.dumps(self.study.device_path.name))  # no line break in them
         header = f"# The design selected by study {names[0]} from device file {names[1]}:\n# {shown}\n"
         lines = "".join(f"# {' '.join(line.splitlines())}\n" for line in comments)  # a reason's line break stays a comment
-        return (header + lines + self.where_evaluated(values)
+        return (header + lines + (self.where_evaluated(values) if evaluated else "")
                 + yaml.safe_dump(self.device_mapping(values), sort_keys=False, allow_unicode=False))
 
     def _at_points(self, values: dict[str, float]) -> tuple[Device, WorkspacePoses | None, dict | None]:

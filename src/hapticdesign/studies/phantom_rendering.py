@@ -28,6 +28,7 @@ from hapticdesign.simulation.impedance import Criteria, impedance_range, type_pa
 from hapticdesign.simulation.loop import simulate
 from hapticdesign.simulation.paths import Chirp
 from hapticdesign.simulation.transparency import transparency
+from hapticdesign.studies.phantom_explorer import campaign_explorer
 from hapticdesign.studies.plots import plt
 from hapticdesign.studies.seed_reference import (
     AGREEMENT,
@@ -206,7 +207,8 @@ def campaign(ctx: Context) -> Outcome:
     designs_csv = ctx.shared.get("designs_csv")
     if designs_csv is None:
         raise NotAvailable("this campaign runs over the design sets, whose step did not finish")
-    return _campaign(ctx, designs_csv, "the design sets of the design-set step (every design a realizable rigid body)")
+    return _campaign(ctx, designs_csv, "the design sets of the design-set step (every design a realizable rigid body)",
+                     explore=True)
 
 
 def campaign_appendix_c(ctx: Context) -> Outcome:
@@ -219,8 +221,10 @@ def campaign_appendix_c(ctx: Context) -> Outcome:
                                        "one breaks the triangle inequality in some link")
 
 
-def _campaign(ctx: Context, designs_csv: Path, source: str) -> Outcome:
-    """Run (or resume) a campaign and lay its results beside Tables 4.4, 4.6 and Figures 4.9-4.11, 4.18-4.21."""
+def _campaign(ctx: Context, designs_csv: Path, source: str, explore: bool = False) -> Outcome:
+    """Run (or resume) a campaign and lay its results beside Tables 4.4, 4.6 and Figures 4.9-4.11, 4.18-4.21; with
+    ``explore``, its designs in the design explorer too (:func:`~hapticdesign.studies.phantom_explorer.
+    campaign_explorer`)."""
     s = ctx.settings
     digest = hashlib.sha1(Path(designs_csv).read_bytes()).hexdigest()[:12]
     out = ctx.work_dir / f"campaign_{digest}"  # a rerun with the same designs resumes; other designs start afresh
@@ -232,7 +236,8 @@ def _campaign(ctx: Context, designs_csv: Path, source: str) -> Outcome:
         except RuntimeError:  # a local Dask worker that failed to start (seen under heavy load): resume once
             counts = run_campaign(designs_csv, out, options, workers=s.workers, progress=ctx.update, quiet=True)
         designs = read_designs(designs_csv, s.preset)
-    summary = summarize(designs, load_cases(designs, out), options)
+    cases = load_cases(designs, out)
+    summary = summarize(designs, cases, options)
     tables = [_side_by_side(summary, "impedance", TABLE_4_4, "Table 4.4", "N m/rad"),
               _side_by_side(summary, "transparency", TABLE_4_6, "Table 4.6", "Hz"),
               _agreement(summary)]
@@ -256,6 +261,7 @@ def _campaign(ctx: Context, designs_csv: Path, source: str) -> Outcome:
         numbers={"designs": len(designs), "cases": counts["cases"],
                  "agreement_level0": {r["criterion"]: r["agreement_share"] for r in zero if r["type"] == 1},
                  "summary": summary},
+        explorer=campaign_explorer(designs, cases, s.preset) if explore else None,
     )
 
 

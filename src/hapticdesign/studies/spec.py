@@ -263,6 +263,39 @@ def spec_sheet(device: Device, q=None, loop: SampledLoop | None = None, workspac
     return sheet
 
 
+SUMMARY = (
+    ("force_continuous", "continuous force (largest ball in the force polytope)", "N"),
+    ("force_peak", "peak force (largest ball in the force polytope)", "N"),
+    ("resolution", "resolution (one motor count at the handle, the largest)", "m"),
+    ("apparent_mass.min", "apparent mass, lightest direction", "kg"),
+    ("apparent_mass.max", "apparent mass, heaviest direction", "kg"),
+    ("renderable_stiffness.exact", "renderable wall, exact limit (worst direction)", "N/m"),
+    ("renderable_stiffness.exact_with_hand", "renderable wall with the hand, exact limit", "N/m"),
+)
+"""The spec sheet's headline numbers (:func:`spec_summary`): the name as a path into ``spec.json`` (``a.b`` is
+``sheet["a"]["b"]``), what it is, its unit."""
+
+
+def spec_summary(device: Device, q=None, loop: SampledLoop | None = None) -> list[dict]:
+    """The :data:`SUMMARY` rows of :func:`spec_sheet` at pose ``q`` (default: home) under ``loop`` (default: practice's,
+    :class:`SampledLoop`), computed by the sheet's own functions (the force polytope, the resolution, the apparent mass,
+    :func:`renderable` without its simulation) but without the workspace cube, the stiffness and the simulated limit,
+    so that it costs a fraction of the sheet: ``[{"name", "label", "value", "unit"}]`` in SI units, None where the
+    device file lacks what a row needs (motors' limits, encoders). A singular pose raises
+    :class:`~hapticdesign.errors.UserError` as the sheet does."""
+    loop = loop or SampledLoop()
+    q = configuration_of(device).home.copy() if q is None else np.asarray(q, dtype=float)
+    h = handle_at(device, q)
+    res = resolution(device, h)
+    mass = apparent_mass(device, h)
+    wall = renderable(device, h, loop, res, backdrive_friction(device, h), simulate=False)
+    values = {"force_continuous": inscribed_force(device, h, "continuous"),
+              "force_peak": inscribed_force(device, h, "peak"), "resolution": res,
+              "apparent_mass.min": mass[0], "apparent_mass.max": mass[1],
+              "renderable_stiffness.exact": wall["exact"], "renderable_stiffness.exact_with_hand": wall["exact_with_hand"]}
+    return [{"name": name, "label": label, "value": values[name], "unit": unit} for name, label, unit in SUMMARY]
+
+
 def _stiffness(device: Device, h: Handle) -> float | None:
     """The ``stiffness`` index where the file's links or joints are elastic, else None."""
     elasticity = device.elasticity

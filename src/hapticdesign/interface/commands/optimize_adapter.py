@@ -23,7 +23,7 @@ from hapticdesign.errors import RunWarning, UserError
 from hapticdesign.files import quote, write_atomically
 from hapticdesign.interface.report.optimization_page import PLOTLY, Picture, plotly_js, render, render_failure
 from hapticdesign.optimization.study_evaluation import BoundStudy, bind_study, require_study_workload
-from hapticdesign.optimization.study_explorer import DESIGNS, explorer_data, front_designs
+from hapticdesign.optimization.study_explorer import DESIGNS, STUDY_COPY, explorer_data, front_designs, study_copy
 from hapticdesign.optimization.study_polish import most_designs
 from hapticdesign.optimization.study_file import Study, load_study
 from hapticdesign.optimization.study_methods import ConvexProgram, PopulationSearch, method_of, with_baseline
@@ -32,7 +32,8 @@ from hapticdesign.optimization.study_outputs import (Selection, baseline_lines, 
 from hapticdesign.optimization.study_run import Record, StudyRun
 
 FILES = ("front.csv", "evaluations.csv", "pareto.png", "pareto.svg", "selected.yaml", "report.html", PLOTLY,
-         f"{DESIGNS}/design-N.yaml (each front design's device file)")
+         f"{DESIGNS}/design-N.yaml (each front design's device file)",
+         f"{STUDY_COPY} (the study and device files as the run read them: hapticdesign explore reads it)")
 
 
 def parse_select(text: str) -> dict:
@@ -129,10 +130,13 @@ def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Select
     paths = [out / "front.csv", out / "evaluations.csv", *pareto_figure(run, selection, out, registry=bound.registry)]
     chosen = run.records[selection.record]
     write_atomically(out / "selected.yaml", bound.device_file_text(chosen.values, baseline_lines(run, chosen)))
+    write_atomically(out / STUDY_COPY, study_copy(bound.study))
     pictures = [Picture(png, caption) for png, caption in bound.pictures(chosen.values)]
     kept = (["checkpoint/ (one file per generation; a rerun into this folder continues)"]
             if method_of(run.spec).checkpointed else [])
-    designs = front_designs(run, bound)
+    from hapticdesign.studies.spec import spec_summary
+
+    designs = front_designs(run, bound, spec_summary)  # the spec summary on each card (docs/optimization.md)
     for design in designs:
         write_atomically(out / design.file, design.text)
     _remove_stale_designs(out, len(designs))
@@ -141,7 +145,7 @@ def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Select
                   [*FILES, *kept], explorer_data(run, bound, selection, designs), bound.coarseness,
                   bound.spread_rows(chosen.values), bound.units())
     write_atomically(out / "report.html", page)
-    return [*paths, out / "selected.yaml", *(out / d.file for d in designs), out / PLOTLY, out / "report.html"]
+    return [*paths, out / "selected.yaml", out / STUDY_COPY, *(out / d.file for d in designs), out / PLOTLY, out / "report.html"]
 
 
 def _remove_stale_designs(out: Path, count: int) -> None:
