@@ -21,6 +21,7 @@ from hapticdesign.analysis.metrics.indices import evaluate_designs, reduce, redu
 from hapticdesign.analysis.view.skeleton import home_pose, snapshot
 from hapticdesign.analysis.workspace import reach_workspace
 from hapticdesign.errors import UserError
+from hapticdesign.optimization.study_design_outputs import device_file_text
 from hapticdesign.optimization.study_evaluation import BoundStudy, workspace_of
 from hapticdesign.optimization.study_file import Choice, IndexConstraint
 from hapticdesign.optimization.study_outputs import Selection, baseline_lines
@@ -128,8 +129,8 @@ def front_designs(run: StudyRun, bound: BoundStudy) -> list[FrontDesign]:
                 named = r.index + (json.dumps(r.options, sort_keys=True) if r.options else "")
                 maps[named] = {"index": r.index, "unit": _unit(bound.registry[r.index].unit),
                                "values": [_number(v) for v in got], "reductions": reductions}
-        text = bound.device_file_text(record.values, [f"Front design {n} of the study's report (report.html)",
-                                                      *baseline_lines(run, record)])
+        text = device_file_text(bound, record.values, [f"Front design {n} of the study's report (report.html)",
+                                                       *baseline_lines(run, record)])
         out.append(FrontDesign(file, text, maps, picture, commands))
     return out
 
