@@ -31,9 +31,9 @@ from hapticdesign.devices.design_space import design_space
 from hapticdesign.devices.device_file import load_device_file
 from hapticdesign.errors import UserError
 from hapticdesign.interface.cli import app
+from hapticdesign.optimization.pymoo_run import NSGA_II
 from hapticdesign.optimization.study_evaluation import bind_study
 from hapticdesign.optimization.study_evaluator import StudyEvaluator
-from hapticdesign.optimization.pymoo_run import NSGA_II
 from hapticdesign.optimization.study_file import load_study
 from hapticdesign.optimization.study_run import run_study
 

@@ -246,6 +246,7 @@ def test_every_documented_method_is_reachable_from_a_study_file():
         method = method_of(spec)
         assert method.name == name == spec.algorithm.method
         assert getattr(method, "title", None) == title and method.checkpointed is checkpointed
+        assert type(spec.algorithm) is method.settings  # the record carries the settings the file is read into
     assert method_of(study_from_mapping(base)).name == "nsga2"
 
 
