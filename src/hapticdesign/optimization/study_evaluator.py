@@ -7,9 +7,10 @@ that misses a workspace point, has no values and says why.
 
 Batches go through one hook, pymoo's element-wise runner
 (:func:`~hapticdesign.optimization.pymoo_run.elementwise_runner`): in this process a batch is one piece of work; with
-the Dask client of ``optimize --scheduler`` it is cut into contiguous chunks, a few per worker, each sent with the study itself (its text and its device file's text, so a worker needs no
-file of the caller's machine); each worker binds the study once (kept per study fingerprint) and answers its chunks.
-The answers are gathered in the designs' order, so a run on a cluster gives the same numbers as a run here.
+the Dask client of ``optimize --scheduler`` it is cut into contiguous chunks, a few per worker, each sent with the
+study itself (its text and its device file's text, so a worker needs no file of the caller's machine); each worker
+binds the study once (kept per study fingerprint) and answers its chunks. The answers are gathered in the designs'
+order, so a run on a cluster gives the same numbers as a run here.
 """
 
 from __future__ import annotations

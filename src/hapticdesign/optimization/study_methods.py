@@ -62,7 +62,7 @@ class PopulationSearch:
         ``evaluate`` answers batches of designs (:class:`~.study_evaluator.StudyEvaluator` in this process by
         default), ``out`` keeps the checkpoint, ``progress(generation, generations)``."""
         if not self.algorithm.genetic and Encoding.of(bound.study.spec).discrete:
-            genetic = ", ".join(m.name for m in METHODS.values() if getattr(m, "algorithm", None) and m.algorithm.genetic)
+            genetic = ", ".join(m.name for m in METHODS.values() if m.algorithm is not None and m.algorithm.genetic)
             raise UserError(f"variables that are discrete choices need a genetic method ({genetic}), not {self.name}")
         here = StudyEvaluator(bound)
         evaluate = evaluate or here
@@ -142,10 +142,11 @@ def _kept_none(run: StudyRun, feasible: list) -> UserError:
 
 @dataclass(frozen=True)
 class ConvexProgram:
-    """Seed 000's LN minimization as one exact convex program (:mod:`.study_convex`): one design, no generations, no
-    pymoo algorithm."""
+    """Seed 000's LN minimization as one exact convex program (:mod:`.study_convex`): one design, no generations."""
 
     settings: type[Convex] = Convex
+    algorithm: None = None
+    """No pymoo algorithm: the program is solved at once."""
     checkpointed = False
     evaluates_designs = False
 
