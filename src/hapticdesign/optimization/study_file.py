@@ -4,8 +4,8 @@ A study names a device file (relative to the study file), the ``variables`` the 
 (continuous bounds ``[low, high]`` or a discrete choice ``{values: [...]}``), the ``workspace`` the handle
 must reach (a box and a grid), the ``objectives`` (an index reduced over the workspace and a sense), the
 ``constraints`` (an index or an affine expression of the variables, bounded by ``<=`` and/or ``>=``) and
-the ``algorithm`` (one record per method, :data:`AlgorithmSettings`: NSGA-II, NSGA-III or particle swarm, population and
-generations; or ``convex``, seed 000's exact LN minimization over inertial parameters, which needs no workspace).
+the ``algorithm`` (one record per method, :data:`AlgorithmSettings`: NSGA-II, NSGA-III or particle swarm, population
+and generations; or ``convex``, seed 000's exact LN minimization over inertial parameters, which needs no workspace).
 Everything is checked here with one-line messages naming the field; the names of variables and indices are
 checked against the device and the index registry when the study is bound to them (:mod:`.study_run`).
 

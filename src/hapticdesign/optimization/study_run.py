@@ -406,9 +406,9 @@ def run_study(study: Study, seed: int, evaluate: Evaluator, out: Path | None = N
     ``evaluate_constraints`` answers the constraints of ``algorithm.start``'s minimization (``evaluate`` by default).
 
     Each run ``k`` of ``algorithm.runs`` (one run without them) is the population search over its bounds seeded
-    ``seed + k``; with
-    ``algorithm.start``, the minimized design joins the first population of every run whose bounds hold it, the
-    rest of that population drawn uniformly with the run's seed (pymoo's own seeded sampling otherwise)."""
+    ``seed + k``; with ``algorithm.start``, the minimized design joins the first population of every run whose bounds
+    hold it, the rest of that population drawn uniformly with the run's seed (pymoo's own seeded sampling
+    otherwise)."""
     if seed < 0:
         raise UserError(f"the seed must be at least 0, got {seed}")
     spec = study.spec
