@@ -1,6 +1,6 @@
 """A study bound to its device file and the index registry: the parsed device file, its design space and the plan of
-index requests (the answers for a batch of designs: :mod:`.study_evaluator`; a design's files and pictures:
-:mod:`.study_design_outputs`).
+index requests (the answers for a batch of designs: :mod:`.study_evaluator`; a design's device file, spread and
+pictures: :mod:`.study_outputs`).
 
 :func:`bind_study` checks what the study file alone cannot: every variable is one the device file has
 (:class:`~hapticdesign.devices.design_space.DesignSpace`), every index is registered

@@ -21,10 +21,9 @@ from hapticdesign.analysis.metrics.indices import evaluate_designs, reduce, redu
 from hapticdesign.analysis.view.skeleton import home_pose, snapshot
 from hapticdesign.analysis.workspace import reach_workspace
 from hapticdesign.errors import UserError
-from hapticdesign.optimization.study_design_outputs import device_file_text
 from hapticdesign.optimization.study_evaluation import BoundStudy, workspace_of
 from hapticdesign.optimization.study_file import Choice, IndexConstraint
-from hapticdesign.optimization.study_outputs import Selection, baseline_lines
+from hapticdesign.optimization.study_outputs import Selection, baseline_lines, device_file_text
 from hapticdesign.optimization.study_run import Record, StudyRun
 
 DESIGNS = "designs"

@@ -22,15 +22,15 @@ from hapticdesign.analysis.metrics.indices import Index
 from hapticdesign.errors import RunWarning, UserError
 from hapticdesign.files import quote, write_atomically
 from hapticdesign.interface.report.optimization_page import PLOTLY, Picture, plotly_js, render, render_failure
-from hapticdesign.optimization.study_design_outputs import device_file_text, pictures, spread_rows
 from hapticdesign.optimization.study_evaluation import BoundStudy, bind_study, require_study_workload
 from hapticdesign.optimization.study_evaluator import StudyEvaluator, unmeetable_walls
 from hapticdesign.optimization.study_explorer import DESIGNS, explorer_data, front_designs
 from hapticdesign.optimization.study_polish import most_designs
 from hapticdesign.optimization.study_file import Study, load_study
 from hapticdesign.optimization.study_methods import ConvexProgram, PopulationSearch, method_of, with_baseline
-from hapticdesign.optimization.study_outputs import (Selection, baseline_lines, check_selection, evaluations_csv,
-                                                     front_csv, pareto_figure, select_design)
+from hapticdesign.optimization.study_outputs import (Selection, baseline_lines, check_selection, device_file_text,
+                                                     evaluations_csv, front_csv, pareto_figure, pictures, select_design,
+                                                     spread_rows)
 from hapticdesign.optimization.study_run import Record, StudyRun
 
 FILES = ("front.csv", "evaluations.csv", "pareto.png", "pareto.svg", "selected.yaml", "report.html", PLOTLY,
