@@ -18,8 +18,7 @@ import time
 from pathlib import Path
 
 from hapticdesign.devices.loading import load_device
-from hapticdesign.optimization.study_evaluation import bind_study
-from hapticdesign.optimization.study_evaluator import StudyEvaluator
+from hapticdesign.optimization.study_evaluation import StudyEvaluator, bind_study
 from hapticdesign.optimization.study_file import load_study
 from hapticdesign.studies.spec import spec_sheet
 

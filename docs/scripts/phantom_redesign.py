@@ -38,8 +38,7 @@ from hapticdesign.analysis.metrics.indices import Request, reduce  # noqa: E402
 from hapticdesign.analysis.workspace import Workspace, reach_workspace  # noqa: E402
 from hapticdesign.devices.device_file import load_device_file  # noqa: E402
 from hapticdesign.errors import UserError  # noqa: E402
-from hapticdesign.optimization.study_evaluation import bind_study  # noqa: E402
-from hapticdesign.optimization.study_evaluator import StudyEvaluator  # noqa: E402
+from hapticdesign.optimization.study_evaluation import StudyEvaluator, bind_study  # noqa: E402
 from hapticdesign.optimization.study_file import load_study  # noqa: E402
 from hapticdesign.optimization.study_outputs import without_unit  # noqa: E402
 from hapticdesign.analysis.metrics.indices import evaluate  # noqa: E402

@@ -26,8 +26,7 @@ from typer.testing import CliRunner
 from hapticdesign.analysis.metrics.indices import reduce, reduced_at, reduction_label, spread
 from hapticdesign.errors import UserError
 from hapticdesign.interface.cli import app
-from hapticdesign.optimization.study_evaluation import bind_study
-from hapticdesign.optimization.study_evaluator import StudyEvaluator
+from hapticdesign.optimization.study_evaluation import StudyEvaluator, bind_study
 from hapticdesign.optimization.study_file import load_study
 from hapticdesign.optimization.study_outputs import spread_rows, where_evaluated
 from tests.helpers.phantom_premium_ik import closed_form

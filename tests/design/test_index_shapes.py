@@ -24,8 +24,7 @@ from hapticdesign.analysis.workspace import Workspace
 from hapticdesign.devices.design_space import design_space
 from hapticdesign.errors import UserError
 from hapticdesign.interface.cli import app
-from hapticdesign.optimization.study_evaluation import bind_study
-from hapticdesign.optimization.study_evaluator import StudyEvaluator
+from hapticdesign.optimization.study_evaluation import StudyEvaluator, bind_study
 from hapticdesign.optimization.study_file import load_study
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -32,8 +32,7 @@ from hapticdesign.devices.device_file import load_device_file
 from hapticdesign.errors import UserError
 from hapticdesign.interface.cli import app
 from hapticdesign.optimization.pymoo_run import NSGA_II
-from hapticdesign.optimization.study_evaluation import bind_study
-from hapticdesign.optimization.study_evaluator import StudyEvaluator
+from hapticdesign.optimization.study_evaluation import StudyEvaluator, bind_study
 from hapticdesign.optimization.study_file import load_study
 from hapticdesign.optimization.study_run import run_study
 

@@ -12,8 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from hapticdesign.optimization.study_evaluation import bind_study
-from hapticdesign.optimization.study_evaluator import StudyEvaluator
+from hapticdesign.optimization.study_evaluation import StudyEvaluator, bind_study
 from hapticdesign.optimization.study_file import load_study
 from hapticdesign.optimization.study_outputs import without_unit
 

@@ -13,8 +13,7 @@ import numpy as np
 import pytest
 
 from hapticdesign.optimization.pymoo_run import NSGA_II
-from hapticdesign.optimization.study_evaluation import bind_study
-from hapticdesign.optimization.study_evaluator import StudyEvaluator
+from hapticdesign.optimization.study_evaluation import StudyEvaluator, bind_study
 from hapticdesign.optimization.study_file import load_study, study_from_mapping
 from hapticdesign.optimization.study_run import feasibility, run_study
 from tests.optimization.test_study_run import ISOTROPY, MASS, write_study
@@ -67,3 +66,16 @@ def test_every_record_is_feasible_exactly_when_its_values_meet_the_bounds_by_han
         assert r.feasible == (by_hand and all(np.isfinite(r.objectives))), r
         kinds.add(by_hand)
     assert kinds == {True, False}  # the run holds both kinds
+
+
+def test_the_bound_study_still_answers_for_a_release_and_says_so(tmp_path):
+    """``bind_study(study).evaluate`` and ``.evaluate_constraints`` (docs/optimization.md before the evaluator had a
+    class of its own) warn once per call and give the evaluator's answers."""
+    path = write_study(tmp_path, {"l1": [0.1, 0.3], "l2": [0.05, 0.3]}, [ISOTROPY], 4, 1)
+    bound = bind_study(load_study(path))
+    batch = [{"l1": 0.2, "l2": 0.14}, {"l1": 0.1, "l2": 0.05}]
+    with pytest.warns(FutureWarning, match="StudyEvaluator"):
+        old = bound.evaluate(batch)
+    with pytest.warns(FutureWarning, match="StudyEvaluator"):
+        constraints = bound.evaluate_constraints(batch)
+    assert old == StudyEvaluator(bound)(batch) and constraints == StudyEvaluator(bound).constraints(batch)

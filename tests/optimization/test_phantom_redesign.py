@@ -26,8 +26,7 @@ from typer.testing import CliRunner
 from hapticdesign.analysis.metrics.indices import Request, reduce
 from hapticdesign.devices.device_file import load_device_file
 from hapticdesign.interface.cli import app
-from hapticdesign.optimization.study_evaluation import bind_study
-from hapticdesign.optimization.study_evaluator import StudyEvaluator
+from hapticdesign.optimization.study_evaluation import StudyEvaluator, bind_study
 from hapticdesign.optimization.study_file import load_study
 from hapticdesign.optimization.study_outputs import without_unit
 from hapticdesign.analysis.metrics.indices import evaluate

@@ -55,10 +55,20 @@ def test_spec_is_checked():
         AlgorithmSpec(population=1)
     with pytest.raises(UserError, match="generations"):
         AlgorithmSpec(generations=0)
+    with pytest.raises(UserError, match="method"):
+        AlgorithmSpec("simplex")
     with pytest.raises(UserError, match="integer variables and discrete choices need a genetic algorithm, not pso"):
         AlgorithmSpec(PARTICLE_SWARM, integer=True)
     with pytest.raises(UserError, match="discrete choices need a genetic algorithm"):
         AlgorithmSpec(PARTICLE_SWARM, discrete=(0,))
+
+
+def test_a_method_named_as_before_still_runs_for_a_release_and_says_so():
+    with pytest.warns(FutureWarning, match="deprecated"):
+        spec = AlgorithmSpec("pso", population=10, generations=3)
+    assert spec.algorithm is PARTICLE_SWARM
+    with pytest.warns(FutureWarning), pytest.raises(UserError, match="integer"):
+        AlgorithmSpec("pso", integer=True)
 
 
 def test_row_objective_matches_direct_evaluation():

@@ -19,8 +19,7 @@ from hapticdesign.interface.cli import app
 from hapticdesign.optimization.formula import formula
 from hapticdesign.optimization.rcube.shortest import constrained_minimum
 from hapticdesign.optimization.pymoo_run import NSGA_II
-from hapticdesign.optimization.study_evaluation import bind_study
-from hapticdesign.optimization.study_evaluator import StudyEvaluator
+from hapticdesign.optimization.study_evaluation import StudyEvaluator, bind_study
 from hapticdesign.optimization.study_file import load_study
 from hapticdesign.optimization.study_outputs import front_csv
 from hapticdesign.optimization.study_run import run_study

@@ -30,8 +30,7 @@ from typer.testing import CliRunner
 import hapticdesign as hd
 from hapticdesign.errors import UserError
 from hapticdesign.interface.cli import app
-from hapticdesign.optimization.study_evaluation import STUDY_LIMIT, bind_study, require_study_workload
-from hapticdesign.optimization.study_evaluator import StudyEvaluator
+from hapticdesign.optimization.study_evaluation import STUDY_LIMIT, StudyEvaluator, bind_study, require_study_workload
 from hapticdesign.optimization.study_file import load_study, study_from_mapping
 from hapticdesign.optimization.study_methods import METHODS, method_of
 from hapticdesign.optimization.study_outputs import evaluations_csv, front_csv

@@ -11,12 +11,13 @@ numbers), and the final population comes back as a plain :class:`RunResult` whos
 Work that may go to a Dask cluster goes through one hook, pymoo's element-wise runner (:func:`elementwise_runner`): a
 plain loop by default, or the workers of a Dask client that the caller passes (none is started here). Expensive
 objectives of one design vector are a :class:`RowObjective`, pymoo's ``ElementwiseProblem``, whose rows go through it;
-a study's batches of designs go through it too (:mod:`~hapticdesign.optimization.study_evaluator`).
+a study's batches of designs go through it too (:mod:`~hapticdesign.optimization.study_evaluation`).
 """
 
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -78,6 +79,14 @@ class AlgorithmSpec:
     partitions: int | None = None
 
     def __post_init__(self) -> None:
+        if isinstance(self.algorithm, str):  # a name of the former table ALGORITHMS, kept one release
+            named = {a.name: a for a in (NSGA_II, NSGA_III, PARTICLE_SWARM)}
+            if self.algorithm not in named:
+                raise UserError(f"unknown optimization method {self.algorithm!r}; choose one of {', '.join(named)}")
+            warnings.warn(f"AlgorithmSpec({self.algorithm!r}): a method's name is deprecated; pass pymoo's algorithm "
+                          "(hapticdesign.optimization.pymoo_run.NSGA_II, NSGA_III or PARTICLE_SWARM)", FutureWarning,
+                          stacklevel=3)
+            object.__setattr__(self, "algorithm", named[self.algorithm])
         if (self.integer or self.discrete) and not self.algorithm.genetic:
             raise UserError("integer variables and discrete choices need a genetic algorithm, not "
                             f"{self.algorithm.name}")

@@ -24,8 +24,7 @@ import numpy as np
 from hapticdesign.errors import UserError
 from hapticdesign.optimization.pymoo_run import NSGA_II, NSGA_III, PARTICLE_SWARM, PymooAlgorithm
 from hapticdesign.optimization.study_convex import ln_of, run_convex
-from hapticdesign.optimization.study_evaluation import BoundStudy
-from hapticdesign.optimization.study_evaluator import StudyEvaluator, points_reached
+from hapticdesign.optimization.study_evaluation import BoundStudy, StudyEvaluator, points_reached
 from hapticdesign.optimization.study_file import Convex, Nsga2, Nsga3, Pso, StudySpec, method_name
 from hapticdesign.optimization.study_polish import polish
 from hapticdesign.optimization.study_run import Answer, Encoding, Evaluator, StudyRun, record_of, run_study
@@ -59,7 +58,7 @@ class PopulationSearch:
     def run(self, bound: BoundStudy, seed: int, evaluate: Evaluator | None = None, out: Path | None = None,
             progress: Progress | None = None) -> StudyRun:
         """The search seeded ``seed`` (:func:`~hapticdesign.optimization.study_run.run_study`), its front polished;
-        ``evaluate`` answers batches of designs (:class:`~.study_evaluator.StudyEvaluator` in this process by
+        ``evaluate`` answers batches of designs (:class:`~.study_evaluation.StudyEvaluator` in this process by
         default), ``out`` keeps the checkpoint, ``progress(generation, generations)``."""
         if not self.algorithm.genetic and Encoding.of(bound.study.spec).discrete:
             genetic = ", ".join(m.name for m in METHODS.values() if m.algorithm is not None and m.algorithm.genetic)

@@ -2,7 +2,7 @@
 
 The study's variables become pymoo's design vector: a continuous variable its value, a discrete one the
 index of its choice (a whole number, :class:`~hapticdesign.optimization.pymoo_run.RoundColumns`). Each
-generation's designs go to an evaluator in one batch (in this process or on a Dask cluster, :mod:`.study_evaluator`),
+generation's designs go to an evaluator in one batch (in this process or on a Dask cluster, :mod:`.study_evaluation`),
 which answers every reduced index the study reads, or why the design has none (a workspace point out of
 reach, an invalid device). Objectives enter pymoo as minimized values (a maximized one negated);
 constraints as ``g <= 0`` scaled by their bound, plus one column that is 1 for a design without values

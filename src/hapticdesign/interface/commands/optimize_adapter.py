@@ -22,8 +22,8 @@ from hapticdesign.analysis.metrics.indices import Index
 from hapticdesign.errors import RunWarning, UserError
 from hapticdesign.files import quote, write_atomically
 from hapticdesign.interface.report.optimization_page import PLOTLY, Picture, plotly_js, render, render_failure
-from hapticdesign.optimization.study_evaluation import BoundStudy, bind_study, require_study_workload
-from hapticdesign.optimization.study_evaluator import StudyEvaluator, unmeetable_walls
+from hapticdesign.optimization.study_evaluation import (BoundStudy, StudyEvaluator, bind_study, require_study_workload,
+                                                        unmeetable_walls)
 from hapticdesign.optimization.study_explorer import DESIGNS, explorer_data, front_designs
 from hapticdesign.optimization.study_polish import most_designs
 from hapticdesign.optimization.study_file import Study, load_study
@@ -235,7 +235,7 @@ def optimize(study: Path | str, seed: int = 1, out: Path | str | None = None, *,
     indices (functions decorated with :func:`hapticdesign.index`, or a Python file defining them, run in this
     process), which the study may name beside the registered ones. Nothing is printed on stdout; a bad study, seed or
     selection raises :class:`~hapticdesign.errors.UserError`; a ``kmax`` constraint that no design can meet, known
-    before the run (:func:`~hapticdesign.optimization.study_evaluator.unmeetable_walls`), is a
+    before the run (:func:`~hapticdesign.optimization.study_evaluation.unmeetable_walls`), is a
     :class:`~hapticdesign.errors.RunWarning` before the run starts. The device file's own design is evaluated beside
     the run (:func:`~hapticdesign.optimization.study_methods.with_baseline`); a run without a feasible design
     writes evaluations.csv and report.html to ``out`` before its UserError."""
