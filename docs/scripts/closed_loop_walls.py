@@ -55,7 +55,7 @@ def main() -> None:
         w = CARTESIAN_JOINT[name]
         v = configuration_of(device).jacobian(home)[:3, w]
         n = v / np.linalg.norm(v)
-        j_nw = float(normal_jacobian(device, Wall(w, 1.0, 0.0, 0.0, direction=tuple(n)), home)[w])
+        j_nw = float(normal_jacobian(device, Wall(w, 1.0, equilibrium=0.0, direction=tuple(n)), home)[w])
         h_ww = float(hd.mass_matrix(device, home)[w, w])
         limit = device.damping[w] ** 2 / h_ww / j_nw ** 2
         found = [hd.impedance_range(device, 1, method=m, wall_joint=w, resolution=limit / 10, k_limit=20,

@@ -181,12 +181,16 @@ def parse_structured(text: str, kind: str, where: str) -> object:
     return data
 
 
+def structured_kind(path: Path | str) -> str:
+    """The kind of data file :func:`parse_structured` reads by ``path``'s suffix (json, yaml or toml), "" for another."""
+    return {".json": "json", ".yaml": "yaml", ".yml": "yaml", ".toml": "toml"}.get(Path(path).suffix.lower(), "")
+
+
 def load_structured(path: Path | str, what: str = "file") -> object:
     """Read and parse a JSON, YAML or TOML file chosen by its suffix."""
     path = Path(path)
-    kinds = {".json": "json", ".yaml": "yaml", ".yml": "yaml", ".toml": "toml"}
-    kind = kinds.get(path.suffix.lower())
-    if kind is None:
+    kind = structured_kind(path)
+    if not kind:
         raise UserError(f"{path}: unknown file type {quote(path.suffix)} (use .json, .yaml, .yml or .toml)")
     return parse_structured(read_text(path, what), kind, str(path))
 

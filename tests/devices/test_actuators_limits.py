@@ -344,7 +344,7 @@ def test_coupled_motor_in_the_simulation_equals_the_scipy_loop():
     from tests.helpers.reference import simulate_adaptive
 
     motors = load_device_file(EXAMPLES / "phantom-3dof-motors.yaml")
-    config = LoopConfig(duration=0.3, step=1e-5, wall=Wall(1, 20.0, 0.0, 0.01))
+    config = LoopConfig(duration=0.3, step=1e-5, wall=Wall(1, 20.0, equilibrium=0.01))
     paths = {0: type_paths(2, 3, 1)[0]}
     fast, slow = simulate(motors, config, paths), simulate_adaptive(motors, config, paths, rtol=1e-10, atol=1e-12)
     assert fast.status == slow.status == 0

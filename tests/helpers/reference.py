@@ -45,17 +45,20 @@ def simulate_adaptive(
     """Run the loop of :func:`~hapticdesign.simulation.loop.simulate` with SciPy's RK45."""
     n = device.n_dof
     sub = config.steps_per_sample()
-    period = config.sensors.period
+    loop = config.loop
+    period = loop.period
     paths = dict(paths or {})
     wall = config.wall
     if not 0 <= wall.joint < n:
         raise UserError(f"unknown joint {wall.joint + 1}; the device has joints 1..{n}")
-    comp = config.compensator
+    comp, full = config.compensator, loop.compensation == "full"
+    inertial, coriolis = comp.inertial and full, comp.coriolis and full
+    gravity_on = comp.gravity and loop.compensation != "none"
     pi_plant = device.standard_parameters()
-    pi_model = compensator_device(device, comp).standard_parameters()
+    pi_model = compensator_device(device, config).standard_parameters()
     damping = plant_damping(device, config)
-    quant = 0.0 if config.sensors.counts_per_revolution is None else 2 * np.pi / config.sensors.counts_per_revolution
-    delay = config.sensors.delay_samples
+    quant = 0.0 if config.counts is None else 2 * np.pi / config.counts
+    delay = loop.delay
     safety = math.inf if config.safety_limit is None else config.safety_limit
     stop = math.inf if config.stop_excursion is None else config.stop_excursion
     free = [j for j in range(n) if j not in paths]
@@ -70,7 +73,7 @@ def simulate_adaptive(
 
     q_start = np.zeros(n) if q0 is None else np.asarray(q0, dtype=float).copy()
     q_start[fixed] = path_at(0.0)[0][fixed]
-    hand_mass, hand_damping, hand_stiffness = hand_matrices(device, config.hand, q_start)
+    hand_mass, hand_damping, hand_stiffness = hand_matrices(device, loop.hand, q_start)
     damping = damping + hand_damping
     friction_map, friction = plant_friction(device, config)
 
@@ -117,10 +120,10 @@ def simulate_adaptive(
     def wall_torque(qs: np.ndarray, qds: np.ndarray) -> np.ndarray:
         tau = np.zeros(n)
         if direction is None:
-            tau[wall.joint] = wall.stiffness * (qs[wall.joint] - wall.equilibrium) + wall.damping * qds[wall.joint]
+            tau[wall.joint] = wall.stiffness * (qs[wall.joint] - wall.equilibrium) + loop.wall_damping * qds[wall.joint]
             return tau
         j_n = direction @ space.jacobian(qs)[:3]
-        return j_n * (wall.stiffness * (coordinate(qs) - rest) + wall.damping * (j_n @ qds))
+        return j_n * (wall.stiffness * (coordinate(qs) - rest) + loop.wall_damping * (j_n @ qds))
 
     reference = coordinate(q_start)
     rest = reference + wall.equilibrium
@@ -158,7 +161,7 @@ def simulate_adaptive(
         if quant > 0:
             qs = np.round(qs / quant) * quant
         h_m, c_m, g_m = _terms(device, pi_model, qs)
-        tau_f = comp.inertial * (h_m @ qdds) + comp.coriolis * (c_m @ (qds[j_] * qds[k_])) + comp.gravity * g_m
+        tau_f = inertial * (h_m @ qdds) + coriolis * (c_m @ (qds[j_] * qds[k_])) + gravity_on * g_m
         tau_imp = wall_torque(qs, qds)
         if tripped_at is not None:
             tau_f, tau_imp = np.zeros(n), np.zeros(n)

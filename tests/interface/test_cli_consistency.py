@@ -138,7 +138,7 @@ def _json_cases(tmp: Path) -> dict[tuple[str, ...], list]:
     }
 
 
-OWN_TESTS = {("campaign",), ("rcube", "maps")}  # checked below, with their files
+OWN_TESTS = {("campaign",), ("rcube", "maps"), ("explore",)}  # checked below or in their own tests (explore serves)
 
 
 @pytest.mark.parametrize("path", [p for p in COMMANDS if p not in SLOW | OWN_TESTS], ids=" ".join)
@@ -300,6 +300,7 @@ def _bad_inputs(tmp: Path) -> dict[tuple[str, ...], list]:
         ("study", "device"): ["--device", tmp / "missing.yaml", "--out", tmp / "s"],
         ("maps",): ["--device", RCUBE_FILE.parent / "five-bar.yaml", "--size", "0.1,0,0", "--out", tmp / "m"],
         ("optimize",): [tmp / "missing-study.yaml", "--out", tmp / "o"],
+        ("explore",): [a_file],
     }
 
 

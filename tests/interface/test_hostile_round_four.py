@@ -79,12 +79,13 @@ def test_the_analytic_criteria_estimate_their_loops_before_building_them():
     import numpy as np
 
     from hapticdesign.simulation.analytic import WallJoint, wall_loops
-    from hapticdesign.simulation.config import LoopConfig, Sensors
+    from hapticdesign.analysis.sampled_loop import SampledLoop
+    from hapticdesign.simulation.config import LoopConfig
     from hapticdesign.workload import WorkloadTooLarge
 
     wall = WallJoint(0.04, 0.5, np.array([1.0, 0.0, 0.0]), 0.0, 0.04, 0.0, 0.0, True)
     with pytest.raises(WorkloadTooLarge, match="order 3,003 .* above the limit of 600 rows"):
-        wall_loops([wall], LoopConfig(sensors=Sensors(delay_samples=1000)))
+        wall_loops([wall], LoopConfig(loop=SampledLoop.seed(delay=1000)))
 
 
 def test_the_default_damper_grid_stops_at_the_largest_damper():

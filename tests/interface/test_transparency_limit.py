@@ -70,9 +70,30 @@ def test_the_docs_quote_the_five_bar_limit(simulated_limit):
 def test_the_engine_gives_the_limit_and_says_where_the_linearization_does_not_decide(simulated_limit):
     """The search is the engine's (:func:`hapticdesign.simulation.transparency.stable_limit`), the command only
     reports it: the same limit from the API, None with encoder counts (a quantized loop is not linear)."""
-    from hapticdesign.simulation.config import LoopConfig, Sensors
+    from hapticdesign.simulation.config import LoopConfig
     from hapticdesign.simulation.transparency import stable_limit
 
     device = load_device_file(FIVE_BAR)
     assert stable_limit(device, 1, 0, LoopConfig()) == pytest.approx(simulated_limit, rel=2e-4)
-    assert stable_limit(device, 1, 0, LoopConfig(sensors=Sensors(counts_per_revolution=4096))) is None
+    assert stable_limit(device, 1, 0, LoopConfig(counts=4096)) is None
+
+
+def test_transparency_builds_the_one_loop_record_from_its_flags():
+    """``--compensation gravity`` is the loop's gravity-only compensation: the same run as the full compensation with
+    its inertial and Coriolis terms dropped (``--no-inertial --no-coriolis``); the hand's flags put the hand in the
+    loop as the Python API's ``SampledLoop.seed(hand=...)`` does (the analytic method, type 1, joint 1)."""
+    import hapticdesign as hd
+    from hapticdesign.analysis.sampled_loop import Hand, SampledLoop
+    from hapticdesign.simulation.config import LoopConfig
+    from hapticdesign.simulation.paths import Chirp
+
+    base = ["transparency", "--device", str(FIVE_BAR), "--method", "analytic", "--json"]
+    runs = [runner.invoke(app, [*base, *extra]) for extra in
+            (["--compensation", "gravity"], ["--no-inertial", "--no-coriolis"],
+             ["--hand-mass", "0.2", "--hand-damping", "2", "--hand-stiffness", "50"])]
+    assert [r.exit_code for r in runs] == [0, 0, 0], [r.output for r in runs]
+    gravity, dropped, hand = (json.loads(r.stdout) for r in runs)
+    assert gravity == dropped
+    api = hd.transparency(load_device_file(FIVE_BAR), 1, 4.0, Chirp(0.3, 0.1, 15.0, 10.0),
+                          LoopConfig(duration=10.0, loop=SampledLoop.seed(hand=Hand(0.2, 2.0, 50.0))), method="analytic")
+    assert hand["bandwidth_hz"] == api.bandwidth_hz is not None and hand["bandwidth_hz"] != gravity["bandwidth_hz"]

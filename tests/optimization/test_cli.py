@@ -42,7 +42,8 @@ def test_optimize_quick_json_and_files(tmp_path):
     for name in ("table_7_2_front.csv", "table_7_3_post_evaluation.csv", "table_7_5_weighted_rms.csv",
                  "cross_section_front.csv", "table_7_6_7_plies.csv", "table_7_8_final_design.csv",
                  "figure_7_1_frequency_vs_manipulability.png", "figure_7_3_weighted_rms.svg",
-                 "figure_7_4_cross_section.png", "pareto_front_synthesis.svg", "summary.json"):
+                 "figure_7_4_cross_section.png", "pareto_front_synthesis.svg", "summary.json", "report.html",
+                 "plotly.min.js"):
         assert (tmp_path / name).exists(), name
     rows = (tmp_path / "table_7_2_front.csv").read_text().strip().splitlines()
     assert len(rows) == summary["front_size"] + 1

@@ -70,10 +70,12 @@ def _console(driver) -> list[dict]:
     return [e for e in driver.get_log("browser") if e["level"] in ("SEVERE", "WARNING")]
 
 
-def _card(driver) -> dict[str, float]:
+def _card(driver, kind: str = ":not([data-kind=spec])") -> dict[str, float]:
+    """The card's numbers by name: its variables, objectives and constrained values (``kind="[data-kind=spec]"``: its
+    spec summary)."""
     cells = driver.execute_script(
-        "return Array.from(document.querySelectorAll('#design-card [data-name]')).map(function (e) {"
-        " return [e.getAttribute('data-name'), e.getAttribute('data-value')]; })")
+        "return Array.from(document.querySelectorAll('#design-card [data-name]' + arguments[0])).map(function (e) {"
+        " return [e.getAttribute('data-name'), e.getAttribute('data-value')]; })", kind)
     return {name: float(value) if value else math.nan for name, value in cells}
 
 
@@ -170,6 +172,38 @@ def test_a_click_on_a_line_of_the_parallel_coordinates_picks_that_design(browser
                                  " c = document.getElementById('parallel'); return [r.left, r.top, r.width / c.width];")
     _click_at(browser, box[0] + x * box[2], box[1] + y * box[2])
     assert _card(browser) == _expected(front[n - 1])
+
+
+def _sheet_value(sheet: dict, path: str) -> float:
+    for key in path.split("."):
+        sheet = sheet[key]
+    return math.nan if sheet is None else float(sheet)
+
+
+def test_the_cards_spec_summary_is_what_spec_says_of_its_device_file(browser, two, monkeypatch):
+    """Oracle: ``hapticdesign spec --json`` on the device file the card names, run in the output folder (the card's
+    own command, without the workspace cube and the simulation the summary leaves out)."""
+    out, _ = two
+    front = _rows(out / "front.csv")
+    _open(browser, (out / "report.html").resolve().as_uri())
+    monkeypatch.chdir(out)
+    for n in (1, len(front)):
+        browser.execute_script("window.hdExplorer.select(arguments[0])", n)
+        card = _card(browser, "[data-kind=spec]")
+        design = browser.execute_script("return window.hdExplorer.design(arguments[0])", n)
+        assert design["commands"][0]["command"] == f"hapticdesign spec --device {design['file']}"
+        done = runner.invoke(app, ["spec", "--device", design["file"], "--json", "--no-workspace", "--no-simulate"])
+        assert done.exit_code == 0, done.output
+        sheet = json.loads(done.stdout)
+        assert set(card) == {"force_continuous", "force_peak", "resolution", "apparent_mass.min", "apparent_mass.max",
+                             "renderable_stiffness.exact", "renderable_stiffness.exact_with_hand"}
+        for name, value in card.items():
+            expected = _sheet_value(sheet, name)
+            assert (math.isnan(value) and math.isnan(expected)) or value == expected, name
+        units = browser.execute_script("return Array.from(document.querySelectorAll('#card-spec tr')).slice(1)"
+                                       ".map(function (tr) { return tr.lastChild.textContent; })")
+        assert units == ["N", "N", "m", "kg", "kg", "N/m", "N/m"] == [sheet["units"][k.split(".")[0]] for k in card]
+    assert _console(browser) == []
 
 
 def test_each_map_reduces_to_its_objective(browser, two):

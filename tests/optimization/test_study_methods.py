@@ -297,8 +297,8 @@ def test_the_python_door_is_the_command(tmp_path, capsys):
     assert len(result.records) == summary["evaluations"]
     designs = [f"designs/design-{n}.yaml" for n in range(1, len(result.front) + 1)]  # each front design's device file
     assert [p.relative_to(tmp_path / "api").as_posix() for p in result.files] == [
-        "front.csv", "evaluations.csv", "pareto.png", "pareto.svg", "selected.yaml", *designs, "plotly.min.js",
-        "report.html"]
+        "front.csv", "evaluations.csv", "pareto.png", "pareto.svg", "selected.yaml", "study.json", *designs,
+        "plotly.min.js", "report.html"]
     for name in ("front.csv", "evaluations.csv", "selected.yaml"):
         assert (tmp_path / "api" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes()
     with pytest.raises(UserError, match="the seed must be at least 0"):

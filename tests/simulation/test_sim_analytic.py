@@ -11,13 +11,13 @@ from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.simulation.analytic import AnalyticProblem
 from hapticdesign.simulation.analytic_driven import DrivenLoop
 from hapticdesign.simulation.criteria import type_paths
-from hapticdesign.analysis.sampled_loop import Hand
-from hapticdesign.simulation.config import Compensator, LoopConfig, Sensors
+from hapticdesign.analysis.sampled_loop import Hand, SampledLoop
+from hapticdesign.simulation.config import Compensator, LoopConfig
 from hapticdesign.simulation.impedance import ImpedanceProblem, fast_search, impedance_range
 
 NONLINEAR = {"r3y": 0.01, "Ixy2": 4e-4, "m3": 0.05}
-CONFIGS = [LoopConfig(), LoopConfig(compensator=Compensator(error_percent=5)),
-           LoopConfig(sensors=Sensors(delay_samples=2)), LoopConfig(compensator=Compensator(inertial=False))]
+CONFIGS = [LoopConfig(), LoopConfig(loop=SampledLoop.seed(error_percent=5)),
+           LoopConfig(loop=SampledLoop.seed(delay=2)), LoopConfig(compensator=Compensator(inertial=False))]
 
 
 def assert_same_search(analytic, simulated, stop_times: bool = True) -> None:
@@ -94,7 +94,7 @@ def test_api_and_resolution():
 
 def test_quantization_and_friction_are_not_linear():
     with pytest.raises(UserError, match="quantization"):
-        AnalyticProblem(preset("phantom-3dof"), 1, config=LoopConfig(sensors=Sensors(counts_per_revolution=4096)))
+        AnalyticProblem(preset("phantom-3dof"), 1, config=LoopConfig(counts=4096))
     with pytest.raises(UserError, match="Coulomb"):
         AnalyticProblem(preset("phantom-3dof"), 1, config=LoopConfig(coulomb=(0.01, 0.0, 0.0)))
 
@@ -106,9 +106,9 @@ def test_group_errors_with_random_signs_equal_the_simulation():
     assert fast_search(analytic).k_max == fast_search(simulated).k_max
 
 
-@pytest.mark.parametrize("config", [LoopConfig(hand=Hand(0.2, 1.0, 0.0)),
-                                    LoopConfig(hand=Hand(0.2, 1.0, 0.0), compensator=Compensator(error_percent=5),
-                                               sensors=Sensors(delay_samples=1))], ids=["hand", "hand-error5-delay1"])
+@pytest.mark.parametrize("config", [LoopConfig(loop=SampledLoop.seed(hand=Hand(0.2, 1.0, 0.0))),
+                                    LoopConfig(loop=SampledLoop.seed(hand=Hand(0.2, 1.0, 0.0), error_percent=5,
+                                                                     delay=1))], ids=["hand", "hand-error5-delay1"])
 def test_a_hand_in_type_one_equals_the_simulation(config):
     """A hand's mass and damping on the handle (``x J_v^T J_v`` on joint 1): the compensator's model has no hand, so
     it feeds its own ``H_m,11`` times the sampled acceleration of the joint with the hand; the analytic loop (the

@@ -9,17 +9,18 @@ import pytest
 
 from hapticdesign.devices.registry import preset
 from hapticdesign.errors import UserError
-from hapticdesign.simulation.config import Compensator, Hand, LoopConfig, Sensors, Wall
+from hapticdesign.analysis.sampled_loop import SampledLoop
+from hapticdesign.simulation.config import Compensator, Hand, LoopConfig, Wall
 from hapticdesign.simulation.loop import simulate
 from hapticdesign.simulation.paths import Held, Sine
 from hapticdesign.simulation.transparency import transparency
 
 NONLINEAR = {"r3y": 0.01, "Ixy2": 4e-4, "m3": 0.05}
-EXACT_IN_BOTH_TYPES = {"seed": LoopConfig(), "delay2": LoopConfig(sensors=Sensors(delay_samples=2)),
+EXACT_IN_BOTH_TYPES = {"seed": LoopConfig(), "delay2": LoopConfig(loop=SampledLoop.seed(delay=2)),
                        "no-inertial": LoopConfig(compensator=Compensator(inertial=False)),
-                       "hand": LoopConfig(hand=Hand(0.2, 2.0, 50.0))}
-MODEL_ERRORS = {"error5": LoopConfig(compensator=Compensator(error_percent=5)),
-                "error10-delay2": LoopConfig(compensator=Compensator(error_percent=10), sensors=Sensors(delay_samples=2))}
+                       "hand": LoopConfig(loop=SampledLoop.seed(hand=Hand(0.2, 2.0, 50.0)))}
+MODEL_ERRORS = {"error5": LoopConfig(loop=SampledLoop.seed(error_percent=5)),
+                "error10-delay2": LoopConfig(loop=SampledLoop.seed(error_percent=10, delay=2))}
 
 
 def _same_estimate(device, sim_type, config):
@@ -62,7 +63,7 @@ def _periodic_impedance(device, config, frequency, duration=5.0):
     1e-5 s plant step."""
     periods = int(round(duration * frequency))
     cfg = replace(config, duration=duration, step=1e-5, safety_limit=None, record_stride=1,
-                  wall=Wall(0, 4.0, 0.0, 0.0))
+                  wall=Wall(0, 4.0, equilibrium=0.0))
     trace = simulate(device, cfg, {0: Sine(0.3, 2 * np.pi * frequency), 1: Held(0.0), 2: Held(0.0)})
     q, tau = trace.q[:-1, 0], trace.tau_c[:-1, 0]
     return np.fft.rfft(tau)[periods] / np.fft.rfft(q)[periods]
@@ -93,7 +94,7 @@ def test_estimate_and_steady_state_differ_by_the_window_edges():
 
 def test_nonlinear_parts_are_refused():
     with pytest.raises(UserError, match="quantization"):
-        transparency(preset("phantom-3dof"), 1, config=LoopConfig(sensors=Sensors(counts_per_revolution=4096)),
+        transparency(preset("phantom-3dof"), 1, config=LoopConfig(counts=4096),
                      method="analytic")
     with pytest.raises(UserError, match="Coulomb"):
         transparency(preset("phantom-3dof"), 1, config=LoopConfig(coulomb=(0.01, 0.0, 0.0)), method="analytic")

@@ -197,7 +197,7 @@ def test_hand_on_a_one_dof_device_meets_the_exact_discrete_analysis():
     assert j == pytest.approx(0.007, rel=1e-12)
     r2 = 0.15 ** 2
     hand = Hand(mass=0.4, damping=2.0, stiffness=40.0)
-    config = LoopConfig(hand=hand, compensator=Compensator(coriolis=False, gravity=False))
+    config = LoopConfig(loop=SampledLoop.seed(hand=hand), compensator=Compensator(coriolis=False, gravity=False))
     simulated = growth_boundary(ImpedanceProblem(device, 1, config=config))
     at_joint = Hand(hand.mass * r2, hand.damping * r2, hand.stiffness * r2)  # the hand seen at the joint
     exact = joint_limit(j, 0.3, SampledLoop.seed(hand=at_joint))

@@ -92,11 +92,12 @@ def test_realistic_conditions_reach_every_case(tmp_path, cluster):
     every case. Each case equals the engine called directly under the same conditions, and a sample of
     delay lowers every stable range (the Z-width shrinks with delay, Gil et al. 2004)."""
     from hapticdesign.devices.registry import preset
-    from hapticdesign.simulation.config import Compensator, LoopConfig, Sensors
+    from hapticdesign.analysis.sampled_loop import SampledLoop
+    from hapticdesign.simulation.config import Compensator, LoopConfig
     from hapticdesign.simulation.impedance import impedance_range
 
     designs = write_designs(tmp_path / "designs.csv")
-    conditions = LoopConfig(sensors=Sensors(delay_samples=1),
+    conditions = LoopConfig(loop=SampledLoop.seed(delay=1),
                             compensator=Compensator(group_errors=(("mass", 5.0), ("inertia", 5.0)), error_seed=3))
     real = replace(QUICK, method="analytic", conditions=conditions)
     run_campaign(designs, tmp_path / "real", real, scheduler=cluster.scheduler_address)
@@ -111,7 +112,7 @@ def test_realistic_conditions_reach_every_case(tmp_path, cluster):
             assert got["value"] == direct.k_max
             assert got["value"] < ideal["value"]
     with pytest.raises(UserError, match="no encoder quantization"):
-        CampaignOptions(method="analytic", conditions=LoopConfig(sensors=Sensors(counts_per_revolution=4096)))
+        CampaignOptions(method="analytic", conditions=LoopConfig(counts=4096))
 
 
 def test_campaign_command_takes_the_conditions(tmp_path):

@@ -12,7 +12,8 @@ from hapticdesign.devices.loading import resolve_device
 from hapticdesign.devices.registry import preset
 from hapticdesign.errors import UserError
 from hapticdesign.simulation.analytic import AnalyticProblem
-from hapticdesign.simulation.config import Compensator, LoopConfig, Sensors, Wall
+from hapticdesign.analysis.sampled_loop import SampledLoop
+from hapticdesign.simulation.config import Compensator, LoopConfig, Wall
 from hapticdesign.simulation.criteria import Criteria
 from hapticdesign.simulation.impedance import ImpedanceProblem, grid_search, impedance_range
 from hapticdesign.simulation.loop import simulate
@@ -47,9 +48,11 @@ def test_a_slanted_wall_on_a_prismatic_joint_is_the_joint_wall(gantry):
     (K/2, B/2, sqrt(2) x_eq) on x, to rounding; the driven y joint does not move the handle along n."""
     k, b, x_eq = 30.0, 0.4, 0.01
     paths = {1: Sine(0.52, 3 * np.pi)}
-    base = LoopConfig(duration=1.0, compensator=Compensator(error_percent=10), sensors=Sensors(delay_samples=1))
-    cart = simulate(gantry, replace(base, wall=Wall(0, k, b, x_eq, direction=SLANT)), paths)
-    joint = simulate(gantry, replace(base, wall=Wall(0, k / 2, b / 2, np.sqrt(2) * x_eq)), paths)
+    loop = SampledLoop.seed(error_percent=10, delay=1)
+    cart = simulate(gantry, LoopConfig(duration=1.0, loop=replace(loop, wall_damping=b),
+                                       wall=Wall(0, k, equilibrium=x_eq, direction=SLANT)), paths)
+    joint = simulate(gantry, LoopConfig(duration=1.0, loop=replace(loop, wall_damping=b / 2),
+                                        wall=Wall(0, k / 2, equilibrium=np.sqrt(2) * x_eq)), paths)
     assert np.abs(cart.q - joint.q).max() < 1e-12
     assert np.abs(cart.tau_imp[:, 0] - joint.tau_imp[:, 0]).max() < 1e-10
     assert np.allclose(cart.tau_imp[:, 1], 0.0, atol=1e-12)
@@ -62,8 +65,8 @@ def test_a_slanted_wall_on_a_prismatic_joint_is_the_joint_wall(gantry):
 def test_phantom_cartesian_wall_matches_the_scipy_loop(paths):
     """The numba loop (compiled frame tree) against solve_ivp with the Python kinematics."""
     device = preset("phantom-3dof").with_params({"r3y": 0.01, "Ixy2": 4e-4, "m3": 0.05})
-    config = LoopConfig(duration=0.3, wall=Wall(0, 150.0, 2.0, 0.005, direction=(0.3, 1.0, 0.2)),
-                        compensator=Compensator(error_percent=20), sensors=Sensors(delay_samples=1))
+    config = LoopConfig(duration=0.3, wall=Wall(0, 150.0, equilibrium=0.005, direction=(0.3, 1.0, 0.2)),
+                        loop=SampledLoop.seed(error_percent=20, delay=1, wall_damping=2.0))
     fast, slow = simulate(device, config, paths), simulate_adaptive(device, config, paths)
     assert np.abs(fast.q - slow.q).max() < 1e-9
     assert np.abs(fast.tau_imp - slow.tau_imp).max() < 1e-6 * max(1.0, np.abs(slow.tau_imp).max())
@@ -75,7 +78,8 @@ def test_the_handle_settles_where_the_spring_rests():
     """One link of 0.15 m turning about z, wall along y: the handle rests at y = x_eq, i.e. at
     ``q = asin(x_eq / 0.15)`` (the torque ``J_n K (0.15 sin q - x_eq)`` vanishes there only)."""
     device = resolve_device(None, Path(__file__).with_name("one_link.yaml"), None)
-    trace = simulate(device, LoopConfig(duration=4.0, wall=Wall(0, 100.0, 1.0, 0.01, direction=(0.0, 1.0, 0.0))))
+    trace = simulate(device, LoopConfig(duration=4.0, wall=Wall(0, 100.0, equilibrium=0.01, direction=(0.0, 1.0, 0.0)),
+                                        loop=SampledLoop.seed(wall_damping=1.0)))
     assert trace.q[-1, 0] == pytest.approx(np.arcsin(0.01 / 0.15), rel=1e-6)
     y = forward_kinematics(device.mechanism, trace.q[-1])[1, 3]
     assert trace.wall_position[-1] == pytest.approx(y, abs=1e-15) and y == pytest.approx(0.01, rel=1e-6)
@@ -86,7 +90,7 @@ def test_the_wall_dissipates_without_a_compensator():
     ``1/2 J qd^2 + 1/2 K (x.n - x_eq)^2`` at the end is below the spring's energy at the start."""
     device = resolve_device(None, Path(__file__).with_name("one_link.yaml"), None)
     k = 20.0
-    config = LoopConfig(duration=4.0, wall=Wall(0, k, 0.0, 0.01, direction=(0.0, 1.0, 0.0)),
+    config = LoopConfig(duration=4.0, wall=Wall(0, k, equilibrium=0.01, direction=(0.0, 1.0, 0.0)),
                         compensator=Compensator(inertial=False, coriolis=False, gravity=False))
     trace = simulate(device, config)
     energy = 0.5 * 0.007 * trace.qd[:, 0] ** 2 + 0.5 * k * (trace.wall_position - 0.01) ** 2

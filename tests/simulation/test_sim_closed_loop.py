@@ -20,13 +20,8 @@ import hapticdesign as hd
 from hapticdesign.devices.device_file import load_device_file
 from hapticdesign.interface.cli import app
 from hapticdesign.simulation.boundary import envelope_grows
-from hapticdesign.simulation.config import (
-    Compensator,
-    LoopConfig,
-    Sensors,
-    Wall,
-    rest_pose,
-)
+from hapticdesign.analysis.sampled_loop import SampledLoop
+from hapticdesign.simulation.config import Compensator, LoopConfig, Wall, rest_pose
 from hapticdesign.simulation.loop import simulate
 from hapticdesign.simulation.paths import Held, Sine
 from tests.helpers.reference import simulate_adaptive
@@ -53,8 +48,9 @@ def test_kernel_matches_the_scipy_reference_loop(device, sim_type, control):
     RK45 at rtol 1e-8, with a model error, a delay and a damped wall: the two integrators agree to their
     own accuracy (the closure's Newton tolerance is far below it)."""
     home, w = rest_pose(device), WALL_JOINT[device.name]
-    config = LoopConfig(duration=0.2, wall=Wall(w, 0.05, 0.001, home[w] + 0.01), step_control=control,
-                        compensator=Compensator(error_percent=20, error_seed=3), sensors=Sensors(delay_samples=1))
+    config = LoopConfig(duration=0.2, wall=Wall(w, 0.05, equilibrium=home[w] + 0.01), step_control=control,
+                        loop=SampledLoop.seed(error_percent=20, delay=1, wall_damping=0.001),
+                        compensator=Compensator(error_seed=3))
     paths = _paths(device, sim_type)
     fast = simulate(device, config, paths)
     slow = simulate_adaptive(device, config, paths, q0=home)
@@ -76,7 +72,7 @@ def test_stable_and_unstable_stiffness_bracket_the_limit(device):
     base = LoopConfig(duration=4.0)
     grows = []
     for k in (0.9 * limit, 1.1 * limit):
-        trace = simulate(device, LoopConfig(duration=4.0, wall=Wall(w, k, 0.0, home[w] + 0.01)), _paths(device, 1))
+        trace = simulate(device, LoopConfig(duration=4.0, wall=Wall(w, k, equilibrium=home[w] + 0.01)), _paths(device, 1))
         assert trace.status == 0
         grows.append(envelope_grows(trace.q[:, w] - (home[w] + 0.01)))
     assert grows == [False, True]
@@ -102,7 +98,7 @@ def test_free_undamped_motion_conserves_energy(device):
     ``qd^T H qd / 2 + integral of G . qd dt`` stays at 0 (H and G from the slow exact path; the integral by
     Simpson's rule at 0.5 ms, whose error is far below the bound, as is RK4's drift at 1e-4 s)."""
     home = rest_pose(device)
-    config = LoopConfig(duration=0.1, wall=Wall(0, 0.0, 0.0, 0.0), damping=np.zeros(device.n_dof),
+    config = LoopConfig(duration=0.1, wall=Wall(0, 0.0, equilibrium=0.0), damping=np.zeros(device.n_dof),
                         compensator=Compensator(False, False, False), safety_limit=None, record_stride=5)
     trace = simulate(device, config)
     assert trace.status == 0
@@ -118,7 +114,7 @@ def test_a_run_that_leaves_the_branch_ends_with_its_status():
     delta = load_device_file(EXAMPLES / "delta.yaml")
     home = rest_pose(delta)
     paths = {0: Sine(2.0, 2 * np.pi, home[0]), 1: Held(home[1]), 2: Held(home[2])}
-    trace = simulate(delta, LoopConfig(duration=1.0, wall=Wall(0, 0.0, 0.0, home[0])), paths)
+    trace = simulate(delta, LoopConfig(duration=1.0, wall=Wall(0, 0.0, equilibrium=home[0])), paths)
     assert trace.loop_lost and 0 < trace.end_time < 1.0
     assert np.all(np.isfinite(trace.q))
 

@@ -21,7 +21,8 @@ from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.devices.device_file import load_device_file
 from hapticdesign.interface.cli import app
 from hapticdesign.simulation.boundary import envelope_grows
-from hapticdesign.simulation.config import Compensator, Hand, LoopConfig, Sensors, Wall, normal_jacobian, rest_pose
+from hapticdesign.analysis.sampled_loop import SampledLoop
+from hapticdesign.simulation.config import Compensator, Hand, LoopConfig, Wall, normal_jacobian, rest_pose
 from hapticdesign.simulation.loop import simulate
 from hapticdesign.simulation.paths import Held, Sine
 from tests.helpers.reference import simulate_adaptive
@@ -50,7 +51,7 @@ def _paths(device, sim_type: int) -> dict:
 def test_normal_jacobian_is_the_derivative_of_the_closed_handle_position(device):
     """``J_n`` from ``J T`` equals central differences of ``n . p`` with the loops closed at each pose."""
     home, n = rest_pose(device), _direction(device)
-    wall = Wall(0, 1.0, 0.0, 0.0, direction=tuple(n))
+    wall = Wall(0, 1.0, equilibrium=0.0, direction=tuple(n))
     eps = 1e-6
     numeric = [(n @ configuration_of(device).pose(home + eps * e)[:3, 3]
                 - n @ configuration_of(device).pose(home - eps * e)[:3, 3]) / (2 * eps) for e in np.eye(device.n_dof)]
@@ -63,8 +64,9 @@ def test_cartesian_wall_kernel_matches_the_scipy_reference_loop(device, sim_type
     delay and (type 2) a hand at the handle."""
     home, w, n = rest_pose(device), WALL_JOINT[device.name], _direction(device)
     hand = Hand(mass=0.05, damping=0.5, stiffness=20.0) if sim_type == 2 else None
-    config = LoopConfig(duration=0.2, wall=Wall(w, 50.0, 0.2, 0.002, direction=tuple(n)), hand=hand,
-                        compensator=Compensator(error_percent=20, error_seed=3), sensors=Sensors(delay_samples=1))
+    config = LoopConfig(duration=0.2, wall=Wall(w, 50.0, equilibrium=0.002, direction=tuple(n)),
+                        loop=SampledLoop.seed(hand=hand, error_percent=20, delay=1, wall_damping=0.2),
+                        compensator=Compensator(error_seed=3))
     paths = _paths(device, sim_type)
     fast = simulate(device, config, paths)
     slow = simulate_adaptive(device, config, paths, q0=home)
@@ -80,13 +82,13 @@ def test_cartesian_stiffness_brackets_the_joint_limit_over_j_n_squared(device):
     """Type 1, full compensation, no delay: the Cartesian wall's oscillation decays at 0.9 and grows at
     1.1 times ``b^2 / (H_ww J_n,w^2)`` (H_ww from :func:`hapticdesign.mass_matrix`)."""
     home, w, n = rest_pose(device), WALL_JOINT[device.name], _direction(device)
-    wall = Wall(w, 1.0, 0.0, 0.0, direction=tuple(n))
+    wall = Wall(w, 1.0, equilibrium=0.0, direction=tuple(n))
     j_nw = normal_jacobian(device, wall, home)[w]
     limit = device.damping[w] ** 2 / hd.mass_matrix(device, home)[w, w] / j_nw ** 2
     rest = 0.01 * j_nw
     grows = []
     for k in (0.9 * limit, 1.1 * limit):
-        config = LoopConfig(duration=4.0, wall=Wall(w, k, 0.0, rest, direction=tuple(n)))
+        config = LoopConfig(duration=4.0, wall=Wall(w, k, equilibrium=rest, direction=tuple(n)))
         trace = simulate(device, config, _paths(device, 1))
         assert trace.status == 0
         grows.append(envelope_grows(trace.wall_position - trace.wall_position[0] - rest))
@@ -100,7 +102,7 @@ def test_analytic_search_equals_the_simulated_one_for_a_cartesian_wall(device):
     previous test). Before the criteria scaled with the step, the delta's 0.64-mm step passed 1.2 times that limit
     (3.29 N/m, growing)."""
     home, w, n = rest_pose(device), WALL_JOINT[device.name], _direction(device)
-    j_nw = normal_jacobian(device, Wall(w, 1.0, 0.0, 0.0, direction=tuple(n)), home)[w]
+    j_nw = normal_jacobian(device, Wall(w, 1.0, equilibrium=0.0, direction=tuple(n)), home)[w]
     limit = device.damping[w] ** 2 / hd.mass_matrix(device, home)[w, w] / j_nw ** 2
     found = {method: hd.impedance_range(device, 1, method=method, wall_joint=w, resolution=limit / 10, k_limit=20,
                                         equilibrium=0.01 * j_nw, wall_direction=n)

@@ -148,10 +148,10 @@ def test_the_analytic_growth_check_holds_the_pendulum_where_gravity_and_the_spri
     from scipy.optimize import bisect
 
     from hapticdesign.simulation.analytic import AnalyticProblem
-    from hapticdesign.simulation.config import Compensator, LoopConfig, Sensors
+    from hapticdesign.simulation.config import Compensator, LoopConfig
 
     rest, period = 1.0, 0.02
-    config = LoopConfig(sensors=Sensors(period, delay_samples=1), compensator=Compensator(False, False, False))
+    config = LoopConfig(loop=SampledLoop.seed(period=period, delay=1), compensator=Compensator(False, False, False))
     problem = AnalyticProblem(_pendulum(), 1, 0, rest, config=config)
 
     def limit_where_held(k: float) -> float:

@@ -7,7 +7,7 @@ from hapticdesign.analysis.dynamics.device import mass_matrix
 from hapticdesign.devices.registry import preset
 from hapticdesign.errors import UserError
 from hapticdesign.devices.loading import resolve_device
-from hapticdesign.analysis.sampled_loop import compensated_boundary
+from hapticdesign.analysis.sampled_loop import SampledLoop, compensated_boundary
 from hapticdesign.simulation.config import Compensator, LoopConfig, Wall
 from hapticdesign.simulation.impedance import (
     Criteria, ImpedanceProblem, fast_search, grid_search, impedance_range, linear_scan, growth_boundary,
@@ -69,7 +69,7 @@ def test_compensator_error_boundary_is_the_closed_form(error_percent):
                                 for k in device.inertial_names()})
     h11, b = mass_matrix(device, np.zeros(3))[0, 0], device.damping[0]
     c = mass_matrix(model, np.zeros(3))[0, 0] / h11
-    config = LoopConfig(compensator=Compensator(error_percent=error_percent))
+    config = LoopConfig(loop=SampledLoop.seed(error_percent=error_percent))
     k = growth_boundary(ImpedanceProblem(device, 1, config=config))
     expected = compensated_boundary(h11, b, 1e-3, c)
     assert k == pytest.approx(expected, rel=1e-3)
@@ -79,7 +79,7 @@ def test_compensator_error_boundary_is_the_closed_form(error_percent):
 def _oracle(device, sim_type, stiffness, criteria=Criteria()):
     """The verdict rebuilt from a run without the excursion stop, recorded at every plant step."""
     problem = ImpedanceProblem(device, sim_type)
-    config = LoopConfig(wall=Wall(0, stiffness, 0.0, 0.01), safety_limit=criteria.safety_limit,
+    config = LoopConfig(wall=Wall(0, stiffness, equilibrium=0.01), safety_limit=criteria.safety_limit,
                         stop_excursion=None, record_stride=1)
     trace = simulate(device, config, problem.paths)
     q = trace.q[:, 0]

@@ -65,6 +65,22 @@ def test_a_study_can_ask_for_a_wall_with_a_hand_and_friction(tmp_path):
         require_study_workload(load_study(path))
 
 
+def test_the_simulated_wall_takes_the_loops_wall_damping():
+    """The wall's damper is the loop's ``wall_damping`` in both indices: friction and quantization off, the simulated
+    limit with a 2 N s/m damper on the sampled velocity is ``kmax``'s with the same damper (the damper raises both
+    above the undamped wall's); a damper on the backward difference is analysed exactly only (one line)."""
+    device = load_device_file(FIVE_BAR)
+    point = _home_point(device)[None]
+    damped = {"wall_damping": 2.0, "velocity": "sampled"}
+    linear = Request("kmax_simulated", {"friction": False, "quantization": False, "rel_tol": 1e-3, **damped})
+    found = evaluate(device, point, [Request("kmax", damped, "exact"), linear, "kmax"])
+    assert found.reason is None, found.reason
+    np.testing.assert_allclose(found.values["kmax_simulated"], found.values["exact"], rtol=2e-3)
+    assert found.values["exact"][0] > found.values["kmax"][0]
+    refused = evaluate(device, point, [Request("kmax_simulated", {"wall_damping": 2.0})])
+    assert refused.reason is not None and "backward-difference damper is analysed exactly only" in refused.reason
+
+
 @pytest.mark.parametrize("options, message", [({"friction": "yes"}, "friction is true or false"),
                                               ({"rel_tol": 0.0}, "rel_tol is a number from 1e-4 to 0.5"),
                                               ({"delay": -1}, "the delay is a whole number")])

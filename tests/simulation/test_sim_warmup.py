@@ -77,3 +77,42 @@ def test_ensure_compiled_compiles_the_arguments_signature_under_the_cache_folder
     assert folder is not None and os.path.isdir(os.path.dirname(folder) or ".")
     with warmup.compile_lock(kernel.run_loop):
         assert os.path.exists(os.path.join(folder, warmup.LOCK_FILE))
+
+
+KERNEL_SOURCE = '''
+import numba as nb
+import numpy as np
+
+from hapticdesign.simulation.warmup import ensure_compiled
+
+
+@nb.njit(cache=True)
+def double(x):
+    return 2.0 * x
+
+
+def warm():
+    ensure_compiled(double, np.zeros(3))
+'''
+
+
+def test_a_kernel_compiled_aside_is_loaded_here_from_the_cache_not_compiled_again(tmp_path, monkeypatch):
+    import importlib
+    import sys
+
+    (tmp_path / "aside_kernel.py").write_text(KERNEL_SOURCE)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    module = importlib.import_module("aside_kernel")
+    try:
+        assert not warmup.in_cache(module.double)
+        process = warmup.compile_aside(module.double, module.warm)
+        assert process is not None
+        process.join()
+        assert process.exitcode == 0 and warmup.in_cache(module.double)
+        warmup.ensure_compiled(module.double, np.zeros(3))
+        stats = module.double.stats
+        assert sum(stats.cache_hits.values()) == 1 and sum(stats.cache_misses.values()) == 0
+        assert module.double(np.ones(3)).tolist() == [2.0, 2.0, 2.0]
+        assert warmup.compile_aside(module.double, module.warm) is None  # in the cache: no second process
+    finally:
+        sys.modules.pop("aside_kernel", None)

@@ -4,9 +4,10 @@ Every analysis that needs "the device at actuated coordinates ``q_a``" asks :fun
 (cached per geometry, like :func:`~hapticdesign.analysis.dynamics.device.dynamics_of`):
 
 - ``names``, ``home``: the actuated coordinates and the home pose (zeros for a tree, the file's ``home``
-  for a closed-loop device, whose loops need not close at 0); ``is_tree``;
-- :meth:`Configuration.full`: every tree coordinate at actuated ones (the identity for a tree; for loops
-  the passive joints continued from home on the assembly branch, :class:`~.loops.solver.LoopSolver`);
+  for a closed-loop device, whose loops need not close at 0); ``full_home``, every coordinate there;
+- :meth:`Configuration.full`: every tree coordinate at actuated ones, the passive joints continued from home on
+  the assembly branch by the device's :class:`~.loops.solver.LoopSolver`; :meth:`Configuration.passive`: the
+  passive ones of a full pose;
 - :meth:`Configuration.velocity_transform`: ``T`` with ``qd = T qd_a`` (``T = [I; S]``,
   ``S = -Phi_p^-1 Phi_a``; the identity for a tree; seed 000 eq. 2.38-2.43 generalized);
 - :meth:`Configuration.pose`, :meth:`Configuration.jacobian`: a frame's pose and its Jacobian over the
@@ -17,12 +18,14 @@ Every analysis that needs "the device at actuated coordinates ``q_a``" asks :fun
   small Cartesian steps, point after point, by the compiled kernel the design batch runs over many designs
   (:func:`~.reach_kernel.reach_designs`, here a batch of one).
 
-A closed-loop device's configuration (:class:`LoopConfiguration`) owns the loop solver; its dynamics model
+Every device takes the same calls (Pinocchio's view: a tree's list of constraints is empty, so its solver closes
+nothing). The configuration owns the loop solver; a closed-loop device's dynamics model
 (:class:`~.dynamics.closed_loop.ClosedLoopModel`) takes it, so one solver serves every caller.
 """
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -30,9 +33,9 @@ import numpy as np
 
 from hapticdesign.analysis import kinematics
 from hapticdesign.analysis.loops.records import BRANCH_CHANGE, OK, OUT_OF_REACH, SINGULAR, Settings
-from hapticdesign.analysis.loops.solver import LoopSolver, settings_of
+from hapticdesign.analysis.loops.solver import LoopSolver
 from hapticdesign.analysis.reach_kernel import MESSAGES, Reach, Reached, Structure, reach_designs, structure_of
-from hapticdesign.errors import UserError
+from hapticdesign.errors import RenamedWarning, UserError
 from hapticdesign.model.device import Device, MechanismBuilder, build_mechanism
 from hapticdesign.model.mechanism import Mechanism
 from hapticdesign.model.walk import WalkPlan
@@ -50,22 +53,21 @@ IK_PIVOTS = 1e-9
 
 
 class Configuration:
-    """The configuration space of a tree (every coordinate actuated); see the module docstring."""
-
-    is_tree = True
+    """The configuration space of a device's geometry; see the module docstring."""
 
     def __init__(self, mechanism: Mechanism):
         self.mechanism = mechanism
-        self.names: tuple[str, ...] = mechanism.coordinates if mechanism.loops is None else mechanism.actuated_coordinates
+        self.solver = LoopSolver(mechanism)
+        """The loop solver (:class:`~.loops.solver.LoopSolver`), which closes the poses."""
+        self.names: tuple[str, ...] = mechanism.actuated_coordinates
         self.n_actuated = len(self.names)
-        self.home = self._home()
+        self.full_home = self.solver.home
+        """Every coordinate of the home pose (the loops closed on their assembly branch)."""
+        self.home = self.full_home[self.actuated_index()]
         """Actuated coordinates of the home pose."""
-        self.settings = settings_of(mechanism)
+        self.settings = self.solver.settings
         """The loop solver's settings (:func:`~.loops.solver.settings_of`), whose tolerance the reach closes to."""
         self._walks: dict[str | None, tuple[Structure, WalkPlan]] = {}
-
-    def _home(self) -> np.ndarray:
-        return np.zeros(self.mechanism.n_dof)
 
     def _actuated(self, q_a) -> np.ndarray:
         q_a = np.asarray(q_a, dtype=float)
@@ -78,12 +80,15 @@ class Configuration:
     def full(self, q_a, start: np.ndarray | None = None) -> np.ndarray:
         """Every tree coordinate at actuated poses (n_a,) or a motion (P, n_a) (continued from ``start``, a
         closed full pose, default home)."""
-        return self._actuated(q_a)
+        return self.solver.solve(self._actuated(q_a), start)
+
+    def passive(self, q: np.ndarray) -> np.ndarray:
+        """The passive coordinates (..., n_p) of full poses ``q`` (..., N) (none for a tree)."""
+        return np.asarray(q)[..., self.solver.closures.passive]
 
     def velocity_transform(self, q: np.ndarray) -> np.ndarray:
-        """``T`` (N x n_a) with ``qd = T qd_a`` at full coordinates ``q`` (N,) or (P, N)."""
-        q = np.asarray(q, dtype=float)
-        return np.broadcast_to(np.eye(self.n_actuated), q.shape[:-1] + (self.n_actuated, self.n_actuated)).copy()
+        """``T`` (N x n_a) with ``qd = T qd_a`` at closed full coordinates ``q`` (N,) or (P, N)."""
+        return self.solver.velocity_transform(q)
 
     def pose(self, q_a, frame: str | None = None) -> np.ndarray:
         """World pose (4 x 4) of ``frame`` (default: the end effector) at actuated coordinates ``q_a`` (n_a,)."""
@@ -150,7 +155,7 @@ class Configuration:
 
     def actuated_index(self) -> np.ndarray:
         """The places of the actuated coordinates among the full ones."""
-        return np.arange(self.n_actuated)
+        return self.solver.closures.actuated
 
 
 def reach_settings(handle: int, jac: np.ndarray, start: np.ndarray, settings: Settings) -> Reach:
@@ -198,8 +203,7 @@ def handle_pose(device: Device, position, frame: str | None = None, start=None) 
     begin = None if start is None else space.full(np.asarray(start, dtype=float))
     q_a, q = space.reach(np.reshape(np.asarray(position, dtype=float), (1, -1)), frame, begin)
     check_limits(device, q_a, np.reshape(position, (1, 3)))
-    passive = q[0][list(device.mechanism.loops.passive)] if not space.is_tree else np.zeros(0)
-    return HandlePose(q_a[0], q[0], passive, space.position_and_jacobian(q[0], frame)[0])
+    return HandlePose(q_a[0], q[0], space.passive(q[0]), space.position_and_jacobian(q[0], frame)[0])
 
 
 def check_limits(device: Device, q_a: np.ndarray, positions: np.ndarray) -> None:
@@ -215,31 +219,18 @@ def check_limits(device: Device, q_a: np.ndarray, positions: np.ndarray) -> None
                             f"limits [{span[0]:.6g}, {span[1]:.6g}]")
 
 
-class LoopConfiguration(Configuration):
-    """The configuration space of a closed-loop device: its :class:`~.loops.solver.LoopSolver` closes the poses."""
-
-    is_tree = False
-
-    def __init__(self, mechanism: Mechanism):
-        self.solver = LoopSolver(mechanism)
-        super().__init__(mechanism)
-
-    def _home(self) -> np.ndarray:
-        return np.array(self.mechanism.loops.home, dtype=float)
-
-    def actuated_index(self) -> np.ndarray:
-        return self.solver.closures.actuated
-
-    def full(self, q_a, start: np.ndarray | None = None) -> np.ndarray:
-        return self.solver.solve(self._actuated(q_a), start)
-
-    def velocity_transform(self, q: np.ndarray) -> np.ndarray:
-        return self.solver.velocity_transform(q)
-
-
 def configuration(mechanism: Mechanism) -> Configuration:
     """The configuration space of a mechanism (not cached: prefer :func:`configuration_of` for a device)."""
-    return Configuration(mechanism) if mechanism.loops is None else LoopConfiguration(mechanism)
+    return Configuration(mechanism)
+
+
+def __getattr__(name: str):
+    """``LoopConfiguration``, the former name of a closed-loop device's :class:`Configuration`, for one release."""
+    if name == "LoopConfiguration":
+        warnings.warn("LoopConfiguration is now Configuration (one configuration for every device)", RenamedWarning,
+                      stacklevel=2)
+        return Configuration
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def configuration_of(device: Device) -> Configuration:

@@ -11,7 +11,9 @@ and takes per design only what changes:
   links' rigidities (:class:`DesignValues`, which a design space fills from its variables).
 
 A tree is a closed-loop device without loops (no closures, no passive coordinates: Pinocchio's view), so trees and
-closed loops take the same kernels. The frame tree, the closures on its node numbering and the handle's node are the
+closed loops take the same kernels. The frame tree, the closures on its node numbering
+(:data:`~hapticdesign.model.mechanism.UNFOLDED`, :meth:`~hapticdesign.model.mechanism.CompiledMechanism.nodes`)
+and the handle's node are the
 configuration space's (:func:`~.reach_kernel.structure_of`), the statuses those every loop kernel returns
 (:mod:`.loops.records`), the Newton start at home :meth:`~hapticdesign.model.loops.ClosedLoops.guess`.
 
@@ -211,6 +213,8 @@ class DesignValues(NamedTuple):
     refused: list
     transmission: Transmission | None = None
     """The motors' compliant transmissions (D, n_a, n_a) each, None when the motors are rigid."""
+    motor_damping: np.ndarray | None = None
+    """The motors' own damping ``B_m`` (D, n_a, n_a): the part of ``B`` on the motors' side of a compliant drive."""
 
 
 class Evaluated(NamedTuple):
@@ -267,7 +271,7 @@ class DesignBatch:
         self.moving = [b for b in range(len(device.body_names)) if np.any(c.body_path[b] >= 0)]
         """The bodies some coordinate moves (:func:`~hapticdesign.analysis.metrics.indices.moving_mass`)."""
         self.settings = space.settings
-        guess = np.zeros(mech.n_dof) if mech.loops is None else mech.loops.guess(mech.n_dof)
+        guess = mech.loops.guess(mech.n_dof)
         jac = space.position_and_jacobian(space.full(space.home), frame)[1]
         s = np.linalg.svd(jac, compute_uv=False)
         if not s[-1] > IK_SINGULAR * s[0]:

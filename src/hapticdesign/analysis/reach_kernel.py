@@ -3,7 +3,9 @@ device or many designs of it (issue 36: one IK behind one door, as Robotics Tool
 
 A tree is a closed-loop device without loops (no closures, no passive coordinates: Pinocchio's view), so trees and
 closed loops take the same kernel. The device's frame tree comes with one node per elementary transform
-(:class:`Shape`, the design's node offsets beside it), the closures on that node numbering (:class:`Closures`) and
+(:class:`Shape`, the design's node offsets beside it), the closures on that node numbering
+(:data:`~hapticdesign.model.mechanism.UNFOLDED`, :meth:`~hapticdesign.model.mechanism.CompiledMechanism.nodes` says
+which walk takes which numbering; :class:`Closures`) and
 the loop solver's :func:`~.loops.solver.settings_of`; the statuses are those every loop kernel returns
 (:mod:`.loops.records`).
 
@@ -43,7 +45,7 @@ from hapticdesign.analysis.loops.records import (
     BRANCH_CHANGE, NO_HOME, OK, OUT_OF_REACH, SINGULAR, Closures, closure_scratch,
 )
 from hapticdesign.model.dense import lu_in_place
-from hapticdesign.model.mechanism import Mechanism
+from hapticdesign.model.mechanism import UNFOLDED, Mechanism
 from hapticdesign.model.walk import KinematicTree, Tree, frame_jacobian, planned_poses, trig_workspace
 
 MESSAGES = {
@@ -111,9 +113,8 @@ def structure_of(mech: Mechanism, frame: str | None = None) -> Structure:
                   np.broadcast_to(np.eye(3), (n_node, 3, 3)).copy(), np.zeros((n_node, 3)))
     raw = KinematicTree(c.node_parent, c.node_axis, c.node_coef, c.node_offset, shape.const_rot, shape.const_pos,
                         dict(c.frame_node), c.body_node)
-    closures = Closures.of(mech, c.frame_node) if mech.loops is not None else Closures(
-        *(np.zeros(0, dtype=np.int64),) * 4, np.arange(mech.n_dof, dtype=np.int64), np.zeros(0, dtype=np.int64))
-    return Structure(shape, c.node_offset.copy(), raw, closures, int(c.frame_node[frame or mech.end_effector]))
+    return Structure(shape, c.node_offset.copy(), raw, Closures.of(mech, UNFOLDED),
+                     int(c.frame_node[frame or mech.end_effector]))
 
 
 class Scratch(NamedTuple):

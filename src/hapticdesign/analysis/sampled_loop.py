@@ -577,7 +577,10 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
     (n, n) or (P, n, n)) the motors sit behind springs: the plant's coordinates are the motors' ``phi`` and the
     links' ``q``, ``M_r phi'' + B_m phi' + K_t (phi - q) = u`` and ``(H_h - M_r) q'' + (B_h - B_m) q' + (K_h + K_G)
     q + K_t (q - phi) = 0`` (the rotors and the motors' damping on the motor side, the links, the hand and gravity on
-    the other), and the controller senses ``phi`` (the encoders are on the motors). Every period the controller
+    the other), and the controller senses ``phi`` (the encoders are on the motors); ``K_t`` is the drive's full
+    symmetric stiffness, the transmissions' and the links' compliance in series
+    (:mod:`hapticdesign.analysis.stiffness.drive`), and motors of no rotor inertia make a massless motor side
+    (:func:`_massless_plant`: the encoders read ``q + K_t^-1 u``). Every period the controller
     holds, ``d`` samples late, ``u_k = H_m a_(k-d) + K_Gm q_(k-d) - K w w^T q_(k-d) - B_w w w^T v^_(k-d)``, ``q``,
     ``a`` the sensed position and the acceleration sampled under the previous torque, ``K_Gm q`` the linearized
     gravity compensation, ``v^`` the sampled velocity or the backward difference of positions. The state is ``[x_k,
@@ -613,13 +616,14 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
         h_model = np.zeros_like(h)
     if loop.compensation == "none":
         held = np.zeros_like(h)
-    plant = (hh, bh, kp) if transmission is None else _compliant_plant(hh, bh, kp, *(joints(x) for x in transmission),
-                                                                        period=loop.period)
-    phi, gamma = held_plant(*plant, loop.period, inputs=n)
+    plant, massless = ((hh, bh, kp), None) if transmission is None else _compliant_plant(
+        hh, bh, kp, *(joints(x) for x in transmission), period=loop.period)
+    phi, gamma = held_plant(*plant, loop.period, inputs=n) if massless is None else massless[:2]
     if poses is not None:  # each loop takes its pose's plant
         pick = np.asarray(poses, dtype=np.int64)
         phi, gamma, h_model, bh, held = (x[pick] for x in (phi, gamma, h_model, bh, held))
         plant = tuple(x[pick] for x in plant)
+        massless = None if massless is None else tuple(x[pick] for x in massless)
     w = np.asarray(spring, dtype=float)[:, free]
     count, coords = len(w), plant[0].shape[-1]  # coords: n, or 2 n with the motors' own coordinates
     d = loop.delay
@@ -631,7 +635,10 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
     at, rate = nx * d, nx * d + coords  # the sensed sample's positions and rates
     law = np.zeros((count, n, size))  # u_k from the state, spring left out
     ww = w[:, :, None] * w[:, None, :]
-    if compensated:  # H_m a, a the sensed coordinates' rows of M^-1 (u_prev - D v - K q)
+    if compensated and massless is not None:  # H_m a, a the links' acceleration (the motors' between torque steps)
+        law[:, :, u0 + n * d:u0 + n * (d + 1)] += h_model @ massless[3]
+        law[:, :, at:at + 2 * coords] += h_model @ massless[2]
+    elif compensated:  # H_m a, a the sensed coordinates' rows of M^-1 (u_prev - D v - K q)
         feed = h_model @ np.linalg.inv(plant[0])[:, :n, :]
         law[:, :, u0 + n * d:u0 + n * (d + 1)] += feed[:, :, :n]
         law[:, :, at:at + coords] -= feed @ plant[2]
@@ -661,6 +668,11 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
         net = plant[2].copy()
         net[:, :n, :n] -= held
         net *= loop.period ** 2 / np.linalg.norm(plant[0], axis=(1, 2))[:, None, None]
+        if massless is not None:  # in compliance form (K may be huge): phi - q = C K_Gm phi, K_p q = K_Gm phi
+            scale = loop.period ** 2 / np.linalg.norm(plant[0], axis=(1, 2))[:, None, None]
+            eye = np.broadcast_to(np.eye(n), held.shape)
+            net = np.concatenate([np.concatenate([eye - massless[4] @ held, -eye], axis=2),
+                                  np.concatenate([-held, massless[5]], axis=2) * scale], axis=1)
         m, g, hvec, law = _deflated(m, g, hvec, law, w, net, held, depth, u0 if compensated else None)
     reach = np.einsum("sn,sn->s", w, w)
     viscous = np.einsum("sn,snm,sm->s", w, bh, w) / np.maximum(reach, 1e-300) ** 2 + loop.wall_damping
@@ -670,13 +682,20 @@ def handle_loops(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, sp
 
 def _compliant_plant(mass: np.ndarray, damping: np.ndarray, stiffness: np.ndarray, rotor: np.ndarray,
                      motor_damping: np.ndarray, spring: np.ndarray,
-                     period: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The plant of :func:`handle_loops` with compliant transmissions over ``(phi, q)`` (P, 2n, 2n each): the rotors
-    ``M_r`` and the motors' damping ``B_m`` moved from the rigid ``H_h`` and ``B_h`` to the motor side, the
-    transmissions' ``K_t`` between the sides; a one-line error when the link side keeps no positive definite
-    inertia (a link of no mass but the rotor's), or when a motor resonates on its transmission more than
-    :data:`RESONANCE_LIMIT` radians per period (the exact discretization loses its precision there, and the rigid
-    model, which the compliant one tends to, is the answer)."""
+                     period: float) -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray], tuple | None]:
+    """The plant of :func:`handle_loops` with a compliant drive over ``(phi, q)`` (P, 2n, 2n each): the rotors
+    ``M_r`` and the motors' damping ``B_m`` moved from the rigid ``H_h`` and ``B_h`` to the motor side, the drive's
+    ``K`` (a full symmetric matrix: the transmissions' and the links' compliance in series,
+    :mod:`hapticdesign.analysis.stiffness.drive`) between the sides, and None; a one-line error when the link side
+    keeps no positive definite inertia (a link of no mass but the rotor's), or when a motor resonates on its drive
+    more than :data:`RESONANCE_LIMIT` radians per period (the exact discretization loses its precision there, and
+    the rigid model, which the compliant one tends to, is the answer). Motors with no rotor inertia and no damping
+    of their own make a massless motor side (:func:`_massless_plant`), the second item then."""
+    if not np.any(rotor):
+        if np.any(motor_damping):
+            raise UserError("a motor with damping of its own needs a rotor inertia behind a compliant drive (the "
+                            "transmission's or the links'): give rotor_inertia, or the damping on the joint")
+        return _massless_plant(mass, damping, stiffness, spring, period)
     link = mass - rotor
     if not np.all(np.linalg.eigvalsh(link)[..., 0] > 0) or not np.all(np.linalg.eigvalsh(rotor)[..., 0] > 0):
         raise UserError("a compliant transmission needs a rotor inertia on every motor and a link side of positive "
@@ -690,7 +709,35 @@ def _compliant_plant(mass: np.ndarray, damping: np.ndarray, stiffness: np.ndarra
                         "this loop (leave out transmission_stiffness)")
     zero = np.zeros_like(mass)
     return (np.block([[rotor, zero], [zero, link]]), np.block([[motor_damping, zero], [zero, damping - motor_damping]]),
-            np.block([[spring, -spring], [-spring, spring + stiffness]]))
+            np.block([[spring, -spring], [-spring, spring + stiffness]])), None
+
+
+def _massless_plant(mass: np.ndarray, damping: np.ndarray, stiffness: np.ndarray, spring: np.ndarray,
+                    period: float) -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray], tuple]:
+    """A drive ``K`` whose motor side has no inertia and no damping: the spring passes the held torque ``u`` to the
+    links unchanged, ``H_h q'' + B_h q' + K_h q = u``, and stretches by ``C u`` (``C = K^-1``), so an encoder
+    sampled at instant k reads ``phi_k = q_k + C u_(k-1)`` and the motors turn at ``phi' = q'`` between torque steps.
+    Over the state ``(phi, q, phi', q')`` of the compliant plant the held map is the links' exact one
+    (:func:`held_plant`), each of ``phi``, ``phi'`` following its link's row, and ``C`` added to ``phi``'s input
+    (the motors' own columns are zero: eigenvalues 0). Returns the static plant ``(0 (+) H_h, 0 (+) B_h,
+    [[K, -K], [-K, K + K_h]])`` (the fixed points' stiffness and the inertia's scale) and ``(Phi, Gamma, A_x, A_u,
+    C, K_h)``: the held map, the links' acceleration ``A_x x + A_u u_prev`` (the compensator's sampled one) and what
+    :func:`_deflated` needs in compliance form."""
+    n = mass.shape[-1]
+    phi_links, gamma_links = held_plant(mass, damping, stiffness, period)
+    phi, gamma = np.zeros((len(mass), 4 * n, 4 * n)), np.zeros((len(mass), 4 * n, n))
+    columns = np.r_[n:2 * n, 3 * n:4 * n]  # q and q'
+    for block, rows in enumerate((slice(0, n), slice(0, n), slice(n, 2 * n), slice(n, 2 * n))):
+        phi[:, block * n:(block + 1) * n, columns] = phi_links[:, rows]
+        gamma[:, block * n:(block + 1) * n] = gamma_links[:, rows]
+    compliance = np.linalg.inv(spring)
+    gamma[:, :n] += compliance
+    inverse = np.linalg.inv(mass)
+    zero = np.zeros_like(mass)
+    accel = -np.concatenate([zero, inverse @ stiffness, zero, inverse @ damping], axis=2)
+    return ((np.block([[zero, zero], [zero, mass]]), np.block([[zero, zero], [zero, damping]]),
+             np.block([[spring, -spring], [-spring, spring + stiffness]])),
+            (phi, gamma, accel, inverse, compliance, stiffness))
 
 
 RESONANCE_LIMIT = 1e4

@@ -67,8 +67,7 @@ def handle_range(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray) ->
     """The basis ``U`` (P, 3, k) of the directions the handle moves, its mobility ``U^T J_v H^-1 J_v^T U`` and
     damping ``U^T J_v^+T B J_v^+ U`` (P, k, k) in it."""
     basis, _, along = handle_range_basis(jacobian)
-    pinv = np.linalg.pinv(jacobian) @ basis
-    return basis, cartesian.mobility(mass, along), np.swapaxes(pinv, 1, 2) @ damping @ pinv
+    return basis, cartesian.mobility(mass, along), cartesian.damping(jacobian, basis, damping)
 
 
 CHUNK_BYTES = 1 << 24
@@ -81,8 +80,9 @@ def wall_limit(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray, loop
     """The exact stable wall stiffness (N/m) at one pose along ``direction`` (a unit base-frame 3-vector), or the
     smallest over :func:`wall_directions` when it is None (see the module docstring); ``gravity`` the gradient
     ``dG/dq`` (n, n) at the pose (None: 0), ``model`` the compensator's ``H_m`` and ``dG_m/dq`` there (None: the
-    loop's shares, :func:`~hapticdesign.analysis.sampled_loop.handle_loops`), ``transmission`` the motors'
-    compliant transmissions (n, n) each (None: rigid)."""
+    loop's shares, :func:`~hapticdesign.analysis.sampled_loop.handle_loops`), ``transmission`` the compliant drive
+    between the motors and the handle (n, n) each (the transmissions' and the links',
+    :mod:`hapticdesign.analysis.stiffness.drive`; None: rigid)."""
     along = None if direction is None else np.reshape(direction, (1, 1, 3))
     return float(wall_limits(jacobian[None], mass[None], damping, loop, along,
                              None if gravity is None else np.asarray(gravity)[None],
@@ -211,8 +211,8 @@ def kmax(jacobian: np.ndarray, mass: np.ndarray, damping: np.ndarray,
     """The ``kmax`` index (N/m) at P poses: ``J_v`` (P, 3, n), ``H`` (P, n, n), ``B`` (n, n) or (P, n, n), the
     handle's range as :func:`handle_range` gives it (the basis ``U``, mobility and damping in it, already known to
     the caller), the options of :data:`KMAX_OPTIONS`, gravity's gradient ``dG/dq`` (P, n, n) or None and the
-    compensator's ``H_m`` and ``dG_m/dq`` (P, n, n each; None: the loop's uniform shares) and the motors' compliant
-    transmissions (None: rigid)."""
+    compensator's ``H_m`` and ``dG_m/dq`` (P, n, n each; None: the loop's uniform shares) and the compliant drive
+    between the motors and the handle (the transmissions' and the links'; None: rigid)."""
     loop, direction = kmax_loop(options)
     basis, mobility, cartesian_damping = ranges
     if direction is None:

@@ -95,7 +95,7 @@ class ChainBuilder:
     frames: tuple[FrameTemplate, ...]
     bodies: tuple[tuple[str, str], ...]
     end_effector: str | None = None
-    loops: ClosedLoops | None = None
+    loops: ClosedLoops = ClosedLoops()
 
     def value(self, expr: LinearExpr, params: Mapping[str, float]) -> JointValue:
         """The joint value ``offset + sum_k c_k q_k`` of an expression at parameter values ``params``."""

@@ -198,9 +198,8 @@ class DesignSpace:
         self.cache: dict[str, object] = {}
         """What a caller builds once per space (the batched kernels' structure, ...)."""
         position = self.spec.home.get(HOME_POSITION)
-        self.home_position = (np.array(position, dtype=float)
-                              if isinstance(position, list) and self.base.mechanism.loops is not None else None)
-        """The handle's home position of a closed-loop device whose file gives one: each design's home follows it
+        self.home_position = np.array(position, dtype=float) if isinstance(position, list) else None
+        """The handle's home position of a device whose file gives one: each design's home follows it
         (:meth:`_home_follows`; the batched kernels reach it first)."""
 
     # -- names --------------------------------------------------------------------------------
@@ -314,7 +313,7 @@ class DesignSpace:
         file's own loading does), so a design whose loops do not close at the file's joint home is not refused
         for it."""
         position = self.spec.home.get(HOME_POSITION)
-        if not isinstance(position, list) or device.mechanism.loops is None:
+        if not isinstance(position, list):
             return device
         return replace(device, builder=chain_builder(self.spec, home_at(device, position)))
 
@@ -422,7 +421,8 @@ class DesignSpace:
             compliant) and built else None
         return DesignValues(kinematic, standard, np.array([b.reflected for b in built]),
                             np.array([b.damping_matrix for b in built]),
-                            inverse, torques, rigidity, refused, transmission)
+                            inverse, torques, rigidity, refused, transmission,
+                            np.array([damping_matrix(b.actuators, base.n_dof) for b in built]))
 
     def _motors(self, key: tuple) -> "Motors":
         """The motors with the changes ``key`` (:attr:`Applied.motor_key`), built and validated once per distinct
@@ -444,8 +444,7 @@ class DesignSpace:
         mechanism = device.mechanism
         if device.elasticity is not None:
             check_elasticity(mechanism, device.elasticity)
-        if mechanism.loops is not None:
-            configuration_of(device)
+        configuration_of(device)
 
 
 def _number(name: str, value: object) -> float:

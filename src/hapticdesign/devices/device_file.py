@@ -55,7 +55,7 @@ def home_at(device: Device, position: list[float]) -> ClosedLoops:
     return replace(loops, home=tuple(float(v) for v in q_a), assembly=tuple(float(full[k]) for k in loops.passive))
 
 
-def _device(spec: DeviceFileSpec, loops: ClosedLoops | None) -> Device:
+def _device(spec: DeviceFileSpec, loops: ClosedLoops) -> Device:
     """The Device of the file with the given loops (their home and assembly)."""
     builder = chain_builder(spec, loops)
     kinematic = {**spec.parameters, "g": spec.g}
@@ -97,9 +97,9 @@ def link_body_inertias(spec: DeviceFileSpec, mechanism: Mechanism,
     return out
 
 
-def chain_builder(spec: DeviceFileSpec, loops: ClosedLoops | None = None) -> ChainBuilder:
+def chain_builder(spec: DeviceFileSpec, loops: ClosedLoops) -> ChainBuilder:
     """The mechanism builder of a validated device file (its geometry, for any parameter values), with ``loops``
-    (default: the file's own, :func:`_closed_loops`)."""
+    (the file's own, :func:`_closed_loops`, or those with another home, :func:`home_at`)."""
     return ChainBuilder(
         coordinates=tuple(j.name for j in spec.joints),
         joint_types=tuple(JointType(j.type) for j in spec.joints),
@@ -111,7 +111,7 @@ def chain_builder(spec: DeviceFileSpec, loops: ClosedLoops | None = None) -> Cha
         ),
         bodies=tuple((b.name, body_frame(spec, b)) for b in spec.bodies),
         end_effector=spec.end_effector,
-        loops=_closed_loops(spec) if loops is None else loops,
+        loops=loops,
     )
 
 
@@ -124,10 +124,8 @@ def _elasticity(spec: DeviceFileSpec) -> Elasticity | None:
     return Elasticity(links, tuple((name, float(k)) for name, k in spec.joint_stiffness.items()))
 
 
-def _closed_loops(spec: DeviceFileSpec) -> ClosedLoops | None:
-    """Passive joints, closures, assembly guess and home of a file with ``loops`` (None for a tree)."""
-    if not spec.loops:
-        return None
+def _closed_loops(spec: DeviceFileSpec) -> ClosedLoops:
+    """Passive joints, closures, assembly guess and home of a file (a tree's: none, and home 0)."""
     names = [j.name for j in spec.joints]
     return ClosedLoops(
         passive=tuple(k for k, j in enumerate(spec.joints) if not j.actuated),

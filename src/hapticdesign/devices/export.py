@@ -185,7 +185,10 @@ def to_mjcf(device: Device) -> Export:
     rows = {j.name: j for j in joints}
     ordered = tuple(rows[j.get("name")] for j in world.iter("joint"))
     keyframe = ET.SubElement(root, "keyframe")
-    ET.SubElement(keyframe, "key", name="home", qpos=_fmt(np.array([j.row for j in ordered]) @ _home(mech)))
+    from hapticdesign.analysis.configuration import configuration_of  # the loop solver, when a device is exported
+
+    home = configuration_of(device).full_home
+    ET.SubElement(keyframe, "key", name="home", qpos=_fmt(np.array([j.row for j in ordered]) @ home))
     ET.indent(root)
     return Export(_xml_text(root, device), ordered)
 
@@ -202,14 +205,6 @@ def _joint_efforts(device: Device) -> dict[str, float]:
             if not a.coupled and a.torque_peak is not None}
 
 
-def _home(mech: Mechanism) -> np.ndarray:
-    """Full coordinates of the home pose (zeros for a tree)."""
-    if mech.loops is None:
-        return np.zeros(mech.n_dof)
-    from hapticdesign.analysis.loops.solver import LoopSolver
-
-    return LoopSolver(mech).home
-
 
 _STIFFEST = {"solref": EQUALITY_REFERENCE, "solimp": EQUALITY_IMPEDANCE}
 
@@ -225,18 +220,17 @@ def _loops(mech: Mechanism, element: dict, root: ET.Element, couplings) -> None:
             if c and not (mech.coordinates[k] == name):
                 ET.SubElement(fixed, "joint", joint=mech.coordinates[k], coef=f"{-c:.17g}")
         ET.SubElement(equality, "tendon", tendon1=f"coupling_{name}", **_STIFFEST)
-    if mech.loops is not None:
-        for i, closure in enumerate(mech.loops.closures):
-            kind = {(0, 1, 2): "connect", (0, 1, 2, 3, 4, 5): "weld"}.get(tuple(closure.components))
-            if kind is None and any(c >= 3 for c in closure.components):
-                raise UserError(f"cannot export loop {i + 1}: a closure of some rotation components only has no MJCF "
-                                "equality (position or the whole pose can be exported)")
-            sites = []
-            for side, frame in zip("ab", closure.frames):
-                site = f"loop{i + 1}_{side}"
-                ET.SubElement(element[frame], "site", name=site)
-                sites.append(site)
-            ET.SubElement(equality, kind or "connect", site1=sites[0], site2=sites[1], **_STIFFEST)
+    for i, closure in enumerate(mech.loops.closures):
+        kind = {(0, 1, 2): "connect", (0, 1, 2, 3, 4, 5): "weld"}.get(tuple(closure.components))
+        if kind is None and any(c >= 3 for c in closure.components):
+            raise UserError(f"cannot export loop {i + 1}: a closure of some rotation components only has no MJCF "
+                            "equality (position or the whole pose can be exported)")
+        sites = []
+        for side, frame in zip("ab", closure.frames):
+            site = f"loop{i + 1}_{side}"
+            ET.SubElement(element[frame], "site", name=site)
+            sites.append(site)
+        ET.SubElement(equality, kind or "connect", site1=sites[0], site2=sites[1], **_STIFFEST)
     if len(equality):
         equality.insert(0, ET.Comment(
             f" solref {EQUALITY_REFERENCE}: time constant 2 x timestep ({TIMESTEP:g} s), the stiffest MuJoCo keeps "
@@ -286,7 +280,7 @@ def to_urdf(device: Device) -> Export:
     """The device as a URDF robot: a tree only (URDF has no loop closures), each coupled transform a joint that
     ``<mimic>``s the one coordinate it follows (URDF cannot state a combination of two coordinates)."""
     mech = device.mechanism
-    if mech.loops is not None:
+    if not mech.loops.empty:
         raise UserError(f"cannot export {device.name!r} as URDF: it has closed loops, which URDF cannot describe "
                         "(export it as MJCF)")
     tree = _Tree(mech)

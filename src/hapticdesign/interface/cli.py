@@ -32,6 +32,7 @@ CONTENTS = {
     "rcube": "R-CUBE mechanism and its optimization (seed 001)",
     "rcube_optimize": "R-CUBE mechanism and its optimization (seed 001)",
     "optimize": "Design optimization of any device",
+    "explore": "Design optimization of any device",
     "study": "Studies and reports (both seeds end to end)",
 }
 OTHER = "More commands"

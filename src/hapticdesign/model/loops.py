@@ -77,14 +77,22 @@ class ClosedLoops:
     """Which tree coordinates are passive, the closures that fix them, and the assembly at home.
 
     ``passive`` are indices into the mechanism's coordinates (the others are actuated, in order);
-    ``home`` holds the actuated values of the home pose and ``assembly`` the passive values near
-    the intended assembly branch at home (the Newton start of :mod:`hapticdesign.analysis.loops`).
+    ``home`` holds the actuated values of the home pose (none given: 0) and ``assembly`` the passive values near
+    the intended assembly branch at home (the Newton start of :mod:`hapticdesign.analysis.loops`). A tree's loops
+    are the empty ones, ``ClosedLoops()``: no closures, no passive coordinates (Pinocchio's view: a tree is a
+    device whose list of constraints is empty), so every device is solved by the same calls.
     """
 
-    passive: tuple[int, ...]
-    closures: tuple[LoopClosure, ...]
-    assembly: tuple[float, ...]
-    home: tuple[float, ...]
+    passive: tuple[int, ...] = ()
+    closures: tuple[LoopClosure, ...] = ()
+    assembly: tuple[float, ...] = ()
+    home: tuple[float, ...] = ()
+
+    @property
+    def empty(self) -> bool:
+        """No closures (a tree): nothing to close, no passive coordinates, the device's equations of motion keep
+        their exact trigonometric basis."""
+        return not self.closures
 
     @property
     def n_constraints(self) -> int:
@@ -96,21 +104,21 @@ class ClosedLoops:
     def guess(self, n_coordinates: int) -> np.ndarray:
         """The Newton start at home (every coordinate): ``home``'s actuated values, ``assembly``'s passive ones."""
         q = np.zeros(n_coordinates)
-        q[list(self.actuated(n_coordinates))] = self.home
+        q[list(self.actuated(n_coordinates))] = self.home or 0.0
         q[list(self.passive)] = self.assembly
         return q
 
     def validate(self, coordinates: tuple[str, ...], frames: set[str]) -> None:
-        """Square closure system and known frames; raises a one-line UserError."""
+        """Square closure system (none for a tree) and known frames; raises a one-line UserError."""
         n = len(coordinates)
         if len(set(self.passive)) != len(self.passive) or not all(0 <= k < n for k in self.passive):
             raise UserError("passive joints must be distinct coordinates of the mechanism")
-        if not self.passive:
-            raise UserError("loops need at least one passive joint (actuated: false)")
-        if len(self.passive) == n:
+        if self.passive and len(self.passive) == n:
             raise UserError("every joint is passive: mark at least one joint as actuated")
-        if not self.closures:
+        if self.passive and not self.closures:
             raise UserError(f"passive joints {', '.join(coordinates[k] for k in self.passive)} need loops to close")
+        if self.closures and not self.passive:
+            raise UserError("loops need at least one passive joint (actuated: false)")
         for closure in self.closures:
             for frame in closure.frames:
                 if frame not in frames:
@@ -126,7 +134,7 @@ class ClosedLoops:
             )
         if len(self.assembly) != k:
             raise UserError(f"assembly: expected {k} passive values, got {len(self.assembly)}")
-        if len(self.home) != n - k:
+        if len(self.home) not in (0, n - k):
             raise UserError(f"home: expected {n - k} actuated values, got {len(self.home)}")
         for label, values in (("home", self.home), ("assembly", self.assembly)):
             if not all(math.isfinite(v) and abs(v) <= POSE_LIMIT for v in values):

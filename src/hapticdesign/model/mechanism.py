@@ -59,7 +59,8 @@ class Mechanism:
     gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
     end_effector: str | None = None
     metadata: dict = field(default_factory=dict)
-    loops: ClosedLoops | None = None
+    loops: ClosedLoops = field(default_factory=ClosedLoops)
+    """The closed loops (a tree's are the empty ones, the default)."""
 
     def __post_init__(self) -> None:
         names = [f.name for f in self.frames]
@@ -79,8 +80,7 @@ class Mechanism:
                 raise UserError(f"body {b.name}: unknown frame {b.frame!r}")
         if self.end_effector is not None and self.end_effector not in known:
             raise UserError(f"unknown end-effector frame {self.end_effector!r}")
-        if self.loops is not None:
-            self.loops.validate(self.coordinates, known)
+        self.loops.validate(self.coordinates, known)
 
     @property
     def n_dof(self) -> int:
@@ -89,12 +89,10 @@ class Mechanism:
     @property
     def n_actuated(self) -> int:
         """Independent (actuated) coordinates: all of them for a tree, fewer with passive joints."""
-        return self.n_dof - (len(self.loops.passive) if self.loops else 0)
+        return self.n_dof - len(self.loops.passive)
 
     @property
     def actuated_coordinates(self) -> tuple[str, ...]:
-        if self.loops is None:
-            return self.coordinates
         return tuple(self.coordinates[k] for k in self.loops.actuated(self.n_dof))
 
     @property
@@ -110,6 +108,12 @@ class Mechanism:
         return self.compiled.frame_pose(np.asarray(q, dtype=float), frame)
 
 
+UNFOLDED = "unfolded"
+"""The node numbering with one node per elementary transform (:class:`CompiledMechanism`'s own arrays)."""
+FOLDED = "folded"
+"""The node numbering with the constant transforms folded into the nodes (``CompiledMechanism.tree``)."""
+
+
 @dataclass(frozen=True)
 class CompiledMechanism:
     """Flat arrays of the frame tree: one node per elementary transform.
@@ -117,9 +121,19 @@ class CompiledMechanism:
     ``node_parent[n]`` is the previous node (``-1`` for the base), ``node_axis[n]`` the
     :class:`~hapticdesign.model.transforms.Axis` code, ``node_coef[n]`` and ``node_offset[n]`` the
     affine joint value, ``body_node[b]`` the node whose frame body ``b`` is attached to, and
-    ``body_path[b]`` the variable nodes from the base to that body (padded with ``-1``). These exact
-    elementary transforms serve the symbolic derivation and drawing; numeric walks take ``tree``, the
-    same tree with its constant transforms folded (:class:`~hapticdesign.model.walk.KinematicTree`).
+    ``body_path[b]`` the variable nodes from the base to that body (padded with ``-1``).
+
+    One device's frames are walked on two node numberings, each for its own job (:meth:`nodes`):
+
+    - :data:`UNFOLDED`, these arrays, one node per elementary transform: the symbolic derivation and drawing, and
+      the walks over many designs of one geometry, whose constant transforms differ from design to design so that
+      none can be folded (the design batch, :mod:`hapticdesign.analysis.design_batch`, and the inverse kinematics,
+      :mod:`hapticdesign.analysis.reach_kernel`, which one device shares with them as a batch of one);
+    - :data:`FOLDED`, ``tree``, the same tree with its constant transforms folded into the variable nodes
+      (:class:`~hapticdesign.model.walk.KinematicTree`): the walks of one geometry, fewer nodes per pose (forward
+      kinematics, the loop solver of :mod:`hapticdesign.analysis.loops`, the dynamics and the simulation plant).
+
+    Poses closed on either are the same; a kernel takes the closures on the numbering of the tree it walks.
     """
 
     n_dof: int
@@ -179,6 +193,10 @@ class CompiledMechanism:
             tree=KinematicTree.fold(node_parent, node_axis, node_coef, node_offset, frame_node,
                                     [b.frame for b in mech.bodies]),
         )
+
+    def nodes(self, numbering: str) -> dict[str, int]:
+        """Frame name to the node it ends on (-1: the base) in ``numbering``, :data:`FOLDED` or :data:`UNFOLDED`."""
+        return {UNFOLDED: self.frame_node, FOLDED: self.tree.frame_node}[numbering]
 
     def path_to(self, frame: str) -> list[int]:
         """Nodes from the base to ``frame``, in order."""

@@ -26,7 +26,6 @@ import math
 import warnings
 from collections.abc import Iterable, Mapping
 from functools import partial
-from pathlib import Path
 
 import numpy as np
 
@@ -40,7 +39,7 @@ from hapticdesign.analysis.view.skeleton import home_pose
 from hapticdesign.analysis.workspace import Workspace, reach_workspace
 from hapticdesign.devices.design_space import DesignSpace
 from hapticdesign.errors import UserError
-from hapticdesign.files import parse_structured, quote
+from hapticdesign.files import parse_structured, quote, structured_kind
 from hapticdesign.optimization.pymoo_run import elementwise_runner
 from hapticdesign.optimization.study_file import Choice, IndexConstraint, Study
 from hapticdesign.optimization.study_polish import most_designs
@@ -76,10 +75,6 @@ def workspace_of(study: Study) -> Workspace | None:
         raise UserError(f"{study.path}: {exc}") from None
 
 
-def _kind(path: Path) -> str:
-    return {".yml": "yaml", ".yaml": "yaml", ".toml": "toml", ".json": "json"}.get(path.suffix.lower(), "")
-
-
 class BoundStudy:
     """A study with its device file's design space, its workspace points and its index requests checked: the
     ``mapping`` of the device file, its ``space``, the reduced index ``keys`` of the study, the ``labels`` of its
@@ -91,7 +86,7 @@ class BoundStudy:
         self.registry = registry
         """The indices the study may name."""
         spec = study.spec
-        kind = _kind(study.device_path)
+        kind = structured_kind(study.device_path)
         if not kind:
             raise UserError(f"{study.path}: device {study.device_path.name!r} must be a device file (.yaml, .yml, "
                             ".toml or .json)")

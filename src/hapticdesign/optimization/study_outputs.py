@@ -409,14 +409,16 @@ def device_mapping(bound: BoundStudy, values: dict[str, float]) -> dict:
     return data
 
 
-def device_file_text(bound: BoundStudy, values: dict[str, float], comments: Sequence[str] = ()) -> str:
+def device_file_text(bound: BoundStudy, values: dict[str, float], comments: Sequence[str] = (),
+                     evaluated: bool = True) -> str:
     """:func:`device_mapping` as YAML, headed by where it comes from, the ``comments`` lines (the device file's design
-    beside it) and where the study evaluated it (:func:`where_evaluated`)."""
+    beside it) and, with ``evaluated``, where the study evaluated it (:func:`where_evaluated`; a design the device file
+    refuses has no such lines, and the comments say why)."""
     shown = ", ".join(f"{k} = {v!r}" for k, v in values.items())
     names = (json.dumps(bound.study.path.name), json.dumps(bound.study.device_path.name))  # no line break in them
     header = f"# The design selected by study {names[0]} from device file {names[1]}:\n# {shown}\n"
     lines = "".join(f"# {' '.join(line.splitlines())}\n" for line in comments)  # a reason's line break stays a comment
-    return (header + lines + where_evaluated(bound, values)
+    return (header + lines + (where_evaluated(bound, values) if evaluated else "")
             + yaml.safe_dump(device_mapping(bound, values), sort_keys=False, allow_unicode=False))
 
 

@@ -43,6 +43,7 @@ from threadpoolctl import ThreadpoolController
 from hapticdesign.analysis.dynamics.device import (
     coriolis_centrifugal, dynamics_of, gravity, gravity_gradient, mass_matrix,
 )
+from hapticdesign.analysis.dynamics.model import has_trigonometric_basis
 from hapticdesign.analysis.sampled_loop import Hand, SampledLoop, SpringLoops, handle_loops, held_plant
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
@@ -104,8 +105,7 @@ class WallJoint:
 def wall_loop(config: LoopConfig) -> SampledLoop:
     """The settings of :func:`wall_loops` from ``config``: its period, delay, wall damper and hand, the sampled
     velocity and the full compensator (each wall's own model)."""
-    return SampledLoop(config.sensors.period, config.sensors.delay_samples, "sampled", "full", 0.0,
-                       config.wall.damping, config.hand)
+    return replace(config.loop, velocity="sampled", compensation="full", error_percent=0.0, held=())
 
 
 def wall_loops(walls: list[WallJoint], config: LoopConfig) -> SpringLoops:
@@ -123,7 +123,7 @@ def wall_loops(walls: list[WallJoint], config: LoopConfig) -> SpringLoops:
 
 def linear_loop(device: Device, config: LoopConfig) -> bool:
     """Whether the sampled loop is linear about a pose: no encoder quantization, no Coulomb friction."""
-    return config.sensors.counts_per_revolution is None and not np.any(plant_friction(device, config)[1] > 0)
+    return config.counts is None and not np.any(plant_friction(device, config)[1] > 0)
 
 
 def start_pose(device: Device, sim_type: int, wall_joint: int) -> tuple[np.ndarray, np.ndarray, dict]:
@@ -167,7 +167,7 @@ def equilibrium_pose(device: Device, sim_type: int, wall_joint: int, config: Loo
 def linearize(device: Device, sim_type: int, wall_joint: int, config: LoopConfig,
               pose: np.ndarray | None = None) -> WallJoint:
     """The 1-DOF sampled loop of the wall joint at ``pose`` (default: the start pose; see the module docstring)."""
-    if config.sensors.counts_per_revolution is not None:
+    if config.counts is not None:
         raise UserError("the analytic method has no encoder quantization (not linear): use the simulation")
     if np.any(plant_friction(device, config)[1] > 0):
         raise UserError("the analytic method has no Coulomb friction (not linear): use the simulation")
@@ -176,15 +176,15 @@ def linearize(device: Device, sim_type: int, wall_joint: int, config: LoopConfig
         q0 = np.asarray(pose, dtype=float)
     w = wall_joint
     damping = np.asarray(config.damping if config.damping is not None else device.damping, dtype=float)
-    model = compensator_device(device, config.compensator)
-    comp = config.compensator
+    model = compensator_device(device, config)
+    inertial, _, gravity_term = config.switches
     reach = handle_jacobian(device, q0)[:3, w]
     wall = WallJoint(
         inertia=float(mass_matrix(device, q0)[w, w]), damping=float(damping[w]), reach=reach,
         gravity=float(gravity_gradient(device, q0)[w, w]),
-        model_inertia=float(mass_matrix(model, q0)[w, w]) if comp.inertial else 0.0,
-        model_gravity=float(comp.gravity * gravity_gradient(model, q0)[w, w]),
-        torque=-(float(gravity(device, q0)[w]) - comp.gravity * float(gravity(model, q0)[w])),
+        model_inertia=float(mass_matrix(model, q0)[w, w]) if inertial else 0.0,
+        model_gravity=float(gravity_term * gravity_gradient(model, q0)[w, w]),
+        torque=-(float(gravity(device, q0)[w]) - gravity_term * float(gravity(model, q0)[w])),
         exact=sim_type == 1 or _decoupled(device, w, paths, rest))
     if not config.wall.cartesian:
         return wall
@@ -258,11 +258,11 @@ class AnalyticProblem(WallProblem):
         self.held = self._held()
         self.rest = self.equilibrium / self.wall.scale  # the spring's rest in joint units
         self.sub = self.config.steps_per_sample()
-        self.samples = int(round(self.config.duration / self.config.sensors.period))
+        self.samples = int(round(self.config.duration / self.config.loop.period))
         self.driven = None
         with one_blas_thread():
             self.loops = wall_loops([self.wall, self.held], self.config)
-            inertia, damping, stiffness = (np.full((1, 1, 1), v) for v in self.wall.plant(self.config.hand))
+            inertia, damping, stiffness = (np.full((1, 1, 1), v) for v in self.wall.plant(self.config.loop.hand))
             phi, gamma = held_plant(inertia, damping, stiffness, self.config.step)
             self._steps = _sub_steps((phi[0], gamma[0, :, 0]), self.sub)
             if self._time_varying():
@@ -280,14 +280,13 @@ class AnalyticProblem(WallProblem):
         a hand's spring, resting at the start pose, move the pose by about their torque over ``K``); the loop at the
         spring's rest when nothing pushes there, None when the wall cannot hold the joint (it falls)."""
         w, held = self.wall_joint, self.held
-        hand = self.config.hand or Hand()
+        hand = self.config.loop.hand or Hand()
         row = np.zeros(self.device.n_dof)
         row[w] = held.scale
         hand_spring = np.zeros((self.device.n_dof, self.device.n_dof))
         hand_spring[w, w] = hand.stiffness * float(held.reach @ held.reach)
         start = start_pose(self.device, self.sim_type, w)[1]
-        comp = self.config.compensator
-        model = compensator_device(self.device, comp) if comp.gravity else None
+        model = compensator_device(self.device, self.config) if self.config.switches[2] else None
         pose = spring_rest(self.device, model, self.held_pose, row, stiffness, [w], (hand_spring, start))
         if pose is None:
             return None
@@ -296,24 +295,23 @@ class AnalyticProblem(WallProblem):
     def _time_varying(self) -> bool:
         """Type 2 with the wall joint coupled to the motion, on a joint wall of an open chain without a hand."""
         cfg = self.config
-        return (self.sim_type == 2 and not self.wall.exact and not cfg.wall.cartesian and cfg.hand is None
-                and self.device.mechanism.loops is None)
+        return (self.sim_type == 2 and not self.wall.exact and not cfg.wall.cartesian and cfg.loop.hand is None
+                and has_trigonometric_basis(self.device.mechanism))
 
     def _driven_loop(self) -> DrivenLoop:
         device, cfg, w = self.device, self.config, self.wall_joint
         rest = rest_pose(device)
         damping = np.asarray(cfg.damping if cfg.damping is not None else device.damping, dtype=float)
-        comp = cfg.compensator
-        switches = (float(comp.inertial), float(comp.coriolis), float(comp.gravity))
-        return DrivenLoop.build(device, compensator_device(device, comp), w, type_paths(2, device.n_dof, w, rest), rest,
-                                float(damping[w]), switches, cfg.sensors.period, self.sub, self.samples,
-                                cfg.sensors.delay_samples, cfg.wall.damping, self.rest)
+        switches = tuple(float(on) for on in cfg.switches)
+        return DrivenLoop.build(device, compensator_device(device, cfg), w, type_paths(2, device.n_dof, w, rest), rest,
+                                float(damping[w]), switches, cfg.loop.period, self.sub, self.samples,
+                                cfg.loop.delay, cfg.loop.wall_damping, self.rest)
 
     @property
     def exact(self) -> bool:
         if self.driven is not None:
             return bool(dynamics_of(self.device).cyclic[self.wall_joint] and
-                        dynamics_of(compensator_device(self.device, self.config.compensator)).cyclic[self.wall_joint])
+                        dynamics_of(compensator_device(self.device, self.config)).cyclic[self.wall_joint])
         return self.wall.exact
 
     @property
@@ -324,8 +322,8 @@ class AnalyticProblem(WallProblem):
         return self.sim_type == 1 or self.exact
 
     def estimate(self) -> float:
-        inertia, damping, _ = self.wall.plant(self.config.hand)
-        joint = damping ** 2 / inertia if self.wall.model_inertia > 0 else 2.0 * damping / self.config.sensors.period
+        inertia, damping, _ = self.wall.plant(self.config.loop.hand)
+        joint = damping ** 2 / inertia if self.wall.model_inertia > 0 else 2.0 * damping / self.config.loop.period
         return joint / self.wall.scale ** 2
 
     def response(self, stiffness: float) -> np.ndarray:
@@ -340,13 +338,13 @@ class AnalyticProblem(WallProblem):
         acceleration (the seed's initial conditions); between samples the plant moves exactly under the held torque.
         """
         wall = self.wall
-        _, _, k = wall.plant(self.config.hand)
+        _, _, k = wall.plant(self.config.loop.hand)
         s2 = wall.scale ** 2
         push = wall.torque - k * self.rest  # the constant torque in the spring's coordinate p = x - rest
         with np.errstate(divide="ignore", invalid="ignore"):
             p_eq = (push + wall.model_gravity * self.rest) / (k - wall.model_gravity + stiffness * s2)
         u_eq = -stiffness * s2 * p_eq + wall.model_gravity * (p_eq + self.rest)
-        size, lines = self.loops.base.shape[-1], 2 * (self.config.sensors.delay_samples + 1)
+        size, lines = self.loops.base.shape[-1], 2 * (self.config.loop.delay + 1)
         start, fixed = np.zeros(size), np.zeros(size)
         start[:lines:2], fixed[:lines:2] = -self.rest, p_eq
         start[lines:], fixed[lines:] = -k * self.rest - push, u_eq
@@ -393,7 +391,7 @@ class AnalyticProblem(WallProblem):
             return Verdict(stiffness, False, cause, peak, math.nan, i * self.config.step)
         peak = float(excursion.max())
         samples = q[:, 0]
-        t = np.arange(len(samples)) * self.config.sensors.period
+        t = np.arange(len(samples)) * self.config.loop.period
         tail = samples[t >= t[-1] - self.criteria.settle_window]
         final = float(np.max(np.abs(tail - self.equilibrium)))
         if final > self.criteria.settle_tolerance:

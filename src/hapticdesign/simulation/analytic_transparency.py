@@ -143,17 +143,16 @@ def linear_along(rows: tuple[_Row, _Row], switches: np.ndarray, amplitude: float
 def transparency_loop(device: Device, sim_type: int, wall_joint: int, config: LoopConfig,
                       amplitude: float) -> TransparencyLoop:
     """The wall joint's loop along the chirp at the start pose (module docstring)."""
-    if config.sensors.counts_per_revolution is not None:
+    if config.counts is not None:
         raise UserError("the analytic method has no encoder quantization (not linear): use the simulation")
     if np.any(plant_friction(device, config)[1] > 0):
         raise UserError("the analytic method has no Coulomb friction (not linear): use the simulation")
     w, n = wall_joint, device.n_dof
     m = moving_joints(n, sim_type, w)
-    comp = config.compensator
-    switches = np.array([comp.inertial, comp.coriolis, comp.gravity], dtype=float)
+    switches = np.array(config.switches, dtype=float)
     rest = rest_pose(device)
-    plant, model = _Row(device, w, m, rest), _Row(compensator_device(device, comp), w, m, rest)
-    hand_mass, hand_damping, hand_stiffness = hand_matrices(device, config.hand, rest)
+    plant, model = _Row(device, w, m, rest), _Row(compensator_device(device, config), w, m, rest)
+    hand_mass, hand_damping, hand_stiffness = hand_matrices(device, config.loop.hand, rest)
     damping = plant_damping(device, config)
     zero = np.zeros(1)
     j, c = float(plant.inertia(zero)[0]), switches[0] * float(model.inertia(zero)[0])
@@ -221,18 +220,18 @@ def analytic_transparency(
         raise UserError(f"unknown joint {wall_joint + 1}; the device has joints 1..{device.n_dof}")
     if not math.isfinite(equilibrium):
         raise UserError("the wall equilibrium must be finite")
-    if cfg.sensors.delay_samples * cfg.sensors.period >= chirp.sweep_time:
-        raise UserError(f"the sensor delay ({cfg.sensors.delay_samples} samples) must be shorter than the sweep "
+    delay = cfg.loop.delay
+    if delay * cfg.loop.period >= chirp.sweep_time:
+        raise UserError(f"the sensor delay ({delay} samples) must be shorter than the sweep "
                         f"({chirp.sweep_time:g} s)")
-    wall_damping = cfg.wall.damping
+    wall_damping = cfg.loop.wall_damping
     loop = transparency_loop(device, sim_type, wall_joint, cfg, chirp.amplitude)
-    delay = cfg.sensors.delay_samples
     f, z = signal_spectra(chirp, cfg.step, cfg.steps_per_sample(), delay, segment_seconds, window)
     z_d = stiffness * z["pos"] + wall_damping * z["vel"]
     z_m = (loop.inertia * z["acc"] + loop.damping * z["vel"] + loop.spring * z["pos"]
            - loop.compensated_inertia * z["held_acc"] + (stiffness - loop.compensated_spring) * z["held_pos"]
            + wall_damping * z["held_vel"])
-    steady = steady_response(loop, f, cfg.sensors.period, delay, stiffness, wall_damping)
+    steady = steady_response(loop, f, cfg.loop.period, delay, stiffness, wall_damping)
     z_steady_d = stiffness + 1j * wall_damping * 2 * np.pi * f
     gain_db = 20 * np.log10(np.abs(z_m / z_d))
     steady_db = 20 * np.log10(np.abs(steady / z_steady_d))

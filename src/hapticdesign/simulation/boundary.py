@@ -13,7 +13,7 @@ import numpy as np
 
 from hapticdesign.analysis.sampled_loop import SampledLoop
 from hapticdesign.errors import UserError
-from hapticdesign.simulation.config import Wall, loop_config
+from hapticdesign.simulation.config import LoopConfig, Wall
 from hapticdesign.simulation.loop import simulate_tables
 from hapticdesign.simulation.tables import DynamicsTables
 from hapticdesign.workload import require_plant_steps
@@ -25,8 +25,9 @@ def grows(inertia: float, damping: float, loop: SampledLoop, stiffness: float, s
           substeps: int = 10) -> bool:
     """True when the simulated oscillation of the 1-DOF loop (inertia, damping, the settings ``loop``; a hand adds
     its mass, damping and stiffness to the joint's) about the wall's rest grows (last vs second quarter)."""
-    cfg = loop_config(loop, Wall(0, stiffness, 0.0, 0.01), duration=samples * loop.period, step=loop.period / substeps,
-                      damping=(damping,), safety_limit=None, stop_excursion=1e6)
+    cfg = LoopConfig(duration=samples * loop.period, step=loop.period / substeps, loop=loop,
+                     wall=Wall(0, stiffness, equilibrium=0.01), damping=(damping,), safety_limit=None,
+                     stop_excursion=1e6)
     model = inertia * (1.0 - loop.error_percent / 100.0)
     plant = DynamicsTables.constant_inertia(inertia)
     hand = loop.hand

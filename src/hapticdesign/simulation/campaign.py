@@ -85,15 +85,16 @@ class CampaignOptions:
     transmitted torque of :mod:`.analytic_transparency`; exact for type 1, and for type 2 when LN = 0)."""
 
     conditions: LoopConfig = field(default_factory=LoopConfig)
-    """Realistic conditions for every case (seed 000 ch. 5's first future-work item): sensors (period,
-    encoder quantization, delay), the compensator (its terms, its modelling error, per group with seeded
-    signs), Coulomb friction in the plant and the hand. The seed's ideal loop by default; ``duration`` above
-    sets the impedance runs' length, the campaign sets the wall."""
+    """Realistic conditions for every case (seed 000 ch. 5's first future-work item): the loop (its
+    :class:`~hapticdesign.analysis.sampled_loop.SampledLoop`: period, delay, modelling error, hand), encoder
+    quantization, the compensator (its terms, its error per group with seeded signs) and Coulomb friction in the
+    plant. The seed's ideal loop by default; ``duration`` above sets the impedance runs' length, the campaign sets
+    the wall."""
 
     def __post_init__(self) -> None:
         if self.method not in ("simulation", "analytic"):
             raise UserError(f"the campaign method must be 'simulation' or 'analytic', got {self.method!r}")
-        if self.method == "analytic" and self.conditions.sensors.counts_per_revolution is not None:
+        if self.method == "analytic" and self.conditions.counts is not None:
             raise UserError("the analytic method has no encoder quantization (not linear): use the simulation")
         if self.method == "analytic" and self.conditions.coulomb is not None and any(self.conditions.coulomb):
             raise UserError("the analytic method has no Coulomb friction (not linear): use the simulation")

@@ -1,7 +1,8 @@
 """What a sampled-data simulation is configured with and what it returns (seed 000 §4.1.1).
 
 Shared by the fast loop (:mod:`.loop`, :mod:`.kernel`) and the independent SciPy loop
-(``tests/helpers/reference.py``), so that neither imports the other. Defaults follow the seed: plant step
+(``tests/helpers/reference.py``), so that neither imports the other. The loop's settings are the one
+:class:`~hapticdesign.analysis.sampled_loop.SampledLoop` of every command; defaults follow the seed: plant step
 1e-4 s, sample period 1 ms, perfect sensors (condition ix), no modelling error (condition vi), no
 hand (condition vii), safety switch at 0.06 rad (Fig. 4.7).
 """
@@ -9,14 +10,15 @@ hand (condition vii), safety switch at 0.06 rad (Fig. 4.7).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+import warnings
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.analysis.dynamics.device import gravity, gravity_gradient, mass_matrix
 from hapticdesign.analysis.sampled_loop import Hand, SampledLoop
-from hapticdesign.errors import InputError, UserError
+from hapticdesign.errors import InputError, RenamedWarning, UserError
 from hapticdesign.model.device import Device
 from hapticdesign.model.compensator_model import model_device
 
@@ -37,9 +39,16 @@ FRICTION_VELOCITY = 1e-3
 made smooth enough for a fixed-step integrator; above 3 v_f it is within 0.5 % of ``F_c sign(qd)``."""
 
 
+def renamed(old: str, new: str, stacklevel: int = 4) -> None:
+    """One :class:`~hapticdesign.errors.RenamedWarning` for an old keyword of the simulation's records and calls, taken
+    one release more."""
+    warnings.warn(f"{old} is now {new}; {old} will be removed", RenamedWarning, stacklevel=stacklevel)
+
+
 @dataclass(frozen=True)
 class Wall:
-    """The virtual wall: a joint wall, or a Cartesian wall when ``direction`` is given.
+    """The virtual wall: a joint wall, or a Cartesian wall when ``direction`` is given; its damper is the loop's
+    ``wall_damping`` (:class:`~hapticdesign.analysis.sampled_loop.SampledLoop`).
 
     Joint wall: ``tau_imp = K (q_j - q_eq) + B qd_j`` on joint ``joint`` (K in N m/rad, B in N m s/rad,
     ``equilibrium`` the angle q_eq; N/m, N s/m and m for a prismatic joint).
@@ -50,17 +59,18 @@ class Wall:
     x_eq) + B J_n qd)``, ``J_n = n^T J_v``). ``equilibrium`` is then the rest of the spring in metres
     along n from the handle's start, and ``joint`` only names the joint the seed's experiments leave
     free (:func:`~.criteria.type_paths`). Like the joint wall it pulls from both sides of its rest.
+    ``damping`` is the damper's former place, taken one release (a :class:`LoopConfig` moves it to its loop).
     """
 
     joint: int = 0
     stiffness: float = 1.0
-    damping: float = 0.0
+    damping: float | None = None
     equilibrium: float = 0.01
     direction: tuple[float, float, float] | None = None
 
     def __post_init__(self) -> None:
-        if not (math.isfinite(self.damping) and self.damping >= 0):
-            raise InputError(f"the wall damping must be a finite number >= 0, got {self.damping}", "wall_damping")
+        if self.damping is not None:
+            renamed("Wall(damping=...)", "SampledLoop(wall_damping=...) of LoopConfig(loop=...)")
 
     @property
     def cartesian(self) -> bool:
@@ -76,19 +86,10 @@ class Wall:
 
 def loop_config(loop: SampledLoop, wall: Wall | None = None, counts_per_revolution: int | None = None,
                 **simulation) -> LoopConfig:
-    """The simulation's configuration of the loop settings ``loop`` (one record for every command): its period,
-    delay, compensation (``gravity``: the gravity term only; ``full``: inertial, Coriolis and gravity terms with the
-    modelling error), wall damper and hand; ``simulation`` the run's own fields (duration, step, ...). The simulated
-    damper uses the sampled velocity: a backward difference with a damper is refused."""
-    if loop.velocity == "difference" and loop.wall_damping > 0:
-        raise InputError("the simulated wall's damper uses the sampled velocity; a backward-difference damper is "
-                         "analysed exactly only", "velocity")
-    full = loop.compensation == "full"
-    wall = wall or Wall()
-    return LoopConfig(sensors=Sensors(loop.period, counts_per_revolution, loop.delay),
-                      compensator=Compensator(full, full, loop.compensation != "none", loop.error_percent),
-                      wall=Wall(wall.joint, wall.stiffness, loop.wall_damping, wall.equilibrium, wall.direction),
-                      hand=loop.hand, **simulation)
+    """``LoopConfig(loop=loop, wall=wall, counts=counts_per_revolution, **simulation)``, its former spelling, taken
+    one release."""
+    renamed("loop_config(loop, wall, counts)", "LoopConfig(loop=loop, wall=wall, counts=counts)")
+    return LoopConfig(loop=loop, wall=wall or Wall(), counts=counts_per_revolution, **simulation)
 
 
 def unit_direction(direction) -> np.ndarray:
@@ -108,58 +109,69 @@ def unit_direction(direction) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Compensator:
-    """Inverse dynamics of a model device (§4.1.1.2) and its modelling error.
+    """How the compensator's model departs from the loop's compensation (§4.1.1.2): which of its terms are kept and
+    how its modelling error (the loop's ``error_percent``) spreads over the parameters.
 
-    ``error_percent`` scales every inertial parameter by ``1 - E/100`` (the seed's "error %" of
-    masses, inertias and mass centres alike). ``group_errors`` gives each group its own error in
-    percent: ``{"mass": E_m, "centre": E_r, "inertia": E_I}`` (masses ``m``; mass-centre offsets
-    ``rx ry rz``; inertia entries ``Ixx ... Iyz``); with ``error_seed`` each parameter of a group gets
-    a random sign (``numpy.random.default_rng(error_seed)``, in the order of the device's parameter
-    names), so the model over- and underestimates as a real identification would.
+    ``inertial``, ``coriolis``, ``gravity`` keep (True) or drop each term the loop's ``compensation`` feeds forward
+    (``full``: all three; ``gravity``: gravity only; ``none``: none): an ablation of the seed's law. The loop's
+    ``error_percent`` scales every inertial parameter by ``1 - E/100`` (the seed's "error %" of masses, inertias
+    and mass centres alike). ``group_errors`` gives each group its own error in percent on top: ``{"mass": E_m,
+    "centre": E_r, "inertia": E_I}`` (masses ``m``; mass-centre offsets ``rx ry rz``; inertia entries ``Ixx ...
+    Iyz``); with ``error_seed`` each parameter of a group gets a random sign (``numpy.random.default_rng(error_seed)``,
+    in the order of the device's parameter names), so the model over- and underestimates as a real identification
+    would. ``error_percent`` is the error's former place, taken one release (a :class:`LoopConfig` moves it to its
+    loop).
     """
 
     inertial: bool = True
     coriolis: bool = True
     gravity: bool = True
-    error_percent: float = 0.0
+    error_percent: float | None = None
     group_errors: tuple[tuple[str, float], ...] = ()
     error_seed: int | None = None
 
     def __post_init__(self) -> None:
-        if not (math.isfinite(self.error_percent) and -100 < self.error_percent < 100):
-            raise InputError(f"the error percentage must be a finite number between -100 and 100 (exclusive), got "
-                             f"{self.error_percent}", "error_percent")
+        if self.error_percent is not None:
+            renamed("Compensator(error_percent=...)", "SampledLoop(error_percent=...) of LoopConfig(loop=...)")
 
 
 @dataclass(frozen=True)
 class Sensors:
-    """Sampling period ``T``, optional encoder counts per revolution and delay in samples."""
+    """The former record of the sample period, encoder counts and delay, taken one release: a :class:`LoopConfig`
+    moves them to its ``loop`` (``period``, ``delay``) and ``counts``."""
 
     period: float = 1e-3
     counts_per_revolution: int | None = None
     delay_samples: int = 0
 
     def __post_init__(self) -> None:
+        renamed("Sensors(period, counts_per_revolution, delay_samples)",
+                 "LoopConfig(loop=SampledLoop(period=..., delay=...), counts=...)")
         if isinstance(self.delay_samples, bool) or self.delay_samples != int(self.delay_samples) or self.delay_samples < 0:
             raise InputError(f"the sensor delay must be a non-negative number of samples, got {self.delay_samples}", "delay")
-        if self.counts_per_revolution is not None and not self.counts_per_revolution >= 1:
-            raise InputError(f"the encoder counts per revolution must be at least 1, got {self.counts_per_revolution}", "counts")
 
 
 @dataclass(frozen=True)
 class LoopConfig:
-    """Everything but the device and the joint motions."""
+    """A run of the sampled loop: its settings ``loop`` (a :class:`~hapticdesign.analysis.sampled_loop.SampledLoop`,
+    the one record of every command: period, delay, compensation with its modelling error, wall damper, hand; the
+    seed's by default, seed 000 §4.1.1) and the run's own fields (duration, plant step, encoder ``counts`` per
+    revolution, the compensator's departures, the wall's spring and rest, plant damping and friction, safety switch,
+    recording, step control). The simulated damper uses the sampled velocity (:meth:`require_simulated`).
+    ``sensors``, ``hand`` and the damper and error of ``wall`` and ``compensator`` are
+    the settings' former places, taken one release (moved into ``loop`` here)."""
 
     duration: float = 5.0
     step: float = 1e-4
-    sensors: Sensors = field(default_factory=Sensors)
+    loop: SampledLoop = field(default_factory=SampledLoop.seed)
     compensator: Compensator = field(default_factory=Compensator)
     wall: Wall = field(default_factory=Wall)
     damping: tuple[float, ...] | None = None
     coulomb: tuple[float, ...] | None = None
     """Coulomb friction torque (N m) or force (N) per joint in the plant; None: the device's (or none)."""
     safety_limit: float | None = 0.06
-    hand: Hand | None = None
+    counts: int | None = None
+    """Encoder counts per revolution (position quantization); None: none."""
     record_stride: int | None = None
     stop_excursion: float | None = None
     step_control: str = "auto"
@@ -168,12 +180,56 @@ class LoopConfig:
     ``tolerance`` (:func:`~.kernel.run_loop`); ``auto``: fixed for a tree (its results on the seed's
     grid), adaptive for a closed-loop device (each evaluation of its dynamics solves the loops)."""
     tolerance: float = ADAPTIVE_TOLERANCE
+    sensors: Sensors | None = None
+    hand: Hand | None = None
 
     def __post_init__(self) -> None:
+        self._fold_former()
+        if not isinstance(self.loop, SampledLoop):
+            raise UserError(f"loop must be a SampledLoop, got {type(self.loop).__name__}")
+        if self.counts is not None and not self.counts >= 1:
+            raise InputError(f"the encoder counts per revolution must be at least 1, got {self.counts}", "counts")
         if not (math.isfinite(self.duration) and self.duration > 0):
             raise InputError(f"the simulated time must be a positive number of seconds, got {self.duration}", "duration")
         self.steps_per_sample()
         self.adaptive(False)
+
+    def _fold_former(self) -> None:
+        """Move the settings given in their former places into ``loop`` (and ``counts``)."""
+        for name, kind in (("wall", Wall), ("compensator", Compensator), ("sensors", (Sensors, type(None)))):
+            if not isinstance(getattr(self, name), kind):
+                raise UserError(f"{name} must be a {name.capitalize()}, got {type(getattr(self, name)).__name__}")
+        changes, sensors = {}, self.sensors
+        if sensors is not None:
+            changes.update(period=sensors.period, delay=int(sensors.delay_samples))
+            object.__setattr__(self, "counts", sensors.counts_per_revolution)
+        if self.hand is not None:
+            renamed("LoopConfig(hand=...)", "SampledLoop(hand=...) of LoopConfig(loop=...)")
+            changes["hand"] = self.hand
+        if self.wall.damping is not None:
+            changes["wall_damping"] = self.wall.damping
+            object.__setattr__(self, "wall", replace(self.wall, damping=None))
+        if self.compensator.error_percent is not None:
+            changes["error_percent"] = self.compensator.error_percent
+            object.__setattr__(self, "compensator", replace(self.compensator, error_percent=None))
+        if changes:
+            object.__setattr__(self, "loop", replace(self.loop, **changes))
+        object.__setattr__(self, "sensors", None)
+        object.__setattr__(self, "hand", None)
+
+    def require_simulated(self) -> None:
+        """The run's loop can be simulated: its damper uses the sampled velocity (a backward-difference damper is
+        analysed exactly only)."""
+        if self.loop.velocity == "difference" and self.loop.wall_damping > 0:
+            raise InputError("the simulated wall's damper uses the sampled velocity; a backward-difference damper is "
+                             "analysed exactly only", "velocity")
+
+    @property
+    def switches(self) -> tuple[bool, bool, bool]:
+        """The inertial, Coriolis and gravity terms the compensator feeds forward: the loop's compensation's, less
+        those the :class:`Compensator` drops."""
+        full, comp = self.loop.compensation == "full", self.compensator
+        return (full and comp.inertial, full and comp.coriolis, self.loop.compensation != "none" and comp.gravity)
 
     def adaptive(self, closed_loop: bool) -> bool:
         """Whether the run controls its steps by error (``step_control``, for a closed-loop device or not)."""
@@ -187,9 +243,7 @@ class LoopConfig:
     def steps_per_sample(self) -> int:
         if not (self.step > 0 and math.isfinite(self.step)):
             raise InputError(f"the plant step must be positive, got {self.step}", "step")
-        period = self.sensors.period
-        if not (period > 0 and math.isfinite(period)):
-            raise InputError(f"the sample period must be positive, got {period}", "period")
+        period = self.loop.period
         ratio = period / self.step
         if not math.isfinite(ratio):
             raise InputError(f"the sample period {period} s over the plant step {self.step} s overflows", "period", "step")
@@ -259,9 +313,11 @@ def require_options(sim_type: object, config: object, config_type: type) -> None
         raise UserError(f"config must be a {config_type.__name__}, got {type(config).__name__}")
 
 
-def compensator_device(device: Device, compensator: Compensator) -> Device:
-    """The device the compensator models, with its errors (:func:`model_device`)."""
-    return model_device(device, compensator.error_percent, compensator.group_errors, compensator.error_seed)
+def compensator_device(device: Device, config: LoopConfig) -> Device:
+    """The device the compensator of the run ``config`` models, with the loop's modelling error spread as its
+    :class:`Compensator` says (:func:`model_device`)."""
+    comp = config.compensator
+    return model_device(device, config.loop.error_percent, comp.group_errors, comp.error_seed)
 
 
 def loop_model(device: Device, loop: SampledLoop, pose: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:

@@ -118,6 +118,7 @@ class WallProblem:
 
     def __post_init__(self) -> None:
         check_settle_window(self.criteria, self.config.duration)
+        self.config.require_simulated()
         require_inertia(self.device, rest_pose(self.device), self.wall_joint)
         if self.config.wall.cartesian:
             require_reach(self.device, self.config, self.wall_joint)

@@ -31,13 +31,14 @@ import numpy as np
 from hapticdesign.analysis.configuration import configuration_of, handle_pose
 from hapticdesign.analysis.dynamics.device import gravity_gradient, mass_matrix
 from hapticdesign.analysis.sampled_loop import SampledLoop, handle_intervals
+from hapticdesign.analysis.stiffness.drive import device_drive
 from hapticdesign.errors import InputError, UserError
 from hapticdesign.model.compensator_model import model_device
 from hapticdesign.model.device import Device
 from hapticdesign.simulation.analytic import GROWS, AnalyticProblem, linear_loop
 from hapticdesign.simulation.boundary import envelope_grows, growth_onset
 from hapticdesign.simulation.config import (
-    REST_STEPS, LoopConfig, Wall, compensator_device, handle_jacobian, loop_config, loop_model, normal_jacobian,
+    REST_STEPS, LoopConfig, Wall, compensator_device, handle_jacobian, loop_model, normal_jacobian, renamed,
     require_device, require_options, rest_pose, spring_rest, unit_direction,
 )
 from hapticdesign.simulation.loop import simulate, tables_of
@@ -61,7 +62,7 @@ class ImpedanceProblem(WallProblem):
         self.rest = rest_pose(self.device)
         self.paths = type_paths(self.sim_type, self.device.n_dof, self.wall_joint, self.rest)
         self.plant = tables_of(self.device)
-        self.model = tables_of(compensator_device(self.device, self.config.compensator))
+        self.model = tables_of(compensator_device(self.device, self.config))
         self.config = replace(self.config, safety_limit=self.criteria.safety_limit,
                               stop_excursion=self.criteria.overshoot_limit)
 
@@ -84,7 +85,7 @@ class ImpedanceProblem(WallProblem):
         q0 = self.rest
         b = (self.config.damping or self.device.damping)[w]
         h = mass_matrix(self.device, q0)[w, w]
-        guess = b * b / h if self.config.compensator.inertial else 2 * b / self.config.sensors.period
+        guess = b * b / h if self.config.switches[0] else 2 * b / self.config.loop.period
         if self.config.wall.cartesian:
             guess /= float(normal_jacobian(self.device, self.config.wall, q0)[w]) ** 2
         return guess if math.isfinite(guess) and guess > 0 else 1.0
@@ -185,10 +186,12 @@ def wall_interval(device: Device, pose: np.ndarray, loop: SampledLoop, wall_join
     """The exact stable springs ``[low, high]`` of a wall on ``wall_joint`` (or along the Cartesian ``direction``) held
     at ``pose``, every actuated joint free but ``loop.held`` (:func:`stability_limit`'s at one pose; ``low`` 0 unless
     gravity pulls the handle off the wall)."""
-    low, high = handle_intervals(handle_jacobian(device, pose)[:3][None], mass_matrix(device, pose)[None],
+    jv = handle_jacobian(device, pose)[:3][None]
+    low, high = handle_intervals(jv, mass_matrix(device, pose)[None],
                                  device.damping_matrix, _wall_row(device, pose, wall_joint, direction)[None], loop,
                                  k_max=k_max, gravity=gravity_gradient(device, pose)[None],
-                                 model=loop_model(device, loop, pose), transmission=device.transmission)
+                                 model=loop_model(device, loop, pose),
+                                 transmission=device_drive(device, configuration_of(device).full(pose)[None], jv))
     return float(low[0]), float(high[0])
 
 
@@ -233,11 +236,12 @@ def simulated_limit(device: Device, loop: SampledLoop | None = None, wall_joint:
     paths = {j: Held(float(rest[j])) for j in loop.held}
     if direction is not None:
         direction = tuple(unit_direction(direction).tolist())
-    base = loop_config(loop, Wall(wall_joint, 1.0, 0.0, equilibrium + (0.0 if direction else float(rest[wall_joint])),
-                                  direction), counts, duration=duration, safety_limit=None,
-                       stop_excursion=ESCAPE * abs(equilibrium) if equilibrium else 1e-3,
-                       coulomb=None if friction else (0.0,) * device.n_dof)
-    plant, model = tables_of(device), tables_of(compensator_device(device, base.compensator))
+    wall = Wall(wall_joint, 1.0, equilibrium=equilibrium + (0.0 if direction else float(rest[wall_joint])),
+                direction=direction)
+    base = LoopConfig(duration=duration, loop=loop, wall=wall, counts=counts, safety_limit=None,
+                      stop_excursion=ESCAPE * abs(equilibrium) if equilibrium else 1e-3,
+                      coulomb=None if friction else (0.0,) * device.n_dof)
+    plant, model = tables_of(device), tables_of(compensator_device(device, base))
 
     def grows(k: float) -> bool:
         cfg = replace(base, wall=replace(base.wall, stiffness=k))
@@ -512,13 +516,15 @@ def impedance_range(device: Device, sim_type: int = 1, method: str = "fast", k_l
                     wall_joint: int = 0, equilibrium: float = 0.01,
                     resolution: float | None = None, wall_direction=None, true_boundary: bool = False,
                     loop: SampledLoop | None = None, counts: int | None = None, simulate: bool = False) -> RangeResult:
-    """Maximum stable impedance of ``wall_joint`` for simulation type 1 or 2 (seed §4.1.2).
+    """Maximum stable impedance of ``wall_joint`` for simulation type 1 or 2 (seed §4.1.2) under the run ``config``
+    (its loop settings ``config.loop``; default: the seed's settings, practice's for the limit method).
 
-    ``method="limit"`` answers from the stability limit of the sampled loop under the settings ``loop`` at the wall's
+    ``method="limit"`` answers from the stability limit of the sampled loop ``config.loop`` at the wall's
     equilibrium, every joint free (:func:`limit_range`, with ``simulate`` its simulated limit with dry friction and
-    ``counts`` beside it; ``sim_type``, ``criteria`` and ``config`` do not enter);
+    ``config.counts`` beside it; ``sim_type``, ``criteria`` and the run's other fields do not enter);
     the other methods judge the seed's performance criteria on simulated (or exact linear) runs of type 1 or 2
-    under ``config``.
+    under ``config``. ``loop`` and ``counts`` are the settings' former places, taken one release (moved into
+    ``config``).
 
     With ``wall_direction`` (x, y, z) the wall is Cartesian: K in N/m along that direction at the
     handle, ``equilibrium`` in metres from the handle's start, the criteria on the handle's
@@ -551,13 +557,18 @@ def impedance_range(device: Device, sim_type: int = 1, method: str = "fast", k_l
     if resolution is not None and resolution > k_limit:
         raise InputError(f"the stiffness resolution {resolution:g} is above the stiffness limit {k_limit:g}",
                          "resolution", "k_limit")
+    if loop is not None or counts is not None:
+        renamed("impedance_range(loop=..., counts=...)", "impedance_range(config=LoopConfig(loop=..., counts=...))", 3)
+        config = replace(config or LoopConfig(loop=loop or SampledLoop()), **({} if loop is None else {"loop": loop}),
+                         **({} if counts is None else {"counts": counts}))
     if method == "limit":
         if true_boundary:
             raise InputError("the growth boundary is a simulated check of the seed's searches; the limit method is "
                              "the boundary itself", "true_boundary", "method")
-        return limit_range(device, loop, k_limit, wall_joint, equilibrium, resolution, wall_direction, counts,
-                           simulate)
-    config = config or LoopConfig(wall=Wall())
+        config = config or LoopConfig(loop=SampledLoop())
+        return limit_range(device, config.loop, k_limit, wall_joint, equilibrium, resolution, wall_direction,
+                           config.counts, simulate)
+    config = config or LoopConfig()
     if wall_direction is not None:
         config = replace(config, wall=replace(config.wall, direction=tuple(unit_direction(wall_direction).tolist())))
     require_search_workload(config, planned_simulations(method, k_limit, resolution, true_boundary))

@@ -5,7 +5,8 @@ not hold is asked for.
 
 ``kmax_simulated`` (N/m) is the wall a device renders with what real devices have and the linear loop leaves out
 (issue 35; seed 000 ch. 4): at each pose, along the worst direction of the exact limit (``kmax``, the same loop
-settings), the spring at which the simulated loop's oscillation starts to grow with the device's dry friction and
+settings, ``wall_damping`` the simulated wall's damper on the sampled velocity), the spring at which the simulated
+loop's oscillation starts to grow with the device's dry friction and
 its encoders' quantization in it (:func:`~hapticdesign.simulation.impedance.simulated_limit`, the wall resting
 :data:`~hapticdesign.simulation.impedance.TOUCH` from the pose), the ``simulated`` row of the spec sheet at any
 pose. With ``hand`` a study can ask for a 1000-N/m wall under a hand, with friction. Each value is a bisection of
@@ -19,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from hapticdesign.analysis.metrics.indices import HandleStates, index
+from hapticdesign.analysis.stiffness.drive import compliances
 from hapticdesign.analysis.wall_stiffness import KMAX_OPTIONS, kmax_loop, worst_direction
 from hapticdesign.errors import UserError
 from hapticdesign.simulation.impedance import SIMULATED_CAP, TOUCH, device_counts, simulated_limit
@@ -32,19 +34,20 @@ COST = 1000.0
        needs=("device",), cost=COST)
 def kmax_simulated(pose: HandleStates, period: float = 0.001, delay: int = 1, velocity: str = "difference",
                    compensation: str = "gravity", error_percent: float = 0.0, hand: object = None,
-                   friction: bool = True, quantization: bool = True, rel_tol: float = 1e-2) -> np.ndarray:
+                   friction: bool = True, quantization: bool = True, rel_tol: float = 1e-2,
+                   wall_damping: float = 0.0) -> np.ndarray:
     for name, value in (("friction", friction), ("quantization", quantization)):
         if not isinstance(value, bool):
             raise UserError(f"index kmax_simulated: {name} is true or false, got {value!r}")
     if isinstance(rel_tol, bool) or not isinstance(rel_tol, (int, float)) or not 1e-4 <= rel_tol <= 0.5:
         raise UserError(f"index kmax_simulated: rel_tol is a number from 1e-4 to 0.5, got {rel_tol!r}")
     options = {**KMAX_OPTIONS, "period": period, "delay": delay, "velocity": velocity, "compensation": compensation,
-               "error_percent": error_percent, "hand": hand}
+               "error_percent": error_percent, "hand": hand, "wall_damping": wall_damping}
     loop, _ = kmax_loop(options)
     device = pose.device
-    if device.transmission is not None:
+    if compliances(device) != "rigid":
         raise UserError("index kmax_simulated: the simulated loop's plant is rigid; a device whose actuators state a "
-                        "transmission_stiffness has the exact limit kmax, which models it")
+                        "transmission_stiffness or whose links are elastic has the exact limit kmax, which models it")
     counts = device_counts(device) if quantization else None
     model = None if error_percent == 0 else pose.compensator(error_percent)
     out = np.empty(len(pose.full))

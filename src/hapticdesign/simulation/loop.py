@@ -14,6 +14,7 @@ import numpy as np
 
 from hapticdesign.analysis.dynamics.closed_loop_plant import ClosedLoopPlant
 from hapticdesign.analysis.dynamics.device import dynamics_of
+from hapticdesign.analysis.dynamics.model import has_trigonometric_basis
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.simulation import kernel, records
@@ -52,18 +53,15 @@ def _scratch(dynamics: Dynamics) -> records.DynamicsScratch:
 
 
 def tables_of(device: Device) -> DynamicsTables | None:
-    """The exact basis tables of an open-chain device, to reuse across runs; ``None`` for a closed-loop
-    device, whose compiled plant :func:`simulate` builds for each run at its start pose."""
-    return None if device.mechanism.loops is not None else DynamicsTables.from_device(device)
+    """The exact basis tables of a device whose model has an exact basis (an open chain), to reuse across runs;
+    ``None`` for a closed-loop device, whose compiled plant :func:`simulate` builds for each run at its start pose."""
+    return DynamicsTables.from_device(device) if has_trigonometric_basis(device.mechanism) else None
 
 
 def _dynamics(device: Device, tables: DynamicsTables | None, q_start: np.ndarray) -> Dynamics:
     """The given tables, or the device's own: its tables, or its closed-loop plant started at ``q_start``."""
-    if tables is not None:
-        return tables
-    if device.mechanism.loops is None:
-        return DynamicsTables.from_device(device)
-    return ClosedLoopPlant(dynamics_of(device), device.standard_parameters(), q_start)
+    tables = tables_of(device) if tables is None else tables
+    return ClosedLoopPlant(dynamics_of(device), device.standard_parameters(), q_start) if tables is None else tables
 
 
 def simulate(
@@ -86,9 +84,9 @@ def simulate(
     for j, path in (paths or {}).items():
         if 0 <= j < n:
             q_start[j] = float(path.sample(np.zeros(1))[0][0])
-    hand = hand_matrices(device, config.hand, q_start)
+    hand = hand_matrices(device, config.loop.hand, q_start)
     plant = _dynamics(device, plant, q_start)
-    model = _dynamics(compensator_device(device, config.compensator), model, q_start)
+    model = _dynamics(compensator_device(device, config), model, q_start)
     return simulate_tables(plant, model, config, plant_damping(device, config), paths, q_start, hand,
                            plant_friction(device, config),
                            handle_of(device, config.wall) if config.wall.cartesian else None)
@@ -118,30 +116,23 @@ def simulate_tables(
     wall needs the device's ``handle`` (:func:`handle_of`). ``damping`` is one value per joint or a
     matrix; ``coulomb`` the friction ``(A, f)`` of :func:`~.config.plant_friction`."""
     n = plant.n_dof
+    config.require_simulated()
     sub = config.steps_per_sample()
     if not (config.duration > 0 and math.isfinite(config.duration)):
         raise UserError(f"the duration must be positive, got {config.duration}")
     wall = config.wall
     if not 0 <= wall.joint < n:
         raise UserError(f"unknown joint {wall.joint + 1}; the device has joints 1..{n}")
-    if not all(math.isfinite(v) for v in (wall.stiffness, wall.damping, wall.equilibrium)):
-        raise UserError("the wall stiffness, damping and equilibrium must be finite")
-    if wall.damping < 0:
-        raise UserError(f"the virtual wall damping must be non-negative, got {wall.damping}")
+    if not all(math.isfinite(v) for v in (wall.stiffness, wall.equilibrium)):
+        raise UserError("the wall stiffness and equilibrium must be finite")
     if wall.cartesian and handle is None:
         raise UserError("a Cartesian wall needs the device's handle kinematics")
     paths = dict(paths or {})
     for j in paths:
         if not 0 <= j < n:
             raise UserError(f"unknown joint {j + 1}; the device has joints 1..{n}")
-    sensors = config.sensors
-    if sensors.delay_samples < 0:
-        raise UserError("the sensor delay must be a non-negative number of samples")
-    quant = 0.0
-    if sensors.counts_per_revolution is not None:
-        if sensors.counts_per_revolution <= 0:
-            raise UserError("encoder counts per revolution must be positive")
-        quant = 2 * np.pi / sensors.counts_per_revolution
+    loop = config.loop
+    quant = 0.0 if config.counts is None else 2 * np.pi / config.counts
     damping = np.asarray(damping, dtype=float)
     if damping.shape == (n,):
         damping = np.diag(damping)
@@ -154,10 +145,10 @@ def simulate_tables(
     stride = config.record_stride or sub
     if stride < 1:
         raise UserError("the record stride must be at least one plant step")
-    if sensors.delay_samples * sensors.period >= config.duration:
-        raise UserError(f"the sensor delay ({sensors.delay_samples} samples = {sensors.delay_samples * sensors.period:g} s) "
+    if loop.delay * loop.period >= config.duration:
+        raise UserError(f"the sensor delay ({loop.delay} samples = {loop.delay * loop.period:g} s) "
                         f"must be shorter than the simulated time ({config.duration:g} s)")
-    require_memory(f"a simulation of {n_steps:,} plant steps", loop_bytes(n_steps, n, stride, sensors.delay_samples))
+    require_memory(f"a simulation of {n_steps:,} plant steps", loop_bytes(n_steps, n, stride, loop.delay))
     q_start = np.zeros(n) if q0 is None else np.asarray(q0, dtype=float).copy()
     t_half = 0.5 * config.step * np.arange(2 * n_steps + 1)
     path_q, path_qd, path_qdd = (np.zeros((t_half.size, n)) for _ in range(3))
@@ -167,15 +158,14 @@ def simulate_tables(
         path_q[:, j], path_qd[:, j], path_qdd[:, j] = path.sample(t_half)
         q_start[j] = path_q[0, j]
     hand_mass, hand_damping, hand_stiffness = hand if hand is not None else (np.zeros((n, n)),) * 3
-    comp = config.compensator
     n_rec = n_steps // stride + 1
     rec = records.Records(*(np.zeros((n_rec, n)) for _ in range(6)), np.zeros(n_rec))
-    switches = np.array([comp.inertial, comp.coriolis, comp.gravity], dtype=float)
+    switches = np.array(config.switches, dtype=float)
     friction_map, friction = (np.zeros((0, n)), np.zeros(0)) if coulomb is None else coulomb
     plant_record = _plant_record(plant, damping + hand_damping, np.asarray(friction, dtype=float),
                                  np.ascontiguousarray(friction_map, dtype=float), hand_mass, hand_stiffness,
                                  q_start.copy())
-    controller = _controller_record(model, switches, quant, int(sensors.delay_samples))
+    controller = _controller_record(model, switches, quant, int(loop.delay))
     motion = records.Motion(prescribed, path_q, path_qd, path_qdd, q_start, np.zeros(n))
     adaptive = config.adaptive(isinstance(plant, ClosedLoopPlant))
     timing = records.Timing(float(config.step), sub, n_steps, stride, step_spans(sub, stride) if adaptive
@@ -187,7 +177,7 @@ def simulate_tables(
                  else float(q_start[wall.joint]))
     rest = reference + float(wall.equilibrium) if wall.cartesian else float(wall.equilibrium)
     law = records.WallLaw(
-        cartesian=wall.cartesian, joint=wall.joint, stiffness=float(wall.stiffness), damping=float(wall.damping),
+        cartesian=wall.cartesian, joint=wall.joint, stiffness=float(wall.stiffness), damping=float(loop.wall_damping),
         rest=rest, reference=reference,
         safety_limit=math.inf if config.safety_limit is None else float(config.safety_limit),
         stop_excursion=math.inf if config.stop_excursion is None else float(config.stop_excursion),
@@ -211,7 +201,7 @@ def warm_up(device: Device) -> None:
     if device.mechanism.end_effector is not None:
         walls.append(Wall(joint=0, stiffness=0.0, direction=(1.0, 0.0, 0.0)))
     for wall in walls:
-        simulate(device, LoopConfig(duration=2 * LoopConfig().sensors.period, wall=wall))
+        simulate(device, LoopConfig(duration=2 * LoopConfig().loop.period, wall=wall))
 
 
 def step_spans(sub: int, stride: int) -> np.ndarray:

@@ -48,10 +48,10 @@ class ErrorCase:
     k_max: float
 
 
-def inertia_share(device: Device, compensator: Compensator, joint: int = 0) -> float:
-    """``c = H_model,ww / H_ww`` at the start pose."""
+def inertia_share(device: Device, config: LoopConfig, joint: int = 0) -> float:
+    """``c = H_model,ww / H_ww`` at the start pose under the run ``config``."""
     q0 = rest_pose(device)
-    model = compensator_device(device, compensator)
+    model = compensator_device(device, config)
     return float(mass_matrix(model, q0)[joint, joint] / mass_matrix(device, q0)[joint, joint])
 
 
@@ -82,9 +82,9 @@ def error_cases(devices: list[tuple[str, float, Device]], errors: list[float], s
             for d in range(1 if error == 0 else draws):
                 compensator = Compensator(group_errors=tuple((g, float(error)) for g in groups),
                                           error_seed=seed + i * draws + d)
-                found = impedance_range(device, sim_type, method=method, k_limit=k_limit,
-                                        config=LoopConfig(compensator=compensator))
-                cases.append(ErrorCase(name, level, float(error), d, inertia_share(device, compensator),
+                config = LoopConfig(compensator=compensator)
+                found = impedance_range(device, sim_type, method=method, k_limit=k_limit, config=config)
+                cases.append(ErrorCase(name, level, float(error), d, inertia_share(device, config),
                                        float(found.k_max)))
                 done += 1
                 if progress is not None:

@@ -80,12 +80,12 @@ def transparency(
     rest = rest_pose(device)
     spring_rest = float(rest[wall_joint]) + equilibrium
     cfg = replace(base, duration=chirp.sweep_time, safety_limit=None, stop_excursion=None, record_stride=1,
-                  wall=Wall(wall_joint, stiffness, base.wall.damping, spring_rest))
+                  wall=Wall(wall_joint, stiffness, equilibrium=spring_rest))
     trace = simulate(device, cfg, chirp_paths(device.n_dof, sim_type, wall_joint, chirp, rest))
     require_closed(trace, f"the type {sim_type} chirp")
     q = trace.q[:, wall_joint]
     tau_m = trace.tau_c[:, wall_joint]
-    tau_d = stiffness * (q - spring_rest) + cfg.wall.damping * trace.qd[:, wall_joint]
+    tau_d = stiffness * (q - spring_rest) + cfg.loop.wall_damping * trace.qd[:, wall_joint]
     fs = 1.0 / cfg.step
     seconds, nperseg = segment_length(segment_seconds, chirp, fs, len(q))
     f, z_d = impedance(q, tau_d, fs, nperseg, window)

@@ -84,15 +84,16 @@ def check_request(device: Device, sim_type: int, stiffness: float, chirp: Chirp 
     chirp = chirp or Chirp()
     base = config or LoopConfig()
     base.steps_per_sample()
-    if not chirp.sweep_time >= base.sensors.period:
+    base.require_simulated()
+    if not chirp.sweep_time >= base.loop.period:
         raise InputError(f"the chirp's sweep time {chirp.sweep_time:g} s is shorter than one sample period "
-                         f"({base.sensors.period:g} s)", "sweep")
+                         f"({base.loop.period:g} s)", "sweep")
     require_plant_steps(f"a chirp of {chirp.sweep_time:g} s at a plant step of {base.step:g} s",
                         chirp.sweep_time / base.step)
-    nyquist = 0.5 / base.sensors.period
+    nyquist = 0.5 / base.loop.period
     if not chirp.f1 <= nyquist:
         raise UserError(f"the chirp's end frequency {chirp.f1:g} Hz is beyond the Nyquist frequency {nyquist:g} Hz "
-                        f"of the {base.sensors.period:g} s sample period")
+                        f"of the {base.loop.period:g} s sample period")
     return chirp, base
 
 

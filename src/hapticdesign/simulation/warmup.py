@@ -28,6 +28,7 @@ grows with the size of the caller): ``benchmarks/bench_compile.py`` lists what e
 from __future__ import annotations
 
 import fcntl
+import multiprocessing
 import os
 import time
 from collections.abc import Callable, Iterator
@@ -113,6 +114,38 @@ def ensure_compiled(dispatcher, *args) -> None:
         return
     with compile_lock(dispatcher):
         dispatcher.compile(signature)
+
+
+def in_cache(dispatcher) -> bool:
+    """Whether numba's cache folder holds an index of ``dispatcher``'s machine code, written by an earlier process
+    (for some signature; numba drops the index when the kernel's source file changes)."""
+    cache_file = getattr(getattr(dispatcher, "_cache", None), "_cache_file", None)
+    index = getattr(cache_file, "_index_path", None)
+    return index is not None and os.path.exists(index)
+
+
+def compile_aside(dispatcher, target: Callable[[], None]) -> multiprocessing.process.BaseProcess | None:
+    """Compile ``dispatcher`` in a second process while this one goes on, when numba's cache does not hold it yet:
+    start a fresh (spawned) process that runs ``target`` (a module-level function that calls the kernel through
+    :func:`ensure_compiled`), its output discarded, and return it; None when the cache already holds the kernel.
+
+    The compile lock makes this process's own first call of the kernel wait for the second process's compile and
+    then load it from the cache, so that on a 2-core machine the compile runs beside this process's other work
+    (``make demo``'s equations and Linearity Number step) instead of after it. If the second process fails, this
+    one compiles the kernel itself, as without it."""
+    if in_cache(dispatcher) or cache_folder(dispatcher) is None:
+        return None
+    process = multiprocessing.get_context("spawn").Process(target=_quietly, args=(target,), daemon=True)
+    process.start()
+    return process
+
+
+def _quietly(target: Callable[[], None]) -> None:
+    """Run ``target`` with this process's standard output and error sent to the null device."""
+    null = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(null, 1)
+    os.dup2(null, 2)
+    target()
 
 
 class _FirstCompile(event.Listener):

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from hapticdesign.analysis.dynamics.device import gravity, inverse_dynamics, mass_matrix
+from hapticdesign.analysis.dynamics.model import has_trigonometric_basis
 from hapticdesign.analysis.dynamics.symbolic import derive, export, rounded
 from hapticdesign.analysis.linearity.bounds import practical_bounds
 from hapticdesign.analysis.linearity.conditions import (
@@ -38,7 +39,7 @@ def device_view(ctx: Context) -> Outcome:
     device = ctx.settings.device()
     q = home_pose(device)
     mech = device.mechanism
-    loops = "" if mech.loops is None else f", {len(mech.loops.closures)} loop closures"
+    loops = f", {len(mech.loops.closures)} loop closures" if mech.loops.closures else ""
     return Outcome(
         summary=f"{device.name}: {len(mech.frames)} frames, {len(mech.bodies)} bodies, "
                 f"{mech.n_actuated} actuated joints{loops}.",
@@ -89,7 +90,7 @@ def equations_of_motion(ctx: Context) -> Outcome:
     """Seed 000 eq. 2.50-2.52: exact H and G of the design, evaluations, and the size of the symbolic form."""
     import sympy as sp
     device = ctx.settings.device()
-    if device.mechanism.loops is not None:
+    if not has_trigonometric_basis(device.mechanism):
         return closed_loop_evaluations(device)
     numeric = derive(device, "none")
     full = derive(device, "all")
@@ -179,7 +180,7 @@ def linearization(ctx: Context) -> Outcome:
     """Seed 000 §3.2.1: the conditions for LN = 0 (eq. 3.12-3.26) in the seed's variables, the free
     parameters (Table 3.2), the constant H (eq. 3.27), the design's realizability and linear designs."""
     device = ctx.settings.device()
-    if device.mechanism.loops is not None:
+    if not has_trigonometric_basis(device.mechanism):
         raise Skipped("the conditions for LN = 0 (eq. 3.12-3.27) are linear equations in the coefficients of a tree's "
                       "exact trigonometric basis; a closed loop's H, C and G entries are not trigonometric polynomials "
                       "of the actuated joints (its LN, by quadrature, is in the Linearity Number step)")

@@ -28,6 +28,7 @@ from hapticdesign.simulation.impedance import Criteria, impedance_range, type_pa
 from hapticdesign.simulation.loop import simulate
 from hapticdesign.simulation.paths import Chirp
 from hapticdesign.simulation.transparency import transparency
+from hapticdesign.studies.phantom_explorer import campaign_explorer
 from hapticdesign.studies.plots import plt
 from hapticdesign.studies.seed_reference import (
     AGREEMENT,
@@ -50,7 +51,7 @@ def wall_response(device, stiffness: float, duration: float = 5.0, step: float =
     the device's rest pose (0 for an open chain, ``home`` for a closed loop), the others held there, and the
     wall's spring rests ``step`` from joint 1's start."""
     rest = rest_pose(device)
-    wall = Wall(0, stiffness, 0.0, float(rest[0]) + step)
+    wall = Wall(0, stiffness, equilibrium=float(rest[0]) + step)
     return simulate(device, LoopConfig(duration=duration, wall=wall), type_paths(1, device.n_dof, 0, rest))
 
 
@@ -142,7 +143,7 @@ def _settings_table(device, config, driven) -> Table:
          f"{driven.amplitude:g} sin({driven.omega / np.pi:g} pi t)"],
         ["overshoot limit [rad] (§4.1.3)", 0.012, criteria.overshoot_limit],
         ["safety switch [rad] (Figure 4.7)", 0.06, criteria.safety_limit],
-        ["sample period [s] / plant step [s]", "0.001 / 0.0001", f"{config.sensors.period:g} / {config.step:g}"],
+        ["sample period [s] / plant step [s]", "0.001 / 0.0001", f"{config.loop.period:g} / {config.step:g}"],
         ["chirp (Table 4.5)", "0.3 rad, 0.1-15 Hz, 10 s",
          f"{chirp.amplitude:g} rad, {chirp.f0:g}-{chirp.f1:g} Hz, {chirp.sweep_time:g} s"],
     ]
@@ -206,7 +207,8 @@ def campaign(ctx: Context) -> Outcome:
     designs_csv = ctx.shared.get("designs_csv")
     if designs_csv is None:
         raise NotAvailable("this campaign runs over the design sets, whose step did not finish")
-    return _campaign(ctx, designs_csv, "the design sets of the design-set step (every design a realizable rigid body)")
+    return _campaign(ctx, designs_csv, "the design sets of the design-set step (every design a realizable rigid body)",
+                     explore=True)
 
 
 def campaign_appendix_c(ctx: Context) -> Outcome:
@@ -219,8 +221,10 @@ def campaign_appendix_c(ctx: Context) -> Outcome:
                                        "one breaks the triangle inequality in some link")
 
 
-def _campaign(ctx: Context, designs_csv: Path, source: str) -> Outcome:
-    """Run (or resume) a campaign and lay its results beside Tables 4.4, 4.6 and Figures 4.9-4.11, 4.18-4.21."""
+def _campaign(ctx: Context, designs_csv: Path, source: str, explore: bool = False) -> Outcome:
+    """Run (or resume) a campaign and lay its results beside Tables 4.4, 4.6 and Figures 4.9-4.11, 4.18-4.21; with
+    ``explore``, its designs in the design explorer too (:func:`~hapticdesign.studies.phantom_explorer.
+    campaign_explorer`)."""
     s = ctx.settings
     digest = hashlib.sha1(Path(designs_csv).read_bytes()).hexdigest()[:12]
     out = ctx.work_dir / f"campaign_{digest}"  # a rerun with the same designs resumes; other designs start afresh
@@ -232,7 +236,8 @@ def _campaign(ctx: Context, designs_csv: Path, source: str) -> Outcome:
         except RuntimeError:  # a local Dask worker that failed to start (seen under heavy load): resume once
             counts = run_campaign(designs_csv, out, options, workers=s.workers, progress=ctx.update, quiet=True)
         designs = read_designs(designs_csv, s.preset)
-    summary = summarize(designs, load_cases(designs, out), options)
+    cases = load_cases(designs, out)
+    summary = summarize(designs, cases, options)
     tables = [_side_by_side(summary, "impedance", TABLE_4_4, "Table 4.4", "N m/rad"),
               _side_by_side(summary, "transparency", TABLE_4_6, "Table 4.6", "Hz"),
               _agreement(summary)]
@@ -256,6 +261,7 @@ def _campaign(ctx: Context, designs_csv: Path, source: str) -> Outcome:
         numbers={"designs": len(designs), "cases": counts["cases"],
                  "agreement_level0": {r["criterion"]: r["agreement_share"] for r in zero if r["type"] == 1},
                  "summary": summary},
+        explorer=campaign_explorer(designs, cases, s.preset) if explore else None,
     )
 
 

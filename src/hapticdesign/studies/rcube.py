@@ -108,25 +108,17 @@ def kinematics_step(ctx: Context) -> Outcome:
 
 
 CHAIN_COLOURS = ("#c0392b", "#27ae60", "#2e6fd8")
-CHAIN_POINTS = ("chain_base", "tip1", "tip2", "tip3")
 """Frames of :func:`~hapticdesign.model.rcube.chain_mechanism` joined by the drawn links: base, l1, l2, l3."""
 
 
 def device_figure(design, side: float = 0.12):
     """The design at home: each chain's links l1, l2, l3 from its base (eq. 5.2-5.18, the chain's own forward
     kinematics at the angles of eq. 5.30-5.45), the platform, the dexterous cube and a scale bar."""
-    from hapticdesign.analysis.kinematics import forward_kinematics
-    from hapticdesign.model.rcube import chain_mechanism
-
     g = design.geometry
-    angles = rcube_kinematics.inverse_kinematics(g, g.home)
     fig = plt.figure(figsize=(6.0, 5.2))
     ax = fig.add_subplot(projection="3d", proj_type="ortho")
     points = [np.zeros(3)]
-    for chain, colour in enumerate(CHAIN_COLOURS):
-        mech = chain_mechanism(g, chain)
-        q = np.asarray(angles[chain], dtype=float)
-        path = np.array([forward_kinematics(mech, q, frame)[:3, 3] for frame in CHAIN_POINTS])
+    for chain, (colour, path) in enumerate(zip(CHAIN_COLOURS, rcube_kinematics.chain_paths(g))):
         ax.plot(*path.T, color=colour, linewidth=3.5, solid_capstyle="round", label=f"chain {chain + 1}")
         ax.scatter(*path[:-1].T, s=14, color="#34495e", depthshade=False)
         ax.plot(*np.stack([np.zeros(3), path[0]]).T, color="#7f8c8d", linewidth=1.0, linestyle=":")

@@ -29,18 +29,22 @@ friction reach the handle as follows:
   (:class:`~hapticdesign.analysis.sampled_loop.SampledLoop`, stated in the output; practice's by default: 1 kHz,
   one sample of delay, backward-difference velocity, gravity compensation):
 
-  - ``exact``: the exact stability limit of the n-joint sampled loop, every joint free, H and B (the joint and
-    motor viscous damping) at the pose, the smallest over the axes, the principal directions and 60 evenly spread
-    directions (:mod:`hapticdesign.analysis.wall_stiffness`, the ``kmax`` design index's too), and ``direction``,
-    the worst one. A pure spring uses the position only, so the velocity estimate does not enter. ``exact_lower``:
+  - ``exact``: the registry's ``kmax`` design index at the pose: the exact stability limit of the n-joint sampled
+    loop, every joint free, H and B (the joint and motor viscous damping) at the pose, the smallest over the axes,
+    the principal directions and 60 evenly spread directions (:mod:`hapticdesign.analysis.wall_stiffness`), and
+    ``direction``, the worst one (:func:`~hapticdesign.analysis.wall_stiffness.worst_direction`), with the
+    compliance between the motors and the handle the file gives (``compliance``: ``rigid``, ``transmissions``,
+    ``links`` or both, :mod:`hapticdesign.analysis.stiffness.drive`; the simulated row, whose plant is rigid, is then
+    not run). A pure spring uses the position only, so the velocity estimate does not enter. ``exact_lower``:
     the smallest spring stable in every direction, 0 unless gravity pulls the handle off a wall (an over-compensating
     model, an inverted pose); the sheet then says "stable from exact_lower to exact";
-  - ``exact_with_hand``: the same with the hand (``hand``: the default grasp,
+  - ``exact_with_hand``: ``kmax`` with the hand (``hand``: the default grasp,
     :data:`~hapticdesign.analysis.sampled_loop.GRASP`, unless the settings hold one) as a linear
     mass-spring-damper at the handle;
-  - ``simulated``: the simulated growth boundary along the worst direction with the device's dry friction and
-    its coarsest encoder's quantization (``simulated_counts`` per joint revolution), the wall's rest
-    ``simulated_touch`` from the handle's start (:func:`hapticdesign.simulation.impedance.simulated_limit`);
+  - ``simulated``: the registry's ``kmax_simulated`` at the pose, the simulated growth boundary along the worst
+    direction with the device's dry friction and its coarsest encoder's quantization (``simulated_counts`` per joint
+    revolution), the wall's rest ``simulated_touch`` from the handle's start
+    (:func:`hapticdesign.simulation.impedance.simulated_limit`);
   - the passivity bounds of Abbott & Okamura (2005) and Diolaiti et al. (2006): ``2 b / T`` (viscous) and
     ``2 f_c / Delta`` (Coulomb friction against encoder quantization), with the smallest damping (eigenvalue) and
     friction over directions and the resolution ``Delta``.
@@ -61,11 +65,12 @@ from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.analysis.dynamics.device import gravity_gradient
 from hapticdesign.analysis.metrics import force as polytope
 from hapticdesign.analysis.metrics.indices import INDICES, HandleStates, Index, Request, evaluate_at, requests_of
+from hapticdesign.analysis.stiffness.drive import compliances
 from hapticdesign.errors import UserError
 from hapticdesign.model.actuators import transmission
 from hapticdesign.model.device import Device
 from hapticdesign.analysis.sampled_loop import GRASP, SampledLoop
-from hapticdesign.analysis.wall_stiffness import wall_limit, worst_direction
+from hapticdesign.analysis.wall_stiffness import worst_direction
 from hapticdesign.analysis.workspace import cube_points, reach_workspace
 from hapticdesign.simulation.config import loop_model
 
@@ -149,43 +154,44 @@ def backdrive_friction(device: Device, h: Handle) -> tuple[float, float] | None:
     return float(1.0 / np.linalg.norm(inv, axis=0).max()), float(np.linalg.norm(signs @ c, axis=1).max())
 
 
-def renderable_stiffness(device: Device, h: Handle, loop: SampledLoop | None = None) -> float:
-    """The smallest exact wall limit over directions, every joint free
-    (:func:`hapticdesign.analysis.wall_stiffness.wall_limit`), gravity's gradient at the pose in the loop."""
-    loop = loop or SampledLoop()
-    return wall_limit(h.jacobian, h.states.H[0], device.damping_matrix, loop, gravity=gravity_gradient(device, h.q),
-                      model=loop_model(device, loop, h.q), transmission=device.transmission)
+def _kmax_options(loop: SampledLoop) -> dict:
+    """The loop settings ``loop`` as options of the registry's ``kmax`` and ``kmax_simulated`` (their names are the
+    :class:`SampledLoop`'s; a hand as its mass, damping and stiffness)."""
+    hand = None if loop.hand is None else {k: v for k, v in loop.hand.as_dict().items() if k != "name"}
+    return {"period": loop.period, "delay": loop.delay, "velocity": loop.velocity, "compensation": loop.compensation,
+            "error_percent": loop.error_percent, "wall_damping": loop.wall_damping, "hand": hand}
 
 
 def renderable(device: Device, h: Handle, loop: SampledLoop, res: float | None,
                friction: tuple[float, float] | None, simulate: bool = True, progress: Report = no_progress) -> dict:
-    """The renderable-stiffness rows: the exact limit without the hand (worst direction) and with the hand, the
-    simulated limit along that direction with the device's dry friction and encoder quantization, and the passivity
-    bounds from the sheet's resolution ``res`` and backdrive ``friction`` (see the module docstring); ``progress``
-    hears of each of the three (:data:`RENDERING_STEP`)."""
-    from hapticdesign.simulation.impedance import SIMULATED_CAP, TOUCH, device_counts, simulated_limit
+    """The renderable-stiffness rows: the exact limit without the hand and with it (the registry's ``kmax``) and the
+    direction it is taken along, the simulated limit along that direction with the device's dry friction and
+    encoder quantization (the registry's ``kmax_simulated``), and the passivity bounds from the sheet's resolution
+    ``res`` and backdrive ``friction`` (see the module docstring); ``progress`` hears of each of the three
+    (:data:`RENDERING_STEP`)."""
+    from hapticdesign.simulation.impedance import TOUCH, device_counts
 
     progress(RENDERING_STEP, 0, 3)
-    exact, direction, lower = worst_direction(h.jacobian, h.states.H[0], device.damping_matrix,
-                                              replace(loop, hand=None), gravity_gradient(device, h.q),
-                                              loop_model(device, loop, h.q), device.transmission)
+    bare = replace(loop, hand=None)
+    exact = _index("kmax", h, **_kmax_options(bare))
+    _, direction, lower = worst_direction(h.jacobian, h.states.H[0], device.damping_matrix, bare,
+                                          gravity_gradient(device, h.q), loop_model(device, loop, h.q),
+                                          h.states.drive)
     progress(RENDERING_STEP, 1, 3)
     hand = loop.hand or GRASP
-    with_hand = renderable_stiffness(device, h, replace(loop, hand=hand))
+    with_hand = _index("kmax", h, **_kmax_options(replace(loop, hand=hand)))
     progress(RENDERING_STEP, 2, 3)
-    counts = device_counts(device)
     simulated = None
-    if simulate and device.transmission is None:  # the simulated loop's plant is rigid
-        simulated = simulated_limit(device, replace(loop, hand=None), direction=direction, equilibrium=TOUCH,
-                                    counts=counts, start=max(exact, 1.0), k_limit=SIMULATED_CAP)
+    if simulate and h.states.drive is None:  # the simulated loop's plant is rigid
+        simulated = _index("kmax_simulated", h, **_kmax_options(bare))
     progress(RENDERING_STEP, 3, 3)
     return {
-        "exact": exact, "exact_lower": lower, "direction": direction,
+        "exact": exact, "exact_lower": lower, "direction": direction, "compliance": compliances(device),
         "exact_with_hand": with_hand, "hand": hand.as_dict(),
-        "simulated": simulated, "simulated_counts": counts, "simulated_touch": TOUCH,
+        "simulated": simulated, "simulated_counts": device_counts(device), "simulated_touch": TOUCH,
         "passivity_viscous": 2.0 * float(np.linalg.eigvalsh(h.states.cartesian_damping[0]).min()) * loop.rate,
         "passivity_coulomb": None if friction is None or res is None else 2.0 * friction[0] / res,
-        "settings": replace(loop, hand=None).as_dict(), "rate": loop.rate, "delay": loop.delay,
+        "settings": bare.as_dict(), "rate": loop.rate, "delay": loop.delay,
     }
 
 
@@ -255,6 +261,39 @@ def spec_sheet(device: Device, q=None, loop: SampledLoop | None = None, workspac
         sheet["indices"] = {key: float(value[0]) for key, value in found.items()}
         sheet["units"]["indices"] = {r.key: registry[r.index].unit for r in checked}
     return sheet
+
+
+SUMMARY = (
+    ("force_continuous", "continuous force (largest ball in the force polytope)", "N"),
+    ("force_peak", "peak force (largest ball in the force polytope)", "N"),
+    ("resolution", "resolution (one motor count at the handle, the largest)", "m"),
+    ("apparent_mass.min", "apparent mass, lightest direction", "kg"),
+    ("apparent_mass.max", "apparent mass, heaviest direction", "kg"),
+    ("renderable_stiffness.exact", "renderable wall, exact limit (worst direction)", "N/m"),
+    ("renderable_stiffness.exact_with_hand", "renderable wall with the hand, exact limit", "N/m"),
+)
+"""The spec sheet's headline numbers (:func:`spec_summary`): the name as a path into ``spec.json`` (``a.b`` is
+``sheet["a"]["b"]``), what it is, its unit."""
+
+
+def spec_summary(device: Device, q=None, loop: SampledLoop | None = None) -> list[dict]:
+    """The :data:`SUMMARY` rows of :func:`spec_sheet` at pose ``q`` (default: home) under ``loop`` (default: practice's,
+    :class:`SampledLoop`), computed by the sheet's own functions (the force polytope, the resolution, the apparent mass,
+    :func:`renderable` without its simulation) but without the workspace cube, the stiffness and the simulated limit,
+    so that it costs a fraction of the sheet: ``[{"name", "label", "value", "unit"}]`` in SI units, None where the
+    device file lacks what a row needs (motors' limits, encoders). A singular pose raises
+    :class:`~hapticdesign.errors.UserError` as the sheet does."""
+    loop = loop or SampledLoop()
+    q = configuration_of(device).home.copy() if q is None else np.asarray(q, dtype=float)
+    h = handle_at(device, q)
+    res = resolution(device, h)
+    mass = apparent_mass(device, h)
+    wall = renderable(device, h, loop, res, backdrive_friction(device, h), simulate=False)
+    values = {"force_continuous": inscribed_force(device, h, "continuous"),
+              "force_peak": inscribed_force(device, h, "peak"), "resolution": res,
+              "apparent_mass.min": mass[0], "apparent_mass.max": mass[1],
+              "renderable_stiffness.exact": wall["exact"], "renderable_stiffness.exact_with_hand": wall["exact_with_hand"]}
+    return [{"name": name, "label": label, "value": values[name], "unit": unit} for name, label, unit in SUMMARY]
 
 
 def _stiffness(device: Device, h: Handle) -> float | None:

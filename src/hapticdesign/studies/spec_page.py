@@ -96,7 +96,9 @@ def value_text(sheet: dict, key: str) -> str:
                 f"N s/m, {hand['stiffness']:g} N/m) {value['exact_with_hand']:.4g}; simulated with dry friction and "
                 f"quantization {simulated}; passivity: 2b/T = {value['passivity_viscous']:.4g}, 2 f_c / Delta = "
                 + ("n/a" if value["passivity_coulomb"] is None else f"{value['passivity_coulomb']:.4g}")
-                + f" (at {value['rate']:g} Hz, delay {value['delay']}, every joint free)")
+                + f" (at {value['rate']:g} Hz, delay {value['delay']}, every joint free, drive "
+                + ("rigid" if value.get("compliance", "rigid") == "rigid" else
+                   f"compliance of the {value['compliance']}") + ")")
     return f"{value:.4g}"
 
 

@@ -81,8 +81,22 @@ class Page:
 
 
 @dataclass
+class Explorer:
+    """A step's designs in the design explorer, the page every study opens in, written beside the report as
+    ``explorer/<step>/report.html``: its ``title``, the explorer's ``data``
+    (:func:`~hapticdesign.optimization.study_explorer.explorer_table`), the ``files`` beside the page that the
+    cards' commands read (path inside the folder -> text) and ``paragraphs`` under the explorer."""
+
+    title: str
+    data: dict
+    files: dict[str, str] = field(default_factory=dict)
+    paragraphs: list[str] = field(default_factory=list)
+
+
+@dataclass
 class Outcome:
-    """What a finished step contributes: prose, equations or listings, tables, figures, pages, key numbers."""
+    """What a finished step contributes: prose, equations or listings, tables, figures, pages, key numbers and its
+    designs in the design explorer."""
 
     summary: str = ""
     paragraphs: list[str] = field(default_factory=list)
@@ -91,6 +105,7 @@ class Outcome:
     figures: list[Figure] = field(default_factory=list)
     pages: list[Page] = field(default_factory=list)
     numbers: dict[str, Any] = field(default_factory=dict)
+    explorer: Explorer | None = None
 
 
 @dataclass

@@ -1,11 +1,12 @@
-"""Cartesian (operational-space) inertia of any device: the one place it is computed.
+"""Cartesian (operational-space) inertia and damping of any device: the one place they are computed.
 
 With task velocities ``v = J qd`` the kinetic energy ``1/2 qd^T H qd`` is ``1/2 v^T M_C v`` for
 
     M_C = J^-T H J^-1                 (square J; seed 001 eq. 4.90, 4.106, 5.223)
     M_C = (J H^-1 J^T)^-1             (J with fewer rows than columns; Khatib's operational-space inertia)
 
-and the two agree for a square ``J``.
+and the two agree for a square ``J``. The joints' viscous damping ``B`` is felt at the handle, on an orthonormal basis
+``U`` of the directions it moves, as ``U^T J^+T B J^+ U`` (:func:`damping`).
 """
 
 from __future__ import annotations
@@ -70,6 +71,14 @@ def mobility(mass_matrix: np.ndarray, jacobian: np.ndarray) -> np.ndarray:
     if not _mobilities(hs, js, out):
         raise np.linalg.LinAlgError("Singular matrix")
     return out.reshape(*stack, m, m)
+
+
+def damping(jacobian: np.ndarray, basis: np.ndarray, joint_damping: np.ndarray) -> np.ndarray:
+    """``U^T J^+T B J^+ U`` (P, k, k): the joint damping ``B`` (n, n) or (P, n, n) felt at the handle along the
+    orthonormal basis ``U`` (P, 3, k) of the directions a translational Jacobian ``J`` (P, 3, n) moves it in (N s/m
+    for B in N m s/rad)."""
+    pinv = np.linalg.pinv(jacobian) @ basis
+    return np.swapaxes(pinv, 1, 2) @ joint_damping @ pinv
 
 
 @njit(cache=True)

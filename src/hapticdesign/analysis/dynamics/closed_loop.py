@@ -28,7 +28,7 @@ from hapticdesign.analysis.dynamics.actuated_kernel import (
     pose_dynamics,
     terms_into,
 )
-from hapticdesign.analysis.configuration import LoopConfiguration
+from hapticdesign.analysis.configuration import Configuration
 from hapticdesign.analysis.dynamics.model import EquationsOfMotion, pair_index
 from hapticdesign.analysis.loops.closure_kernel import SINGULAR
 from hapticdesign.analysis.loops.solver import MESSAGES, SINGULAR_RATIO
@@ -42,7 +42,7 @@ CHUNK = 4096
 class ClosedLoopModel(EquationsOfMotion):
     """Regressor model of a closed-loop mechanism in its actuated coordinates (see module docstring)."""
 
-    def __init__(self, configuration: LoopConfiguration):
+    def __init__(self, configuration: Configuration):
         mechanism = configuration.mechanism
         self.configuration = configuration
         """The device's configuration space (:func:`~hapticdesign.analysis.configuration.configuration_of`)."""

@@ -17,7 +17,7 @@ import numpy as np
 from hapticdesign.analysis.configuration import configuration_for
 from hapticdesign.analysis.dynamics.closed_loop import ClosedLoopModel
 from hapticdesign.analysis.dynamics.kernel import regressor_kernel
-from hapticdesign.analysis.dynamics.model import DynamicsModel, EquationsOfMotion
+from hapticdesign.analysis.dynamics.model import DynamicsModel, EquationsOfMotion, has_trigonometric_basis
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device, MechanismBuilder
 from hapticdesign.model.mechanism import Mechanism
@@ -40,35 +40,39 @@ def mass_matrix(device: Device, q: np.ndarray) -> np.ndarray:
 
 def mass_matrix_at(device: Device, q_full: np.ndarray) -> np.ndarray:
     """H over the actuated coordinates, the reflected rotor inertia included, at closed full poses ``q_full``
-    (P, N) (from :meth:`~hapticdesign.analysis.configuration.Configuration.reach` or ``full``): (P, n_a, n_a).
+    (P, N) (from :meth:`~hapticdesign.analysis.configuration.Configuration.reach` or ``full``): (P, n_a, n_a), from
+    :func:`_terms_at` (no continuation from home)."""
+    return _terms_at(device, np.atleast_2d(np.asarray(q_full, dtype=float)))[0] + device.reflected_inertia
 
-    A tree's comes straight from the compiled kernel (:func:`tree_mass_matrix`, no fitted model), a closed-loop
-    device's from the entries of its model at those poses (no continuation from home)."""
-    space = configuration_for(device.builder, device.kinematic_values())
-    q_full = np.atleast_2d(np.asarray(q_full, dtype=float))
-    if space.is_tree:
-        h = tree_mass_matrix(space.mechanism, q_full, device.standard_parameters())
-    else:
-        h = _model(device.builder, device.kinematic_values()).H_at(q_full, device.standard_parameters())
-    return h + device.reflected_inertia
+
+def _terms_at(device: Device, q_full: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """H (P, n_a, n_a) and G (P, n_a) at closed full poses (P, N), the rotors left out: a tree's from the compiled
+    kernel (:func:`tree_terms`, no fitted model), a closed loop's from :meth:`~.closed_loop.ClosedLoopModel.terms_at`."""
+    kinematic, params = device.kinematic_values(), device.standard_parameters()
+    mechanism = configuration_for(device.builder, kinematic).mechanism
+    if has_trigonometric_basis(mechanism):
+        return tree_terms(mechanism, q_full, params)
+    return _model(device.builder, kinematic).terms_at(q_full, params)
 
 
 def tree_mass_matrix(mechanism: Mechanism, q: np.ndarray, parameters: np.ndarray) -> np.ndarray:
-    """H (eq. 2.50) of a tree mechanism at poses ``(..., N)`` for standard inertial parameters
-    ``(10 x bodies,)``, straight from the compiled regressor kernel.
+    """H (eq. 2.50) of a tree mechanism at poses ``(..., N)``: :func:`tree_terms`' H."""
+    return tree_terms(mechanism, q, parameters)[0]
 
-    Exact like :func:`mass_matrix`, without fitting the regressor model of :func:`dynamics_of`: the
-    cheaper choice for a geometry evaluated at a few poses (one candidate of an optimization).
-    """
-    if mechanism.loops is not None:
+
+def tree_terms(mechanism: Mechanism, q: np.ndarray, parameters: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """H (..., N, N) and G (..., N) (eq. 2.50) of a tree mechanism at poses ``(..., N)`` for standard inertial
+    parameters ``(10 x bodies,)``, straight from the compiled regressor kernel: exact like :func:`mass_matrix`,
+    without fitting the model of :func:`dynamics_of` (the cheaper choice for a geometry at a few poses)."""
+    if not has_trigonometric_basis(mechanism):
         raise UserError("a mechanism with closed loops needs the loop solver: use mass_matrix")
     q = np.asarray(q, dtype=float)
     n = mechanism.n_dof
     if q.shape[-1:] != (n,) or not np.all(np.isfinite(q)):
         raise UserError(f"expected finite joint coordinates (..., {n}), got an array of shape {q.shape}")
     c = mechanism.compiled
-    yh, _ = regressor_kernel(np.ascontiguousarray(q.reshape(-1, n)), *c.tree.arrays, c.tree.body_node, c.gravity)
-    return (yh @ parameters).reshape(q.shape + (n,))
+    yh, yg = regressor_kernel(np.ascontiguousarray(q.reshape(-1, n)), *c.tree.arrays, c.tree.body_node, c.gravity)
+    return (yh @ parameters).reshape(q.shape + (n,)), (yg @ parameters).reshape(q.shape)
 
 
 def coriolis_centrifugal(device: Device, q: np.ndarray) -> np.ndarray:
@@ -102,20 +106,13 @@ def gravity_gradient_at(device: Device, q_full: np.ndarray) -> np.ndarray:
     """``dG/dq_a`` (P, n_a, n_a) at closed full poses (P, N), by central differences of G over ``+-``
     :data:`GRADIENT_STEP` along each actuated coordinate's motion ``T e_j`` (the passive coordinates follow to first
     order; the second-order miss of the closure is even in the step and cancels in the difference): a tree's G from
-    the compiled regressor kernel, a closed-loop device's from its model's H and G at those poses
-    (:meth:`~.closed_loop.ClosedLoopModel.terms_at`, as :func:`mass_matrix_at`)."""
+    :func:`_terms_at`, as :func:`mass_matrix_at`)."""
     space = configuration_for(device.builder, device.kinematic_values())
     q_full = np.atleast_2d(np.asarray(q_full, dtype=float))
     steps = GRADIENT_STEP * np.swapaxes(space.velocity_transform(q_full), 1, 2)  # (P, n_a, N)
     poses = np.concatenate([q_full[:, None, :] + steps, q_full[:, None, :] - steps], axis=1)
     poses = poses.reshape(-1, q_full.shape[1])
-    params = device.standard_parameters()
-    if space.is_tree:
-        c = space.mechanism.compiled
-        _, yg = regressor_kernel(np.ascontiguousarray(poses), *c.tree.arrays, c.tree.body_node, c.gravity)
-        torques = yg @ params
-    else:
-        torques = _model(device.builder, device.kinematic_values()).terms_at(poses, params)[1]
+    torques = _terms_at(device, poses)[1]
     n = steps.shape[1]
     torques = torques.reshape(len(q_full), 2, n, -1)  # (P, +-, j, i)
     return np.swapaxes((torques[:, 0] - torques[:, 1]) / (2.0 * GRADIENT_STEP), 1, 2)
@@ -134,7 +131,7 @@ def forward_dynamics(device: Device, q: np.ndarray, qd: np.ndarray, tau: np.ndar
 @lru_cache(maxsize=16)
 def _model(builder: MechanismBuilder, kinematic: tuple[tuple[str, float], ...]):
     space = configuration_for(builder, kinematic)
-    return DynamicsModel(space.mechanism) if space.is_tree else ClosedLoopModel(space)
+    return DynamicsModel(space.mechanism) if has_trigonometric_basis(space.mechanism) else ClosedLoopModel(space)
 
 
 @lru_cache(maxsize=16)

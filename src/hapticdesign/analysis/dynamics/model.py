@@ -237,6 +237,14 @@ class ExactBasis(Protocol):
     def coefficients_for(self, pi: np.ndarray) -> np.ndarray: ...
 
 
+def has_trigonometric_basis(mechanism: Mechanism) -> bool:
+    """Whether the mechanism's H, C and G have an exact trigonometric basis (:class:`ExactBasis`), which the LN = 0
+    conditions (seed 000 eq. 3.12-3.27), the symbolic engine and the simulation's tables need: a tree's have (no
+    closures, an empty constraint list); a closed loop's entries, reduced to the actuated coordinates pose by pose,
+    are no trigonometric polynomials of them."""
+    return mechanism.loops.empty
+
+
 class DynamicsModel(EquationsOfMotion):
     """Regressor model of one tree geometry on its exact basis (:class:`ExactBasis`); parameters ``pi`` are
     inputs of every call.

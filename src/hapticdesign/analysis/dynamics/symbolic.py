@@ -25,7 +25,7 @@ import sympy as sp
 from sympy.polys.domains import QQ, RR
 from sympy.polys.rings import ring
 
-from hapticdesign.analysis.dynamics.model import pair_index
+from hapticdesign.analysis.dynamics.model import has_trigonometric_basis, pair_index
 from hapticdesign.errors import InputError, UserError
 from hapticdesign.escape import docstring_text, python_identifier
 from hapticdesign.model.device import Device
@@ -376,9 +376,8 @@ def derive(device: Device, symbolic: str = "all", started: Callable[[], None] | 
     :mod:`hapticdesign.analysis.dynamics.closed_loop`); the loop-opened tree's equations would
     treat passive joints as driven and leave out the closure forces, so they are refused.
     """
-    loops = device.mechanism.loops
-    if loops is not None:
-        passive = ", ".join(device.mechanism.coordinates[k] for k in loops.passive)
+    if not has_trigonometric_basis(device.mechanism):
+        passive = ", ".join(device.mechanism.coordinates[k] for k in device.mechanism.loops.passive)
         raise UserError(f"{device.name} has closed loops (passive joints {passive}): its equations of motion are "
                         "reduced to the actuated joints numerically at each pose and have no symbolic form here")
     keep = _symbolic_names(device, symbolic)

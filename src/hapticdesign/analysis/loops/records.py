@@ -10,7 +10,6 @@ records built once per geometry (the folded tree :class:`~hapticdesign.model.wal
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from typing import NamedTuple
 
 import numpy as np
@@ -39,11 +38,12 @@ class Closures(NamedTuple):
     passive: np.ndarray
 
     @classmethod
-    def of(cls, mech: Mechanism, nodes: Mapping[str, int] | None = None) -> "Closures":
-        """The closures of ``mech`` on the folded tree's nodes, or on the node numbering ``nodes`` (frame name to
-        node; the unfolded tree's ``compiled.frame_node``, as the design batch walks it)."""
+    def of(cls, mech: Mechanism, numbering: str) -> "Closures":
+        """The closures of ``mech`` on the nodes of ``numbering``
+        (:meth:`~hapticdesign.model.mechanism.CompiledMechanism.nodes`: the loop solver's ``FOLDED``, the design
+        batch's and the inverse kinematics' ``UNFOLDED``); none for a tree, whose loops are empty."""
         loops: ClosedLoops = mech.loops
-        nodes = mech.compiled.tree.frame_node if nodes is None else nodes
+        nodes = mech.compiled.nodes(numbering)
         rows = [(i, c) for i, closure in enumerate(loops.closures) for c in closure.components]
         return cls(
             frame_a=np.array([nodes[c.frames[0]] for c in loops.closures], dtype=np.int64),

@@ -15,7 +15,8 @@ the Linearity Number and the metrics consume it. For a mechanism with
   (the closed-loop counterpart of the constant coupling coefficients of seed 000 eq. 2.38-2.43).
 
 Poses where the loops cannot close, a singular constraint Jacobian and a change of branch are
-reported as one-line UserErrors naming the pose (or, with ``strict=False``, as a status array).
+reported as one-line UserErrors naming the pose (or, with ``strict=False``, as a status array). A tree is a
+mechanism whose loops are empty (no closures, no passive coordinates): its poses are closed as they are.
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ from hapticdesign.analysis.loops import closure_kernel as ck
 from hapticdesign.analysis.loops.records import Closures, Settings
 from hapticdesign.errors import UserError
 from hapticdesign.model.loops import POSE_LIMIT
-from hapticdesign.model.mechanism import Mechanism
+from hapticdesign.model.mechanism import FOLDED, Mechanism
 from hapticdesign.model.walk import node_poses
 
 MAX_STEP = 0.1
@@ -61,20 +62,18 @@ def settings_of(mechanism: Mechanism) -> Settings:
 
 
 class LoopSolver:
-    """Passive coordinates of a closed-loop mechanism (see the module docstring).
+    """Passive coordinates of a mechanism (see the module docstring; a tree's: none).
 
     ``tree``, ``plan``, ``closures`` and ``settings`` are the records the compiled kernels take
-    (:mod:`.records`).
+    (:mod:`.records`), on the folded node numbering (:data:`~hapticdesign.model.mechanism.FOLDED`).
     """
 
     def __init__(self, mechanism: Mechanism):
-        if mechanism.loops is None:
-            raise UserError("the mechanism has no closed loops to solve")
         self.mechanism = mechanism
         self.compiled = mechanism.compiled
         self.tree = self.compiled.tree.arrays
         """The folded tree's record (:class:`~hapticdesign.model.walk.Tree`)."""
-        self.closures = Closures.of(mechanism)
+        self.closures = Closures.of(mechanism, FOLDED)
         self.plan = self.compiled.tree.plan([*self.closures.frame_a, *self.closures.frame_b],
                                             list(self.closures.passive))
         """Walk of the tree, the closures' nodes first (:class:`~hapticdesign.model.walk.WalkPlan`)."""
@@ -82,9 +81,12 @@ class LoopSolver:
         self.n_actuated = mechanism.n_actuated
         self.settings = settings_of(mechanism)
         self.tol = self.settings.tol
+        self.empty = mechanism.loops.empty
+        """No closures (a tree): nothing to solve."""
         loops = mechanism.loops
         q = loops.guess(self.n_dof)
-        status, sign, _ = ck.newton(q, self.tree, self.plan, self.closures, self.settings)
+        status, sign, _ = (ck.OK, 1.0, 1.0) if self.empty else ck.newton(q, self.tree, self.plan, self.closures,
+                                                                          self.settings)
         names = ", ".join(f"{mechanism.coordinates[k]} = {q[k]:.4g}" for k in self.closures.passive)
         if status == ck.NO_CLOSURE:
             raise UserError(
@@ -96,7 +98,7 @@ class LoopSolver:
         self.home = q
         """Full coordinates (actuated and passive) of the home pose on the assembly branch."""
         self.branch = sign
-        """Sign of ``det Phi_p`` on the assembly branch."""
+        """Sign of ``det Phi_p`` on the assembly branch (1 without closures)."""
 
     def _actuated(self, q_a: np.ndarray) -> np.ndarray:
         q_a = np.asarray(q_a, dtype=float)
@@ -116,6 +118,9 @@ class LoopSolver:
         ``start`` is a closed full pose on the branch (default: home). With ``strict`` a failure raises a
         one-line UserError; otherwise returns ``(q, status)`` with status 0 up to the first failure.
         """
+        if self.empty:
+            q = np.asarray(q_a, dtype=float)
+            return q if strict else (q, np.zeros(q.shape[:-1], dtype=np.int64))
         q_a = self._actuated(q_a)
         path = np.ascontiguousarray(np.atleast_2d(q_a))
         begin = np.asarray(self.home if start is None else start, dtype=float)
@@ -221,6 +226,8 @@ class LoopSolver:
     def velocity_transform(self, q: np.ndarray) -> np.ndarray:
         """``T`` (N x n_a) with ``qd = T qd_a`` at closed full coordinates ``q`` (N,) or (P, N)."""
         q = np.asarray(q, dtype=float)
+        if self.empty:
+            return np.broadcast_to(np.eye(self.n_dof), q.shape[:-1] + (self.n_dof, self.n_dof)).copy()
         flat = np.atleast_2d(q)
         out = np.zeros((len(flat), self.n_dof, self.n_actuated))
         a = self.closures

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from hapticdesign.analysis.kinematics import forward_kinematics as frame_pose
 from hapticdesign.analysis.kinematics import poses_and_jacobians
 from hapticdesign.errors import UserError
 from hapticdesign.model.rcube import RCubeGeometry, axis_permutation, chain_mechanism
@@ -266,3 +267,16 @@ def critical_condition_number(q_max: float) -> float:
     singular-value ratio that :func:`hapticdesign.analysis.metrics.kinematic.condition_number` gives.
     """
     return float(1.0 / np.cos(q_max) ** 2)
+
+
+CHAIN_POINTS = ("chain_base", "tip1", "tip2", "tip3")
+"""The frames of a chain drawn as its links: the base, then the ends of l1, l2 and l3 (the platform)."""
+
+
+def chain_paths(geometry: RCubeGeometry, position=None) -> list[np.ndarray]:
+    """Each chain's points :data:`CHAIN_POINTS` (4, 3) with the platform at ``position`` (home by default): the chain's
+    own forward kinematics (eq. 5.2-5.18) at the angles of eq. 5.30-5.45."""
+    position = geometry.home if position is None else _as_positions(position)
+    angles = inverse_kinematics(geometry, position)
+    return [np.array([frame_pose(chain_mechanism(geometry, chain), np.asarray(angles[chain], dtype=float), frame)[:3, 3]
+                      for frame in CHAIN_POINTS]) for chain in range(3)]

@@ -34,12 +34,12 @@ from scipy.linalg import block_diag
 
 from hapticdesign.analysis.configuration import configuration_of
 from hapticdesign.analysis.kinematics import jacobian
-from hapticdesign.analysis.loops.solver import LoopSolver
 from hapticdesign.analysis.stiffness import vjm
 from hapticdesign.analysis.stiffness.link import beam_stiffness
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
 from hapticdesign.model.elastic import Elasticity, ElasticLink
+from hapticdesign.model.loops import LoopClosure
 from hapticdesign.model.mechanism import JointType, Mechanism
 from hapticdesign.model.transforms import Rx, Ry, Rz, joint, tx, ty, tz
 
@@ -83,11 +83,7 @@ def virtual_mechanism(mech: Mechanism, elasticity: Elasticity) -> Mechanism:
     )
     names = tuple(f"{link.name}_{axis}" for link in elasticity.links for axis in ("tx", "ty", "tz", "rx", "ry", "rz"))
     types = ((JointType.PRISMATIC,) * 3 + (JointType.REVOLUTE,) * 3) * len(elasticity.links)
-    loops = mech.loops
-    if loops is not None:
-        loops = replace(loops, home=loops.home + (0.0,) * len(names))
-    return Mechanism(mech.coordinates + names, mech.joint_types + types, frames, (), mech.gravity,
-                     mech.end_effector, {}, loops)
+    return Mechanism(mech.coordinates + names, mech.joint_types + types, frames, (), mech.gravity, mech.end_effector)
 
 
 def _virtual_joint(first: int) -> tuple:
@@ -147,25 +143,26 @@ def cartesian_stiffness_at(device: Device, q: np.ndarray, frame: str | None = No
     frame = frame or mech.end_effector
     virtual = virtual_mechanism(mech, elasticity)
     q_virtual = np.concatenate([q, np.zeros(virtual.n_dof - mech.n_dof)])
-    rows = jacobian(virtual, q_virtual, frame)
-    if mech.loops is not None:
-        rows = np.vstack([rows, LoopSolver(virtual).constraint_jacobian(q_virtual)])
+    rows = np.vstack([jacobian(virtual, q_virtual, frame), *closure_rows(virtual, q_virtual, mech.loops.closures)])
     springs = dict(elasticity.joints)
     index = {name: k for k, name in enumerate(mech.coordinates)}
     theta = list(range(mech.n_dof, virtual.n_dof)) + [index[name] for name in springs]
     blocks = [_link_compliance(mech, link, q) for link in elasticity.links] + [
         np.array([[1.0 / k]]) for k in springs.values()]
     C_theta = block_diag(*blocks)
-    passive = list(mech.loops.passive) if mech.loops is not None else []
     try:
-        if passive:
-            K = vjm.chain_stiffness(rows[:, theta], C_theta, rows[:, passive])
-        else:
-            K = vjm.locked_stiffness(rows[:, theta], C_theta)
+        K = vjm.chain_stiffness(rows[:, theta], C_theta, rows[:, list(mech.loops.passive)])
     except UserError:
         raise UserError(f"the end effector {frame!r} is rigid in some direction at this pose: the elastic links "
                         "and joint springs do not reach it, or the pose is singular") from None
     return K[:6, :6]
+
+
+def closure_rows(mech: Mechanism, q: np.ndarray, closures: tuple[LoopClosure, ...]) -> list[np.ndarray]:
+    """The constraint Jacobian ``Phi = select(J_A - J_B)`` of ``closures`` at the full pose ``q`` of ``mech`` (one
+    array of rows per closure; none for a tree), with ``J`` the geometric Jacobian of a frame's origin (the
+    definition of :mod:`hapticdesign.analysis.loops.closure_kernel`), here over the virtual coordinates too."""
+    return [(jacobian(mech, q, c.frames[0]) - jacobian(mech, q, c.frames[1]))[list(c.components)] for c in closures]
 
 
 def deflection(stiffness: np.ndarray, wrench) -> np.ndarray:

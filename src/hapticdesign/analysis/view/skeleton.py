@@ -200,16 +200,15 @@ def export(device: Device, q: np.ndarray) -> dict:
     compiled = mech.compiled
     poses = frame_poses(device, q)
     loops = mech.loops
-    actuated = list(range(mech.n_dof)) if loops is None else list(loops.actuated(mech.n_dof))
+    actuated = list(loops.actuated(mech.n_dof))
     extent = max([float(np.abs(p[:3, 3]).max()) for p in poses.values()] + [1e-3])
     frames = [{"name": name, "node": int(node)} for name, node in compiled.frame_node.items()]
     return {
         "name": device.name,
         "sliders": [{**s.__dict__, "coordinate": actuated[s.index]} for s in sliders(device, q)],
         "full": [float(v) for v in configuration_of(device).full(q)],
-        "passive": [] if loops is None else [int(k) for k in loops.passive],
-        "closures": [] if loops is None else [[c.frames[0], c.frames[1], [int(v) for v in c.components]]
-                                               for c in loops.closures],
+        "passive": [int(k) for k in loops.passive],
+        "closures": [[c.frames[0], c.frames[1], [int(v) for v in c.components]] for c in loops.closures],
         "nodes": [[int(compiled.node_parent[n]), int(compiled.node_axis[n]), float(compiled.node_offset[n]),
                    [float(c) for c in compiled.node_coef[n]]] for n in range(len(compiled.node_parent))],
         "frames": frames,

@@ -42,8 +42,7 @@ def ik(
         pose = handle_pose(dev, target)
         result = {"device": dev.name, "position": target, "q": pose.q, "passive": pose.passive,
                   "coordinates": list(dev.mechanism.actuated_coordinates),
-                  "passive_coordinates": [dev.mechanism.coordinates[k] for k in
-                                          (dev.mechanism.loops.passive if dev.mechanism.loops else ())],
+                  "passive_coordinates": [dev.mechanism.coordinates[k] for k in dev.mechanism.loops.passive],
                   "units": {"position": "m", "q": "rad or m", "passive": "rad or m"}}
         if json_out:
             print_json(result)
@@ -104,7 +103,10 @@ def spec(
                                     "default the home pose."),
     out: Optional[Path] = typer.Option(None, "--out", help="Folder for spec.html (beside the vendor's numbers where "
                                        "known) and spec.json."),
-    rate: float = typer.Option(1000.0, "--rate", min=1.0, max=1e6, help="Servo rate of the renderable stiffness [Hz]."),
+    period: Optional[float] = typer.Option(None, "--period", min=1e-6, max=1.0, help="Sample period T of the "
+                                           "renderable stiffness's loop [s] (default 0.001, 1 kHz)."),
+    rate: Optional[float] = typer.Option(None, "--rate", min=1.0, max=1e6, help="Former name: the servo rate [Hz], "
+                                         "1 / --period; taken one release with a warning line."),
     delay: int = typer.Option(1, "--delay", min=0, max=100, help="Delay of the renderable stiffness's loop [samples]."),
     compensation: str = typer.Option("gravity", "--compensation", help="none, gravity or full (inverse dynamics)."),
     hand: str = typer.Option("light", "--hand", help="The hand of the 'with the hand' limit: light or firm "
@@ -128,8 +130,11 @@ def spec(
     """Spec sheet at a pose (seed 001 ch. 4 metrics, seed 000 §4 rendering): resolution, continuous and peak
     force, apparent mass, backdrive friction, VJM stiffness (seed 001 §5.2), workspace cube and renderable
     stiffness beside the passivity bounds."""
-    from hapticdesign.files import dumps_json, write_atomically
+    import warnings
     from dataclasses import replace
+
+    from hapticdesign.errors import RenamedWarning
+    from hapticdesign.files import dumps_json, write_atomically
 
     from hapticdesign.analysis.sampled_loop import Hand, SampledLoop
     from hapticdesign.studies.spec import no_progress, spec_sheet
@@ -144,7 +149,13 @@ def spec(
         given = {k: v for k, v in {"mass": hand_mass, "damping": hand_damping, "stiffness": hand_stiffness}.items()
                  if v is not None}
         preset = Hand.named(hand)
-        loop = SampledLoop(period=1.0 / rate, delay=delay, compensation=compensation,
+        if rate is not None:
+            if period is not None:
+                raise UserError("--rate is the former name of 1 / --period: give --period only")
+            warnings.warn("--rate is now --period (the sample period, 1 / rate, in s); --rate will be removed",
+                          RenamedWarning)
+            period = 1.0 / rate
+        loop = SampledLoop(period=1e-3 if period is None else period, delay=delay, compensation=compensation,
                            hand=replace(preset, **given, name=None) if given else preset)
         from hapticdesign.analysis.metrics.indices import INDICES
         from hapticdesign.interface.commands.optimize_adapter import index_module

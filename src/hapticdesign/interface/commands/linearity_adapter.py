@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from hapticdesign.analysis.dynamics.model import has_trigonometric_basis
 from hapticdesign.analysis.linearity.bounds import practical_bounds
 from hapticdesign.analysis.linearity.closed_form import closed_form
 from hapticdesign.analysis.linearity.conditions import linear_conditions, seed_conditions
@@ -113,7 +114,7 @@ def require_tree(device, command: str) -> None:
     trigonometric polynomials of the actuated joints, so those equations do not exist (its LN,
     from converged quadrature, is what ``ln`` gives).
     """
-    if device.mechanism.loops is not None:
+    if not has_trigonometric_basis(device.mechanism):
         raise UserError(
             f"{command} needs a tree device: {device.name} has closed loops, whose equations of motion have no exact "
             "trigonometric basis for the LN = 0 conditions (eq. 3.12-3.27); 'hapticdesign ln' gives its LN"

@@ -24,7 +24,7 @@ from hapticdesign.files import quote, write_atomically
 from hapticdesign.interface.report.optimization_page import PLOTLY, Picture, plotly_js, render, render_failure
 from hapticdesign.optimization.study_evaluation import (BoundStudy, StudyEvaluator, bind_study, require_study_workload,
                                                         unmeetable_walls)
-from hapticdesign.optimization.study_explorer import DESIGNS, explorer_data, front_designs
+from hapticdesign.optimization.study_explorer import DESIGNS, STUDY_COPY, explorer_data, front_designs, study_copy
 from hapticdesign.optimization.study_polish import most_designs
 from hapticdesign.optimization.study_file import Study, load_study
 from hapticdesign.optimization.study_methods import ConvexProgram, PopulationSearch, method_of, with_baseline
@@ -34,7 +34,8 @@ from hapticdesign.optimization.study_outputs import (Selection, baseline_lines, 
 from hapticdesign.optimization.study_run import Record, StudyRun
 
 FILES = ("front.csv", "evaluations.csv", "pareto.png", "pareto.svg", "selected.yaml", "report.html", PLOTLY,
-         f"{DESIGNS}/design-N.yaml (each front design's device file)")
+         f"{DESIGNS}/design-N.yaml (each front design's device file)",
+         f"{STUDY_COPY} (the study and device files as the run read them: hapticdesign explore reads it)")
 
 
 def parse_select(text: str) -> dict:
@@ -131,10 +132,13 @@ def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Select
     paths = [out / "front.csv", out / "evaluations.csv", *pareto_figure(run, selection, out, registry=bound.registry)]
     chosen = run.records[selection.record]
     write_atomically(out / "selected.yaml", device_file_text(bound, chosen.values, baseline_lines(run, chosen)))
+    write_atomically(out / STUDY_COPY, study_copy(bound.study))
     shown = [Picture(png, caption) for png, caption in pictures(bound, chosen.values)]
     kept = (["checkpoint/ (one file per generation; a rerun into this folder continues)"]
             if method_of(run.spec).checkpointed else [])
-    designs = front_designs(run, bound)
+    from hapticdesign.studies.spec import spec_summary
+
+    designs = front_designs(run, bound, spec_summary)  # the spec summary on each card (docs/optimization.md)
     for design in designs:
         write_atomically(out / design.file, design.text)
     _remove_stale_designs(out, len(designs))
@@ -143,7 +147,7 @@ def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Select
                   [*FILES, *kept], explorer_data(run, bound, selection, designs), bound.coarseness,
                   spread_rows(bound, chosen.values), bound.units())
     write_atomically(out / "report.html", page)
-    return [*paths, out / "selected.yaml", *(out / d.file for d in designs), out / PLOTLY, out / "report.html"]
+    return [*paths, out / "selected.yaml", out / STUDY_COPY, *(out / d.file for d in designs), out / PLOTLY, out / "report.html"]
 
 
 def _remove_stale_designs(out: Path, count: int) -> None:

@@ -7,13 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from hapticdesign.analysis.configuration import configuration_of
-from hapticdesign.analysis.loops.solver import LoopSolver
 from hapticdesign.interface.round_off import without_round_off
-
-
-def _solver(device) -> LoopSolver | None:
-    configuration = configuration_of(device)
-    return None if configuration.is_tree else configuration.solver
 
 
 def handle(device, q: np.ndarray) -> dict | None:
@@ -31,10 +25,10 @@ def assembly_branch(device) -> dict | None:
     """The branch a closed-loop device's ``assembly`` selects: the sign of ``det Phi_p`` (the constraint
     Jacobian over the passive joints) at home and the passive joints' values there, beside the file's guess;
     None for a tree."""
-    solver = _solver(device)
-    if solver is None:
-        return None
     mech = device.mechanism
+    if mech.loops.empty:
+        return None
+    solver = configuration_of(device).solver
     passive = mech.loops.passive
     names = [mech.coordinates[k] for k in passive]
     return {"det_phi_p_sign": int(np.sign(solver.branch)),

@@ -14,7 +14,8 @@ from hapticdesign.interface.common import note, print_json, progress_bar, to_jso
 from hapticdesign.interface.options import FORCE, FORCE_HINT, JSON_OUT, QUIET, SEED
 from hapticdesign.workload import allow_large
 
-OUT = typer.Option(None, "--out", help="Directory for the CSV tables and PNG/SVG figures.")
+OUT = typer.Option(None, "--out", help="Directory for the CSV tables and PNG/SVG figures (rcube optimize: and report.html, "
+                   "the synthesis in the design explorer).")
 QUICK = typer.Option(False, "--quick", help="Small populations and few generations (tests, demos).")
 POPULATION = typer.Option(None, "--population", help="Population size (default 100; --quick 24).")
 GENERATIONS = typer.Option(None, "--generations", help="Generations (default 150 synthesis, 100 cross-section, 200 plies).")
@@ -77,6 +78,19 @@ def _note_paths(out: Path, quiet: bool, paths) -> None:
     note(f"wrote {len(paths)} files to {out}", quiet)
 
 
+def _write(out: Path, result, summary: dict, settings, bound_sets, workspace) -> list[Path]:
+    """The chain's tables, figures and summary.json, and report.html: the synthesis in the design explorer."""
+    from hapticdesign.interface.report.seed_explorers import REPORT, rcube_page, write_explorer
+    from hapticdesign.optimization.rcube.chain import write_chain
+    from hapticdesign.optimization.rcube.explorer import chain_explorer
+    from hapticdesign.interface.report.optimization_page import PLOTLY
+
+    written = write_chain(out, result)
+    data = chain_explorer(result, workspace, bound_sets, settings.generations)
+    files = sorted({p.name for p in written} | {REPORT, PLOTLY})
+    return written + write_explorer(out, rcube_page(data, summary, files))
+
+
 def register(app: typer.Typer) -> None:
     from hapticdesign.interface.commands.rcube import rcube_app
 
@@ -87,7 +101,7 @@ def register(app: typer.Typer) -> None:
                  max_deflection: Optional[float] = typer.Option(None, "--max-deflection", help="Ply choice: fewest plies with CF1 below this (m) under 20 N."),
                  json_out: bool = JSON_OUT, quiet: bool = QUIET, force: bool = FORCE) -> None:
         """The whole chain: synthesis, selection, swarm, cross-section and plies (seed 001 ch. 7)."""
-        from hapticdesign.optimization.rcube.chain import chain_summary, run_chain, write_chain
+        from hapticdesign.optimization.rcube.chain import chain_summary, run_chain
         from hapticdesign.optimization.rcube.constraints import CubeWorkspace
 
         with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
@@ -97,7 +111,8 @@ def register(app: typer.Typer) -> None:
                                    max_deflection=max_deflection, progress=report)
             summary = chain_summary(result)
             if out is not None:
-                _note_paths(out, quiet, write_chain(out, result))
+                _note_paths(out, quiet, _write(out, result, summary, settings, _bound_sets(bounds),
+                                               CubeWorkspace(side, virtual_side)))
             if json_out:
                 print_json(summary)
                 return

@@ -32,9 +32,9 @@ STEP_CONTROL = typer.Option(
 COUNTS = typer.Option(None, help="Encoder counts per revolution (position quantization); none by default.")
 DELAY = typer.Option(0, help="Sensor delay in samples.")
 ERROR = typer.Option(0.0, help="Compensator modelling error in percent (scales its inertial parameters).")
-INERTIAL = typer.Option(True, "--inertial/--no-inertial", help="Compensate the inertial term H qdd.")
-CORIOLIS = typer.Option(True, "--coriolis/--no-coriolis", help="Compensate the Coriolis term C qd^2.")
-GRAVITY = typer.Option(True, "--gravity/--no-gravity", help="Compensate gravity G.")
+INERTIAL = typer.Option(True, "--inertial/--no-inertial", help="Keep the inertial term H qdd of --compensation full.")
+CORIOLIS = typer.Option(True, "--coriolis/--no-coriolis", help="Keep the Coriolis term C qd^2 of --compensation full.")
+GRAVITY = typer.Option(True, "--gravity/--no-gravity", help="Keep the gravity term G of --compensation.")
 WALL_DAMPING = typer.Option(0.0, help="Virtual wall damper [N m s/rad; N s/m for a Cartesian wall].")
 WALL_DIRECTION = typer.Option(
     None, help="Cartesian wall: its direction x,y,z at the handle (K in N/m, damper in N s/m, equilibrium and "
@@ -126,7 +126,8 @@ def impedance_range_command(
 
     Practice's default is the stability limit of the sampled loop; the seed's Phantom presets keep the seed's
     settings and performance criteria. The output states the settings and the verdict used."""
-    from hapticdesign.simulation.config import Wall, loop_config, unit_direction
+    from hapticdesign.analysis.stiffness.drive import compliances
+    from hapticdesign.simulation.config import LoopConfig, unit_direction
     from hapticdesign.simulation.impedance import Criteria, impedance_range
     from hapticdesign.simulation.loop import joint_index
 
@@ -141,18 +142,19 @@ def impedance_range_command(
         held = () if hold is None else tuple(joint_index(dev, j) for j in hold.replace(" ", "").split(",") if j)
         loop = sampled_loop(seed, period, delay, velocity, compensation, error_percent, wall_damping, hand_mass,
                             hand_damping, hand_stiffness, held)
-        config = None if method == "limit" else loop_config(loop, Wall(), counts, duration=duration, step=step,
-                                                            step_control=step_control)
+        limit = method == "limit"  # runs no plant steps of its own: the step is the period
+        config = LoopConfig(duration=duration, step=loop.period if limit else step, loop=loop, counts=counts,
+                            step_control=step_control)
         direction = None if wall_direction is None else parse_vector(wall_direction, 3, "wall-direction")
         wall_joint = joint_index(dev, joint)
-        limit = method == "limit"
         result = impedance_range(dev, _sim_type(sim_type), method, k_limit,
                                  Criteria(overshoot, settle_tolerance, settle_window, safety), config, wall_joint,
-                                 equilibrium, resolution, direction, true_boundary and not limit, loop, counts,
-                                 true_boundary and limit)
+                                 equilibrium, resolution, direction, true_boundary and not limit,
+                                 simulate=true_boundary and limit)
+        compliance = compliances(dev)
         out = {"device": dev.name, "type": sim_type, "joint": wall_joint + 1,
                **({} if direction is None else {"wall_direction": unit_direction(direction).tolist()}),
-               "settings": loop.as_dict(), **result.as_dict()}
+               "settings": loop.as_dict(), "compliance": compliance if limit else "rigid", **result.as_dict()}
         unit = {"stiffness": "N/m", "position": "m"} if direction is not None else joint_units(dev)[wall_joint]
         out["units"] = {"k_max": unit["stiffness"], "k_min": unit["stiffness"], "peak_at_first_unstable": unit["position"],
                         "stopped_at_first_unstable": "s"}
@@ -173,6 +175,9 @@ def impedance_range_command(
                        f"{out['simulations']} simulations)")
         typer.echo(f"verdict: {out['verdict']}")
         typer.echo(f"settings: {loop.describe()}")
+        typer.echo("drive: " + ("rigid" if out["compliance"] == "rigid" else f"the compliance of the {compliance}")
+                   + ("" if limit or compliance == "rigid" else " left out (the simulated plant is rigid; the limit "
+                                                                "method models it)"))
         if true_boundary:
             what = "simulated with dry friction and quantization" if method == "limit" else "oscillation-growth"
             found = out["k_true_boundary"]
@@ -197,15 +202,18 @@ def transparency_command(
                                                   "start pose: the same estimate, plus the steady-state response)."),
     period: float = PERIOD, step: float = STEP, step_control: str = STEP_CONTROL, counts: Optional[int] = COUNTS,
     delay: int = DELAY,
+    compensation: Optional[str] = typer.Option(None, help="none, gravity or full (inverse dynamics with the sampled "
+                                                          "acceleration; the seed's, the default)."),
     error_percent: float = ERROR, inertial: bool = INERTIAL, coriolis: bool = CORIOLIS, gravity: bool = GRAVITY,
-    wall_damping: float = WALL_DAMPING,
+    wall_damping: float = WALL_DAMPING, hand_mass: float = HAND_MASS, hand_damping: float = HAND_DAMPING,
+    hand_stiffness: float = HAND_STIFFNESS,
     strict: bool = STRICT,
     json_out: bool = JSON_OUT,
     quiet: bool = QUIET,
     force: bool = FORCE,
 ) -> None:
     """Transparency bandwidth of one joint: G_T = Z_M / Z_D leaves +-3 dB (seed 000 §4.2.2, eq. 4.1-4.2)."""
-    from hapticdesign.simulation.config import Compensator, LoopConfig, Sensors, Wall
+    from hapticdesign.simulation.config import Compensator, LoopConfig
     from hapticdesign.simulation.loop import joint_index
     from hapticdesign.simulation.paths import Chirp
     from hapticdesign.simulation.transparency import stable_limit, transparency
@@ -216,9 +224,10 @@ def transparency_command(
         from hapticdesign.devices.loading import resolve_device
 
         dev = resolve_device(preset, device, params, strict=strict)
-        config = LoopConfig(duration=sweep, step=step, step_control=step_control, sensors=Sensors(period, counts, delay),
-                            compensator=Compensator(inertial, coriolis, gravity, error_percent),
-                            wall=Wall(damping=wall_damping))
+        loop = sampled_loop(True, period, delay, None, compensation, error_percent, wall_damping, hand_mass,
+                            hand_damping, hand_stiffness)
+        config = LoopConfig(duration=sweep, step=step, step_control=step_control, loop=loop, counts=counts,
+                            compensator=Compensator(inertial, coriolis, gravity))
         if not (band > 0):
             raise UserError(f"--band must be positive, got {band}")
         if method not in ("simulation", "analytic"):
@@ -408,7 +417,7 @@ def campaign_command(
     from hapticdesign.devices.registry import preset as preset_device
     from hapticdesign.interface.report.index import write_folder_index
     from hapticdesign.simulation.campaign import CampaignOptions, load_cases, read_designs, run_campaign, summarize
-    from hapticdesign.simulation.config import Compensator, LoopConfig, Sensors, compensator_device
+    from hapticdesign.simulation.config import Compensator, LoopConfig, compensator_device
     from hapticdesign.simulation.paths import Chirp
 
     with user_errors(quiet=quiet), allow_large(force, FORCE_HINT):
@@ -429,11 +438,10 @@ def campaign_command(
         friction = None if coulomb is None else tuple(float(v) for v in parse_vector(coulomb, None, "coulomb"))
         if friction is not None and any(v < 0 for v in friction):
             raise UserError("--coulomb: friction torques must be >= 0")
-        conditions = LoopConfig(duration=duration, sensors=Sensors(counts_per_revolution=counts, delay_samples=delay),
-                                compensator=Compensator(error_percent=error_percent,
-                                                        group_errors=_group_errors(group_errors), error_seed=error_seed),
-                                coulomb=friction)
-        compensator_device(preset_device(preset or "phantom-3dof"), conditions.compensator)  # bad groups fail now
+        conditions = LoopConfig(duration=duration, loop=sampled_loop(True, 1e-3, delay, None, None, error_percent, 0.0),
+                                counts=counts, coulomb=friction,
+                                compensator=Compensator(group_errors=_group_errors(group_errors), error_seed=error_seed))
+        compensator_device(preset_device(preset or "phantom-3dof"), conditions)  # bad groups fail now
         options = CampaignOptions(preset or "phantom-3dof", k_limit, stiffness, Chirp(0.3, 0.1, f1, sweep), duration,
                                   method=method, conditions=conditions)
         with progress_bar(not (quiet or json_out)) as report:

@@ -156,6 +156,25 @@ def _step_lines(found: dict, status: str) -> list[str]:
             if step["status"] == status]
 
 
+def _warm_phantom_loop() -> None:
+    """Compile (or load) the rendering loop of the built-in Phantom, as the seed 000 study's rendering steps run
+    it; the target of :func:`_compile_phantom_loop_aside`'s second process."""
+    from hapticdesign.devices.registry import preset
+    from hapticdesign.simulation.loop import warm_up
+
+    warm_up(preset("phantom-3dof"))
+
+
+def _compile_phantom_loop_aside():
+    """On a machine whose numba cache lacks the rendering loop, compile it in a second process while the seed 000
+    study's first steps (equations, Linearity Number: about 8 s) run here: the loop is the tour's one noticeable
+    compile (about 12 of its 15 compiling CPU-s, ``benchmarks/bench_compile.py demo``)."""
+    from hapticdesign.simulation import kernel
+    from hapticdesign.simulation.warmup import compile_aside
+
+    return compile_aside(kernel.run_loop, _warm_phantom_loop)
+
+
 def phantom(quick: bool = QUICK, out: Path = OUT, seed: int = SEED,
             workers: int = typer.Option(2, "--workers", help="Local processes for the simulation campaign."),
             quiet: bool = QUIET, as_json: bool = JSON_OUT, scale: Optional[str] = SCALE) -> None:
@@ -164,7 +183,9 @@ def phantom(quick: bool = QUICK, out: Path = OUT, seed: int = SEED,
 
     with user_errors(quiet=True):
         settings = study.PhantomSettings.for_scale(_scale(quick, scale), seed, workers)
-        _finish(_run(study, settings, _check_out(out), quiet, as_json), quiet, as_json)
+        out = _check_out(out)
+        _compile_phantom_loop_aside()
+        _finish(_run(study, settings, out, quiet, as_json), quiet, as_json)
 
 
 def rcube(quick: bool = QUICK, out: Path = OUT, seed: int = SEED, quiet: bool = QUIET, as_json: bool = JSON_OUT,
@@ -223,6 +244,7 @@ def demo(out: Path = typer.Option(Path("out/demo"), "--out", help="Folder for th
     with user_errors(quiet=True):
         out = _check_out(out)
         level = scale or "quick"
+        _compile_phantom_loop_aside()
         if not (quiet or as_json):
             _print_equations(typer.echo)
         found = {

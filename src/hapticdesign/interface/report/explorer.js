@@ -10,8 +10,17 @@
   var E = data.evaluations, N = E.generation.length, MAX_PINS = 4;
   var PIN_COLOURS = ["#8e44ad", "#16a085", "#d35400", "#2c3e50"];
   var hasPlotly = typeof window.Plotly !== "undefined";
+  // the records embedded (above a limit, the front and a seeded sample: data.count evaluated in all), each by its
+  // evaluation number (evaluations.csv's row): ev(k) for record k, recordOf[number] back
+  var recordOf = {};
+  E.evaluation.forEach(function (number, k) { recordOf[number] = k; });
+  function ev(k) { return E.evaluation[k]; }
+  // served by `hapticdesign explore`: the card of a design off the front is computed there on demand (cards[k])
+  var served = location.protocol === "http:" || location.protocol === "https:", cards = {};
+  var GL_ABOVE = 2000;  // a scatter trace of more points is drawn by WebGL (scattergl)
 
-  // ---- quantities: variables, objectives, constraints and the evaluation number, each a column over the records
+  // ---- quantities: variables, objectives, constraints (a "result" role: a value shown, not bounded) and the
+  // evaluation number, each a column over the records
   var dims = [];
   data.variables.forEach(function (v, k) {
     dims.push({ key: "var:" + v.name, name: v.name, kind: "variable", unit: v.unit || "SI", values: E.variables[k] });
@@ -21,10 +30,10 @@
                 values: E.objectives[k] });
   });
   data.constraints.forEach(function (c, k) {
-    dims.push({ key: "con:" + c.name, name: c.name, kind: "constraint", unit: c.unit, values: E.constraints[k] });
+    dims.push({ key: "con:" + c.name, name: c.name, kind: "constraint", role: c.role, unit: c.unit, values: E.constraints[k] });
   });
   var numbers = [];
-  for (var r = 0; r < N; r++) { numbers.push(r + 1); }
+  for (var r = 0; r < N; r++) { numbers.push(ev(r)); }
   dims.push({ key: "evaluation", name: "evaluation", kind: "evaluation", unit: "", values: numbers });
   var byKey = {};
   dims.forEach(function (d) { byKey[d.key] = d; });
@@ -53,7 +62,7 @@
   function plotlyText(s) {  // Plotly reads <br>, <b>, ... in its text: escape every user string given to it
     return String(s).replace(/&/g, "&amp;").replace(/</g, "&lt;").replace(/>/g, "&gt;").replace(/"/g, "&quot;").replace(/'/g, "&#39;");
   }
-  function name(k) { return frontOf[k] ? "design " + frontOf[k] : "evaluation " + (k + 1); }
+  function name(k) { return frontOf[k] ? "design " + frontOf[k] : "evaluation " + ev(k); }
   function element(tag, text, cls) {
     var e = document.createElement(tag);
     if (text !== undefined && text !== null) { e.textContent = text; }
@@ -68,7 +77,7 @@
 
   function readHash() {
     var p = new URLSearchParams(location.hash.replace(/^#/, ""));
-    var record = function (text) { var n = parseInt(text, 10); return n >= 1 && n <= N && String(n) === text ? n - 1 : null; };
+    var record = function (text) { var n = parseInt(text, 10); return String(n) === text && recordOf.hasOwnProperty(n) ? recordOf[n] : null; };
     if (p.has("pick")) { var k = record(p.get("pick")); if (k !== null) { state.picked = k; } }
     if (p.has("pins")) {
       state.pins = p.get("pins").split(",").map(record).filter(function (k, i, all) {
@@ -96,8 +105,8 @@
 
   function writeHash() {
     var p = new URLSearchParams();
-    if (state.picked !== null) { p.set("pick", String(state.picked + 1)); }
-    if (state.pins.length) { p.set("pins", state.pins.map(function (k) { return k + 1; }).join(",")); }
+    if (state.picked !== null) { p.set("pick", String(ev(state.picked))); }
+    if (state.pins.length) { p.set("pins", state.pins.map(ev).join(",")); }
     p.set("x", state.x);
     p.set("y", state.y);
     if (state.sel) { p.set("sel", JSON.stringify(state.sel)); }
@@ -146,7 +155,7 @@
   var GROUPS = groups();
 
   function hover(k, xd, yd) {
-    var head = frontOf[k] ? "front design " + frontOf[k] + " (evaluation " + (k + 1) + ")" : "evaluation " + (k + 1);
+    var head = frontOf[k] ? "front design " + frontOf[k] + " (evaluation " + ev(k) + ")" : "evaluation " + ev(k);
     var why = E.feasible[k] ? (frontOf[k] ? "" : "<br>feasible, dominated") : "<br>not feasible: " + plotlyText(E.reason[k].slice(0, 300));
     return plotlyText(head) + why + "<br>" + plotlyText(xd.name) + " = " + shown(xd.values[k]) + "<br>" +
       plotlyText(yd.name) + " = " + shown(yd.values[k]);
@@ -164,7 +173,7 @@
 
   function trace(records, xd, yd, axes, name, marker, extra) {
     var p = pointsOf(records, xd, yd);
-    var t = { type: "scatter", mode: "markers", name: name, x: p.x, y: p.y, customdata: p.customdata,
+    var t = { type: p.x.length > GL_ABOVE ? "scattergl" : "scatter", mode: "markers", name: name, x: p.x, y: p.y, customdata: p.customdata,
               hovertext: p.hovertext, hoverinfo: "text", marker: marker, xaxis: axes[0], yaxis: axes[1],
               showlegend: axes[0] === "x" };
     if (filtering()) {
@@ -311,25 +320,35 @@
     function toY(i, v) { return canvas.height - M.bottom - (v - spans[i][0]) / (spans[i][1] - spans[i][0]) * (canvas.height - M.top - M.bottom); }
     function toValue(i, y) { return spans[i][0] + (canvas.height - M.bottom - y) / (canvas.height - M.top - M.bottom) * (spans[i][1] - spans[i][0]); }
 
-    function polyline(k, colour, width) {
-      ctx.strokeStyle = colour; ctx.lineWidth = width;
-      ctx.beginPath();
-      axes.forEach(function (d, i) { var x = axisX(i), y = toY(i, d.values[k]); if (i === 0) { ctx.moveTo(x, y); } else { ctx.lineTo(x, y); } });
-      ctx.stroke();
+    var layer = document.createElement("canvas"), drawnAt = {};  // the lines, drawn once per change of the filters
+    drawn.forEach(function (k, i) { drawnAt[k] = i; });
+
+    function polyline(k, colour, width, where) {
+      var c = where || ctx;
+      c.strokeStyle = colour; c.lineWidth = width;
+      c.beginPath();
+      axes.forEach(function (d, i) { var x = axisX(i), y = toY(i, d.values[k]); if (i === 0) { c.moveTo(x, y); } else { c.lineTo(x, y); } });
+      c.stroke();
     }
 
-    function draw() {
-      canvas.width = Math.max(600, canvas.parentNode.clientWidth - 4);
-      ctx.clearRect(0, 0, canvas.width, canvas.height);
-      var filter = filtering();
+    function draw() {  // every line into the layer, then the rest (overlay): a brush or a hover redraws only the rest
+      canvas.width = layer.width = Math.max(600, canvas.parentNode.clientWidth - 4);
+      layer.height = canvas.height;
+      var lines = layer.getContext("2d"), filter = filtering();
       drawn.forEach(function (k) {
         var on = !filter || passes(k);
         var colour = frontOf[k] ? (on ? "rgba(46, 111, 216, 0.75)" : "rgba(46, 111, 216, 0.12)")
           : (on ? "rgba(120, 125, 135, 0.35)" : "rgba(120, 125, 135, 0.06)");
-        polyline(k, colour, frontOf[k] ? 1.4 : 1);
+        polyline(k, colour, frontOf[k] ? 1.4 : 1, lines);
       });
-      state.pins.forEach(function (k, i) { if (drawn.indexOf(k) >= 0) { polyline(k, PIN_COLOURS[i], 2.5); } });
-      if (state.picked !== null && drawn.indexOf(state.picked) >= 0) { polyline(state.picked, "#f39c12", 3.5); }
+      overlay();
+    }
+
+    function overlay() {
+      ctx.clearRect(0, 0, canvas.width, canvas.height);
+      ctx.drawImage(layer, 0, 0);
+      state.pins.forEach(function (k, i) { if (drawnAt.hasOwnProperty(k)) { polyline(k, PIN_COLOURS[i], 2.5); } });
+      if (state.picked !== null && drawnAt.hasOwnProperty(state.picked)) { polyline(state.picked, "#f39c12", 3.5); }
       if (hovered !== null) { polyline(hovered, "#111", 2); }
       ctx.font = "11px sans-serif";
       axes.forEach(function (d, i) {
@@ -389,17 +408,17 @@
     });
     window.addEventListener("mousemove", function (event) {
       var p = at(event);
-      if (brushing) { brushing.y1 = p[1]; draw(); return; }
+      if (brushing) { brushing.y1 = p[1]; overlay(); return; }
       if (event.target !== canvas) { return; }
       var k = nearest(p[0], p[1]);
-      if (k !== hovered) { hovered = k; draw(); }
+      if (k !== hovered) { hovered = k; overlay(); }
       if (k === null) { tip.hidden = true; return; }
       tip.hidden = false;
       tip.textContent = name(k) + (frontOf[k] ? "" : " (feasible, dominated)") + ": click to pick";
       tip.style.left = (event.pageX + 12) + "px";
       tip.style.top = (event.pageY + 12) + "px";
     });
-    canvas.addEventListener("mouseleave", function () { tip.hidden = true; if (hovered !== null) { hovered = null; draw(); } });
+    canvas.addEventListener("mouseleave", function () { tip.hidden = true; if (hovered !== null) { hovered = null; overlay(); } });
     window.addEventListener("mouseup", function (event) {
       var p = at(event);
       if (brushing) {
@@ -422,7 +441,7 @@
     return {
       draw: draw,
       line: function (k) {  // the line of record k as canvas pixels per axis (the hook's view of the drawing)
-        return drawn.indexOf(k) < 0 ? null : axes.map(function (d, i) { return [axisX(i), toY(i, d.values[k])]; });
+        return !drawnAt.hasOwnProperty(k) ? null : axes.map(function (d, i) { return [axisX(i), toY(i, d.values[k])]; });
       }
     };
   })();
@@ -496,6 +515,17 @@
   }
 
   // ---- the design card
+  var failures = {}, deviceUrl = null;  // why the server could not compute a card; the computed device file's address
+  function detailOf(k) { return frontOf[k] ? data.designs[frontOf[k] - 1] : cards[k] || null; }
+
+  function fetchCard(k) {  // the card of record k off the front, computed by `hapticdesign explore` (cards[k]; null: failed)
+    cards[k] = undefined;
+    fetch("api/card?evaluation=" + ev(k)).then(function (response) {
+      return response.json().then(function (body) { return response.ok ? body : Promise.reject(body.error); });
+    }).then(function (card) { cards[k] = card; }, function (why) { cards[k] = null; failures[k] = String(why); })
+      .then(function () { if (state.picked === k) { drawCard(); } if (state.pins.indexOf(k) >= 0) { drawCompare(); } });
+  }
+
   function numberCell(kind, nameText, value) {
     var td = element("td", shown(value));
     td.setAttribute("data-kind", kind);
@@ -504,9 +534,28 @@
     return td;
   }
 
+  function specTable(rows) {  // the spec summary at home (hapticdesign spec's numbers), data-kind "spec"
+    var wrap = element("div", null, "table-wrap"), table = element("table");
+    table.id = "card-spec";
+    table.appendChild(element("caption", "Its spec summary at home (hapticdesign spec; blank: the device file lacks what it needs)"));
+    var head = element("tr");
+    ["quantity", "spec.json", "value", "unit"].forEach(function (h) { head.appendChild(element("th", h)); });
+    table.appendChild(head);
+    rows.forEach(function (r) {
+      var tr = element("tr");
+      tr.appendChild(element("td", r.label, "text"));
+      tr.appendChild(element("td", r.name, "text"));
+      tr.appendChild(numberCell("spec", r.name, r.value));
+      tr.appendChild(element("td", r.unit, "text"));
+      table.appendChild(tr);
+    });
+    wrap.appendChild(table);
+    return wrap;
+  }
+
   function quantities(k) {  // [kind, name, value, unit] of record k: variables, objectives, constrained values
     return dims.filter(function (d) { return d.kind !== "evaluation"; }).map(function (d) {
-      return [d.kind, d.name, d.values[k], d.unit === "SI" ? "SI" : d.unit];
+      return [d.role || d.kind, d.name, d.values[k], d.unit === "SI" ? "SI" : d.unit];
     });
   }
 
@@ -563,9 +612,9 @@
     if (k === null) { card.appendChild(element("p", "Pick a design: click a point or a line.", "note")); return; }
     var n = frontOf[k];
     card.setAttribute("data-design", n ? String(n) : "");
-    card.setAttribute("data-evaluation", String(k + 1));
-    card.appendChild(element("h3", n ? "Front design " + n + " (evaluation " + (k + 1) + ", generation " + E.generation[k] + ")"
-      + (k === selectedRecord ? ": the selected design" : "") : "Evaluation " + (k + 1) + " (generation " + E.generation[k] + ")"));
+    card.setAttribute("data-evaluation", String(ev(k)));
+    card.appendChild(element("h3", n ? "Front design " + n + " (evaluation " + ev(k) + ", generation " + E.generation[k] + ")"
+      + (k === selectedRecord ? ": the selected design" : "") : "Evaluation " + ev(k) + " (generation " + E.generation[k] + ")"));
     var status = E.feasible[k] ? (n ? (E.polished[k] ? "On the front, polished by the local search." : "On the front.")
       : "Feasible, but dominated by a front design.") : "Not feasible: " + E.reason[k];
     card.appendChild(element("p", status));
@@ -575,7 +624,7 @@
     card.appendChild(pin);
     var row = element("div", null, "card-row");
     var table = element("table");
-    table.appendChild(element("caption", n ? "Its numbers (front.csv, row " + n + ")" : "Its numbers (evaluations.csv, row " + (k + 1) + ")"));
+    table.appendChild(element("caption", n ? "Its numbers (" + (data.front_file || "front.csv") + ", row " + n + ")" : (data.evaluations_file ? "Its numbers (" + data.evaluations_file + ", row " + ev(k) + ")" : "Its numbers (design " + ev(k) + " of this page)")));
     var head = element("tr");
     ["quantity", "kind", "value", "unit"].forEach(function (h) { head.appendChild(element("th", h)); });
     table.appendChild(head);
@@ -590,7 +639,8 @@
     var wrap = element("div", null, "table-wrap");
     wrap.appendChild(table);
     row.appendChild(wrap);
-    var detail = n ? data.designs[n - 1] : null;
+    var detail = detailOf(k);
+    if (!detail && served && !cards.hasOwnProperty(k)) { fetchCard(k); }
     if (detail && detail.picture) {
       var figure = element("figure");
       var canvas = element("canvas");
@@ -601,8 +651,12 @@
       devicePicture(canvas, detail.picture);
     }
     card.appendChild(row);
+    if (detail && detail.spec) { card.appendChild(specTable(detail.spec)); }
     if (!detail) {
-      card.appendChild(element("p", "The maps, the picture and a device file are written for the front's designs; this one's numbers are evaluations.csv's.", "note"));
+      card.appendChild(element("p", !served ? (data.evaluations_file ? "The maps, the picture and a device file are written for the front's designs; this one's numbers are " + data.evaluations_file + "'s (hapticdesign explore, serving this folder, computes any design's card)."
+          : "The picture and the commands are shown for the front's designs; this one has its numbers only.")
+        : cards[k] === undefined ? "Its maps and picture are being computed (hapticdesign explore)\u2026"
+        : "hapticdesign explore could not compute its card: " + failures[k], "note"));
       return;
     }
     var names = Object.keys(detail.maps);
@@ -624,12 +678,19 @@
       });
     }
     card.appendChild(element("h4", "To reproduce it (in the output folder)"));
-    var link = element("p");
-    link.appendChild(document.createTextNode("Its device file: "));
-    var a = element("a", detail.file);
-    a.href = detail.file;
-    link.appendChild(a);
-    card.appendChild(link);
+    if (detail.file) {
+      var link = element("p");
+      link.appendChild(document.createTextNode("Its device file: "));
+      var a = element("a", detail.file);
+      if (detail.text === undefined) { a.href = detail.file; } else {  // computed on demand: not in the folder, saved from here
+        if (deviceUrl) { URL.revokeObjectURL(deviceUrl); }
+        a.href = deviceUrl = URL.createObjectURL(new Blob([detail.text], { type: "text/yaml" }));
+        a.download = detail.file;
+        link.appendChild(document.createTextNode("(not in the folder: save it from here) "));
+      }
+      link.appendChild(a);
+      card.appendChild(link);
+    }
     var pre = element("pre");
     pre.id = "card-commands";
     pre.textContent = detail.commands.map(function (c) { return "# " + c.what + "\n" + c.command; }).join("\n");
@@ -653,7 +714,7 @@
       if (finiteValues.some(function (v) { return v !== finiteValues[0]; }) || finiteValues.length !== values.length) { tr.className = "differs"; }
       var best = d.sense === "min" ? Math.min.apply(null, finiteValues) : d.sense === "max" ? Math.max.apply(null, finiteValues) : null;
       values.forEach(function (v) {
-        var td = numberCell(d.kind, d.name, v);
+        var td = numberCell(d.role || d.kind, d.name, v);
         if (best !== null && v === best && state.pins.length > 1) { td.className = "best"; }
         tr.appendChild(td);
       });
@@ -663,13 +724,13 @@
     wrap.appendChild(table);
     box.appendChild(wrap);
     var row = element("div", null, "card-row"), pictures = state.pins.map(function (k) {
-      return frontOf[k] && data.designs[frontOf[k] - 1].picture;
+      return detailOf(k) && detailOf(k).picture;
     }).filter(Boolean);
     var common = pictures.length ? Math.max.apply(null, pictures.map(pictureExtent)) : null;
     state.pins.forEach(function (k, i) {
       var figure = element("figure", null, "pinned");
-      if (frontOf[k]) { figure.setAttribute("data-design", String(frontOf[k])); } else { figure.setAttribute("data-evaluation", String(k + 1)); }
-      var detail = frontOf[k] ? data.designs[frontOf[k] - 1] : null;
+      if (frontOf[k]) { figure.setAttribute("data-design", String(frontOf[k])); } else { figure.setAttribute("data-evaluation", String(ev(k))); }
+      var detail = detailOf(k);
       if (detail && detail.picture) {
         var canvas = element("canvas");
         canvas.width = 240; canvas.height = 210;
@@ -691,8 +752,9 @@
   function status() {
     var passing = 0, front = 0;
     for (var k = 0; k < N; k++) { if (passes(k)) { passing++; if (frontOf[k]) { front++; } } }
-    var text = filtering() ? passing + " of " + N + " evaluated designs pass the filters (" + front + " of the front's " + data.front.length + ")"
-      : "No filter: " + N + " evaluated designs, " + data.front.length + " on the front. Drag a box or lasso on a plot, or along a parallel axis, to filter.";
+    var of = N === data.count ? " evaluated designs" : " designs shown (of " + data.count + " evaluated)";
+    var text = filtering() ? passing + " of " + N + of + " pass the filters (" + front + " of the front's " + data.front.length + ")"
+      : "No filter: " + N + of + ", " + data.front.length + " on the front. Drag a box or lasso on a plot, or along a parallel axis, to filter.";
     document.getElementById("filter-status").textContent = text;
     document.getElementById("clear-filters").disabled = !filtering();
   }
@@ -722,7 +784,7 @@
   }
 
   function design(n) {
-    var k = frontRecord(n), detail = data.designs[n - 1], out = { design: n, evaluation: k + 1, variables: {}, objectives: {}, constraints: {} };
+    var k = frontRecord(n), detail = data.designs[n - 1], out = { design: n, evaluation: ev(k), variables: {}, objectives: {}, constraints: {} };
     dims.forEach(function (d) {
       if (d.kind === "variable") { out.variables[d.name] = d.values[k]; }
       if (d.kind === "objective") { out.objectives[d.name] = d.values[k]; }
@@ -732,6 +794,7 @@
     out.file = detail.file;
     out.commands = detail.commands;
     out.picture = detail.picture;
+    out.spec = detail.spec || null;
     out.maps = {};
     Object.keys(detail.maps).forEach(function (m) {
       out.maps[m] = { points: data.workspace.points, values: detail.maps[m].values, unit: detail.maps[m].unit,
@@ -786,9 +849,9 @@
     },
     state: function () {
       var passing = [];
-      for (var k = 0; k < N; k++) { if (passes(k)) { passing.push(k + 1); } }
-      return { selected: designOf(state.picked), evaluation: state.picked === null ? null : state.picked + 1,
-               pins: state.pins.map(designOf), pinnedEvaluations: state.pins.map(function (k) { return k + 1; }),
+      for (var k = 0; k < N; k++) { if (passes(k)) { passing.push(ev(k)); } }
+      return { selected: designOf(state.picked), evaluation: state.picked === null ? null : ev(state.picked),
+               pins: state.pins.map(designOf), pinnedEvaluations: state.pins.map(ev),
                x: state.x, y: state.y, selection: state.sel, ranges: state.ranges, passing: passing };
     },
     parallelLine: function (n) { return parallel.line(frontRecord(n)); }

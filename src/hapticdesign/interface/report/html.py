@@ -78,7 +78,13 @@ def _key_value_table(title: str, mapping: dict) -> str:
     return f'<div class="table-wrap"><table><caption>{escape(title)}</caption><tbody>{rows}</tbody></table></div>'
 
 
-def _step(step: StepResult, table_href, figure_stem, page_href) -> str:
+def _explorer(step: StepResult, href: str) -> str:
+    """A link to the step's designs in the design explorer (a page with scripts beside the report)."""
+    return (f'<p class="files">{escape(step.outcome.explorer.title)}, in the design explorer: '
+            f'<a href="{escape(href)}">{escape(href)}</a></p>')
+
+
+def _step(step: StepResult, table_href, figure_stem, page_href, explorer_href) -> str:
     parts = [f'<h2 id="{escape(step.key)}">{escape(step.title)}</h2>',
              f"<p>{_status(step.status)} &middot; {step.seconds:.2f} s</p>"]
     if step.status != STATUS_DONE:
@@ -96,18 +102,20 @@ def _step(step: StepResult, table_href, figure_stem, page_href) -> str:
     parts += [_table(t, table_href(step, t)) for t in out.tables]
     parts += [_figure(f, figure_stem(step, f)) for f in out.figures]
     parts += [_page(p, page_href(step, p)) for p in out.pages]
+    if out.explorer is not None:
+        parts.append(_explorer(step, explorer_href(step)))
     return "\n".join(parts)
 
 
-def render(study: StudyResult, versions: dict[str, str], table_href, figure_stem, page_href) -> str:
-    """The whole report. ``table_href(step, table)``, ``figure_stem(step, figure)`` and ``page_href(step, page)``
-    name the files."""
+def render(study: StudyResult, versions: dict[str, str], table_href, figure_stem, page_href, explorer_href) -> str:
+    """The whole report. ``table_href(step, table)``, ``figure_stem(step, figure)``, ``page_href(step, page)`` and
+    ``explorer_href(step)`` (a step's design explorer) name the files."""
     toc = "".join(
         f'<tr><td><a href="#{escape(s.key)}">{escape(s.title)}</a></td><td>{_status(s.status)}</td>'
         f"<td>{s.seconds:.2f}</td></tr>" for s in study.steps)
     overview = (f"<table><caption>Steps and timings (total {study.seconds:.1f} s)</caption><thead><tr><th>step</th>"
                 f"<th>status</th><th>time [s]</th></tr></thead><tbody>{toc}</tbody></table>")
-    body = "\n".join(_step(s, table_href, figure_stem, page_href) for s in study.steps)
+    body = "\n".join(_step(s, table_href, figure_stem, page_href, explorer_href) for s in study.steps)
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>{escape(study.title)}</title>
 <link rel="icon" href="data:,">

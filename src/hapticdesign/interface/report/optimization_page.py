@@ -200,20 +200,39 @@ def _explorer_script() -> str:
     return package_files("hapticdesign.interface.report").joinpath("explorer.js").read_text(encoding="utf-8")
 
 
+def shown_count(data: dict) -> str:
+    """How many of the evaluated designs the page holds, in words (the explorer's ``data``,
+    :func:`~hapticdesign.optimization.study_explorer.explorer_table`)."""
+    shown, count, front = len(data["evaluations"]["evaluation"]), data["count"], len(data["front"])
+    if shown == count:
+        return f"This page holds all {count:,} evaluated designs."
+    sample = data["sample"]
+    return (f"This page holds {shown:,} of the {count:,} evaluated designs: the front's {front:,} (and the polished "
+            f"ones) and a sample of {sample['limit']:,} of the others, drawn with the run's seed {sample['seed']} "
+            "(evaluations.csv has every one; hapticdesign explore computes the card of any design shown).")
+
+
 def _explorer(data: dict) -> tuple[str, str, str]:
     """The explorer's section, its scripts (the data, Plotly.js, the explorer's own) and the page's policy: the
-    inline script by its hash, Plotly.js from the page's folder (a ``file:`` address), no network."""
+    inline script by its hash, Plotly.js from the page's folder (a ``file:`` address, or the server's own when
+    ``hapticdesign explore`` serves the folder, which also answers the cards: ``connect-src 'self'``), no other
+    network. ``'unsafe-eval'`` lets those two scripts build functions from their own text: Plotly's WebGL traces (the
+    large scatter plots, ``scattergl``) compile their drawing commands so and show "WebGL is not supported" without it;
+    no inline script or handler runs (a user string in the page stays text)."""
     code = _explorer_script()
     digest = base64.b64encode(hashlib.sha256(code.encode("utf-8")).digest()).decode("ascii")
-    policy = (f"default-src 'none'; script-src 'sha256-{digest}' file: 'self'; style-src 'unsafe-inline'; "
-              "img-src data: blob:; font-src data:")
+    policy = (f"default-src 'none'; script-src 'sha256-{digest}' 'unsafe-eval' file: 'self'; connect-src 'self'; "
+              "style-src 'unsafe-inline'; img-src data: blob:; font-src data:")
+    shown, count = len(data["evaluations"]["evaluation"]), data["count"]
     section = (
         '<section id="explorer"><h2>Explore the designs</h2>'
         '<p class="note">Every evaluated design: click a point or a line to pick a design (its card follows), drag a '
         "box or a lasso on a plot or along an axis of the parallel coordinates to filter (a click on an axis clears "
         "its range), pin up to four designs to compare them. The address keeps the view: a link reopens it. "
         "Each quantity's unit is in brackets (a variable's from its device file). <code>window.hdExplorer</code> scripts it (docs/optimization.md)."
-        '</p><p id="explorer-note"></p>'
+        f'</p><p id="shown-count" class="note" data-shown="{shown}" data-count="{count}">'
+        f"{escape(shown_count(data))}</p>"
+        '<p id="explorer-note"></p>'
         '<div class="toolbar"><label>x <select id="x-axis"></select></label><label>y <select id="y-axis"></select>'
         '</label><button id="clear-filters" type="button">Clear filters</button><span id="filter-status"></span></div>'
         '<div id="objective-space"></div><div id="pairs"></div>'
@@ -245,8 +264,7 @@ def render(run: StudyRun, selection: Selection, title: str, pareto: Picture, pic
     over = [_table(f"The selected design's indices over the workspace ({coarseness}): at the box's centre, median, "
                    "mean and the extremes with the points where they are taken", ["index", "unit", *SPREAD_COLUMNS],
                    spread)] if spread else []
-    section, scripts, policy = _explorer(explorer)
-    body = [f"<h1>Optimization study: {escape(title)}</h1>", section, "<h2>Study</h2>",
+    body = ["<h2>Study</h2>",
             _study_rows(run, coarseness, units),
             "<h2>Pareto front</h2>", _image(pareto),
             _table(f"The front: {len(run.front)} feasible, non-dominated designs (front.csv; click a row to pick it)",
@@ -257,7 +275,16 @@ def render(run: StudyRun, selection: Selection, title: str, pareto: Picture, pic
             _baseline(run, units, chosen), *over,
             *(_image(p) for p in pictures),
             "<h2>Infeasible designs</h2>", _reasons(run)]
-    return _document(title, body, files, scripts, policy)
+    return explorer_page(title, f"Optimization study: {title}", explorer, body, files)
+
+
+def explorer_page(title: str, heading: str, explorer: dict, body: list[str], files: list[str]) -> str:
+    """A design explorer as one HTML document, the one page every study's designs open in (``optimize``'s report,
+    ``rcube optimize``'s, ``study phantom``'s campaign): the ``heading``, the explorer of ``explorer``'s data
+    (:func:`~hapticdesign.optimization.study_explorer.explorer_table`), then ``body``'s parts (HTML, every user string
+    in them escaped) and the list of ``files`` beside it; Plotly.js is loaded from :data:`PLOTLY` beside the page."""
+    section, scripts, policy = _explorer(explorer)
+    return _document(title, [f"<h1>{escape(heading)}</h1>", section, *body], files, scripts, policy)
 
 
 def _closest(run: StudyRun, units: Mapping[str, str]) -> str:

@@ -143,7 +143,7 @@ def frequency(pose: HandleStates) -> np.ndarray:
 
 @index(unit="N/m", formula="exact stable wall stiffness of the sampled loop along a direction (or the worst)",
        source="seed 000 ch. 4-5; hapticdesign.analysis.sampled_loop.handle_limits",
-       needs=("kinematics", "dynamics", "damping", "gravity"), renamed={"damping": "wall_damping"})
+       needs=("kinematics", "dynamics", "damping", "gravity", "compliance"), renamed={"damping": "wall_damping"})
 def kmax(pose: HandleStates, period: float = 0.001, delay: int = 1, wall_damping: float = 0.0,
          direction: list[float] | None = None, velocity: str = "difference", compensation: str = "gravity",
          error_percent: float = 0.0, hand: object = None) -> np.ndarray:
@@ -151,7 +151,7 @@ def kmax(pose: HandleStates, period: float = 0.001, delay: int = 1, wall_damping
                    compensation=compensation, error_percent=error_percent, hand=hand)
     return wall_kmax(pose.J_v, pose.H, pose.B, (pose.svd[0], pose.mobility, pose.cartesian_damping), options,
                      pose.gravity, None if error_percent == 0 else pose.compensator(error_percent),
-                     pose.transmission)
+                     pose.drive)
 
 
 @index(unit="LN", formula="Linearity Number over the joint region (limits, else full turns)",

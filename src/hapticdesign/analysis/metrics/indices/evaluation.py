@@ -23,6 +23,7 @@ import numpy as np
 from hapticdesign.analysis.design_batch import DesignBatch
 from hapticdesign.analysis.metrics.indices.registry import INDICES, Index, Request, requests_of
 from hapticdesign.analysis.metrics.indices.states import BATCH_NEEDS, HandleStates, ParameterStates
+from hapticdesign.analysis.stiffness.drive import compliant_drive, elastic, joint_compliance
 from hapticdesign.analysis.workspace import reach_workspace
 from hapticdesign.errors import UserError
 from hapticdesign.model.device import Device
@@ -116,18 +117,23 @@ def evaluate_designs(space: DesignFamily, designs: Sequence[Mapping[str, float]]
     batch = _batch(space, checked, registry) if designs else None
     if batch is None:
         return [_one(space, values, points, checked, registry) for values in designs]
-    sections = any("sections" in registry[r.index].needs for r in checked)
+    links = any("compliance" in registry[r.index].needs for r in checked) and elastic(space.base)
+    sections = links or any("sections" in registry[r.index].needs for r in checked)
     gravity = any("gravity" in registry[r.index].needs for r in checked)
     got = batch.evaluate(space.batch_values(designs, batch), points, sections, space.home_position, gravity)
     ok, v = got.ok, got.values
     per_pose = np.repeat(np.flatnonzero(ok), len(points))
     n_a = got.jacobian.shape[-1]
+    transmission = None if v.transmission is None else v.transmission.taken(per_pose)
+    drive = transmission if not (links and ok.any()) else compliant_drive(
+        transmission, joint_compliance(got.jacobian[ok].reshape(-1, 3, n_a), got.stiffness[ok].reshape(-1, 6, 6)),
+        v.reflected[per_pose], v.motor_damping[per_pose])
     states = HandleStates.of(
         got.jacobian[ok].reshape(-1, 3, n_a), got.mass[ok].reshape(-1, n_a, n_a), v.damping[per_pose],
         got.q[ok].reshape(-1, n_a), int(ok.sum()), motor_map=None if v.motor_map is None else v.motor_map[per_pose],
         torque_limits={k: None if t is None else t[per_pose] for k, t in v.torques.items()},
         moving_mass=got.moving_mass[per_pose], name=space.base.name,
-        transmission=None if v.transmission is None else v.transmission.taken(per_pose),
+        transmission=transmission, drive=drive,
         model=lambda error: tuple(x[ok].reshape(-1, n_a, n_a) for x in got.model(error)),
         **({} if got.gravity is None else {"gravity": got.gravity[ok].reshape(-1, n_a, n_a)}))
     if sections:

@@ -4,9 +4,10 @@ decorator that registers one (docs/indices.md).
 An index is one function over a design state (:mod:`.states`): ``function(state, **options)`` gives one value per
 pose (or per design, for an index of the parameters alone). It declares its unit, formula, source, its options (the
 function's keyword parameters and their defaults) and what it ``needs`` of the state: ``kinematics``, ``dynamics``,
-``damping``, ``sections``, ``motors``, ``bodies`` (a device at poses; the batch of many designs gives the first
-three), or ``parameters`` alone. The built-in indices (:mod:`.builtin`), a device family's own (the R-CUBE's) and a
-user's all register the same way, with :func:`index` or :func:`register`.
+``damping``, ``sections``, ``motors``, ``bodies``, ``gravity``, ``compliance`` (the drive between the motors and the
+handle; a device at poses, and the batch of many designs, give them, :data:`~.states.BATCH_NEEDS`), ``device`` (a
+device at poses only), or ``parameters`` alone. The built-in indices (:mod:`.builtin`), a device family's own (the
+R-CUBE's) and a user's all register the same way, with :func:`index` or :func:`register`.
 
 Indices of installed packages are found through the entry-point group :data:`ENTRY_POINTS` (``[project.entry-points.
 "hapticdesign.indices"] name = "package.module"``): the first lookup of a name the registry does not hold imports

@@ -23,21 +23,25 @@ import numpy as np
 
 from hapticdesign.analysis import kinematics
 from hapticdesign.analysis.configuration import configuration_of
+from hapticdesign.analysis.dynamics import cartesian
 from hapticdesign.analysis.dynamics.cartesian import cartesian_inertia, mobility
 from hapticdesign.analysis.dynamics.device import gravity_gradient_at, mass_matrix_at
 from hapticdesign.analysis.metrics import force
 from hapticdesign.analysis.metrics.kinematic import handle_range_basis
 from hapticdesign.analysis.stiffness.device import cartesian_stiffness_at
+from hapticdesign.analysis.stiffness.drive import device_drive, elastic
 from hapticdesign.errors import UserError
 from hapticdesign.model.dense import symmetric_eigenvalues
 from hapticdesign.model.actuators import Transmission
 from hapticdesign.model.compensator_model import model_device
 from hapticdesign.model.device import Device
 
-BATCH_NEEDS = frozenset({"kinematics", "dynamics", "damping", "sections", "motors", "bodies", "gravity"})
+BATCH_NEEDS = frozenset({"kinematics", "dynamics", "damping", "sections", "motors", "bodies", "gravity",
+                         "compliance"})
 """What :meth:`HandleStates.of` gives of many designs' poses: ``J_v`` and ``q`` (kinematics), ``H`` (dynamics),
 ``B`` (damping), the links' sections (``stiffness``, ``U^T K_C[:3, :3] U``), the motors (``motor_map``,
-``torque_limits``), the bodies (``moving_mass``) and gravity's gradient (``gravity``)."""
+``torque_limits``), the bodies (``moving_mass``), gravity's gradient (``gravity``) and the compliance between the
+motors and the handle (``drive``: the transmissions' and, when the file's links carry sections, the links')."""
 POSE_NEEDS = BATCH_NEEDS | {"device"}
 """What a device at poses gives an index: all of :data:`BATCH_NEEDS`, and the ``device`` itself (an index of the
 whole device, such as its exact Linearity Number, is evaluated design by design)."""
@@ -129,6 +133,16 @@ class HandleStates:
         return None if found is None else Transmission(*(per_pose(x, self.count, 2) for x in found))
 
     @cached_property
+    def drive(self) -> Transmission | None:
+        """The compliance between the motors and the handle at each pose (:class:`~hapticdesign.model.actuators.
+        Transmission`, (P, n_a, n_a) each): the transmissions' and, where the device file gives elastic links, the
+        links' in series (:func:`~hapticdesign.analysis.stiffness.drive.device_drive`); None when both are rigid."""
+        device = self._device
+        found = device_drive(device, self.full, self.J_v, self.frame,
+                             self.cartesian_stiffness if elastic(device) else None)
+        return None if found is None else Transmission(*(per_pose(x, self.count, 2) for x in found))
+
+    @cached_property
     def gravity(self) -> np.ndarray:
         """``dG/dq`` (P, n_a, n_a): the stiffness gravity adds to the linearized plant at each pose
         (:func:`~hapticdesign.analysis.dynamics.device.gravity_gradient_at`)."""
@@ -190,16 +204,20 @@ class HandleStates:
     @cached_property
     def cartesian_damping(self) -> np.ndarray:
         """``U^T J_v^+T B J_v^+ U`` (P, k, k) in N s/m: the joints' and motors' damping felt at the handle."""
-        pinv = np.linalg.pinv(self.J_v) @ self.svd[0]
-        return np.swapaxes(pinv, 1, 2) @ self.B @ pinv
+        return cartesian.damping(self.J_v, self.svd[0], self.B)
+
+    @cached_property
+    def cartesian_stiffness(self) -> np.ndarray:
+        """The VJM's ``K_C`` (P, 6, 6) at the handle
+        (:func:`~hapticdesign.analysis.stiffness.device.cartesian_stiffness_at`)."""
+        return np.array([cartesian_stiffness_at(self._device, q, self.frame) for q in self.full])
 
     @cached_property
     def stiffness(self) -> np.ndarray:
         """``U^T K_C[:3, :3] U`` (P, k, k) in N/m: the VJM's translational stiffness on the directions the handle
-        moves (:func:`~hapticdesign.analysis.stiffness.device.cartesian_stiffness_at`)."""
+        moves."""
         u, _ = self.svd
-        k = np.array([cartesian_stiffness_at(self._device, q, self.frame)[:3, :3] for q in self.full])
-        return np.swapaxes(u, 1, 2) @ k @ u
+        return np.swapaxes(u, 1, 2) @ self.cartesian_stiffness[:, :3, :3] @ u
 
     @property
     def _device(self) -> Device:
@@ -216,12 +234,14 @@ class HandleStates:
         :mod:`hapticdesign.analysis.design_batch`), with any other quantity of :data:`BATCH_NEEDS` known per pose by
         its name (``stiffness`` (P, k, k), ``motor_map``, ``torque_limits``, ``moving_mass``, ``name``, ``gravity``
         (P, n_a, n_a), ``model``: the compensator's ``H_m`` and ``dG_m/dq`` for a modelling error in percent, as
-        :meth:`compensator` gives them, ``transmission``: the motors' compliant transmissions, None when rigid): enough for an index that needs at most :data:`BATCH_NEEDS`, of those
-        quantities given. ``designs``: how many designs the poses belong to, one after the other. One design's
-        ``B``, ``motor_map``, ``torque_limits`` or ``transmission`` (without the leading axis) is taken at every pose,
+        :meth:`compensator` gives them, ``transmission``: the motors' compliant transmissions, None when rigid,
+        ``drive``: the compliance between the motors and the handle, the transmissions' unless given): enough for an
+        index that needs at most :data:`BATCH_NEEDS`, of those quantities given. ``designs``: how many designs the
+        poses belong to, one after the other. One design's ``B``, ``motor_map``, ``torque_limits``, ``transmission``
+        or ``drive`` (without the leading axis) is taken at every pose,
         so that every field has the leading axis P (the class's docstrings give each shape)."""
         unknown = set(known) - {"stiffness", "motor_map", "torque_limits", "moving_mass", "name", "gravity", "model",
-                                "transmission"}
+                                "transmission", "drive"}
         if unknown:
             raise TypeError(f"HandleStates.of: unknown quantities {sorted(unknown)}")
         count = len(J_v)
@@ -230,10 +250,12 @@ class HandleStates:
         if "torque_limits" in known:
             known["torque_limits"] = {k: None if x is None else per_pose(x, count, 1)
                                       for k, x in known["torque_limits"].items()}
-        if known.get("transmission") is not None:
-            known["transmission"] = Transmission(*(per_pose(x, count, 2) for x in known["transmission"]))
+        for name in ("transmission", "drive"):
+            if known.get(name) is not None:
+                known[name] = Transmission(*(per_pose(x, count, 2) for x in known[name]))
+        known.setdefault("drive", known.get("transmission"))
         states = cls(None, np.zeros((count, 0)))
-        states.__dict__.update(J_v=J_v, H=H, designs=int(designs), **{"transmission": None, **known})
+        states.__dict__.update(J_v=J_v, H=H, designs=int(designs), **{"transmission": None, "drive": None, **known})
         for name, value in (("B", None if B is None else per_pose(B, count, 2)), ("q", q)):
             if value is not None:
                 states.__dict__[name] = value
