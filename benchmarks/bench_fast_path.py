@@ -8,7 +8,7 @@ geometry-only one, and the example five-bar study end to end.
   two tube sections (links.prox1.D, links.dist1.D) and the two capstan ratios as discrete choices. Goal: tubes at
   most 1.5x the CPU of geometry. Each is run end to end (``hapticdesign optimize ... --seed 1``, CPU time of the
   child process, start-up included), and its evaluation alone is timed in this process (one generation's worth of
-  random designs through ``BoundStudy.evaluate``, the best of three).
+  random designs through the study's ``StudyEvaluator``, the best of three).
 - **(b) examples/studies/five-bar.yaml end to end** (``hapticdesign optimize examples/studies/five-bar.yaml --seed 1``):
   wall-clock and CPU time of the child process. Goal: under 30 s on the project's 2-core machine.
 
@@ -35,7 +35,7 @@ from pathlib import Path  # noqa: E402
 
 import yaml  # noqa: E402
 
-from hapticdesign.optimization.study_evaluation import bind_study  # noqa: E402
+from hapticdesign.optimization.study_evaluation import StudyEvaluator, bind_study  # noqa: E402
 from hapticdesign.optimization.study_file import load_study  # noqa: E402
 from bench_study import random_designs  # noqa: E402  (benchmarks/ is the script's folder)
 
@@ -65,15 +65,15 @@ def _cli(study: Path, out: Path) -> tuple[float, float]:
 
 
 def _evaluation(study_path: Path, designs: int = 40, seed: int = 0) -> float:
-    """CPU seconds of one generation of random designs through ``BoundStudy.evaluate`` (the best of three)."""
+    """CPU seconds of one generation of random designs through the study's ``StudyEvaluator`` (the best of three)."""
     study = load_study(study_path)
-    bound = bind_study(study)
+    evaluate = StudyEvaluator(bind_study(study))
     batch = random_designs(study, designs, seed)
-    bound.evaluate(batch[:2])  # the first call builds the caches
+    evaluate(batch[:2])  # the first call builds the caches
     best = float("inf")
     for _ in range(3):
         start = time.process_time()
-        bound.evaluate(batch)
+        evaluate(batch)
         best = min(best, time.process_time() - start)
     return best
 

@@ -14,7 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
-from hapticdesign.optimization.study_evaluation import bind_study
+from hapticdesign.optimization.pymoo_run import NSGA_II
+from hapticdesign.optimization.study_evaluation import StudyEvaluator, bind_study
 from hapticdesign.optimization.study_file import Study, load_study
 from hapticdesign.optimization.study_run import run_study
 from hapticdesign.optimization.rcube.synthesis import BOUND_SETS, hypervolume, synthesize
@@ -36,8 +37,8 @@ def timed(function):
 
 
 def generic(study: Study):
-    bound = bind_study(study)
-    return run_study(study, SEED, bound.evaluate, None, None, bound.evaluate_constraints)
+    evaluate = StudyEvaluator(bind_study(study))
+    return run_study(study, SEED, evaluate, None, None, evaluate.constraints, algorithm=NSGA_II)
 
 
 def main() -> None:

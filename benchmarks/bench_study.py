@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from hapticdesign.optimization.study_evaluation import bind_study
+from hapticdesign.optimization.study_evaluation import StudyEvaluator, bind_study
 from hapticdesign.optimization.study_file import Study, load_study, study_from_mapping
 from hapticdesign.optimization.study_run import Encoding
 
@@ -45,10 +45,11 @@ def random_designs(study: Study, designs: int, seed: int = 0) -> list[dict[str, 
 def rate(study: Study, designs: int = 60, seed: int = 0) -> tuple[float, float, int]:
     """Designs per second, milliseconds per workspace point and the designs that reached the workspace."""
     bound = bind_study(study)
+    evaluate = StudyEvaluator(bound)
     batch = random_designs(study, designs, seed)
-    bound.evaluate(batch[:2])  # first calls build the caches
+    evaluate(batch[:2])  # first calls build the caches
     start = time.perf_counter()
-    answers = bound.evaluate(batch)
+    answers = evaluate(batch)
     elapsed = time.perf_counter() - start
     return designs / elapsed, 1e3 * elapsed / (designs * len(bound.points)), sum(not a.reason for a in answers)
 

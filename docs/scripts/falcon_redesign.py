@@ -18,7 +18,7 @@ import time
 from pathlib import Path
 
 from hapticdesign.devices.loading import load_device
-from hapticdesign.optimization.study_evaluation import bind_study
+from hapticdesign.optimization.study_evaluation import StudyEvaluator, bind_study
 from hapticdesign.optimization.study_file import load_study
 from hapticdesign.studies.spec import spec_sheet
 
@@ -51,7 +51,8 @@ def lightest_full_legs() -> tuple[dict, list[float]] | None:
     designs = [{"a": a / 1000, "b": b / 1000, "ratio": 0.110 / 0.01425, "rod": 1.0}
                for a in range(45, 86, 5) for b in range(85, 141, 5)]
     keys = list(bound.keys)
-    reached = [(d, dict(zip(keys, ans.reduced))) for d, ans in zip(designs, bound.evaluate(designs)) if not ans.reason]
+    answers = StudyEvaluator(bound)(designs)
+    reached = [(d, dict(zip(keys, ans.reduced))) for d, ans in zip(designs, answers) if not ans.reason]
     if not reached:
         return None
     mass = next(k for k in keys if k[0] == "mass")

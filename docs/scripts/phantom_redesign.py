@@ -38,7 +38,7 @@ from hapticdesign.analysis.metrics.indices import Request, reduce  # noqa: E402
 from hapticdesign.analysis.workspace import Workspace, reach_workspace  # noqa: E402
 from hapticdesign.devices.device_file import load_device_file  # noqa: E402
 from hapticdesign.errors import UserError  # noqa: E402
-from hapticdesign.optimization.study_evaluation import bind_study  # noqa: E402
+from hapticdesign.optimization.study_evaluation import StudyEvaluator, bind_study  # noqa: E402
 from hapticdesign.optimization.study_file import load_study  # noqa: E402
 from hapticdesign.optimization.study_outputs import without_unit  # noqa: E402
 from hapticdesign.analysis.metrics.indices import evaluate  # noqa: E402
@@ -229,7 +229,7 @@ def main() -> None:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the published be and df bodies' triangle-inequality note (device file)
         unmodified = load_device_file(DEVICE)
-        as_study = bound.evaluate([published])[0]
+        as_study = StudyEvaluator(bound)([published])[0]
         with tempfile.TemporaryDirectory() as scratch:
             summary, elapsed = run_study(Path(scratch))
         front, selected = summary["front"], summary["selected"]["design"]

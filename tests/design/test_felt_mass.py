@@ -26,8 +26,9 @@ from typer.testing import CliRunner
 from hapticdesign.analysis.metrics.indices import reduce, reduced_at, reduction_label, spread
 from hapticdesign.errors import UserError
 from hapticdesign.interface.cli import app
-from hapticdesign.optimization.study_evaluation import bind_study
+from hapticdesign.optimization.study_evaluation import StudyEvaluator, bind_study
 from hapticdesign.optimization.study_file import load_study
+from hapticdesign.optimization.study_outputs import spread_rows, where_evaluated
 from tests.helpers.phantom_premium_ik import closed_form
 from tests.helpers.phantom_premium_mass import apparent_mass
 
@@ -84,12 +85,12 @@ def test_a_study_reduces_the_published_phantoms_apparent_mass_as_the_closed_form
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the published be and df bodies' triangle-inequality note
         bound = bind_study(load_study(felt_study(tmp_path, grid)))
-    answer = bound.evaluate([PUBLISHED])[0]
+    answer = StudyEvaluator(bound)([PUBLISHED])[0]
     assert answer.reason == ""
     got = dict(zip(REDUCED, answer.reduced))
     for name in REDUCED:
         assert got[name] == pytest.approx(expected[name], rel=1e-9), name
-    header = bound.where_evaluated(PUBLISHED)
+    header = where_evaluated(bound, PUBLISHED)
     line, = [t for t in header.splitlines() if t.startswith("# max apparent_mass")]
     assert f"(max of {grid ** 3} points, grid {grid})" in line
     # the worst point named: one of the grid's, where the closed form takes its largest value (the device is
@@ -99,7 +100,7 @@ def test_a_study_reduces_the_published_phantoms_apparent_mass_as_the_closed_form
     assert apparent_mass(closed_form(worst)) == pytest.approx(masses.max(), rel=1e-5)
     centre, = [t for t in header.splitlines() if t.startswith("# center apparent_mass")]
     np.testing.assert_allclose(_point_in(centre), center, atol=1e-6)
-    row, = bound.spread_rows(PUBLISHED)
+    row, = spread_rows(bound, PUBLISHED)
     assert row[-1] == line.split(" at ")[1].split(";")[0] + " (one of 4 points)"  # the far corners, mirrored in y, z
     assert [float(v) for v in row[2:5]] == pytest.approx([expected[k] for k in ("centre", "median", "mean")],
                                                          rel=1e-5)

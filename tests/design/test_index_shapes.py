@@ -24,7 +24,7 @@ from hapticdesign.analysis.workspace import Workspace
 from hapticdesign.devices.design_space import design_space
 from hapticdesign.errors import UserError
 from hapticdesign.interface.cli import app
-from hapticdesign.optimization.study_evaluation import bind_study
+from hapticdesign.optimization.study_evaluation import StudyEvaluator, bind_study
 from hapticdesign.optimization.study_file import load_study
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -102,7 +102,7 @@ def test_one_user_index_through_maps_metrics_spec_and_a_study(tmp_path, index_fi
     from hapticdesign.interface.commands.optimize_adapter import index_module
     own = index_module(index_file)
     bound = bind_study(load_study(study_file(tmp_path, home, 3)), indices=own)
-    answer = bound.evaluate([{"l1": float(device.params["l1"])}])[0]  # the compiled batch of designs
+    answer = StudyEvaluator(bound)([{"l1": float(device.params["l1"])}])[0]  # the compiled batch of designs
     assert answer.reason == ""
     centre, low, high = answer.reduced
 

@@ -31,7 +31,8 @@ from hapticdesign.devices.design_space import design_space
 from hapticdesign.devices.device_file import load_device_file
 from hapticdesign.errors import UserError
 from hapticdesign.interface.cli import app
-from hapticdesign.optimization.study_evaluation import bind_study
+from hapticdesign.optimization.pymoo_run import NSGA_II
+from hapticdesign.optimization.study_evaluation import StudyEvaluator, bind_study
 from hapticdesign.optimization.study_file import load_study
 from hapticdesign.optimization.study_run import run_study
 
@@ -132,7 +133,7 @@ BUILT_IN = {"name": "iso", "index": "isotropy", "reduce": "min", "sense": "max"}
 def test_your_own_index_in_a_study_equals_the_built_in_it_mirrors(tmp_path):
     study = load_study(_five_bar_study(tmp_path, [SQUARED, BUILT_IN]))
     bound = bind_study(study, indices=[isotropy_squared])
-    run = run_study(study, 2, bound.evaluate)
+    run = run_study(study, 2, StudyEvaluator(bound), algorithm=NSGA_II)
     evaluated = [r for r in run.records if not r.invalid]
     assert len(evaluated) >= 16
     for record in evaluated:
@@ -145,7 +146,7 @@ def test_a_study_of_a_study_local_index_and_the_cli_flag_that_runs_a_file(tmp_pa
     local = hd.index(unit="1", name="isotropy_local", registry=Registry(INDICES))(isotropy_squared.function)
     assert "isotropy_local" not in INDICES
     study = load_study(_five_bar_study(tmp_path, [{**SQUARED, "index": "isotropy_local"}, BUILT_IN]))
-    answers = bind_study(study, indices=[local]).evaluate([{"l1": 0.1, "l2": 0.15}])
+    answers = StudyEvaluator(bind_study(study, indices=[local]))([{"l1": 0.1, "l2": 0.15}])
     assert answers[0].reduced[0] == pytest.approx(answers[0].reduced[1] ** 2, rel=1e-12)
     with pytest.raises(UserError, match="unknown index 'isotropy_local'"):
         bind_study(study)

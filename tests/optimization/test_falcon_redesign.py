@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from hapticdesign.optimization.study_evaluation import bind_study
+from hapticdesign.optimization.study_evaluation import StudyEvaluator, bind_study
 from hapticdesign.optimization.study_file import load_study
 from hapticdesign.optimization.study_outputs import without_unit
 
@@ -32,7 +32,7 @@ def test_the_published_falcon_misses_novints_cube(bound):
     device file fixes no `rod`, so the report has no device file's design and says why."""
     values, why = bound.baseline()
     assert values is None and "states no value of variable rod" in why
-    answer = bound.evaluate([PUBLISHED])[0]
+    answer = StudyEvaluator(bound)([PUBLISHED])[0]
     assert answer.reason.startswith("the handle cannot reach")
     assert bound.space.base.reference == "falcon"
 
@@ -53,7 +53,7 @@ def test_the_documented_front_holds_on_this_machine(bound):
         rows = [{without_unit(k): v for k, v in row.items()} for row in csv.DictReader(handle)]
     names = list(bound.study.spec.variables)
     assert len(rows) == 22
-    answers = bound.evaluate([{name: float(row[name]) for name in names} for row in rows])
+    answers = StudyEvaluator(bound)([{name: float(row[name]) for name in names} for row in rows])
     for row, answer in zip(rows, answers):
         assert answer.reason == ""
         stated = [float(v) for k, v in row.items() if k not in ("design", "polished", *names)]

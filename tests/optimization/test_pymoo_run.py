@@ -10,7 +10,7 @@ from hapticdesign.errors import UserError
 from hapticdesign.model.rcube import RCubeGeometry
 from hapticdesign.optimization.rcube.objectives import objectives
 from hapticdesign.optimization.rcube.plies import optimize_plies
-from hapticdesign.optimization.pymoo_run import AlgorithmSpec, RowObjective, RunResult, run
+from hapticdesign.optimization.pymoo_run import NSGA_II, PARTICLE_SWARM, AlgorithmSpec, RowObjective, RunResult, run
 from hapticdesign.optimization.rcube.synthesis import BOUND_SETS, run_nsga2
 
 
@@ -30,7 +30,7 @@ def dominated(F: np.ndarray) -> np.ndarray:
 
 
 def test_same_seed_same_front_and_the_front_is_the_non_dominated_set():
-    spec = AlgorithmSpec("nsga2", population=30, generations=40)
+    spec = AlgorithmSpec(NSGA_II, population=30, generations=40)
     a, b = run(Schaffer(), spec, seed=7), run(Schaffer(), spec, seed=7)
     assert np.array_equal(a.X, b.X) and np.array_equal(a.F, b.F)
     assert np.array_equal(a.front(), b.front())
@@ -57,7 +57,17 @@ def test_spec_is_checked():
         AlgorithmSpec(generations=0)
     with pytest.raises(UserError, match="method"):
         AlgorithmSpec("simplex")
-    with pytest.raises(UserError, match="integer"):
+    with pytest.raises(UserError, match="integer variables and discrete choices need a genetic algorithm, not pso"):
+        AlgorithmSpec(PARTICLE_SWARM, integer=True)
+    with pytest.raises(UserError, match="discrete choices need a genetic algorithm"):
+        AlgorithmSpec(PARTICLE_SWARM, discrete=(0,))
+
+
+def test_a_method_named_as_before_still_runs_for_a_release_and_says_so():
+    with pytest.warns(FutureWarning, match="deprecated"):
+        spec = AlgorithmSpec("pso", population=10, generations=3)
+    assert spec.algorithm is PARTICLE_SWARM
+    with pytest.warns(FutureWarning), pytest.raises(UserError, match="integer"):
         AlgorithmSpec("pso", integer=True)
 
 

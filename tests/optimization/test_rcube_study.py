@@ -18,7 +18,8 @@ from hapticdesign.errors import UserError
 from hapticdesign.interface.cli import app
 from hapticdesign.optimization.formula import formula
 from hapticdesign.optimization.rcube.shortest import constrained_minimum
-from hapticdesign.optimization.study_evaluation import bind_study
+from hapticdesign.optimization.pymoo_run import NSGA_II
+from hapticdesign.optimization.study_evaluation import StudyEvaluator, bind_study
 from hapticdesign.optimization.study_file import load_study
 from hapticdesign.optimization.study_outputs import front_csv
 from hapticdesign.optimization.study_run import run_study
@@ -45,7 +46,8 @@ def study_file(folder: Path, **changes) -> Path:
 def run_generic(path: Path):
     study = load_study(path)
     bound = bind_study(study)
-    return study, run_study(study, SEED, bound.evaluate, None, None, bound.evaluate_constraints)
+    evaluate = StudyEvaluator(bound)
+    return study, run_study(study, SEED, evaluate, None, None, evaluate.constraints, algorithm=NSGA_II)
 
 
 @pytest.fixture(scope="module")
@@ -105,7 +107,7 @@ def test_rcube_o1_is_the_tangent_of_the_travel_that_covers_the_cube(tmp_path):
     meets the constraints (so that its objectives are computed)."""
     bound = bind_study(load_study(study_file(tmp_path)))
     q = 0.5
-    answer = bound.evaluate([{"q_max": q, "l2": 0.1, "l3": 0.15}])[0]
+    answer = StudyEvaluator(bound)([{"q_max": q, "l2": 0.1, "l3": 0.15}])[0]
     assert answer.reason == "" and all(np.isfinite(answer.reduced))
     l1 = 0.06 / math.sin(q)
     assert answer.reduced[0] == pytest.approx(0.06 / math.sqrt(l1 ** 2 - 0.06 ** 2), rel=1e-12)
@@ -156,21 +158,22 @@ def test_an_interrupted_run_of_several_runs_continues_from_its_checkpoint(tmp_pa
                                                                                         "starts": 4}})
     study = load_study(path)
     bound = bind_study(study)
-    whole = run_study(study, SEED, bound.evaluate, None, None, bound.evaluate_constraints)
+    evaluate = StudyEvaluator(bound)
+    whole = run_study(study, SEED, evaluate, None, None, evaluate.constraints, algorithm=NSGA_II)
     asked = []
 
     def counting(batch):
         asked.append(len(batch))
-        return bound.evaluate(batch)
+        return StudyEvaluator(bound)(batch)
 
     def stop(generation, total):
         if generation == 5:  # the second generation of the second run
             raise Interrupt
 
     with pytest.raises(Interrupt):
-        run_study(study, SEED, counting, tmp_path / "out", stop, bound.evaluate_constraints)
+        run_study(study, SEED, counting, tmp_path / "out", stop, evaluate.constraints, algorithm=NSGA_II)
     assert len(asked) == 5
-    resumed = run_study(study, SEED, counting, tmp_path / "out", None, bound.evaluate_constraints)
+    resumed = run_study(study, SEED, counting, tmp_path / "out", None, evaluate.constraints, algorithm=NSGA_II)
     assert len(asked) == 5 + 4  # generations 3 of run 2 and 1-3 of run 3
     assert resumed.front == whole.front and front_csv(resumed) == front_csv(whole)
     np.testing.assert_array_equal([r.objectives for r in resumed.records], [r.objectives for r in whole.records])

@@ -30,7 +30,7 @@ from typer.testing import CliRunner
 import hapticdesign as hd
 from hapticdesign.errors import UserError
 from hapticdesign.interface.cli import app
-from hapticdesign.optimization.study_evaluation import STUDY_LIMIT, bind_study, require_study_workload
+from hapticdesign.optimization.study_evaluation import STUDY_LIMIT, StudyEvaluator, bind_study, require_study_workload
 from hapticdesign.optimization.study_file import load_study, study_from_mapping
 from hapticdesign.optimization.study_methods import METHODS, method_of
 from hapticdesign.optimization.study_outputs import evaluations_csv, front_csv
@@ -83,8 +83,8 @@ def run_of(path: Path, seed: int = 1, out: Path | None = None, evaluate=None):
 def test_the_closed_form_is_the_registry_isotropy(tmp_path):
     bound = bind_study(load_study(length_study(tmp_path)))
     for l1, l2 in [(0.17, 0.12), (0.2, 0.09), (0.15, 0.1)]:
-        assert bound.evaluate([{"l1": l1, "l2": l2}])[0].reduced[0] == pytest.approx(closed_form_isotropy(l1, l2),
-                                                                                     rel=1e-9)
+        assert StudyEvaluator(bound)([{"l1": l1, "l2": l2}])[0].reduced[0] == pytest.approx(
+            closed_form_isotropy(l1, l2), rel=1e-9)
 
 
 @pytest.mark.parametrize("method", ["nsga2", "pso"])
@@ -178,11 +178,11 @@ def test_polishing_resumes_from_the_checkpoint_with_the_same_bytes(tmp_path):
         asked.append(len(batch))
         if len(asked) == 7:  # four generations, then three batches of the polishing
             raise Interrupt
-        return bound.evaluate(batch)
+        return StudyEvaluator(bound)(batch)
 
     with pytest.raises(Interrupt):
         run_of(path, 3, tmp_path / "out", stopping)
-    resumed = run_of(path, 3, tmp_path / "out", lambda batch: asked.append(len(batch)) or bound.evaluate(batch))
+    resumed = run_of(path, 3, tmp_path / "out", lambda batch: asked.append(len(batch)) or StudyEvaluator(bound)(batch))
     assert asked[7] == asked[6]  # the stopped batch is asked again first, then only the batches after it
     assert sum(asked) == whole.evaluations + asked[6] and len(asked) > 8
     assert front_csv(resumed) == front_csv(whole) and evaluations_csv(resumed) == evaluations_csv(whole)
@@ -206,7 +206,7 @@ def test_nsga3_is_pymoos_nsga3_on_the_same_problem_with_the_same_seed(tmp_path):
 
         def _evaluate(self, X, out, *args, **kwargs):
             evaluated.extend(map(tuple, X))
-            answers = bound.evaluate([{"l2": a, "actuators.q2.gear_ratio": b} for a, b in X])
+            answers = StudyEvaluator(bound)([{"l2": a, "actuators.q2.gear_ratio": b} for a, b in X])
             out["F"] = np.array([[-a.reduced[0], a.reduced[1]] if not a.reason else [0.0, 0.0] for a in answers])
             out["G"] = np.array([[1.0 if a.reason else 0.0] for a in answers])
 
@@ -245,6 +245,7 @@ def test_every_documented_method_is_reachable_from_a_study_file():
         method = method_of(spec)
         assert method.name == name == spec.algorithm.method
         assert getattr(method, "title", None) == title and method.checkpointed is checkpointed
+        assert type(spec.algorithm) is method.settings  # the record carries the settings the file is read into
     assert method_of(study_from_mapping(base)).name == "nsga2"
 
 

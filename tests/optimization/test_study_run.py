@@ -19,7 +19,8 @@ import yaml
 from pymoo.indicators.hv import HV
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
-from hapticdesign.optimization.study_evaluation import bind_study
+from hapticdesign.optimization.pymoo_run import NSGA_II
+from hapticdesign.optimization.study_evaluation import StudyEvaluator, bind_study
 from hapticdesign.optimization.study_file import load_study
 from hapticdesign.optimization.study_outputs import front_csv
 from hapticdesign.optimization.study_run import run_study
@@ -58,7 +59,7 @@ def best(run, k: int = 0):
 def test_single_objective_finds_the_isotropic_two_link_arm(tmp_path):
     path = write_study(tmp_path, {"l2": [0.08, 0.3]}, [ISOTROPY], population=12, generations=40)
     study = load_study(path)
-    run = run_study(study, 3, bind_study(study).evaluate)
+    run = run_study(study, 3, StudyEvaluator(bind_study(study)), algorithm=NSGA_II)
     top = best(run)
     assert len(run.front) == 1
     assert top.values["l2"] == pytest.approx(L1 / math.sqrt(2.0), rel=1e-3)  # 0.14 mm of 141 mm
@@ -74,8 +75,8 @@ def test_single_objective_over_choices_finds_the_brute_force_optimum(tmp_path):
     study = load_study(path)
     bound = bind_study(study)
     designs = [{"l2": a, "actuators.q1.gear_ratio": b} for a, b in itertools.product(l2_values, ratios)]
-    masses = [answer.reduced[0] for answer in bound.evaluate(designs)]
-    run = run_study(study, 5, bound.evaluate)
+    masses = [answer.reduced[0] for answer in StudyEvaluator(bound)(designs)]
+    run = run_study(study, 5, StudyEvaluator(bound), algorithm=NSGA_II)
     assert best(run).values == designs[int(np.argmin(masses))]
     assert best(run).objectives[0] == min(masses)
     assert run.evaluations < len(designs) * 2
@@ -89,10 +90,10 @@ def test_two_objective_front_against_a_brute_force_front(tmp_path):
     bound = bind_study(study)
     grid = [{"l2": a, "actuators.q2.gear_ratio": b}
             for a, b in itertools.product(np.linspace(0.09, 0.3, 15), np.linspace(4.0, 20.0, 8))]
-    answers = [a for a in bound.evaluate(grid) if not a.reason]
+    answers = [a for a in StudyEvaluator(bound)(grid) if not a.reason]
     brute = np.array([[-a.reduced[0], a.reduced[1]] for a in answers])  # minimized: -isotropy, mass
     brute = brute[NonDominatedSorting().do(brute, only_non_dominated_front=True)]
-    run = run_study(study, 11, bound.evaluate)
+    run = run_study(study, 11, StudyEvaluator(bound), algorithm=NSGA_II)
     found = np.array([[-run.records[k].objectives[0], run.records[k].objectives[1]] for k in run.front])
     reference = np.max(np.vstack([brute, found]), axis=0) + 0.05 * np.ptp(np.vstack([brute, found]), axis=0)
     hv_brute, hv_found = HV(ref_point=reference)(brute), HV(ref_point=reference)(found)
@@ -108,8 +109,8 @@ def small_study(tmp_path) -> Path:
 
 def test_same_seed_same_front_other_seed_other_designs(tmp_path):
     study = load_study(small_study(tmp_path))
-    evaluate = bind_study(study).evaluate
-    a, b, c = (run_study(study, seed, evaluate) for seed in (2, 2, 3))
+    evaluate = StudyEvaluator(bind_study(study))
+    a, b, c = (run_study(study, seed, evaluate, algorithm=NSGA_II) for seed in (2, 2, 3))
     assert front_csv(a) == front_csv(b)
     assert [r.x for r in a.records] == [r.x for r in b.records]
     assert [r.x for r in a.records] != [r.x for r in c.records]
@@ -122,21 +123,21 @@ class Interrupt(Exception):
 def test_an_interrupted_run_continues_from_its_checkpoint_and_ends_with_the_same_front(tmp_path):
     study = load_study(small_study(tmp_path))
     bound = bind_study(study)
-    whole = run_study(study, 4, bound.evaluate)
+    whole = run_study(study, 4, StudyEvaluator(bound), algorithm=NSGA_II)
     asked = []
 
     def counting(batch):
         asked.append(len(batch))
-        return bound.evaluate(batch)
+        return StudyEvaluator(bound)(batch)
 
     def stop_after_two(generation, total):
         if generation == 2:
             raise Interrupt
 
     with pytest.raises(Interrupt):
-        run_study(study, 4, counting, tmp_path / "out", stop_after_two)
+        run_study(study, 4, counting, tmp_path / "out", stop_after_two, algorithm=NSGA_II)
     first = len(asked)
-    resumed = run_study(study, 4, counting, tmp_path / "out")
+    resumed = run_study(study, 4, counting, tmp_path / "out", algorithm=NSGA_II)
     assert first == 2 and len(asked) == first + 2  # generations 3 and 4 only
     assert front_csv(resumed) == front_csv(whole)
     assert [r.objectives for r in resumed.records] == [r.objectives for r in whole.records]
@@ -163,7 +164,7 @@ def test_a_checkpoint_whose_reasons_were_edited_is_not_trusted(tmp_path, alter):
     study = load_study(small_study(tmp_path))
     designs = [{"l2": 0.15, "actuators.q2.gear_ratio": 4.0}, {"l2": 0.02, "actuators.q2.gear_ratio": 8.0},
                {"l2": 0.2, "actuators.q2.gear_ratio": 16.0}, {"l2": 0.03, "actuators.q2.gear_ratio": 4.0}]
-    answers = bind_study(study).evaluate(designs)
+    answers = StudyEvaluator(bind_study(study))(designs)
     assert [bool(a.reason) for a in answers] == [False, True, False, True]  # l1 - l2 > 0.15 m: out of reach
     X = np.array([[d["l2"], float(k)] for d, k in zip(designs, (0, 1, 2, 0))])
     checkpoint = Checkpoint(tmp_path / "out", study, 5)
@@ -194,7 +195,7 @@ def test_when_no_design_reaches_the_workspace_the_closest_is_the_one_reaching_th
     study = load_study(path)
     bound = bind_study(study)
     assert np.allclose(sorted(p[0] for p in bound.points), xs) and len(bound.points) == 4
-    run = run_study(study, 1, bound.evaluate)
+    run = run_study(study, 1, StudyEvaluator(bound), algorithm=NSGA_II)
     assert all(r.invalid for r in run.records)
     last = [r for r in run.records if r.generation == run.records[-1].generation][:CLOSEST_CANDIDATES]
     counts = {r.values["l2"]: points_reached(L1, r.values["l2"], [(x, 0.0, 0.0) for x in xs]) for r in last}

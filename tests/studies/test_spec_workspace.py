@@ -120,7 +120,7 @@ def test_the_falcon_cube_of_the_sheet_is_reached_as_a_study_box_and_the_next_ste
     """Issue 45: the sheet said 92.77 mm while a study box of 92.7 mm lost rank on the way. Now the sheet's cube, as a
     study's box on grid 3 and on the default grid 5, is reached by the study's evaluation (the batched kernel, the
     device file's design), and the cube one bisection step larger is not, on one of the two grids."""
-    from hapticdesign.optimization.study_evaluation import bind_study
+    from hapticdesign.optimization.study_evaluation import StudyEvaluator, bind_study
     from hapticdesign.optimization.study_file import load_study
     from hapticdesign.analysis.configuration import configuration_of
     from hapticdesign.studies.spec import handle_at, workspace_cube
@@ -136,7 +136,7 @@ def test_the_falcon_cube_of_the_sheet_is_reached_as_a_study_box_and_the_next_ste
         out = []
         for grid in (3, 5):
             bound = bind_study(load_study(falcon_study(tmp_path, size, grid, h.position)))
-            out.append(bound.evaluate([{"a": 0.060}])[0].reason)
+            out.append(StudyEvaluator(bound)([{"a": 0.060}])[0].reason)
         return out
 
     assert reasons(edge) == ["", ""]

@@ -3,18 +3,21 @@
 The searches of :mod:`~hapticdesign.optimization.rcube.synthesis`, :mod:`~hapticdesign.optimization.rcube.swarm`,
 :mod:`~hapticdesign.optimization.rcube.cross_section`, :mod:`~hapticdesign.optimization.rcube.plies` and the study files'
 population searches (:mod:`~hapticdesign.optimization.study_run`) all run through :func:`run`: an
-:class:`AlgorithmSpec` names the algorithm (:data:`ALGORITHMS`) and its size, ``minimize`` runs
-it with a seed (the same seed gives the same numbers), and the final population comes back as a
-plain :class:`RunResult` whose :meth:`RunResult.feasible` and :meth:`RunResult.front` filter it.
+:class:`AlgorithmSpec` holds the algorithm (one of pymoo's, :class:`PymooAlgorithm`: :data:`NSGA_II`,
+:data:`NSGA_III`, :data:`PARTICLE_SWARM`) and its size, ``minimize`` runs it with a seed (the same seed gives the same
+numbers), and the final population comes back as a plain :class:`RunResult` whose :meth:`RunResult.feasible` and
+:meth:`RunResult.front` filter it.
 
-Expensive objectives of one design vector are a :class:`RowObjective`, pymoo's
-``ElementwiseProblem``: its rows go through pymoo's element-wise runner, in a loop by default or
-on the workers of a Dask client that the caller passes (none is started here).
+Work that may go to a Dask cluster goes through one hook, pymoo's element-wise runner (:func:`elementwise_runner`): a
+plain loop by default, or the workers of a Dask client that the caller passes (none is started here). Expensive
+objectives of one design vector are a :class:`RowObjective`, pymoo's ``ElementwiseProblem``, whose rows go through it;
+a study's batches of designs go through it too (:mod:`~hapticdesign.optimization.study_evaluation`).
 """
 
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -39,16 +42,35 @@ from hapticdesign.errors import UserError
 
 
 @dataclass(frozen=True)
+class PymooAlgorithm:
+    """One of pymoo's algorithms: ``name`` (in messages), ``build(spec, n_obj, options)`` makes it; ``genetic``: it
+    takes sampling, crossover, mutation and repair operators (integer and discrete variables)."""
+
+    name: str
+    build: Callable[["AlgorithmSpec", int, dict], Algorithm]
+    genetic: bool
+
+
+NSGA_II = PymooAlgorithm("nsga2", lambda spec, n_obj, options: NSGA2(pop_size=spec.population, **options), True)
+"""NSGA-II (Deb et al. 2002)."""
+NSGA_III = PymooAlgorithm("nsga3", lambda spec, n_obj, options: NSGA3(
+    reference_directions(n_obj, spec.population, spec.partitions), pop_size=spec.population, **options), True)
+"""NSGA-III (Deb & Jain 2014): survival by the niches of Das-Dennis reference directions."""
+PARTICLE_SWARM = PymooAlgorithm("pso", lambda spec, n_obj, options: PSO(pop_size=spec.population, **options), False)
+"""Particle swarm optimization (Kennedy & Eberhart 1995) of one objective."""
+
+
+@dataclass(frozen=True)
 class AlgorithmSpec:
-    """The algorithm of one run: ``method`` (a name of :data:`ALGORITHMS`), ``population`` and ``generations``.
-    ``integer``: integer variables, genetic methods only (integer sampling, SBX and polynomial mutation with
+    """The algorithm of one run: ``algorithm`` (one of pymoo's), ``population`` and ``generations``.
+    ``integer``: integer variables, genetic algorithms only (integer sampling, SBX and polynomial mutation with
     distribution index 3 and rounding repair, duplicates eliminated). ``discrete``: columns that hold whole numbers
-    among real ones (the index of a discrete choice), genetic methods only: sampled and varied as reals and rounded
+    among real ones (the index of a discrete choice), genetic algorithms only: sampled and varied as reals and rounded
     by :class:`RoundColumns`, duplicates eliminated. ``initial``: the first population's rows; without it pymoo's
     own seeded random sampling is used. ``partitions``: NSGA-III's Das-Dennis divisions per objective axis (None:
     the most whose reference directions fit in the population)."""
 
-    method: str = "nsga2"
+    algorithm: PymooAlgorithm = NSGA_II
     population: int = 100
     generations: int = 100
     integer: bool = False
@@ -57,11 +79,17 @@ class AlgorithmSpec:
     partitions: int | None = None
 
     def __post_init__(self) -> None:
-        if self.method not in ALGORITHMS:
-            raise UserError(f"unknown optimization method {self.method!r}; choose one of {', '.join(ALGORITHMS)}")
-        if (self.integer or self.discrete) and not ALGORITHMS[self.method].genetic:
-            raise UserError(f"integer variables and discrete choices need a genetic method "
-                            f"({', '.join(n for n, a in ALGORITHMS.items() if a.genetic)}), not {self.method}")
+        if isinstance(self.algorithm, str):  # a name of the former table ALGORITHMS, kept one release
+            named = {a.name: a for a in (NSGA_II, NSGA_III, PARTICLE_SWARM)}
+            if self.algorithm not in named:
+                raise UserError(f"unknown optimization method {self.algorithm!r}; choose one of {', '.join(named)}")
+            warnings.warn(f"AlgorithmSpec({self.algorithm!r}): a method's name is deprecated; pass pymoo's algorithm "
+                          "(hapticdesign.optimization.pymoo_run.NSGA_II, NSGA_III or PARTICLE_SWARM)", FutureWarning,
+                          stacklevel=3)
+            object.__setattr__(self, "algorithm", named[self.algorithm])
+        if (self.integer or self.discrete) and not self.algorithm.genetic:
+            raise UserError("integer variables and discrete choices need a genetic algorithm, not "
+                            f"{self.algorithm.name}")
         if self.population < 2:
             raise UserError(f"population must be at least 2, got {self.population}")
         if self.generations < 1:
@@ -84,24 +112,6 @@ def reference_directions(n_obj: int, population: int, partitions: int | None = N
     return get_reference_directions("das-dennis", n_obj, n_partitions=partitions)
 
 
-@dataclass(frozen=True)
-class PymooAlgorithm:
-    """One of pymoo's algorithms: ``build(spec, n_obj, options)`` makes it; ``genetic``: it takes sampling,
-    crossover, mutation and repair operators (integer and discrete variables)."""
-
-    build: Callable[[AlgorithmSpec, int, dict], Algorithm]
-    genetic: bool
-
-
-ALGORITHMS = {
-    "nsga2": PymooAlgorithm(lambda spec, n_obj, options: NSGA2(pop_size=spec.population, **options), True),
-    "nsga3": PymooAlgorithm(lambda spec, n_obj, options: NSGA3(
-        reference_directions(n_obj, spec.population, spec.partitions), pop_size=spec.population, **options), True),
-    "pso": PymooAlgorithm(lambda spec, n_obj, options: PSO(pop_size=spec.population, **options), False),
-}
-"""pymoo's algorithms by name: NSGA-II (Deb et al. 2002), NSGA-III (Deb & Jain 2014) and particle swarm."""
-
-
 def build_algorithm(spec: AlgorithmSpec, n_obj: int) -> Algorithm:
     """The pymoo algorithm of ``spec`` for ``n_obj`` objectives."""
     options = {} if spec.initial is None else {"sampling": spec.initial}
@@ -112,7 +122,7 @@ def build_algorithm(spec: AlgorithmSpec, n_obj: int) -> Algorithm:
                    "eliminate_duplicates": True, **options}
     elif spec.discrete:
         options = {"repair": RoundColumns(spec.discrete), "eliminate_duplicates": True, **options}
-    return ALGORITHMS[spec.method].build(spec, n_obj, options)
+    return spec.algorithm.build(spec, n_obj, options)
 
 
 class RoundColumns(Repair):

@@ -113,9 +113,7 @@ def _affine(spec: StudySpec, places: dict[str, tuple[int, int]], n_params: int) 
         else:
             raise UserError(f"method convex: constraint {c.expression!r} is not convex in the inertial parameters; "
                             "only sums of masses, or of one body's mass-centre coordinates, are")
-        for value, sign in ((c.at_most, 1.0), (c.at_least, -1.0)):
-            if value is None:
-                continue
+        for value, sign, _ in c.sides:
             limit = value - parsed.constant
             out = sign * row
             if mass is None:

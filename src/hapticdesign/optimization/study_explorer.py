@@ -27,9 +27,9 @@ from hapticdesign.analysis.workspace import reach_workspace
 from hapticdesign.errors import UserError
 from hapticdesign.files import parse_structured, quote, read_text, structured_kind
 from hapticdesign.model.device import Device
-from hapticdesign.optimization.study_evaluation import BoundStudy, workspace_of
+from hapticdesign.optimization.study_evaluation import BoundStudy, StudyEvaluator, workspace_of
 from hapticdesign.optimization.study_file import Choice, IndexConstraint, Study, study_from_mapping
-from hapticdesign.optimization.study_outputs import Selection, baseline_lines
+from hapticdesign.optimization.study_outputs import Selection, baseline_lines, device_file_text
 from hapticdesign.optimization.study_run import Encoding, Record, StudyRun, record_of
 
 DESIGNS = "designs"
@@ -164,7 +164,7 @@ def design_cards(bound: BoundStudy, designs: list[dict[str, float]], files: list
                 named = r.index + (json.dumps(r.options, sort_keys=True) if r.options else "")
                 maps[named] = {"index": r.index, "unit": _unit(bound.registry[r.index].unit),
                                "values": [_number(v) for v in got], "reductions": reductions}
-        out.append(FrontDesign(file, bound.device_file_text(variables, header, evaluated=device is not None), maps,
+        out.append(FrontDesign(file, device_file_text(bound, variables, header, evaluated=device is not None), maps,
                                picture, commands, _summary(summary, device)))
     return out
 
@@ -188,11 +188,12 @@ def evaluation_card(bound: BoundStudy, evaluation: int, generation: int, values:
                     summary: Summary | None = None) -> dict:
     """The card of evaluated design number ``evaluation`` (evaluations.csv's row, of ``generation``) of variable
     ``values``, computed again from the study: its variables, objectives and constrained values as the run computed
-    them (:meth:`BoundStudy.evaluate`, :func:`~.study_run.record_of`), feasible or why not, and its maps, picture,
-    commands, spec summary (with ``summary``) and device file's ``text`` (:func:`design_cards`; the file is named
-    :func:`evaluation_file`)."""
+    them (:class:`~.study_evaluation.StudyEvaluator`, :func:`~.study_run.record_of`), feasible or why not, and its
+    maps, picture, commands, spec summary (with ``summary``) and device file's ``text`` (:func:`design_cards`; the
+    file is named :func:`evaluation_file`)."""
     spec = bound.study.spec
-    record = record_of(spec, generation, Encoding.of(spec).encode(values), values, bound.evaluate([values])[0])
+    answer = StudyEvaluator(bound)([values])[0]
+    record = record_of(spec, generation, Encoding.of(spec).encode(values), values, answer)
     header = f"Evaluation {evaluation} of the study (evaluations.csv), computed by hapticdesign explore"
     card = design_cards(bound, [values], [evaluation_file(evaluation)], [[header]], summary)[0]
     return {"evaluation": evaluation, "generation": generation, **_record([o.name for o in spec.objectives], record),

@@ -4,8 +4,8 @@ A study names a device file (relative to the study file), the ``variables`` the 
 (continuous bounds ``[low, high]`` or a discrete choice ``{values: [...]}``), the ``workspace`` the handle
 must reach (a box and a grid), the ``objectives`` (an index reduced over the workspace and a sense), the
 ``constraints`` (an index or an affine expression of the variables, bounded by ``<=`` and/or ``>=``) and
-the ``algorithm`` (one record per method, :data:`SETTINGS`: NSGA-II, NSGA-III or particle swarm, population and
-generations; or ``convex``, seed 000's exact LN minimization over inertial parameters, which needs no workspace).
+the ``algorithm`` (one record per method, :data:`AlgorithmSettings`: NSGA-II, NSGA-III or particle swarm, population
+and generations; or ``convex``, seed 000's exact LN minimization over inertial parameters, which needs no workspace).
 Everything is checked here with one-line messages naming the field; the names of variables and indices are
 checked against the device and the index registry when the study is bound to them (:mod:`.study_run`).
 
@@ -19,7 +19,7 @@ import functools
 import hashlib
 import math
 from pathlib import Path
-from typing import Annotated, ClassVar, Literal
+from typing import Annotated, ClassVar, Literal, get_args
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError, field_validator, model_validator
 
@@ -114,8 +114,28 @@ def _bounds(data: object) -> object:
 
 
 class _Bounded(_StudyModel):
+    """A quantity bounded by ``<=`` and/or ``>=``: the one place that reads a bound's side, sign and word."""
+
     at_most: Finite | None = Field(None, alias="<=")
     at_least: Finite | None = Field(None, alias=">=")
+
+    @property
+    def sides(self) -> tuple[tuple[float, float, str], ...]:
+        """Each bound given, ``<=`` first, as (bound, sign, word): a value meets it when
+        ``sign * (value - bound) <= 0``."""
+        both = ((self.at_most, 1.0, "<="), (self.at_least, -1.0, ">="))
+        return tuple((bound, sign, word) for bound, sign, word in both if bound is not None)
+
+    def beyond(self, value: float) -> list[tuple[float, float, str]]:
+        """Each side of :attr:`sides` as (how far ``value`` is beyond the bound, scaled by the bound's size, 1 for a
+        bound of 0; the bound; its word): above 0 where ``value`` misses the bound (NaN for a NaN value)."""
+        return [(sign * (value - bound) / (abs(bound) if bound != 0.0 else 1.0), bound, word)
+                for bound, sign, word in self.sides]
+
+    @staticmethod
+    def missed(label: str, value: float, bound: float, word: str) -> str:
+        """A bound missed, in words: ``l1 + l2 = 0.31, not <= 0.3``."""
+        return f"{label} = {value:.6g}, not {word} {bound:g}"
 
     @model_validator(mode="after")
     def _ordered(self) -> "_Bounded":
@@ -336,19 +356,31 @@ class Convex(_StudyModel):
         return 1
 
 
-SETTINGS = {"nsga2": Nsga2, "nsga3": Nsga3, "pso": Pso, "convex": Convex}
-"""Each method's settings record, by name (the methods themselves: :mod:`.study_methods`)."""
+AlgorithmSettings = Annotated[Nsga2 | Nsga3 | Pso | Convex, Field(discriminator="method")]
+"""The ``algorithm`` of a study: one record per method, chosen by ``method`` (:func:`algorithm_settings`; each record's
+pymoo algorithm and run: :data:`~hapticdesign.optimization.study_methods.METHODS`)."""
+
+
+def method_name(settings: type[_StudyModel]) -> str:
+    """The ``algorithm.method`` of a method's settings record (``nsga2`` of :class:`Nsga2`)."""
+    return get_args(settings.model_fields["method"].annotation)[0]
+
+
+def _settings() -> dict[str, type[_StudyModel]]:
+    """Each method's settings record by its name (the members of :data:`AlgorithmSettings`)."""
+    return {method_name(record): record for record in get_args(get_args(AlgorithmSettings)[0])}
 
 
 def algorithm_settings(value: dict) -> Nsga2 | Nsga3 | Pso | Convex:
     """The ``algorithm`` mapping as its method's record (``nsga2`` without ``method``); a setting of another method
     is refused in one line naming the methods it belongs to."""
+    settings = _settings()
     method = value.get("method", "nsga2")
-    if method not in SETTINGS:
-        raise ValueError(f"algorithm.method: unknown method {quote(method)}; choose one of {', '.join(SETTINGS)}")
-    record = SETTINGS[method]
+    if method not in settings:
+        raise ValueError(f"algorithm.method: unknown method {quote(method)}; choose one of {', '.join(settings)}")
+    record = settings[method]
     for key in value:
-        owners = [name for name, other in SETTINGS.items() if key in other.model_fields]
+        owners = [name for name, other in settings.items() if key in other.model_fields]
         if key not in record.model_fields and owners:
             named = " and ".join([", ".join(owners[:-1]), owners[-1]] if len(owners) > 1 else owners)
             raise ValueError(f"algorithm.{key}: a setting of method {named}, not of method {method} "
@@ -357,10 +389,6 @@ def algorithm_settings(value: dict) -> Nsga2 | Nsga3 | Pso | Convex:
         return record.model_validate({**value, "method": method})
     except ValidationError as exc:
         raise ValueError(f"algorithm.{describe_validation_error(exc)}") from None
-
-
-AlgorithmSettings = Annotated[Nsga2 | Nsga3 | Pso | Convex, Field(discriminator="method")]
-"""The ``algorithm`` of a study: one record per method, chosen by ``method`` (:func:`algorithm_settings`)."""
 
 
 class StudySpec(_StudyModel):

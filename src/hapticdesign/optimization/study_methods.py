@@ -1,29 +1,31 @@
-"""The study's optimization methods as a table: :data:`METHODS` maps the ``algorithm.method`` of a study file to a
-method object with one :meth:`~PopulationSearch.run` (pymoo's style: the study is the Problem, the method the
-Algorithm, the :class:`~hapticdesign.optimization.study_run.StudyRun` the Result that keeps them).
+"""The study's optimization methods: one record per method (:data:`METHODS`, by the ``algorithm.method`` of a study
+file) carrying its settings (its record of the study file, a pydantic model of
+:mod:`~hapticdesign.optimization.study_file`), its pymoo algorithm (:class:`~.pymoo_run.PymooAlgorithm`) and its
+:meth:`~PopulationSearch.run` (pymoo's style: the study is the Problem, the method the Algorithm, the
+:class:`~hapticdesign.optimization.study_run.StudyRun` the Result that keeps them).
 
-- ``nsga2``, ``nsga3``, ``pso``: a population search of pymoo (:data:`~hapticdesign.optimization.pymoo_run.ALGORITHMS`),
-  each generation checkpointed, then the front polished as ``algorithm.polish`` asks (:mod:`.study_polish`).
+- ``nsga2``, ``nsga3``, ``pso``: a population search of pymoo, each generation checkpointed, then the front polished
+  as ``algorithm.polish`` asks (:mod:`.study_polish`).
 - ``convex``: seed 000's LN minimization over inertial parameters as one exact convex program (:mod:`.study_convex`).
 
-Each method's settings are its record of the study file (:data:`~hapticdesign.optimization.study_file.SETTINGS`);
-what a method does differently (how it runs, how its report and its empty front read, whether it keeps a
-checkpoint or evaluates designs on a cluster) is asked of its object here, nowhere by its name.
+What a method does differently (how it runs, how its report and its empty front read, whether it keeps a checkpoint
+or evaluates designs on a cluster) is asked of its record here, nowhere by its name.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
 from hapticdesign.errors import UserError
+from hapticdesign.optimization.pymoo_run import NSGA_II, NSGA_III, PARTICLE_SWARM, PymooAlgorithm
 from hapticdesign.optimization.study_convex import ln_of, run_convex
-from hapticdesign.optimization.study_evaluation import BoundStudy
-from hapticdesign.optimization.study_file import StudySpec
+from hapticdesign.optimization.study_evaluation import BoundStudy, StudyEvaluator, points_reached
+from hapticdesign.optimization.study_file import Convex, Nsga2, Nsga3, Pso, StudySpec, method_name
 from hapticdesign.optimization.study_polish import polish
 from hapticdesign.optimization.study_run import Answer, Encoding, Evaluator, StudyRun, record_of, run_study
 
@@ -35,32 +37,41 @@ POLISHED = {"ends": "each objective's best front design", "all": "every front de
 """What a polishing setting refines, in words (the report)."""
 
 
+@dataclass(frozen=True)
 class PopulationSearch:
-    """A pymoo population search over the study's variables (``name`` in
-    :data:`~hapticdesign.optimization.pymoo_run.ALGORITHMS`; ``title`` names it in the report)."""
+    """A pymoo population search over the study's variables: its ``settings`` (the study file's record), pymoo's
+    ``algorithm`` and the ``title`` that names it in the report."""
+
+    settings: type[Nsga2 | Nsga3 | Pso]
+    algorithm: PymooAlgorithm
+    title: str
 
     checkpointed = True
     """A run keeps each generation in the output folder's checkpoint, and a rerun continues."""
     evaluates_designs = True
     """Its designs go to an evaluator in batches (here, or on a Dask cluster)."""
 
-    def __init__(self, name: str, title: str):
-        self.name = name
-        self.title = title
+    @property
+    def name(self) -> str:
+        return method_name(self.settings)
 
     def run(self, bound: BoundStudy, seed: int, evaluate: Evaluator | None = None, out: Path | None = None,
             progress: Progress | None = None) -> StudyRun:
         """The search seeded ``seed`` (:func:`~hapticdesign.optimization.study_run.run_study`), its front polished;
-        ``evaluate`` answers batches of designs (the bound study's own by default), ``out`` keeps the checkpoint,
-        ``progress(generation, generations)``."""
-        evaluate = evaluate or bound.evaluate
-        run = run_study(bound.study, seed, evaluate, out, progress, bound.evaluate_constraints)
+        ``evaluate`` answers batches of designs (:class:`~.study_evaluation.StudyEvaluator` in this process by
+        default), ``out`` keeps the checkpoint, ``progress(generation, generations)``."""
+        if not self.algorithm.genetic and Encoding.of(bound.study.spec).discrete:
+            genetic = ", ".join(m.name for m in METHODS.values() if m.algorithm is not None and m.algorithm.genetic)
+            raise UserError(f"variables that are discrete choices need a genetic method ({genetic}), not {self.name}")
+        here = StudyEvaluator(bound)
+        evaluate = evaluate or here
+        run = run_study(bound.study, seed, evaluate, out, progress, here.constraints, algorithm=self.algorithm)
         return polish(run, bound.study, evaluate, out)
 
     def evaluate_baseline(self, bound: BoundStudy, values: dict[str, float]) -> Answer:
         """The answer for the device file's design of variable ``values``: the bound study's, as every design's, with
         its objectives even when it breaks a constraint."""
-        return bound.evaluate([values], every_objective=True)[0]
+        return StudyEvaluator(bound).answers([values], every_objective=True)[0]
 
     def describe(self, run: StudyRun) -> str:
         """The run in words (the report)."""
@@ -91,7 +102,7 @@ class PopulationSearch:
         valid = [r for r in run.records if not r.invalid]
         if not valid:
             last = [r for r in run.records if r.generation == run.records[-1].generation][:CLOSEST_CANDIDATES]
-            counts = [bound.points_reached(r.values) for r in last]
+            counts = [points_reached(bound, r.values) for r in last]
             best = int(np.argmax(counts))
             shown = ", ".join(f"{k} = {v:.6g}" for k, v in last[best].values.items())
             return UserError(f"no design of {run.evaluations} reaches the whole workspace; the closest ({shown}) "
@@ -115,13 +126,11 @@ def _kept_none(run: StudyRun, feasible: list) -> UserError:
         total, first = 0.0, ""
         for keep in spec.keep:
             v = float(keep.formula.value(full))
-            for bound, sign, word in ((keep.at_most, 1.0, "<="), (keep.at_least, -1.0, ">=")):
-                if bound is None:
-                    continue
-                excess = math.inf if not math.isfinite(v) else sign * (v - bound) / (abs(bound) or 1.0)
+            for excess, bound, word in keep.beyond(v):
+                excess = excess if math.isfinite(v) else math.inf
                 if excess > 0.0:
                     total += excess
-                    first = first or f"{keep.formula.text} = {v:.6g}, not {word} {bound:g}"
+                    first = first or keep.missed(keep.formula.text, v, bound, word)
         return total, first
 
     closest = min(feasible, key=lambda r: misses(r)[0])
@@ -130,12 +139,19 @@ def _kept_none(run: StudyRun, feasible: list) -> UserError:
                      f"every one; the closest ({shown}) has {misses(closest)[1]}")
 
 
+@dataclass(frozen=True)
 class ConvexProgram:
     """Seed 000's LN minimization as one exact convex program (:mod:`.study_convex`): one design, no generations."""
 
-    name = "convex"
+    settings: type[Convex] = Convex
+    algorithm: None = None
+    """No pymoo algorithm: the program is solved at once."""
     checkpointed = False
     evaluates_designs = False
+
+    @property
+    def name(self) -> str:
+        return method_name(self.settings)
 
     def run(self, bound: BoundStudy, seed: int, evaluate: Evaluator | None = None, out: Path | None = None,
             progress: Progress | None = None) -> StudyRun:
@@ -156,10 +172,11 @@ class ConvexProgram:
         return UserError(f"{bound.study.path}: the convex program's design is infeasible: {run.records[0].reason}")
 
 
-METHODS = {method.name: method for method in (PopulationSearch("nsga2", "NSGA-II"),
-                                               PopulationSearch("nsga3", "NSGA-III"),
-                                               PopulationSearch("pso", "Particle swarm"), ConvexProgram())}
-"""The study file's methods by name (their settings: :data:`~hapticdesign.optimization.study_file.SETTINGS`)."""
+METHODS = {method.name: method for method in (PopulationSearch(Nsga2, NSGA_II, "NSGA-II"),
+                                               PopulationSearch(Nsga3, NSGA_III, "NSGA-III"),
+                                               PopulationSearch(Pso, PARTICLE_SWARM, "Particle swarm"),
+                                               ConvexProgram())}
+"""The study file's methods by name, each its settings, pymoo algorithm and run."""
 
 
 def with_baseline(run: StudyRun, bound: BoundStudy) -> StudyRun:

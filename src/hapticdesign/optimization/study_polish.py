@@ -29,7 +29,7 @@ import numpy as np
 
 from hapticdesign.optimization.local_search import Gradients, minimize_in_boxes
 from hapticdesign.optimization.study_run import (CHECKPOINT, Checkpoint, Encoding, Evaluator, Record, StudyRun,
-                                                 front_of, minimized, record_of, violations)
+                                                 constraint_columns, front_of, minimized, record_of, violations)
 from hapticdesign.optimization.study_file import Choice, Study, StudySpec
 
 STEP = 1e-6
@@ -96,7 +96,7 @@ class _Target:
         self.spec = designs.spec
         self.m0 = minimized(self.spec, start)
         self.f0 = float(weights @ self.m0)
-        self.n_g = len(violations(self.spec, [0.0] * len(self.spec.constraints))[0])
+        self.n_g = constraint_columns(self.spec)
         self.first_batch = designs.batches
         self.best: Record | None = None
 

@@ -2,7 +2,7 @@
 
 The study's variables become pymoo's design vector: a continuous variable its value, a discrete one the
 index of its choice (a whole number, :class:`~hapticdesign.optimization.pymoo_run.RoundColumns`). Each
-generation's designs go to an evaluator in one batch (a loop here, or a Dask cluster, :mod:`.study_cluster`),
+generation's designs go to an evaluator in one batch (in this process or on a Dask cluster, :mod:`.study_evaluation`),
 which answers every reduced index the study reads, or why the design has none (a workspace point out of
 reach, an invalid device). Objectives enter pymoo as minimized values (a maximized one negated);
 constraints as ``g <= 0`` scaled by their bound, plus one column that is 1 for a design without values
@@ -33,7 +33,7 @@ from pymoo.core.problem import Problem
 
 from hapticdesign.errors import RunWarning, UserError
 from hapticdesign.files import output_folder, read_text, write_atomically
-from hapticdesign.optimization.pymoo_run import AlgorithmSpec, initial_population, pareto_filter, run
+from hapticdesign.optimization.pymoo_run import AlgorithmSpec, PymooAlgorithm, initial_population, pareto_filter, run
 from hapticdesign.optimization.local_search import minimize_in_boxes
 from hapticdesign.optimization.study_file import Choice, ExpressionConstraint, Study, StudySpec
 
@@ -129,17 +129,20 @@ class Record:
 
 
 def violations(spec: StudySpec, constraints: Sequence[float]) -> tuple[np.ndarray, str]:
-    """Scaled ``g <= 0`` columns of the constraints and the first violated one in words."""
+    """Scaled ``g <= 0`` columns of the constraints (:meth:`~.study_file._Bounded.beyond`) and the first violated one
+    in words."""
     g, first = [], ""
     for c, value in zip(spec.constraints, constraints):
-        for bound, sign, word in ((c.at_most, 1.0, "<="), (c.at_least, -1.0, ">=")):
-            if bound is None:
-                continue
-            scale = abs(bound) if bound != 0.0 else 1.0
-            g.append(sign * (value - bound) / scale)
-            if g[-1] > 0.0 and not first:
-                first = f"{c.label} = {value:.6g}, not {word} {bound:g}"
+        for excess, bound, word in c.beyond(value):
+            g.append(excess)
+            if excess > 0.0 and not first:
+                first = c.missed(c.label, value, bound, word)
     return np.array(g), first
+
+
+def constraint_columns(spec: StudySpec) -> int:
+    """How many ``g <= 0`` columns the constraints give (one per bound)."""
+    return sum(len(c.sides) for c in spec.constraints)
 
 
 def constraint_labels(spec: StudySpec) -> tuple[str, ...]:
@@ -147,19 +150,32 @@ def constraint_labels(spec: StudySpec) -> tuple[str, ...]:
     return tuple(c.label for c in spec.constraints)
 
 
+def constrained_values(spec: StudySpec, values: dict[str, float], reduced: dict[tuple, float]) -> tuple[float, ...]:
+    """The constrained values of a design of variable ``values`` whose reduced indices are ``reduced`` (by key)."""
+    return tuple(c.value(values) if isinstance(c, ExpressionConstraint) else reduced[c.key] for c in spec.constraints)
+
+
+def feasibility(spec: StudySpec, constraints: Sequence[float]) -> tuple[str, str, float]:
+    """The one judgement of constrained values: why they give no design (a value that is not a finite number), the
+    first constraint they break in words (both empty: they meet every constraint) and the total scaled violation."""
+    invalid = _not_finite(constraint_labels(spec), constraints)
+    if invalid:
+        return invalid, "", 0.0
+    g, violated = violations(spec, constraints)
+    return "", violated, float(np.sum(np.maximum(g, 0.0)))
+
+
 def record_of(spec: StudySpec, generation: int, x, values: dict[str, float], answer: Answer) -> Record:
-    """One design's record from its answer: objectives, constrained values and whether it is feasible."""
-    keys = reduced_keys(spec)
-    reduced = dict(zip(keys, answer.reduced))
+    """One design's record from its answer: objectives, constrained values and whether it is feasible
+    (:func:`feasibility`)."""
+    reduced = dict(zip(reduced_keys(spec), answer.reduced))
     objectives = tuple(reduced[o.key] for o in spec.objectives)
-    constraints = tuple(c.value(values) if isinstance(c, ExpressionConstraint) else reduced[c.key]
-                        for c in spec.constraints)
-    invalid = answer.reason or _not_finite(constraint_labels(spec), constraints)
-    g, violated = violations(spec, constraints) if not invalid else (np.zeros(0), "")
+    constraints = constrained_values(spec, values, reduced)
+    invalid, violated, violation = (answer.reason, "", 0.0) if answer.reason else feasibility(spec, constraints)
     if not invalid and not violated:  # a design that breaks a constraint may have no objectives (module docstring)
         invalid = _not_finite([o.name for o in spec.objectives], objectives)
     return Record(generation, tuple(float(v) for v in x), values, objectives, constraints, invalid, violated,
-                  float(np.sum(np.maximum(g, 0.0))))
+                  violation)
 
 
 def _not_finite(labels: Sequence[str], values: Sequence[float]) -> str:
@@ -178,7 +194,7 @@ def minimized(spec: StudySpec, record: Record) -> np.ndarray:
 def _g(spec: StudySpec, record: Record) -> np.ndarray:
     """pymoo's ``g <= 0`` row: the validity column, then the scaled constraints (0 for a design without values)."""
     if record.invalid:
-        return np.concatenate([[1.0], np.zeros(len(violations(spec, [0.0] * len(spec.constraints))[0]))])
+        return np.concatenate([[1.0], np.zeros(constraint_columns(spec))])
     return np.concatenate([[0.0], violations(spec, record.constraints)[0]])
 
 
@@ -288,7 +304,7 @@ class StudyProblem(Problem):
         self.checkpoint = checkpoint
         self.records: list[Record] = []
         self.generation = 0
-        n_g = 1 + len(violations(spec, [0.0] * len(spec.constraints))[0])
+        n_g = 1 + constraint_columns(spec)
         super().__init__(n_var=len(self.encoding.names), n_obj=len(spec.objectives), n_ieq_constr=n_g,
                          xl=self.encoding.xl, xu=self.encoding.xu)
 
@@ -354,11 +370,7 @@ def front_of(spec: StudySpec, records: list[Record], among: Sequence[int] | None
 def kept_by(spec: StudySpec, values: dict[str, float]) -> bool:
     """Whether a design of variable ``values`` meets every ``keep`` filter of the study."""
     full = spec.with_parameters(values)
-    for keep in spec.keep:
-        v = float(keep.formula.value(full))
-        if not ((keep.at_most is None or v <= keep.at_most) and (keep.at_least is None or v >= keep.at_least)):
-            return False
-    return True
+    return all(excess <= 0.0 for keep in spec.keep for excess, _, _ in keep.beyond(float(keep.formula.value(full))))
 
 
 def start_design(study: Study, seed: int, evaluate: Evaluator, encodings: list[Encoding]) -> np.ndarray | None:
@@ -387,15 +399,16 @@ def start_design(study: Study, seed: int, evaluate: Evaluator, encodings: list[E
 
 def run_study(study: Study, seed: int, evaluate: Evaluator, out: Path | None = None,
               progress: Callable[[int, int], None] | None = None,
-              evaluate_constraints: Evaluator | None = None) -> StudyRun:
-    """Run ``study`` with ``seed``; ``evaluate`` answers batches of designs; ``out`` keeps the checkpoint
-    (``out/checkpoint``); ``progress(generation, generations)`` after each generation; ``evaluate_constraints``
-    answers the constraints of ``algorithm.start``'s minimization (``evaluate`` by default).
+              evaluate_constraints: Evaluator | None = None, *, algorithm: PymooAlgorithm) -> StudyRun:
+    """Run ``study`` with ``seed`` by pymoo's ``algorithm`` (the study's method's,
+    :data:`~hapticdesign.optimization.study_methods.METHODS`); ``evaluate`` answers batches of designs; ``out`` keeps
+    the checkpoint (``out/checkpoint``); ``progress(generation, generations)`` after each generation;
+    ``evaluate_constraints`` answers the constraints of ``algorithm.start``'s minimization (``evaluate`` by default).
 
-    Each run ``k`` of ``algorithm.runs`` (one run without them) is the study's population search (NSGA-II or
-    NSGA-III, :data:`~hapticdesign.optimization.pymoo_run.ALGORITHMS`) over its bounds seeded ``seed + k``; with
-    ``algorithm.start``, the minimized design joins the first population of every run whose bounds hold it, the
-    rest of that population drawn uniformly with the run's seed (pymoo's own seeded sampling otherwise)."""
+    Each run ``k`` of ``algorithm.runs`` (one run without them) is the population search over its bounds seeded
+    ``seed + k``; with ``algorithm.start``, the minimized design joins the first population of every run whose bounds
+    hold it, the rest of that population drawn uniformly with the run's seed (pymoo's own seeded sampling
+    otherwise)."""
     if seed < 0:
         raise UserError(f"the seed must be at least 0, got {seed}")
     spec = study.spec
@@ -413,10 +426,10 @@ def run_study(study: Study, seed: int, evaluate: Evaluator, out: Path | None = N
         initial = None
         if start is not None and np.all(encoding.xl <= start) and np.all(start <= encoding.xu):
             initial = initial_population(encoding.xl, encoding.xu, spec.algorithm.population, seed + k, start[None])
-        algorithm = AlgorithmSpec(spec.algorithm.method, spec.algorithm.population, spec.algorithm.generations,
-                                  initial=initial, discrete=encoding.discrete, **spec.algorithm.options)
+        search = AlgorithmSpec(algorithm, spec.algorithm.population, spec.algorithm.generations, initial=initial,
+                               discrete=encoding.discrete, **spec.algorithm.options)
         done = k * spec.algorithm.generations
-        result = run(problem, algorithm, seed + k,
+        result = run(problem, search, seed + k,
                      (lambda generation, done=done: progress(done + generation, total)) if progress else None)
         last = {r.x: len(records) + i for i, r in enumerate(problem.records)}
         final += [last[tuple(float(v) for v in x)] for x in result.X]

@@ -247,7 +247,7 @@ class _Handler(BaseHTTPRequestHandler):
             self._refuse(HTTPStatus.NOT_FOUND, self.folder.why, body)
             return
         n = int(text[0])
-        with self.lock:  # one card at a time: the bound study keeps its last design's poses
+        with self.lock:  # one card at a time: study_outputs keeps the last design's poses
             if n not in self.cards:
                 row = self.folder.evaluations[n - 1]
                 try:

@@ -22,13 +22,15 @@ from hapticdesign.analysis.metrics.indices import Index
 from hapticdesign.errors import RunWarning, UserError
 from hapticdesign.files import quote, write_atomically
 from hapticdesign.interface.report.optimization_page import PLOTLY, Picture, plotly_js, render, render_failure
-from hapticdesign.optimization.study_evaluation import BoundStudy, bind_study, require_study_workload
+from hapticdesign.optimization.study_evaluation import (BoundStudy, StudyEvaluator, bind_study, require_study_workload,
+                                                        unmeetable_walls)
 from hapticdesign.optimization.study_explorer import DESIGNS, STUDY_COPY, explorer_data, front_designs, study_copy
 from hapticdesign.optimization.study_polish import most_designs
 from hapticdesign.optimization.study_file import Study, load_study
 from hapticdesign.optimization.study_methods import ConvexProgram, PopulationSearch, method_of, with_baseline
-from hapticdesign.optimization.study_outputs import (Selection, baseline_lines, check_selection, evaluations_csv,
-                                                     front_csv, pareto_figure, select_design)
+from hapticdesign.optimization.study_outputs import (Selection, baseline_lines, check_selection, device_file_text,
+                                                     evaluations_csv, front_csv, pareto_figure, pictures, select_design,
+                                                     spread_rows)
 from hapticdesign.optimization.study_run import Record, StudyRun
 
 FILES = ("front.csv", "evaluations.csv", "pareto.png", "pareto.svg", "selected.yaml", "report.html", PLOTLY,
@@ -57,17 +59,17 @@ def parse_select(text: str) -> dict:
     return {"weights": weights}
 
 
-def _evaluator(bound: BoundStudy, scheduler: str | None, quiet: bool, stack):
+def _evaluator(bound: BoundStudy, scheduler: str | None, quiet: bool, stack) -> StudyEvaluator:
+    """The study's evaluator: in this process, or on the workers of the Dask scheduler (closed with ``stack``)."""
     if scheduler is None:
-        return bound.evaluate
-    from hapticdesign.optimization.study_cluster import cluster_evaluator
+        return StudyEvaluator(bound)
     from hapticdesign.simulation.campaign import check_scheduler, close_client, dask_client, dask_logging
 
     check_scheduler(scheduler)
     stack.enter_context(dask_logging(quiet))
     client = dask_client(scheduler, None, quiet)
     stack.callback(close_client, client, False)
-    return cluster_evaluator(client, bound.study)
+    return StudyEvaluator(bound, client)
 
 
 def _shown_progress(stack: ExitStack) -> Callable[[int, int], None]:
@@ -129,9 +131,9 @@ def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Select
     write_atomically(out / "evaluations.csv", evaluations_csv(run, bound.units()))
     paths = [out / "front.csv", out / "evaluations.csv", *pareto_figure(run, selection, out, registry=bound.registry)]
     chosen = run.records[selection.record]
-    write_atomically(out / "selected.yaml", bound.device_file_text(chosen.values, baseline_lines(run, chosen)))
+    write_atomically(out / "selected.yaml", device_file_text(bound, chosen.values, baseline_lines(run, chosen)))
     write_atomically(out / STUDY_COPY, study_copy(bound.study))
-    pictures = [Picture(png, caption) for png, caption in bound.pictures(chosen.values)]
+    shown = [Picture(png, caption) for png, caption in pictures(bound, chosen.values)]
     kept = (["checkpoint/ (one file per generation; a rerun into this folder continues)"]
             if method_of(run.spec).checkpointed else [])
     from hapticdesign.studies.spec import spec_summary
@@ -141,9 +143,9 @@ def write_outputs(out: Path, run: StudyRun, bound: BoundStudy, selection: Select
         write_atomically(out / design.file, design.text)
     _remove_stale_designs(out, len(designs))
     write_atomically(out / PLOTLY, plotly_js())
-    page = render(run, selection, bound.title, Picture((out / "pareto.png").read_bytes(), "Pareto front"), pictures,
+    page = render(run, selection, bound.title, Picture((out / "pareto.png").read_bytes(), "Pareto front"), shown,
                   [*FILES, *kept], explorer_data(run, bound, selection, designs), bound.coarseness,
-                  bound.spread_rows(chosen.values), bound.units())
+                  spread_rows(bound, chosen.values), bound.units())
     write_atomically(out / "report.html", page)
     return [*paths, out / "selected.yaml", out / STUDY_COPY, *(out / d.file for d in designs), out / PLOTLY, out / "report.html"]
 
@@ -237,7 +239,7 @@ def optimize(study: Path | str, seed: int = 1, out: Path | str | None = None, *,
     indices (functions decorated with :func:`hapticdesign.index`, or a Python file defining them, run in this
     process), which the study may name beside the registered ones. Nothing is printed on stdout; a bad study, seed or
     selection raises :class:`~hapticdesign.errors.UserError`; a ``kmax`` constraint that no design can meet, known
-    before the run (:meth:`~hapticdesign.optimization.study_evaluation.BoundStudy.unmeetable_walls`), is a
+    before the run (:func:`~hapticdesign.optimization.study_evaluation.unmeetable_walls`), is a
     :class:`~hapticdesign.errors.RunWarning` before the run starts. The device file's own design is evaluated beside
     the run (:func:`~hapticdesign.optimization.study_methods.with_baseline`); a run without a feasible design
     writes evaluations.csv and report.html to ``out`` before its UserError."""
@@ -250,7 +252,7 @@ def optimize(study: Path | str, seed: int = 1, out: Path | str | None = None, *,
     check_selection(study.spec, weights, design, study.spec.algorithm.designs + most_designs(study.spec))
     bound = bind_study(study, indices=own)
     require_study_workload(study, bound.registry)
-    for message in bound.unmeetable_walls():
+    for message in unmeetable_walls(bound):
         warnings.warn(message, RunWarning, stacklevel=2)
     out = None if out is None else Path(out)
     if out is not None:

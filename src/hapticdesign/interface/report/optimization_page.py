@@ -26,10 +26,10 @@ from importlib.resources import files as package_files
 from hapticdesign.escape import script_json
 from hapticdesign.interface.report.html import STYLE
 from hapticdesign.interface.report.tables import cell_text
-from hapticdesign.optimization.study_evaluation import SPREAD_COLUMNS
 from hapticdesign.optimization.study_file import Choice
 from hapticdesign.optimization.study_methods import method_of
-from hapticdesign.optimization.study_outputs import Selection, at_bounds, changes, closest_designs, with_unit
+from hapticdesign.optimization.study_outputs import (SPREAD_COLUMNS, Selection, at_bounds, changes, closest_designs,
+                                                     with_unit)
 from hapticdesign.optimization.study_run import Record, StudyRun, constraint_labels
 
 
@@ -251,7 +251,7 @@ def render(run: StudyRun, selection: Selection, title: str, pareto: Picture, pic
     """The report as one HTML document: the explorer of ``explorer``'s data
     (:func:`~hapticdesign.optimization.study_explorer.explorer_data`), then the static report; ``coarseness`` says how
     coarse the workspace grid is (``27 points, grid 3``), ``spread`` gives the selected design's pose indices over the
-    points (:meth:`~hapticdesign.optimization.study_evaluation.BoundStudy.spread_rows`), ``units`` each quantity's unit
+    points (:func:`~hapticdesign.optimization.study_outputs.spread_rows`), ``units`` each quantity's unit
     (:meth:`~hapticdesign.optimization.study_evaluation.BoundStudy.units`), shown in the tables' headers or a unit
     column."""
     spec = run.spec

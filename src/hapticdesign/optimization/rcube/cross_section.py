@@ -26,7 +26,7 @@ from scipy.optimize import minimize_scalar
 
 from hapticdesign.errors import UserError
 from hapticdesign.optimization.front_selection import normalize, weighted_rms
-from hapticdesign.optimization.pymoo_run import AlgorithmSpec, run
+from hapticdesign.optimization.pymoo_run import NSGA_II, AlgorithmSpec, run
 
 RATIO_BOUNDS = (0.0, 0.9)
 
@@ -85,7 +85,7 @@ def optimize_ratio(bounds=RATIO_BOUNDS, population: int = 100, generations: int 
                    progress: Callable[[int], None] | None = None) -> CrossSectionResult:
     """NSGA-II (pymoo) on ``(CS1, CS2)`` over ``d / D``, then the minimum-RMS front point (§7.3)."""
     lo, hi = _check(bounds)
-    result = run(CrossSectionProblem((lo, hi)), AlgorithmSpec("nsga2", population, generations), seed, progress)
+    result = run(CrossSectionProblem((lo, hi)), AlgorithmSpec(NSGA_II, population, generations), seed, progress)
     ratios = np.sort(result.X[result.front(), 0])
     best, rms = min_rms_ratio(ratios)
     return CrossSectionResult(ratios, cs1(ratios), cs2(ratios), rms, float(ratios[best]))

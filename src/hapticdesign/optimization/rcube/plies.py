@@ -28,7 +28,7 @@ from hapticdesign.analysis.stiffness import vjm
 from hapticdesign.analysis.stiffness.link import LinkDesign
 from hapticdesign.analysis.stiffness.materials import PLY_THICKNESS, Lamina, M55J, laminate
 from hapticdesign.analysis.stiffness.sections import Tube
-from hapticdesign.optimization.pymoo_run import AlgorithmSpec, RowObjective, run
+from hapticdesign.optimization.pymoo_run import NSGA_II, AlgorithmSpec, RowObjective, run
 
 MAX_PLIES = 10
 DESIGN_FORCE = 20.0
@@ -121,7 +121,7 @@ def optimize_plies(geometry: RCubeGeometry, ratio: float, population: int = 100,
                    progress: Callable[[int], None] | None = None, client=None) -> PlyResult:
     """NSGA-II with integer variables (pymoo: integer sampling, rounded SBX and polynomial mutation);
     ``client``: a ``dask.distributed.Client`` whose workers evaluate the designs."""
-    spec = AlgorithmSpec("nsga2", population, generations, integer=True)
+    spec = AlgorithmSpec(NSGA_II, population, generations, integer=True)
     if max_plies < 1:
         raise UserError(f"the ply limit must be at least 1, got {max_plies}")
     evaluator = PlyEvaluator(geometry, ratio, force=force)

@@ -16,7 +16,7 @@ from pymoo.core.problem import Problem
 from hapticdesign.errors import UserError
 from hapticdesign.optimization.rcube.constraints import CubeWorkspace, constraint_values
 from hapticdesign.optimization.rcube.objectives import EvaluationLinks, objectives
-from hapticdesign.optimization.pymoo_run import AlgorithmSpec, RowObjective, run
+from hapticdesign.optimization.pymoo_run import PARTICLE_SWARM, AlgorithmSpec, RowObjective, run
 from hapticdesign.optimization.rcube.synthesis import BOUND_SETS, Bounds, Front
 
 PENALTY = 1e3
@@ -65,7 +65,7 @@ def weighted_sum_swarm(front: Front, weights=(1 / 3, 1 / 3, 1 / 3), bounds: Boun
     ``client``: a ``dask.distributed.Client`` whose workers evaluate the objectives."""
     if len(front) == 0:
         raise UserError("the weighted-sum comparison needs a non-empty Pareto front")
-    spec = AlgorithmSpec("pso", population, generations)
+    spec = AlgorithmSpec(PARTICLE_SWARM, population, generations)
     w = np.asarray(weights, dtype=float)
     if w.shape != (3,) or np.any(w < 0) or w.sum() == 0:
         raise UserError(f"three non-negative weights are needed, got {weights!r}")

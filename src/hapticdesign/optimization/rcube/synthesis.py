@@ -25,7 +25,8 @@ from pymoo.indicators.hv import HV
 from hapticdesign.errors import UserError
 from hapticdesign.optimization.rcube.constraints import Q_MAX_RANGE, CubeWorkspace, constraint_values, link1_length
 from hapticdesign.optimization.rcube.objectives import EvaluationLinks, objectives
-from hapticdesign.optimization.pymoo_run import AlgorithmSpec, RowObjective, initial_population, pareto_filter, run
+from hapticdesign.optimization.pymoo_run import (NSGA_II, AlgorithmSpec, RowObjective, initial_population,
+                                                 pareto_filter, run)
 from hapticdesign.optimization.rcube.shortest import ConstrainedMinimum, constrained_minimum, design_summary, inside
 
 INFEASIBLE_OBJECTIVE = 1e30
@@ -114,7 +115,7 @@ def run_nsga2(bounds: Bounds, population: int, generations: int, seed: int, work
     number of objective evaluations. ``initial``: designs placed in the first population (see
     :func:`~hapticdesign.optimization.pymoo_run.initial_population`); without them pymoo's own seeded random sampling is used.
     ``client``: a ``dask.distributed.Client`` whose workers evaluate the objectives."""
-    spec = AlgorithmSpec("nsga2", population, generations)
+    spec = AlgorithmSpec(NSGA_II, population, generations)
     if initial is not None:
         spec = replace(spec, initial=initial_population(bounds.lower, bounds.upper, population, seed, initial))
     problem = SynthesisProblem(bounds, workspace, links, client)
