@@ -9,6 +9,7 @@ import time
 from pathlib import Path
 
 import pytest
+from selenium.webdriver.support.ui import WebDriverWait
 from typer.testing import CliRunner
 
 from hapticdesign.interface.cli import app
@@ -18,9 +19,15 @@ from hapticdesign.interface.cli import app
 pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("smoke-studies")]
 
 
+def _loaded(driver) -> None:
+    """Wait until the page and its images have loaded (Chromium may hand the page back while a large image of a busy
+    machine is still decoding: readyState "interactive")."""
+    WebDriverWait(driver, 120).until(lambda d: d.execute_script("return document.readyState") == "complete")
+
+
 def _check(driver, report: Path, summary: dict) -> None:
     driver.get(report.resolve().as_uri())
-    assert driver.execute_script("return document.readyState") == "complete"
+    _loaded(driver)
     assert driver.title.startswith(("Phantom", "Modified R-CUBE"))
     sections = driver.execute_script("return Array.from(document.querySelectorAll('h2')).map(h => h.id)")
     assert set(summary["steps"]) <= set(sections)
@@ -48,7 +55,7 @@ def test_report_opens_the_interactive_device_view(browser, phantom_study):
         "return Array.from(document.querySelectorAll('a')).map(a => a.href).filter(h => h.includes('/pages/'))")
     assert len(links) == 1
     browser.get(links[0])
-    assert browser.execute_script("return document.readyState") == "complete"
+    _loaded(browser)
     assert browser.find_element("tag name", "h1").text == "phantom-3dof"
     sliders = browser.execute_script("return document.querySelectorAll('input[type=range]').length")
     assert sliders == 3  # the 3-DOF Phantom's joints
