@@ -257,3 +257,45 @@ def test_a_wall_within_reach_or_a_study_of_the_geometry_has_no_warning(tmp_path)
     assert low.exit_code == 0 and "warning" not in low.stderr, low.output
     geometry = optimize(_wall_study(tmp_path, {"l2": [0.1, 0.3]}, 1e6, 0.01), "--seed", 1)
     assert geometry.exit_code == 2 and "warning" not in geometry.stderr and "meets the constraints" in geometry.stderr
+
+
+
+DRIVES = {"rigid": (False, False), "links": (True, False), "transmissions": (False, True),
+          "transmissions and links": (True, True)}
+"""What the planar arm's device file holds, by the drive it makes (the oracle): (its links' sections, its actuators'
+transmission_stiffness, 3000 N m/rad each)."""
+
+
+@pytest.mark.parametrize("drive", DRIVES)
+def test_a_study_of_kmax_says_which_compliance_its_drive_includes(tmp_path, drive):
+    """Issue 41: a study reporting kmax says once which compliance between the motors and the handle it took, as the
+    device file's fields decide it (links with sections, actuators with transmission_stiffness, neither: rigid): in
+    --json, the text answer, selected.yaml, the report's study section and the explorer's objective; a study without
+    kmax says nothing of it."""
+    wall = {"name": "wall", "index": "kmax", "reduce": "min", "sense": "max"}
+    study = write_study(tmp_path, {"l2": [0.09, 0.3]}, [ISOTROPY, wall], population=4, generations=2,
+                        center=point(0.15))
+    arm = yaml.safe_load((tmp_path / "arm.yaml").read_text())
+    arm["joints"] = [{"name": "q1", "damping": 0.002}, {"name": "q2", "damping": 0.003}]
+    links, transmissions = DRIVES[drive]
+    if not links:
+        del arm["links"]
+    for actuator in arm["actuators"] if transmissions else []:
+        actuator["transmission_stiffness"] = 3000.0
+    (tmp_path / "arm.yaml").write_text(yaml.safe_dump(arm))
+    res = optimize(study, "--seed", 1, "--out", tmp_path / "out", "--json")
+    assert res.exit_code == 0, res.output
+    assert json.loads(res.stdout)["compliance"] == {"kmax": drive}
+    line = f"kmax: drive compliance: {drive}"
+    text = optimize(study, "--seed", 1, "--out", tmp_path / "out", "--quiet")
+    assert text.exit_code == 0 and text.stdout.splitlines().count(line) == 1, text.output
+    assert f"# {line}\n" in (tmp_path / "out" / "selected.yaml").read_text()
+    page = (tmp_path / "out" / "report.html").read_text()
+    assert page.count(f'<p id="compliance">{line} (') == 1
+    data = json.loads(page.split('id="explorer-data">', 1)[1].split("</script>", 1)[0])
+    assert data["objectives"][1]["about"].endswith(f"; drive compliance: {drive}")
+    (tmp_path / "plain").mkdir()
+    plain = write_study(tmp_path / "plain", {"l2": [0.09, 0.3]}, [ISOTROPY], population=4, generations=2,
+                        center=point(0.15))
+    other = optimize(plain, "--seed", 1, "--json")
+    assert other.exit_code == 0 and "compliance" not in json.loads(other.stdout), other.output

@@ -30,8 +30,8 @@ from functools import partial
 import numpy as np
 
 from hapticdesign.analysis.metrics.indices import (
-    INDICES, Evaluation, Index, Registry, Request, evaluate_at, evaluate_designs, evaluate_parameters, reduce,
-    requests_of,
+    INDICES, Evaluation, Index, Registry, Request, drive_compliance, evaluate_at, evaluate_designs,
+    evaluate_parameters, reduce, requests_of,
 )
 from hapticdesign.analysis.metrics.indices.registry import EVALUATION_LIMIT, require_evaluations
 from hapticdesign.analysis.configuration import configuration_of
@@ -168,6 +168,12 @@ class BoundStudy:
                 shared = {out.get(name, "") for name, _ in c.parsed.terms}
                 out[c.label] = shared.pop() if len(shared) == 1 else ""
         return out
+
+    def compliance(self) -> dict[str, str]:
+        """Which compliance between the motors and the handle each index of the study that includes it (``kmax``)
+        takes, by index name (:func:`~hapticdesign.analysis.metrics.indices.drive_compliance` of the device file's
+        design: the fields of the device file, which every design of the study shares, decide it)."""
+        return drive_compliance(self.space.base, [key[0] for key in self.keys], self.registry)
 
     def device_values(self, values: dict[str, float]) -> dict[str, float]:
         """The device design variables' values of a design: its variables' and the ``parameters`` formulas'."""

@@ -276,12 +276,14 @@ def explorer_data(run: StudyRun, bound: BoundStudy, selection: Selection, design
     spec = bound.study.spec
     units = bound.units()
     grid = "" if not bound.coarseness else f" ({bound.coarseness})"
+    compliance = run.compliance
     objectives = []
     for o in spec.objectives:
         index = bound.registry[o.index]
         over = "" if index.of_parameters else f" over the workspace{grid}"
+        drive = f"; drive compliance: {compliance[o.index]}" if o.index in compliance else ""
         objectives.append(quantity(o.name, index.unit, index=o.index, reduce=o.reduce, sense=o.sense,
-                                   about=f"{o.sense}imize the {o.reduce} of {o.index}{over}"))
+                                   about=f"{o.sense}imize the {o.reduce} of {o.index}{over}{drive}"))
     constraints = []
     for c in spec.constraints:
         unit = bound.registry[c.index].unit if isinstance(c, IndexConstraint) else units[c.label]

@@ -183,13 +183,14 @@ def with_baseline(run: StudyRun, bound: BoundStudy) -> StudyRun:
     """``run`` with the device file's own design (:meth:`~.study_evaluation.BoundStudy.baseline`) evaluated by the
     study's method as every design is (through the bound study's registry, or the convex program's LN), its
     objectives even when it breaks a constraint (generation 0, kept apart from the records and the front); without
-    one, the note says why."""
+    one, the note says why. What the device file's fields decide for every design comes with it: which compliance
+    between the motors and the handle ``kmax`` takes (:meth:`~.study_evaluation.BoundStudy.compliance`)."""
     values, note = bound.baseline()
     if values is None:
-        return replace(run, baseline_note=note)
+        return replace(run, baseline_note=note, compliance=bound.compliance())
     answer = method_of(run.spec).evaluate_baseline(bound, values)
     record = record_of(run.spec, 0, Encoding.of(run.spec).encode(values), values, answer)
-    return replace(run, baseline=record, baseline_note=note)
+    return replace(run, baseline=record, baseline_note=note, compliance=bound.compliance())
 
 
 def method_of(spec: StudySpec) -> PopulationSearch | ConvexProgram:

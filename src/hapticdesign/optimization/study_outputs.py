@@ -22,8 +22,8 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from hapticdesign.analysis.metrics.indices import (INDICES, Index, evaluate_at, reduce, reduced_at, reduction_label,
-                                                   spread)
+from hapticdesign.analysis.metrics.indices import (INDICES, Index, compliance_line, evaluate_at, reduce, reduced_at,
+                                                   reduction_label, spread)
 from hapticdesign.analysis.view.figure import render_png
 from hapticdesign.analysis.view.skeleton import home_pose
 from hapticdesign.analysis.workspace import Workspace, WorkspacePoses, reach_workspace
@@ -447,11 +447,13 @@ def where_evaluated(bound: BoundStudy, values: dict[str, float]) -> str:
     takes it and its actuated coordinates there, with the ``spec`` command that gives the sheet at that pose
     (issue 35: a sheet at home, outside the study's box, reads another pose's numbers; at this pose its renderable
     stiffness is the study's ``kmax`` with the same loop settings); then each pose index by every reduction
-    (:func:`spread_rows`)."""
+    (:func:`spread_rows`). First, which compliance between the motors and the handle ``kmax`` took
+    (:meth:`BoundStudy.compliance`), when the study asks for it."""
     device, poses, got = _at_points(bound, values)
     if got is None:
         return ""
-    lines = []
+    compliance = compliance_line(bound.compliance())
+    lines = [f"# {compliance}\n"] if compliance else []
     for index, options, how in bound.keys:
         label = bound.labels.get((index, options))
         if label not in got:

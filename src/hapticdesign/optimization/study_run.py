@@ -332,7 +332,9 @@ class StudyRun:
     them (method convex: ``lower_bound``, :mod:`.study_convex`); ``probes``: designs the polishing evaluated beside
     the polished ones it kept (:mod:`.study_polish`); ``baseline``: the device file's own design evaluated as every
     design is (None when the file does not fix every variable), outside ``records`` and the front;
-    ``baseline_note``: why there is none, or what to know of it (:meth:`~.study_evaluation.BoundStudy.baseline`)."""
+    ``baseline_note``: why there is none, or what to know of it (:meth:`~.study_evaluation.BoundStudy.baseline`);
+    ``compliance``: which compliance between the motors and the handle each index that includes it (``kmax``) took,
+    by index name (:meth:`~.study_evaluation.BoundStudy.compliance`), which the outputs state."""
 
     spec: StudySpec
     seed: int
@@ -344,6 +346,7 @@ class StudyRun:
     probes: int = 0
     baseline: Record | None = None
     baseline_note: str = ""
+    compliance: dict[str, str] = field(default_factory=dict)
 
     @property
     def evaluations(self) -> int:

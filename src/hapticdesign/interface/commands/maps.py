@@ -42,7 +42,8 @@ def maps(
     from hapticdesign.analysis.configuration import configuration_of
     from hapticdesign.analysis.metrics.maps import device_map
     from hapticdesign.analysis.workspace import Workspace
-    from hapticdesign.analysis.metrics.indices import INDICES, options_line, options_used, requests_of
+    from hapticdesign.analysis.metrics.indices import (INDICES, compliance_line, drive_compliance, options_line,
+                                                       options_used, requests_of)
 
     with user_errors(strict=strict, quiet=quiet):
         from hapticdesign.devices.loading import resolve_device
@@ -66,6 +67,7 @@ def maps(
         with progress_bar(not (quiet or json_out)) as report:
             found = device_map(dev, points, names, registry=registry, progress=report)
         used = options_used(requests_of(names, registry), registry)
+        compliance = drive_compliance(dev, names, registry)
         files = _write(out, found, names, plane, {k: registry[k].unit for k in names})
         spreads = {k: _spread(found, k, workspace.center_index, grid) for k in names}
         note(f"wrote {len(files)} files to {out} ({int(found.reached.sum())} of {len(points)} points reached)",
@@ -74,13 +76,16 @@ def maps(
             print_json({"device": dev.name, "out": str(out), "files": files, "points": len(points),
                         "reached": int(found.reached.sum()),
                         "range": {k: [_finite(v, min), _finite(v, max)] for k, v in found.values.items()},
-                        "spread": spreads, "units": {k: registry[k].unit for k in names}, "options": used})
+                        "spread": spreads, "units": {k: registry[k].unit for k in names}, "options": used,
+                        **({"compliance": compliance} if compliance else {})})
             return
         for key, values in found.values.items():
             low, high = _finite(values, min), _finite(values, max)
             span = "no point reached" if low is None else f"{low:.6g} to {high:.6g} {registry[key].unit}"
             typer.echo(f"{key}: {span}" + (f" ({options_line(used[key])})" if key in used else "")
                        + _spread_line(spreads[key], len(points)))
+        if compliance:
+            typer.echo(compliance_line(compliance))
 
 
 def _spread(found, key: str, center: int | None, grid: int) -> dict | None:

@@ -47,9 +47,10 @@ def device_metrics(device: Device, q: np.ndarray, extra: Sequence[str] = (), reg
     :mod:`hapticdesign.analysis.metrics.names`: the indices of the one registry on the task Jacobian
     (:attr:`~hapticdesign.analysis.metrics.indices.states.HandleStates.task`: translational rows for devices of up
     to 3 joints, all six rows for 6 joints), and under ``indices`` the indices ``extra`` of ``registry`` (default:
-    the one registry) by name."""
+    the one registry) by name, with the ``options`` they ran with and, for those that include the drive's compliance
+    (``kmax``), which (``compliance``, :func:`~hapticdesign.analysis.metrics.indices.drive_compliance`)."""
     from hapticdesign.analysis.configuration import configuration_of
-    from hapticdesign.analysis.metrics.indices import INDICES, evaluate_at, options_used, requests_of
+    from hapticdesign.analysis.metrics.indices import INDICES, drive_compliance, evaluate_at, options_used, requests_of
     from hapticdesign.analysis.metrics import kinematic, names
     from hapticdesign.analysis.metrics.indices.states import HandleStates
 
@@ -71,6 +72,9 @@ def device_metrics(device: Device, q: np.ndarray, extra: Sequence[str] = (), reg
         used = options_used(extra, registry)
         if used:
             out["options"] = used
+        compliance = drive_compliance(device, [r.index for r in extra], registry)
+        if compliance:
+            out["compliance"] = compliance
     return out
 
 
@@ -105,7 +109,7 @@ def metrics(
     force: bool = FORCE,
 ) -> None:
     """Kinematic and dynamic metrics of any device at one pose (seed 001 eq. 4.24-4.38, 4.90-4.99)."""
-    from hapticdesign.analysis.metrics.indices import INDICES, options_line
+    from hapticdesign.analysis.metrics.indices import INDICES, compliance_line, options_line
     from hapticdesign.devices.loading import resolve_device
     from hapticdesign.interface.commands.optimize_adapter import index_module
     from hapticdesign.interface.commands.pose_adapter import handle, handle_line
@@ -133,6 +137,8 @@ def metrics(
             elif key == "options":
                 for name, used in value.items():
                     typer.echo(f"{name} options: {options_line(used)}")
+            elif key == "compliance":
+                typer.echo(compliance_line(value))
             elif key in ("jacobian", "cartesian_inertia"):
                 typer.echo(f"{key}:")
                 for row in value:

@@ -18,7 +18,7 @@ from contextlib import ExitStack
 from dataclasses import dataclass
 from pathlib import Path
 
-from hapticdesign.analysis.metrics.indices import Index
+from hapticdesign.analysis.metrics.indices import Index, compliance_line
 from hapticdesign.errors import RunWarning, UserError
 from hapticdesign.files import quote, write_atomically
 from hapticdesign.interface.report.optimization_page import PLOTLY, Picture, plotly_js, render, render_failure
@@ -100,10 +100,11 @@ def _design(run: StudyRun, k: int) -> dict:
 
 def summary_of(run: StudyRun, selection: Selection) -> dict:
     """The ``--json`` answer: the front, the number of evaluations and the selected design, in the
-    study's own sense and units, and the method's own results (:attr:`StudyRun.notes`)."""
+    study's own sense and units, the method's own results (:attr:`StudyRun.notes`) and, when the study asks for
+    ``kmax``, which compliance between the motors and the handle it took (``compliance``, by index name)."""
     return {"front": [_design(run, k) for k in run.front], "evaluations": run.evaluations,
             "selected": {"design": selection.position + 1, "rule": selection.rule, **_design(run, selection.record)},
-            **run.notes}
+            **run.notes, **({"compliance": run.compliance} if run.compliance else {})}
 
 
 def summary_lines(summary: dict) -> list[str]:
@@ -122,6 +123,8 @@ def summary_lines(summary: dict) -> list[str]:
                  + ", ".join(f"{k} = {v:.6g}" for k, v in {**s["variables"], **s["objectives"]}.items()))
     if "lower_bound" in summary:
         lines.append(f"lower bound on the minimum (the convex relaxation): {summary['lower_bound']:.6g}")
+    if "compliance" in summary:
+        lines.append(compliance_line(summary["compliance"]))
     return lines
 
 

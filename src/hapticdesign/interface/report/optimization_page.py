@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from html import escape
 from importlib.resources import files as package_files
 
+from hapticdesign.analysis.metrics.indices import compliance_line
 from hapticdesign.escape import script_json
 from hapticdesign.interface.report.html import STYLE
 from hapticdesign.interface.report.tables import cell_text
@@ -82,6 +83,10 @@ def _study_rows(run: StudyRun, coarseness: str, units: Mapping[str, str]) -> str
                                                                   "sense"], objectives)]
     if constraints:
         parts.append(_table("Constraints", ["constrained value", "unit", ">=", "<="], constraints))
+    if run.compliance:
+        parts.append(f'<p id="compliance">{escape(compliance_line(run.compliance), quote=False)} (the compliance between '
+                     "the motors and the handle the device file gives: its actuators' transmission_stiffness, its "
+                     "links' sections)</p>")
     parts.append(f"<p>{escape(method_of(spec).describe(run), quote=False)}</p>")
     return "".join(parts)
 

@@ -17,11 +17,12 @@ from hapticdesign.analysis.metrics.indices.evaluation import (
     evaluate_parameters, reduce, reduced_at, reduction_label, spread,
 )
 from hapticdesign.analysis.metrics.indices.registry import (
-    INDICES, Index, Registry, Request, index, options_line, options_used, register, requests_of,
+    INDICES, Index, Registry, Request, compliance_line, drive_compliance, index, options_line, options_used, register,
+    requests_of,
 )
 from hapticdesign.analysis.metrics.indices.states import HandleStates, ParameterStates, handle_jacobians, moving_mass
 
 __all__ = ["INDICES", "REDUCTIONS", "Evaluation", "HandleStates", "Index", "ParameterStates",
-           "Registry", "Request", "check_reduction", "evaluate", "evaluate_at", "evaluate_designs",
+           "Registry", "Request", "check_reduction", "compliance_line", "drive_compliance", "evaluate", "evaluate_at", "evaluate_designs",
            "evaluate_parameters", "handle_jacobians", "index", "moving_mass", "options_line", "options_used",
            "reduce", "reduced_at", "reduction_label", "register", "requests_of", "spread"]

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from hapticdesign.analysis.metrics.indices.states import PARAMETER_NEEDS, POSE_NEEDS
+from hapticdesign.analysis.stiffness.drive import compliances
 from hapticdesign.errors import RenamedWarning, UserError
 from hapticdesign.workload import require_within
 
@@ -271,6 +272,22 @@ def options_used(requests: Iterable[Request], registry: Mapping[str, Index] = IN
 def options_line(options: Mapping[str, object]) -> str:
     """``name=value, ...`` of :func:`options_used`'s options of one request, for a text output."""
     return ", ".join(f"{k}={v}" for k, v in options.items())
+
+
+def drive_compliance(device, indices: Iterable[str], registry: Mapping[str, Index] = INDICES) -> dict[str, str]:
+    """Which compliance between the motors and the handle each of the named ``indices`` that include it (``compliance``
+    in their needs: ``kmax``) took for ``device``, by index name, each once:
+    :func:`~hapticdesign.analysis.stiffness.drive.compliances` (``rigid``, ``transmissions``, ``links`` or
+    ``transmissions and links``; the device file's fields decide it). What every output that reports such an index
+    states beside its values (:func:`compliance_line` in words); empty when none of them includes it."""
+    names = [name for name in dict.fromkeys(indices) if name in registry and "compliance" in registry[name].needs]
+    return dict.fromkeys(names, compliances(device)) if names else {}
+
+
+def compliance_line(compliance: Mapping[str, str]) -> str:
+    """:func:`drive_compliance`'s answer in words, ``kmax: drive compliance: links`` (``; `` between indices), empty
+    when it is."""
+    return "; ".join(f"{name}: drive compliance: {which}" for name, which in compliance.items())
 
 
 EVALUATION_LIMIT = 1e5
