@@ -18,6 +18,7 @@ from typer.testing import CliRunner
 from hapticdesign.devices.device_file import load_device_file
 from hapticdesign.interface.cli import app
 from hapticdesign.analysis.metrics.indices import evaluate
+from tests.helpers.planar_arm import planar_arm
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "devices"
 runner = CliRunner()
@@ -73,3 +74,47 @@ def test_the_kmax_map_states_the_loop_settings_it_used(tmp_path):
     metrics = runner.invoke(app, ["metrics", "--device", str(EXAMPLES / "five-bar.yaml"), "--q", "2.2,0.9", "--index",
                                   "kmax", "--json"])
     assert json.loads(metrics.stdout)["options"] == {"kmax": KMAX_OPTIONS}
+
+
+def _five_bar(transmissions: bool) -> dict:
+    """The example five-bar (no links' sections), with motors whose drives have a transmission_stiffness (3000 N m/rad)
+    when ``transmissions``."""
+    import yaml
+
+    data = yaml.safe_load((EXAMPLES / "five-bar.yaml").read_text())
+    if transmissions:
+        data["actuators"] = [{"joint": name, "rotor_inertia": 2e-6, "gear_ratio": 10.0, "damping": 0.004,
+                              "transmission_stiffness": 3000.0} for name in ("q1", "q2")]
+    return data
+
+
+DEVICES = {"rigid": lambda: _five_bar(False), "transmissions": lambda: _five_bar(True),
+           "links": planar_arm}
+"""A device file by the drive it makes, as its fields decide it (the oracle): the five-bar has neither links' sections
+nor transmission_stiffness; with its motors' transmission_stiffness, transmissions; the planar arm's links carry
+sections (tests/helpers/planar_arm.py) and its motors none."""
+
+
+@pytest.mark.parametrize("drive", DEVICES)
+def test_a_kmax_map_and_metrics_say_which_compliance_the_drive_includes(tmp_path, drive):
+    """Issue 41: ``maps --index kmax`` and ``metrics --index kmax`` say once which compliance between the motors and
+    the handle kmax took (``compliance`` in --json, ``kmax: drive compliance: ...`` in text); without kmax, nothing."""
+    import yaml
+
+    path = tmp_path / "device.yaml"
+    path.write_text(yaml.safe_dump(DEVICES[drive]()))
+    args = ["maps", "--device", str(path), "--size", "0.02,0,0.02", "--grid", "2", "--index", "kmax,isotropy",
+            "--out", str(tmp_path / "maps"), "--json"]
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, result.output
+    assert json.loads(result.stdout)["compliance"] == {"kmax": drive}
+    text = runner.invoke(app, args[:-1])
+    assert text.stdout.splitlines().count(f"kmax: drive compliance: {drive}") == 1, text.output
+    plain = runner.invoke(app, [*args[:8], "isotropy", *args[9:]])
+    assert plain.exit_code == 0 and "compliance" not in json.loads(plain.stdout), plain.output
+    home = "0,0" if drive == "links" else "2.2,0.9"
+    metrics = [["metrics", "--device", str(path), "--q", home, "--index", "kmax", *flag] for flag in (["--json"], [])]
+    answers = [runner.invoke(app, m) for m in metrics]
+    assert all(a.exit_code == 0 for a in answers), [a.output for a in answers]
+    assert json.loads(answers[0].stdout)["compliance"] == {"kmax": drive}
+    assert answers[1].stdout.splitlines().count(f"kmax: drive compliance: {drive}") == 1, answers[1].output
