@@ -12,11 +12,11 @@ from math import cos, pi, sin
 
 import numpy as np
 import pytest
-from Pynite import FEModel3D
 
 from hapticdesign.analysis.stiffness.device import cartesian_stiffness, deflection
 from hapticdesign.devices.device_file import device_from_mapping
 from hapticdesign.errors import UserError
+from tests.helpers.pynite_chain import chain_compliance
 
 # Both the VJM and PyNite's frame are linear Euler-Bernoulli models of the same beams, so they agree to
 # round-off: 1e-8 (relative) is far below any modelling difference and far above double-precision noise.
@@ -96,26 +96,6 @@ def _two_link_arm() -> dict:
     }
 
 
-def _pynite_stiffness(points: list[np.ndarray], sections: list[tuple], materials: list[tuple]) -> np.ndarray:
-    """K at the last node of a clamped chain of beams through ``points`` (six unit load cases)."""
-    fe = FEModel3D()
-    names = [f"n{k}" for k in range(len(points))]
-    for name, p in zip(names, points):
-        fe.add_node(name, *map(float, p))
-    for k, ((A, I, J), (E, G)) in enumerate(zip(sections, materials)):
-        fe.add_section(f"s{k}", A, I, I, J)
-        fe.add_material(f"m{k}", E, G, 0.3, 1000.0)
-        fe.add_member(f"b{k}", names[k], names[k + 1], f"m{k}", f"s{k}")
-    fe.def_support(names[0], True, True, True, True, True, True)
-    directions = ("FX", "FY", "FZ", "MX", "MY", "MZ")
-    for direction in directions:
-        fe.add_node_load(names[-1], direction, 1.0, case=direction)
-        fe.add_load_combo(direction, {direction: 1.0})
-    fe.analyze_linear()
-    n = fe.nodes[names[-1]]
-    return np.linalg.inv(np.column_stack([[n.DX[c], n.DY[c], n.DZ[c], n.RX[c], n.RY[c], n.RZ[c]] for c in directions]))
-
-
 def test_two_link_arm_matches_a_pynite_frame():
     q1, q2, h, l1, l2 = 0.4, -0.6, 0.05, 0.25, 0.2
     K = cartesian_stiffness(device_from_mapping(_two_link_arm()), [q1, q2])
@@ -125,7 +105,7 @@ def test_two_link_arm_matches_a_pynite_frame():
     tip = elbow + l2 * np.array([cos(q2) * cos(q1), cos(q2) * sin(q1), -sin(q2)])
     rod = 0.008
     sections = [(AREA, I_TUBE, J_TUBE), (pi / 4 * rod**2, pi / 64 * rod**4, pi / 32 * rod**4)]
-    K_fe = _pynite_stiffness([shoulder, elbow, tip], sections, [(E_AL, G_AL), (200e9, 200e9 / 2.6)])
+    K_fe = np.linalg.inv(chain_compliance([shoulder, elbow, tip], sections, [(E_AL, G_AL), (200e9, 200e9 / 2.6)]))
     scale = np.sqrt(np.outer(np.diag(K_fe), np.diag(K_fe)))
     assert np.max(np.abs(K - K_fe) / scale) < ROUND_OFF
 

@@ -24,7 +24,6 @@ import control
 import numpy as np
 import pytest
 import yaml
-from Pynite import FEModel3D
 from scipy.integrate import solve_ivp
 from typer.testing import CliRunner
 
@@ -39,6 +38,7 @@ from hapticdesign.devices.design_space import design_space
 from hapticdesign.devices.device_file import device_from_mapping, load_device_file
 from hapticdesign.interface.cli import app
 from hapticdesign.model.actuators import Transmission
+from tests.helpers.pynite_chain import chain_compliance
 from tests.simulation.test_sim_transmission import AXIS, LEVER, LINK, PERIOD, X, _limit, _plant, _wall_gain
 
 TUBES = Path(__file__).resolve().parents[2] / "examples" / "studies" / "five-bar-tubes.yaml"
@@ -106,26 +106,6 @@ def _two_link_arm() -> dict:
     }
 
 
-def _pynite_compliance(points, sections, materials) -> np.ndarray:
-    """The 6 x 6 compliance at the last node of a chain of beams through ``points`` clamped at the first."""
-    fe = FEModel3D()
-    names = [f"n{k}" for k in range(len(points))]
-    for name, p in zip(names, points):
-        fe.add_node(name, *map(float, p))
-    for k, ((A, I, J), (E, G)) in enumerate(zip(sections, materials)):
-        fe.add_section(f"s{k}", A, I, I, J)
-        fe.add_material(f"m{k}", E, G, 0.3, 1000.0)
-        fe.add_member(f"b{k}", names[k], names[k + 1], f"m{k}", f"s{k}")
-    fe.def_support(names[0], True, True, True, True, True, True)
-    cases = ("FX", "FY", "FZ", "MX", "MY", "MZ")
-    for case in cases:
-        fe.add_node_load(names[-1], case, 1.0, case=case)
-        fe.add_load_combo(case, {case: 1.0})
-    fe.analyze_linear()
-    n = fe.nodes[names[-1]]
-    return np.column_stack([[n.DX[c], n.DY[c], n.DZ[c], n.RX[c], n.RY[c], n.RZ[c]] for c in cases])
-
-
 def test_a_two_link_arms_joint_compliance_is_pyNites_carried_to_the_joints():
     q1, q2, h, l1, l2 = 0.4, -0.6, 0.05, 0.25, 0.2
     shoulder = np.array([0.0, 0.0, h])
@@ -134,7 +114,7 @@ def test_a_two_link_arms_joint_compliance_is_pyNites_carried_to_the_joints():
     forearm = np.array([cos(q2) * cos(q1), cos(q2) * sin(q1), -sin(q2)])
     tip = elbow + l2 * forearm
     rod = 0.008
-    compliance = _pynite_compliance([shoulder, elbow, tip],
+    compliance = chain_compliance([shoulder, elbow, tip],
                                     [(AREA, I_TUBE, J_TUBE), (pi / 4 * rod**2, pi / 64 * rod**4, pi / 32 * rod**4)],
                                     [(E_AL, G_AL), (200e9, 200e9 / 2.6)])[:3, :3]
     # the tip's velocity per joint rate: q1 turns the tip about z, q2 turns the forearm about the elbow's y axis
